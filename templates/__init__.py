@@ -1,0 +1,1 @@
+"""Built-in URDF templates (xacro), shipped as package data ``urdfkit.templates``."""

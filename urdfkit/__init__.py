@@ -1,0 +1,10 @@
+"""urdfkit: build, inspect and test-drive URDF robot descriptions with PyBullet.
+
+The command-line tool is ``urdfkit``; the library's entry points live in
+:mod:`urdfkit.builder` (the URDF model), :mod:`urdfkit.catalog` (templates),
+:mod:`urdfkit.inspect` (decoded PyBullet tables) and the simulation modules.
+"""
+
+__version__ = "0.1.0"
+
+__all__ = ["__version__"]

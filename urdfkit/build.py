@@ -1,0 +1,81 @@
+"""``urdfkit build``: a template or a xacro file in, checked URDF bytes out."""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .builder import Robot
+from .catalog import TEMPLATES, build_template, parse_assignments
+from .errors import InputError, ParameterError
+from .resolve import expand_xacro, locate
+from .validate import guard
+from .xmlio import atomic_write, parse_xml, to_bytes
+
+
+@dataclass
+class BuildResult:
+    """A built URDF, not yet written."""
+
+    data: bytes
+    default_output: str
+    links: int
+    joints: int
+    warnings: list[str] = field(default_factory=list)
+
+
+def yourdfpy_errors(data: bytes) -> list[str]:
+    """What yourdfpy's ``validate()`` objects to, as messages (empty when valid)."""
+    import yourdfpy
+
+    try:
+        urdf = yourdfpy.URDF.load(io.BytesIO(data), load_meshes=False, build_scene_graph=False,
+                                  build_collision_scene_graph=False)
+    except Exception as e:  # yourdfpy raises assorted errors on bad input
+        return [f"yourdfpy cannot read it: {e}"]
+    if urdf.validate(validation_fn=lambda errors: not errors):
+        return []
+    return [str(e) for e in urdf._errors]
+
+
+def build(target: str, params: list[str] | None = None,
+          xacro_args: list[str] | None = None) -> BuildResult:
+    """Build ``target``: a built-in template name, or a path to a ``.xacro`` file."""
+    if target in TEMPLATES:
+        if xacro_args:
+            raise ParameterError("--arg is for xacro files; templates take --set KEY=VALUE")
+        robot = build_template(target, parse_assignments(params))
+        data = robot.to_bytes()
+        default = f"{target}.urdf"
+        name = f"template {target}"
+    else:
+        path = Path(target)
+        if path.suffix != ".xacro" and not path.exists():
+            known = ", ".join(TEMPLATES)
+            raise ParameterError(f"'{target}' is neither a template ({known}) nor a file")
+        if params:
+            raise ParameterError("--set is for built-in templates; xacro files take "
+                                 "--arg NAME:=VALUE")
+        source = locate(target)
+        if source.suffix != ".xacro":
+            raise InputError("build takes a template name or a .xacro file; this file is "
+                             "already URDF", file=target)
+        expanded = expand_xacro(source, parse_assignments(xacro_args, "--arg"), display=target)
+        tree = parse_xml(expanded, target)
+        guard(tree, target)
+        robot = Robot.from_string(expanded, file=target)
+        data = to_bytes(tree.getroot())
+        default = source.name.removesuffix(".xacro")
+        if not default.endswith(".urdf"):
+            default += ".urdf"
+        name = target
+    problems = yourdfpy_errors(data)
+    if problems:
+        raise InputError(f"the built URDF is invalid: {problems[0]}", file=name)
+    return BuildResult(data, default, len(robot.links), len(robot.joints))
+
+
+def write_output(path: str, data: bytes, *, force: bool) -> Path:
+    """Write atomically, never replacing a file without ``force``."""
+    return atomic_write(path, data, force=force)

@@ -1,0 +1,1134 @@
+"""A typed model of a URDF robot, and its XML.
+
+The classes are named after the URDF tags (:class:`Link`, :class:`Joint`, :class:`Inertial`,
+:class:`Origin`, :class:`Limit`, :class:`Contact`, ...). Values are checked where they are set,
+so a bad value fails at the line that set it, naming the tag and the attribute::
+
+    >>> Box(size=(1, -2, 3))
+    Traceback (most recent call last):
+    ...
+    urdfkit.errors.ModelError: during assignment to attribute 'size' of element <box>: ...
+
+Inertia is derived from the collision shapes and the mass (solid box, cylinder, sphere, with
+shape offsets and rotations) unless it is given explicitly; see :meth:`Inertial.from_shapes`.
+
+Writing is deterministic: fixed float precision, no ``-0``, a stable element order, pretty
+printing. Declaration order is kept, because PyBullet numbers joints depth-first from the root,
+taking each link's child joints in file order: declaring joints in the order you want their
+indices gives you those indices. :meth:`Robot.pybullet_joint_order` predicts them.
+
+Every tag has a ``_parse_*`` and a ``_write_*`` function side by side, and
+``parse(write(robot)) == robot`` holds for everything the model holds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar
+
+from lxml import etree
+
+from .errors import ModelError
+from .xmlio import atomic_write, fmt_float, fmt_vec, load_xml, parse_xml, to_bytes
+
+Vec3 = tuple[float, float, float]
+Matrix3 = tuple[Vec3, Vec3, Vec3]
+
+#: Joint types of the URDF specification.
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+#: Joint types that need ``<limit>`` with effort and velocity.
+LIMITED_JOINT_TYPES = ("revolute", "prismatic")
+
+_REL_TOL = 1e-9
+_ABS_TOL = 1e-12
+
+
+# --------------------------------------------------------------------------- value checks
+
+
+def _fail(msg: str) -> ModelError:
+    return ModelError(msg)
+
+
+def _finite(value: Any) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise _fail(f"expected a number, got {value!r}") from None
+    if not math.isfinite(x):
+        raise _fail(f"expected a finite number, got {value!r}")
+    return x
+
+
+def _optional(check: Callable[[Any], Any]) -> Callable[[Any], Any]:
+    return lambda v: None if v is None else check(v)
+
+
+def _positive(value: Any) -> float:
+    x = _finite(value)
+    if x <= 0:
+        raise _fail(f"must be > 0, got {fmt_float(x)}")
+    return x
+
+
+def _non_negative(value: Any) -> float:
+    x = _finite(value)
+    if x < 0:
+        raise _fail(f"must be >= 0, got {fmt_float(x)}")
+    return x
+
+
+def _vector(n: int, elem: Callable[[Any], float] = _finite) -> Callable[[Any], tuple[float, ...]]:
+    def check(value: Any) -> tuple[float, ...]:
+        if isinstance(value, str):
+            value = value.split()
+        try:
+            items = list(value)
+        except TypeError:
+            raise _fail(f"expected {n} numbers, got {value!r}") from None
+        if len(items) != n:
+            raise _fail(f"expected {n} numbers, got {len(items)}")
+        return tuple(elem(v) for v in items)
+
+    return check
+
+
+def _rgba(value: Any) -> tuple[float, ...]:
+    rgba = _vector(4)(value)
+    if any(c < 0 or c > 1 for c in rgba):
+        raise _fail(f"colour components must lie in 0..1, got {fmt_vec(rgba)}")
+    return rgba
+
+
+def _name(value: Any) -> str:
+    if not isinstance(value, str) or not value:
+        raise _fail(f"expected a non-empty name, got {value!r}")
+    return value
+
+
+def _optional_name(value: Any) -> str | None:
+    return None if value is None else _name(value)
+
+
+def _joint_type(value: Any) -> str:
+    if value not in JOINT_TYPES:
+        raise _fail(f"unknown joint type {value!r}; expected one of {', '.join(JOINT_TYPES)}")
+    return str(value)
+
+
+def _checked(default: Any = dataclasses.MISSING, check: Callable[[Any], Any] | None = None,
+             **kw: Any) -> Any:
+    md = {"check": check} if check else {}
+    if default is dataclasses.MISSING:
+        return field(metadata=md, **kw)
+    return field(default=default, metadata=md, **kw)
+
+
+def _close(a: Any, b: Any) -> bool:
+    if isinstance(a, float) or isinstance(b, float):
+        if not isinstance(a, int | float) or not isinstance(b, int | float):
+            return False
+        return math.isclose(a, b, rel_tol=_REL_TOL, abs_tol=_ABS_TOL)
+    if isinstance(a, tuple | list) and isinstance(b, tuple | list):
+        return len(a) == len(b) and all(_close(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, etree._Element) and isinstance(b, etree._Element):
+        return bool(etree.tostring(a) == etree.tostring(b))
+    return bool(a == b)
+
+
+class _Element:
+    """Base of the model classes: checks on assignment, float-tolerant equality."""
+
+    _tag: ClassVar[str] = ""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        f = self.__dataclass_fields__.get(name)  # type: ignore[attr-defined]
+        check = f.metadata.get("check") if f is not None else None
+        if check is not None:
+            try:
+                value = check(value)
+            except ModelError as e:
+                raise ModelError(
+                    f"during assignment to attribute '{name}' of element <{self._tag}>: "
+                    f"{e.message}"
+                ) from None
+        object.__setattr__(self, name, value)
+
+    def __eq__(self, other: object) -> bool:
+        if type(self) is not type(other):
+            return NotImplemented
+        return all(
+            _close(getattr(self, f.name), getattr(other, f.name))
+            for f in dataclasses.fields(self)  # type: ignore[arg-type]
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+# --------------------------------------------------------------------------- geometry math
+
+
+def rpy_to_matrix(rpy: Sequence[float]) -> Matrix3:
+    """Rotation matrix of URDF roll-pitch-yaw (fixed axes X, Y, Z): ``R = Rz(y) Ry(p) Rx(r)``."""
+    r, p, y = rpy
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), \
+        math.sin(y)
+    return (
+        (cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr),
+        (sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr),
+        (-sp, cp * sr, cp * cr),
+    )
+
+
+def _matmul(a: Matrix3, b: Matrix3) -> Matrix3:
+    return tuple(  # type: ignore[return-value]
+        tuple(sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)) for i in range(3)
+    )
+
+
+def _transpose(a: Matrix3) -> Matrix3:
+    return tuple(tuple(a[j][i] for j in range(3)) for i in range(3))  # type: ignore[return-value]
+
+
+# --------------------------------------------------------------------------- elements
+
+
+@dataclass(eq=False)
+class Origin(_Element):
+    """A pose: ``xyz`` in metres and ``rpy`` (fixed-axis roll, pitch, yaw) in radians."""
+
+    _tag = "origin"
+    xyz: Vec3 = _checked((0.0, 0.0, 0.0), _vector(3))
+    rpy: Vec3 = _checked((0.0, 0.0, 0.0), _vector(3))
+
+    @property
+    def is_identity(self) -> bool:
+        """Whether this origin is the identity (and can be left out of the XML)."""
+        return all(v == 0 for v in self.xyz + self.rpy)
+
+    @property
+    def rotation(self) -> Matrix3:
+        """The rotation matrix of ``rpy``."""
+        return rpy_to_matrix(self.rpy)
+
+
+@dataclass(eq=False)
+class Inertia(_Element):
+    """The six independent entries of a symmetric inertia tensor, in kg m^2."""
+
+    _tag = "inertia"
+    ixx: float = _checked(0.0, _finite)
+    ixy: float = _checked(0.0, _finite)
+    ixz: float = _checked(0.0, _finite)
+    iyy: float = _checked(0.0, _finite)
+    iyz: float = _checked(0.0, _finite)
+    izz: float = _checked(0.0, _finite)
+
+    @property
+    def matrix(self) -> Matrix3:
+        """The full 3x3 tensor."""
+        return (
+            (self.ixx, self.ixy, self.ixz),
+            (self.ixy, self.iyy, self.iyz),
+            (self.ixz, self.iyz, self.izz),
+        )
+
+    @classmethod
+    def from_matrix(cls, m: Matrix3) -> Inertia:
+        """Build from a 3x3 tensor, symmetrising it and rounding away float noise."""
+
+        def clean(x: float) -> float:
+            return 0.0 if abs(x) < 1e-15 else x
+
+        return cls(
+            ixx=clean(m[0][0]), ixy=clean((m[0][1] + m[1][0]) / 2), ixz=clean((m[0][2] + m[2][0]) / 2),
+            iyy=clean(m[1][1]), iyz=clean((m[1][2] + m[2][1]) / 2), izz=clean(m[2][2]),
+        )
+
+    def rotated(self, rotation: Matrix3) -> Inertia:
+        """The tensor expressed in a frame rotated by ``rotation``: ``R I R^T``."""
+        return Inertia.from_matrix(_matmul(_matmul(rotation, self.matrix), _transpose(rotation)))
+
+    @property
+    def principal_moments(self) -> tuple[float, float, float]:
+        """Eigenvalues of the tensor, ascending (closed form for symmetric 3x3)."""
+        return _sym_eigenvalues(self.matrix)
+
+
+def _sym_eigenvalues(m: Matrix3) -> tuple[float, float, float]:
+    # Closed form (Smith 1961) for a real symmetric 3x3 matrix; no numpy on this path.
+    p1 = m[0][1] ** 2 + m[0][2] ** 2 + m[1][2] ** 2
+    q = (m[0][0] + m[1][1] + m[2][2]) / 3
+    if p1 == 0:
+        return tuple(sorted((m[0][0], m[1][1], m[2][2])))  # type: ignore[return-value]
+    p2 = sum((m[i][i] - q) ** 2 for i in range(3)) + 2 * p1
+    p = math.sqrt(p2 / 6)
+    b = [[(m[i][j] - (q if i == j else 0)) / p for j in range(3)] for i in range(3)]
+    det_b = (
+        b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1])
+        - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
+        + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0])
+    )
+    r = max(-1.0, min(1.0, det_b / 2))
+    phi = math.acos(r) / 3
+    e1 = q + 2 * p * math.cos(phi)
+    e3 = q + 2 * p * math.cos(phi + 2 * math.pi / 3)
+    e2 = 3 * q - e1 - e3
+    return tuple(sorted((e1, e2, e3)))  # type: ignore[return-value]
+
+
+@dataclass(eq=False)
+class Box(_Element):
+    """A box centred on its origin; ``size`` is the full extent along x, y, z."""
+
+    _tag = "box"
+    size: Vec3 = _checked(check=_vector(3, _positive))
+
+    @property
+    def volume(self) -> float:
+        """Volume in m^3."""
+        x, y, z = self.size
+        return x * y * z
+
+    def inertia(self, mass: float) -> Inertia:
+        """Solid-box inertia about its centre, in its own frame."""
+        x, y, z = self.size
+        k = mass / 12
+        return Inertia(ixx=k * (y * y + z * z), iyy=k * (x * x + z * z), izz=k * (x * x + y * y))
+
+
+@dataclass(eq=False)
+class Cylinder(_Element):
+    """A cylinder centred on its origin, its axis along the local z axis."""
+
+    _tag = "cylinder"
+    radius: float = _checked(check=_positive)
+    length: float = _checked(check=_positive)
+
+    @property
+    def volume(self) -> float:
+        """Volume in m^3."""
+        return math.pi * self.radius**2 * self.length
+
+    def inertia(self, mass: float) -> Inertia:
+        """Solid-cylinder inertia about its centre, in its own frame (axis z)."""
+        r, h = self.radius, self.length
+        radial = mass * (3 * r * r + h * h) / 12
+        return Inertia(ixx=radial, iyy=radial, izz=mass * r * r / 2)
+
+
+@dataclass(eq=False)
+class Sphere(_Element):
+    """A sphere centred on its origin."""
+
+    _tag = "sphere"
+    radius: float = _checked(check=_positive)
+
+    @property
+    def volume(self) -> float:
+        """Volume in m^3."""
+        return 4 / 3 * math.pi * self.radius**3
+
+    def inertia(self, mass: float) -> Inertia:
+        """Solid-sphere inertia about its centre."""
+        i = 2 / 5 * mass * self.radius**2
+        return Inertia(ixx=i, iyy=i, izz=i)
+
+
+@dataclass(eq=False)
+class Mesh(_Element):
+    """A mesh file (STL, OBJ, DAE), optionally scaled per axis."""
+
+    _tag = "mesh"
+    filename: str = _checked(check=_name)
+    scale: Vec3 | None = _checked(None, _optional(_vector(3)))
+
+    @property
+    def volume(self) -> float:
+        """Meshes have no volume urdfkit can know without loading them."""
+        raise ModelError(f"cannot derive inertia from mesh {self.filename!r}; give <inertia> "
+                         "explicitly")
+
+    def inertia(self, mass: float) -> Inertia:
+        """Not derivable without the mesh; raises :class:`ModelError`."""
+        raise ModelError(f"cannot derive inertia from mesh {self.filename!r}; give <inertia> "
+                         "explicitly")
+
+
+Geometry = Box | Cylinder | Sphere | Mesh
+
+
+def _geometry(value: Any) -> Geometry:
+    if not isinstance(value, Box | Cylinder | Sphere | Mesh):
+        raise _fail(f"expected Box, Cylinder, Sphere or Mesh, got {type(value).__name__}")
+    return value
+
+
+def _origin(value: Any) -> Origin:
+    if value is None:
+        return Origin()
+    if not isinstance(value, Origin):
+        raise _fail(f"expected Origin, got {type(value).__name__}")
+    return value
+
+
+@dataclass(eq=False)
+class Inertial(_Element):
+    """Mass, centre of mass and inertia of a link.
+
+    ``inertia`` may be None only while building: :meth:`Robot.complete_inertia` fills it in
+    from the collision shapes. A written file always has it.
+    """
+
+    _tag = "inertial"
+    mass: float = _checked(check=_non_negative)
+    inertia: Inertia | None = None
+    origin: Origin = _checked(None, _origin)
+
+    @classmethod
+    def from_shapes(cls, mass: float, shapes: Iterable[tuple[Geometry, Origin]]) -> Inertial:
+        """The inertial of a solid made of ``shapes`` with total ``mass``, uniform density.
+
+        Mass is shared by volume, the centre of mass is the volume-weighted centre, and the
+        tensor is each shape's rotated tensor moved to that centre by the parallel-axis theorem.
+        """
+        shapes = list(shapes)
+        if not shapes:
+            raise ModelError("cannot derive inertia: the link has no shapes")
+        volumes = [g.volume for g, _ in shapes]
+        total = sum(volumes)
+        com = tuple(sum(v * o.xyz[i] for v, (_, o) in zip(volumes, shapes, strict=True)) / total
+                    for i in range(3))
+        acc = [[0.0] * 3 for _ in range(3)]
+        for v, (geom, origin) in zip(volumes, shapes, strict=True):
+            m = mass * v / total
+            tensor = geom.inertia(m).rotated(origin.rotation).matrix
+            d = [origin.xyz[i] - com[i] for i in range(3)]
+            d2 = sum(x * x for x in d)
+            for i in range(3):
+                for j in range(3):
+                    acc[i][j] += tensor[i][j] + m * ((d2 if i == j else 0.0) - d[i] * d[j])
+        return cls(mass=mass, inertia=Inertia.from_matrix(acc),  # type: ignore[arg-type]
+                   origin=Origin(xyz=com))  # type: ignore[arg-type]
+
+
+@dataclass(eq=False)
+class Material(_Element):
+    """A named material; with neither colour nor texture it is a reference by name."""
+
+    _tag = "material"
+    name: str = _checked(check=_name)
+    color: tuple[float, float, float, float] | None = _checked(None, _optional(_rgba))
+    texture: str | None = None
+
+    @property
+    def is_reference(self) -> bool:
+        """Whether this only names a material defined elsewhere."""
+        return self.color is None and self.texture is None
+
+
+def _material(value: Any) -> Material | None:
+    if value is None or isinstance(value, Material):
+        return value
+    if isinstance(value, str):
+        return Material(name=value)
+    raise _fail(f"expected Material or a material name, got {type(value).__name__}")
+
+
+@dataclass(eq=False)
+class Visual(_Element):
+    """What a link looks like."""
+
+    _tag = "visual"
+    geometry: Geometry = _checked(check=_geometry)
+    origin: Origin = _checked(None, _origin)
+    material: Material | None = _checked(None, _material)
+    name: str | None = _checked(None, _optional_name)
+
+
+@dataclass(eq=False)
+class Collision(_Element):
+    """The shape a link collides with (and, by default in PyBullet, its inertia comes from)."""
+
+    _tag = "collision"
+    geometry: Geometry = _checked(check=_geometry)
+    origin: Origin = _checked(None, _origin)
+    name: str | None = _checked(None, _optional_name)
+
+
+@dataclass(eq=False)
+class Contact(_Element):
+    """PyBullet's ``<contact>`` extension: per-link friction and contact coefficients.
+
+    ``stiffness`` and ``damping`` only take effect together, as in PyBullet.
+    """
+
+    _tag = "contact"
+    lateral_friction: float | None = _checked(None, _optional(_non_negative))
+    rolling_friction: float | None = _checked(None, _optional(_non_negative))
+    spinning_friction: float | None = _checked(None, _optional(_non_negative))
+    restitution: float | None = _checked(None, _optional(_non_negative))
+    stiffness: float | None = _checked(None, _optional(_non_negative))
+    damping: float | None = _checked(None, _optional(_non_negative))
+    contact_cfm: float | None = _checked(None, _optional(_non_negative))
+    contact_erp: float | None = _checked(None, _optional(_non_negative))
+    inertia_scaling: float | None = _checked(None, _optional(_non_negative))
+    friction_anchor: bool = False
+
+    #: Value-carrying children, in the order they are written.
+    VALUE_TAGS: ClassVar[tuple[str, ...]] = (
+        "lateral_friction", "rolling_friction", "spinning_friction", "restitution",
+        "stiffness", "damping", "contact_cfm", "contact_erp", "inertia_scaling",
+    )
+
+
+def _inertial(value: Any) -> Inertial | None:
+    if value is not None and not isinstance(value, Inertial):
+        raise _fail(f"expected Inertial, got {type(value).__name__}")
+    return value
+
+
+def _contact(value: Any) -> Contact | None:
+    if value is not None and not isinstance(value, Contact):
+        raise _fail(f"expected Contact, got {type(value).__name__}")
+    return value
+
+
+@dataclass(eq=False)
+class Link(_Element):
+    """A rigid body: inertial, visuals, collisions and PyBullet contact coefficients."""
+
+    _tag = "link"
+    name: str = _checked(check=_name)
+    inertial: Inertial | None = _checked(None, _inertial)
+    visuals: list[Visual] = field(default_factory=list)
+    collisions: list[Collision] = field(default_factory=list)
+    contact: Contact | None = _checked(None, _contact)
+
+
+@dataclass(eq=False)
+class Limit(_Element):
+    """Joint limits: position (rad or m), effort (N m or N), velocity (rad/s or m/s)."""
+
+    _tag = "limit"
+    effort: float = _checked(check=_non_negative)
+    velocity: float = _checked(check=_non_negative)
+    lower: float | None = _checked(None, _optional(_finite))
+    upper: float | None = _checked(None, _optional(_finite))
+
+    def __post_init__(self) -> None:
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
+            raise ModelError(f"<limit> lower {fmt_float(self.lower)} is above upper "
+                             f"{fmt_float(self.upper)}")
+
+
+@dataclass(eq=False)
+class Dynamics(_Element):
+    """Joint damping and static friction."""
+
+    _tag = "dynamics"
+    damping: float | None = _checked(None, _optional(_non_negative))
+    friction: float | None = _checked(None, _optional(_non_negative))
+
+
+@dataclass(eq=False)
+class Mimic(_Element):
+    """This joint follows ``joint``: ``q = multiplier * q_joint + offset``."""
+
+    _tag = "mimic"
+    joint: str = _checked(check=_name)
+    multiplier: float | None = _checked(None, _optional(_finite))
+    offset: float | None = _checked(None, _optional(_finite))
+
+
+@dataclass(eq=False)
+class SafetyController(_Element):
+    """Soft limits for a real robot's controller."""
+
+    _tag = "safety_controller"
+    k_velocity: float = _checked(check=_finite)
+    soft_lower_limit: float | None = _checked(None, _optional(_finite))
+    soft_upper_limit: float | None = _checked(None, _optional(_finite))
+    k_position: float | None = _checked(None, _optional(_finite))
+
+
+@dataclass(eq=False)
+class Calibration(_Element):
+    """Reference positions of the joint's calibration edges."""
+
+    _tag = "calibration"
+    rising: float | None = _checked(None, _optional(_finite))
+    falling: float | None = _checked(None, _optional(_finite))
+
+
+def _axis(value: Any) -> Vec3 | None:
+    if value is None:
+        return None
+    axis = _vector(3)(value)
+    if all(a == 0 for a in axis):
+        raise _fail("axis must not be zero")
+    return axis  # type: ignore[return-value]
+
+
+@dataclass(eq=False)
+class Joint(_Element):
+    """A joint from ``parent`` to ``child``; the child's frame is ``origin`` in the parent's."""
+
+    _tag = "joint"
+    name: str = _checked(check=_name)
+    type: str = _checked(check=_joint_type)
+    parent: str = _checked(check=_name)
+    child: str = _checked(check=_name)
+    origin: Origin = _checked(None, _origin)
+    axis: Vec3 | None = _checked(None, _axis)
+    limit: Limit | None = None
+    dynamics: Dynamics | None = None
+    mimic: Mimic | None = None
+    safety_controller: SafetyController | None = None
+    calibration: Calibration | None = None
+
+    def __post_init__(self) -> None:
+        if self.type in LIMITED_JOINT_TYPES and self.limit is None:
+            raise ModelError(f"<joint name={self.name!r}> of type {self.type} needs "
+                             "<limit effort=... velocity=...>")
+        if self.parent == self.child:
+            raise ModelError(f"<joint name={self.name!r}> joins link {self.parent!r} to itself")
+
+    @property
+    def movable(self) -> bool:
+        """Whether the joint has a degree of freedom."""
+        return self.type != "fixed"
+
+
+# --------------------------------------------------------------------------- the robot
+
+
+@dataclass(eq=False)
+class Robot(_Element):
+    """A robot: links and joints in declaration order, plus top-level materials.
+
+    ``extras`` keeps top-level elements the model does not know (``<gazebo>``,
+    ``<transmission>``) so they survive a read-write round trip.
+    """
+
+    _tag = "robot"
+    name: str = _checked(check=_name)
+    links: list[Link] = field(default_factory=list)
+    joints: list[Joint] = field(default_factory=list)
+    materials: list[Material] = field(default_factory=list)
+    extras: list[etree._Element] = field(default_factory=list)
+
+    # ---- composing
+
+    def add_link(self, link: Link) -> Link:
+        """Append a link; its name must be new."""
+        if any(x.name == link.name for x in self.links):
+            raise ModelError(f"<robot name={self.name!r}> already has a link named {link.name!r}")
+        self.links.append(link)
+        return link
+
+    def add_joint(self, joint: Joint) -> Joint:
+        """Append a joint; its name must be new and its links must exist."""
+        if any(x.name == joint.name for x in self.joints):
+            raise ModelError(f"<robot name={self.name!r}> already has a joint named "
+                             f"{joint.name!r}")
+        names = {x.name for x in self.links}
+        for role in ("parent", "child"):
+            ref = getattr(joint, role)
+            if ref not in names:
+                raise ModelError(f"<joint name={joint.name!r}> {role} link {ref!r} does not "
+                                 "exist; add the link first")
+        if any(j.child == joint.child for j in self.joints):
+            raise ModelError(f"<joint name={joint.name!r}>: link {joint.child!r} already has "
+                             "a parent joint")
+        self.joints.append(joint)
+        return joint
+
+    def add_material(self, material: Material) -> Material:
+        """Define a top-level material that visuals can refer to by name."""
+        if any(m.name == material.name for m in self.materials):
+            raise ModelError(f"<robot name={self.name!r}> already has a material named "
+                             f"{material.name!r}")
+        self.materials.append(material)
+        return material
+
+    def link(self, name: str) -> Link:
+        """The link called ``name``."""
+        for x in self.links:
+            if x.name == name:
+                return x
+        raise KeyError(name)
+
+    def joint(self, name: str) -> Joint:
+        """The joint called ``name``."""
+        for x in self.joints:
+            if x.name == name:
+                return x
+        raise KeyError(name)
+
+    # ---- structure
+
+    @property
+    def root(self) -> str:
+        """The root link: the one link that is no joint's child."""
+        children = {j.child for j in self.joints}
+        roots = [x.name for x in self.links if x.name not in children]
+        if len(roots) != 1:
+            raise ModelError(f"<robot name={self.name!r}> must have exactly one root link, "
+                             f"found {len(roots)}: {', '.join(roots) or 'none (a cycle)'}")
+        return roots[0]
+
+    def pybullet_joint_order(self) -> list[Joint]:
+        """Joints in PyBullet's index order: depth-first from the root, children in file order."""
+        by_parent: dict[str, list[Joint]] = {}
+        for j in self.joints:
+            by_parent.setdefault(j.parent, []).append(j)
+        order: list[Joint] = []
+        seen = {self.root}
+        # Pre-order walk without recursion (a 5000-link chain must not overflow the stack);
+        # push children reversed so the first declared pops first.
+        walk: list[Joint] = list(reversed(by_parent.get(self.root, [])))
+        while walk:
+            j = walk.pop()
+            if j.child in seen:
+                continue  # a cycle or second parent: validate() reports it
+            seen.add(j.child)
+            order.append(j)
+            walk.extend(reversed(by_parent.get(j.child, [])))
+        return order
+
+    def validate(self) -> None:
+        """Check the tree: known links, unique names, one root, no cycle, single parents."""
+        names = [x.name for x in self.links]
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise ModelError(f"<robot name={self.name!r}> has duplicate link names: "
+                             f"{', '.join(sorted(dup))}")
+        jnames = [j.name for j in self.joints]
+        dup = {n for n in jnames if jnames.count(n) > 1}
+        if dup:
+            raise ModelError(f"<robot name={self.name!r}> has duplicate joint names: "
+                             f"{', '.join(sorted(dup))}")
+        known = set(names)
+        parents: dict[str, str] = {}
+        for j in self.joints:
+            for role in ("parent", "child"):
+                if getattr(j, role) not in known:
+                    raise ModelError(f"<joint name={j.name!r}> {role} link "
+                                     f"{getattr(j, role)!r} does not exist")
+            if j.child in parents:
+                raise ModelError(f"link {j.child!r} has two parent joints: "
+                                 f"{parents[j.child]!r} and {j.name!r}")
+            parents[j.child] = j.name
+        order = self.pybullet_joint_order()
+        if len(order) != len(self.joints):
+            raise ModelError(f"<robot name={self.name!r}> has a kinematic cycle: "
+                             f"{len(self.joints) - len(order)} joint(s) unreachable from root "
+                             f"{self.root!r}")
+
+    def complete_inertia(self) -> None:
+        """Fill in every inertial whose tensor is missing, from the link's collision shapes."""
+        for link in self.links:
+            if link.inertial is not None and link.inertial.inertia is None:
+                shapes = [(c.geometry, c.origin) for c in link.collisions] or \
+                         [(v.geometry, v.origin) for v in link.visuals]
+                if not shapes:
+                    raise ModelError(f"<link name={link.name!r}> has a mass but no shapes to "
+                                     "derive its inertia from; give <inertia> explicitly")
+                derived = Inertial.from_shapes(link.inertial.mass, shapes)
+                link.inertial = derived
+
+    # ---- XML
+
+    def to_element(self) -> etree._Element:
+        """The robot as an lxml element tree, in a stable order."""
+        return _write_robot(self)
+
+    def to_bytes(self) -> bytes:
+        """Deterministic, pretty-printed URDF bytes."""
+        return to_bytes(self.to_element())
+
+    def to_string(self) -> str:
+        """Deterministic, pretty-printed URDF text."""
+        return self.to_bytes().decode("utf-8")
+
+    def write(self, path: str | Path, *, force: bool = False) -> Path:
+        """Write atomically; an existing file is kept unless ``force``."""
+        return atomic_write(path, self.to_bytes(), force=force)
+
+    @classmethod
+    def from_string(cls, text: str | bytes, file: str = "<string>") -> Robot:
+        """Parse URDF text into the model."""
+        data = text.encode("utf-8") if isinstance(text, str) else text
+        return _parse_robot(parse_xml(data, file).getroot(), file)
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> Robot:
+        """Parse a URDF file into the model."""
+        return _parse_robot(load_xml(path).getroot(), str(path))
+
+
+# --------------------------------------------------------------------------- parse / write
+# One _parse_X / _write_X pair per tag; keep them side by side so none is forgotten.
+
+
+class _Ctx:
+    """Where we are in the file, for error messages."""
+
+    def __init__(self, file: str):
+        self.file = file
+
+    def error(self, el: etree._Element, msg: str) -> ModelError:
+        return ModelError(msg, file=self.file, line=el.sourceline)
+
+    def attr(self, el: etree._Element, name: str, required: bool = True) -> str | None:
+        value = el.get(name)
+        if value is None and required:
+            raise self.error(el, f"<{el.tag}> is missing attribute '{name}'")
+        return value
+
+    def build(self, el: etree._Element, factory: Callable[..., Any], **kw: Any) -> Any:
+        try:
+            return factory(**kw)
+        except ModelError as e:
+            raise self.error(el, e.message) from None
+
+    def num(self, el: etree._Element, name: str, required: bool = True) -> float | None:
+        raw = self.attr(el, name, required)
+        if raw is None:
+            return None
+        try:
+            return _finite(raw)
+        except ModelError as e:
+            raise self.error(el, f"<{el.tag} {name}>: {e.message}") from None
+
+
+def _set(el: etree._Element, name: str, value: float | None) -> None:
+    if value is not None:
+        el.set(name, fmt_float(value))
+
+
+def _parse_origin(ctx: _Ctx, el: etree._Element | None) -> Origin:
+    if el is None:
+        return Origin()
+    return ctx.build(el, Origin, xyz=el.get("xyz", "0 0 0"), rpy=el.get("rpy", "0 0 0"))
+
+
+def _write_origin(parent: etree._Element, origin: Origin) -> None:
+    if not origin.is_identity:
+        el = etree.SubElement(parent, "origin")
+        if any(origin.xyz):
+            el.set("xyz", fmt_vec(origin.xyz))
+        if any(origin.rpy):
+            el.set("rpy", fmt_vec(origin.rpy))
+
+
+def _parse_geometry(ctx: _Ctx, el: etree._Element | None, owner: etree._Element) -> Geometry:
+    if el is None:
+        raise ctx.error(owner, f"<{owner.tag}> has no <geometry>")
+    shapes = [c for c in el if isinstance(c.tag, str)]
+    if len(shapes) != 1:
+        raise ctx.error(el, f"<geometry> must hold exactly one shape, found {len(shapes)}")
+    s = shapes[0]
+    if s.tag == "box":
+        return ctx.build(s, Box, size=ctx.attr(s, "size"))
+    if s.tag == "cylinder":
+        return ctx.build(s, Cylinder, radius=ctx.num(s, "radius"), length=ctx.num(s, "length"))
+    if s.tag == "sphere":
+        return ctx.build(s, Sphere, radius=ctx.num(s, "radius"))
+    if s.tag == "mesh":
+        return ctx.build(s, Mesh, filename=ctx.attr(s, "filename"), scale=s.get("scale"))
+    raise ctx.error(s, f"unknown shape <{s.tag}>; expected box, cylinder, sphere or mesh")
+
+
+def _write_geometry(parent: etree._Element, g: Geometry) -> None:
+    geo = etree.SubElement(parent, "geometry")
+    if isinstance(g, Box):
+        etree.SubElement(geo, "box", size=fmt_vec(g.size))
+    elif isinstance(g, Cylinder):
+        etree.SubElement(geo, "cylinder", radius=fmt_float(g.radius), length=fmt_float(g.length))
+    elif isinstance(g, Sphere):
+        etree.SubElement(geo, "sphere", radius=fmt_float(g.radius))
+    else:
+        m = etree.SubElement(geo, "mesh", filename=g.filename)
+        if g.scale is not None:
+            m.set("scale", fmt_vec(g.scale))
+
+
+def _parse_material(ctx: _Ctx, el: etree._Element) -> Material:
+    color = el.find("color")
+    texture = el.find("texture")
+    return ctx.build(
+        el, Material, name=ctx.attr(el, "name"),
+        color=None if color is None else ctx.attr(color, "rgba"),
+        texture=None if texture is None else ctx.attr(texture, "filename"),
+    )
+
+
+def _write_material(parent: etree._Element, m: Material) -> None:
+    el = etree.SubElement(parent, "material", name=m.name)
+    if m.color is not None:
+        etree.SubElement(el, "color", rgba=fmt_vec(m.color))
+    if m.texture is not None:
+        etree.SubElement(el, "texture", filename=m.texture)
+
+
+def _parse_inertial(ctx: _Ctx, el: etree._Element) -> Inertial:
+    mass_el = el.find("mass")
+    if mass_el is None:
+        raise ctx.error(el, "<inertial> has no <mass>")
+    inertia_el = el.find("inertia")
+    inertia = None
+    if inertia_el is not None:
+        inertia = ctx.build(inertia_el, Inertia, **{
+            k: ctx.num(inertia_el, k, required=False) or 0.0
+            for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+        })
+    return ctx.build(el, Inertial, mass=ctx.num(mass_el, "value"), inertia=inertia,
+                     origin=_parse_origin(ctx, el.find("origin")))
+
+
+def _write_inertial(parent: etree._Element, i: Inertial) -> None:
+    el = etree.SubElement(parent, "inertial")
+    _write_origin(el, i.origin)
+    etree.SubElement(el, "mass", value=fmt_float(i.mass))
+    if i.inertia is not None:
+        t = i.inertia
+        etree.SubElement(el, "inertia", ixx=fmt_float(t.ixx), ixy=fmt_float(t.ixy),
+                         ixz=fmt_float(t.ixz), iyy=fmt_float(t.iyy), iyz=fmt_float(t.iyz),
+                         izz=fmt_float(t.izz))
+
+
+def _parse_visual(ctx: _Ctx, el: etree._Element) -> Visual:
+    mat = el.find("material")
+    return ctx.build(el, Visual, geometry=_parse_geometry(ctx, el.find("geometry"), el),
+                     origin=_parse_origin(ctx, el.find("origin")),
+                     material=None if mat is None else _parse_material(ctx, mat),
+                     name=el.get("name"))
+
+
+def _write_visual(parent: etree._Element, v: Visual) -> None:
+    el = etree.SubElement(parent, "visual")
+    if v.name is not None:
+        el.set("name", v.name)
+    _write_origin(el, v.origin)
+    _write_geometry(el, v.geometry)
+    if v.material is not None:
+        _write_material(el, v.material)
+
+
+def _parse_collision(ctx: _Ctx, el: etree._Element) -> Collision:
+    return ctx.build(el, Collision, geometry=_parse_geometry(ctx, el.find("geometry"), el),
+                     origin=_parse_origin(ctx, el.find("origin")), name=el.get("name"))
+
+
+def _write_collision(parent: etree._Element, c: Collision) -> None:
+    el = etree.SubElement(parent, "collision")
+    if c.name is not None:
+        el.set("name", c.name)
+    _write_origin(el, c.origin)
+    _write_geometry(el, c.geometry)
+
+
+def _parse_contact(ctx: _Ctx, el: etree._Element) -> Contact:
+    values: dict[str, Any] = {}
+    for tag in Contact.VALUE_TAGS:
+        child = el.find(tag)
+        if child is not None:
+            values[tag] = ctx.num(child, "value")
+    values["friction_anchor"] = el.find("friction_anchor") is not None
+    return ctx.build(el, Contact, **values)
+
+
+def _write_contact(parent: etree._Element, c: Contact) -> None:
+    el = etree.SubElement(parent, "contact")
+    for tag in Contact.VALUE_TAGS:
+        value = getattr(c, tag)
+        if value is not None:
+            etree.SubElement(el, tag, value=fmt_float(value))
+    if c.friction_anchor:
+        etree.SubElement(el, "friction_anchor")
+
+
+def _parse_link(ctx: _Ctx, el: etree._Element) -> Link:
+    inertial = el.find("inertial")
+    contact = el.find("contact")
+    return ctx.build(
+        el, Link, name=ctx.attr(el, "name"),
+        inertial=None if inertial is None else _parse_inertial(ctx, inertial),
+        visuals=[_parse_visual(ctx, v) for v in el.findall("visual")],
+        collisions=[_parse_collision(ctx, c) for c in el.findall("collision")],
+        contact=None if contact is None else _parse_contact(ctx, contact),
+    )
+
+
+def _write_link(parent: etree._Element, link: Link) -> None:
+    el = etree.SubElement(parent, "link", name=link.name)
+    if link.contact is not None:
+        _write_contact(el, link.contact)
+    if link.inertial is not None:
+        _write_inertial(el, link.inertial)
+    for v in link.visuals:
+        _write_visual(el, v)
+    for c in link.collisions:
+        _write_collision(el, c)
+
+
+def _parse_limit(ctx: _Ctx, el: etree._Element) -> Limit:
+    return ctx.build(el, Limit, effort=ctx.num(el, "effort"), velocity=ctx.num(el, "velocity"),
+                     lower=ctx.num(el, "lower", False), upper=ctx.num(el, "upper", False))
+
+
+def _write_limit(parent: etree._Element, lim: Limit) -> None:
+    el = etree.SubElement(parent, "limit")
+    _set(el, "lower", lim.lower)
+    _set(el, "upper", lim.upper)
+    _set(el, "effort", lim.effort)
+    _set(el, "velocity", lim.velocity)
+
+
+def _parse_dynamics(ctx: _Ctx, el: etree._Element) -> Dynamics:
+    return ctx.build(el, Dynamics, damping=ctx.num(el, "damping", False),
+                     friction=ctx.num(el, "friction", False))
+
+
+def _write_dynamics(parent: etree._Element, d: Dynamics) -> None:
+    el = etree.SubElement(parent, "dynamics")
+    _set(el, "damping", d.damping)
+    _set(el, "friction", d.friction)
+
+
+def _parse_mimic(ctx: _Ctx, el: etree._Element) -> Mimic:
+    return ctx.build(el, Mimic, joint=ctx.attr(el, "joint"),
+                     multiplier=ctx.num(el, "multiplier", False),
+                     offset=ctx.num(el, "offset", False))
+
+
+def _write_mimic(parent: etree._Element, m: Mimic) -> None:
+    el = etree.SubElement(parent, "mimic", joint=m.joint)
+    _set(el, "multiplier", m.multiplier)
+    _set(el, "offset", m.offset)
+
+
+def _parse_safety(ctx: _Ctx, el: etree._Element) -> SafetyController:
+    return ctx.build(el, SafetyController, k_velocity=ctx.num(el, "k_velocity"),
+                     soft_lower_limit=ctx.num(el, "soft_lower_limit", False),
+                     soft_upper_limit=ctx.num(el, "soft_upper_limit", False),
+                     k_position=ctx.num(el, "k_position", False))
+
+
+def _write_safety(parent: etree._Element, s: SafetyController) -> None:
+    el = etree.SubElement(parent, "safety_controller")
+    _set(el, "soft_lower_limit", s.soft_lower_limit)
+    _set(el, "soft_upper_limit", s.soft_upper_limit)
+    _set(el, "k_position", s.k_position)
+    _set(el, "k_velocity", s.k_velocity)
+
+
+def _parse_calibration(ctx: _Ctx, el: etree._Element) -> Calibration:
+    return ctx.build(el, Calibration, rising=ctx.num(el, "rising", False),
+                     falling=ctx.num(el, "falling", False))
+
+
+def _write_calibration(parent: etree._Element, c: Calibration) -> None:
+    el = etree.SubElement(parent, "calibration")
+    _set(el, "rising", c.rising)
+    _set(el, "falling", c.falling)
+
+
+_JOINT_CHILDREN: tuple[tuple[str, str, Callable[..., Any], Callable[..., None]], ...] = (
+    ("limit", "limit", _parse_limit, _write_limit),
+    ("dynamics", "dynamics", _parse_dynamics, _write_dynamics),
+    ("mimic", "mimic", _parse_mimic, _write_mimic),
+    ("safety_controller", "safety_controller", _parse_safety, _write_safety),
+    ("calibration", "calibration", _parse_calibration, _write_calibration),
+)
+
+
+def _parse_joint(ctx: _Ctx, el: etree._Element) -> Joint:
+    parent, child, axis = el.find("parent"), el.find("child"), el.find("axis")
+    for tag, sub in (("parent", parent), ("child", child)):
+        if sub is None:
+            raise ctx.error(el, f"<joint name={el.get('name')!r}> has no <{tag} link=...>")
+    kw: dict[str, Any] = {
+        attr: None if (sub := el.find(tag)) is None else parse(ctx, sub)
+        for tag, attr, parse, _ in _JOINT_CHILDREN
+    }
+    return ctx.build(
+        el, Joint, name=ctx.attr(el, "name"), type=ctx.attr(el, "type"),
+        parent=ctx.attr(parent, "link"), child=ctx.attr(child, "link"),
+        origin=_parse_origin(ctx, el.find("origin")),
+        axis=None if axis is None else axis.get("xyz", "1 0 0"), **kw,
+    )
+
+
+def _write_joint(parent: etree._Element, j: Joint) -> None:
+    el = etree.SubElement(parent, "joint", name=j.name, type=j.type)
+    etree.SubElement(el, "parent", link=j.parent)
+    etree.SubElement(el, "child", link=j.child)
+    _write_origin(el, j.origin)
+    if j.axis is not None:
+        etree.SubElement(el, "axis", xyz=fmt_vec(j.axis))
+    for _, attr, _, write in _JOINT_CHILDREN:
+        value = getattr(j, attr)
+        if value is not None:
+            write(el, value)
+
+
+_KNOWN_TOP = ("link", "joint", "material")
+
+
+def _parse_robot(el: etree._Element, file: str) -> Robot:
+    ctx = _Ctx(file)
+    if el.tag != "robot":
+        raise ctx.error(el, f"root element is <{el.tag}>, expected <robot>")
+    robot = ctx.build(el, Robot, name=ctx.attr(el, "name"))
+    for child in el:
+        if not isinstance(child.tag, str):
+            continue  # comments and processing instructions
+        try:
+            if child.tag == "link":
+                robot.add_link(_parse_link(ctx, child))
+            elif child.tag == "joint":
+                joint = _parse_joint(ctx, child)
+                if any(x.name == joint.name for x in robot.joints):
+                    raise ModelError(f"duplicate joint name {joint.name!r}")
+                robot.joints.append(joint)  # links may be declared after their joints
+            elif child.tag == "material":
+                robot.add_material(_parse_material(ctx, child))
+            else:
+                robot.extras.append(_copy(child))
+        except ModelError as e:
+            if e.line is None:
+                raise ctx.error(child, e.message) from None
+            raise
+    try:
+        robot.validate()
+    except ModelError as e:
+        raise ModelError(e.message, file=file) from None
+    return robot
+
+
+def _copy(el: etree._Element) -> etree._Element:
+    import copy
+
+    dup = copy.deepcopy(el)
+    dup.tail = None
+    return dup
+
+
+def _write_robot(robot: Robot) -> etree._Element:
+    el = etree.Element("robot", name=robot.name)
+    for m in robot.materials:
+        _write_material(el, m)
+    for link in robot.links:
+        _write_link(el, link)
+    for joint in robot.joints:
+        _write_joint(el, joint)
+    for extra in robot.extras:
+        el.append(_copy(extra))
+    return el

@@ -1,0 +1,205 @@
+"""From a name on the command line to a checked URDF file PyBullet can load.
+
+``resolve`` does, in order:
+
+1. find the file: as given (relative to the current folder), else in ``pybullet_data``, the
+   way ``p.loadURDF("r2d2.urdf")`` finds it after ``setAdditionalSearchPath``;
+2. expand ``.xacro`` in a subprocess with a timeout (xacro's ``${}`` runs Python code: it is
+   not a sandbox, and a hostile file must not hang or own the process);
+3. parse it safely and run the crash guard;
+4. resolve ``package://NAME/...`` through ``--package NAME=PATH`` or by walking up from the
+   file, and make relative mesh paths absolute, writing a rewritten copy to a temp folder only
+   when something changed.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from lxml import etree
+
+from .errors import InputError, ParameterError
+from .validate import guard
+from .xmlio import parse_xml, read_bytes, to_bytes
+
+#: Seconds a xacro expansion may take before it is killed.
+XACRO_TIMEOUT = float(os.environ.get("URDFKIT_XACRO_TIMEOUT", "20"))
+
+#: Elements whose ``filename`` attribute names a file.
+_FILE_TAGS = ("mesh", "texture")
+
+
+def pybullet_data_path() -> Path | None:
+    """The folder of PyBullet's bundled models, if pybullet_data is installed."""
+    try:
+        import pybullet_data
+    except ImportError:  # pragma: no cover - ships with pybullet
+        return None
+    return Path(pybullet_data.getDataPath())
+
+
+def locate(name: str | Path) -> Path:
+    """Find a file as given, else in pybullet_data; refuse folders."""
+    path = Path(name).expanduser()
+    if path.exists():
+        if path.is_dir():
+            raise InputError("is a directory, not a URDF file", file=name)
+        return path
+    if not path.is_absolute():
+        data = pybullet_data_path()
+        if data is not None and (data / path).is_file():
+            return data / path
+    raise InputError("no such file (looked in the current folder and in pybullet_data)",
+                     file=name)
+
+
+def parse_packages(items: list[str] | None) -> dict[str, Path]:
+    """Parse repeated ``--package NAME=PATH`` options."""
+    out: dict[str, Path] = {}
+    for item in items or []:
+        name, sep, path = item.partition("=")
+        if not sep or not name or not path:
+            raise ParameterError(f"--package expects NAME=PATH, got {item!r}")
+        if not Path(path).is_dir():
+            raise ParameterError(f"--package {name}: folder {path!r} does not exist")
+        out[name] = Path(path).resolve()
+    return out
+
+
+def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
+                 timeout: float | None = None, display: str | None = None) -> bytes:
+    """Expand a xacro file in a subprocess; return the URDF bytes.
+
+    Raises:
+        InputError: xacro failed, or ran longer than ``timeout`` seconds.
+    """
+    name = display or str(path)
+    cmd = [sys.executable, "-m", "urdfkit._xacro_worker", str(path)]
+    cmd += [f"{k}:={v}" for k, v in (args or {}).items()]
+    limit = XACRO_TIMEOUT if timeout is None else timeout
+    try:
+        proc = subprocess.run(cmd, capture_output=True, timeout=limit, stdin=subprocess.DEVNULL,
+                              cwd=str(Path(path).resolve().parent))
+    except subprocess.TimeoutExpired:
+        raise InputError(f"xacro expansion took longer than {limit:g} s and was stopped",
+                         file=name) from None
+    if proc.returncode != 0:
+        lines = [ln for ln in proc.stderr.decode("utf-8", "replace").splitlines() if ln.strip()]
+        msg = lines[0] if lines else f"exited with code {proc.returncode}"
+        raise InputError(f"xacro failed: {msg}", file=name)
+    return proc.stdout
+
+
+@dataclass
+class Resolved:
+    """A located, expanded, parsed and guarded URDF.
+
+    Attributes:
+        name: The file as the user named it (used in every message).
+        source: The file found on disk (the xacro itself for xacro input).
+        load_path: What to hand to ``loadURDF``: ``source`` or a rewritten temp copy.
+        tree: The parsed document (after xacro and package:// rewriting).
+    """
+
+    name: str
+    source: Path
+    load_path: Path
+    tree: etree._ElementTree
+    _tmp: tempfile.TemporaryDirectory[str] | None = field(default=None, repr=False)
+
+    @property
+    def root(self) -> etree._Element:
+        """The ``<robot>`` element."""
+        return self.tree.getroot()
+
+    @property
+    def robot_name(self) -> str:
+        """The robot's name attribute."""
+        return self.root.get("name", "")
+
+    def close(self) -> None:
+        """Remove the temp copy, if any."""
+        if self._tmp is not None:
+            self._tmp.cleanup()
+            self._tmp = None
+
+    def __enter__(self) -> Resolved:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _find_package(name: str, start: Path) -> Path | None:
+    # ROS layout without ROS: a parent folder named NAME, or one holding NAME/, or a folder
+    # whose package.xml declares <name>NAME</name>.
+    for folder in [start, *start.parents]:
+        if folder.name == name:
+            return folder
+        if (folder / name).is_dir():
+            return folder / name
+        pkg = folder / "package.xml"
+        if pkg.is_file():
+            try:
+                text = pkg.read_text("utf-8", "replace")
+            except OSError:
+                continue
+            if f"<name>{name}</name>" in text:
+                return folder
+    return None
+
+
+def _rewrite_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
+                   name: str) -> bool:
+    changed = False
+    for el in root.iter(*_FILE_TAGS):
+        fn = el.get("filename")
+        if not fn:
+            continue
+        if fn.startswith("package://"):
+            pkg, _, rest = fn[len("package://"):].partition("/")
+            folder = packages.get(pkg) or _find_package(pkg, base)
+            if folder is None:
+                raise InputError(f"cannot resolve {fn!r}: package {pkg!r} not found; pass "
+                                 f"--package {pkg}=PATH", file=name, line=el.sourceline)
+            el.set("filename", str(folder / rest))
+            changed = True
+        elif fn.startswith("file://"):
+            el.set("filename", fn[len("file://"):])
+            changed = True
+        elif not os.path.isabs(fn):
+            el.set("filename", str((base / fn).resolve()))
+            changed = True
+    return changed
+
+
+def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
+            xacro_args: Mapping[str, str] | None = None) -> Resolved:
+    """Locate, expand, parse, guard and package-resolve a URDF for loading."""
+    display = str(name)
+    source = locate(name)
+    if source.suffix == ".xacro":
+        data = expand_xacro(source, xacro_args, display=display)
+        tree = parse_xml(data, display)
+    else:
+        tree = parse_xml(read_bytes(source), display)
+    guard(tree, display)
+    root = tree.getroot()
+    needs_copy = source.suffix == ".xacro"
+    has_packages = any((el.get("filename") or "").startswith(("package://", "file://"))
+                       for el in root.iter(*_FILE_TAGS))
+    if has_packages or needs_copy:
+        _rewrite_files(root, source.resolve().parent, packages or {}, display)
+        tmp = tempfile.TemporaryDirectory(prefix="urdfkit-")
+        load_path = Path(tmp.name) / (source.name.removesuffix(".xacro") or "robot.urdf")
+        if load_path.suffix != ".urdf":
+            load_path = load_path.with_suffix(load_path.suffix + ".urdf")
+        load_path.write_bytes(to_bytes(root))
+        return Resolved(display, source, load_path, tree, tmp)
+    return Resolved(display, source, source, tree)

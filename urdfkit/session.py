@@ -1,0 +1,215 @@
+"""The one place that talks to PyBullet's connection: connect, flags, quiet, disconnect.
+
+PyBullet's C++ core prints diagnostics (``b3Printf``, URDF warnings, even "pybullet build
+time" on import) with C ``printf`` to file descriptor 1. A Python-level ``redirect_stdout``
+never sees them, and they would corrupt ``--json`` output. So every call that can print runs
+inside :func:`quiet_stdout`, which points fd 1 at a temp file with ``os.dup2``, flushes the C
+stdio buffer through ctypes before restoring it, and hands the captured text back as
+diagnostics. The redirect stays in place across ``disconnect()``, which prints too.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import sys
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import EngineError
+
+_libc: Any = None
+
+
+def _c_fflush() -> None:
+    global _libc
+    try:
+        if _libc is None:
+            _libc = ctypes.CDLL(None)
+        _libc.fflush(None)
+    except (OSError, AttributeError):  # pragma: no cover - non-POSIX libc
+        pass
+
+
+@dataclass
+class Captured:
+    """Text the C side printed while :func:`quiet_stdout` was active."""
+
+    text: str = ""
+
+    @property
+    def lines(self) -> list[str]:
+        """Non-empty lines, stripped."""
+        return [ln.strip() for ln in self.text.splitlines() if ln.strip()]
+
+
+_depth = 0
+
+
+@contextmanager
+def quiet_stdout() -> Iterator[Captured]:
+    """Capture everything written to fd 1 (C and Python) while the block runs.
+
+    Re-entrant: an inner block captures nothing of its own; the outermost one collects all.
+    """
+    global _depth
+    captured = Captured()
+    if _depth > 0:
+        _depth += 1
+        try:
+            yield captured
+        finally:
+            _depth -= 1
+        return
+    sys.stdout.flush()
+    _c_fflush()
+    saved = os.dup(1)
+    sink = tempfile.TemporaryFile(mode="w+b")
+    os.dup2(sink.fileno(), 1)
+    _depth = 1
+    try:
+        yield captured
+    finally:
+        try:
+            sys.stdout.flush()
+        except (OSError, ValueError):
+            pass
+        _c_fflush()
+        os.dup2(saved, 1)
+        os.close(saved)
+        _depth = 0
+        sink.seek(0)
+        captured.text = sink.read().decode("utf-8", "replace")
+        sink.close()
+
+
+def import_pybullet() -> Any:
+    """Import pybullet without letting its "build time" banner reach stdout."""
+    if "pybullet" in sys.modules:
+        return sys.modules["pybullet"]
+    with quiet_stdout():
+        import pybullet
+
+    return pybullet
+
+
+@dataclass
+class LoadOptions:
+    """How to load a URDF.
+
+    Attributes:
+        fixed_base: Pin the root link to the world.
+        inertia_from_file: Use the file's ``<inertia>``. Without this flag PyBullet discards
+            it and recomputes inertia from the collision shapes.
+        implicit_cylinder: Load cylinders as true cylinders. Without it PyBullet turns them
+            into convex meshes, and wheels roll on facets.
+        self_collision: Enable collisions between the robot's own links.
+        merge_fixed_links: Let PyBullet merge links joined by fixed joints (changes indices).
+        base_position: Where the root link starts.
+        base_orientation: Quaternion (x, y, z, w) of the root link.
+        global_scaling: Scale the whole model.
+    """
+
+    fixed_base: bool = False
+    inertia_from_file: bool = False
+    implicit_cylinder: bool = True
+    self_collision: bool = False
+    merge_fixed_links: bool = False
+    base_position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    base_orientation: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
+    global_scaling: float = 1.0
+
+    def flags(self, p: Any) -> int:
+        """The ``loadURDF`` flags these options mean."""
+        flags = 0
+        if self.inertia_from_file:
+            flags |= p.URDF_USE_INERTIA_FROM_FILE
+        if self.implicit_cylinder:
+            flags |= p.URDF_USE_IMPLICIT_CYLINDER
+        if self.self_collision:
+            flags |= p.URDF_USE_SELF_COLLISION
+        if self.merge_fixed_links:
+            flags |= p.URDF_MERGE_FIXED_LINKS
+        return flags
+
+
+@dataclass
+class Session:
+    """A PyBullet physics client of its own (DIRECT by default), quiet on stdout.
+
+    Several sessions can live in one process; each has its own ``client`` id, and every call
+    made through :attr:`p` must pass ``physicsClientId=session.client``.
+
+    Use it as a context manager so the client is always disconnected::
+
+        with Session() as s:
+            body = s.load_urdf("car.urdf")
+            print(s.p.getNumJoints(body, physicsClientId=s.client))
+    """
+
+    gui: bool = False
+    diagnostics: list[str] = field(default_factory=list)
+    p: Any = None
+    client: int = -1
+
+    def __post_init__(self) -> None:
+        self.p = import_pybullet()
+        with quiet_stdout() as out:
+            mode = self.p.GUI if self.gui else self.p.DIRECT
+            try:
+                self.client = self.p.connect(mode)
+            except self.p.error as e:  # pragma: no cover - needs a display
+                raise EngineError(f"cannot connect to PyBullet: {e}") from None
+        self.diagnostics.extend(out.lines)
+        if self.client < 0:
+            raise EngineError("cannot open the PyBullet GUI: no display available "
+                              "(set DISPLAY, or drop --gui)")
+
+    def __enter__(self) -> Session:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Disconnect, keeping stdout quiet while PyBullet tears down."""
+        if self.client >= 0:
+            with quiet_stdout() as out:
+                try:
+                    self.p.disconnect(physicsClientId=self.client)
+                except self.p.error:
+                    pass
+            self.diagnostics.extend(out.lines)
+            self.client = -1
+
+    def call(self, fn: str, *args: Any, **kwargs: Any) -> Any:
+        """Call ``p.<fn>`` on this client with stdout captured into :attr:`diagnostics`."""
+        with quiet_stdout() as out:
+            try:
+                return getattr(self.p, fn)(*args, physicsClientId=self.client, **kwargs)
+            finally:
+                self.diagnostics.extend(out.lines)
+
+    def load_urdf(self, path: str | Path, options: LoadOptions | None = None,
+                  display: str | None = None) -> int:
+        """Load a URDF file that has already passed the guard; return the body id.
+
+        Callers must run :func:`urdfkit.validate.guard` first: PyBullet segfaults on some
+        malformed files instead of raising.
+        """
+        o = options or LoadOptions()
+        name = display or str(path)
+        try:
+            return int(self.call(
+                "loadURDF", str(path), basePosition=o.base_position,
+                baseOrientation=o.base_orientation, useFixedBase=o.fixed_base,
+                flags=o.flags(self.p), globalScaling=o.global_scaling,
+            ))
+        except self.p.error:
+            said = "; ".join(self.diagnostics[-3:])
+            raise EngineError(f"PyBullet could not load it{': ' + said if said else ''}",
+                              file=name) from None

@@ -1,0 +1,157 @@
+"""Safe XML parsing and deterministic XML text.
+
+Every URDF that urdfkit reads goes through :func:`parse_xml`, which refuses external
+entities, network access and huge trees, so a hostile file cannot read ``/etc/passwd``
+through an entity or exhaust memory with a billion-laughs bomb.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+from lxml import etree
+
+from .errors import InputError
+
+#: Files larger than this are refused before parsing; real URDFs are far smaller.
+MAX_FILE_BYTES = 32 * 1024 * 1024
+
+
+def _parser() -> etree.XMLParser:
+    return etree.XMLParser(
+        resolve_entities=False,
+        no_network=True,
+        huge_tree=False,
+        load_dtd=False,
+        dtd_validation=False,
+        remove_comments=False,
+        remove_blank_text=True,
+    )
+
+
+def read_bytes(path: str | Path) -> bytes:
+    """Read a file for parsing, refusing folders, oversized and unreadable files."""
+    path = Path(path)
+    if path.is_dir():
+        raise InputError("is a directory, not a URDF file", file=path)
+    try:
+        size = path.stat().st_size
+    except FileNotFoundError:
+        raise InputError("no such file", file=path) from None
+    except OSError as e:
+        raise InputError(f"cannot read: {e.strerror}", file=path) from None
+    if size > MAX_FILE_BYTES:
+        raise InputError(
+            f"file is {size / 1e6:.0f} MB; urdfkit refuses files over "
+            f"{MAX_FILE_BYTES // (1024 * 1024)} MiB",
+            file=path,
+        )
+    try:
+        with open(path, "rb") as f:
+            return f.read()
+    except OSError as e:
+        raise InputError(f"cannot read: {e.strerror}", file=path) from None
+
+
+def parse_xml(data: bytes, file: str | Path) -> etree._ElementTree:
+    """Parse XML bytes safely; malformed input raises :class:`InputError` with the line."""
+    if not data.strip():
+        raise InputError("file is empty", file=file)
+    try:
+        root = etree.fromstring(data, _parser())
+    except etree.XMLSyntaxError as e:
+        line = e.lineno if e.lineno else None
+        msg = str(e.msg if hasattr(e, "msg") and e.msg else e)
+        # lxml appends "(line N, column M)"; we report the line ourselves.
+        msg = msg.split(", line ")[0]
+        raise InputError(f"not well-formed XML: {msg}", file=file, line=line) from None
+    except ValueError as e:  # e.g. unicode strings with encoding declarations
+        raise InputError(f"not well-formed XML: {e}", file=file) from None
+    _refuse_entities(root, file)
+    return root.getroottree()
+
+
+def _refuse_entities(root: etree._Element, file: str | Path) -> None:
+    # With resolve_entities=False, entity references survive as nodes; a URDF has no
+    # business declaring them, and expanding them is how XXE and entity bombs work.
+    docinfo = root.getroottree().docinfo
+    if docinfo.internalDTD is not None and len(list(docinfo.internalDTD.iterentities())) > 0:
+        raise InputError("declares XML entities; urdfkit refuses them (XXE / entity bombs)",
+                         file=file, line=1)
+    for node in root.iter(etree.Entity):
+        raise InputError("uses an XML entity reference; urdfkit refuses them",
+                         file=file, line=node.sourceline)
+
+
+def load_xml(path: str | Path) -> etree._ElementTree:
+    """Read and safely parse an XML file."""
+    return parse_xml(read_bytes(path), path)
+
+
+def fmt_float(x: float, digits: int = 10) -> str:
+    """Format a float deterministically: fixed significant digits, no ``-0``.
+
+    ``0.1 * 3`` prints as ``0.3``, not ``0.30000000000000004``, so golden files never churn.
+    """
+    if not math.isfinite(x):
+        raise ValueError(f"cannot write non-finite number {x!r}")
+    s = f"{x:.{digits}g}"
+    if float(s) == 0.0:
+        return "0"
+    return s
+
+
+def fmt_vec(v: tuple[float, ...] | list[float]) -> str:
+    """Format a vector as space-separated deterministic floats."""
+    return " ".join(fmt_float(x) for x in v)
+
+
+def to_bytes(root: etree._Element) -> bytes:
+    """Serialize pretty-printed with an XML declaration and a trailing newline."""
+    etree.indent(root, space="  ")
+    body = etree.tostring(root, encoding="utf-8", pretty_print=True)
+    return b'<?xml version="1.0" encoding="utf-8"?>\n' + body
+
+
+def atomic_write(path: str | Path, data: bytes, *, force: bool = False) -> Path:
+    """Write ``data`` to ``path`` atomically: a temp file in the same folder, then rename.
+
+    Refuses to replace an existing file unless ``force`` is set, so nothing is lost.
+    """
+    from .errors import OutputError
+
+    path = Path(path)
+    if path.is_dir():
+        raise OutputError("is a directory", file=path)
+    if path.exists() and not force:
+        raise OutputError("exists; pass --force to overwrite it", file=path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise OutputError(f"folder {folder} does not exist", file=path)
+    import tempfile
+
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    except OSError as e:
+        raise OutputError(f"cannot write: {e.strerror}", file=path) from None
+    try:
+        # mkstemp makes the file 0600; give it the mode a plain open() would have.
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        if not force and path.exists():
+            raise OutputError("exists; pass --force to overwrite it", file=path)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+    return path
