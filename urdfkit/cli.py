@@ -108,6 +108,12 @@ SetOpt = Annotated[list[str] | None, typer.Option(
 ArgOpt = Annotated[list[str] | None, typer.Option(
     "--arg", "-a", metavar="NAME:=VALUE", help="xacro argument (repeatable).")]
 ForceOpt = Annotated[bool, typer.Option("--force", "-f", help="Overwrite an existing file.")]
+# Options shared by every command that reads a robot file (resolve.open_input takes them raw).
+PackageOpt = Annotated[list[str] | None, typer.Option(
+    "--package", "-p", metavar="NAME=PATH",
+    help="Where package://NAME/ points (repeatable); else found by walking up from the file.")]
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
+FixedBaseOpt = Annotated[bool, typer.Option("--fixed-base", help="Pin the root link to the world.")]
 
 
 @app.command()

@@ -203,3 +203,12 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
         load_path.write_bytes(to_bytes(root))
         return Resolved(display, source, load_path, tree, tmp)
     return Resolved(display, source, source, tree)
+
+
+def open_input(name: str | Path, packages: list[str] | None = None,
+               xacro_args: list[str] | None = None) -> Resolved:
+    """:func:`resolve` with the raw ``--package NAME=PATH`` and ``--arg k:=v`` option lists."""
+    from .catalog import parse_assignments
+
+    return resolve(name, packages=parse_packages(packages),
+                   xacro_args=parse_assignments(xacro_args, "--arg"))
