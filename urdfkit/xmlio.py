@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from pathlib import Path
 
 from lxml import etree
@@ -55,10 +56,61 @@ def read_bytes(path: str | Path) -> bytes:
         raise InputError(f"cannot read: {e.strerror}", file=path) from None
 
 
+#: An XML declaration anywhere near the start of a file.
+_DECL = re.compile(rb"<\?xml\s[^>]*?\?>")
+
+
+def tolerate_quirks(data: bytes) -> tuple[bytes, list[tuple[int, str]]]:
+    """Repair the XML quirks PyBullet's tinyxml2 accepts but libxml2 refuses.
+
+    pybullet_data itself ships such files (``plane.urdf`` declares ``version="0.0"``,
+    ``humanoid.urdf`` ends in a NUL byte, ``biped2d_pybullet.urdf`` has blank lines before the
+    declaration). Refusing them would refuse files PyBullet loads. Line numbers are kept.
+
+    Returns:
+        The repaired bytes and ``(line, note)`` pairs saying what was repaired.
+    """
+    notes: list[tuple[int, str]] = []
+    trimmed = data.rstrip(b"\0 \t\r\n")
+    if b"\0" in data[len(trimmed):]:
+        # tinyxml2 reads the file as a C string: everything after a NUL is invisible to it.
+        notes.append((trimmed.count(b"\n") + 1, "the file ends in NUL bytes; PyBullet ignores "
+                      "them but other XML parsers refuse the file: remove them"))
+        data = trimmed
+    m = _DECL.search(data, 0, 4096)
+    if m is None:
+        return data, notes
+    decl = m.group(0)
+    line = data.count(b"\n", 0, m.start()) + 1
+    version = re.search(rb"""version\s*=\s*["']([^"']*)["']""", decl)
+    if m.start() > 0 and not data[:m.start()].strip(b" \t\r\n\xef\xbb\xbf"):
+        notes.append((line, "the XML declaration is not at the very start of the file; remove "
+                      "the blank lines before it"))
+        enc = re.search(rb"""encoding\s*=\s*["']([^"']*)["']""", decl)
+        if enc and enc.group(1).lower() not in (b"utf-8", b"utf8", b"ascii", b"us-ascii"):
+            try:
+                data = data.decode(enc.group(1).decode("ascii")).encode("utf-8")
+            except (LookupError, UnicodeError):
+                return data, notes
+            m = _DECL.search(data, 0, 4096)
+            if m is None:  # pragma: no cover - the declaration survives re-encoding
+                return data, notes
+        # Blank the declaration out, keeping every newline so lines still match the file.
+        data = data[:m.start()] + b" " * len(m.group(0)) + data[m.end():]
+    elif version and not version.group(1).startswith(b"1."):
+        said = version.group(1).decode("ascii", "replace")
+        notes.append((line, f"the XML declaration says version=\"{said}\"; PyBullet ignores "
+                      "it but other XML parsers refuse it: write version=\"1.0\""))
+        fixed = decl[:version.start(1)] + b"1.0" + decl[version.end(1):]
+        data = data[:m.start()] + fixed + data[m.end():]
+    return data, notes
+
+
 def parse_xml(data: bytes, file: str | Path) -> etree._ElementTree:
     """Parse XML bytes safely; malformed input raises :class:`InputError` with the line."""
     if not data.strip():
         raise InputError("file is empty", file=file)
+    data, _ = tolerate_quirks(data)
     try:
         root = etree.fromstring(data, _parser())
     except etree.XMLSyntaxError as e:
