@@ -1,0 +1,153 @@
+"""`urdfkit build` and `urdfkit templates` as users call them."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from urdfkit.cli import app
+
+DATA = Path(__file__).parent / "data"
+GOLDEN = Path(__file__).parent / "golden"
+
+
+@pytest.fixture
+def runner() -> CliRunner:
+    return CliRunner()
+
+
+@pytest.fixture
+def in_tmp(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def test_build_writes_the_template_in_the_current_folder(runner: CliRunner, in_tmp: Path) -> None:
+    result = runner.invoke(app, ["build", "simplecar"])
+    assert result.exit_code == 0, result.output
+    assert (in_tmp / "simplecar.urdf").read_bytes() == (GOLDEN / "simplecar.urdf").read_bytes()
+    assert "wrote simplecar.urdf (7 links, 6 joints)" in result.output
+
+
+def test_build_twice_is_byte_identical(runner: CliRunner, in_tmp: Path) -> None:
+    assert runner.invoke(app, ["build", "simplecar", "-o", "a.urdf"]).exit_code == 0
+    assert runner.invoke(app, ["build", "simplecar", "-o", "b.urdf"]).exit_code == 0
+    assert (in_tmp / "a.urdf").read_bytes() == (in_tmp / "b.urdf").read_bytes()
+
+
+def test_build_refuses_to_overwrite_without_force(runner: CliRunner, in_tmp: Path) -> None:
+    target = in_tmp / "simplecar.urdf"
+    target.write_text("my precious edits")
+    result = runner.invoke(app, ["build", "simplecar"])
+    assert result.exit_code == 2
+    assert "simplecar.urdf: exists; pass --force to overwrite it" in result.output
+    assert target.read_text() == "my precious edits"
+    result = runner.invoke(app, ["build", "simplecar", "--force"])
+    assert result.exit_code == 0
+    assert target.read_bytes() == (GOLDEN / "simplecar.urdf").read_bytes()
+    assert not [p for p in in_tmp.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_build_to_stdout(runner: CliRunner, in_tmp: Path) -> None:
+    result = runner.invoke(app, ["build", "simpleplane", "-o", "-"])
+    assert result.exit_code == 0
+    assert result.stdout.encode() == (GOLDEN / "simpleplane.urdf").read_bytes()
+    assert not list(in_tmp.iterdir())
+
+
+def test_build_with_parameters(runner: CliRunner, in_tmp: Path) -> None:
+    result = runner.invoke(app, ["build", "simplecar", "--set", "wheel_radius=0.15",
+                                 "-s", "body_mass=4", "-o", "-"])
+    assert result.exit_code == 0
+    assert 'radius="0.15"' in result.stdout
+    assert '<mass value="4"/>' in result.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["build", "simplecar", "--set", "wheel_radius=-1"], "parameter 'wheel_radius' must be > 0"),
+        (["build", "simplecar", "--set", "wings=2"], "has no parameter 'wings'"),
+        (["build", "simplecar", "--set", "wheel_radius"], "--set expects key=value"),
+        (["build", "truck"], "'truck' is neither a template"),
+        (["build", "simplecar", "-o", "no/such/dir/car.urdf"], "folder no/such/dir does not exist"),
+    ],
+)
+def test_build_errors_are_one_line(runner: CliRunner, in_tmp: Path, args: list[str],
+                                   message: str) -> None:
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    assert message in result.output
+    assert len(result.output.strip().splitlines()) == 1
+    assert "Traceback" not in result.output
+
+
+def test_build_a_users_xacro_with_args(runner: CliRunner, in_tmp: Path) -> None:
+    shutil.copy(DATA / "arm.urdf.xacro", in_tmp)
+    result = runner.invoke(app, ["build", "arm.urdf.xacro", "--arg", "length:=0.8"])
+    assert result.exit_code == 0, result.output
+    text = (in_tmp / "arm.urdf").read_text()
+    assert 'length="0.8"' in text
+    assert "xacro:" not in text
+
+
+def test_build_reports_a_broken_xacro(runner: CliRunner, in_tmp: Path) -> None:
+    (in_tmp / "bad.urdf.xacro").write_text(
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<link name="${undefined_name}"/></robot>')
+    result = runner.invoke(app, ["build", "bad.urdf.xacro"])
+    assert result.exit_code == 2
+    assert "bad.urdf.xacro: xacro failed:" in result.output
+    assert not (in_tmp / "bad.urdf").exists()
+
+
+def test_build_validates_the_result_before_writing(runner: CliRunner, in_tmp: Path) -> None:
+    (in_tmp / "tworoots.urdf.xacro").write_text(
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<link name="a"/><link name="b"/></robot>')
+    result = runner.invoke(app, ["build", "tworoots.urdf.xacro"])
+    assert result.exit_code == 2
+    assert "2 root links" in result.output
+    assert not (in_tmp / "tworoots.urdf").exists()
+
+
+def test_xacro_expansion_is_time_limited(in_tmp: Path) -> None:
+    from urdfkit.errors import InputError
+    from urdfkit.resolve import expand_xacro
+
+    slow = in_tmp / "slow.urdf.xacro"
+    slow.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                    '<link name="${[x for x in range(10**12)]}"/></robot>')
+    with pytest.raises(InputError, match="took longer than 1 s"):
+        expand_xacro(slow, timeout=1)
+
+
+def test_templates_lists_parameters(runner: CliRunner) -> None:
+    result = runner.invoke(app, ["templates", "--json"])
+    assert result.exit_code == 0
+    data = json.loads(result.stdout)
+    car = next(t for t in data["templates"] if t["name"] == "simplecar")
+    names = {p["name"] for p in car["params"]}
+    assert {"wheel_radius", "wheel_width", "wheelbase", "track", "body_size", "body_mass",
+            "wheel_mass", "steer_limit", "lateral_friction"} <= names
+    table = runner.invoke(app, ["templates"])
+    assert "wheel_radius" in table.output and "simpleplane" in table.output
+
+
+def test_installed_command_runs_as_a_subprocess(tmp_path: Path) -> None:
+    exe = shutil.which("urdfkit") or str(Path(sys.executable).parent / "urdfkit")
+    out = subprocess.run([exe, "--help"], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0
+    assert "build" in out.stdout and "Usage" in out.stdout
+    mod = subprocess.run([sys.executable, "-m", "urdfkit", "build", "simplecar", "-o",
+                          str(tmp_path / "car.urdf")], capture_output=True, text=True,
+                         timeout=60, env={**os.environ, "NO_COLOR": "1"})
+    assert mod.returncode == 0, mod.stderr
+    assert (tmp_path / "car.urdf").read_bytes() == (GOLDEN / "simplecar.urdf").read_bytes()

@@ -1,0 +1,24 @@
+"""The wheel carries the templates: a plain (non-editable) install must find them."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+ROOT = Path(__file__).parent.parent
+
+
+def test_wheel_ships_templates_as_package_data(tmp_path: Path) -> None:
+    out = subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(tmp_path), str(ROOT)],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert out.returncode == 0, out.stderr
+    (wheel,) = tmp_path.glob("urdfkit-*.whl")
+    names = set(zipfile.ZipFile(wheel).namelist())
+    for template in (ROOT / "templates").glob("*.xacro"):
+        assert f"urdfkit/templates/{template.name}" in names
+    assert "urdfkit/py.typed" in names
+    assert "urdfkit/cli.py" in names
