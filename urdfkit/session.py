@@ -188,10 +188,13 @@ class Session:
 
     def call(self, fn: str, *args: Any, **kwargs: Any) -> Any:
         """Call ``p.<fn>`` on this client with stdout captured into :attr:`diagnostics`."""
-        with quiet_stdout() as out:
-            try:
+        out = None
+        try:
+            with quiet_stdout() as out:
                 return getattr(self.p, fn)(*args, physicsClientId=self.client, **kwargs)
-            finally:
+        finally:
+            # Only after the with block has exited does ``out`` hold the captured text.
+            if out is not None:
                 self.diagnostics.extend(out.lines)
 
     def load_urdf(self, path: str | Path, options: LoadOptions | None = None,
