@@ -214,6 +214,11 @@ def test_complete_inertia_fills_missing_tensors_from_collisions() -> None:
     i = r.link("a").inertial
     assert i.origin.xyz == pytest.approx((0, 0, 0.5))
     assert i.inertia.ixx == pytest.approx(2 / 6)
+    # Writing derives it too, without the caller asking.
+    lazy = Robot("r")
+    lazy.add_link(Link("a", inertial=Inertial(3.0), collisions=[Collision(Sphere(0.1))]))
+    written = Robot.from_string(lazy.to_bytes()).link("a").inertial
+    assert written.inertia.ixx == pytest.approx(0.4 * 3 * 0.01)
     mesh_only = Robot("m")
     mesh_only.add_link(Link("a", inertial=Inertial(1.0), collisions=[Collision(Mesh("x.stl"))]))
     with pytest.raises(ModelError, match="cannot derive inertia from mesh"):

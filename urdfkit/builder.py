@@ -380,8 +380,9 @@ def _origin(value: Any) -> Origin:
 class Inertial(_Element):
     """Mass, centre of mass and inertia of a link.
 
-    ``inertia`` may be None only while building: :meth:`Robot.complete_inertia` fills it in
-    from the collision shapes. A written file always has it.
+    Leave ``inertia`` as None to have it derived from the link's collision shapes (solid, of
+    uniform density) when the robot is written or :meth:`Robot.complete_inertia` runs; a
+    written file always has a tensor.
     """
 
     _tag = "inertial"
@@ -508,6 +509,24 @@ class Link(_Element):
     visuals: list[Visual] = field(default_factory=list)
     collisions: list[Collision] = field(default_factory=list)
     contact: Contact | None = _checked(None, _contact)
+
+    def resolved_inertial(self) -> Inertial | None:
+        """The inertial with its tensor filled in from the shapes when none was given.
+
+        Collision shapes are used (they are what PyBullet derives inertia from); a link with
+        none falls back to its visuals.
+        """
+        if self.inertial is None or self.inertial.inertia is not None:
+            return self.inertial
+        shapes = [(c.geometry, c.origin) for c in self.collisions] or \
+                 [(v.geometry, v.origin) for v in self.visuals]
+        if not shapes:
+            raise ModelError(f"<link name={self.name!r}> has a mass but no shapes to derive "
+                             "its inertia from; give <inertia> explicitly")
+        try:
+            return Inertial.from_shapes(self.inertial.mass, shapes)
+        except ModelError as e:
+            raise ModelError(f"<link name={self.name!r}>: {e.message}") from None
 
 
 @dataclass(eq=False)
@@ -733,14 +752,7 @@ class Robot(_Element):
     def complete_inertia(self) -> None:
         """Fill in every inertial whose tensor is missing, from the link's collision shapes."""
         for link in self.links:
-            if link.inertial is not None and link.inertial.inertia is None:
-                shapes = [(c.geometry, c.origin) for c in link.collisions] or \
-                         [(v.geometry, v.origin) for v in link.visuals]
-                if not shapes:
-                    raise ModelError(f"<link name={link.name!r}> has a mass but no shapes to "
-                                     "derive its inertia from; give <inertia> explicitly")
-                derived = Inertial.from_shapes(link.inertial.mass, shapes)
-                link.inertial = derived
+            link.inertial = link.resolved_inertial()
 
     # ---- XML
 
@@ -970,8 +982,9 @@ def _write_link(parent: etree._Element, link: Link) -> None:
     el = etree.SubElement(parent, "link", name=link.name)
     if link.contact is not None:
         _write_contact(el, link.contact)
-    if link.inertial is not None:
-        _write_inertial(el, link.inertial)
+    inertial = link.resolved_inertial()  # a written file always has a tensor
+    if inertial is not None:
+        _write_inertial(el, inertial)
     for v in link.visuals:
         _write_visual(el, v)
     for c in link.collisions:
