@@ -12,10 +12,9 @@ indices the motors are addressed by:
   PyBullet would hold it still like a brake.
 
 PyBullet gives a joint's axis in the child link's frame. To know whether it is horizontal we
-need that frame's world orientation at load time. It is composed from ``getJointInfo``'s
-``parentFrameOrn`` (relative to the *parent's centre-of-mass* frame) and ``getDynamicsInfo``'s
-local inertial frame, instead of calling ``getLinkState``, which fails on bodies with 128 links
-or more.
+need that frame's world orientation at load time: ``getLinkState``'s ``worldLinkFrameOrientation``,
+or, composed from ``getJointInfo``'s ``parentFrameOrn`` and ``getDynamicsInfo``'s
+local inertial frame only when ``getLinkState`` fails (bodies with 128 links or more).
 
 Signs are part of detection. Positive throttle means "forward along the base's x axis" and
 positive steer means "left, counter-clockwise seen from above", whatever way each joint's axis
@@ -96,12 +95,21 @@ def _rotate(p: Any, orn: Sequence[float], v: Sequence[float]) -> tuple[float, fl
 def _link_orientations(p: Any, body: int, client: int, infos: list[tuple[Any, ...]]
                        ) -> list[tuple[float, ...]]:
     """World orientation of each link's URDF frame (= its joint frame) at load time."""
+    try:
+        return [tuple(p.getLinkState(body, j, computeForwardKinematics=True,
+                                     physicsClientId=client)[5]) for j in range(len(infos))]
+    except p.error:
+        pass
+    # getLinkState fails on bodies with 128 links or more: compose the frames ourselves.
+    # Measured on PyBullet 3.2.7: getJointInfo's parentFrameOrn is the *inverse* of the URDF
+    # <origin rpy> (racecar.urdf's rpy="1.5708 0 0" comes back as -90 degrees about x), while
+    # getLinkState agrees with the file; hence the invertTransform.
     _, base_com_orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
     com: dict[int, tuple[float, ...]] = {-1: tuple(base_com_orn)}
     frames: list[tuple[float, ...]] = []
     for j, info in enumerate(infos):
-        parent = info[16]
-        _, link_orn = p.multiplyTransforms((0, 0, 0), com[parent], (0, 0, 0), info[15])
+        _, joint_orn = p.invertTransform((0, 0, 0), info[15])
+        _, link_orn = p.multiplyTransforms((0, 0, 0), com[info[16]], (0, 0, 0), joint_orn)
         frames.append(tuple(link_orn))
         dyn = p.getDynamicsInfo(body, j, physicsClientId=client)
         _, com_orn = p.multiplyTransforms((0, 0, 0), link_orn, (0, 0, 0), dyn[4])
