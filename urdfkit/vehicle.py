@@ -35,6 +35,11 @@ HORIZONTAL_TOLERANCE = 0.2
 #: |axis . z| above this is "vertical".
 VERTICAL_TOLERANCE = 0.98
 
+#: Hinge motor force (N m): PyBullet's own default for POSITION_CONTROL, which the tutorial
+#: relies on. With the wheel force (10) instead, one hinge of simplecar stalls at 0.02 rad of
+#: a 0.2 rad target while the tyres scrub: steering would silently not happen.
+STEER_FORCE = 100000.0
+
 _REVOLUTE = 0  # p.JOINT_REVOLUTE
 _PRISMATIC = 1  # p.JOINT_PRISMATIC
 
@@ -239,7 +244,7 @@ def disable_default_motors(p: Any, body: int, client: int, joints: Sequence[int]
 
 
 def apply_drive(p: Any, body: int, client: int, train: Drivetrain, throttle: float,
-                steer: float, max_force: float) -> None:
+                steer: float, max_force: float, steer_force: float = STEER_FORCE) -> None:
     """Set the wheel and hinge motors once; PyBullet keeps them until they are changed.
 
     Args:
@@ -250,7 +255,8 @@ def apply_drive(p: Any, body: int, client: int, train: Drivetrain, throttle: flo
         throttle: Target wheel angular velocity, rad/s (positive = forward).
         steer: Target hinge angle, rad (positive = left). Callers clamp it to
             :meth:`Drivetrain.steer_range` first.
-        max_force: Maximum motor force (torque, N m) of every wheel and hinge motor.
+        max_force: Maximum torque (N m) of every wheel motor.
+        steer_force: Maximum torque (N m) of every hinge motor.
     """
     if train.wheels:
         p.setJointMotorControlArray(
@@ -261,4 +267,4 @@ def apply_drive(p: Any, body: int, client: int, train: Drivetrain, throttle: flo
         p.setJointMotorControlArray(
             body, train.hinges, p.POSITION_CONTROL,
             targetPositions=[steer * train.hinge_signs.get(j, 1.0) for j in train.hinges],
-            forces=[max_force] * len(train.hinges), physicsClientId=client)
+            forces=[steer_force] * len(train.hinges), physicsClientId=client)
