@@ -91,9 +91,20 @@ def import_pybullet() -> Any:
     """Import pybullet without letting its "build time" banner reach stdout."""
     if "pybullet" in sys.modules:
         return sys.modules["pybullet"]
-    with quiet_stdout():
-        import pybullet
-
+    # The banner goes to stderr (fd 2) in the PyPI 3.2.7 wheels, to stdout in other builds:
+    # silence both, so `urdfkit ... 2>&1` shows only what urdfkit says.
+    sys.stderr.flush()
+    saved_err = os.dup(2)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 2)
+    try:
+        with quiet_stdout():
+            import pybullet
+    finally:
+        _c_fflush()
+        os.dup2(saved_err, 2)
+        os.close(saved_err)
+        os.close(devnull)
     return pybullet
 
 
