@@ -178,6 +178,277 @@ def templates(
         console.print()
 
 
+# ---- inspect: joints, links, tree, info (urdfkit/inspect.py holds the data)
+
+MovableOpt = Annotated[bool, typer.Option("--movable", help="Only joints that can move.")]
+TypeOpt = Annotated[list[str] | None, typer.Option(
+    "--type", "-t", metavar="TYPE",
+    help="Only joints of this type (repeatable): revolute, continuous, prismatic, fixed, ...")]
+AllOpt = Annotated[bool, typer.Option("--all", help="Show every field, however wide.")]
+FileArg = Annotated[str, typer.Argument(
+    help="A .urdf or .xacro file; a bare name is also looked up in pybullet_data.")]
+
+
+def _inspect(file: str, package: list[str] | None, arg: list[str] | None, *,
+             fixed_base: bool = False, inertia_from_file: bool = False,
+             links: bool = False, info: bool = False) -> Any:
+    from .inspect import inspect_file
+    from .resolve import open_input
+    from .session import LoadOptions
+
+    options = LoadOptions(fixed_base=fixed_base, inertia_from_file=inertia_from_file)
+    with open_input(file, package, arg) as resolved:
+        return inspect_file(resolved, options, links=links, info=info)
+
+
+def _num(x: float) -> str:
+    s = f"{x:.4g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def _nums(v: Any) -> str:
+    return " ".join(_num(x) for x in v)
+
+
+def _show_diagnostics(lines: list[str]) -> None:
+    for line in lines:
+        _warn(f"pybullet: {line}")
+
+
+def _fitted_table(title: str, columns: list[tuple[str, int, str]], rows: list[list[str]],
+                  show_all: bool) -> Any:
+    """A rich table of the columns that fit the terminal, most important first.
+
+    ``columns`` holds (header, priority, justify): priority 0 always shows, then priorities
+    1, 2, ... join while they fit; 9 shows only with ``--all``. With ``--all`` on a terminal
+    too narrow for every column, each row becomes a block of "field value" lines instead, so
+    nothing is squeezed into ellipses.
+    """
+    from rich.table import Table
+
+    width = _console().width
+    needed = [max([len(h), *(len(r[i]) for r in rows)]) + 3 for i, (h, _, _) in
+              enumerate(columns)]
+    if show_all and sum(needed) > width:
+        from rich.console import Group
+
+        blocks: list[Any] = [f"[bold]{title}[/]"]
+        for r in rows:
+            block = Table(show_header=False, show_edge=False, box=None, padding=(0, 1))
+            block.add_column(style="bold")
+            block.add_column()
+            for (header, _, _), cell in zip(columns, r):
+                block.add_row(_escape(header), _escape(cell))
+            blocks += ["", block]
+        return Group(*blocks)
+    keep: set[int] = set()
+    used = 0
+    for i in sorted(range(len(columns)), key=lambda i: columns[i][1]):
+        prio = columns[i][1]
+        if not (show_all or prio == 0 or (prio < 9 and used + needed[i] <= width)):
+            break  # a column of this priority does not fit: drop all less important ones
+        keep.add(i)
+        used += needed[i]
+    table = Table(title=title, title_justify="left", show_edge=False, header_style="bold")
+    for i, (header, _, justify) in enumerate(columns):
+        if i in keep:
+            table.add_column(header, justify=justify)  # type: ignore[arg-type]
+    for r in rows:
+        table.add_row(*(_escape(c) for i, c in enumerate(r) if i in keep))
+    return table
+
+
+@app.command()
+@_handle_errors
+def joints(
+    file: FileArg,
+    as_json: JsonOpt = False,
+    show_all: AllOpt = False,
+    movable: MovableOpt = False,
+    joint_type: TypeOpt = None,
+    fixed_base: FixedBaseOpt = False,
+    package: PackageOpt = None,
+    arg: ArgOpt = None,
+) -> None:
+    """Every joint as PyBullet's getJointInfo sees it, decoded: index, type, limits, axis.
+
+    --json prints {"file", "robot", "base_link", "joints": [...]} with the 17 getJointInfo
+    fields under the Quickstart Guide names (jointIndex ... parentIndex); see docs/inspect.md.
+    """
+    from .inspect import filter_joints
+
+    report = _inspect(file, package, arg, fixed_base=fixed_base)
+    rows = filter_joints(report.joints, movable=movable, types=joint_type or ())
+    if as_json:
+        _print_json({**report.header(), "joints": [j.to_dict() for j in rows],
+                     "diagnostics": report.diagnostics})
+        return
+    _show_diagnostics(report.diagnostics)
+    columns = [("#", 0, "right"), ("joint", 0, "left"), ("type", 0, "left"),
+               ("child link", 1, "left"), ("parent", 2, "left"), ("limits", 1, "right"),
+               ("axis", 2, "left"), ("max force", 3, "right"), ("max vel", 3, "right"),
+               ("xyz", 4, "left"), ("rpy", 4, "left"), ("q", 5, "right"), ("u", 5, "right"),
+               ("damping", 6, "right"), ("friction", 6, "right"), ("quat", 9, "left"),
+               ("flags", 9, "right")]
+    cells = []
+    for j in rows:
+        if j.limited:
+            limits = f"{_num(j.joint_lower_limit)} .. {_num(j.joint_upper_limit)}"
+        else:
+            limits = "unlimited" if j.movable else ""
+        cells.append([
+            str(j.joint_index), j.joint_name, j.type_label, j.link_name,
+            f"{j.parent_index} {j.parent_link_name}", limits,
+            _nums(j.joint_axis) if j.movable else "", _num(j.joint_max_force),
+            _num(j.joint_max_velocity), _nums(j.parent_frame_pos), _nums(j.parent_frame_rpy),
+            str(j.q_index), str(j.u_index), _num(j.joint_damping), _num(j.joint_friction),
+            _nums(j.parent_frame_orn), str(j.flags)])
+    shown = f"{len(rows)} of {len(report.joints)}" if len(rows) != len(report.joints) \
+        else str(len(rows))
+    title = (f"[bold]{_escape(report.robot)}[/]: {shown} joints, "
+             f"base link {_escape(report.base_link)}")
+    _console().print(_fitted_table(title, columns, cells, show_all))
+
+
+@app.command()
+@_handle_errors
+def links(
+    file: FileArg,
+    as_json: JsonOpt = False,
+    show_all: AllOpt = False,
+    inertia_from_file: Annotated[bool, typer.Option(
+        "--inertia-from-file",
+        help="Load with URDF_USE_INERTIA_FROM_FILE. Without it PyBullet ignores <inertia> "
+             "and recomputes it from the collision shapes.")] = False,
+    fixed_base: FixedBaseOpt = False,
+    package: PackageOpt = None,
+    arg: ArgOpt = None,
+) -> None:
+    """Each link's getDynamicsInfo (mass, friction, inertia) beside what the file says.
+
+    A '!' marks engine values that differ from the file's: by default PyBullet recomputes
+    inertia from the collision shapes, and a link without <inertial> gets 1 kg.
+    """
+    report = _inspect(file, package, arg, fixed_base=fixed_base,
+                      inertia_from_file=inertia_from_file, links=True)
+    if as_json:
+        _print_json({**report.header(), "inertia_from_file": inertia_from_file,
+                     "links": [link.to_dict() for link in report.links],
+                     "diagnostics": report.diagnostics})
+        return
+    _show_diagnostics(report.diagnostics)
+    columns = [("#", 0, "right"), ("link", 0, "left"), ("mass", 0, "right"),
+               ("file mass", 1, "right"), ("inertia diagonal", 0, "left"),
+               ("file principal inertia", 1, "left"), ("lateral", 2, "right"),
+               ("rolling", 3, "right"), ("spinning", 3, "right"), ("restitution", 4, "right"),
+               ("stiffness", 5, "right"), ("damping", 5, "right"), ("com xyz", 4, "left"),
+               ("com quat", 9, "left")]
+    cells = []
+    differs = False
+    for link in report.links:
+        f = link.file
+        mass_mark = " !" if link.mass_differs else ""
+        inertia_mark = " !" if link.inertia_differs else ""
+        differs = differs or bool(mass_mark or inertia_mark)
+        cells.append([
+            str(link.link_index), link.link_name, _num(link.mass) + mass_mark,
+            _num(f.mass) if f else "none", _nums(link.local_inertia_diagonal) + inertia_mark,
+            _nums(f.principal) if f else "none", _num(link.lateral_friction),
+            _num(link.rolling_friction), _num(link.spinning_friction), _num(link.restitution),
+            _num(link.contact_stiffness), _num(link.contact_damping),
+            _nums(link.local_inertial_pos), _nums(link.local_inertial_orn)])
+    title = (f"[bold]{_escape(report.robot)}[/]: {len(report.links)} links, inertia "
+             f"{'from the file' if inertia_from_file else 'recomputed by PyBullet'}")
+    console = _console()
+    console.print(_fitted_table(title, columns, cells, show_all))
+    if differs and not inertia_from_file:
+        console.print("[dim]! = PyBullet's value differs from the file's; "
+                      "--inertia-from-file keeps the file's <inertia>[/]")
+
+
+@app.command()
+@_handle_errors
+def tree(
+    file: FileArg,
+    as_json: JsonOpt = False,
+    package: PackageOpt = None,
+    arg: ArgOpt = None,
+) -> None:
+    """The kinematic tree: links, and the joints between them with type, axis and index.
+
+    Read from the file alone; PyBullet is not loaded. [n] is the index PyBullet will give
+    the joint.
+    """
+    from .inspect import TreeNode, kinematic_tree
+    from .resolve import open_input
+
+    with open_input(file, package, arg) as resolved:
+        root = kinematic_tree(resolved.root)
+        robot = resolved.robot_name
+    if as_json:
+        _print_json({"file": file, "robot": robot, "tree": root.to_dict()})
+        return
+    from rich.tree import Tree
+
+    def label(node: TreeNode) -> str:
+        j = node.joint
+        if j is None:
+            return f"[bold]{_escape(node.link)}[/]"
+        extra = f" axis {_nums(j.axis)}" if j.axis is not None else ""
+        if j.limit is not None:
+            extra += f" [{_num(j.limit[0])} .. {_num(j.limit[1])}]"
+        return (f"[dim]\\[{j.index}][/] [cyan]{_escape(j.name)}[/] ({j.type}"
+                f"{_escape(extra)}) -> [bold]{_escape(node.link)}[/]")
+
+    def grow(node: TreeNode, branch: Any) -> None:
+        for child in node.children:
+            grow(child, branch.add(label(child)))
+
+    top = Tree(f"{label(root)} [dim]({_escape(robot)})[/]")
+    grow(root, top)
+    _console().print(top)
+
+
+@app.command()
+@_handle_errors
+def info(
+    file: FileArg,
+    as_json: JsonOpt = False,
+    fixed_base: FixedBaseOpt = False,
+    package: PackageOpt = None,
+    arg: ArgOpt = None,
+) -> None:
+    """The robot at a glance: links, joints by type, DOF, total mass, bounding box."""
+    report = _inspect(file, package, arg, fixed_base=fixed_base, info=True)
+    s = report.summary
+    if as_json:
+        _print_json({**report.header(), **s.to_dict(), "diagnostics": report.diagnostics})
+        return
+    _show_diagnostics(report.diagnostics)
+    from rich.table import Table
+
+    table = Table(show_header=False, show_edge=False, box=None)
+    table.add_column(style="bold")
+    table.add_column()
+    types = ", ".join(f"{n} {t}" for t, n in s.joint_types.items()) or "none"
+    mass = f"{_num(s.total_mass)} kg"
+    if abs(s.total_mass - s.file_mass) > 1e-9 * max(1.0, s.file_mass):
+        mass += f" (file says {_num(s.file_mass)} kg"
+        if s.links_without_inertial:
+            mass += f"; {len(s.links_without_inertial)} link(s) without <inertial> get 1 kg"
+        mass += ")"
+    for key, value in (
+        ("robot", s.robot), ("file", report.path), ("base link", s.base_link),
+        ("links", str(s.links)), ("joints", f"{s.joints} ({types})"),
+        ("degrees of freedom", f"{s.dof}" + ("" if s.fixed_base else " + 6 (floating base)")),
+        ("total mass", mass),
+        ("bounding box", f"{_nums(s.aabb_min)} .. {_nums(s.aabb_max)}"),
+        ("size", f"{_nums(s.size)} m"),
+    ):
+        table.add_row(key, _escape(value))
+    _console().print(table)
+
+
 def main() -> None:
     """Entry point of the ``urdfkit`` console script."""
     app()
