@@ -80,7 +80,8 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
         InputError: xacro failed, or ran longer than ``timeout`` seconds.
     """
     name = display or str(path)
-    cmd = [sys.executable, "-m", "urdfkit._xacro_worker", str(path)]
+    # Absolute, because the worker runs in the file's folder (for its relative includes).
+    cmd = [sys.executable, "-m", "urdfkit._xacro_worker", str(Path(path).resolve())]
     cmd += [f"{k}:={v}" for k, v in (args or {}).items()]
     limit = XACRO_TIMEOUT if timeout is None else timeout
     try:
