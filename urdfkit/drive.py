@@ -1,0 +1,533 @@
+"""``urdfkit drive``: run a car headless at a fixed throttle and steer, and measure it.
+
+The scenario is the PyBullet simplecar tutorial without its ``while True`` loop: a car on a
+plane, gravity -10, time step 1/240 s, wheels under VELOCITY_CONTROL, steering hinges under
+POSITION_CONTROL. The built-in simplecar and simpleplane are built from the templates into a
+temp folder (never into the user's folder) on every run.
+
+Load flags, chosen on purpose (see ``docs/drive.md``):
+
+- ``URDF_USE_IMPLICIT_CYLINDER``: without it PyBullet turns a ``<cylinder>`` into a convex
+  mesh, and the wheels roll on facets (the car shakes and drifts).
+- ``URDF_USE_INERTIA_FROM_FILE``: without it PyBullet throws the file's ``<inertia>`` away and
+  recomputes it from the collision shapes. ``drive`` is there to test *the model*, so it
+  uses the inertia the model declares (wrong inertia should show up here, not be hidden).
+
+Speed: motors are set once (PyBullet keeps a motor's target until it changes), the loop does
+nothing but ``stepSimulation`` between samples, and stdout is quieted once around the whole
+loop rather than per call. The physics step is the floor; see ``bench/drive_bench.py``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import tempfile
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import ParameterError
+from .session import LoadOptions, Session, quiet_stdout
+from .vehicle import Drivetrain, apply_drive, detect_drivetrain, disable_default_motors
+from .xmlio import atomic_write, fmt_float
+
+#: Default simulated samples per second in the trajectory (and for the statistics).
+SAMPLES_PER_SECOND = 20
+#: The settled part of a turn, for the circle fit: samples after this fraction of the run.
+SETTLED_FRACTION = 0.5
+#: A circle is only fitted when the car turned at least this much (rad) while settled.
+MIN_TURN = 0.5
+#: Trajectory formats by file suffix.
+TRAJECTORY_FORMATS = (".csv", ".jsonl")
+
+BASE_COLUMNS = ("t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz")
+
+
+def _finite(name: str, value: float) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise ParameterError(f"{name} must be a finite number, got {value!r}")
+    return v
+
+
+@dataclass
+class DriveConfig:
+    """Everything that defines a drive; checked by :meth:`check`.
+
+    Attributes:
+        urdf: The car file (resolved like every input: pybullet_data included); ``None`` for
+            the built-in simplecar.
+        plane: The ground file; ``None`` for the built-in simpleplane.
+        template_params: ``--set`` values for the built-in simplecar.
+        packages: Raw ``--package NAME=PATH`` options.
+        xacro_args: Raw ``--arg NAME:=VALUE`` options.
+        seconds: Simulated duration; ignored when ``steps`` is given.
+        steps: Number of physics steps.
+        time_step: Physics time step (s).
+        throttle: Target wheel angular velocity (rad/s), positive = forward.
+        steer: Target steering angle (rad), positive = left (counter-clockwise from above).
+        max_force: Maximum wheel motor torque (N m).
+        wheels: Joint names/indices to drive instead of the detected wheels.
+        hinges: Joint names/indices to steer instead of the detected hinges.
+        sample_every: Steps between trajectory samples; default: 20 samples per second.
+        gravity: Vertical gravity (m/s^2).
+        base_position: Where the car's base starts.
+        gui: Open the PyBullet GUI with Steering and Throttle sliders.
+    """
+
+    urdf: str | None = None
+    plane: str | None = None
+    template_params: Mapping[str, str] | None = None
+    packages: list[str] | None = None
+    xacro_args: list[str] | None = None
+    seconds: float | None = 10.0
+    steps: int | None = None
+    time_step: float = 1.0 / 240.0
+    throttle: float = 10.0
+    steer: float = 0.0
+    max_force: float = 10.0
+    wheels: list[str] | None = None
+    hinges: list[str] | None = None
+    sample_every: int | None = None
+    gravity: float = -10.0
+    base_position: tuple[float, float, float] = (0.0, 0.0, 0.1)
+    gui: bool = False
+
+    def check(self) -> None:
+        """Refuse values that would make the run meaningless (exit 2 in the CLI)."""
+        self.time_step = _finite("--time-step", self.time_step)
+        if not 0 < self.time_step <= 0.1:
+            raise ParameterError(f"--time-step must be in (0, 0.1] s, got {self.time_step:g}")
+        if self.steps is not None:
+            if isinstance(self.steps, bool) or int(self.steps) != self.steps or self.steps < 1:
+                raise ParameterError(f"--steps must be a positive whole number, "
+                                     f"got {self.steps!r}")
+        else:
+            if self.seconds is None:
+                raise ParameterError("give --seconds or --steps")
+            self.seconds = _finite("--seconds", self.seconds)
+            if self.seconds <= 0:
+                raise ParameterError(f"--seconds must be positive, got {self.seconds:g}")
+        self.throttle = _finite("--throttle", self.throttle)
+        self.steer = _finite("--steer", self.steer)
+        self.max_force = _finite("--max-force", self.max_force)
+        if self.max_force < 0:
+            raise ParameterError(f"--max-force must be >= 0, got {self.max_force:g}")
+        self.gravity = _finite("gravity", self.gravity)
+        if self.sample_every is not None and (isinstance(self.sample_every, bool)
+                                              or self.sample_every < 1):
+            raise ParameterError(f"--sample-every must be >= 1, got {self.sample_every!r}")
+        if self.template_params and self.urdf is not None:
+            raise ParameterError("--set is for the built-in simplecar; --urdf files take "
+                                 "--arg NAME:=VALUE")
+
+    @property
+    def total_steps(self) -> int:
+        """How many physics steps the run takes."""
+        if self.steps is not None:
+            return int(self.steps)
+        assert self.seconds is not None
+        return max(1, round(self.seconds / self.time_step))
+
+    @property
+    def sample_period(self) -> int:
+        """Steps between samples."""
+        if self.sample_every is not None:
+            return int(self.sample_every)
+        return max(1, round(1.0 / (SAMPLES_PER_SECOND * self.time_step)))
+
+
+@dataclass
+class Trajectory:
+    """Samples of the car's state: one row per sample, in :attr:`columns` order."""
+
+    columns: list[str]
+    rows: list[tuple[float, ...]] = field(default_factory=list)
+
+    def column(self, name: str) -> list[float]:
+        """All values of one column."""
+        i = self.columns.index(name)
+        return [r[i] for r in self.rows]
+
+    def to_bytes(self, fmt: str) -> bytes:
+        """The trajectory as ``.csv`` or ``.jsonl`` bytes (deterministic: fixed precision)."""
+        cells = [[fmt_float(v) for v in row] for row in self.rows]
+        if fmt == ".csv":
+            buf = io.StringIO()
+            w = csv.writer(buf, lineterminator="\n")
+            w.writerow(self.columns)
+            w.writerows(cells)
+            return buf.getvalue().encode("utf-8")
+        if fmt == ".jsonl":
+            lines = ("{" + ", ".join(f"{json.dumps(k)}: {v}" for k, v in zip(self.columns, row))
+                     + "}\n" for row in cells)
+            return "".join(lines).encode("utf-8")
+        raise ParameterError(f"trajectory format must be one of {', '.join(TRAJECTORY_FORMATS)}"
+                             f", got {fmt or 'no suffix'!r}")
+
+
+def trajectory_format(path: str | Path) -> str:
+    """The format a trajectory path asks for, checked before the run starts."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in TRAJECTORY_FORMATS:
+        raise ParameterError(f"--trajectory must end in {' or '.join(TRAJECTORY_FORMATS)}",
+                             )
+    return suffix
+
+
+def write_trajectory(traj: Trajectory, path: str | Path, *, force: bool = False) -> Path:
+    """Write the trajectory atomically as CSV or JSON lines (by suffix)."""
+    return atomic_write(path, traj.to_bytes(trajectory_format(path)), force=force)
+
+
+@dataclass
+class Circle:
+    """A circle fitted to a path: centre and radius (m), and the RMS distance off it."""
+
+    center: tuple[float, float]
+    radius: float
+    rms: float
+
+
+def fit_circle(xs: list[float], ys: list[float]) -> Circle | None:
+    """Least-squares circle through points (Kasa's algebraic fit), or None if degenerate.
+
+    Solves ``x^2 + y^2 + D x + E y + F = 0`` in the least-squares sense; coordinates are
+    centred first so the 3x3 normal equations stay well conditioned. Pure Python: numpy is
+    not worth importing for a 3x3 system.
+    """
+    n = len(xs)
+    if n < 5:
+        return None
+    mx, my = sum(xs) / n, sum(ys) / n
+    u = [x - mx for x in xs]
+    v = [y - my for y in ys]
+    w = [a * a + b * b for a, b in zip(u, v)]
+    suu = sum(a * a for a in u)
+    svv = sum(b * b for b in v)
+    suv = sum(a * b for a, b in zip(u, v))
+    suw = sum(a * c for a, c in zip(u, w))
+    svw = sum(b * c for b, c in zip(v, w))
+    # With centred data, sum(u) = sum(v) = 0, and the system for (D, E) decouples from F.
+    det = suu * svv - suv * suv
+    if abs(det) < 1e-12 * max(1.0, suu * svv):
+        return None
+    d = (-suw * svv + svw * suv) / det
+    e = (-svw * suu + suw * suv) / det
+    f = -sum(w) / n
+    r2 = (d * d + e * e) / 4 - f
+    if r2 <= 0:
+        return None
+    cu, cv = -d / 2, -e / 2
+    radius = math.sqrt(r2)
+    rms = math.sqrt(sum((math.hypot(a - cu, b - cv) - radius) ** 2 for a, b in zip(u, v)) / n)
+    return Circle((cu + mx, cv + my), radius, rms)
+
+
+@dataclass
+class DriveResult:
+    """What a drive measured. Distances in m, angles in rad, times in s.
+
+    Attributes:
+        model: The car, as named on the command line (or ``simplecar``).
+        final_position: Base position at the end.
+        final_yaw: Base yaw at the end, in (-pi, pi].
+        heading_change: Total yaw turned (unwrapped; positive = left).
+        distance: Length of the base's path in the x-y plane (from the samples).
+        mean_speed: ``distance / sim_time``.
+        turning_radius: Radius of the circle fitted to the settled half of the path, when the
+            car turned at least :data:`MIN_TURN` rad there; else None.
+        turn_center: That circle's centre.
+        sim_time: Simulated time.
+        steps: Physics steps taken.
+        time_step: The physics time step.
+        wall_time: Wall-clock time of the stepping loop.
+        real_time_factor: ``sim_time / wall_time``.
+        throttle: The throttle applied (rad/s).
+        steer: The steer applied, after clamping (rad).
+        interrupted: Ctrl-C stopped the run early.
+        drivetrain: The wheels and hinges driven.
+        trajectory: The samples.
+        warnings: Things the user should know (a clamped steer, ...).
+    """
+
+    model: str
+    final_position: tuple[float, float, float]
+    final_yaw: float
+    heading_change: float
+    distance: float
+    mean_speed: float
+    turning_radius: float | None
+    turn_center: tuple[float, float] | None
+    sim_time: float
+    steps: int
+    time_step: float
+    wall_time: float
+    real_time_factor: float
+    throttle: float
+    steer: float
+    interrupted: bool
+    drivetrain: Drivetrain
+    trajectory: Trajectory
+    warnings: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form (the trajectory goes to its own file, not here)."""
+        def r(x: float) -> float:
+            return round(x, 6)
+
+        return {
+            "model": self.model,
+            "final_position": [r(v) for v in self.final_position],
+            "final_yaw": r(self.final_yaw),
+            "heading_change": r(self.heading_change),
+            "distance": r(self.distance),
+            "mean_speed": r(self.mean_speed),
+            "turning_radius": None if self.turning_radius is None else r(self.turning_radius),
+            "turn_center": None if self.turn_center is None else [r(v) for v in self.turn_center],
+            "sim_time": r(self.sim_time),
+            "steps": self.steps,
+            "time_step": self.time_step,
+            "wall_time": r(self.wall_time),
+            "real_time_factor": r(self.real_time_factor),
+            "throttle": self.throttle,
+            "steer": self.steer,
+            "interrupted": self.interrupted,
+            "samples": len(self.trajectory.rows),
+            "drivetrain": self.drivetrain.to_dict(),
+            "warnings": self.warnings,
+        }
+
+
+ProgressFn = Callable[[int, int], None]
+
+
+class Scenario:
+    """A loaded car on a plane, ready to drive: open it, look at what was detected, run it.
+
+    Use it as a context manager so the PyBullet client and temp files always go away::
+
+        with Scenario(DriveConfig(throttle=10, steer=0.2)) as sc:
+            print(sc.drivetrain.wheels)
+            result = sc.run()
+    """
+
+    def __init__(self, config: DriveConfig):
+        config.check()
+        self.config = config
+        self.model = config.urdf or "simplecar"
+        self.warnings: list[str] = []
+        self._tmp: tempfile.TemporaryDirectory[str] | None = None
+        self.session: Session | None = None
+        try:
+            self._open()
+        except BaseException:
+            self.close()
+            raise
+
+    def _builtin(self, name: str, params: Mapping[str, str] | None) -> Path:
+        from .catalog import build_template
+
+        if self._tmp is None:
+            self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-drive-")
+        path = Path(self._tmp.name) / f"{name}.urdf"
+        path.write_bytes(build_template(name, params).to_bytes())
+        return path
+
+    def _load(self, s: Session, name: str | None, builtin: str, options: LoadOptions,
+              params: Mapping[str, str] | None = None) -> int:
+        if name is None:
+            return s.load_urdf(self._builtin(builtin, params), options, display=builtin)
+        from .resolve import open_input
+
+        with open_input(name, self.config.packages, self.config.xacro_args) as res:
+            return s.load_urdf(res.load_path, options, display=res.name)
+
+    def _open(self) -> None:
+        c = self.config
+        self.session = s = Session(gui=c.gui)
+        p, client = s.p, s.client
+        p.setGravity(0, 0, c.gravity, physicsClientId=client)
+        p.setTimeStep(c.time_step, physicsClientId=client)
+        self._load(s, c.plane, "simpleplane", LoadOptions(fixed_base=True))
+        # Flags: implicit cylinders (smooth wheels) and the file's own inertia; see module doc.
+        self.body = self._load(s, c.urdf, "simplecar", LoadOptions(
+            base_position=c.base_position, inertia_from_file=True, implicit_cylinder=True),
+            c.template_params)
+        self.drivetrain = train = detect_drivetrain(p, self.body, client, c.wheels, c.hinges)
+        self.steer = c.steer
+        if train.hinges:
+            lo, hi = train.steer_range()
+            if not lo <= c.steer <= hi:
+                self.steer = min(max(c.steer, lo), hi)
+                self.warnings.append(f"--steer {c.steer:g} is beyond the hinge limits "
+                                     f"[{lo:g}, {hi:g}]; clamped to {self.steer:g}")
+        elif c.steer != 0:
+            self.warnings.append("the model has no steering hinges; --steer is ignored")
+        self.columns = list(BASE_COLUMNS)
+        for j in train.wheels + train.hinges:
+            name = train.joint_names[j]
+            self.columns += [f"{name}_angle", f"{name}_speed"]
+
+    def close(self) -> None:
+        """Disconnect and remove the temp folder."""
+        if self.session is not None:
+            self.session.close()
+            self.session = None
+        if self._tmp is not None:
+            self._tmp.cleanup()
+            self._tmp = None
+
+    def __enter__(self) -> Scenario:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def _sampler(self) -> Callable[[float], tuple[float, ...]]:
+        assert self.session is not None
+        p, body, client = self.session.p, self.body, self.session.client
+        joints = self.drivetrain.wheels + self.drivetrain.hinges
+        pose, velocity = p.getBasePositionAndOrientation, p.getBaseVelocity
+        euler, states = p.getEulerFromQuaternion, p.getJointStates
+
+        def sample(t: float) -> tuple[float, ...]:
+            pos, orn = pose(body, physicsClientId=client)
+            lin, _ = velocity(body, physicsClientId=client)
+            row = [t, *pos, *euler(orn), *lin]
+            if joints:
+                for st in states(body, joints, physicsClientId=client):
+                    row += (st[0], st[1])
+            return tuple(row)
+
+        return sample
+
+    def run(self, progress: ProgressFn | None = None) -> DriveResult:
+        """Drive for the configured number of steps and measure the run.
+
+        Ctrl-C ends the loop early; the result then covers what was simulated, with
+        ``interrupted`` set, so the caller can still write the trajectory.
+
+        Args:
+            progress: Called as ``progress(done, total)`` after every sample.
+        """
+        assert self.session is not None
+        c, s, train = self.config, self.session, self.drivetrain
+        p, body, client = s.p, self.body, s.client
+        disable_default_motors(p, body, client, train.passive)
+        apply_drive(p, body, client, train, c.throttle, self.steer, c.max_force)
+        total, period, dt = c.total_steps, c.sample_period, c.time_step
+        sample = self._sampler()
+        rows = [sample(0.0)]
+        step = p.stepSimulation
+        done = 0
+        interrupted = False
+        gui = _GuiControls(self) if c.gui else None
+        start = time.perf_counter()
+        with quiet_stdout() as out:
+            try:
+                while done < total:
+                    n = min(period, total - done)
+                    if gui is not None:
+                        n = gui.steps(n)
+                    else:
+                        # The hot loop: nothing but the physics step (positional client id is
+                        # a little cheaper than the keyword).
+                        for _ in range(n):
+                            step(client)
+                    done += n
+                    if done % period == 0 or done == total:
+                        rows.append(sample(done * dt))
+                    if progress is not None:
+                        progress(done, total)
+            except KeyboardInterrupt:
+                interrupted = True
+            except p.error:
+                if gui is None:
+                    raise
+                interrupted = True  # the GUI window was closed
+        wall = time.perf_counter() - start
+        s.diagnostics.extend(out.lines)
+        if rows[-1][0] != done * dt:
+            rows.append(sample(done * dt))
+        return self._result(Trajectory(self.columns, rows), done, wall, interrupted)
+
+    def _result(self, traj: Trajectory, done: int, wall: float,
+                interrupted: bool) -> DriveResult:
+        c = self.config
+        xs, ys, yaws = traj.column("x"), traj.column("y"), traj.column("yaw")
+        distance = sum(math.hypot(x1 - x0, y1 - y0)
+                       for x0, y0, x1, y1 in zip(xs, ys, xs[1:], ys[1:]))
+        unwrapped = [yaws[0]]
+        for a in yaws[1:]:
+            d = a - unwrapped[-1]
+            unwrapped.append(unwrapped[-1] + (d + math.pi) % (2 * math.pi) - math.pi)
+        sim_time = done * c.time_step
+        settled = [i for i, t in enumerate(traj.column("t")) if t >= SETTLED_FRACTION * sim_time]
+        radius = center = None
+        if len(settled) >= 5 and abs(unwrapped[-1] - unwrapped[settled[0]]) >= MIN_TURN:
+            circle = fit_circle([xs[i] for i in settled], [ys[i] for i in settled])
+            if circle is not None:
+                radius, center = circle.radius, circle.center
+        last = traj.rows[-1]
+        return DriveResult(
+            model=self.model, final_position=(last[1], last[2], last[3]), final_yaw=last[6],
+            heading_change=unwrapped[-1] - unwrapped[0], distance=distance,
+            mean_speed=distance / sim_time if sim_time > 0 else 0.0,
+            turning_radius=radius, turn_center=center, sim_time=sim_time, steps=done,
+            time_step=c.time_step, wall_time=wall,
+            real_time_factor=sim_time / wall if wall > 0 else math.inf,
+            throttle=c.throttle, steer=self.steer, interrupted=interrupted,
+            drivetrain=self.drivetrain, trajectory=traj, warnings=list(self.warnings))
+
+
+class _GuiControls:
+    """The tutorial's Steering and Throttle sliders, read every step, applied on change.
+
+    Runs at real time so a person can drive; the run ends at the configured duration or
+    when the window is closed.
+    """
+
+    def __init__(self, sc: Scenario):
+        assert sc.session is not None
+        self.sc, self.p, self.client = sc, sc.session.p, sc.session.client
+        lo, hi = sc.drivetrain.steer_range()
+        lo, hi = max(lo, -1.0), min(hi, 1.0)
+        top = max(20.0, abs(sc.config.throttle))
+        self.steer_id = self.p.addUserDebugParameter("Steering", lo, hi, sc.steer,
+                                                     physicsClientId=self.client)
+        self.throttle_id = self.p.addUserDebugParameter("Throttle", -top, top,
+                                                        sc.config.throttle,
+                                                        physicsClientId=self.client)
+        self.last = (sc.config.throttle, sc.steer)
+        self.next_tick = time.perf_counter()
+
+    def steps(self, n: int) -> int:
+        p, client, dt = self.p, self.client, self.sc.config.time_step
+        for _ in range(n):
+            now = (p.readUserDebugParameter(self.throttle_id, physicsClientId=client),
+                   p.readUserDebugParameter(self.steer_id, physicsClientId=client))
+            if now != self.last:
+                self.last = now
+                apply_drive(p, self.sc.body, client, self.sc.drivetrain, now[0], now[1],
+                            self.sc.config.max_force)
+            p.stepSimulation(physicsClientId=client)
+            self.next_tick += dt
+            delay = self.next_tick - time.perf_counter()
+            if delay > 0:
+                time.sleep(delay)
+        return n
+
+
+def drive(config: DriveConfig, progress: ProgressFn | None = None) -> DriveResult:
+    """Load, detect, drive and measure in one call (the library entry point)."""
+    with Scenario(config) as sc:
+        return sc.run(progress)
