@@ -373,6 +373,12 @@ def tree(
     as_json: JsonOpt = False,
     package: PackageOpt = None,
     arg: ArgOpt = None,
+    dot: Annotated[bool, typer.Option(
+        "--dot", help="Print the graph as Graphviz DOT (links boxes, joints edges).")] = False,
+    output: Annotated[str | None, typer.Option(
+        "--output", "-o", help="Write the graph: .dot/.gv as DOT text, .svg/.png/.pdf drawn "
+        "by Graphviz `dot` (implies --dot).")] = None,
+    force: ForceOpt = False,
 ) -> None:
     """The kinematic tree: links, and the joints between them with type, axis and index.
 
@@ -382,6 +388,9 @@ def tree(
     from .inspect import TreeNode, kinematic_tree
     from .resolve import open_input
 
+    if dot or output is not None:
+        _tree_dot(file, package, arg, output, force, as_json)  # see "# ---- render"
+        return
     with open_input(file, package, arg) as resolved:
         root = kinematic_tree(resolved.root)
         robot = resolved.robot_name
@@ -446,6 +455,242 @@ def info(
         ("size", f"{_nums(s.size)} m"),
     ):
         table.add_row(key, _escape(value))
+    _console().print(table)
+
+
+# ---- check: validation rules over files and folders (urdfkit/check.py, urdfkit/validate.py)
+
+_LEVEL_STYLE = {"error": "bold red", "warning": "yellow", "info": "cyan"}
+
+
+@app.command()
+@_handle_errors
+def check(
+    paths: Annotated[list[str], typer.Argument(
+        metavar="FILE_OR_DIR...", help="URDF/xacro files, or folders searched recursively.")],
+    as_json: JsonOpt = False,
+    fail_on: Annotated[str, typer.Option(
+        "--fail-on", metavar="error|warning",
+        help="Exit 1 when a finding is at or above this level.")] = "error",
+    package: PackageOpt = None,
+    select: Annotated[list[str] | None, typer.Option(
+        "--select", metavar="CODES",
+        help="Only these codes or prefixes, comma-separated (e.g. U2,U601).")] = None,
+    ignore: Annotated[list[str] | None, typer.Option(
+        "--ignore", metavar="CODES", help="Drop these codes or prefixes, comma-separated.")]
+    = None,
+) -> None:
+    """Check URDF files for errors PyBullet crashes on, physics mistakes and typos.
+
+    Exit 0: nothing at or above --fail-on; 1: findings at or above it; 2: unusable invocation.
+    See docs/check.md for every rule code.
+    """
+    from .check import check_paths, parse_codes
+    from .errors import ParameterError
+    from .resolve import parse_packages
+
+    if fail_on not in ("error", "warning", "info"):
+        raise ParameterError(f"--fail-on expects error, warning or info, got {fail_on!r}")
+    result = check_paths(paths, packages=parse_packages(package),
+                         select=parse_codes(select, "--select"),
+                         ignore=parse_codes(ignore, "--ignore"))
+    if as_json:
+        _print_json(result.to_dict())
+    else:
+        console = _console()
+        for fr in result.files:
+            if not fr.findings:
+                continue
+            console.print(f"[bold]{_escape(fr.file)}[/]", soft_wrap=True)
+            for f in fr.findings:
+                line = f"{f.line:>5}" if f.line is not None else "    -"
+                style = _LEVEL_STYLE[f.level]
+                console.print(f"  {line}  [{style}]{f.level:<7}[/] [dim]{f.code}[/]  "
+                              f"{_escape(f.message)}", soft_wrap=True)
+        s = result.summary()
+        colour = "red" if s["error"] else ("yellow" if s["warning"] else "green")
+        console.print(f"[{colour}]{s['files']} file(s) checked: {s['error']} error(s), "
+                      f"{s['warning']} warning(s), {s['info']} note(s); "
+                      f"{s['files_with_errors']} file(s) with errors[/]", soft_wrap=True)
+    raise typer.Exit(result.exit_code(fail_on))
+
+
+# ---- drive: a headless throttle/steer run (urdfkit/drive.py, vehicle.py, plot.py)
+
+
+def _split_joints(items: list[str] | None) -> list[str] | None:
+    if items is None:
+        return None
+    return [j.strip() for item in items for j in item.split(",") if j.strip()]
+
+
+def _drive_progress(as_json: bool) -> tuple[Callable[[int, int], None] | None, Callable[[], None]]:
+    """A progress callback that shows a rich bar on a terminal once a run looks longer than ~1 s.
+
+    Returns the callback (None when output is piped or --json) and a function that stops it.
+    """
+    if as_json or not (sys.stdout.isatty() and sys.stderr.isatty()):
+        return None, lambda: None
+    import time
+
+    state: dict[str, Any] = {"start": time.perf_counter(), "bar": None, "task": None}
+
+    def update(done: int, total: int) -> None:
+        bar = state["bar"]
+        if bar is None:
+            elapsed = time.perf_counter() - state["start"]
+            if elapsed < 0.25 or elapsed * total / max(done, 1) < 1.0:
+                return
+            from rich.progress import (BarColumn, Progress, TextColumn, TimeRemainingColumn)
+
+            bar = Progress(TextColumn("driving"), BarColumn(), TextColumn("{task.completed:,}/"
+                           "{task.total:,} steps"), TimeRemainingColumn(),
+                           console=_console(stderr=True), transient=True)
+            state["task"] = bar.add_task("drive", total=total)
+            bar.start()
+            state["bar"] = bar
+        bar.update(state["task"], completed=done)
+
+    def stop() -> None:
+        if state["bar"] is not None:
+            state["bar"].stop()
+
+    return update, stop
+
+
+@app.command()
+@_handle_errors
+def drive(
+    throttle: Annotated[float, typer.Option(
+        help="Target wheel speed, rad/s (VELOCITY_CONTROL on every wheel); negative reverses.")]
+    = 10.0,
+    steer: Annotated[float, typer.Option(
+        help="Steering angle, rad (POSITION_CONTROL on the hinges); positive turns left.")]
+    = 0.0,
+    seconds: Annotated[float | None, typer.Option(
+        help="Simulated duration in seconds (default 10).")] = None,
+    steps: Annotated[int | None, typer.Option(help="Number of physics steps instead.")] = None,
+    time_step: Annotated[float, typer.Option(help="Physics time step, s.")] = 1.0 / 240.0,
+    max_force: Annotated[float, typer.Option(help="Wheel motor torque limit, N m.")] = 10.0,
+    urdf: Annotated[str | None, typer.Option(
+        help="Car to drive (.urdf/.xacro; pybullet_data names work). Default: simplecar.")]
+    = None,
+    plane: Annotated[str | None, typer.Option(
+        help="Ground to drive on. Default: the built-in simpleplane.")] = None,
+    set_: SetOpt = None,
+    arg: ArgOpt = None,
+    package: PackageOpt = None,
+    wheels: Annotated[list[str] | None, typer.Option(
+        metavar="JOINTS", help="Wheel joints (names or indices, comma-separated) instead of "
+        "the detected ones.")] = None,
+    hinges: Annotated[list[str] | None, typer.Option(
+        metavar="JOINTS", help="Steering hinge joints instead of the detected ones.")] = None,
+    trajectory: Annotated[str | None, typer.Option(
+        metavar="FILE", help="Write samples to FILE.csv or FILE.jsonl.")] = None,
+    sample_every: Annotated[int | None, typer.Option(
+        help="Steps between samples (default: 20 per simulated second).")] = None,
+    plot: Annotated[str | None, typer.Option(
+        metavar="FILE.png", help="Draw the path and speed (needs urdfkit[plot]).")] = None,
+    force: ForceOpt = False,
+    gui: Annotated[bool, typer.Option(
+        "--gui", help="Open the PyBullet GUI with Steering and Throttle sliders.")] = False,
+    as_json: JsonOpt = False,
+) -> None:
+    """Drive a car headless at a fixed throttle and steer, and report where it went.
+
+    Wheels (continuous joints about a horizontal axis) and steering hinges (revolute joints
+    about a vertical axis that carry wheels) are detected. See docs/drive.md.
+    """
+    from pathlib import Path as _Path
+
+    from .catalog import parse_assignments
+    from .drive import DriveConfig, Scenario, trajectory_format
+    from .errors import OutputError, ParameterError
+
+    if seconds is not None and steps is not None:
+        raise ParameterError("give --seconds or --steps, not both")
+    if gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+                    or sys.platform in ("darwin", "win32")):
+        raise ParameterError("--gui needs a display (DISPLAY is not set); drop --gui to "
+                             "drive headless")
+    # Check the outputs before a long run, not after it.
+    for out in (trajectory, plot):
+        if out is not None and _Path(out).exists() and not force:
+            raise OutputError("exists; pass --force to overwrite it", file=out)
+    if trajectory is not None:
+        trajectory_format(trajectory)
+    if plot is not None:
+        from .plot import check_plot_path
+
+        check_plot_path(plot)
+    config = DriveConfig(
+        urdf=urdf, plane=plane, template_params=parse_assignments(set_) or None,
+        packages=package, xacro_args=arg, seconds=10.0 if seconds is None else seconds,
+        steps=steps, time_step=time_step, throttle=throttle, steer=steer, max_force=max_force,
+        wheels=_split_joints(wheels), hinges=_split_joints(hinges), sample_every=sample_every,
+        gui=gui)
+    err = _console(stderr=True)
+    with Scenario(config) as sc:
+        t = sc.drivetrain
+
+        def names(joints: list[int]) -> str:
+            return ", ".join(t.joint_names[j] for j in joints) or "none"
+
+        err.print(f"[dim]{_escape(sc.model)}: wheels {_escape(names(t.wheels))}; "
+                  f"hinges {_escape(names(t.hinges))}; passive {_escape(names(t.passive))}[/]",
+                  soft_wrap=True)
+        for w in sc.warnings:
+            _warn(w)
+        progress, stop = _drive_progress(as_json)
+        try:
+            result = sc.run(progress)
+        finally:
+            stop()
+    written = []
+    if trajectory is not None:
+        from .drive import write_trajectory
+
+        written.append(write_trajectory(result.trajectory, trajectory, force=force))
+    if plot is not None:
+        from .plot import write_plot
+
+        written.append(write_plot(result, plot, force=force))
+    if as_json:
+        data = result.to_dict()
+        data["files"] = [str(w) for w in written]
+        _print_json(data)
+    else:
+        _drive_summary(result)
+        for w in written:
+            err.print(f"wrote [bold]{_escape(str(w))}[/]", soft_wrap=True)
+    if result.interrupted:
+        err.print("[yellow]urdfkit: interrupted; the results cover the steps simulated[/]")
+        raise typer.Exit(130)
+
+
+def _drive_summary(r: Any) -> None:
+    from rich.table import Table
+
+    table = Table(title=f"[bold]drive[/] {_escape(r.model)}: throttle {r.throttle:g} rad/s, "
+                  f"steer {r.steer:g} rad", title_justify="left", show_header=False,
+                  show_edge=False)
+    table.add_column(style="cyan")
+    table.add_column()
+    x, y, z = r.final_position
+    turn = ("straight (no settled turn)" if r.turning_radius is None else
+            f"{r.turning_radius:.3f} m around ({r.turn_center[0]:.2f}, {r.turn_center[1]:.2f})")
+    rows = [
+        ("final position", f"x {x:.3f}  y {y:.3f}  z {z:.3f} m"),
+        ("final yaw", f"{r.final_yaw:.3f} rad ({r.final_yaw * 57.29577951308232:.1f} deg)"),
+        ("heading change", f"{r.heading_change:.3f} rad"),
+        ("distance", f"{r.distance:.3f} m along the path"),
+        ("mean speed", f"{r.mean_speed:.3f} m/s"),
+        ("turning radius", turn),
+        ("simulated", f"{r.sim_time:.3f} s in {r.steps:,} steps of {r.time_step:.5g} s"),
+        ("wall time", f"{r.wall_time:.3f} s (real-time factor {r.real_time_factor:.1f}x)"),
+    ]
+    for key, value in rows:
+        table.add_row(key, value)
     _console().print(table)
 
 

@@ -1,0 +1,95 @@
+"""The ``drive --plot`` picture: the x-y path seen from above, and speed over time.
+
+matplotlib is an optional extra (``pip install 'urdfkit[plot]'``) and costs ~0.3 s to import,
+so it is imported here, inside the function, and only when a plot is asked for. The Agg
+backend is selected explicitly: it needs no display and renders the same bytes everywhere.
+Colours and fonts come from :mod:`urdfkit.style`, the same look as ``urdfkit render``.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from . import style
+from .errors import MissingDependencyError, ParameterError
+from .xmlio import atomic_write
+
+if TYPE_CHECKING:
+    from .drive import DriveResult
+
+
+def _pyplot() -> Any:
+    try:
+        import matplotlib
+    except ImportError as e:
+        raise MissingDependencyError("--plot needs matplotlib: pip install 'urdfkit[plot]'") from e
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def check_plot_path(path: str | Path) -> None:
+    """Refuse a plot path that is not a PNG before the run starts."""
+    if Path(path).suffix.lower() != ".png":
+        raise ParameterError(f"--plot must end in .png, got {str(path)!r}")
+
+
+def plot_bytes(result: DriveResult) -> bytes:
+    """Draw the path and speed of a drive as PNG bytes."""
+    plt = _pyplot()
+    traj = result.trajectory
+    t, xs, ys = traj.column("t"), traj.column("x"), traj.column("y")
+    yaws = traj.column("yaw")
+    speed = [math.hypot(vx, vy) for vx, vy in zip(traj.column("vx"), traj.column("vy"))]
+    hexc = style.hex_color
+    with plt.rc_context({"font.family": style.FONT_FAMILY, "font.size": style.FONT_SIZE,
+                         "text.color": hexc(style.TEXT), "axes.labelcolor": hexc(style.TEXT),
+                         "xtick.color": hexc(style.TEXT), "ytick.color": hexc(style.TEXT),
+                         "axes.edgecolor": hexc(style.GRID), "grid.color": hexc(style.GRID),
+                         "svg.hashsalt": "urdfkit"}):
+        fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 4.5), dpi=100,
+                                     gridspec_kw={"width_ratios": [1.2, 1]})
+        fig.patch.set_facecolor(hexc(style.BACKGROUND))
+        ax.set_facecolor(hexc(style.GROUND))
+        ax.plot(xs, ys, color=hexc(style.PRIMARY), linewidth=2, label="path")
+        # Heading marks: an arrow along the yaw at the start and at the end.
+        span = max(max(xs) - min(xs), max(ys) - min(ys), 0.5)
+        arrow = 0.08 * span
+        for i, colour, label in ((0, style.START, "start"), (-1, style.END, "end")):
+            ax.plot(xs[i], ys[i], "o", color=hexc(colour), markersize=8, label=label, zorder=3)
+            ax.annotate("", xy=(xs[i] + arrow * math.cos(yaws[i]),
+                                ys[i] + arrow * math.sin(yaws[i])),
+                        xytext=(xs[i], ys[i]), zorder=4,
+                        arrowprops={"arrowstyle": "-|>", "color": hexc(colour), "lw": 2})
+        if result.turn_center is not None and result.turning_radius is not None:
+            cx, cy = result.turn_center
+            ax.plot(cx, cy, "+", color=hexc(style.SECONDARY), markersize=10,
+                    label=f"turn centre, R = {result.turning_radius:.2f} m")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        ax.set_title(f"{result.model}: path from above")
+        ax.grid(True, linewidth=0.5)
+        ax.legend(loc="best", fontsize=style.FONT_SIZE - 1)
+        bx.plot(t, speed, color=hexc(style.SECONDARY), linewidth=2)
+        bx.set_xlabel("time (s)")
+        bx.set_ylabel("speed (m/s)")
+        bx.set_title(f"speed (mean {result.mean_speed:.2f} m/s)")
+        bx.set_ylim(bottom=0)
+        bx.grid(True, linewidth=0.5)
+        fig.tight_layout()
+        buf = io.BytesIO()
+        # No timestamp/software metadata: the same run gives the same bytes.
+        fig.savefig(buf, format="png", metadata={"Software": None})
+        plt.close(fig)
+    return buf.getvalue()
+
+
+def write_plot(result: DriveResult, path: str | Path, *, force: bool = False) -> Path:
+    """Draw the drive to a PNG file, atomically."""
+    check_plot_path(path)
+    return atomic_write(path, plot_bytes(result), force=force)
