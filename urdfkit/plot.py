@@ -33,9 +33,13 @@ def _pyplot() -> Any:
 
 
 def check_plot_path(path: str | Path) -> None:
-    """Refuse a plot path that is not a PNG before the run starts."""
+    """Refuse, before the run starts, a plot path that is not a PNG or a missing matplotlib."""
     if Path(path).suffix.lower() != ".png":
         raise ParameterError(f"--plot must end in .png, got {str(path)!r}")
+    import importlib.util
+
+    if importlib.util.find_spec("matplotlib") is None:
+        raise MissingDependencyError("--plot needs matplotlib: pip install 'urdfkit[plot]'")
 
 
 def plot_bytes(result: DriveResult) -> bytes:
