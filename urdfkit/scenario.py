@@ -1,0 +1,491 @@
+"""The scenario file: what ``urdfkit sim`` reads, checked before anything is simulated.
+
+A scenario is a JSON or TOML document (see ``docs/scenario.md`` for every key). It is
+validated with pydantic, imported lazily (it costs ~0.1 s and is an optional extra), into the
+models built by :func:`schema`. Every problem is reported with its path in the document, the
+way a user would point at it: ``robots[1].drive[0].until: expected a number``.
+
+Checks that need more than the types (a template's parameters, a URDF file that must exist,
+segments in time order) run right after pydantic, in :func:`check`, and use the same paths.
+Checks that need the loaded body (joint and link names) run in :mod:`urdfkit.sim` and name the
+path too.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+import sys
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
+
+from .errors import InputError, MissingDependencyError, ParameterError
+
+#: The observation fields that carry noise; each is a vector or a joint-keyed mapping.
+OBSERVATION_FIELDS = (
+    "motor_angles", "motor_velocities", "motor_accelerations", "base_position",
+    "base_orientation", "base_lin_vel", "base_ang_vel", "base_lin_vel_body_frame",
+    "base_ang_vel_body_frame",
+)
+
+_INSTALL_HINT = "pip install 'urdfkit[scenario]'"
+
+
+@functools.cache
+def schema() -> SimpleNamespace:
+    """The pydantic models of a scenario, built on first use so pydantic loads lazily.
+
+    Returns:
+        A namespace with ``Scenario`` (the document) and the models it nests: ``Physics``,
+        ``Ground``, ``Record``, ``Robot``, ``DriveSegment``, ``Vehicle``, ``JointSegment``,
+        ``Motor``, ``InitialJoint``, ``Noise``.
+
+    Raises:
+        MissingDependencyError: pydantic is not installed.
+    """
+    try:
+        from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
+    except ImportError as e:
+        raise MissingDependencyError(f"scenario files need pydantic: {_INSTALL_HINT}") from e
+
+    class Model(BaseModel):
+        # strict: "3" is not a number and 1 is not true; a typo must not pass silently.
+        # forbid: an unknown key is almost always a misspelt known one.
+        model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
+
+    vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+    vec4 = Annotated[list[float], Field(min_length=4, max_length=4)]
+    positive = Annotated[float, Field(gt=0)]
+    non_negative = Annotated[float, Field(ge=0)]
+
+    class Physics(Model):
+        time_step: Annotated[float, Field(gt=0, le=1)] = 1.0 / 240.0
+        gravity: vec3 = Field(default_factory=lambda: [0.0, 0.0, -9.81])
+        solver_iterations: Annotated[int, Field(ge=1)] = 50
+        cone_friction: bool = True
+
+    class Ground(Model):
+        template: str | None = None
+        params: dict[str, Any] = Field(default_factory=dict)
+        urdf: str | None = None
+        position: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+        @model_validator(mode="before")
+        @classmethod
+        def _shorthand(cls, data: Any) -> Any:
+            # "ground": "simpleplane" or "ground": "plane.urdf".
+            if isinstance(data, str):
+                from .catalog import TEMPLATES
+
+                return {"template": data} if data in TEMPLATES else {"urdf": data}
+            return data
+
+    class Record(Model):
+        every: Annotated[int, Field(ge=1)] = 1
+        contact_links: list[str] = Field(default_factory=list)
+        joint_forces: list[str] = Field(default_factory=list)
+
+    class DriveSegment(Model):
+        until: positive
+        throttle: float = 0.0
+        steer: float = 0.0
+
+    class Vehicle(Model):
+        wheels: list[str] | None = None
+        hinges: list[str] | None = None
+        max_force: positive = 10.0
+
+    class JointSegment(Model):
+        until: positive
+        mode: Literal["position", "velocity", "torque"] = "position"
+        targets: dict[str, float]
+        max_force: positive | None = None
+
+    class Motor(Model):
+        kp: non_negative = 0.0
+        kd: non_negative = 0.0
+        viscous_friction: non_negative = 0.0
+        stiffness: non_negative = 0.0
+        max_torque: positive | None = None
+        joints: list[str] | None = None
+
+    class InitialJoint(Model):
+        position: float = 0.0
+        velocity: float = 0.0
+
+        @model_validator(mode="before")
+        @classmethod
+        def _shorthand(cls, data: Any) -> Any:
+            # "initial_joints": {"hinge": 0.3} means a position.
+            if isinstance(data, (int, float)) and not isinstance(data, bool):
+                return {"position": data}
+            if not isinstance(data, dict):
+                raise ValueError("expected a number, or an object with position and velocity")
+            return data
+
+    class Noise(Model):
+        motor_angles: non_negative = 0.0
+        motor_velocities: non_negative = 0.0
+        motor_accelerations: non_negative = 0.0
+        base_position: non_negative = 0.0
+        base_orientation: non_negative = 0.0
+        base_lin_vel: non_negative = 0.0
+        base_ang_vel: non_negative = 0.0
+        base_lin_vel_body_frame: non_negative = 0.0
+        base_ang_vel_body_frame: non_negative = 0.0
+
+    class Robot(Model):
+        name: Annotated[str, Field(min_length=1)] | None = None
+        template: str | None = None
+        params: dict[str, Any] = Field(default_factory=dict)
+        urdf: str | None = None
+        position: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+        orientation_rpy: vec3 | None = None
+        orientation_quat: vec4 | None = None
+        base: Literal["floating", "fixed"] = "floating"
+        inertia_from_file: bool = True
+        self_collision: bool = False
+        initial_joints: dict[str, InitialJoint] = Field(default_factory=dict)
+        drive: list[DriveSegment] | None = None
+        vehicle: Vehicle | None = None
+        joints: list[JointSegment] | None = None
+        motor: Motor | None = None
+        motor_offsets: dict[str, float] = Field(default_factory=dict)
+        motor_directions: dict[str, Literal[1, -1]] = Field(default_factory=dict)
+        noise: Noise | None = None
+        delay: Annotated[int, Field(ge=0)] = 0
+
+    class Scenario(Model):
+        physics: Physics = Field(default_factory=Physics)
+        ground: Ground | None = None
+        duration: positive = 1.0
+        seed: int = 0
+        record: Record = Field(default_factory=Record)
+        robots: Annotated[list[Robot], Field(min_length=1)]
+
+        _source: str | None = PrivateAttr(default=None)
+        _base_dir: Path = PrivateAttr(default_factory=Path.cwd)
+
+        @property
+        def source(self) -> str | None:
+            """The file this scenario came from (for messages), if any."""
+            return self._source
+
+        @property
+        def base_dir(self) -> Path:
+            """The folder relative ``urdf`` paths are resolved against."""
+            return self._base_dir
+
+        def path_of(self, name: str) -> str:
+            """A ``urdf`` value as a path: next to the scenario if there, else as given.
+
+            "As given" lets :func:`urdfkit.resolve.locate` find ``plane.urdf`` in pybullet_data.
+            """
+            candidate = self._base_dir / Path(name).expanduser()
+            return str(candidate) if candidate.exists() else name
+
+    return SimpleNamespace(
+        Scenario=Scenario, Physics=Physics, Ground=Ground, Record=Record, Robot=Robot,
+        DriveSegment=DriveSegment, Vehicle=Vehicle, JointSegment=JointSegment, Motor=Motor,
+        InitialJoint=InitialJoint, Noise=Noise,
+    )
+
+
+# --------------------------------------------------------------------------- error paths
+
+
+def format_path(loc: Sequence[str | int]) -> str:
+    """``('robots', 1, 'drive', 0, 'until')`` -> ``robots[1].drive[0].until``."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += f".{part}" if out else str(part)
+    return out or "(top level)"
+
+
+def _peel(tp: Any) -> Any:
+    """Strip Annotated and Optional down to the type that holds the next level."""
+    while True:
+        origin = get_origin(tp)
+        if origin is Annotated:
+            tp = get_args(tp)[0]
+        elif origin is Union or type(tp).__name__ == "UnionType":
+            args = [a for a in get_args(tp) if a is not type(None)]
+            tp = args[0]
+        else:
+            return tp
+
+
+def _known_keys(root: Any, loc: Sequence[str | int]) -> list[str]:
+    """The keys the model at ``loc`` accepts (to suggest them after an unknown key)."""
+    tp: Any = root
+    for part in loc:
+        tp = _peel(tp)
+        fields = getattr(tp, "model_fields", None)
+        if isinstance(fields, dict) and isinstance(part, str) and part in fields:
+            tp = fields[part].annotation
+        elif get_origin(tp) is list and isinstance(part, int):
+            tp = get_args(tp)[0]
+        elif get_origin(tp) is dict and isinstance(part, str):
+            tp = get_args(tp)[1]
+        else:
+            return []
+    fields = getattr(_peel(tp), "model_fields", None)
+    return list(fields) if isinstance(fields, dict) else []
+
+
+def _known_size(root: Any, loc: Sequence[str | int]) -> int | None:
+    """The fixed length of the vector field at ``loc`` (3 for a position), if it has one."""
+    if not loc or not isinstance(loc[-1], str):
+        return None
+    parent: Any = root
+    for part in loc[:-1]:
+        parent = _peel(parent)
+        fields = getattr(parent, "model_fields", None)
+        if isinstance(fields, dict) and isinstance(part, str) and part in fields:
+            parent = fields[part].annotation
+        elif get_origin(parent) in (list, dict):
+            parent = get_args(parent)[-1]
+        else:
+            return None
+    fields = getattr(_peel(parent), "model_fields", None)
+    if not isinstance(fields, dict) or loc[-1] not in fields:
+        return None
+    field = fields[loc[-1]]
+    metadata = list(field.metadata)
+    tp = field.annotation
+    for arg in (get_args(tp) if get_origin(tp) is Union or type(tp).__name__ == "UnionType"
+                else (tp,)):
+        if get_origin(arg) is Annotated:
+            for m in arg.__metadata__:  # a Field(...) inside Optional keeps its own metadata
+                metadata += list(getattr(m, "metadata", [m]))
+    low = {getattr(m, "min_length", None) for m in metadata} - {None}
+    high = {getattr(m, "max_length", None) for m in metadata} - {None}
+    return low.pop() if len(low) == 1 and low == high else None
+
+
+def _describe(error: Mapping[str, Any], root: Any) -> str:
+    """One pydantic error as ``path: what was expected``."""
+    kind = error["type"]
+    loc = tuple(error["loc"])
+    ctx = error.get("ctx") or {}
+    simple = {
+        "float_type": "expected a number", "float_parsing": "expected a number",
+        "finite_number": "expected a finite number",
+        "int_type": "expected an integer", "int_parsing": "expected an integer",
+        "int_from_float": "expected an integer",
+        "bool_type": "expected true or false", "bool_parsing": "expected true or false",
+        "string_type": "expected a string", "list_type": "expected a list",
+        "dict_type": "expected an object (a table in TOML)",
+        "model_type": "expected an object (a table in TOML)",
+        "model_attributes_type": "expected an object (a table in TOML)",
+        "missing": "required key is missing",
+    }
+    if kind in simple:
+        message = simple[kind]
+    elif kind == "extra_forbidden":
+        known = _known_keys(root, loc[:-1])
+        message = f"unknown key {loc[-1]!r}" + (f"; known keys: {', '.join(known)}"
+                                                 if known else "")
+    elif kind == "literal_error":
+        message = f"expected {ctx.get('expected', 'one of the allowed values')}"
+    elif kind in ("too_short", "too_long"):
+        bound = ctx.get("min_length" if kind == "too_short" else "max_length")
+        size = _known_size(root, loc)
+        if size is not None:
+            message = f"expected {size} numbers, got {ctx.get('actual_length')}"
+        else:
+            least = "at least" if kind == "too_short" else "at most"
+            message = (f"expected {least} {bound} item{'' if bound == 1 else 's'}, "
+                       f"got {ctx.get('actual_length')}")
+    elif kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
+        op = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<",
+              "less_than_equal": "<="}[kind]
+        bound = next(iter(ctx.values()), "?")
+        message = f"must be {op} {bound}"
+    else:
+        message = str(error.get("msg", kind)).removeprefix("Value error, ")
+    return f"{format_path(loc)}: {message}"
+
+
+# --------------------------------------------------------------------------- loading
+
+
+def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"duplicate key {key!r}")
+        out[key] = value
+    return out
+
+
+def read_document(path: str | Path) -> dict[str, Any]:
+    """Read a scenario file's JSON or TOML into plain data (not yet validated).
+
+    Raises:
+        InputError: missing, a folder, not .json/.toml, or not parseable (with the line).
+    """
+    file = Path(path)
+    if not file.exists():
+        raise InputError("no such file", file=path)
+    if file.is_dir():
+        raise InputError("is a directory, not a scenario file", file=path)
+    suffix = file.suffix.lower()
+    if suffix not in (".json", ".toml"):
+        raise InputError("a scenario is a .json or .toml file", file=path)
+    try:
+        text = file.read_text("utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(f"cannot read: {e}", file=path) from None
+    if suffix == ".toml":
+        if sys.version_info >= (3, 11):
+            import tomllib
+        else:  # pragma: no cover - Python 3.10
+            import tomli as tomllib
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as e:
+            raise InputError(f"invalid TOML: {e}", file=path) from None
+    else:
+        try:
+            data = json.loads(text, object_pairs_hook=_no_duplicates)
+        except json.JSONDecodeError as e:
+            raise InputError(f"invalid JSON: {e.msg} (column {e.colno})", file=path,
+                             line=e.lineno) from None
+        except ValueError as e:  # a duplicate key
+            raise InputError(f"invalid JSON: {e}", file=path) from None
+    if not isinstance(data, dict):
+        raise InputError("the top level must be an object", file=path)
+    return data
+
+
+def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
+                   base_dir: str | Path | None = None) -> Any:
+    """Validate plain data into a ``Scenario`` model and run the cross-field checks.
+
+    Args:
+        data: The document, as JSON or TOML parse it.
+        source: The file name used in messages.
+        base_dir: Where relative ``urdf`` paths are resolved; default: the source's folder,
+            else the current folder.
+
+    Raises:
+        InputError: with the path in the document of the first problem.
+    """
+    models = schema()
+    from pydantic import ValidationError
+
+    try:
+        scenario = models.Scenario.model_validate(dict(data))
+    except ValidationError as e:
+        errors = e.errors()
+        message = _describe(errors[0], models.Scenario)
+        if len(errors) > 1:
+            message += f" (and {len(errors) - 1} more problem{'s' if len(errors) > 2 else ''})"
+        raise InputError(message, file=source) from None
+    scenario._source = str(source) if source is not None else None
+    if base_dir is not None:
+        scenario._base_dir = Path(base_dir)
+    elif source is not None:
+        scenario._base_dir = Path(source).resolve().parent
+    check(scenario)
+    return scenario
+
+
+def load_scenario(path: str | Path) -> Any:
+    """Read and validate a scenario file (``.json`` or ``.toml``)."""
+    return parse_scenario(read_document(path), source=path)
+
+
+def _fail(scenario: Any, path: str, message: str) -> InputError:
+    return InputError(f"{path}: {message}", file=scenario.source)
+
+
+def _check_segments(scenario: Any, path: str, segments: Sequence[Any]) -> None:
+    last = 0.0
+    for i, seg in enumerate(segments):
+        if seg.until <= last:
+            raise _fail(scenario, f"{path}[{i}].until",
+                        f"must be later than the previous segment's ({last:g} s)")
+        last = seg.until
+
+
+def _check_template(scenario: Any, path: str, name: str, params: Mapping[str, Any]) -> None:
+    from .catalog import get_template
+
+    try:
+        get_template(name).resolve(params)
+    except ParameterError as e:
+        where = f"{path}.params" if params and not str(e).startswith("no template") else \
+            f"{path}.template"
+        raise _fail(scenario, where, str(e)) from None
+
+
+def _check_file(scenario: Any, path: str, name: str) -> None:
+    from .resolve import locate
+
+    try:
+        locate(scenario.path_of(name))
+    except InputError:
+        raise _fail(scenario, path, f"no such file: {name} (looked next to the scenario and "
+                                    "in pybullet_data)") from None
+
+
+def check(scenario: Any) -> None:
+    """The checks pydantic's types cannot express; each error names its path.
+
+    Raises:
+        InputError: the first problem found.
+    """
+    if scenario.ground is not None:
+        g = scenario.ground
+        if (g.template is None) == (g.urdf is None):
+            raise _fail(scenario, "ground", "give either 'template' or 'urdf'")
+        if g.template is not None:
+            _check_template(scenario, "ground", g.template, g.params)
+        else:
+            if g.params:
+                raise _fail(scenario, "ground.params", "params are for templates only")
+            _check_file(scenario, "ground.urdf", g.urdf)
+    names: dict[str, int] = {}
+    for i, robot in enumerate(scenario.robots):
+        path = f"robots[{i}]"
+        if robot.name is None:
+            robot.name = f"robot{i}"
+        if robot.name in names:
+            raise _fail(scenario, f"{path}.name",
+                        f"{robot.name!r} is already the name of robots[{names[robot.name]}]")
+        names[robot.name] = i
+        if (robot.template is None) == (robot.urdf is None):
+            raise _fail(scenario, path, "give either 'template' or 'urdf'")
+        if robot.template is not None:
+            _check_template(scenario, path, robot.template, robot.params)
+        else:
+            if robot.params:
+                raise _fail(scenario, f"{path}.params", "params are for templates only")
+            _check_file(scenario, f"{path}.urdf", robot.urdf)
+        if robot.orientation_rpy is not None and robot.orientation_quat is not None:
+            raise _fail(scenario, path, "give orientation_rpy or orientation_quat, not both")
+        if robot.orientation_quat is not None and \
+                math.fsum(q * q for q in robot.orientation_quat) < 1e-12:
+            raise _fail(scenario, f"{path}.orientation_quat", "must not be all zeros")
+        if robot.drive is not None and robot.joints is not None:
+            raise _fail(scenario, path, "give one controller: 'drive' or 'joints', not both")
+        if robot.vehicle is not None and robot.drive is None:
+            raise _fail(scenario, f"{path}.vehicle", "only applies with 'drive'")
+        if robot.motor is not None and robot.drive is not None:
+            raise _fail(scenario, f"{path}.motor",
+                        "the servo model drives 'joints' targets; it cannot be used with 'drive'")
+        for key in ("drive", "joints"):
+            segments = getattr(robot, key)
+            if segments is not None:
+                if not segments:
+                    raise _fail(scenario, f"{path}.{key}", "needs at least one segment")
+                _check_segments(scenario, f"{path}.{key}", segments)
+

@@ -1,0 +1,790 @@
+"""Config-driven simulation: a scenario in, per-step observations out.
+
+:class:`Simulation` sets up one PyBullet client of its own (a :class:`~urdfkit.session.Session`,
+so several simulations in one process never share a world: every call passes
+``physicsClientId``), loads the ground and the robots of a scenario, and steps them under their
+controllers. It is the library behind ``urdfkit sim`` and is meant to be driven from a notebook
+or an RL environment too::
+
+    with Simulation.from_file("examples/two_cars.json") as sim:
+        sim.step(10)
+        obs = sim.observe("north")        # what a sensor reports (noise, delay)
+        true = sim.observe("north", ideal=True)
+        result = sim.run()                # to the scenario's duration, recording rows
+
+Observations are measured through each robot's motor offsets and directions; the *reported*
+ones then go through delay and noise. Neither touches the physics: the controllers and the
+servo model read the true joint state.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import random
+import tempfile
+from collections import deque
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import InputError, MissingDependencyError, OutputError, ParameterError
+from .scenario import OBSERVATION_FIELDS, load_scenario, parse_scenario
+from .session import LoadOptions, Session
+
+_REVOLUTE, _PRISMATIC, _FIXED = 0, 1, 4  # p.JOINT_* values
+#: Joint types with one degree of freedom: what getJointState can report.
+_ACTIVE = (_REVOLUTE, _PRISMATIC)
+#: Suffixes for flattened vector columns, by vector length.
+_AXES = {3: ("x", "y", "z"), 4: ("x", "y", "z", "w"), 6: ("fx", "fy", "fz", "mx", "my", "mz")}
+OUTPUT_FORMATS = (".jsonl", ".csv", ".parquet")
+
+
+# --------------------------------------------------------------------------- observations
+
+
+@dataclass
+class Observation:
+    """One robot's state at one time: a row of the output.
+
+    Motor fields are keyed by joint name over the robot's active (revolute, continuous and
+    prismatic) joints, in the measured frame: ``(q - offset) * direction``. Base fields are
+    PyBullet's base frame, which is the root link's centre of mass.
+
+    Attributes:
+        t: Simulated time, s.
+        step: Physics steps since the start.
+        robot: The robot's name in the scenario.
+        motor_angles: Joint positions, rad or m.
+        motor_velocities: Joint velocities.
+        motor_accelerations: Finite difference of the velocities over one physics step.
+        base_position: World position, m.
+        base_orientation: World orientation, quaternion (x, y, z, w).
+        base_lin_vel: World linear velocity, m/s.
+        base_ang_vel: World angular velocity, rad/s.
+        base_lin_vel_body_frame: ``base_lin_vel`` rotated into the base frame.
+        base_ang_vel_body_frame: ``base_ang_vel`` rotated into the base frame.
+        contacts: For ``record.contact_links``: ``{link: {"normal_force", "count"}}``.
+        joint_forces: For ``record.joint_forces``: reaction ``[fx, fy, fz, mx, my, mz]``.
+    """
+
+    t: float
+    step: int
+    robot: str
+    motor_angles: dict[str, float]
+    motor_velocities: dict[str, float]
+    motor_accelerations: dict[str, float]
+    base_position: list[float]
+    base_orientation: list[float]
+    base_lin_vel: list[float]
+    base_ang_vel: list[float]
+    base_lin_vel_body_frame: list[float]
+    base_ang_vel_body_frame: list[float]
+    contacts: dict[str, dict[str, float]] | None = None
+    joint_forces: dict[str, list[float]] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON row (optional fields only when recorded)."""
+        row: dict[str, Any] = {"t": self.t, "step": self.step, "robot": self.robot}
+        for name in OBSERVATION_FIELDS:
+            value = getattr(self, name)
+            row[name] = dict(value) if isinstance(value, dict) else list(value)
+        if self.contacts is not None:
+            row["contacts"] = {k: dict(v) for k, v in self.contacts.items()}
+        if self.joint_forces is not None:
+            row["joint_forces"] = {k: list(v) for k, v in self.joint_forces.items()}
+        return row
+
+    def _replace(self, **changes: Any) -> Observation:
+        data = {**self.__dict__, **changes}
+        return Observation(**data)
+
+
+def _rotate_into(matrix: Sequence[float], v: Sequence[float]) -> list[float]:
+    """R^T v for PyBullet's row-major 3x3 ``matrix``: a world vector in the body frame."""
+    return [matrix[0] * v[0] + matrix[3] * v[1] + matrix[6] * v[2],
+            matrix[1] * v[0] + matrix[4] * v[1] + matrix[7] * v[2],
+            matrix[2] * v[0] + matrix[5] * v[1] + matrix[8] * v[2]]
+
+
+# --------------------------------------------------------------------------- robots
+
+
+@dataclass
+class JointSpec:
+    """What the simulation needs to know of one joint of a loaded body."""
+
+    index: int
+    name: str
+    type: int
+    effort: float
+    child_link: str
+
+    @property
+    def active(self) -> bool:
+        """Whether the joint has one degree of freedom we measure and drive."""
+        return self.type in _ACTIVE
+
+
+@dataclass
+class _Command:
+    """A controller command: a drive (throttle, steer) or joint targets."""
+
+    kind: str  # "drive" or "joints"
+    throttle: float = 0.0
+    steer: float = 0.0
+    mode: str = "position"
+    targets: dict[str, float] = field(default_factory=dict)
+    max_force: float | None = None
+
+
+@dataclass
+class _Body:
+    """A loaded robot and the state the simulation keeps for it."""
+
+    name: str
+    path: str  # "robots[i]", for messages
+    config: Any
+    body: int
+    joints: list[JointSpec]
+    active: list[JointSpec]
+    links: dict[str, int]
+    offsets: dict[str, float]
+    directions: dict[str, float]
+    rng: random.Random
+    history: deque[Observation]
+    train: Any = None
+    servo: list[JointSpec] = field(default_factory=list)
+    contact_links: dict[str, int] = field(default_factory=dict)
+    force_joints: dict[str, int] = field(default_factory=dict)
+    previous_velocities: dict[str, float] = field(default_factory=dict)
+    applied: _Command | None = None
+    override: _Command | None = None
+    reported: tuple[int, Observation] | None = None
+
+    def joint(self, name: str) -> JointSpec:
+        for j in self.joints:
+            if j.name == name:
+                return j
+        raise KeyError(name)
+
+
+@dataclass
+class RobotSummary:
+    """What a run did to one robot, for the summary table."""
+
+    robot: str
+    rows: int
+    start: list[float]
+    end: list[float]
+    distance: float
+    top_speed: float
+    heading_deg: float
+    final_joints: dict[str, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form."""
+        return dict(self.__dict__)
+
+
+@dataclass
+class SimResult:
+    """The rows a run recorded.
+
+    Attributes:
+        rows: Reported observations (noise and delay applied), in time order.
+        ideal: The true observations at the same steps.
+        time_step: Physics time step, s.
+        steps: Physics steps taken.
+    """
+
+    rows: list[Observation]
+    ideal: list[Observation]
+    time_step: float
+    steps: int
+
+    def to_dicts(self) -> list[dict[str, Any]]:
+        """The reported rows as JSON-ready dicts."""
+        return [r.to_dict() for r in self.rows]
+
+
+# --------------------------------------------------------------------------- the simulation
+
+
+class Simulation:
+    """A scenario running in its own PyBullet client.
+
+    Args:
+        config: A validated scenario (:func:`urdfkit.scenario.load_scenario`) or the plain
+            dict of one, which is validated here.
+        base_dir: Where relative ``urdf`` paths of a dict ``config`` are resolved.
+
+    Raises:
+        InputError: the scenario is invalid, or names a joint or link a robot lacks.
+        EngineError: PyBullet refused a file.
+    """
+
+    def __init__(self, config: Any, *, base_dir: str | Path | None = None):
+        if isinstance(config, Mapping):
+            config = parse_scenario(config, base_dir=base_dir)
+        self.config = config
+        self.time_step: float = config.physics.time_step
+        self.step_count = 0
+        self.ground: int | None = None
+        self.bodies: dict[str, _Body] = {}
+        self._resolved: list[Any] = []
+        self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-sim-")
+        self.session = Session()
+        try:
+            self._setup()
+        except BaseException:
+            self.close()
+            raise
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> Simulation:
+        """Load and validate a ``.json`` or ``.toml`` scenario and set it up."""
+        return cls(load_scenario(path))
+
+    # ---- lifecycle
+
+    def __enter__(self) -> Simulation:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Disconnect the client and remove temp files (safe to call twice)."""
+        if hasattr(self, "session"):
+            self.session.close()
+        for r in self._resolved:
+            r.close()
+        self._resolved = []
+        self._tmp.cleanup()
+
+    @property
+    def t(self) -> float:
+        """Simulated time, s."""
+        return self.step_count * self.time_step
+
+    @property
+    def total_steps(self) -> int:
+        """Steps in the scenario's ``duration``."""
+        return max(1, round(self.config.duration / self.time_step))
+
+    @property
+    def robots(self) -> list[str]:
+        """Robot names, in scenario order."""
+        return list(self.bodies)
+
+    def _error(self, path: str, message: str) -> InputError:
+        return InputError(f"{path}: {message}", file=self.config.source)
+
+    # ---- setup
+
+    def _setup(self) -> None:
+        p, client = self.session.p, self.session.client
+        ph = self.config.physics
+        p.setTimeStep(ph.time_step, physicsClientId=client)
+        p.setGravity(*ph.gravity, physicsClientId=client)
+        p.setPhysicsEngineParameter(numSolverIterations=ph.solver_iterations,
+                                    enableConeFriction=int(ph.cone_friction),
+                                    physicsClientId=client)
+        if self.config.ground is not None:
+            g = self.config.ground
+            self.ground = self._load("ground", g.template, g.params, g.urdf,
+                                     LoadOptions(fixed_base=True,
+                                                 base_position=tuple(g.position)))
+        for i, robot in enumerate(self.config.robots):
+            self.bodies[robot.name] = self._add_robot(i, robot)
+        self._check_record()
+        for b in self.bodies.values():
+            b.history.append(self._measure(b))
+
+    def _load(self, path: str, template: str | None, params: Mapping[str, Any],
+              urdf: str | None, options: LoadOptions) -> int:
+        from .catalog import build_template
+        from .resolve import open_input
+
+        if template is not None:
+            folder = Path(self._tmp.name) / f"{len(self._resolved)}"
+            folder.mkdir()
+            name = str(build_template(template, params).write(folder / f"{template}.urdf"))
+            display = f"{path}: template {template}"
+        else:
+            assert urdf is not None
+            name = self.config.path_of(urdf)
+            display = urdf
+        resolved = open_input(name)
+        self._resolved.append(resolved)
+        return self.session.load_urdf(resolved.load_path, options, display=display)
+
+    def _add_robot(self, i: int, cfg: Any) -> _Body:
+        p, client = self.session.p, self.session.client
+        path = f"robots[{i}]"
+        if cfg.orientation_quat is not None:
+            norm = math.sqrt(math.fsum(q * q for q in cfg.orientation_quat))
+            orientation = tuple(q / norm for q in cfg.orientation_quat)
+        else:
+            orientation = tuple(p.getQuaternionFromEuler(cfg.orientation_rpy or (0, 0, 0)))
+        options = LoadOptions(fixed_base=cfg.base == "fixed",
+                              inertia_from_file=cfg.inertia_from_file,
+                              self_collision=cfg.self_collision,
+                              base_position=tuple(cfg.position), base_orientation=orientation)
+        body = self._load(path, cfg.template, cfg.params, cfg.urdf, options)
+
+        joints: list[JointSpec] = []
+        for j in range(p.getNumJoints(body, physicsClientId=client)):
+            info = p.getJointInfo(body, j, physicsClientId=client)
+            joints.append(JointSpec(j, info[1].decode("utf-8", "replace"), info[2],
+                                    float(info[10]), info[12].decode("utf-8", "replace")))
+        active = [j for j in joints if j.active]
+        links = {p.getBodyInfo(body, physicsClientId=client)[0].decode("utf-8", "replace"): -1}
+        links.update({j.child_link: j.index for j in joints})
+        seed = self.config.seed * 1_000_003 + i
+        b = _Body(cfg.name, path, cfg, body, joints, active, links, {}, {},
+                  random.Random(seed), deque(maxlen=cfg.delay + 1))
+
+        def active_joint(where: str, name: str) -> JointSpec:
+            try:
+                spec = b.joint(name)
+            except KeyError:
+                known = ", ".join(j.name for j in active) or "none"
+                raise self._error(where, f"no joint named {name!r} in {cfg.name}; active "
+                                         f"joints: {known}") from None
+            if not spec.active:
+                kind = "fixed" if spec.type == _FIXED else "not a 1-DOF joint"
+                raise self._error(where, f"joint {name!r} is {kind} and cannot be moved")
+            return spec
+
+        for name, value in cfg.motor_offsets.items():
+            b.offsets[active_joint(f"{path}.motor_offsets.{name}", name).name] = value
+        for name, value in cfg.motor_directions.items():
+            b.directions[active_joint(f"{path}.motor_directions.{name}", name).name] = value
+        for k, seg in enumerate(cfg.joints or []):
+            for name in seg.targets:
+                active_joint(f"{path}.joints[{k}].targets.{name}", name)
+        if cfg.motor is not None:
+            names = cfg.motor.joints
+            b.servo = active if names is None else [
+                active_joint(f"{path}.motor.joints", n) for n in names]
+
+        if cfg.drive is not None:
+            from .vehicle import detect_drivetrain
+
+            v = cfg.vehicle
+            # Detection judges axes from the pose at load time: before any reset or step.
+            try:
+                b.train = detect_drivetrain(p, body, client, wheels=v.wheels if v else None,
+                                            hinges=v.hinges if v else None)
+            except ParameterError as e:
+                raise self._error(f"{path}.vehicle" if v else f"{path}.drive", e.message) \
+                    from None
+
+        from .vehicle import disable_default_motors
+
+        # PyBullet holds every joint with a velocity motor (target 0) until told otherwise.
+        disable_default_motors(p, body, client, [j.index for j in active])
+        for name, init in cfg.initial_joints.items():
+            spec = active_joint(f"{path}.initial_joints.{name}", name)
+            p.resetJointState(body, spec.index, self._to_physical(b, name, init.position),
+                              init.velocity * b.directions.get(name, 1.0),
+                              physicsClientId=client)
+        return b
+
+    def _check_record(self) -> None:
+        p, client = self.session.p, self.session.client
+        rec = self.config.record
+        for i, link in enumerate(rec.contact_links):
+            found = [b for b in self.bodies.values() if link in b.links]
+            if not found:
+                raise self._error(f"record.contact_links[{i}]", f"no robot has a link named "
+                                                                f"{link!r}")
+            for b in found:
+                b.contact_links[link] = b.links[link]
+        for i, name in enumerate(rec.joint_forces):
+            found = [b for b in self.bodies.values() if any(j.name == name for j in b.joints)]
+            if not found:
+                raise self._error(f"record.joint_forces[{i}]", f"no robot has a joint named "
+                                                               f"{name!r}")
+            for b in found:
+                index = b.joint(name).index
+                b.force_joints[name] = index
+                p.enableJointForceTorqueSensor(b.body, index, True, physicsClientId=client)
+
+    # ---- frames
+
+    @staticmethod
+    def _to_physical(b: _Body, name: str, measured: float) -> float:
+        return measured * b.directions.get(name, 1.0) + b.offsets.get(name, 0.0)
+
+    # ---- control
+
+    def set_drive(self, robot: str, throttle: float, steer: float = 0.0) -> None:
+        """Drive ``robot`` with this throttle and steer until :meth:`clear_command`.
+
+        Overrides the scenario's ``drive`` segments (for an RL policy, say).
+        """
+        b = self._body(robot)
+        if b.train is None:
+            raise ParameterError(f"robot {robot!r} has no drive controller; give it 'drive' "
+                                 "segments in the scenario")
+        b.override = _Command("drive", throttle=throttle, steer=steer)
+
+    def set_joint_targets(self, robot: str, targets: Mapping[str, float],
+                          mode: str = "position", max_force: float | None = None) -> None:
+        """Command joints of ``robot`` (measured frame) until :meth:`clear_command`.
+
+        Args:
+            robot: The robot's name.
+            targets: Joint name to position, velocity or torque.
+            mode: ``position``, ``velocity`` or ``torque``.
+            max_force: Motor force limit for position and velocity modes (default: the
+                joint's effort limit).
+        """
+        b = self._body(robot)
+        if mode not in ("position", "velocity", "torque"):
+            raise ParameterError(f"mode must be position, velocity or torque, got {mode!r}")
+        for name in targets:
+            if not any(j.name == name and j.active for j in b.joints):
+                raise ParameterError(f"robot {robot!r} has no active joint named {name!r}")
+        b.override = _Command("joints", mode=mode, targets=dict(targets), max_force=max_force)
+
+    def clear_command(self, robot: str) -> None:
+        """Return ``robot`` to the scenario's own controller."""
+        self._body(robot).override = None
+
+    def _body(self, robot: str) -> _Body:
+        try:
+            return self.bodies[robot]
+        except KeyError:
+            raise ParameterError(f"no robot named {robot!r}; robots: "
+                                 f"{', '.join(self.bodies)}") from None
+
+    def _scheduled(self, b: _Body) -> _Command | None:
+        """The segment in force at the current time; the last one holds after it ends."""
+        t = self.t
+        if b.config.drive is not None:
+            segs = b.config.drive
+            seg = next((s for s in segs if t < s.until - 1e-9), segs[-1])
+            return _Command("drive", throttle=seg.throttle, steer=seg.steer)
+        if b.config.joints is not None:
+            segs = b.config.joints
+            seg = next((s for s in segs if t < s.until - 1e-9), segs[-1])
+            return _Command("joints", mode=seg.mode, targets=dict(seg.targets),
+                            max_force=seg.max_force)
+        return None
+
+    def _control(self, b: _Body) -> None:
+        p, client = self.session.p, self.session.client
+        cmd = b.override or self._scheduled(b)
+        if cmd != b.applied:
+            if b.applied is not None:
+                # Free every joint before the new command: a position motor set by the last
+                # segment would otherwise keep fighting a torque command.
+                from .vehicle import disable_default_motors
+
+                disable_default_motors(p, b.body, client, [j.index for j in b.active])
+            if cmd is not None and cmd.kind == "drive":
+                from .vehicle import apply_drive
+
+                lo, hi = b.train.steer_range()
+                max_force = b.config.vehicle.max_force if b.config.vehicle else 10.0
+                # Motors persist in PyBullet: set once per change of command.
+                apply_drive(p, b.body, client, b.train, cmd.throttle,
+                            min(max(cmd.steer, lo), hi), max_force)
+            elif cmd is not None and not b.servo:
+                self._apply_motors(b, cmd)
+            b.applied = cmd
+        if cmd is not None and cmd.kind == "joints" and cmd.mode == "torque" and not b.servo:
+            self._apply_motors(b, cmd)  # torques last one step only
+        if b.servo:
+            self._apply_servo(b, cmd)
+
+    def _apply_motors(self, b: _Body, cmd: _Command) -> None:
+        """PyBullet's own motors for a ``joints`` command (no servo model)."""
+        p, client = self.session.p, self.session.client
+        for name, target in cmd.targets.items():
+            spec = b.joint(name)
+            sign = b.directions.get(name, 1.0)
+            if cmd.mode == "torque":
+                p.setJointMotorControl2(b.body, spec.index, p.TORQUE_CONTROL,
+                                        force=target * sign, physicsClientId=client)
+                continue
+            force = cmd.max_force or (spec.effort if spec.effort > 0 else None)
+            kwargs: dict[str, Any] = {} if force is None else {"force": force}
+            if cmd.mode == "position":
+                p.setJointMotorControl2(b.body, spec.index, p.POSITION_CONTROL,
+                                        targetPosition=self._to_physical(b, name, target),
+                                        physicsClientId=client, **kwargs)
+            else:
+                p.setJointMotorControl2(b.body, spec.index, p.VELOCITY_CONTROL,
+                                        targetVelocity=target * sign,
+                                        physicsClientId=client, **kwargs)
+
+    def _apply_servo(self, b: _Body, cmd: _Command | None) -> None:
+        """The servo model: a PD law plus viscous friction and a spring, as joint torques.
+
+        torque = -kp (q - q_des) - kd (qd - qd_des) - b qd - k q, clipped to the effort limit.
+        A position target sets q_des (qd_des = 0); a velocity target sets qd_des and drops the
+        kp term; a torque target is added as is. Joints without a target feel only friction and
+        the spring.
+        """
+        p, client = self.session.p, self.session.client
+        m = b.config.motor
+        indices = [j.index for j in b.servo]
+        states = p.getJointStates(b.body, indices, physicsClientId=client)
+        torques = []
+        targets = cmd.targets if cmd is not None and cmd.kind == "joints" else {}
+        mode = cmd.mode if cmd is not None else "position"
+        for spec, state in zip(b.servo, states, strict=True):
+            q, qd = state[0], state[1]
+            tau = -m.viscous_friction * qd - m.stiffness * q
+            if spec.name in targets:
+                sign = b.directions.get(spec.name, 1.0)
+                target = targets[spec.name]
+                if mode == "position":
+                    tau += -m.kp * (q - self._to_physical(b, spec.name, target)) - m.kd * qd
+                elif mode == "velocity":
+                    tau += -m.kd * (qd - target * sign)
+                else:
+                    tau += target * sign
+            limit = m.max_torque or (spec.effort if spec.effort > 0 else math.inf)
+            torques.append(min(max(tau, -limit), limit))
+        p.setJointMotorControlArray(b.body, indices, p.TORQUE_CONTROL, forces=torques,
+                                    physicsClientId=client)
+
+    # ---- stepping and measuring
+
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` physics steps, applying every robot's controller before each."""
+        p, client = self.session.p, self.session.client
+        for _ in range(n):
+            for b in self.bodies.values():
+                self._control(b)
+            p.stepSimulation(physicsClientId=client)
+            self.step_count += 1
+            for b in self.bodies.values():
+                b.history.append(self._measure(b))
+
+    def _measure(self, b: _Body) -> Observation:
+        """The true observation now, in the measured joint frame."""
+        p, client = self.session.p, self.session.client
+        pos, orn = p.getBasePositionAndOrientation(b.body, physicsClientId=client)
+        lin, ang = p.getBaseVelocity(b.body, physicsClientId=client)
+        matrix = p.getMatrixFromQuaternion(orn)
+        angles: dict[str, float] = {}
+        velocities: dict[str, float] = {}
+        accelerations: dict[str, float] = {}
+        forces: dict[str, list[float]] | None = None
+        if b.active:
+            states = p.getJointStates(b.body, [j.index for j in b.active],
+                                      physicsClientId=client)
+            first = not b.previous_velocities
+            for spec, state in zip(b.active, states, strict=True):
+                sign = b.directions.get(spec.name, 1.0)
+                angles[spec.name] = (state[0] - b.offsets.get(spec.name, 0.0)) * sign
+                velocities[spec.name] = state[1] * sign
+                accelerations[spec.name] = 0.0 if first else \
+                    (velocities[spec.name] - b.previous_velocities[spec.name]) / self.time_step
+            b.previous_velocities = dict(velocities)
+        if b.force_joints:
+            forces = {}
+            for name, index in b.force_joints.items():
+                state = p.getJointState(b.body, index, physicsClientId=client)
+                forces[name] = [float(x) for x in state[2]]
+        contacts = None
+        if b.contact_links:
+            contacts = {}
+            for link, index in b.contact_links.items():
+                kwargs: dict[str, Any] = {"bodyA": b.body, "linkIndexA": index}
+                if self.ground is not None:
+                    kwargs["bodyB"] = self.ground
+                points = p.getContactPoints(physicsClientId=client, **kwargs)
+                contacts[link] = {"normal_force": float(sum(pt[9] for pt in points)),
+                                  "count": len(points)}
+        return Observation(
+            t=self.t, step=self.step_count, robot=b.name, motor_angles=angles,
+            motor_velocities=velocities, motor_accelerations=accelerations,
+            base_position=list(pos), base_orientation=list(orn), base_lin_vel=list(lin),
+            base_ang_vel=list(ang), base_lin_vel_body_frame=_rotate_into(matrix, lin),
+            base_ang_vel_body_frame=_rotate_into(matrix, ang), contacts=contacts,
+            joint_forces=forces)
+
+    def observe(self, robot: str | None = None, *, ideal: bool = False
+                ) -> Observation | dict[str, Observation]:
+        """The observation now: as reported (delay, then noise) or ``ideal``.
+
+        For the first ``delay`` steps a delayed robot reports its initial state. Asking twice
+        at the same step returns the same noisy values.
+
+        Args:
+            robot: One robot's name; default: all, as a dict keyed by name.
+            ideal: The true values, without noise or delay.
+        """
+        if robot is None:
+            return {name: self.observe(name, ideal=ideal)  # type: ignore[misc]
+                    for name in self.bodies}
+        b = self._body(robot)
+        if ideal:
+            return b.history[-1]
+        if b.reported is not None and b.reported[0] == self.step_count:
+            return b.reported[1]
+        # history holds the last delay+1 observations; its oldest is the delayed one.
+        source = b.history[0]
+        obs = self._add_noise(b, source._replace(t=self.t, step=self.step_count))
+        b.reported = (self.step_count, obs)
+        return obs
+
+    def _add_noise(self, b: _Body, obs: Observation) -> Observation:
+        noise = b.config.noise
+        if noise is None:
+            return obs
+        changes: dict[str, Any] = {}
+        for name in OBSERVATION_FIELDS:
+            std = getattr(noise, name)
+            if std <= 0:
+                continue
+            value = getattr(obs, name)
+            if isinstance(value, dict):
+                changes[name] = {k: v + b.rng.gauss(0.0, std) for k, v in value.items()}
+            else:
+                changes[name] = [v + b.rng.gauss(0.0, std) for v in value]
+        return obs._replace(**changes)
+
+    def run(self, duration: float | None = None) -> SimResult:
+        """Step to ``duration`` (default: the scenario's), recording every ``record.every``.
+
+        Rows are taken at every step that is a multiple of ``record.every``, the starting
+        state included when the run starts at step 0.
+        """
+        end = self.total_steps if duration is None else \
+            self.step_count + max(0, round(duration / self.time_step))
+        every = self.config.record.every
+        rows: list[Observation] = []
+        ideal: list[Observation] = []
+
+        def record() -> None:
+            for name in self.bodies:
+                rows.append(self.observe(name))  # type: ignore[arg-type]
+                ideal.append(self.observe(name, ideal=True))  # type: ignore[arg-type]
+
+        if self.step_count % every == 0:
+            record()
+        while self.step_count < end:
+            self.step(min(every - self.step_count % every, end - self.step_count))
+            if self.step_count % every == 0:
+                record()
+        return SimResult(rows, ideal, self.time_step, self.step_count)
+
+
+# --------------------------------------------------------------------------- summary
+
+
+def summarize(result: SimResult) -> list[RobotSummary]:
+    """Per robot: where it started and ended, how far and fast it went, its final joints."""
+    by_robot: dict[str, list[Observation]] = {}
+    for row in result.ideal:
+        by_robot.setdefault(row.robot, []).append(row)
+    out = []
+    for name, rows in by_robot.items():
+        first, last = rows[0], rows[-1]
+        x, y, z, w = last.base_orientation
+        heading = math.degrees(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
+        out.append(RobotSummary(
+            robot=name, rows=len(rows), start=list(first.base_position),
+            end=list(last.base_position),
+            distance=math.dist(first.base_position, last.base_position),
+            top_speed=max(math.hypot(*r.base_lin_vel) for r in rows),
+            heading_deg=heading, final_joints=dict(last.motor_angles)))
+    return out
+
+
+# --------------------------------------------------------------------------- writers
+
+
+def flatten(row: Mapping[str, Any]) -> dict[str, Any]:
+    """A nested row as flat columns: ``motor_angles.hinge``, ``base_position.x``."""
+    out: dict[str, Any] = {}
+
+    def put(prefix: str, value: Any) -> None:
+        if isinstance(value, Mapping):
+            for k, v in value.items():
+                put(f"{prefix}.{k}", v)
+        elif isinstance(value, (list, tuple)):
+            names = _AXES.get(len(value), tuple(str(i) for i in range(len(value))))
+            for k, v in zip(names, value, strict=False):
+                out[f"{prefix}.{k}"] = v
+        else:
+            out[prefix] = value
+
+    for key, value in row.items():
+        put(key, value)
+    return out
+
+
+def _columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:
+    seen: dict[str, None] = {}
+    for row in rows:
+        seen.update(dict.fromkeys(row))
+    return list(seen)
+
+
+def _pyarrow() -> Any:
+    try:
+        import pyarrow
+        import pyarrow.parquet
+    except ImportError as e:
+        raise MissingDependencyError("writing .parquet needs pyarrow: "
+                                     "pip install 'urdfkit[parquet]'") from e
+    return pyarrow
+
+
+def check_output(path: str | Path, *, force: bool) -> None:
+    """Refuse a bad ``--out`` before simulating: unknown format, existing file, no pyarrow."""
+    out = Path(path)
+    if out.suffix.lower() not in OUTPUT_FORMATS:
+        raise OutputError(f"unknown output format {out.suffix or '(none)'!r}; use "
+                          f"{', '.join(OUTPUT_FORMATS)}", file=path)
+    if out.is_dir():
+        raise OutputError("is a directory", file=path)
+    if out.exists() and not force:
+        raise OutputError("exists; pass --force to overwrite it", file=path)
+    folder = out.parent if str(out.parent) else Path(".")
+    if not folder.is_dir():
+        raise OutputError(f"folder {folder} does not exist", file=path)
+    if out.suffix.lower() == ".parquet":
+        _pyarrow()
+
+
+def rows_to_bytes(rows: Sequence[Mapping[str, Any]], fmt: str) -> bytes:
+    """Serialise rows as ``.jsonl`` (nested), ``.csv`` or ``.parquet`` (flattened)."""
+    if fmt == ".jsonl":
+        return "".join(json.dumps(r, allow_nan=False) + "\n" for r in rows).encode("utf-8")
+    flat = [flatten(r) for r in rows]
+    columns = _columns(flat)
+    if fmt == ".csv":
+        text = io.StringIO()
+        writer = csv.DictWriter(text, fieldnames=columns, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(flat)
+        return text.getvalue().encode("utf-8")
+    if fmt == ".parquet":
+        pa = _pyarrow()
+        table = pa.table({c: [r.get(c) for r in flat] for c in columns})
+        sink = pa.BufferOutputStream()
+        pa.parquet.write_table(table, sink)
+        return bytes(sink.getvalue().to_pybytes())
+    raise OutputError(f"unknown output format {fmt!r}; use {', '.join(OUTPUT_FORMATS)}")
+
+
+def write_rows(path: str | Path, rows: Sequence[Mapping[str, Any]], *, force: bool) -> Path:
+    """Write rows in the format the suffix names, atomically; never replace without ``force``."""
+    from .xmlio import atomic_write
+
+    check_output(path, force=force)
+    return atomic_write(path, rows_to_bytes(rows, Path(path).suffix.lower()), force=force)
