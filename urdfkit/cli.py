@@ -285,7 +285,7 @@ def joints(
         return
     _show_diagnostics(report.diagnostics)
     columns = [("#", 0, "right"), ("joint", 0, "left"), ("type", 0, "left"),
-               ("child link", 1, "left"), ("parent", 2, "left"), ("limits", 1, "right"),
+               ("child link", 1, "left"), ("parent", 3, "left"), ("limits", 1, "right"),
                ("axis", 2, "left"), ("max force", 3, "right"), ("max vel", 3, "right"),
                ("xyz", 4, "left"), ("rpy", 4, "left"), ("q", 5, "right"), ("u", 5, "right"),
                ("damping", 6, "right"), ("friction", 6, "right"), ("quat", 9, "left"),
@@ -692,6 +692,164 @@ def _drive_summary(r: Any) -> None:
     for key, value in rows:
         table.add_row(key, value)
     _console().print(table)
+
+
+# ---- render: headless PNG pictures (urdfkit/render.py) and tree --dot (urdfkit/graph.py)
+
+
+@app.command()
+@_handle_errors
+def render(
+    file: FileArg,
+    output: Annotated[str | None, typer.Option(
+        "--output", "-o", help="The PNG to write; '-' for stdout. Default: <name>.png here.")]
+    = None,
+    view: Annotated[str, typer.Option(
+        "--view", help="Camera: iso, front, side or top.")] = "iso",
+    views: Annotated[str | None, typer.Option(
+        "--views", metavar="all|V,V,V,V",
+        help="Four views as a labelled 2x2 grid: 'all' (iso, front, side, top) or a list.")]
+    = None,
+    size: Annotated[str, typer.Option("--size", metavar="WxH", help="Image size in pixels.")]
+    = "800x600",
+    ground: Annotated[str, typer.Option(
+        "--ground", help="grid (lines), plane (shaded, with shadow) or none.")] = "grid",
+    joints: Annotated[list[str] | None, typer.Option(
+        "--joints", "-j", metavar="NAME=VALUE",
+        help="Pose a joint before the shot, in rad or m (repeatable, or a=1,b=2).")] = None,
+    collision: Annotated[bool, typer.Option(
+        "--collision", help="Draw the collision shapes instead of the visuals.")] = False,
+    frames: Annotated[bool, typer.Option(
+        "--frames", help="Mark link frames (x red, y green, z blue) and joint axes.")] = False,
+    as_json: Annotated[bool, typer.Option(
+        "--json", help="Print what was drawn (cameras, bounding box) as JSON.")] = False,
+    force: ForceOpt = False,
+    package: PackageOpt = None,
+    arg: ArgOpt = None,
+) -> None:
+    """Draw a robot to a PNG, headless (PyBullet's TinyRenderer: no GPU, no display)."""
+    from . import render as rendering
+
+    width, height = rendering.parse_size(size)
+    if views is None:
+        chosen: tuple[str, ...] = (view,)
+    elif views.strip() == "all":
+        chosen = rendering.ALL_VIEWS
+    else:
+        chosen = tuple(v.strip() for v in views.split(",") if v.strip())
+    options = rendering.RenderOptions(
+        views=chosen, width=width, height=height, ground=ground,
+        joints=rendering.parse_joint_positions(joints), collision=collision, frames=frames)
+    out = output if output is not None else f"{Path(file).name.split('.')[0] or 'robot'}.png"
+    if out != "-":  # refuse before the work, not after it
+        rendering.check_output(out, force=force)
+    picture = rendering.render_file(file, options, packages=package, xacro_args=arg)
+    for w in picture.warnings:
+        _warn(w)
+    if out == "-":
+        sys.stdout.buffer.write(picture.png_bytes())
+        sys.stdout.flush()
+        return
+    path = rendering.write_png(picture, out, force=force)
+    if as_json:
+        _print_json({"output": str(path), **picture.to_dict()})
+        return
+    _console(stderr=True).print(
+        f"wrote [bold]{_escape(str(path))}[/] ({picture.width}x{picture.height}, "
+        f"{', '.join(chosen)}{', collision shapes' if collision else ''})")
+
+
+def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
+              output: str | None, force: bool, as_json: bool) -> None:
+    """``tree --dot`` / ``tree -o graph.svg``: the kinematic graph as DOT text or a drawing."""
+    from .errors import ParameterError
+    from .graph import check_output, dot_graph, write_graph
+    from .resolve import open_input
+
+    if as_json:
+        raise ParameterError("--json and --dot/-o are different outputs; choose one")
+    if output is not None and output != "-":
+        check_output(output, force=force)
+    with open_input(file, package, arg) as resolved:
+        text = dot_graph(resolved.root)
+    if output is None or output == "-":
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        return
+    path = write_graph(text, output, force=force)
+    _console(stderr=True).print(f"wrote [bold]{_escape(str(path))}[/]")
+
+
+# ---- sim: scenario files (urdfkit/scenario.py) run by urdfkit/sim.py
+
+
+@app.command()
+@_handle_errors
+def sim(
+    scenario: Annotated[str, typer.Argument(
+        help="A scenario file (.json or .toml): robots, controllers, physics. See "
+             "docs/scenario.md.")],
+    out: Annotated[str | None, typer.Option(
+        "--out", "-o", metavar="FILE",
+        help="Write the observation rows to FILE.jsonl, FILE.csv or FILE.parquet.")] = None,
+    as_json: JsonOpt = False,
+    force: ForceOpt = False,
+) -> None:
+    """Simulate a scenario of one or more robots and record their observations.
+
+    Without --out a summary per robot prints; with --json, one JSON object (holding the rows
+    too when there is no --out).
+    """
+    from . import sim as simulation
+
+    if out is not None:
+        simulation.check_output(out, force=force)  # fail before the run, not after it
+    with simulation.Simulation.from_file(scenario) as s:
+        result = s.run()
+    rows = result.to_dicts()
+    written = None if out is None else simulation.write_rows(out, rows, force=force)
+    summaries = simulation.summarize(result)
+    if as_json:
+        data: dict[str, Any] = {
+            "scenario": scenario, "time_step": result.time_step, "steps": result.steps,
+            "duration": result.steps * result.time_step, "rows": len(rows),
+            "robots": [x.to_dict() for x in summaries],
+            "out": None if written is None else str(written)}
+        if written is None:
+            data["observations"] = rows
+        _print_json(data)
+        return
+    _sim_summary(scenario, result, summaries)
+    if written is not None:
+        _console(stderr=True).print(f"wrote [bold]{_escape(str(written))}[/] "
+                                    f"({len(rows):,} rows)", soft_wrap=True)
+
+
+def _sim_summary(scenario: str, result: Any, summaries: list[Any]) -> None:
+    from rich.table import Table
+
+    table = Table(title=f"[bold]sim[/] {_escape(scenario)}: {result.steps:,} steps of "
+                  f"{result.time_step:.5g} s", title_justify="left", show_edge=False)
+    table.add_column("robot", style="cyan")
+    table.add_column("rows", justify="right")
+    table.add_column("end x y z (m)", no_wrap=True)
+    table.add_column("moved m", justify="right")
+    table.add_column("top m/s", justify="right")
+    table.add_column("yaw deg", justify="right")
+
+    def num(v: float, digits: int = 3) -> str:
+        text = f"{v:.{digits}f}"
+        return text[1:] if text.startswith("-") and not text.strip("-0.") else text
+
+    for x in summaries:
+        table.add_row(_escape(x.robot), str(x.rows), " ".join(num(v) for v in x.end),
+                      num(x.distance), num(x.top_speed), num(x.heading_deg, 1))
+    console = _console()
+    console.print(table)
+    for x in summaries:
+        if x.final_joints:
+            joints = ", ".join(f"{k} {num(v)}" for k, v in x.final_joints.items())
+            console.print(f"[cyan]{_escape(x.robot)}[/] final joints: {_escape(joints)}")
 
 
 def main() -> None:

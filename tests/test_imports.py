@@ -1,0 +1,64 @@
+"""Heavy modules stay unimported where they are not needed (typer's test_rich_import idea).
+
+yourdfpy costs ~0.9 s through trimesh, matplotlib more; `urdfkit --help` must not even pay for
+PyBullet and numpy. Each case runs the CLI in a fresh interpreter and lists sys.modules.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+HEAVY = ("yourdfpy", "trimesh", "matplotlib", "pydantic", "PIL")
+
+PROBE = """
+import json, sys
+from urdfkit.cli import app
+try:
+    app(sys.argv[1:], standalone_mode=False)
+except SystemExit:
+    pass
+sys.stderr.write("\\nMODULES:" + json.dumps(sorted(m.split(".")[0] for m in sys.modules)))
+"""
+
+
+def loaded_modules(*args: str) -> tuple[subprocess.CompletedProcess[str], set[str]]:
+    proc = subprocess.run([sys.executable, "-c", PROBE, *args], capture_output=True, text=True,
+                          timeout=60)
+    marker = proc.stderr.rindex("MODULES:")
+    return proc, set(json.loads(proc.stderr[marker + len("MODULES:"):]))
+
+
+def test_help_imports_nothing_heavy() -> None:
+    proc, modules = loaded_modules("--help")
+    assert "joints" in proc.stdout
+    assert modules.isdisjoint({*HEAVY, "pybullet", "numpy", "lxml"}), modules & {
+        *HEAVY, "pybullet", "numpy", "lxml"}
+
+
+def test_joints_json_imports_only_pybullet(simplecar_urdf: Path) -> None:
+    proc, modules = loaded_modules("joints", str(simplecar_urdf), "--json")
+    assert len(json.loads(proc.stdout)["joints"]) == 6
+    assert "pybullet" in modules
+    assert modules.isdisjoint(HEAVY), modules & set(HEAVY)
+
+
+@pytest.mark.parametrize("command", ["links", "info", "tree"])
+def test_other_inspect_commands_import_nothing_heavy(command: str, simplecar_urdf: Path) -> None:
+    proc, modules = loaded_modules(command, str(simplecar_urdf), "--json")
+    assert json.loads(proc.stdout)["robot"] == "simplecar"
+    assert modules.isdisjoint(HEAVY), modules & set(HEAVY)
+    if command == "tree":
+        assert "pybullet" not in modules
+
+
+def test_installed_console_script_help() -> None:
+    script = Path(sys.executable).parent / "urdfkit"
+    proc = subprocess.run([str(script), "--help"], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0
+    for command in ("joints", "links", "tree", "info"):
+        assert command in proc.stdout
