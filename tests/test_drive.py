@@ -1,0 +1,288 @@
+"""`urdfkit drive`: physics against theory, detection, determinism, files and errors.
+
+Runs are short (5-10 simulated seconds, ~0.2-0.4 s of wall time each) and shared through
+module-scoped fixtures so the whole file stays well under a minute.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from urdfkit.cli import app
+from urdfkit.drive import DriveConfig, DriveResult, Scenario, drive, fit_circle
+from urdfkit.errors import ParameterError
+from urdfkit.session import LoadOptions, Session
+from urdfkit.vehicle import DrivetrainError, _link_orientations, detect_drivetrain
+
+WHEEL_RADIUS = 0.1  # simplecar default
+WHEELBASE = 0.4
+
+
+@pytest.fixture(scope="module")
+def straight() -> DriveResult:
+    return drive(DriveConfig(throttle=10, steer=0, seconds=5))
+
+
+@pytest.fixture(scope="module")
+def left() -> DriveResult:
+    return drive(DriveConfig(throttle=10, steer=0.2, seconds=10))
+
+
+@pytest.fixture(scope="module")
+def right() -> DriveResult:
+    return drive(DriveConfig(throttle=10, steer=-0.2, seconds=10))
+
+
+# --------------------------------------------------------------------------- physics
+
+
+def test_straight_run_matches_rolling_without_slip(straight: DriveResult) -> None:
+    # v = omega * r = 10 rad/s * 0.1 m = 1 m/s, so 5 s covers ~5 m.
+    x, y, z = straight.final_position
+    assert x == pytest.approx(10 * WHEEL_RADIUS * 5, rel=0.05)
+    assert abs(y) < 0.1, "sideways drift"
+    assert abs(straight.final_yaw) < 0.05
+    assert straight.mean_speed == pytest.approx(1.0, rel=0.05)
+    assert straight.distance == pytest.approx(x, rel=0.01)
+    assert straight.turning_radius is None
+    assert straight.steps == 1200 and straight.sim_time == pytest.approx(5.0)
+    # Rests on its wheels: base centre at wheel radius above the plane's top (z = 0.005).
+    assert z == pytest.approx(0.105, abs=0.01)
+
+
+def test_constant_steer_settles_on_a_circle_a_bit_wider_than_the_bicycle_model(
+        left: DriveResult) -> None:
+    kinematic = WHEELBASE / math.tan(0.2)  # 1.97 m
+    assert left.turning_radius is not None
+    # Tyres slip, so the real circle is wider, but not wildly so.
+    assert kinematic < left.turning_radius < 1.5 * kinematic
+    # It really is a circle: the settled samples lie on the fitted one within a few cm.
+    t = left.trajectory
+    half = [i for i, ti in enumerate(t.column("t")) if ti >= 5.0]
+    circle = fit_circle([t.column("x")[i] for i in half], [t.column("y")[i] for i in half])
+    assert circle is not None and circle.rms < 0.05
+    assert left.heading_change > 0, "positive steer turns left (counter-clockwise)"
+    assert left.heading_change == pytest.approx(left.distance / left.turning_radius, rel=0.15)
+
+
+def test_left_and_right_turns_are_mirror_images(left: DriveResult, right: DriveResult) -> None:
+    assert right.heading_change < 0
+    assert right.turning_radius == pytest.approx(left.turning_radius, rel=0.05)
+    lx, ly, _ = left.final_position
+    rx, ry, _ = right.final_position
+    assert rx == pytest.approx(lx, abs=0.3)
+    assert ry == pytest.approx(-ly, abs=0.3)
+    assert right.turn_center[1] == pytest.approx(-left.turn_center[1], abs=0.2)
+
+
+def test_negative_throttle_reverses() -> None:
+    r = drive(DriveConfig(throttle=-10, seconds=5))
+    assert r.final_position[0] == pytest.approx(-5.0, rel=0.05)
+    assert abs(r.final_position[1]) < 0.1
+
+
+def test_racecar_from_pybullet_data_drives_forward_and_steers_left() -> None:
+    straight = drive(DriveConfig(urdf="racecar/racecar.urdf", throttle=10, seconds=4))
+    # racecar's wheels have a 0.05 m radius: ~0.5 m/s, forward along its +x.
+    assert straight.final_position[0] == pytest.approx(2.0, rel=0.1)
+    assert abs(straight.final_position[1]) < 0.1
+    turn = drive(DriveConfig(urdf="racecar/racecar.urdf", throttle=10, steer=0.3, seconds=6))
+    assert turn.heading_change > 0.5 and turn.final_position[1] > 0.3
+
+
+# --------------------------------------------------------------------------- detection
+
+
+def test_detects_the_tutorial_indices_of_simplecar(simplecar_urdf: Path) -> None:
+    with Session() as s:
+        body = s.load_urdf(simplecar_urdf)
+        t = detect_drivetrain(s.p, body, s.client)
+    # The tutorial's wheel_indices = [1, 3, 4, 5] and hinge_indices = [0, 2].
+    assert t.wheels == [1, 3, 4, 5] and t.hinges == [0, 2] and t.passive == []
+    assert t.hinge_limits == {0: (-0.5, 0.5), 2: (-0.5, 0.5)}
+    assert set(t.wheel_signs.values()) == {1.0}
+
+
+def test_detects_racecar_wheels_and_hinges_with_rotated_joint_frames() -> None:
+    from urdfkit.resolve import open_input
+
+    with open_input("racecar/racecar.urdf") as res, Session() as s:
+        body = s.load_urdf(res.load_path)
+        t = detect_drivetrain(s.p, body, s.client)
+        # The fallback for >= 128 links composes frames from getJointInfo; it must agree.
+        infos = [s.p.getJointInfo(body, j, physicsClientId=s.client) for j in range(12)]
+        fast = _link_orientations(s.p, body, s.client, infos)
+
+        class NoLinkState:
+            error = s.p.error
+
+            def __getattr__(self, name: str) -> object:
+                return getattr(s.p, name)
+
+            def getLinkState(self, *a: object, **k: object) -> None:
+                raise s.p.error("too many links")
+
+        slow = _link_orientations(NoLinkState(), body, s.client, infos)
+    assert t.wheels == [2, 3, 5, 7] and t.hinges == [4, 6]
+    assert [t.joint_names[j] for j in t.hinges] == ["left_steering_hinge_joint",
+                                                   "right_steering_hinge_joint"]
+    for a, b in zip(fast, slow):
+        assert a == pytest.approx(b, abs=1e-5)
+
+
+def test_wheel_and_hinge_overrides_take_names_or_indices(simplecar_urdf: Path) -> None:
+    with Session() as s:
+        body = s.load_urdf(simplecar_urdf)
+        t = detect_drivetrain(s.p, body, s.client, wheels=["base_to_left_back_wheel", "5"],
+                              hinges=[0])
+        assert t.wheels == [4, 5] and t.hinges == [0]
+        assert t.passive == [1, 2, 3]
+        with pytest.raises(DrivetrainError, match="no joint named 'nope'"):
+            detect_drivetrain(s.p, body, s.client, wheels=["nope"])
+        with pytest.raises(DrivetrainError, match="no joint with index 9"):
+            detect_drivetrain(s.p, body, s.client, wheels=[9])
+
+
+def test_a_model_without_wheels_is_an_error(simpleplane_urdf: Path) -> None:
+    with pytest.raises(DrivetrainError, match="no wheels found"):
+        Scenario(DriveConfig(urdf=str(simpleplane_urdf)))
+
+
+def test_steer_beyond_the_hinge_limits_is_clamped_with_a_warning() -> None:
+    r = drive(DriveConfig(steer=2.0, steps=10))
+    assert r.steer == 0.5
+    assert any("clamped to 0.5" in w for w in r.warnings)
+
+
+# --------------------------------------------------------------------------- recording
+
+
+def test_ctrl_c_stops_cleanly_and_keeps_what_was_recorded() -> None:
+    def interrupt(done: int, total: int) -> None:
+        if done >= 240:
+            raise KeyboardInterrupt
+
+    with Scenario(DriveConfig(seconds=10)) as sc:
+        r = sc.run(interrupt)
+    assert r.interrupted and r.steps == 240
+    assert r.trajectory.rows[-1][0] == pytest.approx(1.0)
+    assert r.final_position[0] == pytest.approx(1.0, abs=0.15)
+
+
+def test_fit_circle_recovers_a_known_circle() -> None:
+    pts = [(3 + 2 * math.cos(a / 10), -1 + 2 * math.sin(a / 10)) for a in range(40)]
+    c = fit_circle([p[0] for p in pts], [p[1] for p in pts])
+    assert c is not None
+    assert c.radius == pytest.approx(2.0) and c.center == pytest.approx((3.0, -1.0))
+    assert fit_circle([0, 1, 2, 3, 4], [0, 1, 2, 3, 4]) is None  # collinear
+
+
+def test_fixed_flags_make_wheels_implicit_cylinders(simplecar_urdf: Path) -> None:
+    # The drive loads with URDF_USE_IMPLICIT_CYLINDER: the wheel's collision shape must be a
+    # real cylinder (GEOM_CYLINDER = 4), not a convex mesh (GEOM_MESH = 5).
+    with Session() as s:
+        body = s.load_urdf(simplecar_urdf, LoadOptions(inertia_from_file=True))
+        shapes = s.p.getCollisionShapeData(body, 4, physicsClientId=s.client)
+        assert shapes[0][2] == s.p.GEOM_CYLINDER
+
+
+# --------------------------------------------------------------------------- CLI
+
+
+@pytest.fixture
+def runner() -> CliRunner:
+    return CliRunner()
+
+
+def test_cli_json_has_the_contract_keys(runner: CliRunner) -> None:
+    result = runner.invoke(app, ["drive", "--throttle", "10", "--steer", "0.2", "--seconds",
+                                 "2", "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.stdout)
+    for key in ("final_position", "final_yaw", "distance", "steps", "sim_time"):
+        assert key in data
+    assert len(data["final_position"]) == 3 and data["steps"] == 480
+    assert data["drivetrain"]["hinges"][0]["name"] == "base_to_left_hinge"
+    assert "wheels left_hinge_to_left_front_wheel," in result.stderr
+    assert "hinges base_to_left_hinge, base_to_right_hinge" in result.stderr
+
+
+def test_cli_summary(runner: CliRunner) -> None:
+    result = runner.invoke(app, ["drive", "--steps", "240"])
+    assert result.exit_code == 0, result.output
+    for text in ("final position", "distance", "mean speed", "real-time factor", "240 steps"):
+        assert text in result.stdout
+
+
+def test_trajectory_files_are_byte_identical_across_runs(runner: CliRunner,
+                                                         tmp_path: Path) -> None:
+    for name in ("a.csv", "b.csv", "a.jsonl", "b.jsonl"):
+        result = runner.invoke(app, ["drive", "--steer", "0.3", "--seconds", "3",
+                                     "--trajectory", str(tmp_path / name), "--json"])
+        assert result.exit_code == 0, result.output
+    assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
+    assert (tmp_path / "a.jsonl").read_bytes() == (tmp_path / "b.jsonl").read_bytes()
+    header = (tmp_path / "a.csv").read_text().splitlines()[0].split(",")
+    assert header[:10] == ["t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz"]
+    assert "base_to_left_hinge_angle" in header and "base_to_left_back_wheel_speed" in header
+    rows = [json.loads(line) for line in (tmp_path / "a.jsonl").read_text().splitlines()]
+    assert len(rows) == 3 * 20 + 1  # 20 samples per simulated second, plus t = 0
+    assert rows[-1]["t"] == pytest.approx(3.0)
+    assert rows[-1]["base_to_left_hinge_angle"] == pytest.approx(0.3, abs=0.02)
+
+
+def test_plot_is_a_png(runner: CliRunner, tmp_path: Path) -> None:
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "drive.png"
+    result = runner.invoke(app, ["drive", "--steer", "0.3", "--seconds", "3", "--plot",
+                                 str(out)])
+    assert result.exit_code == 0, result.output
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--seconds", "nan"], "--seconds must be a finite number"),
+        (["--seconds", "inf"], "--seconds must be a finite number"),
+        (["--seconds", "-1"], "--seconds must be positive"),
+        (["--throttle", "nan"], "--throttle must be a finite number"),
+        (["--throttle", "-inf"], "--throttle must be a finite number"),
+        (["--steer", "nan"], "--steer must be a finite number"),
+        (["--steps", "0"], "--steps must be a positive whole number"),
+        (["--seconds", "1", "--steps", "10"], "not both"),
+        (["--time-step", "0"], "--time-step must be in"),
+        (["--wheels", "nope"], "--wheels: no joint named 'nope'"),
+        (["--trajectory", "out.txt"], "--trajectory must end in .csv or .jsonl"),
+        (["--plot", "out.jpg"], "--plot must end in .png"),
+        (["--urdf", "no_such_car.urdf"], "no such file"),
+    ],
+)
+def test_bad_arguments_exit_2_with_one_clear_line(runner: CliRunner, args: list[str],
+                                                  message: str) -> None:
+    result = runner.invoke(app, ["drive", "--steps", "10", *args] if "--seconds" not in args
+                           and "--steps" not in args else ["drive", *args])
+    assert result.exit_code == 2, result.output
+    assert message in result.stderr
+    assert "Traceback" not in result.output
+
+
+def test_cli_no_wheels_and_existing_output(runner: CliRunner, simpleplane_urdf: Path,
+                                           tmp_path: Path) -> None:
+    result = runner.invoke(app, ["drive", "--urdf", str(simpleplane_urdf)])
+    assert result.exit_code == 2 and "no wheels found" in result.stderr
+    existing = tmp_path / "t.csv"
+    existing.write_text("keep me")
+    result = runner.invoke(app, ["drive", "--steps", "10", "--trajectory", str(existing)])
+    assert result.exit_code == 2 and "--force" in result.stderr
+    assert existing.read_text() == "keep me"
+
+
+def test_library_refuses_bad_config() -> None:
+    with pytest.raises(ParameterError, match="--max-force must be >= 0"):
+        DriveConfig(max_force=-1).check()
