@@ -10,8 +10,12 @@ error as an :class:`~urdfkit.errors.InputError`. Every command that loads a file
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+import math
+import os
+import sys
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import asdict, dataclass
+from pathlib import Path
 
 from lxml import etree
 
@@ -21,6 +25,9 @@ LEVELS = ("info", "warning", "error")
 
 #: PyBullet's state queries fail on bodies with this many links or more (MAX_DEGREE_OF_FREEDOM).
 MAX_PYBULLET_LINKS = 128
+
+#: Longest link or joint name the guard lets through; PyBullet 3.2.7 segfaults from 1264.
+MAX_NAME_LENGTH = 1000
 
 
 @dataclass(frozen=True)
@@ -51,10 +58,19 @@ class Finding:
 
 
 class Report:
-    """Collects findings for one file."""
+    """Collects findings for one file.
 
-    def __init__(self, file: str):
+    Attributes:
+        file: The file, as the user named it.
+        base: The folder relative mesh paths start from; None skips the file-system rules.
+        packages: ``--package NAME=PATH`` mappings for ``package://`` URIs.
+    """
+
+    def __init__(self, file: str, base: Path | None = None,
+                 packages: Mapping[str, Path] | None = None):
         self.file = file
+        self.base = base
+        self.packages = dict(packages or {})
         self.findings: list[Finding] = []
 
     def add(self, code: str, level: str, message: str, el: etree._Element | None = None,
@@ -92,7 +108,10 @@ def rule_document(root: etree._Element, r: Report) -> None:
     if not root.get("name"):
         r.add("U002", "error", "<robot> has no name attribute; add name=\"...\"", root)
     if next(_elements(root, "link"), None) is None:
-        r.add("U003", "error", "<robot> has no <link>; a robot needs at least one link", root)
+        soft = next(_elements(root, "deformable"), None) is not None
+        r.add("U003", "error", "<robot> has no <link>; a robot needs at least one link" +
+              (" (this is a PyBullet soft body, <deformable>: load it with loadSoftBody)"
+               if soft else ""), root)
 
 
 def _check_name(el: etree._Element, r: Report) -> str | None:
@@ -105,11 +124,16 @@ def _check_name(el: etree._Element, r: Report) -> str | None:
         # writes memory. It crashes the process.
         r.add("U104", "error", f"{_label(el)} contains '%', which crashes PyBullet "
               "(it uses names as printf formats); rename it", el)
+    if len(name) > MAX_NAME_LENGTH and el.tag in ("link", "joint"):
+        # Measured on PyBullet 3.2.7: a 1264-character joint name or a 2288-character link
+        # name overflows a fixed buffer in its URDF importer and segfaults the process.
+        r.add("U106", "error", f"<{el.tag}> name is {len(name)} characters long; PyBullet "
+              f"crashes on long names: keep names under {MAX_NAME_LENGTH} characters", el)
     return name
 
 
 def rule_names(root: etree._Element, r: Report) -> None:
-    """U101-U104: links, joints and materials are named, uniquely, without '%'."""
+    """U101-U106: links, joints and materials are named, uniquely, without '%', not too long."""
     if root.tag != "robot":
         return
     for tag, code in (("link", "U102"), ("joint", "U103")):
@@ -210,13 +234,462 @@ def rule_link_count(root: etree._Element, r: Report) -> None:
               "the model", root)
 
 
+# --------------------------------------------------------------------------- values and physics
+# Numbers are parsed once per attribute by _num/_vec, which never report: rule_numbers reports
+# every malformed number once, and the other rules simply skip what does not parse.
+
+#: Numeric attributes: (tag, attribute) -> how many numbers it holds.
+NUMERIC: dict[tuple[str, str], int] = {
+    ("origin", "xyz"): 3, ("origin", "rpy"): 3, ("axis", "xyz"): 3,
+    ("box", "size"): 3, ("cylinder", "radius"): 1, ("cylinder", "length"): 1,
+    ("capsule", "radius"): 1, ("capsule", "length"): 1, ("sphere", "radius"): 1,
+    ("mesh", "scale"): 3, ("cdf", "scale"): 3, ("plane", "normal"): 3,
+    ("color", "rgba"): 4, ("specular", "rgb"): 3, ("mass", "value"): 1,
+    **{("inertia", a): 1 for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
+    **{("limit", a): 1 for a in ("lower", "upper", "effort", "velocity")},
+    ("dynamics", "damping"): 1, ("dynamics", "friction"): 1,
+    ("mimic", "multiplier"): 1, ("mimic", "offset"): 1,
+    **{("safety_controller", a): 1
+       for a in ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity")},
+    ("calibration", "rising"): 1, ("calibration", "falling"): 1,
+    **{(t, "value"): 1 for t in (
+        "lateral_friction", "rolling_friction", "spinning_friction", "restitution",
+        "stiffness", "damping", "contact_cfm", "contact_erp", "inertia_scaling")},
+}
+
+#: PyBullet's joint types: the URDF ones plus its ``spherical`` extension.
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar", "spherical")
+#: Shapes a ``<geometry>`` may hold in PyBullet (capsule, plane and cdf are its extensions).
+SHAPES = ("box", "cylinder", "sphere", "mesh", "capsule", "plane", "cdf")
+#: Subtrees urdfkit does not look into: ROS/Gazebo extensions and PyBullet's soft bodies.
+OPAQUE = ("gazebo", "transmission", "deformable")
+_CONTACT_VALUES = ("lateral_friction", "rolling_friction", "spinning_friction", "restitution",
+                   "stiffness", "damping", "contact_cfm", "contact_erp", "inertia_scaling",
+                   "friction_anchor")
+
+#: Known children and attributes per tag, PyBullet's extensions included (``<contact>``,
+#: ``<collision group= mask= concave=>``, ``<specular>``, capsule/plane/cdf shapes).
+SCHEMA: dict[str, tuple[frozenset[str], frozenset[str]]] = {
+    tag: (frozenset(attrs.split()), frozenset(children.split()))
+    for tag, attrs, children in (
+        ("robot", "name version", "link joint material " + " ".join(OPAQUE)),
+        ("link", "name type", "inertial visual collision contact"),
+        ("inertial", "", "origin mass inertia"),
+        ("origin", "xyz rpy", ""),
+        ("mass", "value", ""),
+        ("inertia", "ixx ixy ixz iyy iyz izz", ""),
+        ("visual", "name", "origin geometry material"),
+        ("collision", "name group mask concave", "origin geometry"),
+        ("geometry", "", " ".join(SHAPES)),
+        ("box", "size", ""), ("cylinder", "radius length", ""), ("sphere", "radius", ""),
+        ("capsule", "radius length", ""), ("mesh", "filename scale", ""),
+        ("plane", "normal", ""), ("cdf", "filename scale", ""),
+        ("material", "name", "color texture specular"),
+        ("color", "rgba", ""), ("texture", "filename", ""), ("specular", "rgb", ""),
+        ("contact", "", " ".join(_CONTACT_VALUES)),
+        *((t, "value", "") for t in _CONTACT_VALUES),
+        ("joint", "name type", "origin parent child axis calibration dynamics limit mimic "
+                               "safety_controller"),
+        ("parent", "link", ""), ("child", "link", ""), ("axis", "xyz", ""),
+        ("calibration", "rising falling reference_position", ""),
+        ("dynamics", "damping friction", ""),
+        ("limit", "lower upper effort velocity", ""),
+        ("mimic", "joint multiplier offset", ""),
+        ("safety_controller", "soft_lower_limit soft_upper_limit k_position k_velocity", ""),
+    )
+}
+
+#: Drake's tolerance unit for inertia checks (DBL_EPSILON).
+_DBL_EPSILON = sys.float_info.epsilon
+
+
+def _walk(root: etree._Element) -> Iterator[etree._Element]:
+    """Every element urdfkit checks: skips comments, namespaced tags and opaque subtrees."""
+    stack = [root]
+    while stack:
+        el = stack.pop()
+        yield el
+        for child in reversed(el):
+            if isinstance(child.tag, str) and not child.tag.startswith("{") \
+                    and child.tag not in OPAQUE:
+                stack.append(child)
+
+
+def _numbers(text: str | None) -> list[float] | None:
+    if text is None:
+        return None
+    try:
+        return [float(x) for x in text.split()]
+    except ValueError:
+        return None
+
+
+def _vec(el: etree._Element | None, attr: str, n: int) -> tuple[float, ...] | None:
+    """``n`` finite numbers from ``el.attr``, or None (missing or malformed: not reported here)."""
+    if el is None:
+        return None
+    vals = _numbers(el.get(attr))
+    if vals is None or len(vals) != n or not all(math.isfinite(v) for v in vals):
+        return None
+    return tuple(vals)
+
+
+def _num(el: etree._Element | None, attr: str) -> float | None:
+    v = _vec(el, attr, 1)
+    return None if v is None else v[0]
+
+
+def rule_numbers(root: etree._Element, r: Report) -> None:
+    """U401-U402: every number parses and is finite; vectors have the right length."""
+    for el in _walk(root):
+        for attr, text in el.attrib.items():
+            n = NUMERIC.get((el.tag, attr))
+            if n is None:
+                continue
+            vals = _numbers(text)
+            if vals is None or not all(math.isfinite(v) for v in (vals or [])):
+                r.add("U401", "error", f"<{el.tag} {attr}={text!r}>: expected "
+                      f"{'a finite number' if n == 1 else f'{n} finite numbers'}", el)
+            elif len(vals) != n:
+                r.add("U402", "error", f"<{el.tag} {attr}={text!r}>: expected {n} numbers, got "
+                      f"{len(vals)}", el)
+
+
+def rule_joints(root: etree._Element, r: Report) -> None:
+    """U301-U307: joint type known, limits present and ordered, axis non-zero, mimic exists."""
+    joints = {j.get("name") for j in _elements(root, "joint")}
+    for j in _elements(root, "joint"):
+        jtype = j.get("type")
+        if jtype not in JOINT_TYPES:
+            r.add("U301", "error", f"{_label(j)} has type {jtype!r}; use one of "
+                  f"{', '.join(JOINT_TYPES)}", j)
+        limit = j.find("limit")
+        if jtype in ("revolute", "prismatic"):
+            if limit is None:
+                r.add("U302", "error", f"{_label(j)} is {jtype} but has no <limit>; add <limit "
+                      "lower=... upper=... effort=... velocity=...>", j)
+            else:
+                missing = [a for a in ("effort", "velocity") if limit.get(a) is None]
+                if missing:
+                    r.add("U303", "error", f"<limit> of {_label(j)} has no "
+                          f"{' or '.join(missing)}; add {'='.join(missing[:1])}=\"...\"", limit)
+        lower, upper = _num(limit, "lower"), _num(limit, "upper")
+        if lower is not None and upper is not None and lower > upper:
+            r.add("U304", "error", f"<limit> of {_label(j)} has lower {lower:g} above upper "
+                  f"{upper:g}; swap them (PyBullet reads lower > upper as 'no limit', other "
+                  "tools refuse it)", limit)
+        axis_el = j.find("axis")
+        axis = _vec(axis_el, "xyz", 3)
+        if axis is not None and jtype != "fixed":
+            norm = math.sqrt(sum(a * a for a in axis))
+            if norm == 0:
+                r.add("U305", "error", f"<axis> of {_label(j)} is zero; give a direction such "
+                      "as xyz=\"0 0 1\"", axis_el)
+            elif abs(norm - 1) > 1e-4:
+                r.add("U306", "warning", f"<axis> of {_label(j)} has length {norm:.6g}, not 1; "
+                      "PyBullet normalises it, other tools may not: write a unit vector",
+                      axis_el)
+        mimic = j.find("mimic")
+        if mimic is not None:
+            target = mimic.get("joint")
+            if target not in joints or target == j.get("name"):
+                r.add("U307", "error", f"<mimic> of {_label(j)} follows joint {target!r}, which "
+                      "does not exist (or is itself); name another joint", mimic)
+
+
+def rule_geometry(root: etree._Element, r: Report) -> None:
+    """U501-U503: one shape per <geometry>, positive sizes, meshes have a filename."""
+    for geom in root.iter("geometry"):
+        shapes = [c for c in geom if isinstance(c.tag, str) and c.tag in SHAPES]
+        if len(shapes) != 1:
+            owner = geom.getparent()
+            what = f"<{owner.tag}> of {_label(owner.getparent())}" if owner is not None \
+                and owner.getparent() is not None else "<geometry>"
+            r.add("U502", "error", f"<geometry> in {what} holds {len(shapes)} shapes; it needs "
+                  f"exactly one of {', '.join(SHAPES[:4])}", geom)
+        for shape in shapes:
+            for attr in {"box": ("size",), "cylinder": ("radius", "length"),
+                         "capsule": ("radius", "length"), "sphere": ("radius",)}.get(
+                             shape.tag, ()):
+                vals = _numbers(shape.get(attr))
+                if shape.get(attr) is None:
+                    r.add("U501", "error", f"<{shape.tag}> has no {attr}; add {attr}=\"...\"",
+                          shape)
+                elif vals and all(math.isfinite(v) for v in vals) and min(vals) <= 0:
+                    r.add("U501", "error", f"<{shape.tag} {attr}={shape.get(attr)!r}>: sizes must "
+                          "be > 0", shape)
+            if shape.tag in ("mesh", "cdf") and not (shape.get("filename") or "").strip():
+                r.add("U503", "error", f"<{shape.tag}> has no filename", shape)
+
+
+def _mass_of(link: etree._Element) -> float | None:
+    """The mass PyBullet gives a link: its <mass>, or 1 kg if there is no <inertial>."""
+    inertial = link.find("inertial")
+    if inertial is None:
+        return 1.0
+    return _num(inertial.find("mass"), "value")
+
+
+def rule_mass(root: etree._Element, r: Report) -> None:
+    """U601-U602, U606: mass >= 0, > 0 on links that move; warn on missing <inertial>."""
+    links = {el.get("name"): el for el in _elements(root, "link") if el.get("name")}
+    fixed_children: dict[str, list[str]] = {}
+    moving: list[tuple[str, etree._Element]] = []
+    for j in _elements(root, "joint"):
+        parent, child = j.find("parent"), j.find("child")
+        if parent is None or child is None:
+            continue
+        if j.get("type") == "fixed":
+            fixed_children.setdefault(parent.get("link", ""), []).append(child.get("link", ""))
+        else:
+            moving.append((child.get("link", ""), j))
+    for name, link in links.items():
+        inertial = link.find("inertial")
+        if inertial is None:
+            r.add("U606", "warning", f"{_label(link)} has no <inertial>; PyBullet silently gives "
+                  "it 1 kg and unit inertia: add <inertial> (mass 0 for a frame)", link)
+            continue
+        mass_el = inertial.find("mass")
+        mass = _num(mass_el, "value")
+        if mass_el is None or mass_el.get("value") is None:
+            r.add("U601", "error", f"<inertial> of {_label(link)} has no <mass value=...>",
+                  inertial)
+        elif mass is not None and mass < 0:
+            r.add("U601", "error", f"{_label(link)} has negative mass {mass:g}; mass must be "
+                  ">= 0", mass_el)
+    for name, j in moving:
+        if name not in links:
+            continue
+        # The link moves with everything fixed to it: it is massless only if all of them are.
+        total, stack, seen = 0.0, [name], set()
+        while stack:
+            n = stack.pop()
+            if n in seen or n not in links:
+                continue
+            seen.add(n)
+            total += max(0.0, _mass_of(links[n]) or 0.0)
+            stack.extend(fixed_children.get(n, []))
+        if total == 0:
+            r.add("U602", "error", f"{_label(links[name])} moves (joint {j.get('name')!r} is "
+                  f"{j.get('type')}) but has mass 0; give it a mass > 0", links[name])
+
+
+def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | None:
+    vals = [_num(inertia, a) for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")]
+    if any(v is None for v in vals):
+        return None
+    ixx, ixy, ixz, iyy, iyz, izz = vals  # type: ignore[misc]
+    return ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))  # type: ignore[return-value]
+
+
+def rule_inertia(root: etree._Element, r: Report) -> None:
+    """U603-U605, U607: inertia positive definite, triangle inequality, plausible for shapes.
+
+    Tolerance as in Drake's ``RotationalInertia::CouldBePhysicallyValid``:
+    ``eps = 10 * DBL_EPSILON * max(1, trace / 2)``, on the principal moments.
+    """
+    from .builder import _sym_eigenvalues
+
+    noted = False
+    for link in _elements(root, "link"):
+        inertial = link.find("inertial")
+        inertia = inertial.find("inertia") if inertial is not None else None
+        if inertia is None:
+            continue
+        if not noted:
+            r.add("U607", "info", "PyBullet ignores <inertia> from the file and recomputes it "
+                  "from the collision shapes unless loaded with URDF_USE_INERTIA_FROM_FILE "
+                  "(urdfkit: --inertia-from-file)", inertia)
+            noted = True
+        tensor = _inertia_tensor(inertia)
+        mass = _num(inertial.find("mass"), "value")
+        if tensor is None:
+            continue
+        trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
+        eps = 10 * _DBL_EPSILON * max(1.0, trace / 2)
+        a, b, c = _sym_eigenvalues(tensor)  # type: ignore[arg-type]
+        if a < -eps:
+            r.add("U603", "error", f"inertia of {_label(link)} is not positive definite "
+                  f"(principal moments {a:.4g}, {b:.4g}, {c:.4g}); every principal moment must "
+                  "be > 0", inertia)
+            continue
+        if mass is not None and mass > 0 and a <= eps:
+            r.add("U608", "warning", f"inertia of {_label(link)} is singular (principal moments "
+                  f"{a:.4g}, {b:.4g}, {c:.4g}): a point or a thin rod, not a solid; with "
+                  "URDF_USE_INERTIA_FROM_FILE the solver may blow up", inertia)
+        if a + b < c - eps:
+            r.add("U604", "error", f"inertia of {_label(link)} violates the triangle inequality: "
+                  f"principal moments {a:.4g} + {b:.4g} < {c:.4g}; no rigid body has it", inertia)
+            continue
+        expected = _shape_trace(link, mass)
+        if expected and trace > 0 and not 0.1 <= trace / expected <= 10:
+            r.add("U605", "warning", f"inertia of {_label(link)} is {trace / expected:.3g} times "
+                  f"what its collision shapes and mass {mass:g} kg imply; check the units "
+                  "and the mass", inertia)
+
+
+def _shape_trace(link: etree._Element, mass: float | None) -> float | None:
+    """Trace of the inertia of the link's primitive collision shapes, or None if unknown."""
+    if mass is None or mass <= 0:
+        return None
+    from .builder import Box, Cylinder, Inertial, Origin, Sphere
+    from .errors import ModelError
+
+    shapes = []
+    for col in link.findall("collision"):
+        shape = next((c for c in col.iterfind("geometry/*") if c.tag in SHAPES), None)
+        if shape is None:
+            return None
+        origin = col.find("origin")
+        try:
+            o = Origin(xyz=_vec(origin, "xyz", 3) or (0, 0, 0),
+                       rpy=_vec(origin, "rpy", 3) or (0, 0, 0))
+            if shape.tag == "box":
+                g: object = Box(size=_vec(shape, "size", 3))
+            elif shape.tag == "cylinder":
+                g = Cylinder(radius=_num(shape, "radius"), length=_num(shape, "length"))
+            elif shape.tag == "sphere":
+                g = Sphere(radius=_num(shape, "radius"))
+            else:
+                return None  # meshes, capsules, planes: no volume without loading them
+        except ModelError:
+            return None
+        shapes.append((g, o))
+    if not shapes:
+        return None
+    tensor = Inertial.from_shapes(mass, shapes).inertia  # type: ignore[arg-type]
+    assert tensor is not None
+    return tensor.ixx + tensor.iyy + tensor.izz
+
+
+def _package_folder(name: str, r: Report) -> Path | None:
+    from .resolve import _find_package
+
+    if name in r.packages:
+        return r.packages[name]
+    return _find_package(name, r.base) if r.base is not None else None
+
+
+def rule_meshes(root: etree._Element, r: Report) -> None:
+    """U701-U702: mesh and texture files exist, through package:// and relative paths."""
+    if r.base is None:
+        return
+    for el in root.iter("mesh", "texture", "cdf"):
+        fn = (el.get("filename") or "").strip()
+        if not fn:
+            continue
+        if fn.startswith("package://"):
+            pkg, _, rest = fn[len("package://"):].partition("/")
+            folder = _package_folder(pkg, r)
+            if folder is None:
+                r.add("U702", "error", f"<{el.tag} filename={fn!r}>: package {pkg!r} not found "
+                      f"near the file; pass --package {pkg}=PATH", el)
+                continue
+            path = folder / rest
+        else:
+            path = Path(fn[len("file://"):] if fn.startswith("file://") else fn)
+            if not path.is_absolute():
+                path = r.base / path
+        if os.path.isfile(path):
+            continue
+        data = _pybullet_data()
+        if not fn.startswith("package://") and data is not None and (data / fn).is_file():
+            # PyBullet finds it only after setAdditionalSearchPath(pybullet_data.getDataPath()).
+            r.add("U703", "warning", f"<{el.tag} filename={fn!r}>: not beside the file, found "
+                  "only in pybullet_data's search path; make the path relative to the file", el)
+            continue
+        r.add("U701", "error", f"<{el.tag} filename={fn!r}>: file not found ({path})", el)
+
+
+def _pybullet_data() -> Path | None:
+    from .resolve import pybullet_data_path
+
+    return pybullet_data_path()
+
+
+def rule_schema(root: etree._Element, r: Report) -> None:
+    """U801-U802: unknown tags and attributes (typos, or extensions PyBullet ignores)."""
+    for el in _walk(root):
+        known = SCHEMA.get(el.tag)
+        if known is None:
+            continue
+        attrs, children = known
+        for attr in el.attrib:
+            if attr not in attrs and not attr.startswith("{"):
+                r.add("U802", "warning", f"<{el.tag}> has unknown attribute {attr!r}; PyBullet "
+                      "ignores it", el)
+        for child in el:
+            if isinstance(child.tag, str) and not child.tag.startswith("{") \
+                    and child.tag not in children:
+                r.add("U801", "warning", f"<{child.tag}> is not known inside <{el.tag}>; "
+                      "PyBullet ignores it", child)
+
+
 #: Rules that stand between a file and a PyBullet crash, in order.
 GUARD_RULES: tuple[Rule, ...] = (rule_document, rule_names, rule_tree)
 
+#: Every rule ``urdfkit check`` runs, in order.
+ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_numbers, rule_joints,
+                               rule_geometry, rule_mass, rule_inertia, rule_meshes, rule_schema)
 
-def run_rules(root: etree._Element, file: str, rules: tuple[Rule, ...]) -> list[Finding]:
-    """Run ``rules`` over a document root and return the findings."""
-    report = Report(file)
+#: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
+CODES: dict[str, str] = {
+    "U000": "file unreadable or not well-formed XML",
+    "U004": "XML quirk PyBullet tolerates but other parsers refuse",
+    "U001": "root element is not <robot>",
+    "U002": "<robot> has no name",
+    "U003": "no <link>",
+    "U101": "link, joint or material without a name",
+    "U102": "duplicate link name",
+    "U103": "duplicate joint name",
+    "U104": "'%' in a name (crashes PyBullet)",
+    "U105": "duplicate material name",
+    "U106": "link or joint name over 1000 characters (crashes PyBullet)",
+    "U201": "joint without <parent> or <child>",
+    "U202": "joint refers to a missing link",
+    "U203": "joint joins a link to itself",
+    "U204": "link with two parents",
+    "U205": "more than one root link",
+    "U206": "no root link (cycle)",
+    "U207": "kinematic cycle",
+    "U208": "128 links or more",
+    "U301": "unknown joint type",
+    "U302": "revolute/prismatic joint without <limit>",
+    "U303": "<limit> without effort or velocity",
+    "U304": "limit lower > upper",
+    "U305": "zero joint axis",
+    "U306": "joint axis not unit length",
+    "U307": "mimic refers to a missing joint",
+    "U401": "number does not parse or is not finite",
+    "U402": "vector of the wrong length",
+    "U501": "missing or non-positive shape size",
+    "U502": "<geometry> without exactly one shape",
+    "U503": "mesh without filename",
+    "U601": "negative or missing mass",
+    "U602": "moving link with mass 0",
+    "U603": "inertia not positive definite",
+    "U604": "inertia violates the triangle inequality",
+    "U605": "inertia far from what shapes and mass imply",
+    "U606": "link without <inertial>",
+    "U607": "file inertia ignored without URDF_USE_INERTIA_FROM_FILE",
+    "U608": "singular inertia (a zero principal moment) with positive mass",
+    "U701": "mesh or texture file not found",
+    "U702": "package:// package not found",
+    "U703": "mesh found only through pybullet_data's search path",
+    "U801": "unknown tag",
+    "U802": "unknown attribute",
+}
+
+
+def run_rules(root: etree._Element, file: str, rules: tuple[Rule, ...], *,
+              base: Path | None = None,
+              packages: Mapping[str, Path] | None = None) -> list[Finding]:
+    """Run ``rules`` over a document root and return the findings.
+
+    ``base`` (the file's folder) and ``packages`` enable the rules that look at the file
+    system (meshes exist); without ``base`` they are skipped.
+    """
+    report = Report(file, base, packages)
     for rule in rules:
         rule(root, report)
     return report.findings
