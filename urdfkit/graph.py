@@ -4,10 +4,11 @@ Links are boxes, joints are edges from parent to child labelled with the joint's
 axis and limits, and the index PyBullet will give it. The graph is built from the lxml
 document by :func:`urdfkit.inspect.kinematic_tree`, so no PyBullet is loaded.
 
-Names are written as quoted DOT strings. Inside them only ``"`` needs escaping for the parser,
-but Graphviz also expands escape sequences in *labels* (``\\N`` becomes the node name, ``\\G``
-the graph name, ``\\n`` a line break), so backslashes are doubled as well: a link called
-``a\\N`` shows as ``a\\N``, not as its own name.
+Names are written as quoted DOT strings, with ``"`` and ``\`` escaped. Graphviz expands escape
+sequences in *labels* (``\N`` becomes the node name, ``\G`` the graph name, ``\n`` a line
+break), so doubling backslashes makes a link called ``a\N`` show as ``a\N``. In node IDs the
+doubled backslash stays doubled (DOT cannot end a quoted ID with a single one), which is why
+every node carries an explicit label with the exact name.
 """
 
 from __future__ import annotations
