@@ -13,8 +13,15 @@ from typing import Any
 import pytest
 
 from urdfkit.errors import MissingDependencyError, OutputError, ParameterError
-from urdfkit.sim import Observation, SimResult, Simulation, flatten, rows_to_bytes, summarize, \
-    write_rows
+from urdfkit.sim import (
+    Observation,
+    SimResult,
+    Simulation,
+    flatten,
+    rows_to_bytes,
+    summarize,
+    write_rows,
+)
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
 G = 9.81
