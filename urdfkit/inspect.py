@@ -32,7 +32,7 @@ from typing import Any
 from lxml import etree
 
 from .resolve import Resolved
-from .session import LoadOptions, Session
+from .session import LoadOptions, Session, quiet_stdout
 
 #: ``getJointInfo``'s jointType codes (p.JOINT_REVOLUTE == 0, ...), as names.
 JOINT_TYPE_NAMES = {0: "REVOLUTE", 1: "PRISMATIC", 2: "SPHERICAL", 3: "PLANAR", 4: "FIXED",
@@ -481,15 +481,19 @@ def inspect_file(resolved: Resolved, options: LoadOptions | None = None, *,
     """Load a resolved file and read its joint table, and optionally links and summary."""
     options = options or LoadOptions()
     with loaded(resolved, options) as (s, body):
-        joints = joint_table(s, body, resolved.root)
-        report = Report(resolved.name, str(resolved.source), resolved.robot_name,
-                        base_link_name(s, body), joints)
-        if links:
-            report.links = link_table(s, body, resolved.root, joints)
-        if info:
-            report.summary = summary(s, body, resolved.root, options.fixed_base)
-    # Collected after close() so disconnect's own chatter is included.
-    report.diagnostics = tidy_diagnostics(s.diagnostics)
+        # One capture around all the queries instead of a temp file per PyBullet call (the
+        # inner quiet_stdout blocks are re-entrant no-ops). Loading stays outside it, so a
+        # refused file's error message can quote what PyBullet said.
+        with quiet_stdout() as out:
+            joints = joint_table(s, body, resolved.root)
+            report = Report(resolved.name, str(resolved.source), resolved.robot_name,
+                            base_link_name(s, body), joints)
+            if links:
+                report.links = link_table(s, body, resolved.root, joints)
+            if info:
+                report.summary = summary(s, body, resolved.root, options.fixed_base)
+    # After close(), so disconnect's own chatter is included too.
+    report.diagnostics = tidy_diagnostics([*s.diagnostics, *out.lines])
     return report
 
 

@@ -209,7 +209,10 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
 def open_input(name: str | Path, packages: list[str] | None = None,
                xacro_args: list[str] | None = None) -> Resolved:
     """:func:`resolve` with the raw ``--package NAME=PATH`` and ``--arg k:=v`` option lists."""
-    from .catalog import parse_assignments
+    args: dict[str, str] = {}
+    if xacro_args:
+        # Only now: catalog pulls in the builder model (~15 ms), which plain loads never need.
+        from .catalog import parse_assignments
 
-    return resolve(name, packages=parse_packages(packages),
-                   xacro_args=parse_assignments(xacro_args, "--arg"))
+        args = dict(parse_assignments(xacro_args, "--arg"))
+    return resolve(name, packages=parse_packages(packages), xacro_args=args)
