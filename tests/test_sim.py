@@ -445,3 +445,30 @@ def _no_leaked_clients() -> Iterator[None]:
     before = connected()
     yield
     assert connected() <= before
+
+
+def test_pybullet_data_models_load_by_name() -> None:
+    doc = {"ground": "plane.urdf", "duration": 0.1, "record": {"every": 12},
+           "robots": [{"urdf": "r2d2.urdf", "position": [0, 0, 0.5], "inertia_from_file": False}]}
+    with Simulation(doc) as sim:
+        result = sim.run()
+    assert len(result.rows) == 3
+    assert "head_swivel" in result.rows[-1].motor_angles
+
+
+def test_bodies_too_large_for_state_queries_are_refused(tmp_path: Path) -> None:
+    from urdfkit.builder import Box, Collision, Inertial, Joint, Limit, Link, Origin, Robot
+    from urdfkit.errors import InputError
+
+    chain = Robot("chain")
+    chain.add_link(Link("l0", inertial=Inertial(1.0), collisions=[Collision(Box((0.1,) * 3))]))
+    for i in range(1, 130):
+        chain.add_link(Link(f"l{i}", inertial=Inertial(0.1),
+                            collisions=[Collision(Box((0.05,) * 3))]))
+        chain.add_joint(Joint(f"j{i}", "revolute", f"l{i - 1}", f"l{i}", Origin((0, 0, 0.06)),
+                              axis=(0, 1, 0), limit=Limit(1, 1, -1, 1)))
+    chain.write(tmp_path / "chain.urdf")
+    doc = {"robots": [{"name": "snake", "urdf": str(tmp_path / "chain.urdf"), "base": "fixed"}]}
+    with pytest.raises(InputError, match=r"robots\[0\]: snake has 130 links; PyBullet cannot "
+                                         "report the state"):
+        Simulation(doc)

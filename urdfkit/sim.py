@@ -336,6 +336,14 @@ class Simulation:
                               self_collision=cfg.self_collision,
                               base_position=tuple(cfg.position), base_orientation=orientation)
         body = self._load(path, cfg.template, cfg.params, cfg.urdf, options)
+        from .validate import MAX_PYBULLET_LINKS
+
+        links_count = p.getNumJoints(body, physicsClientId=client) + 1
+        if links_count >= MAX_PYBULLET_LINKS:
+            # getBasePositionAndOrientation, getJointStates... all fail on such bodies.
+            raise self._error(path, f"{cfg.name} has {links_count} links; PyBullet cannot "
+                                    f"report the state of bodies with {MAX_PYBULLET_LINKS} "
+                                    "links or more")
 
         joints: list[JointSpec] = []
         for j in range(p.getNumJoints(body, physicsClientId=client)):
