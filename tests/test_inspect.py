@@ -56,7 +56,7 @@ def test_joint_table_matches_raw_getjointinfo(simplecar_urdf: Path, pb) -> None:
         assert d["linkName"] == raw[12].decode()
         assert d["parentFrameOrn"] == list(raw[15])
         rpy = p.getEulerFromQuaternion(raw[15])
-        assert all(math.isclose(a, b, abs_tol=1e-9) for a, b in zip(j.parent_frame_rpy, rpy))
+        assert j.parent_frame_rpy == pytest.approx(rpy, abs=1e-9)
 
 
 def test_continuous_joint_is_named_and_unlimited(simplecar_urdf: Path) -> None:

@@ -65,7 +65,7 @@ def test_json_agrees_with_raw_getjointinfo(name: str, pb) -> None:
     for joint in data["joints"]:
         raw = p.getJointInfo(body, joint["jointIndex"], physicsClientId=client)
         assert list(joint)[:17] == list(JOINT_INFO_FIELDS)
-        for key, value in zip(JOINT_INFO_FIELDS, raw):
+        for key, value in zip(JOINT_INFO_FIELDS, raw, strict=False):
             if isinstance(value, bytes):
                 value = value.decode()
             elif isinstance(value, tuple):

@@ -175,7 +175,7 @@ class JointInfo:
             self.link_name, list(self.joint_axis), list(self.parent_frame_pos),
             list(self.parent_frame_orn), self.parent_index,
         )
-        out = dict(zip(JOINT_INFO_FIELDS, values))
+        out = dict(zip(JOINT_INFO_FIELDS, values, strict=False))
         out.update(urdfType=self.urdf_type, parentLinkName=self.parent_link_name,
                    parentFrameRpy=list(self.parent_frame_rpy), movable=self.movable,
                    limited=self.limited)
@@ -256,7 +256,7 @@ class FileInertial:
     def to_dict(self) -> dict[str, Any]:
         """The JSON form."""
         names = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-        return {"mass": self.mass, "inertia": dict(zip(names, self.inertia)),
+        return {"mass": self.mass, "inertia": dict(zip(names, self.inertia, strict=False)),
                 "principal": list(self.principal), "xyz": list(self.xyz), "rpy": list(self.rpy)}
 
 
@@ -327,7 +327,7 @@ class LinkDynamics:
             return True
         engine = sorted(self.local_inertia_diagonal)
         return not all(math.isclose(a, b, rel_tol=1e-4, abs_tol=1e-12)
-                       for a, b in zip(engine, self.file.principal))
+                       for a, b in zip(engine, self.file.principal, strict=False))
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form: getDynamicsInfo's fields in snake_case, and the file's values."""
@@ -355,7 +355,7 @@ def link_table(s: Session, body: int, root: etree._Element | None = None,
         by_name = {el.get("name", ""): el for el in _children(root, "link")}
     names = [base_link_name(s, body)] + [j.link_name for j in joints]
     out = []
-    for index, name in zip(range(-1, len(joints)), names):
+    for index, name in zip(range(-1, len(joints)), names, strict=True):
         d = s.call("getDynamicsInfo", body, index)
         out.append(LinkDynamics(
             index, name, float(d[0]), float(d[1]), tuple(d[2]), tuple(d[3]), tuple(d[4]),  # type: ignore[arg-type]
@@ -396,7 +396,7 @@ class Summary:
     @property
     def size(self) -> Vec3:
         """Extent of the bounding box along x, y, z."""
-        return tuple(hi - lo for lo, hi in zip(self.aabb_min, self.aabb_max))  # type: ignore[return-value]
+        return tuple(hi - lo for lo, hi in zip(self.aabb_min, self.aabb_max, strict=False))  # type: ignore[return-value]
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form."""
@@ -422,8 +422,8 @@ def summary(s: Session, body: int, root: etree._Element, fixed_base: bool = Fals
     hi = [-math.inf] * 3
     for index in range(-1, len(joints)):
         a, b = s.call("getAABB", body, index)
-        lo = [min(x, y) for x, y in zip(lo, a)]
-        hi = [max(x, y) for x, y in zip(hi, b)]
+        lo = [min(x, y) for x, y in zip(lo, a, strict=False)]
+        hi = [max(x, y) for x, y in zip(hi, b, strict=False)]
     return Summary(
         robot=root.get("name", ""), base_link=base_link_name(s, body), links=len(links),
         joints=len(joints), joint_types=dict(sorted(types.items())),
@@ -504,8 +504,8 @@ _B3_PREFIX = re.compile(r"b3(?:Warning|Error)\[[^\]]*\]:\s*|b3Printf:\s*")
 def tidy_diagnostics(lines: Sequence[str]) -> list[str]:
     """PyBullet's captured output as readable, de-duplicated messages.
 
-    PyBullet writes each warning as ``b3Warning[file.cpp,126]:\\n`` + text with no newline, so
-    messages run into the next prefix, and it reports the link a warning is about as a
+    PyBullet writes each warning as ``b3Warning[file.cpp,126]:``, a newline, then text with no
+    newline after it, so messages run into the next prefix; and it reports the link a warning is about as a
     separate warning of its own. Drop the prefixes, and fold the link name back into the
     "No inertial data for link" message it belongs to.
     """
