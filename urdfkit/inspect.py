@@ -505,9 +505,9 @@ def tidy_diagnostics(lines: Sequence[str]) -> list[str]:
     """PyBullet's captured output as readable, de-duplicated messages.
 
     PyBullet writes each warning as ``b3Warning[file.cpp,126]:``, a newline, then text with no
-    newline after it, so messages run into the next prefix; and it reports the link a warning is about as a
-    separate warning of its own. Drop the prefixes, and fold the link name back into the
-    "No inertial data for link" message it belongs to.
+    newline after it, so messages run into the next prefix; and it reports the link a warning
+    is about as a separate warning of its own. Drop the prefixes, and fold the link name back into
+    the "No inertial data for link" message it belongs to.
     """
     parts = [p.strip() for p in _B3_PREFIX.split("\n".join(lines))]
     parts = [p for chunk in parts for p in chunk.splitlines() if p.strip()]
