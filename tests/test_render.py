@@ -70,10 +70,11 @@ def test_image_has_requested_size_and_real_content(robot: str, car_views: dict,
     for name, img in views.items():
         assert img.shape == (240, 320, 3), name
         assert img.dtype == np.uint8
-        # Not blank: many distinct colours (shading, edges), and the robot covers a real
-        # share of the frame without filling it (auto framing leaves a margin).
+        # Not blank: many distinct colours (shaded faces, smoothed edges, the grid), a real
+        # contrast, and the robot covers a share of the frame without filling it.
         colours = len(np.unique(img.reshape(-1, 3), axis=0))
-        assert colours > 100, (name, colours)
+        assert colours > 15, (name, colours)
+        assert img.std() > 20, (name, img.std())
         share = _ink(img).mean()
         assert 0.04 < share < 0.8, (name, share)
 

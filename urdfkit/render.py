@@ -13,8 +13,8 @@ What TinyRenderer does and does not do, measured on PyBullet 3.2.7, decides the 
 - It ignores ``addUserDebugLine`` (those are GUI-only; the image does not change by a single
   pixel). Ground grid, link frames and joint axes are therefore projected here with the same
   view and projection matrices and drawn with Pillow.
-- It does not antialias. We render at :data:`SUPERSAMPLE` times the size and downsample with
-  a Lanczos filter, which costs about 0.2 s at 800x600 and makes edges and lines smooth.
+- It does not antialias. We render at :data:`SUPERSAMPLE` times the size and average each
+  block of pixels down, which costs about 0.25 s at 800x600 and makes edges and lines smooth.
 - The segmentation mask tells robot pixels from background exactly, so the drawn grid can go
   *behind* the robot: it is painted only where the mask says background (or ground plane).
 
@@ -174,7 +174,7 @@ class Rendering:
         import io
 
         buf = io.BytesIO()
-        Image.fromarray(self.image, "RGB").save(buf, format="PNG", optimize=True)
+        Image.fromarray(self.image, "RGB").save(buf, format="PNG")
         return buf.getvalue()
 
 
@@ -630,7 +630,8 @@ def render(resolved: Any, options: RenderOptions | None = None) -> Rendering:
         line = style.rgb255(style.GRID)
         draw.line((panel_w * ss, 0, panel_w * ss, o.height * ss), fill=line, width=ss)
         draw.line((0, panel_h * ss, o.width * ss, panel_h * ss), fill=line, width=ss)
-    final = out.resize((o.width, o.height), Image.Resampling.LANCZOS)
+    # A box filter over each ss x ss block: plain supersampling, and 10x cheaper than Lanczos.
+    final = out.reduce(ss)
     lo, hi = scene.lo, scene.hi
     return Rendering(
         image=np.asarray(final, dtype=np.uint8).copy(), robot=resolved.robot_name,
