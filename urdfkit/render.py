@@ -394,8 +394,15 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
             if np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(b >= a):
                 lo, hi = np.minimum(lo, a), np.maximum(hi, b)
         frames = _link_frames(p, c, body, n)
-        for pos, _ in frames:  # links with visuals but no collision still get framed
+        for pos, _ in frames:
             lo, hi = np.minimum(lo, pos), np.maximum(hi, pos)
+        if not o.collision:
+            # getAABB only knows collision shapes; a link with visuals only (common in
+            # hand-written files) would fall outside the frame. Bound its visuals too.
+            names = [p.getBodyInfo(body, physicsClientId=c)[0].decode("utf-8")]
+            names += [i[12].decode("utf-8") for i in infos]
+            v_lo, v_hi = _visual_bounds(resolved.root, dict(zip(names, frames, strict=True)))
+            lo, hi = np.minimum(lo, v_lo), np.maximum(hi, v_hi)
         axes = []
         for j, info in enumerate(infos):
             if info[2] == _JOINT_FIXED or info[2] not in (0, 1):
@@ -407,6 +414,76 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
                           "links or more are beyond its state queries", file=resolved.name) \
             from None
     return _Scene(session, body, lo, hi, frames, axes)
+
+
+def _visual_bounds(root: Any, frames: Mapping[str, tuple[Any, Any]]) -> tuple[Any, Any]:
+    """The world box around every primitive ``<visual>``, from the file and the posed frames.
+
+    Exact for boxes, cylinders and spheres. Meshes are skipped: their size is only known after
+    loading them, and nearly all mesh links have collision shapes that getAABB covers.
+    """
+    import numpy as np
+
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for link in root.iter("link"):
+        frame = frames.get(link.get("name", ""))
+        if frame is None:
+            continue
+        for visual in link.iter("visual"):
+            origin = visual.find("origin")
+            xyz = _floats(origin.get("xyz") if origin is not None else None, 3) or [0.0] * 3
+            rpy = _floats(origin.get("rpy") if origin is not None else None, 3) or [0.0] * 3
+            rot = frame[1] @ _rpy_matrix(rpy)
+            half = _half_extent(visual.find("geometry"), rot)
+            if half is None:
+                continue
+            centre = frame[0] + frame[1] @ np.array(xyz)
+            lo, hi = np.minimum(lo, centre - half), np.maximum(hi, centre + half)
+    return lo, hi
+
+
+def _floats(text: str | None, n: int) -> list[float] | None:
+    try:
+        values = [float(x) for x in (text or "").split()]
+    except ValueError:
+        return None
+    return values if len(values) == n and all(map(math.isfinite, values)) else None
+
+
+def _rpy_matrix(rpy: Sequence[float]) -> Any:
+    """URDF's fixed-axis roll, pitch, yaw as a matrix: Rz(yaw) Ry(pitch) Rx(roll)."""
+    import numpy as np
+
+    cr, sr = math.cos(rpy[0]), math.sin(rpy[0])
+    cp, sp = math.cos(rpy[1]), math.sin(rpy[1])
+    cy, sy = math.cos(rpy[2]), math.sin(rpy[2])
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+def _half_extent(geometry: Any, rot: Any) -> Any:
+    """Half the world-axis extent of a primitive shape turned by ``rot`` (None: unknown)."""
+    import numpy as np
+
+    if geometry is None:
+        return None
+    box, cyl, sphere = geometry.find("box"), geometry.find("cylinder"), geometry.find("sphere")
+    if box is not None:
+        size = _floats(box.get("size"), 3)
+        return np.abs(rot) @ (np.abs(size) / 2) if size else None
+    if cyl is not None:
+        r, length = _floats(cyl.get("radius"), 1), _floats(cyl.get("length"), 1)
+        if not (r and length):
+            return None
+        # A disc of radius r around the axis a reaches r * sqrt(1 - a_i^2) along world axis i;
+        # the axis adds half the length times |a_i|.
+        a = rot[:, 2]
+        return abs(r[0]) * np.sqrt(np.clip(1 - a * a, 0, 1)) + abs(length[0]) / 2 * np.abs(a)
+    if sphere is not None:
+        r = _floats(sphere.get("radius"), 1)
+        return np.full(3, abs(r[0])) if r else None
+    return None
 
 
 def _pose(p: Any, c: int, body: int, by_name: Mapping[str, Any], joints: Mapping[str, float],
