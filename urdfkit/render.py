@@ -18,9 +18,10 @@ What TinyRenderer does and does not do, measured on PyBullet 3.2.7, decides the 
 - The segmentation mask tells robot pixels from background exactly, so the drawn grid can go
   *behind* the robot: it is painted only where the mask says background (or ground plane).
 
-Camera framing is computed in closed form from the robot's axis-aligned bounding box (the
-union of ``getAABB`` over all links, after posing): the distance is the smallest at which all
-eight corners fit the frustum with a margin, then the target is shifted to centre them.
+Camera framing is computed in closed form from the robot's axis-aligned bounding box, after
+posing: the union of ``getAABB`` over all links (collision shapes only) and of the primitive
+visuals' world boxes. The distance is the smallest at which all eight corners fit the frustum
+with a margin, then the target is shifted to centre them.
 """
 
 from __future__ import annotations
