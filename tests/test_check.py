@@ -1,0 +1,285 @@
+"""Every rule of ``urdfkit check`` on its own small fixture: the code AND the line."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from urdfkit.check import check_file, check_paths, discover, parse_codes
+from urdfkit.cli import app
+from urdfkit.errors import ParameterError
+from urdfkit.validate import ALL_RULES, CODES, GUARD_RULES
+
+INERTIAL = ('<inertial><mass value="1"/>'
+            '<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>')
+BOX = '<collision><geometry><box size="0.5 0.5 0.5"/></geometry></collision>'
+
+
+def link(name: str, inertial: str = INERTIAL, body: str = BOX) -> str:
+    return f'<link name="{name}">{inertial}{body}</link>'
+
+
+def joint(name: str = "j", parent: str = "a", child: str = "b", jtype: str = "revolute",
+          inner: str = '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" '
+                       'velocity="1"/>') -> str:
+    return (f'<joint name="{name}" type="{jtype}"><parent link="{parent}"/>'
+            f'<child link="{child}"/>{inner}</joint>')
+
+
+def doc(*lines: str, name: str = "r") -> str:
+    """A robot with one element per line; the line marked <!--HERE--> is the expected one."""
+    return "\n".join([f'<robot name="{name}">', *lines, "</robot>", ""])
+
+
+A, B = link("a"), link("b")
+J = joint()
+
+# (code, document); the finding must be on the line that holds <!--HERE-->.
+CASES = [
+    ("U001", '<model name="m"><!--HERE-->\n<link name="a"/>\n</model>\n'),
+    ("U002", '<robot><!--HERE-->\n' + A + "\n</robot>\n"),
+    ("U003", '<robot name="r"><!--HERE-->\n</robot>\n'),
+    ("U101", doc(A, '<link><!--HERE-->' + INERTIAL + "</link>")),
+    ("U102", doc(A, B, J, link("b") + "<!--HERE-->")),
+    ("U103", doc(A, B, link("c"), J, joint("j", "b", "c") + "<!--HERE-->")),
+    ("U104", doc(A, link("b%n") + "<!--HERE-->", joint(child="b%n"))),
+    ("U105", doc('<material name="m"><color rgba="1 0 0 1"/></material>',
+                 '<material name="m"><!--HERE--><color rgba="1 0 0 1"/></material>', A)),
+    ("U106", doc(A, link("b" * 1001) + "<!--HERE-->", joint(child="b" * 1001))),
+    ("U201", doc(A, B, '<joint name="j" type="fixed"><!--HERE--><child link="b"/></joint>')),
+    ("U202", doc(A, B, '<joint name="j" type="fixed"><parent link="a"/>\n'
+                       '<child link="ghost"/><!--HERE--></joint>')),
+    ("U203", doc(A, B, J, joint("k", "b", "b") + "<!--HERE-->")),
+    ("U204", doc(A, B, link("c"), joint("j1", "a", "c"), joint("j3", "a", "b"),
+                 joint("j2", "b", "c") + "<!--HERE-->")),
+    ("U205", doc(A, B + "<!--HERE-->")),
+    ("U206", doc(A, B, joint("j1", "a", "b"), joint("j2", "b", "a")).replace(
+        '<robot name="r">', '<robot name="r"><!--HERE-->')),
+    ("U207", doc(A, B, link("c"), joint("j1", "b", "c"),
+                 joint("j2", "c", "b") + "<!--HERE-->")),
+    ("U301", doc(A, B, joint(jtype="wobbly") + "<!--HERE-->")),
+    ("U302", doc(A, B, joint(inner="") + "<!--HERE-->")),
+    ("U303", doc(A, B, '<joint name="j" type="prismatic"><parent link="a"/><child link="b"/>',
+                 '<limit lower="0" upper="1" effort="1"/><!--HERE-->', "</joint>")),
+    ("U304", doc(A, B, '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>',
+                 '<limit lower="1" upper="0" effort="1" velocity="1"/><!--HERE-->', "</joint>")),
+    ("U305", doc(A, B, '<joint name="j" type="continuous"><parent link="a"/><child link="b"/>',
+                 '<axis xyz="0 0 0"/><!--HERE-->', "</joint>")),
+    ("U306", doc(A, B, '<joint name="j" type="continuous"><parent link="a"/><child link="b"/>',
+                 '<axis xyz="0 0 2"/><!--HERE-->', "</joint>")),
+    ("U307", doc(A, B, '<joint name="j" type="continuous"><parent link="a"/><child link="b"/>',
+                 '<mimic joint="nope"/><!--HERE-->', "</joint>")),
+    ("U401", doc(A, B, '<joint name="j" type="fixed"><parent link="a"/><child link="b"/>',
+                 '<origin xyz="0 nan 0"/><!--HERE-->', "</joint>")),
+    ("U402", doc(A, B, '<joint name="j" type="fixed"><parent link="a"/><child link="b"/>',
+                 '<origin xyz="0 0"/><!--HERE-->', "</joint>")),
+    ("U501", doc(link("a", body='<collision><geometry>\n<sphere radius="0"/><!--HERE-->\n'
+                                '</geometry></collision>'))),
+    ("U502", doc(link("a", body='<collision>\n<geometry><!--HERE--><box size="1 1 1"/>'
+                                '<sphere radius="1"/></geometry>\n</collision>'))),
+    ("U503", doc(link("a", body='<visual><geometry>\n<mesh/><!--HERE-->\n</geometry></visual>'))),
+    ("U601", doc(link("a", '<inertial>\n<mass value="-1"/><!--HERE-->\n</inertial>'))),
+    ("U602", doc(A, link("b", '<inertial><mass value="0"/></inertial>') + "<!--HERE-->",
+                 joint(jtype="continuous", inner=""))),
+    ("U603", doc(link("a", '<inertial><mass value="1"/>\n<inertia ixx="1" ixy="0" ixz="0" '
+                           'iyy="1" iyz="0" izz="-1"/><!--HERE-->\n</inertial>'))),
+    ("U604", doc(link("a", '<inertial><mass value="1"/>\n<inertia ixx="0.1" ixy="0" ixz="0" '
+                           'iyy="0.1" iyz="0" izz="1"/><!--HERE-->\n</inertial>'))),
+    ("U605", doc(link("a", '<inertial><mass value="1"/>\n<inertia ixx="100" ixy="0" ixz="0" '
+                           'iyy="100" iyz="0" izz="100"/><!--HERE-->\n</inertial>'))),
+    ("U606", doc(link("a", inertial="") + "<!--HERE-->")),
+    ("U607", doc(link("a", '<inertial><mass value="1"/>\n<inertia ixx="0.1" ixy="0" ixz="0" '
+                           'iyy="0.1" iyz="0" izz="0.1"/><!--HERE-->\n</inertial>'))),
+    ("U608", doc(link("a", '<inertial><mass value="1"/>\n<inertia ixx="0.1" ixy="0" ixz="0" '
+                           'iyy="0.1" iyz="0" izz="0"/><!--HERE-->\n</inertial>'))),
+    ("U701", doc(link("a", body='<visual><geometry>\n<mesh filename="gone.stl"/><!--HERE-->\n'
+                                '</geometry></visual>'))),
+    ("U702", doc(link("a", body='<visual><geometry>\n<mesh filename="package://nopkg/m.stl"/>'
+                                '<!--HERE-->\n</geometry></visual>'))),
+    ("U703", doc(link("a", body='<visual><geometry>\n<mesh filename="r2d2.urdf"/>'
+                                '<!--HERE-->\n</geometry></visual>'))),
+    ("U801", doc(link("a", body=BOX + "\n<colision/><!--HERE-->\n"))),
+    ("U802", doc(link("a", body='<collision><geometry>\n<box size="1 1 1" colour="red"/>'
+                                '<!--HERE-->\n</geometry></collision>'))),
+]
+
+
+def _line(text: str) -> int:
+    return next(i for i, ln in enumerate(text.splitlines(), 1) if "<!--HERE-->" in ln)
+
+
+def test_every_code_has_a_case() -> None:
+    tested = {code for code, _ in CASES} | {"U000", "U004", "U208", "U209"}  # below
+    assert tested == set(CODES)
+
+
+@pytest.mark.parametrize(("code", "text"), CASES, ids=[c for c, _ in CASES])
+def test_rule_reports_code_and_line(code: str, text: str, tmp_path: Path) -> None:
+    path = tmp_path / "robot.urdf"
+    path.write_text(text)
+    found = [(f.code, f.line) for f in check_file(str(path), path).findings]
+    assert (code, _line(text)) in found, found
+    level = next(f.level for f in check_file(str(path), path).findings if f.code == code)
+    assert level in ("error", "warning", "info")
+
+
+def test_valid_robot_has_no_errors_or_warnings(simplecar_urdf: Path) -> None:
+    findings = check_file(str(simplecar_urdf), simplecar_urdf).findings
+    assert [f for f in findings if f.level != "info"] == []
+
+
+def test_u208_many_links(tmp_path: Path) -> None:
+    n = 128
+    text = doc(*(link(f"l{i}") for i in range(n)),
+               *(joint(f"j{i}", f"l{i}", f"l{i + 1}") for i in range(n - 1)))
+    path = tmp_path / "chain.urdf"
+    path.write_text(text)
+    found = [(f.code, f.line) for f in check_file("chain.urdf", path).findings]
+    assert ("U208", 1) in found
+    path.write_text(text.replace(link("l127"), "").replace(joint("j126", "l126", "l127"), ""))
+    assert "U208" not in {f.code for f in check_file("chain.urdf", path).findings}
+
+
+def test_u209_huge_body_refused_by_guard(tmp_path: Path) -> None:
+    from urdfkit.errors import InputError
+    from urdfkit.resolve import resolve
+
+    n = 1001
+    path = tmp_path / "chain.urdf"
+    path.write_text(doc(*(link(f"l{i}") for i in range(n)),
+                        *(joint(f"j{i}", f"l{i}", f"l{i + 1}") for i in range(n - 1))))
+    assert ("U209", 1) in [(f.code, f.line) for f in check_file("chain.urdf", path).findings]
+    with pytest.raises(InputError, match="1001 links"):
+        resolve(path)
+
+
+def test_u000_broken_xml_line(tmp_path: Path) -> None:
+    path = tmp_path / "broken.urdf"
+    path.write_text('<robot name="r">\n<link name="a">\n</robot>\n')
+    [f] = check_file("broken.urdf", path).findings
+    assert (f.code, f.level, f.line) == ("U000", "error", 3)
+    assert "not well-formed" in f.message
+
+
+def test_u004_quirks_are_warnings_and_rules_still_run(tmp_path: Path) -> None:
+    path = tmp_path / "old.urdf"
+    path.write_text('\n\n<?xml version="1.0"?>\n' + doc(link("a", inertial="")))
+    codes = [(f.code, f.line) for f in check_file("old.urdf", path).findings]
+    assert ("U004", 3) in codes and ("U606", 5) in codes
+
+
+def test_package_uri_resolved_by_option_and_by_package_xml(tmp_path: Path) -> None:
+    pkg = tmp_path / "src" / "mybot_description"
+    (pkg / "meshes").mkdir(parents=True)
+    (pkg / "meshes" / "m.stl").write_bytes(b"solid x\nendsolid x\n")
+    (pkg / "package.xml").write_text("<package><name>mybot_description</name></package>")
+    urdf = pkg / "urdf" / "r.urdf"
+    urdf.parent.mkdir()
+    urdf.write_text(doc(link("a", body='<visual><geometry><mesh filename="package://'
+                                       'mybot_description/meshes/m.stl"/></geometry></visual>')))
+    assert not [f for f in check_file("r.urdf", urdf).findings if f.code.startswith("U7")]
+    elsewhere = tmp_path / "r.urdf"
+    elsewhere.write_text(urdf.read_text())
+    assert "U702" in {f.code for f in check_file("r.urdf", elsewhere).findings}
+    ok = check_file("r.urdf", elsewhere, packages={"mybot_description": pkg}).findings
+    assert not [f for f in ok if f.code.startswith("U7")]
+
+
+def test_relative_mesh_found_beside_file(tmp_path: Path) -> None:
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "m.obj").write_text("v 0 0 0\n")
+    path = tmp_path / "r.urdf"
+    path.write_text(doc(link("a", body='<visual><geometry><mesh filename="meshes/m.obj"/>'
+                                       "</geometry></visual>")))
+    assert not [f for f in check_file("r.urdf", path).findings if f.code.startswith("U7")]
+
+
+def test_pybullet_extensions_are_not_unknown(tmp_path: Path) -> None:
+    path = tmp_path / "ext.urdf"
+    path.write_text(doc(
+        link("a", body='<contact><lateral_friction value="1"/><rolling_friction value="0"/>'
+                       '<stiffness value="1"/><damping value="1"/><friction_anchor/></contact>'
+                       '<collision group="1" mask="1" concave="yes"><geometry>'
+                       '<capsule radius="0.1" length="0.2"/></geometry></collision>'),
+        '<gazebo reference="a"><mu1>0.2</mu1><anything/></gazebo>',
+        '<transmission name="t"><type>x</type></transmission>'))
+    assert not [f for f in check_file("ext.urdf", path).findings if f.code.startswith("U8")]
+
+
+def test_guard_rules_are_a_subset_of_check() -> None:
+    assert set(GUARD_RULES) < set(ALL_RULES)
+
+
+# --------------------------------------------------------------------------- files, options
+
+
+def test_folder_is_searched_recursively_and_xacro_expanded(tmp_path: Path) -> None:
+    (tmp_path / "a" / "b").mkdir(parents=True)
+    (tmp_path / "a" / "b" / "r.urdf").write_text(doc(A))
+    (tmp_path / "a" / "notes.txt").write_text("not a robot")
+    (tmp_path / "car.urdf.xacro").write_text(
+        '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+        '<xacro:property name="m" value="2"/>\n'
+        '<link name="a"><inertial><mass value="${m * -1}"/></inertial></link>\n</robot>\n')
+    result = check_paths([tmp_path], jobs=1)
+    names = [Path(f.file).name for f in result.files]
+    assert sorted(names) == ["car.urdf.xacro", "r.urdf"]
+    xacro = next(fr for fr in result.files if fr.file.endswith(".xacro"))
+    assert [f.code for f in xacro.findings if f.level == "error"] == ["U601"]
+
+
+def test_missing_path_is_a_parameter_error(tmp_path: Path) -> None:
+    with pytest.raises(ParameterError, match="no such file"):
+        discover([tmp_path / "nope"])
+
+
+def test_select_and_ignore_prefixes() -> None:
+    assert parse_codes(["U2,u601", " U8 "], "--select") == ("U2", "U601", "U8")
+    with pytest.raises(ParameterError, match="U9"):
+        parse_codes(["U9"], "--select")
+
+
+runner = CliRunner()
+
+
+def _two_files(tmp_path: Path) -> tuple[Path, Path]:
+    good = tmp_path / "good.urdf"
+    good.write_text(doc(A))
+    bad = tmp_path / "bad.urdf"
+    bad.write_text(doc(A, link("a") + "\n", link("b", inertial="")))
+    return good, bad
+
+
+def test_cli_exit_codes_and_grouped_output(tmp_path: Path) -> None:
+    good, bad = _two_files(tmp_path)
+    r = runner.invoke(app, ["check", str(good)])
+    assert r.exit_code == 0, r.output
+    assert "1 file(s) checked: 0 error(s)" in r.output
+    r = runner.invoke(app, ["check", str(tmp_path)])
+    assert r.exit_code == 1
+    assert str(bad) in r.output and "U102" in r.output and "U205" in r.output
+    r = runner.invoke(app, ["check", str(tmp_path), "--ignore", "U1,U2"])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["check", str(tmp_path), "--ignore", "U1,U2", "--fail-on", "warning"])
+    assert r.exit_code == 1 and "U606" in r.output
+    r = runner.invoke(app, ["check", str(tmp_path / "missing.urdf")])
+    assert r.exit_code == 2 and "missing.urdf" in r.output
+    r = runner.invoke(app, ["check", str(good), "--fail-on", "fatal"])
+    assert r.exit_code == 2
+
+
+def test_cli_json(tmp_path: Path) -> None:
+    good, bad = _two_files(tmp_path)
+    r = runner.invoke(app, ["check", str(tmp_path), "--json", "--select", "U1"])
+    assert r.exit_code == 1
+    data = json.loads(r.stdout)
+    assert sorted(data["files"]) == sorted([str(good), str(bad)])
+    assert {f["code"] for f in data["findings"]} == {"U102"}
+    [f] = data["findings"]
+    assert f == {"file": str(bad), "line": 3, "level": "error", "code": "U102",
+                 "message": f["message"]}
+    assert data["summary"] == {"files": 2, "files_with_errors": 1, "error": 1, "warning": 0,
+                               "info": 0}
