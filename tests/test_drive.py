@@ -8,19 +8,32 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
-from urdfkit.drive import DriveConfig, DriveResult, Scenario, drive, fit_circle
+from urdfkit.catalog import build_template
+from urdfkit.drive import (DriveConfig, DriveResult, Scenario, builtin_file, drive,
+                           fit_circle)
 from urdfkit.errors import ParameterError
 from urdfkit.session import LoadOptions, Session
 from urdfkit.vehicle import DrivetrainError, _link_orientations, detect_drivetrain
 
 WHEEL_RADIUS = 0.1  # simplecar default
 WHEELBASE = 0.4
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """Keep the built-template cache of these tests out of the user's ~/.cache."""
+    folder = tmp_path_factory.mktemp("cache")
+    mp = pytest.MonkeyPatch()
+    mp.setenv("URDFKIT_CACHE_DIR", str(folder))
+    yield folder
+    mp.undo()
 
 
 @pytest.fixture(scope="module")
@@ -231,7 +244,7 @@ def test_trajectory_files_are_byte_identical_across_runs(runner: CliRunner,
     assert header[:10] == ["t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz"]
     assert "base_to_left_hinge_angle" in header and "base_to_left_back_wheel_speed" in header
     rows = [json.loads(line) for line in (tmp_path / "a.jsonl").read_text().splitlines()]
-    assert len(rows) == 3 * 20 + 1  # 20 samples per simulated second, plus t = 0
+    assert len(rows) == 3 * 10 + 1  # 10 samples per simulated second, plus t = 0
     assert rows[-1]["t"] == pytest.approx(3.0)
     assert rows[-1]["base_to_left_hinge_angle"] == pytest.approx(0.3, abs=0.02)
 
@@ -286,3 +299,14 @@ def test_cli_no_wheels_and_existing_output(runner: CliRunner, simpleplane_urdf: 
 def test_library_refuses_bad_config() -> None:
     with pytest.raises(ParameterError, match="--max-force must be >= 0"):
         DriveConfig(max_force=-1).check()
+
+
+def test_builtin_template_cache_holds_the_built_template(_private_cache: Path,
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    path = builtin_file("simplecar")
+    assert path is not None and path.parent == _private_cache
+    assert path.read_bytes() == build_template("simplecar").to_bytes()
+    assert builtin_file("simplecar") == path  # a hit, not a rebuild
+    monkeypatch.setenv("URDFKIT_CACHE_DIR", "")
+    assert builtin_file("simplecar") is None  # caching off: drive builds into a temp folder
+    assert drive(DriveConfig(steps=5)).steps == 5

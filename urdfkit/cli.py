@@ -603,7 +603,6 @@ def drive(
     """
     from pathlib import Path as _Path
 
-    from .catalog import parse_assignments
     from .drive import DriveConfig, Scenario, trajectory_format
     from .errors import OutputError, ParameterError
 
@@ -623,8 +622,13 @@ def drive(
         from .plot import check_plot_path
 
         check_plot_path(plot)
+    params = None
+    if set_:
+        from .catalog import parse_assignments  # imports the builder: only when needed
+
+        params = parse_assignments(set_)
     config = DriveConfig(
-        urdf=urdf, plane=plane, template_params=parse_assignments(set_) or None,
+        urdf=urdf, plane=plane, template_params=params,
         packages=package, xacro_args=arg, seconds=10.0 if seconds is None else seconds,
         steps=steps, time_step=time_step, throttle=throttle, steer=steer, max_force=max_force,
         wheels=_split_joints(wheels), hinges=_split_joints(hinges), sample_every=sample_every,
@@ -669,13 +673,8 @@ def drive(
 
 
 def _drive_summary(r: Any) -> None:
-    from rich.table import Table
-
-    table = Table(title=f"[bold]drive[/] {_escape(r.model)}: throttle {r.throttle:g} rad/s, "
-                  f"steer {r.steer:g} rad", title_justify="left", show_header=False,
-                  show_edge=False)
-    table.add_column(style="cyan")
-    table.add_column()
+    # Aligned markup lines rather than a rich Table: same look, and ~15 ms less, which
+    # matters for the drive benchmark (whole process against a bare PyBullet loop).
     x, y, z = r.final_position
     turn = ("straight (no settled turn)" if r.turning_radius is None else
             f"{r.turning_radius:.3f} m around ({r.turn_center[0]:.2f}, {r.turn_center[1]:.2f})")
@@ -689,9 +688,10 @@ def _drive_summary(r: Any) -> None:
         ("simulated", f"{r.sim_time:.3f} s in {r.steps:,} steps of {r.time_step:.5g} s"),
         ("wall time", f"{r.wall_time:.3f} s (real-time factor {r.real_time_factor:.1f}x)"),
     ]
-    for key, value in rows:
-        table.add_row(key, value)
-    _console().print(table)
+    title = (f"[bold]drive[/] {_escape(r.model)}: throttle {r.throttle:g} rad/s, "
+             f"steer {r.steer:g} rad")
+    lines = [title] + [f" [cyan]{key:<15}[/] {_escape(value)}" for key, value in rows]
+    _console().print("\n".join(lines), soft_wrap=True)
 
 
 # ---- render: headless PNG pictures (urdfkit/render.py) and tree --dot (urdfkit/graph.py)
