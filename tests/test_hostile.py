@@ -23,11 +23,6 @@ COMMANDS: dict[str, list[str]] = {
     "render": ["{file}", "--size", "64x48", "--force", "-o", "{out}"],
 }
 PASSWD_MARK = "root:x:0:0"
-#: Known gaps, reported to their owners: the message is clear but does not name the file.
-KNOWN_UNNAMED = {"drive": "vehicle.detect_drivetrain raises 'no wheels found' without file="}
-#: Known crashes, reported to their owners (issue 4): a traceback instead of a clean message.
-KNOWN_CRASHES = {"drive": "drive on a body with >= 128 links: pybullet.error from "
-                          "getBasePositionAndOrientation escapes vehicle._link_orientations"}
 
 
 @pytest.fixture(scope="module")
@@ -64,8 +59,6 @@ def test_command_survives_corpus(command: str, corpus: tuple[Path, dict[str, str
     for r in results:
         name = Path(r["file"]).name
         said = r["stdout"] + r["stderr"]
-        if r["exception"] is not None and command in KNOWN_CRASHES:
-            pytest.xfail(f"{KNOWN_CRASHES[command]} ({name})")
         assert r["exception"] is None, f"{command} {name}: {r['exception']}"
         assert "Traceback" not in said, f"{command} {name}: {said[-1500:]}"
         assert r["exit"] in (0, 1, 2), f"{command} {name}: exit {r['exit']}"
@@ -73,8 +66,6 @@ def test_command_survives_corpus(command: str, corpus: tuple[Path, dict[str, str
         assert PASSWD_MARK not in said
         if r["exit"] != 0 and name not in said:
             unnamed.append(f"{name}: {said.strip()!r}")
-    if unnamed and command in KNOWN_UNNAMED:
-        pytest.xfail(f"{KNOWN_UNNAMED[command]}: {unnamed[0]}")
     assert not unnamed, f"`urdfkit {command}` messages that do not name the file: {unnamed}"
 
 

@@ -297,3 +297,26 @@ def test_no_color_and_non_tty(simplecar_urdf: Path) -> None:
             assert "\x1b[" not in proc.stdout and "\x1b[" not in proc.stderr
     proc = subprocess_run("joints", "/nonexistent.urdf", env={"NO_COLOR": "1"})
     assert "\x1b[" not in proc.stderr and proc.returncode == 2
+
+
+def test_tree_handles_chains_deeper_than_the_recursion_limit(tmp_path: Path) -> None:
+    # The guard admits up to 1000 links; a 999-link chain is deeper than Python's default
+    # recursion limit, which the tree code once hit.
+    n = 999
+    links = "".join(f'<link name="l{i}"/>' for i in range(n))
+    joints = "".join(f'<joint name="j{i}" type="fixed"><parent link="l{i - 1}"/>'
+                     f'<child link="l{i}"/></joint>' for i in range(1, n))
+    path = tmp_path / "chain.urdf"
+    path.write_text(f'<robot name="chain">{links}{joints}</robot>')
+    for extra in ([], ["--dot"]):
+        result = CliRunner().invoke(app, ["tree", str(path), *extra])
+        assert result.exit_code == 0, result.output[-500:]
+    result = CliRunner().invoke(app, ["tree", str(path), "--json"])
+    assert result.exit_code == 0
+    node = json.loads(result.stdout)["tree"]
+    depth = 0
+    while node["children"]:
+        node = node["children"][0]
+        depth += 1
+    assert depth == n - 1
+    assert node["joint"]["index"] == n - 2

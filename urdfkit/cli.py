@@ -61,7 +61,10 @@ def _escape(text: str) -> str:
 
 
 def _print_json(data: Any) -> None:
-    # Plain print, not rich: JSON must parse whatever the terminal is.
+    # Plain print, not rich: JSON must parse whatever the terminal is. The encoder recurses
+    # per nesting level, and `tree --json` nests three levels per link of a (guard-capped,
+    # 1000-link) chain: give it room.
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 10_000))
     sys.stdout.write(json.dumps(data, indent=2, allow_nan=False) + "\n")
     sys.stdout.flush()
 
@@ -409,12 +412,11 @@ def tree(
         return (f"[dim]\\[{j.index}][/] [cyan]{_escape(j.name)}[/] ({j.type}"
                 f"{_escape(extra)}) -> [bold]{_escape(node.link)}[/]")
 
-    def grow(node: TreeNode, branch: Any) -> None:
-        for child in node.children:
-            grow(child, branch.add(label(child)))
-
     top = Tree(f"{label(root)} [dim]({_escape(robot)})[/]")
-    grow(root, top)
+    stack: list[tuple[TreeNode, Any]] = [(root, top)]
+    while stack:  # iterative: chains may be deeper than Python's recursion limit
+        node, branch = stack.pop()
+        stack.extend((child, branch.add(label(child))) for child in node.children)
     _console().print(top)
 
 

@@ -34,7 +34,13 @@ from typing import Any
 
 from .errors import ParameterError
 from .session import LoadOptions, Session, quiet_stdout
-from .vehicle import Drivetrain, apply_drive, detect_drivetrain, disable_default_motors
+from .vehicle import (
+    Drivetrain,
+    DrivetrainError,
+    apply_drive,
+    detect_drivetrain,
+    disable_default_motors,
+)
 
 #: Default simulated samples per second in the trajectory (and for the statistics): enough
 #: for a smooth path and a good circle fit, cheap enough to cost nothing next to the physics.
@@ -420,7 +426,12 @@ class Scenario:
         self.body = self._load(s, c.urdf, "simplecar", LoadOptions(
             base_position=c.base_position, inertia_from_file=True, implicit_cylinder=True),
             c.template_params)
-        self.drivetrain = train = detect_drivetrain(p, self.body, client, c.wheels, c.hinges)
+        car = c.urdf or "simplecar"
+        s.require_state_queries(self.body, car)
+        try:
+            self.drivetrain = train = detect_drivetrain(p, self.body, client, c.wheels, c.hinges)
+        except DrivetrainError as e:
+            raise DrivetrainError(e.message, file=car) from None
         self.steer = c.steer
         if train.hinges:
             lo, hi = train.steer_range()

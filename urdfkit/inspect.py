@@ -568,17 +568,27 @@ class TreeNode:
     joint: TreeJoint | None = None
     children: list[TreeNode] = field(default_factory=list)
 
+    # Iterative, not recursive: the guard admits chains of up to 1000 links, deeper than
+    # Python's recursion limit.
     def walk(self) -> Iterator[TreeNode]:
         """Every node, depth-first (PyBullet's joint order after the root)."""
-        yield self
-        for c in self.children:
-            yield from c.walk()
+        stack = [self]
+        while stack:
+            node = stack.pop()
+            yield node
+            stack.extend(reversed(node.children))
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form, nested."""
-        return {"link": self.link,
-                "joint": self.joint.to_dict() if self.joint is not None else None,
-                "children": [c.to_dict() for c in self.children]}
+        out: dict[str, Any] = {}
+        stack: list[tuple[TreeNode, dict[str, Any]]] = [(self, out)]
+        while stack:
+            node, d = stack.pop()
+            d["link"] = node.link
+            d["joint"] = node.joint.to_dict() if node.joint is not None else None
+            d["children"] = [{} for _ in node.children]
+            stack.extend(zip(node.children, d["children"], strict=True))
+        return out
 
 
 #: Joint types whose ``<axis>`` means something (URDF default (1, 0, 0) when absent).
@@ -602,16 +612,25 @@ def kinematic_tree(root: etree._Element) -> TreeNode:
         below.setdefault(parent.get("link", ""), []).append(j)
         has_parent.add(child.get("link", ""))
     root_link = next((n for n in links if n not in has_parent), links[0] if links else "")
-    counter = iter(range(len(links)))
-
-    def grow(link: str, joint: TreeJoint | None) -> TreeNode:
-        node = TreeNode(link, joint)
-        for j in below.get(link, []):
-            node.children.append(grow(j.find("child").get("link", ""),  # type: ignore[union-attr]
-                                      _tree_joint(j, next(counter))))
-        return node
-
-    return grow(root_link, None)
+    top = TreeNode(root_link)
+    # Pre-order walk with an explicit stack (see TreeNode.walk); the visit order is
+    # PyBullet's joint index order.
+    stack = [top]
+    index = 0
+    while stack:
+        node = stack.pop()
+        for j in below.get(node.link, []):
+            child = TreeNode(j.find("child").get("link", ""))  # type: ignore[union-attr]
+            node.children.append(child)
+        stack.extend(reversed(node.children))
+    # Number the joints in pre-order, now that the tree exists.
+    by_child = {j.find("child").get("link", ""): j  # type: ignore[union-attr]
+                for js in below.values() for j in js}
+    for node in top.walk():
+        if node is not top:
+            node.joint = _tree_joint(by_child[node.link], index)
+            index += 1
+    return top
 
 
 def _tree_joint(j: etree._Element, index: int) -> TreeJoint:

@@ -227,3 +227,17 @@ class Session:
             said = "; ".join(self.diagnostics[-3:])
             raise EngineError(f"PyBullet could not load it{': ' + said if said else ''}",
                               file=name) from None
+
+    def require_state_queries(self, body: int, display: str) -> None:
+        """Refuse bodies whose state PyBullet cannot report (128 links or more).
+
+        ``getBasePositionAndOrientation``, ``getJointState`` and ``getLinkState`` raise on
+        such bodies (MAX_DEGREE_OF_FREEDOM), so simulating commands check before they start.
+        """
+        from .validate import MAX_PYBULLET_LINKS
+
+        links = self.p.getNumJoints(body, physicsClientId=self.client) + 1
+        if links >= MAX_PYBULLET_LINKS:
+            raise EngineError(f"{links} links: PyBullet cannot report the state of bodies with "
+                              f"{MAX_PYBULLET_LINKS} links or more; split the model",
+                              file=display)
