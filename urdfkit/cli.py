@@ -854,6 +854,32 @@ def _sim_summary(scenario: str, result: Any, summaries: list[Any]) -> None:
             console.print(f"[cyan]{_escape(x.robot)}[/] final joints: {_escape(joints)}")
 
 
+def _command_name(info: Any) -> str:
+    return info.name or info.callback.__name__.replace("_", "-")
+
+
+def _single_command_app(name: str) -> typer.Typer | None:
+    """A copy of :data:`app` that holds only the command ``name``, or None if unknown.
+
+    typer builds the click command of *every* registered command on each run (signature
+    and type-hint evaluation, ~1 ms each). A user runs one command at a time, so the entry
+    point builds just that one; ``urdfkit --help`` still builds them all.
+    """
+    infos = [i for i in app.registered_commands if _command_name(i) == name]
+    if not infos:
+        return None
+    # no_args_is_help off: with one command, typer would otherwise treat a lone
+    # `urdfkit joints` as the group's own help request.
+    single = typer.Typer(name=app.info.name, add_completion=False,
+                         pretty_exceptions_enable=False,
+                         context_settings={"help_option_names": ["-h", "--help"]})
+    single.registered_callback = app.registered_callback
+    single.registered_commands = infos
+    return single
+
+
 def main() -> None:
     """Entry point of the ``urdfkit`` console script."""
-    app()
+    argv = sys.argv[1:]
+    single = _single_command_app(argv[0]) if argv and not argv[0].startswith("-") else None
+    (single or app)()

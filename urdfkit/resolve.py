@@ -17,10 +17,10 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from lxml import etree
 
@@ -112,7 +112,7 @@ class Resolved:
     source: Path
     load_path: Path
     tree: etree._ElementTree
-    _tmp: tempfile.TemporaryDirectory[str] | None = field(default=None, repr=False)
+    _tmp: Any = field(default=None, repr=False)  # a TemporaryDirectory, when we made a copy
 
     @property
     def root(self) -> etree._Element:
@@ -197,6 +197,8 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
                        for el in root.iter(*_FILE_TAGS))
     if has_packages or needs_copy:
         _rewrite_files(root, source.resolve().parent, packages or {}, display)
+        import tempfile  # here, not at the top: most loads need no copy
+
         tmp = tempfile.TemporaryDirectory(prefix="urdfkit-")
         load_path = Path(tmp.name) / (source.name.removesuffix(".xacro") or "robot.urdf")
         if load_path.suffix != ".urdf":

@@ -13,7 +13,6 @@ from __future__ import annotations
 import ctypes
 import os
 import sys
-import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -50,6 +49,20 @@ class Captured:
 _depth = 0
 
 
+def _sink() -> Any:
+    # A file, not a pipe: a pipe that nobody drains blocks PyBullet once 64 KiB of warnings
+    # pile up. An anonymous memory file where Linux has one (and no tempfile import, which
+    # costs a millisecond of every command's start-up); a temp file elsewhere.
+    if hasattr(os, "memfd_create"):
+        try:
+            return os.fdopen(os.memfd_create("urdfkit-stdout", os.MFD_CLOEXEC), "w+b")
+        except OSError:
+            pass
+    import tempfile
+
+    return tempfile.TemporaryFile(mode="w+b")
+
+
 @contextmanager
 def quiet_stdout() -> Iterator[Captured]:
     """Capture everything written to fd 1 (C and Python) while the block runs.
@@ -68,7 +81,7 @@ def quiet_stdout() -> Iterator[Captured]:
     sys.stdout.flush()
     _c_fflush()
     saved = os.dup(1)
-    sink = tempfile.TemporaryFile(mode="w+b")
+    sink = _sink()
     os.dup2(sink.fileno(), 1)
     _depth = 1
     try:
