@@ -3,7 +3,7 @@
 Three commands, each a fresh Python process, drive the same simplecar on the same
 simpleplane for the same number of steps with the same load flags, gravity and time step:
 
-- ``urdfkit``: ``python -m urdfkit drive --steps N --throttle 10 --steer 0.2`` (builds the
+- ``urdfkit``: ``urdfkit drive --steps N --throttle 10 --steer 0.2`` (builds the
   templates, detects the wheels, samples a trajectory, prints the summary).
 - ``tutorial``: the PyBullet tutorial's loop, re-sending ``setJointMotorControl2`` for every
   wheel and hinge on every step.
@@ -29,6 +29,7 @@ import time
 from pathlib import Path
 
 GOAL_TUTORIAL = 1.0
+URDFKIT = str(Path(sys.executable).with_name("urdfkit"))
 GOAL_BARE = 1.10
 
 # The baselines load with the same flags as `urdfkit drive`: implicit cylinders and the
@@ -96,7 +97,8 @@ def main() -> int:
         def commands_for(steps: int) -> dict[str, list[str]]:
             n = str(steps)
             return {
-                "urdfkit": [sys.executable, "-m", "urdfkit", "drive", "--steps", n,
+                # The installed console script, as users run it (`python -m` adds runpy).
+                "urdfkit": [URDFKIT, "drive", "--steps", n,
                             "--throttle", "10", "--steer", "0.2"],
                 "tutorial": [sys.executable, str(script), str(car), str(plane), n, "1"],
                 "bare": [sys.executable, str(script), str(car), str(plane), n, "0"],

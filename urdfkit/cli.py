@@ -42,16 +42,42 @@ def _console(stderr: bool = False) -> Any:
     return Console(stderr=stderr, highlight=False)
 
 
+Part = str | tuple[str, str]
+
+
+def _styled(stream: Any) -> bool:
+    try:
+        tty = stream.isatty()
+    except (AttributeError, ValueError):
+        tty = False
+    return tty or bool(os.environ.get("FORCE_COLOR"))
+
+
+def _line(*parts: Part, stderr: bool = False) -> None:
+    """Print one line made of plain strings and ``(text, rich style)`` pairs.
+
+    On a terminal rich styles it; elsewhere (pipes, CI, tests) it is written as plain text,
+    which is what rich would print there too, without paying ~15 ms to import rich. User
+    text needs no markup escaping: it never passes through the markup parser.
+    """
+    stream = sys.stderr if stderr else sys.stdout
+    if _styled(stream):
+        from rich.text import Text
+
+        _console(stderr).print(Text.assemble(*parts), soft_wrap=True)
+    else:
+        stream.write("".join(p if isinstance(p, str) else p[0] for p in parts) + "\n")
+        stream.flush()
+
+
 def _fail(message: str, code: int = 2) -> None:
-    # soft_wrap: an error is one line, however narrow the terminal.
-    _console(stderr=True).print(f"[bold red]urdfkit: error:[/] {_escape(message)}",
-                                soft_wrap=True)
+    # One line, however narrow the terminal.
+    _line(("urdfkit: error:", "bold red"), " ", message, stderr=True)
     raise typer.Exit(code)
 
 
 def _warn(message: str) -> None:
-    _console(stderr=True).print(f"[yellow]urdfkit: warning:[/] {_escape(message)}",
-                                soft_wrap=True)
+    _line(("urdfkit: warning:", "yellow"), " ", message, stderr=True)
 
 
 def _escape(text: str) -> str:
@@ -77,7 +103,7 @@ def _handle_errors(fn: F) -> F:
         except UrdfkitError as e:
             _fail(str(e), e.exit_code)
         except KeyboardInterrupt:
-            _console(stderr=True).print("[yellow]urdfkit: interrupted[/]")
+            _line(("urdfkit: interrupted", "yellow"), stderr=True)
             raise typer.Exit(130) from None
         except BrokenPipeError:
             # `urdfkit joints big.urdf | head`: the reader went away; that is not an error.
@@ -147,8 +173,8 @@ def build(
     path = building.write_output(out, result.data, force=force)
     for w in result.warnings:
         _warn(w)
-    _console(stderr=True).print(
-        f"wrote [bold]{_escape(str(path))}[/] ({result.links} links, {result.joints} joints)")
+    _line("wrote ", (str(path), "bold"), f" ({result.links} links, {result.joints} joints)",
+          stderr=True)
 
 
 @app.command()
@@ -635,16 +661,14 @@ def drive(
         steps=steps, time_step=time_step, throttle=throttle, steer=steer, max_force=max_force,
         wheels=_split_joints(wheels), hinges=_split_joints(hinges), sample_every=sample_every,
         gui=gui)
-    err = _console(stderr=True)
     with Scenario(config) as sc:
         t = sc.drivetrain
 
         def names(joints: list[int]) -> str:
             return ", ".join(t.joint_names[j] for j in joints) or "none"
 
-        err.print(f"[dim]{_escape(sc.model)}: wheels {_escape(names(t.wheels))}; "
-                  f"hinges {_escape(names(t.hinges))}; passive {_escape(names(t.passive))}[/]",
-                  soft_wrap=True)
+        _line((f"{sc.model}: wheels {names(t.wheels)}; hinges {names(t.hinges)}; "
+               f"passive {names(t.passive)}", "dim"), stderr=True)
         for w in sc.warnings:
             _warn(w)
         progress, stop = _drive_progress(as_json)
@@ -668,15 +692,17 @@ def drive(
     else:
         _drive_summary(result)
         for w in written:
-            err.print(f"wrote [bold]{_escape(str(w))}[/]", soft_wrap=True)
+            _line("wrote ", (str(w), "bold"), stderr=True)
     if result.interrupted:
-        err.print("[yellow]urdfkit: interrupted; the results cover the steps simulated[/]")
+        _line(("urdfkit: interrupted; the results cover the steps simulated", "yellow"),
+              stderr=True)
         raise typer.Exit(130)
 
 
 def _drive_summary(r: Any) -> None:
-    # Aligned markup lines rather than a rich Table: same look, and ~15 ms less, which
-    # matters for the drive benchmark (whole process against a bare PyBullet loop).
+    # Aligned lines rather than a rich Table, plain off a terminal: the same look, and no
+    # rich import (~15 ms), which matters for the drive benchmark (whole process against a
+    # bare PyBullet loop).
     x, y, z = r.final_position
     turn = ("straight (no settled turn)" if r.turning_radius is None else
             f"{r.turning_radius:.3f} m around ({r.turn_center[0]:.2f}, {r.turn_center[1]:.2f})")
@@ -690,10 +716,9 @@ def _drive_summary(r: Any) -> None:
         ("simulated", f"{r.sim_time:.3f} s in {r.steps:,} steps of {r.time_step:.5g} s"),
         ("wall time", f"{r.wall_time:.3f} s (real-time factor {r.real_time_factor:.1f}x)"),
     ]
-    title = (f"[bold]drive[/] {_escape(r.model)}: throttle {r.throttle:g} rad/s, "
-             f"steer {r.steer:g} rad")
-    lines = [title] + [f" [cyan]{key:<15}[/] {_escape(value)}" for key, value in rows]
-    _console().print("\n".join(lines), soft_wrap=True)
+    _line(("drive", "bold"), f" {r.model}: throttle {r.throttle:g} rad/s, steer {r.steer:g} rad")
+    for key, value in rows:
+        _line(" ", (f"{key:<15}", "cyan"), " ", value)
 
 
 # ---- render: headless PNG pictures (urdfkit/render.py) and tree --dot (urdfkit/graph.py)
@@ -756,9 +781,8 @@ def render(
     if as_json:
         _print_json({"output": str(path), **picture.to_dict()})
         return
-    _console(stderr=True).print(
-        f"wrote [bold]{_escape(str(path))}[/] ({picture.width}x{picture.height}, "
-        f"{', '.join(chosen)}{', collision shapes' if collision else ''})")
+    _line("wrote ", (str(path), "bold"), f" ({picture.width}x{picture.height}, "
+          f"{', '.join(chosen)}{', collision shapes' if collision else ''})", stderr=True)
 
 
 def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
@@ -779,7 +803,7 @@ def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
         sys.stdout.flush()
         return
     path = write_graph(text, output, force=force)
-    _console(stderr=True).print(f"wrote [bold]{_escape(str(path))}[/]")
+    _line("wrote ", (str(path), "bold"), stderr=True)
 
 
 # ---- sim: scenario files (urdfkit/scenario.py) run by urdfkit/sim.py
@@ -823,8 +847,7 @@ def sim(
         return
     _sim_summary(scenario, result, summaries)
     if written is not None:
-        _console(stderr=True).print(f"wrote [bold]{_escape(str(written))}[/] "
-                                    f"({len(rows):,} rows)", soft_wrap=True)
+        _line("wrote ", (str(written), "bold"), f" ({len(rows):,} rows)", stderr=True)
 
 
 def _sim_summary(scenario: str, result: Any, summaries: list[Any]) -> None:

@@ -21,6 +21,9 @@ from typing import Any
 
 from .errors import EngineError
 
+#: PyBullet's state queries fail on bodies with this many links or more (MAX_DEGREE_OF_FREEDOM).
+MAX_PYBULLET_LINKS = 128
+
 _libc: Any = None
 
 
@@ -247,8 +250,6 @@ class Session:
         ``getBasePositionAndOrientation``, ``getJointState`` and ``getLinkState`` raise on
         such bodies (MAX_DEGREE_OF_FREEDOM), so simulating commands check before they start.
         """
-        from .validate import MAX_PYBULLET_LINKS
-
         links = self.p.getNumJoints(body, physicsClientId=self.client) + 1
         if links >= MAX_PYBULLET_LINKS:
             raise EngineError(f"{links} links: PyBullet cannot report the state of bodies with "

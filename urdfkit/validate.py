@@ -20,11 +20,10 @@ from pathlib import Path
 from lxml import etree
 
 from .errors import InputError
+from .session import MAX_PYBULLET_LINKS
 
 LEVELS = ("info", "warning", "error")
 
-#: PyBullet's state queries fail on bodies with this many links or more (MAX_DEGREE_OF_FREEDOM).
-MAX_PYBULLET_LINKS = 128
 
 #: Bodies with more links than this are refused before loading (see rule_link_limit).
 MAX_LOADABLE_LINKS = 1000
