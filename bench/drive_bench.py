@@ -37,7 +37,8 @@ GOAL_BARE = 1.10
 BASELINE = """
 import sys
 import pybullet as p
-car_file, plane_file, steps, per_step = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4] == "1"
+car_file, plane_file = sys.argv[1], sys.argv[2]
+steps, per_step = int(sys.argv[3]), sys.argv[4] == "1"
 p.connect(p.DIRECT)
 p.setGravity(0, 0, -10)
 p.setTimeStep(1 / 240)

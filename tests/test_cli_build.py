@@ -73,7 +73,8 @@ def test_build_with_parameters(runner: CliRunner, in_tmp: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["build", "simplecar", "--set", "wheel_radius=-1"], "parameter 'wheel_radius' must be > 0"),
+        (["build", "simplecar", "--set", "wheel_radius=-1"],
+         "parameter 'wheel_radius' must be > 0"),
         (["build", "simplecar", "--set", "wings=2"], "has no parameter 'wings'"),
         (["build", "simplecar", "--set", "wheel_radius"], "--set expects key=value"),
         (["build", "truck"], "'truck' is neither a template"),

@@ -14,10 +14,9 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit.cli import app
 from urdfkit.catalog import build_template
-from urdfkit.drive import (DriveConfig, DriveResult, Scenario, builtin_file, drive,
-                           fit_circle)
+from urdfkit.cli import app
+from urdfkit.drive import DriveConfig, DriveResult, Scenario, builtin_file, drive, fit_circle
 from urdfkit.errors import ParameterError
 from urdfkit.session import LoadOptions, Session
 from urdfkit.vehicle import DrivetrainError, _link_orientations, detect_drivetrain
@@ -144,7 +143,7 @@ def test_detects_racecar_wheels_and_hinges_with_rotated_joint_frames() -> None:
     assert t.wheels == [2, 3, 5, 7] and t.hinges == [4, 6]
     assert [t.joint_names[j] for j in t.hinges] == ["left_steering_hinge_joint",
                                                    "right_steering_hinge_joint"]
-    for a, b in zip(fast, slow):
+    for a, b in zip(fast, slow, strict=False):
         assert a == pytest.approx(b, abs=1e-5)
 
 

@@ -38,8 +38,9 @@ def test_templates_ship_as_package_data(name: str) -> None:
 @pytest.mark.parametrize("name", sorted(TEMPLATES))
 def test_python_defaults_match_the_xacro_defaults(name: str) -> None:
     # Plain `xacro file.urdf.xacro` must give the same robot as `urdfkit build name`.
-    import xacro
     from importlib import resources
+
+    import xacro
 
     t = get_template(name)
     with resources.as_file(resources.files("urdfkit.templates") / t.file) as path:

@@ -245,7 +245,8 @@ class Inertia(_Element):
             return 0.0 if abs(x) < 1e-15 else x
 
         return cls(
-            ixx=clean(m[0][0]), ixy=clean((m[0][1] + m[1][0]) / 2), ixz=clean((m[0][2] + m[2][0]) / 2),
+            ixx=clean(m[0][0]), ixy=clean((m[0][1] + m[1][0]) / 2),
+            ixz=clean((m[0][2] + m[2][0]) / 2),
             iyy=clean(m[1][1]), iyz=clean((m[1][2] + m[2][1]) / 2), izz=clean(m[2][2]),
         )
 

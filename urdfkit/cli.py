@@ -266,7 +266,7 @@ def _fitted_table(title: str, columns: list[tuple[str, int, str]], rows: list[li
             block = Table(show_header=False, show_edge=False, box=None, padding=(0, 1))
             block.add_column(style="bold")
             block.add_column()
-            for (header, _, _), cell in zip(columns, r):
+            for (header, _, _), cell in zip(columns, r, strict=False):
                 block.add_row(_escape(header), _escape(cell))
             blocks += ["", block]
         return Group(*blocks)
@@ -569,7 +569,7 @@ def _drive_progress(as_json: bool) -> tuple[Callable[[int, int], None] | None, C
             elapsed = time.perf_counter() - state["start"]
             if elapsed < 0.25 or elapsed * total / max(done, 1) < 1.0:
                 return
-            from rich.progress import (BarColumn, Progress, TextColumn, TimeRemainingColumn)
+            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
             bar = Progress(TextColumn("driving"), BarColumn(), TextColumn("{task.completed:,}/"
                            "{task.total:,} steps"), TimeRemainingColumn(),

@@ -176,7 +176,8 @@ class Trajectory:
             w.writerows(cells)
             return buf.getvalue().encode("utf-8")
         if fmt == ".jsonl":
-            lines = ("{" + ", ".join(f"{json.dumps(k)}: {v}" for k, v in zip(self.columns, row))
+            lines = ("{" + ", ".join(f"{json.dumps(k)}: {v}"
+                                     for k, v in zip(self.columns, row, strict=False))
                      + "}\n" for row in cells)
             return "".join(lines).encode("utf-8")
         raise ParameterError(f"trajectory format must be one of {', '.join(TRAJECTORY_FORMATS)}"
@@ -221,12 +222,12 @@ def fit_circle(xs: list[float], ys: list[float]) -> Circle | None:
     mx, my = sum(xs) / n, sum(ys) / n
     u = [x - mx for x in xs]
     v = [y - my for y in ys]
-    w = [a * a + b * b for a, b in zip(u, v)]
+    w = [a * a + b * b for a, b in zip(u, v, strict=False)]
     suu = sum(a * a for a in u)
     svv = sum(b * b for b in v)
-    suv = sum(a * b for a, b in zip(u, v))
-    suw = sum(a * c for a, c in zip(u, w))
-    svw = sum(b * c for b, c in zip(v, w))
+    suv = sum(a * b for a, b in zip(u, v, strict=False))
+    suw = sum(a * c for a, c in zip(u, w, strict=False))
+    svw = sum(b * c for b, c in zip(v, w, strict=False))
     # With centred data, sum(u) = sum(v) = 0, and the system for (D, E) decouples from F.
     det = suu * svv - suv * suv
     if abs(det) < 1e-12 * max(1.0, suu * svv):
@@ -239,7 +240,8 @@ def fit_circle(xs: list[float], ys: list[float]) -> Circle | None:
         return None
     cu, cv = -d / 2, -e / 2
     radius = math.sqrt(r2)
-    rms = math.sqrt(sum((math.hypot(a - cu, b - cv) - radius) ** 2 for a, b in zip(u, v)) / n)
+    rms = math.sqrt(sum((math.hypot(a - cu, b - cv) - radius) ** 2
+                        for a, b in zip(u, v, strict=False)) / n)
     return Circle((cu + mx, cv + my), radius, rms)
 
 
@@ -534,7 +536,7 @@ class Scenario:
         c = self.config
         xs, ys, yaws = traj.column("x"), traj.column("y"), traj.column("yaw")
         distance = sum(math.hypot(x1 - x0, y1 - y0)
-                       for x0, y0, x1, y1 in zip(xs, ys, xs[1:], ys[1:]))
+                       for x0, y0, x1, y1 in zip(xs, ys, xs[1:], ys[1:], strict=False))
         unwrapped = [yaws[0]]
         for a in yaws[1:]:
             d = a - unwrapped[-1]

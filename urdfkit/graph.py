@@ -127,11 +127,9 @@ def check_output(path: str | Path, *, force: bool = False) -> Path:
         known = ", ".join(DOT_SUFFIXES + RENDERED_SUFFIXES)
         raise OutputError(f"unknown graph format {path.suffix or '(none)'}; name the output "
                           f"with one of {known}", file=path)
-    if path.is_dir():
-        raise OutputError("is a directory", file=path)
-    if path.exists() and not force:
-        raise OutputError("exists; pass --force to overwrite it", file=path)
-    return path
+    from .xmlio import check_writable
+
+    return check_writable(path, force=force)
 
 
 def write_graph(dot: str, path: str | Path, *, force: bool = False) -> Path:

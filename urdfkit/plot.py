@@ -48,7 +48,8 @@ def plot_bytes(result: DriveResult) -> bytes:
     traj = result.trajectory
     t, xs, ys = traj.column("t"), traj.column("x"), traj.column("y")
     yaws = traj.column("yaw")
-    speed = [math.hypot(vx, vy) for vx, vy in zip(traj.column("vx"), traj.column("vy"))]
+    speed = [math.hypot(vx, vy)
+             for vx, vy in zip(traj.column("vx"), traj.column("vy"), strict=False)]
     hexc = style.hex_color
     with plt.rc_context({"font.family": style.FONT_FAMILY, "font.size": style.FONT_SIZE,
                          "text.color": hexc(style.TEXT), "axes.labelcolor": hexc(style.TEXT),

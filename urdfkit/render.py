@@ -737,11 +737,9 @@ def check_output(path: str | Path, *, force: bool = False) -> Path:
     path = Path(path)
     if path.suffix.lower() != ".png":
         raise OutputError("urdfkit render writes PNG; name the output *.png", file=path)
-    if path.is_dir():
-        raise OutputError("is a directory", file=path)
-    if path.exists() and not force:
-        raise OutputError("exists; pass --force to overwrite it", file=path)
-    return path
+    from .xmlio import check_writable
+
+    return check_writable(path, force=force)
 
 
 def write_png(rendering: Rendering, path: str | Path, *, force: bool = False) -> Path:

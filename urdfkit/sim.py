@@ -758,13 +758,9 @@ def check_output(path: str | Path, *, force: bool) -> None:
     if out.suffix.lower() not in OUTPUT_FORMATS:
         raise OutputError(f"unknown output format {out.suffix or '(none)'!r}; use "
                           f"{', '.join(OUTPUT_FORMATS)}", file=path)
-    if out.is_dir():
-        raise OutputError("is a directory", file=path)
-    if out.exists() and not force:
-        raise OutputError("exists; pass --force to overwrite it", file=path)
-    folder = out.parent if str(out.parent) else Path(".")
-    if not folder.is_dir():
-        raise OutputError(f"folder {folder} does not exist", file=path)
+    from .xmlio import check_writable
+
+    check_writable(path, force=force)
     if out.suffix.lower() == ".parquet":
         _pyarrow()
 

@@ -77,12 +77,14 @@ class Report:
 
     def add(self, code: str, level: str, message: str, el: etree._Element | None = None,
             line: int | None = None) -> None:
+        """Record a finding; its line comes from ``el`` unless given."""
         if line is None and el is not None:
             line = el.sourceline
         self.findings.append(Finding(code, level, message, self.file, line))
 
     @property
     def errors(self) -> list[Finding]:
+        """The error-level findings."""
         return [f for f in self.findings if f.level == "error"]
 
 
@@ -445,7 +447,7 @@ def rule_mass(root: etree._Element, r: Report) -> None:
             fixed_children.setdefault(parent.get("link", ""), []).append(child.get("link", ""))
         else:
             moving.append((child.get("link", ""), j))
-    for name, link in links.items():
+    for link in links.values():
         inertial = link.find("inertial")
         if inertial is None:
             r.add("U606", "warning", f"{_label(link)} has no <inertial>; PyBullet silently gives "

@@ -167,10 +167,11 @@ def to_bytes(root: etree._Element) -> bytes:
     return b'<?xml version="1.0" encoding="utf-8"?>\n' + body
 
 
-def atomic_write(path: str | Path, data: bytes, *, force: bool = False) -> Path:
-    """Write ``data`` to ``path`` atomically: a temp file in the same folder, then rename.
+def check_writable(path: str | Path, *, force: bool = False) -> Path:
+    """Refuse an output path that is a folder, exists (without ``force``), or has no folder.
 
-    Refuses to replace an existing file unless ``force`` is set, so nothing is lost.
+    Commands that work for a while before writing (drive, sim, render) call this first, so
+    a run never ends in a refusal; :func:`atomic_write` calls it again at write time.
     """
     from .errors import OutputError
 
@@ -182,6 +183,18 @@ def atomic_write(path: str | Path, data: bytes, *, force: bool = False) -> Path:
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise OutputError(f"folder {folder} does not exist", file=path)
+    return path
+
+
+def atomic_write(path: str | Path, data: bytes, *, force: bool = False) -> Path:
+    """Write ``data`` to ``path`` atomically: a temp file in the same folder, then rename.
+
+    Refuses to replace an existing file unless ``force`` is set, so nothing is lost.
+    """
+    from .errors import OutputError
+
+    path = check_writable(path, force=force)
+    folder = path.parent if str(path.parent) else Path(".")
     import tempfile
 
     try:
