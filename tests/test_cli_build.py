@@ -149,6 +149,17 @@ def test_installed_command_runs_as_a_subprocess(tmp_path: Path) -> None:
     assert "build" in out.stdout and "Usage" in out.stdout
     mod = subprocess.run([sys.executable, "-m", "urdfkit", "build", "simplecar", "-o",
                           str(tmp_path / "car.urdf")], capture_output=True, text=True,
-                         timeout=60, env={**os.environ, "NO_COLOR": "1"})
+                         timeout=60, env={**os.environ, "NO_COLOR": "1"}, cwd=tmp_path)
     assert mod.returncode == 0, mod.stderr
+    assert (tmp_path / "car.urdf").read_bytes() == (GOLDEN / "simplecar.urdf").read_bytes()
+
+
+def test_python_m_urdfkit_works_from_a_source_checkout(tmp_path: Path) -> None:
+    # In the repository folder `python -m urdfkit` imports the source tree, where the
+    # templates are the top-level folder rather than the installed urdfkit.templates.
+    root = Path(__file__).parent.parent
+    out = subprocess.run([sys.executable, "-m", "urdfkit", "build", "simplecar", "-o",
+                          str(tmp_path / "car.urdf")], capture_output=True, text=True,
+                         timeout=60, cwd=root)
+    assert out.returncode == 0, out.stderr
     assert (tmp_path / "car.urdf").read_bytes() == (GOLDEN / "simplecar.urdf").read_bytes()

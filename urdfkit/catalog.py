@@ -14,11 +14,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from importlib import resources
 from typing import Any
 
 from .builder import Robot
 from .errors import ParameterError
+from .templatedir import template_dir
 
 
 @dataclass(frozen=True)
@@ -130,7 +130,7 @@ class Template:
 
     def source(self) -> str:
         """The template's xacro text."""
-        return resources.files("urdfkit.templates").joinpath(self.file).read_text("utf-8")
+        return (template_dir() / self.file).read_text("utf-8")
 
 
 def _body_size_args(v: tuple[float, float, float]) -> dict[str, float]:
@@ -200,11 +200,10 @@ def expand_template(name: str, values: Mapping[str, Any] | None = None) -> bytes
     args = template.xacro_args(values)
     import xacro
 
-    with resources.as_file(resources.files("urdfkit.templates").joinpath(template.file)) as path:
-        try:
-            doc = xacro.process_file(str(path), mappings=args)
-        except Exception as e:  # xacro raises plain Exceptions
-            raise ParameterError(f"template '{name}' failed to expand: {e}") from None
+    try:
+        doc = xacro.process_file(str(template_dir() / template.file), mappings=args)
+    except Exception as e:  # xacro raises plain Exceptions
+        raise ParameterError(f"template '{name}' failed to expand: {e}") from None
     return doc.toxml(encoding="utf-8")  # type: ignore[no-any-return]
 
 

@@ -343,7 +343,8 @@ def builtin_file(name: str) -> Path | None:
     """
     import zlib
 
-    from . import __version__, templates
+    from . import __version__
+    from .templatedir import template_dir
 
     folder = cache_dir()
     if folder is None:
@@ -351,7 +352,7 @@ def builtin_file(name: str) -> Path | None:
     # The package folder directly: importlib.resources (and the zipfile it imports) would
     # cost more than the lookup saves. A zipped install simply skips the cache.
     try:
-        source = (Path(templates.__file__).parent / f"{name}.urdf.xacro").read_bytes()
+        source = (template_dir() / f"{name}.urdf.xacro").read_bytes()
     except (OSError, TypeError):
         return None
     key = f"{zlib.crc32(source):08x}{len(source):x}-{__version__}"

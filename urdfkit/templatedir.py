@@ -1,0 +1,20 @@
+"""Where the built-in xacro templates live (kept tiny: ``drive`` imports it on every run)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def template_dir() -> Path:
+    """The folder of the built-in templates.
+
+    Installed, it is the package ``urdfkit.templates``: pyproject.toml maps the top-level
+    ``templates/`` folder there, and ``tests/test_packaging.py`` checks the wheel carries it.
+    Run from a source checkout (``python -m urdfkit`` in the repository) that package does not
+    exist, and the top-level folder beside the package is the same files.
+    """
+    try:
+        from . import templates
+    except ImportError:
+        return Path(__file__).resolve().parent.parent / "templates"
+    return Path(templates.__file__).parent
