@@ -17,11 +17,12 @@ HEAVY = ("yourdfpy", "trimesh", "matplotlib", "pydantic", "PIL")
 
 PROBE = """
 import json, sys
-from urdfkit.cli import app
+from urdfkit.cli import main
+sys.argv = ["urdfkit", *sys.argv[1:]]
 try:
-    app(sys.argv[1:], standalone_mode=False)
-except SystemExit:
-    pass
+    main()  # the console script's entry point, as users run it
+except SystemExit as e:
+    sys.stderr.write(f"\\nEXIT:{e.code}")
 sys.stderr.write("\\nMODULES:" + json.dumps(sorted(m.split(".")[0] for m in sys.modules)))
 """
 
