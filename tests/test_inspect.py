@@ -12,12 +12,12 @@ from urdfkit.inspect import (
     JOINT_INFO_FIELDS,
     filter_joints,
     inspect_file,
-    kinematic_tree,
     quat_to_rpy,
     tidy_diagnostics,
 )
 from urdfkit.resolve import open_input, resolve
 from urdfkit.session import LoadOptions
+from urdfkit.tree import kinematic_tree
 
 # A link with an off-diagonal <inertia> and an offset, rotated inertial frame, and a child link
 # with no <inertial> at all (which PyBullet gives 1 kg and complains about on stdout).

@@ -2,7 +2,8 @@
 
 The command-line tool is ``urdfkit``; the library's entry points live in
 :mod:`urdfkit.builder` (the URDF model), :mod:`urdfkit.catalog` (templates),
-:mod:`urdfkit.inspect` (decoded PyBullet tables) and the simulation modules.
+:mod:`urdfkit.inspect` and :mod:`urdfkit.body` (decoded PyBullet tables), :mod:`urdfkit.tree`
+(the kinematic tree) and the simulation modules.
 """
 
 __version__ = "0.1.0"

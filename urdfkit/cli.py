@@ -5,7 +5,6 @@ numpy, yourdfpy or trimesh. Library errors (:class:`~urdfkit.errors.UrdfkitError
 once, in :func:`_handle_errors`, and become one red line on stderr plus an exit code.
 """
 
-from __future__ import annotations
 
 import functools
 import json
@@ -414,8 +413,8 @@ def tree(
     Read from the file alone; PyBullet is not loaded. [n] is the index PyBullet will give
     the joint.
     """
-    from .inspect import TreeNode, kinematic_tree
     from .resolve import open_input
+    from .tree import TreeNode, kinematic_tree
 
     if dot or output is not None:
         _tree_dot(file, package, arg, output, force, as_json)  # see "# ---- render"

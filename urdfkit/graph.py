@@ -2,7 +2,7 @@ r"""``urdfkit tree --dot``: the kinematic graph as Graphviz DOT, and SVG/PNG/PDF
 
 Links are boxes, joints are edges from parent to child labelled with the joint's name, type,
 axis and limits, and the index PyBullet will give it. The graph is built from the lxml
-document by :func:`urdfkit.inspect.kinematic_tree`, so no PyBullet is loaded.
+document by :func:`urdfkit.tree.kinematic_tree`, so no PyBullet is loaded.
 
 Names are written as quoted DOT strings, with ``"`` and ``\`` escaped. Graphviz expands escape
 sequences in *labels* (``\N`` becomes the node name, ``\G`` the graph name, ``\n`` a line
@@ -58,7 +58,7 @@ def dot_graph(root: etree._Element, name: str | None = None) -> str:
             cycles and second parents).
         name: The graph's name; defaults to the robot's name attribute.
     """
-    from .inspect import kinematic_tree
+    from .tree import kinematic_tree
 
     tree = kinematic_tree(root)
     title = name if name is not None else root.get("name", "robot")

@@ -1,7 +1,8 @@
-"""Turn a loaded body into plain data: joint table, link dynamics, summary, kinematic tree.
+"""Turn a loaded body into plain data: the joint table, and the report every command fills.
 
 Everything here returns dataclasses; nothing prints. ``cli.py`` presents them as rich tables
-or JSON.
+or JSON. The link table and the summary live in :mod:`urdfkit.body`, the kinematic tree (no
+PyBullet) in :mod:`urdfkit.tree`, so that ``urdfkit joints`` loads only what it shows.
 
 The joint table carries all 17 fields of ``p.getJointInfo`` under the names the PyBullet
 Quickstart Guide uses (``jointIndex`` ... ``parentIndex``); :meth:`JointInfo.to_dict` is the
@@ -13,11 +14,8 @@ shape this module:
   ``<joint>`` element by name to report ``urdfType``.
 - ``parentFramePos``/``parentFrameOrn`` are relative to the parent's *inertial* frame (its
   centre of mass), not to the parent link frame the URDF ``<origin>`` is written in.
-- Without ``URDF_USE_INERTIA_FROM_FILE`` PyBullet discards ``<inertia>`` and recomputes it from
-  the collision shapes, so the link table shows the file's values beside the engine's.
-
-:func:`kinematic_tree` needs no PyBullet at all: it reads the lxml document, and numbers the
-joints the way PyBullet will (depth-first from the root, children in file order).
+- Joints are indexed depth-first from the root, each link's children in file order; a
+  joint's parent link is the child link of joint ``parentIndex`` (-1: the base link).
 """
 
 from __future__ import annotations
@@ -27,12 +25,16 @@ import re
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from lxml import etree
 
 from .resolve import Resolved
 from .session import LoadOptions, Session, quiet_stdout
+from .xmlio import children
+
+if TYPE_CHECKING:
+    from .body import LinkDynamics, Summary
 
 #: ``getJointInfo``'s jointType codes (p.JOINT_REVOLUTE == 0, ...), as names.
 JOINT_TYPE_NAMES = {0: "REVOLUTE", 1: "PRISMATIC", 2: "SPHERICAL", 3: "PLANAR", 4: "FIXED",
@@ -76,27 +78,6 @@ def _clean(x: float) -> float:
     # -0.0 and 1e-17 noise make tables and golden files churn.
     return 0.0 if abs(x) < 1e-12 else x
 
-
-def _vec(el: etree._Element | None, attr: str, default: Sequence[float]) -> tuple[float, ...]:
-    if el is None or el.get(attr) is None:
-        return tuple(float(v) for v in default)
-    try:
-        return tuple(float(v) for v in (el.get(attr) or "").split())
-    except ValueError:
-        return tuple(float(v) for v in default)
-
-
-def _float(el: etree._Element | None, attr: str) -> float | None:
-    if el is None or el.get(attr) is None:
-        return None
-    try:
-        return float(el.get(attr) or "")
-    except ValueError:
-        return None
-
-
-def _children(root: etree._Element, tag: str) -> Iterator[etree._Element]:
-    return (c for c in root if isinstance(c.tag, str) and c.tag == tag)
 
 
 # --------------------------------------------------------------------------- joints
@@ -197,7 +178,7 @@ def joint_table(s: Session, body: int, root: etree._Element | None = None) -> li
     """
     urdf_types: dict[str, str] = {}
     if root is not None:
-        urdf_types = {j.get("name", ""): j.get("type", "") for j in _children(root, "joint")}
+        urdf_types = {j.get("name", ""): j.get("type", "") for j in children(root, "joint")}
     joints = [JointInfo.from_pybullet(s.call("getJointInfo", body, i))
               for i in range(s.call("getNumJoints", body))]
     base = base_link_name(s, body)
@@ -229,210 +210,6 @@ def filter_joints(joints: Sequence[JointInfo], *, movable: bool = False,
             continue
         out.append(j)
     return out
-
-
-# --------------------------------------------------------------------------- links
-
-
-@dataclass
-class FileInertial:
-    """What a link's ``<inertial>`` says.
-
-    Attributes:
-        mass: ``<mass value>``.
-        inertia: ixx, ixy, ixz, iyy, iyz, izz as written.
-        principal: The principal moments (eigenvalues of the tensor), ascending. This is what
-            PyBullet keeps, as ``localInertiaDiagonal``, when it uses the file's inertia.
-        xyz: ``<origin xyz>`` of the inertial frame.
-        rpy: ``<origin rpy>`` of the inertial frame.
-    """
-
-    mass: float
-    inertia: tuple[float, float, float, float, float, float]
-    principal: Vec3
-    xyz: Vec3
-    rpy: Vec3
-
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON form."""
-        names = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-        return {"mass": self.mass, "inertia": dict(zip(names, self.inertia, strict=False)),
-                "principal": list(self.principal), "xyz": list(self.xyz), "rpy": list(self.rpy)}
-
-
-def file_inertial(link: etree._Element | None) -> FileInertial | None:
-    """Read a ``<link>``'s ``<inertial>``; ``None`` if it has none."""
-    if link is None:
-        return None
-    el = link.find("inertial")
-    if el is None:
-        return None
-    from .builder import Inertia
-    from .errors import ModelError
-
-    mass = _float(el.find("mass"), "value") or 0.0
-    i = el.find("inertia")
-    values = tuple(_float(i, k) or 0.0 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
-    try:
-        principal = Inertia(*values).principal_moments
-    except ModelError:  # nan/inf in the file: show the diagonal as written
-        principal = (values[0], values[3], values[5])
-    origin = el.find("origin")
-    return FileInertial(mass, values, tuple(sorted(principal)),  # type: ignore[arg-type]
-                        _vec(origin, "xyz", (0, 0, 0)), _vec(origin, "rpy", (0, 0, 0)))  # type: ignore[arg-type]
-
-
-@dataclass
-class LinkDynamics:
-    """One link's ``p.getDynamicsInfo``, beside what the file says.
-
-    Attributes:
-        link_index: -1 for the base link, else the index of the joint whose child it is.
-        local_inertia_diagonal: The engine's principal moments, in the inertial frame.
-        local_inertial_pos: The inertial frame (centre of mass) in the link frame.
-        local_inertial_orn: Its orientation (x, y, z, w): the principal axes.
-        file: The file's ``<inertial>``, if the link has one.
-    """
-
-    link_index: int
-    link_name: str
-    mass: float
-    lateral_friction: float
-    local_inertia_diagonal: Vec3
-    local_inertial_pos: Vec3
-    local_inertial_orn: Quat
-    restitution: float
-    rolling_friction: float
-    spinning_friction: float
-    contact_damping: float
-    contact_stiffness: float
-    body_type: int
-    collision_margin: float
-    file: FileInertial | None = None
-
-    @property
-    def mass_differs(self) -> bool:
-        """Whether PyBullet's mass is not the file's (a link without ``<inertial>`` gets 1 kg)."""
-        file_mass = self.file.mass if self.file else None
-        return file_mass is None or not math.isclose(self.mass, file_mass, rel_tol=1e-6,
-                                                     abs_tol=1e-12)
-
-    @property
-    def inertia_differs(self) -> bool:
-        """Whether the engine's principal moments are not the file's.
-
-        Compared sorted, because PyBullet orders the diagonal along its own principal axes.
-        """
-        if self.file is None:
-            return True
-        engine = sorted(self.local_inertia_diagonal)
-        return not all(math.isclose(a, b, rel_tol=1e-4, abs_tol=1e-12)
-                       for a, b in zip(engine, self.file.principal, strict=False))
-
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON form: getDynamicsInfo's fields in snake_case, and the file's values."""
-        return {
-            "linkIndex": self.link_index, "linkName": self.link_name, "mass": self.mass,
-            "lateral_friction": self.lateral_friction,
-            "local_inertia_diagonal": list(self.local_inertia_diagonal),
-            "local_inertial_pos": list(self.local_inertial_pos),
-            "local_inertial_orn": list(self.local_inertial_orn),
-            "restitution": self.restitution, "rolling_friction": self.rolling_friction,
-            "spinning_friction": self.spinning_friction,
-            "contact_damping": self.contact_damping, "contact_stiffness": self.contact_stiffness,
-            "body_type": self.body_type, "collision_margin": self.collision_margin,
-            "file": self.file.to_dict() if self.file else None,
-            "mass_differs": self.mass_differs, "inertia_differs": self.inertia_differs,
-        }
-
-
-def link_table(s: Session, body: int, root: etree._Element | None = None,
-               joints: Sequence[JointInfo] | None = None) -> list[LinkDynamics]:
-    """The base link and every child link, with engine dynamics and the file's inertial."""
-    joints = joint_table(s, body, root) if joints is None else joints
-    by_name = {}
-    if root is not None:
-        by_name = {el.get("name", ""): el for el in _children(root, "link")}
-    names = [base_link_name(s, body)] + [j.link_name for j in joints]
-    out = []
-    for index, name in zip(range(-1, len(joints)), names, strict=True):
-        d = s.call("getDynamicsInfo", body, index)
-        out.append(LinkDynamics(
-            index, name, float(d[0]), float(d[1]), tuple(d[2]), tuple(d[3]), tuple(d[4]),  # type: ignore[arg-type]
-            float(d[5]), float(d[6]), float(d[7]), float(d[8]), float(d[9]), int(d[10]),
-            float(d[11]), file_inertial(by_name.get(name))))
-    return out
-
-
-# --------------------------------------------------------------------------- summary
-
-
-@dataclass
-class Summary:
-    """``urdfkit info``: the robot at a glance.
-
-    Attributes:
-        joint_types: Joint counts by URDF type (continuous counted apart from revolute).
-        dof: Degrees of freedom of the joints (the floating base's 6 not included).
-        total_mass: Sum of PyBullet's link masses, kg.
-        file_mass: Sum of the file's ``<mass>`` values, kg.
-        aabb_min: Lower corner of the body's bounding box in its loaded pose.
-        aabb_max: Upper corner.
-    """
-
-    robot: str
-    base_link: str
-    links: int
-    joints: int
-    joint_types: dict[str, int]
-    dof: int
-    fixed_base: bool
-    total_mass: float
-    file_mass: float
-    links_without_inertial: list[str]
-    aabb_min: Vec3
-    aabb_max: Vec3
-
-    @property
-    def size(self) -> Vec3:
-        """Extent of the bounding box along x, y, z."""
-        return tuple(hi - lo for lo, hi in zip(self.aabb_min, self.aabb_max, strict=False))  # type: ignore[return-value]
-
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON form."""
-        return {
-            "robot": self.robot, "base_link": self.base_link, "links": self.links,
-            "joints": self.joints, "joint_types": self.joint_types, "dof": self.dof,
-            "fixed_base": self.fixed_base, "total_mass": self.total_mass,
-            "file_mass": self.file_mass, "links_without_inertial": self.links_without_inertial,
-            "aabb": {"min": list(self.aabb_min), "max": list(self.aabb_max),
-                     "size": list(self.size)},
-        }
-
-
-def summary(s: Session, body: int, root: etree._Element, fixed_base: bool = False) -> Summary:
-    """Counts, DOF, mass and bounding box of a loaded body."""
-    joints = joint_table(s, body, root)
-    links = link_table(s, body, root, joints)
-    types: dict[str, int] = {}
-    for j in joints:
-        key = j.urdf_type or j.joint_type.lower()
-        types[key] = types.get(key, 0) + 1
-    lo = [math.inf] * 3
-    hi = [-math.inf] * 3
-    for index in range(-1, len(joints)):
-        a, b = s.call("getAABB", body, index)
-        lo = [min(x, y) for x, y in zip(lo, a, strict=False)]
-        hi = [max(x, y) for x, y in zip(hi, b, strict=False)]
-    return Summary(
-        robot=root.get("name", ""), base_link=base_link_name(s, body), links=len(links),
-        joints=len(joints), joint_types=dict(sorted(types.items())),
-        dof=sum(JOINT_DOF.get(j.joint_type, 0) for j in joints), fixed_base=fixed_base,
-        total_mass=sum(link.mass for link in links),
-        file_mass=sum(link.file.mass for link in links if link.file),
-        links_without_inertial=[link.link_name for link in links if link.file is None],
-        aabb_min=tuple(lo), aabb_max=tuple(hi),  # type: ignore[arg-type]
-    )
 
 
 # --------------------------------------------------------------------------- reports
@@ -488,6 +265,9 @@ def inspect_file(resolved: Resolved, options: LoadOptions | None = None, *,
             joints = joint_table(s, body, resolved.root)
             report = Report(resolved.name, str(resolved.source), resolved.robot_name,
                             base_link_name(s, body), joints)
+            if links or info:
+                from .body import link_table, summary
+
             if links:
                 report.links = link_table(s, body, resolved.root, joints)
             if info:
@@ -522,124 +302,3 @@ def tidy_diagnostics(lines: Sequence[str]) -> list[str]:
         out.append(msg)
         i += 1
     return list(dict.fromkeys(out))
-
-
-# --------------------------------------------------------------------------- kinematic tree
-
-
-@dataclass
-class TreeJoint:
-    """A ``<joint>`` as the tree shows it.
-
-    Attributes:
-        index: The index PyBullet will give this joint (depth-first, file order).
-        axis: ``<axis xyz>``, ``None`` for joint types that have no axis.
-        limit: (lower, upper) from ``<limit>``, ``None`` when absent or continuous.
-    """
-
-    name: str
-    type: str
-    index: int
-    xyz: Vec3
-    rpy: Vec3
-    axis: Vec3 | None
-    limit: tuple[float, float] | None
-    line: int | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON form."""
-        return {"name": self.name, "type": self.type, "index": self.index,
-                "xyz": list(self.xyz), "rpy": list(self.rpy),
-                "axis": list(self.axis) if self.axis is not None else None,
-                "limit": list(self.limit) if self.limit is not None else None}
-
-
-@dataclass
-class TreeNode:
-    """A link and the joints hanging below it.
-
-    Attributes:
-        link: The link's name.
-        joint: The joint that attaches this link to its parent; ``None`` at the root.
-        children: Child nodes in file order, which is PyBullet's index order.
-    """
-
-    link: str
-    joint: TreeJoint | None = None
-    children: list[TreeNode] = field(default_factory=list)
-
-    # Iterative, not recursive: the guard admits chains of up to 1000 links, deeper than
-    # Python's recursion limit.
-    def walk(self) -> Iterator[TreeNode]:
-        """Every node, depth-first (PyBullet's joint order after the root)."""
-        stack = [self]
-        while stack:
-            node = stack.pop()
-            yield node
-            stack.extend(reversed(node.children))
-
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON form, nested."""
-        out: dict[str, Any] = {}
-        stack: list[tuple[TreeNode, dict[str, Any]]] = [(self, out)]
-        while stack:
-            node, d = stack.pop()
-            d["link"] = node.link
-            d["joint"] = node.joint.to_dict() if node.joint is not None else None
-            d["children"] = [{} for _ in node.children]
-            stack.extend(zip(node.children, d["children"], strict=True))
-        return out
-
-
-#: Joint types whose ``<axis>`` means something (URDF default (1, 0, 0) when absent).
-_AXIS_TYPES = ("revolute", "continuous", "prismatic", "planar")
-
-
-def kinematic_tree(root: etree._Element) -> TreeNode:
-    """The link tree of a guarded ``<robot>`` document, with PyBullet's joint indices.
-
-    Needs no PyBullet. The document must have passed :func:`urdfkit.validate.guard` (one
-    root, single parents, no cycle); :func:`urdfkit.resolve.resolve` ensures that.
-    """
-    links = [el.get("name", "") for el in _children(root, "link")]
-    below: dict[str, list[etree._Element]] = {}
-    has_parent: set[str] = set()
-    for j in _children(root, "joint"):
-        parent = j.find("parent")
-        child = j.find("child")
-        if parent is None or child is None:
-            continue
-        below.setdefault(parent.get("link", ""), []).append(j)
-        has_parent.add(child.get("link", ""))
-    root_link = next((n for n in links if n not in has_parent), links[0] if links else "")
-    top = TreeNode(root_link)
-    # Pre-order walk with an explicit stack (see TreeNode.walk); the visit order is
-    # PyBullet's joint index order.
-    stack = [top]
-    index = 0
-    while stack:
-        node = stack.pop()
-        for j in below.get(node.link, []):
-            child = TreeNode(j.find("child").get("link", ""))  # type: ignore[union-attr]
-            node.children.append(child)
-        stack.extend(reversed(node.children))
-    # Number the joints in pre-order, now that the tree exists.
-    by_child = {j.find("child").get("link", ""): j  # type: ignore[union-attr]
-                for js in below.values() for j in js}
-    for node in top.walk():
-        if node is not top:
-            node.joint = _tree_joint(by_child[node.link], index)
-            index += 1
-    return top
-
-
-def _tree_joint(j: etree._Element, index: int) -> TreeJoint:
-    jtype = j.get("type", "")
-    origin = j.find("origin")
-    axis = _vec(j.find("axis"), "xyz", (1, 0, 0)) if jtype in _AXIS_TYPES else None
-    limit_el = j.find("limit")
-    limit = None
-    if jtype in ("revolute", "prismatic") and limit_el is not None:
-        limit = (_float(limit_el, "lower") or 0.0, _float(limit_el, "upper") or 0.0)
-    return TreeJoint(j.get("name", ""), jtype, index, _vec(origin, "xyz", (0, 0, 0)),  # type: ignore[arg-type]
-                     _vec(origin, "rpy", (0, 0, 0)), axis, limit, j.sourceline)  # type: ignore[arg-type]

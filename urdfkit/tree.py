@@ -1,0 +1,136 @@
+"""The kinematic tree of a URDF document, numbered the way PyBullet will number it.
+
+Needs no PyBullet: it reads the guarded lxml document. PyBullet indexes joints depth-first from
+the root, each link's children in file order, so a pre-order walk of this tree gives each
+joint the index ``p.getJointInfo`` will report for it. ``urdfkit tree`` draws it and ``urdfkit
+tree --dot`` (:mod:`urdfkit.graph`) exports it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+from lxml import etree
+
+from .xmlio import attr_float, attr_vec, children
+
+Vec3 = tuple[float, float, float]
+
+@dataclass
+class TreeJoint:
+    """A ``<joint>`` as the tree shows it.
+
+    Attributes:
+        index: The index PyBullet will give this joint (depth-first, file order).
+        axis: ``<axis xyz>``, ``None`` for joint types that have no axis.
+        limit: (lower, upper) from ``<limit>``, ``None`` when absent or continuous.
+    """
+
+    name: str
+    type: str
+    index: int
+    xyz: Vec3
+    rpy: Vec3
+    axis: Vec3 | None
+    limit: tuple[float, float] | None
+    line: int | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form."""
+        return {"name": self.name, "type": self.type, "index": self.index,
+                "xyz": list(self.xyz), "rpy": list(self.rpy),
+                "axis": list(self.axis) if self.axis is not None else None,
+                "limit": list(self.limit) if self.limit is not None else None}
+
+
+@dataclass
+class TreeNode:
+    """A link and the joints hanging below it.
+
+    Attributes:
+        link: The link's name.
+        joint: The joint that attaches this link to its parent; ``None`` at the root.
+        children: Child nodes in file order, which is PyBullet's index order.
+    """
+
+    link: str
+    joint: TreeJoint | None = None
+    children: list[TreeNode] = field(default_factory=list)
+
+    # Iterative, not recursive: the guard admits chains of up to 1000 links, deeper than
+    # Python's recursion limit.
+    def walk(self) -> Iterator[TreeNode]:
+        """Every node, depth-first (PyBullet's joint order after the root)."""
+        stack = [self]
+        while stack:
+            node = stack.pop()
+            yield node
+            stack.extend(reversed(node.children))
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form, nested."""
+        out: dict[str, Any] = {}
+        stack: list[tuple[TreeNode, dict[str, Any]]] = [(self, out)]
+        while stack:
+            node, d = stack.pop()
+            d["link"] = node.link
+            d["joint"] = node.joint.to_dict() if node.joint is not None else None
+            d["children"] = [{} for _ in node.children]
+            stack.extend(zip(node.children, d["children"], strict=True))
+        return out
+
+
+#: Joint types whose ``<axis>`` means something (URDF default (1, 0, 0) when absent).
+_AXIS_TYPES = ("revolute", "continuous", "prismatic", "planar")
+
+
+def kinematic_tree(root: etree._Element) -> TreeNode:
+    """The link tree of a guarded ``<robot>`` document, with PyBullet's joint indices.
+
+    Needs no PyBullet. The document must have passed :func:`urdfkit.validate.guard` (one
+    root, single parents, no cycle); :func:`urdfkit.resolve.resolve` ensures that.
+    """
+    links = [el.get("name", "") for el in children(root, "link")]
+    below: dict[str, list[etree._Element]] = {}
+    has_parent: set[str] = set()
+    for j in children(root, "joint"):
+        parent = j.find("parent")
+        child = j.find("child")
+        if parent is None or child is None:
+            continue
+        below.setdefault(parent.get("link", ""), []).append(j)
+        has_parent.add(child.get("link", ""))
+    root_link = next((n for n in links if n not in has_parent), links[0] if links else "")
+    top = TreeNode(root_link)
+    # Pre-order walk with an explicit stack (see TreeNode.walk); the visit order is
+    # PyBullet's joint index order.
+    stack = [top]
+    index = 0
+    while stack:
+        node = stack.pop()
+        for j in below.get(node.link, []):
+            child = TreeNode(j.find("child").get("link", ""))  # type: ignore[union-attr]
+            node.children.append(child)
+        stack.extend(reversed(node.children))
+    # Number the joints in pre-order, now that the tree exists.
+    by_child = {j.find("child").get("link", ""): j  # type: ignore[union-attr]
+                for js in below.values() for j in js}
+    for node in top.walk():
+        if node is not top:
+            node.joint = _tree_joint(by_child[node.link], index)
+            index += 1
+    return top
+
+
+def _tree_joint(j: etree._Element, index: int) -> TreeJoint:
+    jtype = j.get("type", "")
+    origin = j.find("origin")
+    axis = attr_vec(j.find("axis"), "xyz", (1, 0, 0)) if jtype in _AXIS_TYPES else None
+    limit_el = j.find("limit")
+    limit = None
+    if jtype in ("revolute", "prismatic") and limit_el is not None:
+        limit = (attr_float(limit_el, "lower") or 0.0, attr_float(limit_el, "upper") or 0.0)
+    return TreeJoint(j.get("name", ""), jtype, index, attr_vec(origin, "xyz", (0, 0, 0)),  # type: ignore[arg-type]
+                     attr_vec(origin, "rpy", (0, 0, 0)), axis, limit, j.sourceline)  # type: ignore[arg-type]
