@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -11,6 +12,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
+from urdfkit import cli
 from urdfkit.cli import app
 from urdfkit.inspect import JOINT_INFO_FIELDS, JOINT_TYPE_NAMES
 from urdfkit.resolve import pybullet_data_path
@@ -107,9 +109,24 @@ def test_unknown_type_is_an_error() -> None:
 
 
 def test_golden_simplecar_table(simplecar_urdf: Path) -> None:
+    # Piped (as here): plain aligned columns.
     code, out, err = run("joints", str(simplecar_urdf), env={"COLUMNS": "140", "NO_COLOR": "1"})
     assert code == 0, err
     assert out == (GOLDEN / "simplecar_joints.txt").read_text()
+    assert "│" not in out and "…" not in out
+
+
+def test_golden_simplecar_table_on_a_terminal(simplecar_urdf: Path,
+                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    # On a terminal: the rich table, with the same columns as the plain one.
+    monkeypatch.setattr(cli, "_styled", lambda stream: True)
+    code, out, err = run("joints", str(simplecar_urdf), env={"COLUMNS": "140", "NO_COLOR": "1"})
+    assert code == 0, err
+    assert out == (GOLDEN / "simplecar_joints_terminal.txt").read_text()
+    plain = (GOLDEN / "simplecar_joints.txt").read_text().splitlines()
+    rich_headers = [h.strip() for h in out.splitlines()[1].split("┃")]
+    assert rich_headers == re.split(r"\s{2,}", plain[1].strip())
+    assert rich_headers[:3] == ["#", "joint", "type"] and len(rich_headers) > 5
 
 
 def test_golden_simplecar_tree(simplecar_urdf: Path) -> None:

@@ -243,47 +243,95 @@ def _show_diagnostics(lines: list[str]) -> None:
         _warn(f"pybullet: {line}")
 
 
-def _fitted_table(title: str, columns: list[tuple[str, int, str]], rows: list[list[str]],
-                  show_all: bool) -> Any:
-    """A rich table of the columns that fit the terminal, most important first.
+def _terminal_width() -> int:
+    # $COLUMNS, else the terminal stdout is on, else the one stderr is on (`urdfkit joints x |
+    # less` is still read on that screen), else 80, as rich assumes.
+    try:
+        return int(os.environ["COLUMNS"])
+    except (KeyError, ValueError):
+        pass
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            return os.get_terminal_size(stream.fileno()).columns
+        except (AttributeError, OSError, ValueError):
+            continue
+    return 80
+
+
+def _print_fitted_table(title: str, columns: list[tuple[str, int, str]],
+                        rows: list[list[str]], show_all: bool) -> None:
+    """Print the columns that fit the terminal, most important first.
 
     ``columns`` holds (header, priority, justify): priority 0 always shows, then priorities
-    1, 2, ... join while they fit; 9 shows only with ``--all``. With ``--all`` on a terminal
-    too narrow for every column, each row becomes a block of "field value" lines instead, so
+    1, 2, ... join while they fit; 9 shows only with ``--all``. With ``--all`` and too little
+    width for every column, each row becomes a block of "field value" lines instead, so
     nothing is squeezed into ellipses.
-    """
-    from rich.table import Table
 
-    width = _console().width
+    On a terminal this is a rich table. Piped (CI logs, ``| grep``, ``> file``) it is plain
+    text in aligned columns, no box drawing and no truncation, as rich's styling would be
+    dropped there anyway, and without paying ~25 ms to import rich.
+    """
+    width = _terminal_width()
     needed = [max([len(h), *(len(r[i]) for r in rows)]) + 3 for i, (h, _, _) in
               enumerate(columns)]
-    if show_all and sum(needed) > width:
-        from rich.console import Group
-
-        blocks: list[Any] = [f"[bold]{title}[/]"]
-        for r in rows:
-            block = Table(show_header=False, show_edge=False, box=None, padding=(0, 1))
-            block.add_column(style="bold")
-            block.add_column()
-            for (header, _, _), cell in zip(columns, r, strict=False):
-                block.add_row(_escape(header), _escape(cell))
-            blocks += ["", block]
-        return Group(*blocks)
-    keep: set[int] = set()
+    blocks = show_all and sum(needed) > width
+    keep: list[int] = []
     used = 0
     for i in sorted(range(len(columns)), key=lambda i: columns[i][1]):
         prio = columns[i][1]
         if not (show_all or prio == 0 or (prio < 9 and used + needed[i] <= width)):
             break  # a column of this priority does not fit: drop all less important ones
-        keep.add(i)
+        keep.append(i)
         used += needed[i]
-    table = Table(title=title, title_justify="left", show_edge=False, header_style="bold")
-    for i, (header, _, justify) in enumerate(columns):
-        if i in keep:
-            table.add_column(header, justify=justify)  # type: ignore[arg-type]
+    keep.sort()
+    if not _styled(sys.stdout):
+        _plain_table(title, columns, rows, keep, blocks)
+        return
+    from rich.table import Table
+    from rich.text import Text
+
+    heading = Text(title)
+    heading.stylize("bold", 0, max(title.find(":"), 0))  # the robot's name
+    if blocks:
+        from rich.console import Group
+
+        parts: list[Any] = [heading]
+        for r in rows:
+            block = Table(show_header=False, show_edge=False, box=None, padding=(0, 1))
+            block.add_column(style="bold")
+            block.add_column()
+            for (header, _, _), cell in zip(columns, r, strict=False):
+                block.add_row(Text(header), Text(cell))
+            parts += ["", block]
+        _console().print(Group(*parts))
+        return
+    table = Table(title=heading, title_justify="left", show_edge=False, header_style="bold")
+    for i in keep:
+        header, _, justify = columns[i]
+        table.add_column(header, justify=justify)  # type: ignore[arg-type]
     for r in rows:
-        table.add_row(*(_escape(c) for i, c in enumerate(r) if i in keep))
-    return table
+        table.add_row(*(Text(r[i]) for i in keep))
+    _console().print(table)
+
+
+def _plain_table(title: str, columns: list[tuple[str, int, str]], rows: list[list[str]],
+                 keep: list[int], blocks: bool) -> None:
+    out = [title]
+    if blocks:
+        label = max(len(h) for h, _, _ in columns)
+        for r in rows:
+            out.append("")
+            out += [f"{h:<{label}}  {cell}".rstrip()
+                    for (h, _, _), cell in zip(columns, r, strict=True)]
+    else:
+        grid = [[columns[i][0] for i in keep], *([r[i] for i in keep] for r in rows)]
+        widths = [max(len(line[k]) for line in grid) for k in range(len(keep))]
+        for line in grid:
+            cells = [cell.rjust(w) if columns[i][2] == "right" else cell.ljust(w)
+                     for i, cell, w in zip(keep, line, widths, strict=True)]
+            out.append("  ".join(cells).rstrip())
+    sys.stdout.write("\n".join(out) + "\n")
+    sys.stdout.flush()
 
 
 @app.command()
@@ -333,9 +381,8 @@ def joints(
             _nums(j.parent_frame_orn), str(j.flags)])
     shown = f"{len(rows)} of {len(report.joints)}" if len(rows) != len(report.joints) \
         else str(len(rows))
-    title = (f"[bold]{_escape(report.robot)}[/]: {shown} joints, "
-             f"base link {_escape(report.base_link)}")
-    _console().print(_fitted_table(title, columns, cells, show_all))
+    _print_fitted_table(f"{report.robot}: {shown} joints, base link {report.base_link}",
+                        columns, cells, show_all)
 
 
 @app.command()
@@ -385,13 +432,12 @@ def links(
             _num(link.rolling_friction), _num(link.spinning_friction), _num(link.restitution),
             _num(link.contact_stiffness), _num(link.contact_damping),
             _nums(link.local_inertial_pos), _nums(link.local_inertial_orn)])
-    title = (f"[bold]{_escape(report.robot)}[/]: {len(report.links)} links, inertia "
-             f"{'from the file' if inertia_from_file else 'recomputed by PyBullet'}")
-    console = _console()
-    console.print(_fitted_table(title, columns, cells, show_all))
+    inertia = "from the file" if inertia_from_file else "recomputed by PyBullet"
+    _print_fitted_table(f"{report.robot}: {len(report.links)} links, inertia {inertia}",
+                        columns, cells, show_all)
     if differs and not inertia_from_file:
-        console.print("[dim]! = PyBullet's value differs from the file's; "
-                      "--inertia-from-file keeps the file's <inertia>[/]")
+        _line(("! = PyBullet's value differs from the file's; --inertia-from-file keeps the "
+               "file's <inertia>", "dim"))
 
 
 @app.command()
