@@ -15,7 +15,7 @@ import os
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -37,11 +37,13 @@ def _c_fflush() -> None:
         pass
 
 
-@dataclass
 class Captured:
     """Text the C side printed while :func:`quiet_stdout` was active."""
 
-    text: str = ""
+    __slots__ = ("text",)
+
+    def __init__(self) -> None:
+        self.text = ""
 
     @property
     def lines(self) -> list[str]:
@@ -170,7 +172,6 @@ class LoadOptions:
         return flags
 
 
-@dataclass
 class Session:
     """A PyBullet physics client of its own (DIRECT by default), quiet on stdout.
 
@@ -182,17 +183,21 @@ class Session:
         with Session() as s:
             body = s.load_urdf("car.urdf")
             print(s.p.getNumJoints(body, physicsClientId=s.client))
+
+    Attributes:
+        gui: Whether the client is a GUI window rather than DIRECT.
+        diagnostics: What PyBullet printed on stdout so far, line by line.
+        p: The pybullet module.
+        client: The physics client id; -1 once closed.
     """
 
-    gui: bool = False
-    diagnostics: list[str] = field(default_factory=list)
-    p: Any = None
-    client: int = -1
-
-    def __post_init__(self) -> None:
-        self.p = import_pybullet()
+    def __init__(self, gui: bool = False) -> None:
+        self.gui = gui
+        self.diagnostics: list[str] = []
+        self.client = -1
+        self.p: Any = import_pybullet()
         with quiet_stdout() as out:
-            mode = self.p.GUI if self.gui else self.p.DIRECT
+            mode = self.p.GUI if gui else self.p.DIRECT
             try:
                 self.client = self.p.connect(mode)
             except self.p.error as e:  # pragma: no cover - needs a display
