@@ -19,7 +19,12 @@ def cases(ctx: Context) -> list[Case]:
         Case("bare typer --help", [*bare, "--help"]),
         Case("urdfkit joints --json", [*ctx.urdfkit, "joints", str(car), "--json"],
              [("tutorial script", 1.4), ("bare typer joints --json", 1.1)]),
-        Case("urdfkit joints (table)", [*ctx.urdfkit, "joints", str(car)],
+        Case("urdfkit joints (table, piped)", [*ctx.urdfkit, "joints", str(car)],
              [("tutorial script", 1.6)]),
+        # On a terminal: the rich table (imports rich), against the tutorial printing its
+        # tuples to the same terminal.
+        Case("tutorial script (terminal)", [ctx.python, script, str(car)], terminal=True),
+        Case("urdfkit joints (table, terminal)", [*ctx.urdfkit, "joints", str(car)],
+             [("tutorial script (terminal)", 1.6)], terminal=True),
         Case("urdfkit --help", [*ctx.urdfkit, "--help"], [("bare typer --help", 1.1)]),
     ]
