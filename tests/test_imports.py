@@ -23,15 +23,19 @@ try:
     main()  # the console script's entry point, as users run it
 except SystemExit as e:
     sys.stderr.write(f"\\nEXIT:{e.code}")
-sys.stderr.write("\\nMODULES:" + json.dumps(sorted(m.split(".")[0] for m in sys.modules)))
+sys.stderr.write("\\nMODULES:" + json.dumps(sorted(sys.modules)))
 """
 
 
-def loaded_modules(*args: str) -> tuple[subprocess.CompletedProcess[str], set[str]]:
+def loaded_modules(*args: str, top_level: bool = True,
+                   ) -> tuple[subprocess.CompletedProcess[str], set[str]]:
+    """Run the CLI with ``args``; return the process and the modules it imported (top-level
+    package names unless ``top_level`` is false)."""
     proc = subprocess.run([sys.executable, "-c", PROBE, *args], capture_output=True, text=True,
                           timeout=60)
     marker = proc.stderr.rindex("MODULES:")
-    return proc, set(json.loads(proc.stderr[marker + len("MODULES:"):]))
+    names = json.loads(proc.stderr[marker + len("MODULES:"):])
+    return proc, {n.split(".")[0] for n in names} if top_level else set(names)
 
 
 def test_help_imports_nothing_heavy() -> None:
@@ -46,6 +50,15 @@ def test_joints_json_imports_only_pybullet(simplecar_urdf: Path) -> None:
     assert len(json.loads(proc.stdout)["joints"]) == 6
     assert "pybullet" in modules
     assert modules.isdisjoint(HEAVY), modules & set(HEAVY)
+
+
+def test_piped_joints_table_needs_no_rich(simplecar_urdf: Path) -> None:
+    # Off a terminal the table is plain text, so rich (~25 ms to import) stays out; nor does
+    # the joints path load the link/summary and tree modules.
+    proc, modules = loaded_modules("joints", str(simplecar_urdf), top_level=False)
+    assert "base_to_right_back_wheel" in proc.stdout and "│" not in proc.stdout
+    assert "rich" not in modules
+    assert modules.isdisjoint({"urdfkit.body", "urdfkit.tree", "urdfkit.builder"}), modules
 
 
 @pytest.mark.parametrize("command", ["links", "info", "tree"])
