@@ -149,7 +149,7 @@ def link_table(s: Session, body: int, root: etree._Element | None = None,
     for index, name in zip(range(-1, len(joints)), names, strict=True):
         d = s.call("getDynamicsInfo", body, index)
         out.append(LinkDynamics(
-            index, name, float(d[0]), float(d[1]), tuple(d[2]), tuple(d[3]), tuple(d[4]),  # type: ignore[arg-type]
+            index, name, float(d[0]), float(d[1]), tuple(d[2]), tuple(d[3]), tuple(d[4]),
             float(d[5]), float(d[6]), float(d[7]), float(d[8]), float(d[9]), int(d[10]),
             float(d[11]), file_inertial(by_name.get(name))))
     return out

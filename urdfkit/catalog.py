@@ -204,7 +204,7 @@ def expand_template(name: str, values: Mapping[str, Any] | None = None) -> bytes
         doc = xacro.process_file(str(template_dir() / template.file), mappings=args)
     except Exception as e:  # xacro raises plain Exceptions
         raise ParameterError(f"template '{name}' failed to expand: {e}") from None
-    return doc.toxml(encoding="utf-8")  # type: ignore[no-any-return]
+    return doc.toxml(encoding="utf-8")
 
 
 def build_template(name: str, values: Mapping[str, Any] | None = None) -> Robot:

@@ -743,8 +743,8 @@ def drive(
         _print_json(data)
     else:
         _drive_summary(result)
-        for w in written:
-            _line("wrote ", (str(w), "bold"), stderr=True)
+        for path in written:
+            _line("wrote ", (str(path), "bold"), stderr=True)
     if result.interrupted:
         _line(("urdfkit: interrupted; the results cover the steps simulated", "yellow"),
               stderr=True)

@@ -125,7 +125,7 @@ class JointInfo:
             int(info[0]), _text(info[1]), JOINT_TYPE_NAMES.get(int(info[2]), str(info[2])),
             int(info[3]), int(info[4]), int(info[5]), float(info[6]), float(info[7]),
             float(info[8]), float(info[9]), float(info[10]), float(info[11]), _text(info[12]),
-            tuple(info[13]), tuple(info[14]), tuple(info[15]), int(info[16]),  # type: ignore[arg-type]
+            tuple(info[13]), tuple(info[14]), tuple(info[15]), int(info[16]),
             parent_frame_rpy=quat_to_rpy(info[15]),
         )
 

@@ -14,7 +14,7 @@ def template_dir() -> Path:
     exist, and the top-level folder beside the package is the same files.
     """
     try:
-        from . import templates
+        from . import templates  # type: ignore[attr-defined]  # only in the wheel
     except ImportError:
         return Path(__file__).resolve().parent.parent / "templates"
     return Path(templates.__file__).parent

@@ -111,11 +111,11 @@ def kinematic_tree(root: etree._Element) -> TreeNode:
     while stack:
         node = stack.pop()
         for j in below.get(node.link, []):
-            child = TreeNode(j.find("child").get("link", ""))  # type: ignore[union-attr]
+            child = TreeNode(j.find("child").get("link", ""))
             node.children.append(child)
         stack.extend(reversed(node.children))
     # Number the joints in pre-order, now that the tree exists.
-    by_child = {j.find("child").get("link", ""): j  # type: ignore[union-attr]
+    by_child = {j.find("child").get("link", ""): j
                 for js in below.values() for j in js}
     for node in top.walk():
         if node is not top:

@@ -482,7 +482,7 @@ def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | 
     vals = [_num(inertia, a) for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")]
     if any(v is None for v in vals):
         return None
-    ixx, ixy, ixz, iyy, iyz, izz = vals  # type: ignore[misc]
+    ixx, ixy, ixz, iyy, iyz, izz = vals
     return ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))  # type: ignore[return-value]
 
 
@@ -545,15 +545,18 @@ def _shape_trace(link: etree._Element, mass: float | None) -> float | None:
         if shape is None:
             return None
         origin = col.find("origin")
+        # Missing or malformed values go in as None on purpose: the model's constructors
+        # check every value as it is set and raise ModelError, handled below.
         try:
-            o = Origin(xyz=_vec(origin, "xyz", 3) or (0, 0, 0),
-                       rpy=_vec(origin, "rpy", 3) or (0, 0, 0))
+            o = Origin(xyz=_vec(origin, "xyz", 3) or (0, 0, 0),  # type: ignore[arg-type]
+                       rpy=_vec(origin, "rpy", 3) or (0, 0, 0))  # type: ignore[arg-type]
             if shape.tag == "box":
-                g: object = Box(size=_vec(shape, "size", 3))
+                g: object = Box(size=_vec(shape, "size", 3))  # type: ignore[arg-type]
             elif shape.tag == "cylinder":
-                g = Cylinder(radius=_num(shape, "radius"), length=_num(shape, "length"))
+                g = Cylinder(radius=_num(shape, "radius"),  # type: ignore[arg-type]
+                             length=_num(shape, "length"))  # type: ignore[arg-type]
             elif shape.tag == "sphere":
-                g = Sphere(radius=_num(shape, "radius"))
+                g = Sphere(radius=_num(shape, "radius"))  # type: ignore[arg-type]
             else:
                 return None  # meshes, capsules, planes: no volume without loading them
         except ModelError:
