@@ -71,10 +71,10 @@ def main() -> int:
         ctx = Context(sys.executable, urdfkit, Path(tmp))
         cs = cases(ctx)
         for c in cs:
-            time_once(c.argv)
+            time_once(c)
         for _ in range(args.rounds):
             for c in cs:
-                c.times.append(time_once(c.argv))
+                c.times.append(time_once(c))
         lib = in_process(ctx.tmp / "car.urdf", args.rounds)
     status = report(cs, {c.name: c for c in cs}, args.rounds)
     worst = max(max(lib), statistics.median(cs[1].times))
