@@ -1,4 +1,4 @@
-"""Expand one xacro file and print the URDF: run in a subprocess by :mod:`urdfkit.resolve`.
+"""Expand one xacro file and print the URDF: run in a subprocess by :mod:`urdfkit.expand`.
 
 xacro's ``${}`` expressions evaluate Python, so a user's xacro file is code. It runs here, in
 a child process with a timeout, never inside urdfkit itself.

@@ -9,7 +9,8 @@ from pathlib import Path
 from .builder import Robot
 from .catalog import TEMPLATES, build_template, parse_assignments
 from .errors import InputError, ParameterError
-from .resolve import expand_xacro, locate
+from .expand import expand_xacro
+from .resolve import locate
 from .validate import guard
 from .xmlio import atomic_write, parse_xml, to_bytes
 

@@ -6,7 +6,7 @@ a message that names the parameter rather than some link deep in the output.
 
 Built-in templates are our own files, so they are expanded in-process (fast: ``drive`` builds
 simplecar on every run). A user's xacro may run arbitrary code and goes through
-:func:`urdfkit.resolve.expand_xacro` in a subprocess instead.
+:func:`urdfkit.expand.expand_xacro` in a subprocess instead.
 """
 
 from __future__ import annotations

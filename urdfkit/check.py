@@ -1,7 +1,7 @@
 """``urdfkit check``: run every validation rule over many files, in parallel, never crashing.
 
 Folders are searched recursively for ``*.urdf`` and ``*.xacro``; xacro is expanded in a
-subprocess (:func:`urdfkit.resolve.expand_xacro`). Each file is checked on its own: a file
+subprocess (:func:`urdfkit.expand.expand_xacro`). Each file is checked on its own: a file
 that cannot be read, expanded or parsed becomes a ``U000`` error finding for that file, never
 an exception, so one broken file cannot stop a sweep over a thousand others. PyBullet is never
 loaded: checking is pure lxml, which is what makes it safe on hostile input and fast.
@@ -119,7 +119,7 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, Path]]:
 
 
 def _read(path: Path, display: str) -> bytes:
-    from .resolve import expand_xacro
+    from .expand import expand_xacro
     from .xmlio import read_bytes
 
     if path.suffix == ".xacro" and not path.is_dir():
