@@ -104,6 +104,7 @@ CASES = [
     ("U801", doc(link("a", body=BOX + "\n<colision/><!--HERE-->\n"))),
     ("U802", doc(link("a", body='<collision><geometry>\n<box size="1 1 1" colour="red"/>'
                                 '<!--HERE-->\n</geometry></collision>'))),
+    ("U901", doc(A, B, joint(jtype="spherical", inner="") + "<!--HERE-->")),
 ]
 
 
@@ -238,8 +239,8 @@ def test_missing_path_is_a_parameter_error(tmp_path: Path) -> None:
 
 def test_select_and_ignore_prefixes() -> None:
     assert parse_codes(["U2,u601", " U8 "], "--select") == ("U2", "U601", "U8")
-    with pytest.raises(ParameterError, match="U9"):
-        parse_codes(["U9"], "--select")
+    with pytest.raises(ParameterError, match="U99"):
+        parse_codes(["U99"], "--select")
 
 
 runner = CliRunner()

@@ -8,15 +8,11 @@ from pathlib import Path
 import pytest
 
 from urdfkit.errors import ParameterError
-from urdfkit.inspect import (
-    JOINT_INFO_FIELDS,
-    filter_joints,
-    inspect_file,
-    quat_to_rpy,
-    tidy_diagnostics,
-)
+from urdfkit.inspect import JOINT_INFO_FIELDS, filter_joints
+from urdfkit.report import inspect_file, tidy_diagnostics
 from urdfkit.resolve import open_input, resolve
 from urdfkit.session import LoadOptions
+from urdfkit.spec import quat_to_rpy
 from urdfkit.tree import kinematic_tree
 
 # A link with an off-diagonal <inertia> and an offset, rotated inertial frame, and a child link

@@ -14,9 +14,10 @@ from typer.testing import CliRunner
 
 from urdfkit import cli
 from urdfkit.cli import app
-from urdfkit.inspect import JOINT_INFO_FIELDS, JOINT_TYPE_NAMES
+from urdfkit.inspect import JOINT_INFO_FIELDS
 from urdfkit.resolve import pybullet_data_path
 from urdfkit.session import LoadOptions
+from urdfkit.spec import PYBULLET_JOINT_CODES as JOINT_TYPE_NAMES
 
 ROOT = Path(__file__).resolve().parent.parent
 GOLDEN = Path(__file__).parent / "golden"

@@ -469,6 +469,6 @@ def test_bodies_too_large_for_state_queries_are_refused(tmp_path: Path) -> None:
                               axis=(0, 1, 0), limit=Limit(1, 1, -1, 1)))
     chain.write(tmp_path / "chain.urdf")
     doc = {"robots": [{"name": "snake", "urdf": str(tmp_path / "chain.urdf"), "base": "fixed"}]}
-    with pytest.raises(InputError, match=r"robots\[0\]: snake has 130 links; PyBullet cannot "
+    with pytest.raises(InputError, match=r"robots\[0\]: snake: 130 links: PyBullet cannot "
                                          "report the state"):
         Simulation(doc)

@@ -18,9 +18,10 @@ from typing import Any
 
 from lxml import etree
 
-from .inspect import JOINT_DOF, JointInfo, base_link_name, joint_table
+from .inspect import JointInfo, base_link_name, joint_table
 from .session import Session
-from .xmlio import attr_float, attr_vec, children
+from .spec import JOINT_DOF, attr_float, attr_vec
+from .xmlio import children
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
@@ -70,7 +71,8 @@ def file_inertial(link: etree._Element | None) -> FileInertial | None:
         principal = (values[0], values[3], values[5])
     origin = el.find("origin")
     return FileInertial(mass, values, tuple(sorted(principal)),  # type: ignore[arg-type]
-                        attr_vec(origin, "xyz", (0, 0, 0)), attr_vec(origin, "rpy", (0, 0, 0)))  # type: ignore[arg-type]
+                        attr_vec(origin, "xyz", 3, (0, 0, 0)),  # type: ignore[arg-type]
+                        attr_vec(origin, "rpy", 3, (0, 0, 0)))  # type: ignore[arg-type]
 
 
 @dataclass

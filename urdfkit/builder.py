@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
@@ -33,15 +33,21 @@ from typing import Any, ClassVar
 from lxml import etree
 
 from .errors import ModelError
+from .spec import (
+    JOINT_TYPES,
+    LIMITED_JOINT_TYPES,
+    SHAPE_SIZES,
+    SHAPES,
+    Matrix3,
+    Vec3,
+    depth_first,
+    matmul,
+    rpy_to_matrix,
+    transpose,
+)
 from .xmlio import atomic_write, fmt_float, fmt_vec, load_xml, parse_xml, to_bytes
 
-Vec3 = tuple[float, float, float]
-Matrix3 = tuple[Vec3, Vec3, Vec3]
-
-#: Joint types of the URDF specification.
-JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
-#: Joint types that need ``<limit>`` with effort and velocity.
-LIMITED_JOINT_TYPES = ("revolute", "prismatic")
+__all__ = ["JOINT_TYPES", "LIMITED_JOINT_TYPES", "rpy_to_matrix"]  # re-exported from spec
 
 _REL_TOL = 1e-9
 _ABS_TOL = 1e-12
@@ -172,28 +178,6 @@ class _Element:
 # --------------------------------------------------------------------------- geometry math
 
 
-def rpy_to_matrix(rpy: Sequence[float]) -> Matrix3:
-    """Rotation matrix of URDF roll-pitch-yaw (fixed axes X, Y, Z): ``R = Rz(y) Ry(p) Rx(r)``."""
-    r, p, y = rpy
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), \
-        math.sin(y)
-    return (
-        (cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr),
-        (sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr),
-        (-sp, cp * sr, cp * cr),
-    )
-
-
-def _matmul(a: Matrix3, b: Matrix3) -> Matrix3:
-    return tuple(  # type: ignore[return-value]
-        tuple(sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)) for i in range(3)
-    )
-
-
-def _transpose(a: Matrix3) -> Matrix3:
-    return tuple(tuple(a[j][i] for j in range(3)) for i in range(3))  # type: ignore[return-value]
-
-
 # --------------------------------------------------------------------------- elements
 
 
@@ -252,7 +236,7 @@ class Inertia(_Element):
 
     def rotated(self, rotation: Matrix3) -> Inertia:
         """The tensor expressed in a frame rotated by ``rotation``: ``R I R^T``."""
-        return Inertia.from_matrix(_matmul(_matmul(rotation, self.matrix), _transpose(rotation)))
+        return Inertia.from_matrix(matmul(matmul(rotation, self.matrix), transpose(rotation)))
 
     @property
     def principal_moments(self) -> tuple[float, float, float]:
@@ -341,6 +325,58 @@ class Sphere(_Element):
 
 
 @dataclass(eq=False)
+class Capsule(_Element):
+    """A capsule (PyBullet extension): a cylinder of ``length`` capped by two hemispheres.
+
+    Its axis is the local z axis and ``length`` excludes the caps, as in PyBullet.
+    """
+
+    _tag = "capsule"
+    radius: float = _checked(check=_positive)
+    length: float = _checked(check=_positive)
+
+    @property
+    def volume(self) -> float:
+        """Volume in m^3."""
+        r, h = self.radius, self.length
+        return math.pi * r * r * h + 4 / 3 * math.pi * r**3
+
+    def inertia(self, mass: float) -> Inertia:
+        """Solid-capsule inertia about its centre (axis z), uniform density."""
+        r, h = self.radius, self.length
+        v_cyl, v_caps = math.pi * r * r * h, 4 / 3 * math.pi * r**3
+        m_cyl = mass * v_cyl / (v_cyl + v_caps)
+        m_caps = mass - m_cyl
+        # The two hemispheres form a sphere split in half and pushed apart by h: each half's
+        # centre of mass sits 3r/8 from its flat face, so h/2 + 3r/8 from the capsule centre.
+        radial = (m_cyl * (3 * r * r + h * h) / 12
+                  + m_caps * (2 * r * r / 5 + h * h / 4 + 3 * h * r / 8))
+        axial = m_cyl * r * r / 2 + m_caps * 2 * r * r / 5
+        return Inertia(ixx=radial, iyy=radial, izz=axial)
+
+
+@dataclass(eq=False)
+class Plane(_Element):
+    """An infinite plane (PyBullet extension) through the origin, with normal ``normal``."""
+
+    _tag = "plane"
+    normal: Vec3 = _checked((0.0, 0.0, 1.0), _vector(3))
+
+    @property
+    def volume(self) -> float:
+        """A plane has no finite volume; raises :class:`ModelError`."""
+        raise ModelError(_PLANE_INERTIA)
+
+    def inertia(self, mass: float) -> Inertia:
+        """Not defined for an infinite plane; raises :class:`ModelError`."""
+        raise ModelError(_PLANE_INERTIA)
+
+
+_PLANE_INERTIA = ("cannot derive inertia from an infinite <plane>; give <inertia> explicitly "
+                  "(or mass 0 for static ground)")
+
+
+@dataclass(eq=False)
 class Mesh(_Element):
     """A mesh file (STL, OBJ, DAE), optionally scaled per axis."""
 
@@ -360,13 +396,27 @@ class Mesh(_Element):
                          "explicitly")
 
 
-Geometry = Box | Cylinder | Sphere | Mesh
+@dataclass(eq=False)
+class Cdf(Mesh):
+    """A signed-distance-field file (PyBullet extension), read like a mesh."""
+
+    _tag = "cdf"
+
+
+Geometry = Box | Cylinder | Sphere | Capsule | Plane | Mesh
+#: The model class of each shape tag in :data:`urdfkit.spec.SHAPES`.
+SHAPE_CLASSES: dict[str, type[_Element]] = {
+    "box": Box, "cylinder": Cylinder, "sphere": Sphere, "mesh": Mesh, "capsule": Capsule,
+    "plane": Plane, "cdf": Cdf,
+}
+assert set(SHAPE_CLASSES) == set(SHAPES), "builder shapes out of step with urdfkit.spec"
 
 
 def _geometry(value: Any) -> Geometry:
-    if not isinstance(value, Box | Cylinder | Sphere | Mesh):
-        raise _fail(f"expected Box, Cylinder, Sphere or Mesh, got {type(value).__name__}")
-    return value
+    if not isinstance(value, tuple(SHAPE_CLASSES.values())):
+        raise _fail(f"expected one of {', '.join(c.__name__ for c in SHAPE_CLASSES.values())}, "
+                    f"got {type(value).__name__}")
+    return value  # type: ignore[return-value]
 
 
 def _origin(value: Any) -> Origin:
@@ -707,19 +757,7 @@ class Robot(_Element):
         by_parent: dict[str, list[Joint]] = {}
         for j in self.joints:
             by_parent.setdefault(j.parent, []).append(j)
-        order: list[Joint] = []
-        seen = {self.root}
-        # Pre-order walk without recursion (a 5000-link chain must not overflow the stack);
-        # push children reversed so the first declared pops first.
-        walk: list[Joint] = list(reversed(by_parent.get(self.root, [])))
-        while walk:
-            j = walk.pop()
-            if j.child in seen:
-                continue  # a cycle or second parent: validate() reports it
-            seen.add(j.child)
-            order.append(j)
-            walk.extend(reversed(by_parent.get(j.child, [])))
-        return order
+        return depth_first(self.root, by_parent, lambda j: j.child)
 
     def validate(self) -> None:
         """Check the tree: known links, unique names, one root, no cycle, single parents."""
@@ -847,15 +885,15 @@ def _parse_geometry(ctx: _Ctx, el: etree._Element | None, owner: etree._Element)
     if len(shapes) != 1:
         raise ctx.error(el, f"<geometry> must hold exactly one shape, found {len(shapes)}")
     s = shapes[0]
-    if s.tag == "box":
-        return ctx.build(s, Box, size=ctx.attr(s, "size"))
-    if s.tag == "cylinder":
-        return ctx.build(s, Cylinder, radius=ctx.num(s, "radius"), length=ctx.num(s, "length"))
-    if s.tag == "sphere":
-        return ctx.build(s, Sphere, radius=ctx.num(s, "radius"))
-    if s.tag == "mesh":
-        return ctx.build(s, Mesh, filename=ctx.attr(s, "filename"), scale=s.get("scale"))
-    raise ctx.error(s, f"unknown shape <{s.tag}>; expected box, cylinder, sphere or mesh")
+    cls = SHAPE_CLASSES.get(s.tag)
+    if cls is None:
+        raise ctx.error(s, f"unknown shape <{s.tag}>; expected one of {', '.join(SHAPES)}")
+    if s.tag in SHAPE_SIZES:
+        sizes = {a: ctx.attr(s, a) if a == "size" else ctx.num(s, a) for a in SHAPE_SIZES[s.tag]}
+        return ctx.build(s, cls, **sizes)
+    if s.tag == "plane":
+        return ctx.build(s, Plane, normal=s.get("normal", "0 0 1"))
+    return ctx.build(s, cls, filename=ctx.attr(s, "filename"), scale=s.get("scale"))
 
 
 def _write_geometry(parent: etree._Element, g: Geometry) -> None:
@@ -866,8 +904,12 @@ def _write_geometry(parent: etree._Element, g: Geometry) -> None:
         etree.SubElement(geo, "cylinder", radius=fmt_float(g.radius), length=fmt_float(g.length))
     elif isinstance(g, Sphere):
         etree.SubElement(geo, "sphere", radius=fmt_float(g.radius))
+    elif isinstance(g, Capsule):
+        etree.SubElement(geo, "capsule", radius=fmt_float(g.radius), length=fmt_float(g.length))
+    elif isinstance(g, Plane):
+        etree.SubElement(geo, "plane", normal=fmt_vec(g.normal))
     else:
-        m = etree.SubElement(geo, "mesh", filename=g.filename)
+        m = etree.SubElement(geo, g._tag, filename=g.filename)
         if g.scale is not None:
             m.set("scale", fmt_vec(g.scale))
 

@@ -226,7 +226,7 @@ FileArg = Annotated[str, typer.Argument(
 def _inspect(file: str, package: list[str] | None, arg: list[str] | None, *,
              fixed_base: bool = False, inertia_from_file: bool = False,
              links: bool = False, info: bool = False) -> Any:
-    from .inspect import inspect_file
+    from .report import inspect_file
     from .resolve import open_input
     from .session import LoadOptions
 

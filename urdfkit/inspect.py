@@ -2,7 +2,8 @@
 
 Everything here returns dataclasses; nothing prints. ``cli.py`` presents them as rich tables
 or JSON. The link table and the summary live in :mod:`urdfkit.body`, the kinematic tree (no
-PyBullet) in :mod:`urdfkit.tree`, so that ``urdfkit joints`` loads only what it shows.
+PyBullet) in :mod:`urdfkit.tree`, and loading a file into a report in :mod:`urdfkit.report`,
+so that ``urdfkit joints`` loads only what it shows.
 
 The joint table carries all 17 fields of ``p.getJointInfo`` under the names the PyBullet
 Quickstart Guide uses (``jointIndex`` ... ``parentIndex``); :meth:`JointInfo.to_dict` is the
@@ -20,31 +21,15 @@ shape this module:
 
 from __future__ import annotations
 
-import math
-import re
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
 
 from lxml import etree
 
-from .resolve import Resolved
-from .session import LoadOptions, Session, quiet_stdout
+from .session import Session
+from .spec import JOINT_TYPE_FILTERS, pybullet_joint_type, quat_to_rpy
 from .xmlio import children
-
-if TYPE_CHECKING:
-    from .body import LinkDynamics, Summary
-
-#: ``getJointInfo``'s jointType codes (p.JOINT_REVOLUTE == 0, ...), as names.
-JOINT_TYPE_NAMES = {0: "REVOLUTE", 1: "PRISMATIC", 2: "SPHERICAL", 3: "PLANAR", 4: "FIXED",
-                    5: "POINT2POINT", 6: "GEAR"}
-#: Velocity degrees of freedom of each PyBullet joint type (a planar joint is x, y and yaw).
-JOINT_DOF = {"REVOLUTE": 1, "PRISMATIC": 1, "SPHERICAL": 3, "PLANAR": 3, "FIXED": 0}
-
-#: What ``--type`` accepts: PyBullet's type names and the URDF's, lower case.
-FILTER_TYPES = ("revolute", "continuous", "prismatic", "fixed", "spherical", "planar",
-                "floating")
 
 #: The 17 ``getJointInfo`` fields, in tuple order, as the Quickstart Guide names them.
 JOINT_INFO_FIELDS = (
@@ -59,25 +44,6 @@ Quat = tuple[float, float, float, float]
 
 def _text(value: Any) -> str:
     return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
-
-
-def quat_to_rpy(q: Sequence[float]) -> Vec3:
-    """Roll, pitch, yaw (URDF's fixed-axis X-Y-Z convention) of a quaternion (x, y, z, w).
-
-    The same result as ``p.getEulerFromQuaternion``, without needing a PyBullet client.
-    """
-    x, y, z, w = q
-    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-    s = max(-1.0, min(1.0, 2 * (w * y - z * x)))
-    pitch = math.asin(s)
-    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    return (_clean(roll), _clean(pitch), _clean(yaw))
-
-
-def _clean(x: float) -> float:
-    # -0.0 and 1e-17 noise make tables and golden files churn.
-    return 0.0 if abs(x) < 1e-12 else x
-
 
 
 # --------------------------------------------------------------------------- joints
@@ -122,7 +88,7 @@ class JointInfo:
     def from_pybullet(cls, info: Sequence[Any]) -> JointInfo:
         """Decode the raw 17-tuple: bytes to text, type code to name, tuples kept as tuples."""
         return cls(
-            int(info[0]), _text(info[1]), JOINT_TYPE_NAMES.get(int(info[2]), str(info[2])),
+            int(info[0]), _text(info[1]), pybullet_joint_type(info[2]),
             int(info[3]), int(info[4]), int(info[5]), float(info[6]), float(info[7]),
             float(info[8]), float(info[9]), float(info[10]), float(info[11]), _text(info[12]),
             tuple(info[13]), tuple(info[14]), tuple(info[15]), int(info[16]),
@@ -196,12 +162,12 @@ def filter_joints(joints: Sequence[JointInfo], *, movable: bool = False,
     continuous`` and ``--type revolute`` both work.
     """
     wanted = {t.lower() for t in types}
-    unknown = sorted(wanted - set(FILTER_TYPES))
+    unknown = sorted(wanted - set(JOINT_TYPE_FILTERS))
     if unknown:
         from .errors import ParameterError
 
         raise ParameterError(f"--type {unknown[0]!r} is not a joint type; use one of "
-                             f"{', '.join(FILTER_TYPES)}")
+                             f"{', '.join(JOINT_TYPE_FILTERS)}")
     out = []
     for j in joints:
         if movable and not j.movable:
@@ -210,95 +176,3 @@ def filter_joints(joints: Sequence[JointInfo], *, movable: bool = False,
             continue
         out.append(j)
     return out
-
-
-# --------------------------------------------------------------------------- reports
-
-
-@dataclass
-class Report:
-    """What a command shows about one file: its data plus what PyBullet said on the way.
-
-    Attributes:
-        file: The file as the user named it.
-        path: The file found on disk (for example inside pybullet_data).
-        robot: The ``<robot name>``.
-        base_link: PyBullet's root link.
-        joints: The joint table.
-        links: The link table (``urdfkit links`` only).
-        summary: The summary (``urdfkit info`` only).
-        diagnostics: PyBullet's own output (warnings), captured off stdout.
-    """
-
-    file: str
-    path: str
-    robot: str
-    base_link: str
-    joints: list[JointInfo] = field(default_factory=list)
-    links: list[LinkDynamics] = field(default_factory=list)
-    summary: Summary | None = None
-    diagnostics: list[str] = field(default_factory=list)
-
-    def header(self) -> dict[str, Any]:
-        """The keys every ``--json`` output starts with."""
-        return {"file": self.file, "path": self.path, "robot": self.robot,
-                "base_link": self.base_link}
-
-
-@contextmanager
-def loaded(resolved: Resolved, options: LoadOptions | None = None) -> Iterator[tuple[Session, int]]:
-    """A fresh DIRECT session with the resolved file loaded; disconnected on exit."""
-    with Session() as s:
-        body = s.load_urdf(resolved.load_path, options, display=resolved.name)
-        yield s, body
-
-
-def inspect_file(resolved: Resolved, options: LoadOptions | None = None, *,
-                 links: bool = False, info: bool = False) -> Report:
-    """Load a resolved file and read its joint table, and optionally links and summary."""
-    options = options or LoadOptions()
-    with loaded(resolved, options) as (s, body):
-        # One capture around all the queries instead of a temp file per PyBullet call (the
-        # inner quiet_stdout blocks are re-entrant no-ops). Loading stays outside it, so a
-        # refused file's error message can quote what PyBullet said.
-        with quiet_stdout() as out:
-            joints = joint_table(s, body, resolved.root)
-            report = Report(resolved.name, str(resolved.source), resolved.robot_name,
-                            base_link_name(s, body), joints)
-            if links or info:
-                from .body import link_table, summary
-
-            if links:
-                report.links = link_table(s, body, resolved.root, joints)
-            if info:
-                report.summary = summary(s, body, resolved.root, options.fixed_base)
-    # After close(), so disconnect's own chatter is included too.
-    report.diagnostics = tidy_diagnostics([*s.diagnostics, *out.lines])
-    return report
-
-
-#: The location prefix of PyBullet's b3Warning/b3Error/b3Printf output: source file and line.
-_B3_PREFIX = re.compile(r"b3(?:Warning|Error)\[[^\]]*\]:\s*|b3Printf:\s*")
-
-
-def tidy_diagnostics(lines: Sequence[str]) -> list[str]:
-    """PyBullet's captured output as readable, de-duplicated messages.
-
-    PyBullet writes each warning as ``b3Warning[file.cpp,126]:``, a newline, then text with no
-    newline after it, so messages run into the next prefix; and it reports the link a warning
-    is about as a separate warning of its own. Drop the prefixes, and fold the link name back into
-    the "No inertial data for link" message it belongs to.
-    """
-    parts = [p.strip() for p in _B3_PREFIX.split("\n".join(lines))]
-    parts = [p for chunk in parts for p in chunk.splitlines() if p.strip()]
-    out: list[str] = []
-    i = 0
-    while i < len(parts):
-        msg = parts[i]
-        if msg.startswith("No inertial data for link") and i + 1 < len(parts) and \
-                " " not in parts[i + 1]:
-            msg = msg.replace("for link,", f"for link {parts[i + 1]!r},", 1)
-            i += 1
-        out.append(msg)
-        i += 1
-    return list(dict.fromkeys(out))

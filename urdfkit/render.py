@@ -34,6 +34,7 @@ from typing import Any
 
 from . import style
 from .errors import EngineError, MissingDependencyError, OutputError, ParameterError
+from .spec import attr_vec, pybullet_joint_type, rpy_to_matrix, vector
 
 #: The views, as (direction from target to camera, camera up vector). URDF: x forward, z up.
 #: ``front`` looks at the robot's face (+x), ``side`` at its right flank (-y), so the robot
@@ -62,7 +63,6 @@ JOINT_AXIS_COLOR = style.END
 
 # PyBullet joint types (p.JOINT_*), spelled here so that reading them needs no import.
 _JOINT_FIXED = 4
-_JOINT_TYPES = {0: "revolute", 1: "prismatic", 2: "spherical", 3: "planar", 4: "fixed"}
 
 
 @dataclass(frozen=True)
@@ -369,15 +369,9 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
     if o.collision:
         # Make TinyRenderer draw the collision shapes: with this flag PyBullet builds the
         # visual shapes from <collision> (see the module docstring).
-        try:
-            body = int(session.call("loadURDF", str(resolved.load_path), useFixedBase=True,
-                                    flags=opts.flags(p) | p.URDF_IGNORE_VISUAL_SHAPES))
-        except p.error:
-            said = "; ".join(session.diagnostics[-3:])
-            raise EngineError(f"PyBullet could not load it{': ' + said if said else ''}",
-                              file=resolved.name) from None
-    else:
-        body = session.load_urdf(resolved.load_path, opts, display=resolved.name)
+        opts.extra_flags = p.URDF_IGNORE_VISUAL_SHAPES
+    body = session.load_urdf(resolved.load_path, opts, display=resolved.name)
+    session.require_state_queries(body, resolved.name)
     try:
         n = p.getNumJoints(body, physicsClientId=c)
         infos = [p.getJointInfo(body, j, physicsClientId=c) for j in range(n)]
@@ -411,9 +405,8 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
             pos, rot = frames[j + 1]
             axes.append((pos, rot @ np.array(info[13], dtype=float)))
     except p.error as e:
-        raise EngineError(f"PyBullet cannot report this body's state ({e}); bodies with 128 "
-                          "links or more are beyond its state queries", file=resolved.name) \
-            from None
+        raise EngineError(f"PyBullet cannot report this body's state ({e})",
+                          file=resolved.name) from None
     return _Scene(session, body, lo, hi, frames, axes)
 
 
@@ -432,35 +425,15 @@ def _visual_bounds(root: Any, frames: Mapping[str, tuple[Any, Any]]) -> tuple[An
             continue
         for visual in link.iter("visual"):
             origin = visual.find("origin")
-            xyz = _floats(origin.get("xyz") if origin is not None else None, 3) or [0.0] * 3
-            rpy = _floats(origin.get("rpy") if origin is not None else None, 3) or [0.0] * 3
-            rot = frame[1] @ _rpy_matrix(rpy)
+            xyz = attr_vec(origin, "xyz", 3, (0, 0, 0))
+            rpy = attr_vec(origin, "rpy", 3, (0, 0, 0))
+            rot = frame[1] @ np.array(rpy_to_matrix(rpy))  # type: ignore[arg-type]
             half = _half_extent(visual.find("geometry"), rot)
             if half is None:
                 continue
             centre = frame[0] + frame[1] @ np.array(xyz)
             lo, hi = np.minimum(lo, centre - half), np.maximum(hi, centre + half)
     return lo, hi
-
-
-def _floats(text: str | None, n: int) -> list[float] | None:
-    try:
-        values = [float(x) for x in (text or "").split()]
-    except ValueError:
-        return None
-    return values if len(values) == n and all(map(math.isfinite, values)) else None
-
-
-def _rpy_matrix(rpy: Sequence[float]) -> Any:
-    """URDF's fixed-axis roll, pitch, yaw as a matrix: Rz(yaw) Ry(pitch) Rx(roll)."""
-    import numpy as np
-
-    cr, sr = math.cos(rpy[0]), math.sin(rpy[0])
-    cp, sp = math.cos(rpy[1]), math.sin(rpy[1])
-    cy, sy = math.cos(rpy[2]), math.sin(rpy[2])
-    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-                     [-sp, cp * sr, cp * cr]])
 
 
 def _half_extent(geometry: Any, rot: Any) -> Any:
@@ -471,10 +444,10 @@ def _half_extent(geometry: Any, rot: Any) -> Any:
         return None
     box, cyl, sphere = geometry.find("box"), geometry.find("cylinder"), geometry.find("sphere")
     if box is not None:
-        size = _floats(box.get("size"), 3)
+        size = vector(box.get("size"), 3)
         return np.abs(rot) @ (np.abs(size) / 2) if size else None
     if cyl is not None:
-        r, length = _floats(cyl.get("radius"), 1), _floats(cyl.get("length"), 1)
+        r, length = vector(cyl.get("radius"), 1), vector(cyl.get("length"), 1)
         if not (r and length):
             return None
         # A disc of radius r around the axis a reaches r * sqrt(1 - a_i^2) along world axis i;
@@ -482,7 +455,7 @@ def _half_extent(geometry: Any, rot: Any) -> Any:
         a = rot[:, 2]
         return abs(r[0]) * np.sqrt(np.clip(1 - a * a, 0, 1)) + abs(length[0]) / 2 * np.abs(a)
     if sphere is not None:
-        r = _floats(sphere.get("radius"), 1)
+        r = vector(sphere.get("radius"), 1)
         return np.full(3, abs(r[0])) if r else None
     return None
 
@@ -497,9 +470,10 @@ def _pose(p: Any, c: int, body: int, by_name: Mapping[str, Any], joints: Mapping
             raise ParameterError(f"--joints: no joint named {name!r} (movable joints: {known})",
                                  file=file)
         if info[2] != _JOINT_FIXED and info[2] not in (0, 1):
-            raise ParameterError(f"--joints {name}: {_JOINT_TYPES[info[2]]} joints take more "
-                                 "than one position; only revolute, continuous and prismatic "
-                                 "joints can be posed", file=file)
+            kind = pybullet_joint_type(info[2]).lower()
+            raise ParameterError(f"--joints {name}: {kind} joints take more than one position; "
+                                 "only revolute, continuous and prismatic joints can be posed",
+                                 file=file)
         if info[2] == _JOINT_FIXED:
             raise ParameterError(f"--joints {name}: a fixed joint cannot move", file=file)
         lower, upper = info[8], info[9]

@@ -14,7 +14,6 @@
 
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,20 +23,10 @@ from lxml import etree
 
 from .errors import InputError, ParameterError
 from .expand import expand_xacro
+from .spec import FILE_TAGS
+from .uris import pybullet_data_path, resolve_uri
 from .validate import guard
 from .xmlio import parse_xml, read_bytes, to_bytes
-
-#: Elements whose ``filename`` attribute names a file.
-_FILE_TAGS = ("mesh", "texture")
-
-
-def pybullet_data_path() -> Path | None:
-    """The folder of PyBullet's bundled models, if pybullet_data is installed."""
-    try:
-        import pybullet_data
-    except ImportError:  # pragma: no cover - ships with pybullet
-        return None
-    return Path(pybullet_data.getDataPath())
 
 
 def locate(name: str | Path) -> Path:
@@ -108,47 +97,19 @@ class Resolved:
         self.close()
 
 
-def _find_package(name: str, start: Path) -> Path | None:
-    # ROS layout without ROS: a parent folder named NAME, or one holding NAME/, or a folder
-    # whose package.xml declares <name>NAME</name>.
-    for folder in [start, *start.parents]:
-        if folder.name == name:
-            return folder
-        if (folder / name).is_dir():
-            return folder / name
-        pkg = folder / "package.xml"
-        if pkg.is_file():
-            try:
-                text = pkg.read_text("utf-8", "replace")
-            except OSError:
-                continue
-            if f"<name>{name}</name>" in text:
-                return folder
-    return None
-
-
 def _rewrite_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
-                   name: str) -> bool:
-    changed = False
-    for el in root.iter(*_FILE_TAGS):
+                   name: str) -> None:
+    """Point every file reference at an absolute path, for PyBullet (see :mod:`urdfkit.uris`)."""
+    for el in root.iter(*FILE_TAGS):
         fn = el.get("filename")
         if not fn:
             continue
-        if fn.startswith("package://"):
-            pkg, _, rest = fn[len("package://"):].partition("/")
-            folder = packages.get(pkg) or _find_package(pkg, base)
-            if folder is None:
-                raise InputError(f"cannot resolve {fn!r}: package {pkg!r} not found; pass "
-                                 f"--package {pkg}=PATH", file=name, line=el.sourceline)
-            el.set("filename", str(folder / rest))
-            changed = True
-        elif fn.startswith("file://"):
-            el.set("filename", fn[len("file://"):])
-            changed = True
-        elif not os.path.isabs(fn):
-            el.set("filename", str((base / fn).resolve()))
-            changed = True
-    return changed
+        target = resolve_uri(fn, base, packages)
+        if target.path is None:
+            raise InputError(f"cannot resolve {fn!r}: {target.problem}", file=name,
+                             line=el.sourceline)
+        el.set("filename", str(target.path if target.package is not None or
+                               fn.startswith("file://") else target.path.resolve()))
 
 
 def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
@@ -165,7 +126,7 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
     root = tree.getroot()
     needs_copy = source.suffix == ".xacro"
     has_packages = any((el.get("filename") or "").startswith(("package://", "file://"))
-                       for el in root.iter(*_FILE_TAGS))
+                       for el in root.iter(*FILE_TAGS))
     if has_packages or needs_copy:
         _rewrite_files(root, source.resolve().parent, packages or {}, display)
         import tempfile  # here, not at the top: most loads need no copy

@@ -20,9 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import EngineError
-
-#: PyBullet's state queries fail on bodies with this many links or more (MAX_DEGREE_OF_FREEDOM).
-MAX_PYBULLET_LINKS = 128
+from .spec import MAX_STATE_LINKS
 
 _libc: Any = None
 
@@ -147,6 +145,7 @@ class LoadOptions:
         base_position: Where the root link starts.
         base_orientation: Quaternion (x, y, z, w) of the root link.
         global_scaling: Scale the whole model.
+        extra_flags: Further ``p.URDF_*`` flags, or-ed in (render's URDF_IGNORE_VISUAL_SHAPES).
     """
 
     fixed_base: bool = False
@@ -157,10 +156,11 @@ class LoadOptions:
     base_position: tuple[float, float, float] = (0.0, 0.0, 0.0)
     base_orientation: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
     global_scaling: float = 1.0
+    extra_flags: int = 0
 
     def flags(self, p: Any) -> int:
         """The ``loadURDF`` flags these options mean."""
-        flags = 0
+        flags = self.extra_flags
         if self.inertia_from_file:
             flags |= p.URDF_USE_INERTIA_FROM_FILE
         if self.implicit_cylinder:
@@ -262,7 +262,7 @@ class Session:
         such bodies (MAX_DEGREE_OF_FREEDOM), so simulating commands check before they start.
         """
         links = self.p.getNumJoints(body, physicsClientId=self.client) + 1
-        if links >= MAX_PYBULLET_LINKS:
+        if links >= MAX_STATE_LINKS:
             raise EngineError(f"{links} links: PyBullet cannot report the state of bodies with "
-                              f"{MAX_PYBULLET_LINKS} links or more; split the model",
+                              f"{MAX_STATE_LINKS} links or more; split the model",
                               file=display)

@@ -31,9 +31,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .errors import InputError, MissingDependencyError, OutputError, ParameterError
+from .errors import EngineError, InputError, MissingDependencyError, OutputError, ParameterError
 from .scenario import OBSERVATION_FIELDS, load_scenario, parse_scenario
 from .session import LoadOptions, Session
+from .spec import quat_to_matrix, rotate_back
 
 _REVOLUTE, _PRISMATIC, _FIXED = 0, 1, 4  # p.JOINT_* values
 #: Joint types with one degree of freedom: what getJointState can report.
@@ -101,13 +102,6 @@ class Observation:
     def _replace(self, **changes: Any) -> Observation:
         data = {**self.__dict__, **changes}
         return Observation(**data)
-
-
-def _rotate_into(matrix: Sequence[float], v: Sequence[float]) -> list[float]:
-    """R^T v for PyBullet's row-major 3x3 ``matrix``: a world vector in the body frame."""
-    return [matrix[0] * v[0] + matrix[3] * v[1] + matrix[6] * v[2],
-            matrix[1] * v[0] + matrix[4] * v[1] + matrix[7] * v[2],
-            matrix[2] * v[0] + matrix[5] * v[1] + matrix[8] * v[2]]
 
 
 # --------------------------------------------------------------------------- robots
@@ -336,14 +330,11 @@ class Simulation:
                               self_collision=cfg.self_collision,
                               base_position=tuple(cfg.position), base_orientation=orientation)
         body = self._load(path, cfg.template, cfg.params, cfg.urdf, options)
-        from .validate import MAX_PYBULLET_LINKS
-
-        links_count = p.getNumJoints(body, physicsClientId=client) + 1
-        if links_count >= MAX_PYBULLET_LINKS:
-            # getBasePositionAndOrientation, getJointStates... all fail on such bodies.
-            raise self._error(path, f"{cfg.name} has {links_count} links; PyBullet cannot "
-                                    f"report the state of bodies with {MAX_PYBULLET_LINKS} "
-                                    "links or more")
+        try:
+            # getBasePositionAndOrientation, getJointStates... all fail on 128+ link bodies.
+            self.session.require_state_queries(body, cfg.name)
+        except EngineError as e:
+            raise self._error(path, str(e)) from None
 
         joints: list[JointSpec] = []
         for j in range(p.getNumJoints(body, physicsClientId=client)):
@@ -584,7 +575,7 @@ class Simulation:
         p, client = self.session.p, self.session.client
         pos, orn = p.getBasePositionAndOrientation(b.body, physicsClientId=client)
         lin, ang = p.getBaseVelocity(b.body, physicsClientId=client)
-        matrix = p.getMatrixFromQuaternion(orn)
+        matrix = quat_to_matrix(orn)
         angles: dict[str, float] = {}
         velocities: dict[str, float] = {}
         accelerations: dict[str, float] = {}
@@ -619,8 +610,8 @@ class Simulation:
             t=self.t, step=self.step_count, robot=b.name, motor_angles=angles,
             motor_velocities=velocities, motor_accelerations=accelerations,
             base_position=list(pos), base_orientation=list(orn), base_lin_vel=list(lin),
-            base_ang_vel=list(ang), base_lin_vel_body_frame=_rotate_into(matrix, lin),
-            base_ang_vel_body_frame=_rotate_into(matrix, ang), contacts=contacts,
+            base_ang_vel=list(ang), base_lin_vel_body_frame=list(rotate_back(matrix, lin)),
+            base_ang_vel_body_frame=list(rotate_back(matrix, ang)), contacts=contacts,
             joint_forces=forces)
 
     def observe(self, robot: str | None = None, *, ideal: bool = False

@@ -14,7 +14,8 @@ from typing import Any
 
 from lxml import etree
 
-from .xmlio import attr_float, attr_vec, children
+from .spec import AXIS_JOINT_TYPES, LIMITED_JOINT_TYPES, attr_float, attr_vec, depth_first
+from .xmlio import children
 
 Vec3 = tuple[float, float, float]
 
@@ -82,10 +83,6 @@ class TreeNode:
         return out
 
 
-#: Joint types whose ``<axis>`` means something (URDF default (1, 0, 0) when absent).
-_AXIS_TYPES = ("revolute", "continuous", "prismatic", "planar")
-
-
 def kinematic_tree(root: etree._Element) -> TreeNode:
     """The link tree of a guarded ``<robot>`` document, with PyBullet's joint indices.
 
@@ -104,33 +101,31 @@ def kinematic_tree(root: etree._Element) -> TreeNode:
         has_parent.add(child.get("link", ""))
     root_link = next((n for n in links if n not in has_parent), links[0] if links else "")
     top = TreeNode(root_link)
-    # Pre-order walk with an explicit stack (see TreeNode.walk); the visit order is
-    # PyBullet's joint index order.
-    stack = [top]
-    index = 0
-    while stack:
-        node = stack.pop()
-        for j in below.get(node.link, []):
-            child = TreeNode(j.find("child").get("link", ""))
-            node.children.append(child)
-        stack.extend(reversed(node.children))
-    # Number the joints in pre-order, now that the tree exists.
-    by_child = {j.find("child").get("link", ""): j
-                for js in below.values() for j in js}
-    for node in top.walk():
-        if node is not top:
-            node.joint = _tree_joint(by_child[node.link], index)
-            index += 1
+    nodes = {root_link: top}
+    for index, j in enumerate(depth_first(root_link, below, _child_link)):
+        node = TreeNode(_child_link(j), _tree_joint(j, index))
+        nodes[_parent_link(j)].children.append(node)
+        nodes[node.link] = node
     return top
+
+
+def _child_link(j: etree._Element) -> str:
+    return str(j.find("child").get("link", ""))
+
+
+def _parent_link(j: etree._Element) -> str:
+    return str(j.find("parent").get("link", ""))
 
 
 def _tree_joint(j: etree._Element, index: int) -> TreeJoint:
     jtype = j.get("type", "")
     origin = j.find("origin")
-    axis = attr_vec(j.find("axis"), "xyz", (1, 0, 0)) if jtype in _AXIS_TYPES else None
+    axis = attr_vec(j.find("axis"), "xyz", 3, (1, 0, 0)) if jtype in AXIS_JOINT_TYPES else None
     limit_el = j.find("limit")
     limit = None
-    if jtype in ("revolute", "prismatic") and limit_el is not None:
-        limit = (attr_float(limit_el, "lower") or 0.0, attr_float(limit_el, "upper") or 0.0)
-    return TreeJoint(j.get("name", ""), jtype, index, attr_vec(origin, "xyz", (0, 0, 0)),  # type: ignore[arg-type]
-                     attr_vec(origin, "rpy", (0, 0, 0)), axis, limit, j.sourceline)  # type: ignore[arg-type]
+    if jtype in LIMITED_JOINT_TYPES and limit_el is not None:
+        limit = (attr_float(limit_el, "lower", 0.0), attr_float(limit_el, "upper", 0.0))
+    return TreeJoint(j.get("name", ""), jtype, index,
+                     attr_vec(origin, "xyz", 3, (0, 0, 0)),  # type: ignore[arg-type]
+                     attr_vec(origin, "rpy", 3, (0, 0, 0)),  # type: ignore[arg-type]
+                     axis, limit, j.sourceline)  # type: ignore[arg-type]

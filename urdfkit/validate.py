@@ -20,16 +20,26 @@ from pathlib import Path
 from lxml import etree
 
 from .errors import InputError
-from .session import MAX_PYBULLET_LINKS
+from .spec import (
+    FILE_TAGS,
+    JOINT_TYPES,
+    LIMITED_JOINT_TYPES,
+    MAX_LOADABLE_LINKS,
+    MAX_NAME_LENGTH,
+    MAX_STATE_LINKS,
+    NUMERIC,
+    OPAQUE,
+    SCHEMA,
+    SHAPE_SIZES,
+    SHAPES,
+    extension_note,
+    numbers,
+)
+from .spec import attr_float as _num
+from .spec import attr_vec as _vec
+from .uris import pybullet_data_path, resolve_uri
 
 LEVELS = ("info", "warning", "error")
-
-
-#: Bodies with more links than this are refused before loading (see rule_link_limit).
-MAX_LOADABLE_LINKS = 1000
-
-#: Longest link or joint name the guard lets through; PyBullet 3.2.7 segfaults from 1264.
-MAX_NAME_LENGTH = 1000
 
 
 @dataclass(frozen=True)
@@ -232,76 +242,15 @@ def rule_tree(root: etree._Element, r: Report) -> None:
 def rule_link_count(root: etree._Element, r: Report) -> None:
     """U208: 128 links or more break PyBullet's state queries."""
     n = sum(1 for _ in _elements(root, "link"))
-    if n >= MAX_PYBULLET_LINKS:
+    if n >= MAX_STATE_LINKS:
         r.add("U208", "error", f"{n} links: PyBullet's getJointState/getLinkState fail on "
-              f"bodies with {MAX_PYBULLET_LINKS} links or more (MAX_DEGREE_OF_FREEDOM); split "
+              f"bodies with {MAX_STATE_LINKS} links or more (MAX_DEGREE_OF_FREEDOM); split "
               "the model", root)
 
 
 # --------------------------------------------------------------------------- values and physics
 # Numbers are parsed once per attribute by _num/_vec, which never report: rule_numbers reports
 # every malformed number once, and the other rules simply skip what does not parse.
-
-#: Numeric attributes: (tag, attribute) -> how many numbers it holds.
-NUMERIC: dict[tuple[str, str], int] = {
-    ("origin", "xyz"): 3, ("origin", "rpy"): 3, ("axis", "xyz"): 3,
-    ("box", "size"): 3, ("cylinder", "radius"): 1, ("cylinder", "length"): 1,
-    ("capsule", "radius"): 1, ("capsule", "length"): 1, ("sphere", "radius"): 1,
-    ("mesh", "scale"): 3, ("cdf", "scale"): 3, ("plane", "normal"): 3,
-    ("color", "rgba"): 4, ("specular", "rgb"): 3, ("mass", "value"): 1,
-    **{("inertia", a): 1 for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
-    **{("limit", a): 1 for a in ("lower", "upper", "effort", "velocity")},
-    ("dynamics", "damping"): 1, ("dynamics", "friction"): 1,
-    ("mimic", "multiplier"): 1, ("mimic", "offset"): 1,
-    **{("safety_controller", a): 1
-       for a in ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity")},
-    ("calibration", "rising"): 1, ("calibration", "falling"): 1,
-    **{(t, "value"): 1 for t in (
-        "lateral_friction", "rolling_friction", "spinning_friction", "restitution",
-        "stiffness", "damping", "contact_cfm", "contact_erp", "inertia_scaling")},
-}
-
-#: PyBullet's joint types: the URDF ones plus its ``spherical`` extension.
-JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar", "spherical")
-#: Shapes a ``<geometry>`` may hold in PyBullet (capsule, plane and cdf are its extensions).
-SHAPES = ("box", "cylinder", "sphere", "mesh", "capsule", "plane", "cdf")
-#: Subtrees urdfkit does not look into: ROS/Gazebo extensions and PyBullet's soft bodies.
-OPAQUE = ("gazebo", "transmission", "deformable")
-_CONTACT_VALUES = ("lateral_friction", "rolling_friction", "spinning_friction", "restitution",
-                   "stiffness", "damping", "contact_cfm", "contact_erp", "inertia_scaling",
-                   "friction_anchor")
-
-#: Known children and attributes per tag, PyBullet's extensions included (``<contact>``,
-#: ``<collision group= mask= concave=>``, ``<specular>``, capsule/plane/cdf shapes).
-SCHEMA: dict[str, tuple[frozenset[str], frozenset[str]]] = {
-    tag: (frozenset(attrs.split()), frozenset(children.split()))
-    for tag, attrs, children in (
-        ("robot", "name version", "link joint material " + " ".join(OPAQUE)),
-        ("link", "name type", "inertial visual collision contact"),
-        ("inertial", "", "origin mass inertia"),
-        ("origin", "xyz rpy", ""),
-        ("mass", "value", ""),
-        ("inertia", "ixx ixy ixz iyy iyz izz", ""),
-        ("visual", "name", "origin geometry material"),
-        ("collision", "name group mask concave", "origin geometry"),
-        ("geometry", "", " ".join(SHAPES)),
-        ("box", "size", ""), ("cylinder", "radius length", ""), ("sphere", "radius", ""),
-        ("capsule", "radius length", ""), ("mesh", "filename scale", ""),
-        ("plane", "normal", ""), ("cdf", "filename scale", ""),
-        ("material", "name", "color texture specular"),
-        ("color", "rgba", ""), ("texture", "filename", ""), ("specular", "rgb", ""),
-        ("contact", "", " ".join(_CONTACT_VALUES)),
-        *((t, "value", "") for t in _CONTACT_VALUES),
-        ("joint", "name type", "origin parent child axis calibration dynamics limit mimic "
-                               "safety_controller"),
-        ("parent", "link", ""), ("child", "link", ""), ("axis", "xyz", ""),
-        ("calibration", "rising falling reference_position", ""),
-        ("dynamics", "damping friction", ""),
-        ("limit", "lower upper effort velocity", ""),
-        ("mimic", "joint multiplier offset", ""),
-        ("safety_controller", "soft_lower_limit soft_upper_limit k_position k_velocity", ""),
-    )
-}
 
 #: Drake's tolerance unit for inertia checks (DBL_EPSILON).
 _DBL_EPSILON = sys.float_info.epsilon
@@ -319,30 +268,6 @@ def _walk(root: etree._Element) -> Iterator[etree._Element]:
                 stack.append(child)
 
 
-def _numbers(text: str | None) -> list[float] | None:
-    if text is None:
-        return None
-    try:
-        return [float(x) for x in text.split()]
-    except ValueError:
-        return None
-
-
-def _vec(el: etree._Element | None, attr: str, n: int) -> tuple[float, ...] | None:
-    """``n`` finite numbers from ``el.attr``, or None (missing or malformed: not reported here)."""
-    if el is None:
-        return None
-    vals = _numbers(el.get(attr))
-    if vals is None or len(vals) != n or not all(math.isfinite(v) for v in vals):
-        return None
-    return tuple(vals)
-
-
-def _num(el: etree._Element | None, attr: str) -> float | None:
-    v = _vec(el, attr, 1)
-    return None if v is None else v[0]
-
-
 def rule_numbers(root: etree._Element, r: Report) -> None:
     """U401-U402: every number parses and is finite; vectors have the right length."""
     for el in _walk(root):
@@ -350,7 +275,7 @@ def rule_numbers(root: etree._Element, r: Report) -> None:
             n = NUMERIC.get((el.tag, attr))
             if n is None:
                 continue
-            vals = _numbers(text)
+            vals = numbers(text)
             if vals is None or not all(math.isfinite(v) for v in (vals or [])):
                 r.add("U401", "error", f"<{el.tag} {attr}={text!r}>: expected "
                       f"{'a finite number' if n == 1 else f'{n} finite numbers'}", el)
@@ -368,7 +293,7 @@ def rule_joints(root: etree._Element, r: Report) -> None:
             r.add("U301", "error", f"{_label(j)} has type {jtype!r}; use one of "
                   f"{', '.join(JOINT_TYPES)}", j)
         limit = j.find("limit")
-        if jtype in ("revolute", "prismatic"):
+        if jtype in LIMITED_JOINT_TYPES:
             if limit is None:
                 r.add("U302", "error", f"{_label(j)} is {jtype} but has no <limit>; add <limit "
                       "lower=... upper=... effort=... velocity=...>", j)
@@ -412,10 +337,8 @@ def rule_geometry(root: etree._Element, r: Report) -> None:
             r.add("U502", "error", f"<geometry> in {what} holds {len(shapes)} shapes; it needs "
                   f"exactly one of {', '.join(SHAPES[:4])}", geom)
         for shape in shapes:
-            for attr in {"box": ("size",), "cylinder": ("radius", "length"),
-                         "capsule": ("radius", "length"), "sphere": ("radius",)}.get(
-                             shape.tag, ()):
-                vals = _numbers(shape.get(attr))
+            for attr in SHAPE_SIZES.get(shape.tag, ()):
+                vals = numbers(shape.get(attr))
                 if shape.get(attr) is None:
                     r.add("U501", "error", f"<{shape.tag}> has no {attr}; add {attr}=\"...\"",
                           shape)
@@ -569,49 +492,27 @@ def _shape_trace(link: etree._Element, mass: float | None) -> float | None:
     return tensor.ixx + tensor.iyy + tensor.izz
 
 
-def _package_folder(name: str, r: Report) -> Path | None:
-    from .resolve import _find_package
-
-    if name in r.packages:
-        return r.packages[name]
-    return _find_package(name, r.base) if r.base is not None else None
-
-
 def rule_meshes(root: etree._Element, r: Report) -> None:
     """U701-U702: mesh and texture files exist, through package:// and relative paths."""
     if r.base is None:
         return
-    for el in root.iter("mesh", "texture", "cdf"):
+    for el in root.iter(*FILE_TAGS):
         fn = (el.get("filename") or "").strip()
         if not fn:
             continue
-        if fn.startswith("package://"):
-            pkg, _, rest = fn[len("package://"):].partition("/")
-            folder = _package_folder(pkg, r)
-            if folder is None:
-                r.add("U702", "error", f"<{el.tag} filename={fn!r}>: package {pkg!r} not found "
-                      f"near the file; pass --package {pkg}=PATH", el)
-                continue
-            path = folder / rest
-        else:
-            path = Path(fn[len("file://"):] if fn.startswith("file://") else fn)
-            if not path.is_absolute():
-                path = r.base / path
-        if os.path.isfile(path):
+        target = resolve_uri(fn, r.base, r.packages)
+        if target.path is None:
+            r.add("U702", "error", f"<{el.tag} filename={fn!r}>: {target.problem}", el)
             continue
-        data = _pybullet_data()
-        if not fn.startswith("package://") and data is not None and (data / fn).is_file():
+        if os.path.isfile(target.path):
+            continue
+        data = pybullet_data_path()
+        if target.package is None and data is not None and (data / fn).is_file():
             # PyBullet finds it only after setAdditionalSearchPath(pybullet_data.getDataPath()).
             r.add("U703", "warning", f"<{el.tag} filename={fn!r}>: not beside the file, found "
                   "only in pybullet_data's search path; make the path relative to the file", el)
             continue
-        r.add("U701", "error", f"<{el.tag} filename={fn!r}>: file not found ({path})", el)
-
-
-def _pybullet_data() -> Path | None:
-    from .resolve import pybullet_data_path
-
-    return pybullet_data_path()
+        r.add("U701", "error", f"<{el.tag} filename={fn!r}>: file not found ({target.path})", el)
 
 
 def rule_schema(root: etree._Element, r: Report) -> None:
@@ -642,12 +543,26 @@ def rule_link_limit(root: etree._Element, r: Report) -> None:
               "their state); split the model", root)
 
 
+def rule_portability(root: etree._Element, r: Report) -> None:
+    """U901: PyBullet-only joint types and shapes, which other URDF tools refuse (info)."""
+    for j in _elements(root, "joint"):
+        note = extension_note("joint", j.get("type", ""))
+        if note:
+            r.add("U901", "info", f"{_label(j)}: {note}", j)
+    for geom in root.iter("geometry"):
+        for shape in geom:
+            note = extension_note("shape", shape.tag) if isinstance(shape.tag, str) else None
+            if note:
+                r.add("U901", "info", note, shape)
+
+
 #: Rules that stand between a file and a PyBullet crash (or hang), in order.
 GUARD_RULES: tuple[Rule, ...] = (rule_document, rule_names, rule_tree, rule_link_limit)
 
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_numbers, rule_joints,
-                               rule_geometry, rule_mass, rule_inertia, rule_meshes, rule_schema)
+                               rule_geometry, rule_mass, rule_inertia, rule_meshes, rule_schema,
+                               rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -696,6 +611,7 @@ CODES: dict[str, str] = {
     "U703": "mesh found only through pybullet_data's search path",
     "U801": "unknown tag",
     "U802": "unknown attribute",
+    "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
 }
 
 

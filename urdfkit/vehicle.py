@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from .errors import ParameterError
+from .spec import quat_to_matrix, rotate
 
 #: |axis . z| below this is "horizontal" (about 11 degrees of tilt allowed).
 HORIZONTAL_TOLERANCE = 0.2
@@ -90,11 +91,8 @@ class Drivetrain:
                 "passive": named(self.passive)}
 
 
-def _rotate(p: Any, orn: Sequence[float], v: Sequence[float]) -> tuple[float, float, float]:
-    m = p.getMatrixFromQuaternion(orn)
-    return (m[0] * v[0] + m[1] * v[1] + m[2] * v[2],
-            m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
-            m[6] * v[0] + m[7] * v[1] + m[8] * v[2])
+def _rotate(orn: Sequence[float], v: Sequence[float]) -> tuple[float, float, float]:
+    return rotate(quat_to_matrix(orn), v)
 
 
 def _link_orientations(p: Any, body: int, client: int, infos: list[tuple[Any, ...]]
@@ -174,9 +172,9 @@ def detect_drivetrain(p: Any, body: int, client: int,
     names = {j: info[1].decode("utf-8", "replace") for j, info in enumerate(infos)}
     movable = [j for j, info in enumerate(infos) if info[2] in (_REVOLUTE, _PRISMATIC)]
     frames = _link_orientations(p, body, client, infos)
-    axes = {j: _rotate(p, frames[j], infos[j][13]) for j in movable}
+    axes = {j: _rotate(frames[j], infos[j][13]) for j in movable}
     _, base_orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
-    forward = _rotate(p, base_orn, (1.0, 0.0, 0.0))
+    forward = _rotate(base_orn, (1.0, 0.0, 0.0))
 
     if wheels is not None:
         wheel_list = _pick(wheels, names, movable, "--wheels")

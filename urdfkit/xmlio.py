@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import os
 import re
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from pathlib import Path
 
 from lxml import etree
@@ -229,23 +229,3 @@ def atomic_write(path: str | Path, data: bytes, *, force: bool = False) -> Path:
 def children(root: etree._Element, tag: str) -> Iterator[etree._Element]:
     """Direct child elements named ``tag`` (comments and processing instructions skipped)."""
     return (c for c in root if isinstance(c.tag, str) and c.tag == tag)
-
-
-def attr_vec(el: etree._Element | None, attr: str, default: Sequence[float]) -> tuple[float, ...]:
-    """A whitespace-separated vector attribute, or ``default`` when absent or malformed."""
-    if el is None or el.get(attr) is None:
-        return tuple(float(v) for v in default)
-    try:
-        return tuple(float(v) for v in (el.get(attr) or "").split())
-    except ValueError:
-        return tuple(float(v) for v in default)
-
-
-def attr_float(el: etree._Element | None, attr: str) -> float | None:
-    """A number attribute, or ``None`` when absent or malformed."""
-    if el is None or el.get(attr) is None:
-        return None
-    try:
-        return float(el.get(attr) or "")
-    except ValueError:
-        return None

@@ -1,0 +1,303 @@
+"""The one URDF spec: what URDF allows, what PyBullet adds, and what PyBullet cannot do.
+
+Every other module reads its lists from here: the builder (what it accepts), the rules and the
+guard (what they refuse), inspect and tree (how they name and count joints), render, vehicle
+detection and sim. Four copies of these lists once disagreed, and ``build`` refused what
+``check`` accepted; there is now one.
+
+It also holds the small pieces of geometry every step needs, once: number parsing from XML
+attributes, roll-pitch-yaw and quaternion rotations, and PyBullet's depth-first joint order.
+
+Nothing here imports lxml or PyBullet: elements are read through their ``get`` method.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Hashable, Mapping, Sequence
+from typing import Any, Protocol, TypeVar
+
+# --------------------------------------------------------------------------- joints
+
+#: Joint types of the URDF specification.
+URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+#: Joint types PyBullet adds to URDF (other URDF tools refuse them).
+PYBULLET_JOINT_TYPES = ("spherical",)
+#: Every joint type urdfkit accepts: the URDF ones plus PyBullet's.
+JOINT_TYPES = URDF_JOINT_TYPES + PYBULLET_JOINT_TYPES
+#: Joint types that need ``<limit>`` with effort and velocity (and whose lower/upper count).
+LIMITED_JOINT_TYPES = ("revolute", "prismatic")
+#: Joint types whose ``<axis>`` means something (default (1, 0, 0) when absent).
+AXIS_JOINT_TYPES = ("revolute", "continuous", "prismatic", "planar")
+
+#: ``getJointInfo``'s jointType codes (``p.JOINT_REVOLUTE == 0``, ...), as PyBullet names them.
+PYBULLET_JOINT_CODES = {0: "REVOLUTE", 1: "PRISMATIC", 2: "SPHERICAL", 3: "PLANAR", 4: "FIXED",
+                        5: "POINT2POINT", 6: "GEAR"}
+#: Velocity degrees of freedom of each PyBullet joint type (a planar joint is x, y and yaw).
+JOINT_DOF = {"REVOLUTE": 1, "PRISMATIC": 1, "SPHERICAL": 3, "PLANAR": 3, "FIXED": 0,
+             "POINT2POINT": 0, "GEAR": 0}
+#: What ``joints --type`` accepts: the URDF types and PyBullet's, lower case.
+#: (PyBullet's own type names, lower-cased, are all among them.)
+JOINT_TYPE_FILTERS = JOINT_TYPES
+
+
+def pybullet_joint_type(code: int) -> str:
+    """PyBullet's name for a ``getJointInfo`` jointType code (the code itself if unknown)."""
+    return PYBULLET_JOINT_CODES.get(int(code), str(code))
+
+
+# --------------------------------------------------------------------------- shapes
+
+#: Shapes of the URDF specification.
+URDF_SHAPES = ("box", "cylinder", "sphere", "mesh")
+#: Shapes PyBullet adds (other URDF tools refuse them).
+PYBULLET_SHAPES = ("capsule", "plane", "cdf")
+#: Every shape a ``<geometry>`` may hold.
+SHAPES = URDF_SHAPES + PYBULLET_SHAPES
+#: Size attributes of each primitive shape: all required, all > 0.
+SHAPE_SIZES: dict[str, tuple[str, ...]] = {
+    "box": ("size",), "cylinder": ("radius", "length"), "capsule": ("radius", "length"),
+    "sphere": ("radius",),
+}
+#: Shapes that name a file.
+FILE_SHAPES = ("mesh", "cdf")
+#: Elements whose ``filename`` attribute names a file to load.
+FILE_TAGS = ("mesh", "cdf", "texture")
+
+#: PyBullet's extensions to URDF, with what to tell a user who needs portable files.
+EXTENSIONS: dict[str, str] = {
+    "joint:spherical": "a spherical joint is a PyBullet extension; ROS, Drake and MuJoCo's "
+                       "URDF importers refuse it (chain three revolute joints to be portable)",
+    "shape:capsule": "<capsule> is a PyBullet extension; other URDF tools refuse it (use a "
+                     "cylinder and two spheres to be portable)",
+    "shape:plane": "<plane> is a PyBullet extension; other URDF tools refuse it (use a thin "
+                   "box to be portable)",
+    "shape:cdf": "<cdf> is a PyBullet extension (signed-distance fields); other URDF tools "
+                 "refuse it",
+}
+
+
+def extension_note(kind: str, name: str) -> str | None:
+    """The portability note for a PyBullet-only joint type or shape, else None.
+
+    Args:
+        kind: ``"joint"`` or ``"shape"``.
+        name: The joint type or the shape's tag.
+    """
+    return EXTENSIONS.get(f"{kind}:{name}")
+
+
+# --------------------------------------------------------------------------- the document
+
+#: Subtrees urdfkit does not look into: ROS/Gazebo extensions and PyBullet's soft bodies.
+OPAQUE = ("gazebo", "transmission", "deformable")
+#: PyBullet's ``<contact>`` children, each with a ``value``.
+CONTACT_VALUES = ("lateral_friction", "rolling_friction", "spinning_friction", "restitution",
+                  "stiffness", "damping", "contact_cfm", "contact_erp", "inertia_scaling",
+                  "friction_anchor")
+
+#: Numeric attributes: (tag, attribute) -> how many numbers it holds.
+NUMERIC: dict[tuple[str, str], int] = {
+    ("origin", "xyz"): 3, ("origin", "rpy"): 3, ("axis", "xyz"): 3,
+    ("box", "size"): 3, ("cylinder", "radius"): 1, ("cylinder", "length"): 1,
+    ("capsule", "radius"): 1, ("capsule", "length"): 1, ("sphere", "radius"): 1,
+    ("mesh", "scale"): 3, ("cdf", "scale"): 3, ("plane", "normal"): 3,
+    ("color", "rgba"): 4, ("specular", "rgb"): 3, ("mass", "value"): 1,
+    **{("inertia", a): 1 for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
+    **{("limit", a): 1 for a in ("lower", "upper", "effort", "velocity")},
+    ("dynamics", "damping"): 1, ("dynamics", "friction"): 1,
+    ("mimic", "multiplier"): 1, ("mimic", "offset"): 1,
+    **{("safety_controller", a): 1
+       for a in ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity")},
+    ("calibration", "rising"): 1, ("calibration", "falling"): 1,
+    **{(t, "value"): 1 for t in CONTACT_VALUES if t != "friction_anchor"},
+}
+
+#: Known attributes and children per tag, PyBullet's extensions included (``<contact>``,
+#: ``<collision group= mask= concave=>``, ``<specular>``, capsule/plane/cdf shapes).
+SCHEMA: dict[str, tuple[frozenset[str], frozenset[str]]] = {
+    tag: (frozenset(attrs.split()), frozenset(kids.split()))
+    for tag, attrs, kids in (
+        ("robot", "name version", "link joint material " + " ".join(OPAQUE)),
+        ("link", "name type", "inertial visual collision contact"),
+        ("inertial", "", "origin mass inertia"),
+        ("origin", "xyz rpy", ""),
+        ("mass", "value", ""),
+        ("inertia", "ixx ixy ixz iyy iyz izz", ""),
+        ("visual", "name", "origin geometry material"),
+        ("collision", "name group mask concave", "origin geometry"),
+        ("geometry", "", " ".join(SHAPES)),
+        ("box", "size", ""), ("cylinder", "radius length", ""), ("sphere", "radius", ""),
+        ("capsule", "radius length", ""), ("mesh", "filename scale", ""),
+        ("plane", "normal", ""), ("cdf", "filename scale", ""),
+        ("material", "name", "color texture specular"),
+        ("color", "rgba", ""), ("texture", "filename", ""), ("specular", "rgb", ""),
+        ("contact", "", " ".join(CONTACT_VALUES)),
+        *((t, "value", "") for t in CONTACT_VALUES),
+        ("joint", "name type", "origin parent child axis calibration dynamics limit mimic "
+                               "safety_controller"),
+        ("parent", "link", ""), ("child", "link", ""), ("axis", "xyz", ""),
+        ("calibration", "rising falling reference_position", ""),
+        ("dynamics", "damping friction", ""),
+        ("limit", "lower upper effort velocity", ""),
+        ("mimic", "joint multiplier offset", ""),
+        ("safety_controller", "soft_lower_limit soft_upper_limit k_position k_velocity", ""),
+    )
+}
+
+# --------------------------------------------------------------------------- PyBullet's limits
+
+#: PyBullet's state queries (getJointState, getLinkState, getBasePositionAndOrientation) fail
+#: on bodies with this many links or more (its MAX_DEGREE_OF_FREEDOM).
+MAX_STATE_LINKS = 128
+#: Bodies with more links than this are refused before loading: PyBullet takes minutes.
+MAX_LOADABLE_LINKS = 1000
+#: Longest link or joint name the guard lets through; PyBullet 3.2.7 segfaults from 1264.
+MAX_NAME_LENGTH = 1000
+
+# --------------------------------------------------------------------------- numbers
+
+
+class _HasGet(Protocol):
+    def get(self, key: str, default: Any = ...) -> Any: ...
+
+
+def numbers(text: str | None) -> list[float] | None:
+    """The whitespace-separated numbers in ``text``; None when absent or malformed.
+
+    Non-finite values (``nan``, ``inf``) parse; callers that need finite ones use
+    :func:`vector`.
+    """
+    if text is None:
+        return None
+    try:
+        return [float(x) for x in text.split()]
+    except ValueError:
+        return None
+
+
+def vector(text: str | None, n: int) -> tuple[float, ...] | None:
+    """Exactly ``n`` finite numbers from ``text``, else None (missing, malformed, wrong length)."""
+    vals = numbers(text)
+    if vals is None or len(vals) != n or not all(math.isfinite(v) for v in vals):
+        return None
+    return tuple(vals)
+
+
+def attr_vec(el: _HasGet | None, attr: str, n: int,
+             default: Sequence[float] | None = None) -> tuple[float, ...] | None:
+    """``n`` finite numbers from attribute ``attr`` of ``el``, else ``default``."""
+    vals = vector(el.get(attr), n) if el is not None else None
+    if vals is not None:
+        return vals
+    return None if default is None else tuple(float(v) for v in default)
+
+
+def attr_float(el: _HasGet | None, attr: str, default: float | None = None) -> float | None:
+    """One finite number from attribute ``attr`` of ``el``, else ``default``."""
+    v = attr_vec(el, attr, 1)
+    return default if v is None else v[0]
+
+
+# --------------------------------------------------------------------------- rotations
+
+Vec3 = tuple[float, float, float]
+Matrix3 = tuple[Vec3, Vec3, Vec3]
+
+
+def rpy_to_matrix(rpy: Sequence[float]) -> Matrix3:
+    """Rotation matrix of URDF roll-pitch-yaw (fixed axes X, Y, Z): ``R = Rz(y) Ry(p) Rx(r)``."""
+    r, p, y = rpy
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), \
+        math.sin(y)
+    return (
+        (cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr),
+        (sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr),
+        (-sp, cp * sr, cp * cr),
+    )
+
+
+def quat_to_matrix(q: Sequence[float]) -> Matrix3:
+    """Rotation matrix of a unit quaternion (x, y, z, w), PyBullet's order."""
+    x, y, z, w = q
+    return (
+        (1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)),
+        (2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),
+        (2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)),
+    )
+
+
+def quat_to_rpy(q: Sequence[float]) -> Vec3:
+    """Roll, pitch, yaw (URDF's fixed-axis X-Y-Z convention) of a quaternion (x, y, z, w).
+
+    The same result as ``p.getEulerFromQuaternion``, without needing a PyBullet client.
+    """
+    x, y, z, w = q
+    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return (_clean(roll), _clean(pitch), _clean(yaw))
+
+
+def _clean(x: float) -> float:
+    # -0.0 and 1e-17 noise make tables and golden files churn.
+    return 0.0 if abs(x) < 1e-12 else x
+
+
+def matmul(a: Matrix3, b: Matrix3) -> Matrix3:
+    """The product of two 3x3 matrices."""
+    return tuple(  # type: ignore[return-value]
+        tuple(sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)) for i in range(3)
+    )
+
+
+def transpose(a: Matrix3) -> Matrix3:
+    """The transpose (for a rotation, its inverse)."""
+    return tuple(tuple(a[j][i] for j in range(3)) for i in range(3))  # type: ignore[return-value]
+
+
+def rotate(m: Matrix3, v: Sequence[float]) -> Vec3:
+    """``m @ v``."""
+    return (m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
+            m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
+            m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2])
+
+
+def rotate_back(m: Matrix3, v: Sequence[float]) -> Vec3:
+    """``m^T @ v``: a world vector in the frame ``m`` describes."""
+    return (m[0][0] * v[0] + m[1][0] * v[1] + m[2][0] * v[2],
+            m[0][1] * v[0] + m[1][1] * v[1] + m[2][1] * v[2],
+            m[0][2] * v[0] + m[1][2] * v[1] + m[2][2] * v[2])
+
+
+# --------------------------------------------------------------------------- joint order
+
+K = TypeVar("K", bound=Hashable)
+E = TypeVar("E")
+
+
+def depth_first(root: K, below: Mapping[K, Sequence[E]], child: Callable[[E], K]) -> list[E]:
+    """The edges of a tree in PyBullet's joint order: depth-first from ``root``, file order.
+
+    PyBullet numbers joints in a pre-order walk from the root link, taking each link's child
+    joints in the order the file declares them. Iterative, so a 1000-link chain cannot
+    overflow the stack; an edge whose child was already reached (a cycle, a second parent)
+    is skipped, since the guard refuses such files before they get here.
+
+    Args:
+        root: The root link.
+        below: Each link's outgoing edges (joints), in file order.
+        child: The link an edge leads to.
+    """
+    order: list[E] = []
+    seen = {root}
+    stack: list[E] = list(reversed(below.get(root, ())))
+    while stack:
+        edge = stack.pop()
+        link = child(edge)
+        if link in seen:
+            continue
+        seen.add(link)
+        order.append(edge)
+        stack.extend(reversed(below.get(link, ())))
+    return order
