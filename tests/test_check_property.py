@@ -11,7 +11,7 @@ from lxml import etree
 
 from urdfkit.builder import Box, Collision, Inertial, Joint, Limit, Link, Robot
 from urdfkit.errors import InputError
-from urdfkit.validate import ALL_RULES, GUARD_RULES, guard, run_rules
+from urdfkit.validate import ALL_RULES, guard, guard_findings, run_rules
 
 MUTATIONS = ("none", "drop_link", "duplicate_link", "duplicate_joint", "cycle", "corrupt_number")
 
@@ -64,7 +64,7 @@ def test_check_and_guard_agree(robot: Robot, how: str, pick: int, tmp_path_facto
     root = robot.to_element()
     broken = mutate(root, how, pick)
     root = etree.fromstring(etree.tostring(root))  # fresh line numbers
-    guard_codes = {f.code for f in run_rules(root, "p.urdf", GUARD_RULES) if f.level == "error"}
+    guard_codes = {f.code for f in guard_findings(root, "p.urdf")}
     check_codes = {f.code for f in run_rules(root, "p.urdf", ALL_RULES) if f.level == "error"}
     try:
         guard(root, "p.urdf")

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -11,7 +10,7 @@ from .catalog import TEMPLATES, build_template, parse_assignments
 from .errors import InputError, ParameterError
 from .expand import expand_xacro
 from .resolve import locate
-from .validate import guard
+from .validate import ALL_RULES, guard, run_rules
 from .xmlio import atomic_write, parse_xml, to_bytes
 
 
@@ -26,20 +25,6 @@ class BuildResult:
     warnings: list[str] = field(default_factory=list)
 
 
-def yourdfpy_errors(data: bytes) -> list[str]:
-    """What yourdfpy's ``validate()`` objects to, as messages (empty when valid)."""
-    import yourdfpy
-
-    try:
-        urdf = yourdfpy.URDF.load(io.BytesIO(data), load_meshes=False, build_scene_graph=False,
-                                  build_collision_scene_graph=False)
-    except Exception as e:  # yourdfpy raises assorted errors on bad input
-        return [f"yourdfpy cannot read it: {e}"]
-    if urdf.validate(validation_fn=lambda errors: not errors):
-        return []
-    return [str(e) for e in urdf._errors]
-
-
 def build(target: str, params: list[str] | None = None,
           xacro_args: list[str] | None = None) -> BuildResult:
     """Build ``target``: a built-in template name, or a path to a ``.xacro`` file."""
@@ -50,6 +35,7 @@ def build(target: str, params: list[str] | None = None,
         data = robot.to_bytes()
         default = f"{target}.urdf"
         name = f"template {target}"
+        base = None
     else:
         path = Path(target)
         if path.suffix != ".xacro" and not path.exists():
@@ -71,9 +57,14 @@ def build(target: str, params: list[str] | None = None,
         if not default.endswith(".urdf"):
             default += ".urdf"
         name = target
-    problems = yourdfpy_errors(data)
-    if problems:
-        raise InputError(f"the built URDF is invalid: {problems[0]}", file=name)
+        base = source.resolve().parent
+    # The same rules `urdfkit check` runs: what build writes, check accepts.
+    tree = parse_xml(data, name)
+    errors = [f for f in run_rules(tree.getroot(), name, ALL_RULES, base=base)
+              if f.level == "error"]
+    if errors:
+        raise InputError(f"the built URDF is invalid: {errors[0].message} ({errors[0].code})",
+                         file=name)
     return BuildResult(data, default, len(robot.links), len(robot.joints))
 
 

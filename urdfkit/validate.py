@@ -557,12 +557,23 @@ def rule_portability(root: etree._Element, r: Report) -> None:
 
 
 #: Rules that stand between a file and a PyBullet crash (or hang), in order.
-GUARD_RULES: tuple[Rule, ...] = (rule_document, rule_names, rule_tree, rule_link_limit)
+#: The guard also runs rule_joints and rule_geometry, but refuses only what is not URDF by
+#: the one spec (see GUARD_CODES); their value findings are for ``check``.
+GUARD_RULES: tuple[Rule, ...] = (rule_document, rule_names, rule_tree, rule_link_limit,
+                                 rule_joints, rule_geometry)
+
+#: The error codes every command refuses: what crashes PyBullet, and what is not URDF at all
+#: (an unknown joint type or shape, a <geometry> without exactly one shape, a revolute or
+#: prismatic joint without <limit>), which PyBullet refuses or silently misreads. Errors in
+#: values (limits, sizes, masses, inertia) are ``check`` findings: PyBullet loads such files,
+#: and pybullet_data ships some, so the loading commands still load them.
+GUARD_CODES = frozenset({"U001", "U002", "U003", "U101", "U102", "U103", "U104", "U105",
+                         "U106", "U201", "U202", "U203", "U204", "U205", "U206", "U207",
+                         "U209", "U301", "U302", "U502"})
 
 #: Every rule ``urdfkit check`` runs, in order.
-ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_numbers, rule_joints,
-                               rule_geometry, rule_mass, rule_inertia, rule_meshes, rule_schema,
-                               rule_portability)
+ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_numbers, rule_mass,
+                               rule_inertia, rule_meshes, rule_schema, rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -629,9 +640,13 @@ def run_rules(root: etree._Element, file: str, rules: tuple[Rule, ...], *,
     return report.findings
 
 
+def guard_findings(root: etree._Element, file: str) -> list[Finding]:
+    """The findings that make every command refuse a document (codes in GUARD_CODES)."""
+    return [f for f in run_rules(root, file, GUARD_RULES) if f.code in GUARD_CODES]
+
+
 def guard(tree: etree._ElementTree | etree._Element, file: str) -> None:
-    """Raise :class:`InputError` for the first finding that would crash PyBullet."""
+    """Raise :class:`InputError` for the first finding every command refuses."""
     root = tree.getroot() if isinstance(tree, etree._ElementTree) else tree
-    for f in run_rules(root, file, GUARD_RULES):
-        if f.level == "error":
-            raise InputError(f.message, file=f.file, line=f.line)
+    for f in guard_findings(root, file):
+        raise InputError(f.message, file=f.file, line=f.line)

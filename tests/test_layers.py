@@ -1,0 +1,123 @@
+"""Imports flow one way: spec and model, then sources, then the engine, then run/draw, then CLI.
+
+Every import between urdfkit's modules counts, lazy ones inside functions included: a lazy import
+that goes the wrong way is still a step living in the wrong room.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import urdfkit
+
+PACKAGE = Path(urdfkit.__file__).parent
+
+#: The house's floors, lowest first. A module may import from its own floor or below.
+LAYERS: dict[str, int] = {}
+for floor, names in enumerate([
+    # spec and model
+    "errors spec style templatedir _xacro_worker suggest xmlio builder catalog",
+    # sources: files, packages, xacro, and the guard every loader calls
+    "uris expand validate resolve",
+    # the engine session
+    "session",
+    # run and draw
+    "inspect body tree report graph vehicle drive scenario sim render plot check build",
+    # presentation and the command line
+    "present cli __main__",
+]):
+    LAYERS.update(dict.fromkeys(names.split(), floor))
+
+
+def _module_names() -> list[str]:
+    return sorted(p.stem for p in PACKAGE.glob("*.py") if p.stem != "__init__")
+
+
+def _imports(name: str) -> set[str]:
+    tree = ast.parse((PACKAGE / f"{name}.py").read_text("utf-8"))
+    out: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level == 1 and node.module:
+                out.add(node.module.split(".")[0])
+            elif node.level == 1:
+                out.update(a.name for a in node.names)
+            elif node.level == 0 and node.module and node.module.startswith("urdfkit."):
+                out.add(node.module.split(".")[1])
+        elif isinstance(node, ast.Import):
+            out.update(a.name.split(".")[1] for a in node.names
+                       if a.name.startswith("urdfkit."))
+    return out & set(_module_names()) - {name}
+
+
+def test_every_module_has_a_floor() -> None:
+    missing = [m for m in _module_names() if m not in LAYERS]
+    assert not missing, f"add {missing} to LAYERS in tests/test_layers.py"
+
+
+def test_imports_never_go_up_a_floor() -> None:
+    wrong = [f"{m} (floor {LAYERS[m]}) imports {i} (floor {LAYERS[i]})"
+             for m in _module_names() for i in sorted(_imports(m))
+             if m in LAYERS and i in LAYERS and LAYERS[i] > LAYERS[m]]
+    assert not wrong, "\n".join(wrong)
+
+
+def test_no_import_cycles() -> None:
+    graph = {m: _imports(m) for m in _module_names()}
+    # Tarjan's strongly connected components, iteratively.
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    on_stack: set[str] = set()
+    stack: list[str] = []
+    cycles: list[list[str]] = []
+    counter = 0
+    for start in graph:
+        if start in index:
+            continue
+        work = [(start, iter(sorted(graph[start])))]
+        index[start] = low[start] = counter
+        counter += 1
+        stack.append(start)
+        on_stack.add(start)
+        while work:
+            node, it = work[-1]
+            nxt = next(it, None)
+            if nxt is not None:
+                if nxt not in index:
+                    index[nxt] = low[nxt] = counter
+                    counter += 1
+                    stack.append(nxt)
+                    on_stack.add(nxt)
+                    work.append((nxt, iter(sorted(graph[nxt]))))
+                elif nxt in on_stack:
+                    low[node] = min(low[node], index[nxt])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                comp = []
+                while True:
+                    w = stack.pop()
+                    on_stack.discard(w)
+                    comp.append(w)
+                    if w == node:
+                        break
+                if len(comp) > 1:
+                    cycles.append(sorted(comp))
+    assert not cycles, f"import cycles: {cycles}"
+
+
+def test_the_cli_is_in_its_own_room() -> None:
+    """cli.py parses options and presents: it never touches lxml or PyBullet itself."""
+    tree = ast.parse((PACKAGE / "cli.py").read_text("utf-8"))
+    names = {a.name.split(".")[0] for n in ast.walk(tree) if isinstance(n, ast.Import)
+             for a in n.names}
+    names |= {(n.module or "").split(".")[0] for n in ast.walk(tree)
+              if isinstance(n, ast.ImportFrom) and n.level == 0}
+    assert not names & {"lxml", "pybullet", "pybullet_data", "numpy"}, names
+    engine_calls = {"getJointInfo", "loadURDF", "stepSimulation", "getDynamicsInfo",
+                    "setJointMotorControl2", "getBasePositionAndOrientation"}
+    used = {n.attr for n in ast.walk(tree) if isinstance(n, ast.Attribute)}
+    assert not used & engine_calls, used & engine_calls
