@@ -13,8 +13,11 @@ def template_dir() -> Path:
     Run from a source checkout (``python -m urdfkit`` in the repository) that package does not
     exist, and the top-level folder beside the package is the same files.
     """
-    try:
-        from . import templates  # type: ignore[attr-defined]  # only in the wheel
-    except ImportError:
+    from importlib.util import find_spec
+
+    # Looked up by name, not imported: a static import type-checks differently in a source
+    # checkout (no such module) and beside an installed wheel (a real one).
+    spec = find_spec(f"{__package__}.templates")
+    if spec is None or spec.origin is None:
         return Path(__file__).resolve().parent.parent / "templates"
-    return Path(templates.__file__).parent
+    return Path(spec.origin).parent
