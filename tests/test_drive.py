@@ -260,7 +260,7 @@ def test_plot_is_a_png(runner: CliRunner, tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--seconds", "nan"], "--seconds must be a finite number"),
+        (["--seconds", "nan"], "--seconds must be a finite number, got nan"),
         (["--seconds", "inf"], "--seconds must be a finite number"),
         (["--seconds", "-1"], "--seconds must be positive"),
         (["--throttle", "nan"], "--throttle must be a finite number"),
@@ -296,8 +296,13 @@ def test_cli_no_wheels_and_existing_output(runner: CliRunner, simpleplane_urdf: 
 
 
 def test_library_refuses_bad_config() -> None:
-    with pytest.raises(ParameterError, match="--max-force must be >= 0"):
+    # The library speaks Python: it names the parameter, never the CLI flag.
+    with pytest.raises(ParameterError, match="`max_force` must be >= 0") as e:
         DriveConfig(max_force=-1).check()
+    assert e.value.param == "max_force" and "--" not in str(e.value)
+    with pytest.raises(ParameterError, match="`time_step` must be a finite number") as e:
+        DriveConfig(time_step=float("nan")).check()
+    assert e.value.param == "time_step"
 
 
 def test_builtin_template_cache_holds_the_built_template(_private_cache: Path,

@@ -157,7 +157,13 @@ def test_kinematic_tree_fields(simplecar_urdf: Path) -> None:
         "rpy": [0.0, 0.0, 0.0], "axis": [0.0, 0.0, 1.0], "limit": [-0.5, 0.5]}
     wheel = hinge.children[0]
     assert wheel.joint is not None and wheel.joint.limit is None
-    assert wheel.to_dict()["children"] == []
+    assert wheel.children == []
+    flat = tree.to_flat_dict()
+    assert flat["base_link"] == "base_link" and flat["links"][:3] == [
+        "base_link", "left_hinge", "left_front_wheel"]
+    assert [j["index"] for j in flat["joints"]] == list(range(6))
+    assert flat["joints"][1]["parent"] == "left_hinge"
+    assert flat["joints"][1]["child"] == "left_front_wheel"
 
 
 def test_quat_to_rpy_matches_pybullet(pb) -> None:

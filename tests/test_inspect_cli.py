@@ -13,6 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from urdfkit import cli
+from urdfkit import present as show
 from urdfkit.cli import app
 from urdfkit.inspect import JOINT_INFO_FIELDS
 from urdfkit.resolve import pybullet_data_path
@@ -120,13 +121,14 @@ def test_golden_simplecar_table(simplecar_urdf: Path) -> None:
 def test_golden_simplecar_table_on_a_terminal(simplecar_urdf: Path,
                                               monkeypatch: pytest.MonkeyPatch) -> None:
     # On a terminal: the rich table, with the same columns as the plain one.
-    monkeypatch.setattr(cli, "_styled", lambda stream: True)
+    monkeypatch.setattr(show, "styled", lambda stream: True)
     code, out, err = run("joints", str(simplecar_urdf), env={"COLUMNS": "140", "NO_COLOR": "1"})
     assert code == 0, err
     assert out == (GOLDEN / "simplecar_joints_terminal.txt").read_text()
     plain = (GOLDEN / "simplecar_joints.txt").read_text().splitlines()
     rich_headers = [h.strip() for h in out.splitlines()[1].split("┃")]
-    assert rich_headers == re.split(r"\s{2,}", plain[1].strip())
+    plain_headers = re.split(r"\s{2,}", plain[1].strip())
+    assert rich_headers == plain_headers[:len(rich_headers)]
     assert rich_headers[:3] == ["#", "joint", "type"] and len(rich_headers) > 5
 
 
@@ -136,7 +138,8 @@ def test_golden_simplecar_tree(simplecar_urdf: Path) -> None:
     assert out == (GOLDEN / "simplecar_tree.txt").read_text()
 
 
-def test_table_fits_the_terminal(simplecar_urdf: Path) -> None:
+def test_table_fits_the_terminal(simplecar_urdf: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(show, "styled", lambda stream: True)
     for width in (60, 90, 200):
         code, out, _ = run("joints", str(simplecar_urdf), env={"COLUMNS": str(width)})
         assert code == 0
@@ -145,6 +148,22 @@ def test_table_fits_the_terminal(simplecar_urdf: Path) -> None:
     _, narrow, _ = run("joints", str(simplecar_urdf), env={"COLUMNS": "60"})
     _, wide, _ = run("joints", str(simplecar_urdf), env={"COLUMNS": "200"})
     assert "child link" not in narrow and "child link" in wide and "unlimited" in wide
+    # What does not fit is announced, not silently dropped.
+    assert "column(s) hidden" in narrow and "--all" in narrow
+    assert "2 column(s) hidden" in wide
+
+
+def test_piped_tables_keep_every_column(simplecar_urdf: Path) -> None:
+    # Piped, a narrow $COLUMNS does not cut columns: a log or `| grep` loses nothing.
+    _, narrow, _ = run("joints", str(simplecar_urdf), env={"COLUMNS": "40"})
+    _, wide, _ = run("joints", str(simplecar_urdf), env={"COLUMNS": "300"})
+    assert narrow == wide
+    header = narrow.splitlines()[1]
+    for column in ("child link", "parent", "axis", "max vel", "damping", "friction"):
+        assert column in header
+    assert "quat" not in header  # --all only, as on the widest terminal
+    _, everything, _ = run("joints", str(simplecar_urdf), "--all", env={"COLUMNS": "40"})
+    assert "quat" in everything.splitlines()[1] and "flags" in everything.splitlines()[1]
 
 
 def test_all_shows_every_field(simplecar_urdf: Path) -> None:
@@ -229,7 +248,7 @@ def test_xacro_input_with_args() -> None:
     assert pos["base_to_left_back_wheel"][0] == pytest.approx(-0.3)
     code, out, _ = run("tree", str(XACRO), "--json")
     assert code == 0
-    assert json.loads(out)["tree"]["children"][0]["joint"]["xyz"] == [0.2, 0.0, 0.0]
+    assert json.loads(out)["joints"][0]["xyz"] == [0.2, 0.0, 0.0]
     code, _, err = run("joints", str(XACRO), "--arg", "wheelbase")
     assert code == 2 and "wheelbase" in err
 
@@ -331,10 +350,11 @@ def test_tree_handles_chains_deeper_than_the_recursion_limit(tmp_path: Path) -> 
         assert result.exit_code == 0, result.output[-500:]
     result = CliRunner().invoke(app, ["tree", str(path), "--json"])
     assert result.exit_code == 0
-    node = json.loads(result.stdout)["tree"]
-    depth = 0
-    while node["children"]:
-        node = node["children"][0]
-        depth += 1
-    assert depth == n - 1
-    assert node["joint"]["index"] == n - 2
+    doc = json.loads(result.stdout)
+    assert [j["index"] for j in doc["joints"]] == list(range(n - 1))
+    assert doc["joints"][-1] == {**doc["joints"][-1], "parent": f"l{n - 2}", "child": f"l{n - 1}"}
+    # Flat and linear: no indentation that grows with depth.
+    assert len(result.stdout) < 400 * n
+    # Piped text shows every joint, however deep.
+    text = CliRunner().invoke(app, ["tree", str(path)]).stdout
+    assert text.count("->") == n - 1 and f"[{n - 2}] j{n - 1} (fixed) -> l{n - 1}" in text

@@ -248,7 +248,7 @@ def test_parse_size_and_joints() -> None:
     assert parse_size("640x480") == (640, 480)
     assert parse_size("640X480") == (640, 480)
     for bad in ("640", "x480", "axb", ""):
-        with pytest.raises(ParameterError, match="--size"):
+        with pytest.raises(ParameterError, match="`size`"):
             parse_size(bad)
     assert parse_joint_positions(["a=1", "b=-0.5,c=2e-1"]) == {"a": 1.0, "b": -0.5, "c": 0.2}
     with pytest.raises(ParameterError, match="not a number"):
@@ -261,7 +261,7 @@ def test_parse_size_and_joints() -> None:
     ({"views": ("diagonal",)}, "unknown view"),
     ({"views": ("iso", "top")}, "four"),
     ({"width": 8}, "16..8192"),
-    ({"ground": "lava"}, "unknown ground"),
+    ({"ground": "lava"}, "unknown `ground`"),
     ({"joints": {"a": math.nan}}, "finite"),
 ])
 def test_bad_options(kw: dict, match: str) -> None:
@@ -288,7 +288,7 @@ def test_write_png_atomic_and_refuses_overwrite(simplecar_urdf: Path, tmp_path: 
         assert im.format == "PNG" and im.size == (320, 240)
         assert np.array_equal(np.asarray(im.convert("RGB")), r.image)
     before = out.read_bytes()
-    with pytest.raises(OutputError, match="--force"):
+    with pytest.raises(OutputError, match="`force=True`"):
         write_png(r, out)
     assert out.read_bytes() == before
     write_png(r, out, force=True)

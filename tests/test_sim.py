@@ -391,7 +391,7 @@ def rows(two_cars: SimResult) -> list[dict[str, Any]]:
 def test_jsonl_round_trip(tmp_path: Path, rows: list[dict[str, Any]]) -> None:
     path = write_rows(tmp_path / "o.jsonl", rows, force=False)
     assert [json.loads(line) for line in path.read_text().splitlines()] == rows
-    with pytest.raises(OutputError, match="exists; pass --force"):
+    with pytest.raises(OutputError, match="exists; pass `force=True`"):
         write_rows(path, rows, force=False)
     write_rows(path, rows[:1], force=True)
     assert len(path.read_text().splitlines()) == 1

@@ -99,7 +99,7 @@ def mutate(path: str, value: Any) -> dict[str, Any]:
     ("robots.0.drive", "fast", "robots[0].drive: expected a list"),
     ("physics", 3, "physics: expected an object (a table in TOML)"),
     ("robots.0.template", "bicycle",
-     "robots[0].template: no template named 'bicycle'; known: simplecar, simpleplane"),
+     "robots[0].template: no template named 'bicycle' (known: simplecar, simpleplane)"),
     ("robots.1.params.wheel_radius", -0.1,
      "robots[1].params: parameter 'wheel_radius' must be > 0, got -0.1"),
     ("robots.1.params.wheels", 4, "robots[1].params: template 'simplecar' has no parameter"),
@@ -214,7 +214,7 @@ def test_joint_names_are_checked_against_the_loaded_body() -> None:
 def test_vehicle_without_wheels_names_the_path(tmp_path: Path) -> None:
     doc = {"robots": [{"template": "simplecar", "vehicle": {"wheels": ["nope"]},
                        "drive": [{"until": 1, "throttle": 1}]}]}
-    with pytest.raises(InputError, match=r"robots\[0\]\.vehicle: --wheels: no joint named"):
+    with pytest.raises(InputError, match=r"robots\[0\]\.vehicle: `wheels`: no joint named"):
         Simulation(doc)
 
 

@@ -30,7 +30,8 @@ def build(target: str, params: list[str] | None = None,
     """Build ``target``: a built-in template name, or a path to a ``.xacro`` file."""
     if target in TEMPLATES:
         if xacro_args:
-            raise ParameterError("--arg is for xacro files; templates take --set KEY=VALUE")
+            raise ParameterError("`xacro_args` are for xacro files, not templates",
+                                 param="xacro_args")
         robot = build_template(target, parse_assignments(params))
         data = robot.to_bytes()
         default = f"{target}.urdf"
@@ -39,16 +40,21 @@ def build(target: str, params: list[str] | None = None,
     else:
         path = Path(target)
         if path.suffix != ".xacro" and not path.exists():
+            from .suggest import files, hint
+
             known = ", ".join(TEMPLATES)
-            raise ParameterError(f"'{target}' is neither a template ({known}) nor a file")
+            close = [repr(f) for f in files(target)]
+            more = hint(target, TEMPLATES) or (f"; did you mean {' or '.join(close)}?"
+                                               if close else "")
+            raise ParameterError(f"'{target}' is neither a template ({known}) nor a file{more}")
         if params:
-            raise ParameterError("--set is for built-in templates; xacro files take "
-                                 "--arg NAME:=VALUE")
+            raise ParameterError("`params` are for built-in templates; xacro files take "
+                                 "`xacro_args`", param="params")
         source = locate(target)
         if source.suffix != ".xacro":
             raise InputError("build takes a template name or a .xacro file; this file is "
                              "already URDF", file=target)
-        expanded = expand_xacro(source, parse_assignments(xacro_args, "--arg"), display=target)
+        expanded = expand_xacro(source, parse_assignments(xacro_args, "xacro_args"), display=target)
         tree = parse_xml(expanded, target)
         guard(tree, target)
         robot = Robot.from_string(expanded, file=target)

@@ -41,6 +41,7 @@ from .spec import (
     Matrix3,
     Vec3,
     depth_first,
+    finite,
     matmul,
     rpy_to_matrix,
     transpose,
@@ -62,12 +63,9 @@ def _fail(msg: str) -> ModelError:
 
 def _finite(value: Any) -> float:
     try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise _fail(f"expected a number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise _fail(f"expected a finite number, got {value!r}")
-    return x
+        return finite(value)
+    except ValueError as e:
+        raise _fail(str(e)) from None
 
 
 def _optional(check: Callable[[Any], Any]) -> Callable[[Any], Any]:

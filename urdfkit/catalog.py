@@ -108,9 +108,11 @@ class Template:
         for p in self.params:
             if p.name == key:
                 return p
-        known = ", ".join(p.name for p in self.params)
-        raise ParameterError(f"template '{self.name}' has no parameter '{key}'; "
-                             f"known: {known}")
+        from .suggest import hint
+
+        names = [p.name for p in self.params]
+        raise ParameterError(f"template '{self.name}' has no parameter '{key}'"
+                             f"{hint(key, names)} (known: {', '.join(names)})", param="params")
 
     def resolve(self, values: Mapping[str, Any] | None = None) -> dict[str, Any]:
         """Every parameter's value: the defaults overridden by ``values``, checked."""
@@ -179,17 +181,22 @@ def get_template(name: str) -> Template:
     try:
         return TEMPLATES[name]
     except KeyError:
-        raise ParameterError(f"no template named '{name}'; known: "
-                             f"{', '.join(TEMPLATES)}") from None
+        from .suggest import hint
+
+        raise ParameterError(f"no template named '{name}'{hint(name, TEMPLATES)} (known: "
+                             f"{', '.join(TEMPLATES)})") from None
 
 
-def parse_assignments(items: list[str] | None, flag: str = "--set") -> dict[str, str]:
-    """Parse repeated ``key=value`` (or ``key:=value``) options into a dict."""
+def parse_assignments(items: list[str] | None, param: str = "params") -> dict[str, str]:
+    """Parse repeated ``key=value`` (or ``key:=value``) items into a dict.
+
+    ``param`` names the argument they came in, for the error message.
+    """
     out: dict[str, str] = {}
     for item in items or []:
         key, sep, value = item.replace(":=", "=", 1).partition("=")
         if not sep or not key.strip():
-            raise ParameterError(f"{flag} expects key=value, got {item!r}")
+            raise ParameterError(f"`{param}` expects key=value, got {item!r}", param=param)
         out[key.strip()] = value.strip()
     return out
 

@@ -34,6 +34,7 @@ from typing import Any
 
 from .errors import ParameterError
 from .session import LoadOptions, Session, quiet_stdout
+from .spec import finite
 from .vehicle import (
     Drivetrain,
     DrivetrainError,
@@ -57,12 +58,10 @@ BASE_COLUMNS = ("t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz")
 
 def _finite(name: str, value: float) -> float:
     try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ParameterError(f"{name} must be a finite number, got {value!r}")
-    return v
+        return finite(value)
+    except ValueError as e:
+        raise ParameterError(f"`{name}` {str(e).replace('expected', 'must be', 1)}",
+                             param=name) from None
 
 
 @dataclass
@@ -73,9 +72,10 @@ class DriveConfig:
         urdf: The car file (resolved like every input: pybullet_data included); ``None`` for
             the built-in simplecar.
         plane: The ground file; ``None`` for the built-in simpleplane.
-        template_params: ``--set`` values for the built-in simplecar.
-        packages: Raw ``--package NAME=PATH`` options.
-        xacro_args: Raw ``--arg NAME:=VALUE`` options.
+        template_params: Parameter values for the built-in simplecar (see ``urdfkit
+            templates``).
+        packages: ``NAME=PATH`` strings: where ``package://NAME/`` points.
+        xacro_args: ``NAME:=VALUE`` strings for a xacro ``urdf``.
         seconds: Simulated duration; ignored when ``steps`` is given.
         steps: Number of physics steps.
         time_step: Physics time step (s).
@@ -110,31 +110,35 @@ class DriveConfig:
 
     def check(self) -> None:
         """Refuse values that would make the run meaningless (exit 2 in the CLI)."""
-        self.time_step = _finite("--time-step", self.time_step)
+        self.time_step = _finite("time_step", self.time_step)
         if not 0 < self.time_step <= 0.1:
-            raise ParameterError(f"--time-step must be in (0, 0.1] s, got {self.time_step:g}")
+            raise ParameterError(f"`time_step` must be in (0, 0.1] s, got {self.time_step:g}",
+                                 param="time_step")
         if self.steps is not None:
             if isinstance(self.steps, bool) or int(self.steps) != self.steps or self.steps < 1:
-                raise ParameterError(f"--steps must be a positive whole number, "
-                                     f"got {self.steps!r}")
+                raise ParameterError(f"`steps` must be a positive whole number, "
+                                     f"got {self.steps!r}", param="steps")
         else:
             if self.seconds is None:
-                raise ParameterError("give --seconds or --steps")
-            self.seconds = _finite("--seconds", self.seconds)
+                raise ParameterError("give `seconds` or `steps`", param="seconds")
+            self.seconds = _finite("seconds", self.seconds)
             if self.seconds <= 0:
-                raise ParameterError(f"--seconds must be positive, got {self.seconds:g}")
-        self.throttle = _finite("--throttle", self.throttle)
-        self.steer = _finite("--steer", self.steer)
-        self.max_force = _finite("--max-force", self.max_force)
+                raise ParameterError(f"`seconds` must be positive, got {self.seconds:g}",
+                                     param="seconds")
+        self.throttle = _finite("throttle", self.throttle)
+        self.steer = _finite("steer", self.steer)
+        self.max_force = _finite("max_force", self.max_force)
         if self.max_force < 0:
-            raise ParameterError(f"--max-force must be >= 0, got {self.max_force:g}")
+            raise ParameterError(f"`max_force` must be >= 0, got {self.max_force:g}",
+                                 param="max_force")
         self.gravity = _finite("gravity", self.gravity)
         if self.sample_every is not None and (isinstance(self.sample_every, bool)
                                               or self.sample_every < 1):
-            raise ParameterError(f"--sample-every must be >= 1, got {self.sample_every!r}")
+            raise ParameterError(f"`sample_every` must be >= 1, got {self.sample_every!r}",
+                                 param="sample_every")
         if self.template_params and self.urdf is not None:
-            raise ParameterError("--set is for the built-in simplecar; --urdf files take "
-                                 "--arg NAME:=VALUE")
+            raise ParameterError("`template_params` are for the built-in simplecar; a `urdf` "
+                                 "file takes `xacro_args`", param="template_params")
 
     @property
     def total_steps(self) -> int:
@@ -188,8 +192,8 @@ def trajectory_format(path: str | Path) -> str:
     """The format a trajectory path asks for, checked before the run starts."""
     suffix = Path(path).suffix.lower()
     if suffix not in TRAJECTORY_FORMATS:
-        raise ParameterError(f"--trajectory must end in {' or '.join(TRAJECTORY_FORMATS)}",
-                             )
+        raise ParameterError(f"`trajectory` must end in {' or '.join(TRAJECTORY_FORMATS)}",
+                             param="trajectory")
     return suffix
 
 
@@ -434,16 +438,16 @@ class Scenario:
         try:
             self.drivetrain = train = detect_drivetrain(p, self.body, client, c.wheels, c.hinges)
         except DrivetrainError as e:
-            raise DrivetrainError(e.message, file=car) from None
+            raise DrivetrainError(e.message, file=car, param=e.param) from None
         self.steer = c.steer
         if train.hinges:
             lo, hi = train.steer_range()
             if not lo <= c.steer <= hi:
                 self.steer = min(max(c.steer, lo), hi)
-                self.warnings.append(f"--steer {c.steer:g} is beyond the hinge limits "
+                self.warnings.append(f"steer {c.steer:g} rad is beyond the hinge limits "
                                      f"[{lo:g}, {hi:g}]; clamped to {self.steer:g}")
         elif c.steer != 0:
-            self.warnings.append("the model has no steering hinges; --steer is ignored")
+            self.warnings.append("the model has no steering hinges; steer is ignored")
         self.columns = list(BASE_COLUMNS)
         for j in train.wheels + train.hinges:
             name = train.joint_names[j]

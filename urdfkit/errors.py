@@ -17,16 +17,21 @@ class UrdfkitError(Exception):
         message: What went wrong and, where possible, how to fix it.
         file: The file concerned, if any.
         line: The 1-based line in ``file``, if known.
+        param: The Python parameter the error is about (``time_step``), if any. Messages
+            name parameters the way Python code passes them; the CLI, which knows which flag
+            feeds which parameter, shows the flag (``--time-step``) instead.
         exit_code: What the CLI exits with.
     """
 
     exit_code = 2
 
-    def __init__(self, message: str, *, file: str | Path | None = None, line: int | None = None):
+    def __init__(self, message: str, *, file: str | Path | None = None, line: int | None = None,
+                 param: str | None = None):
         super().__init__(message)
         self.message = message
         self.file = str(file) if file is not None else None
         self.line = line
+        self.param = param
 
     def __str__(self) -> str:
         if self.file is None:
@@ -44,7 +49,7 @@ class ModelError(UrdfkitError, ValueError):
 
 
 class ParameterError(UrdfkitError, ValueError):
-    """A template parameter or command-line value is unknown or invalid."""
+    """A template parameter or a function argument is unknown or invalid."""
 
 
 class OutputError(UrdfkitError):

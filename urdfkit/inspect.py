@@ -165,9 +165,11 @@ def filter_joints(joints: Sequence[JointInfo], *, movable: bool = False,
     unknown = sorted(wanted - set(JOINT_TYPE_FILTERS))
     if unknown:
         from .errors import ParameterError
+        from .suggest import hint
 
-        raise ParameterError(f"--type {unknown[0]!r} is not a joint type; use one of "
-                             f"{', '.join(JOINT_TYPE_FILTERS)}")
+        raise ParameterError(f"`types` {unknown[0]!r} is not a joint type"
+                             f"{hint(unknown[0], JOINT_TYPE_FILTERS)} (use one of "
+                             f"{', '.join(JOINT_TYPE_FILTERS)})", param="types")
     out = []
     for j in joints:
         if movable and not j.movable:

@@ -25,7 +25,8 @@ def _pyplot() -> Any:
     try:
         import matplotlib
     except ImportError as e:
-        raise MissingDependencyError("--plot needs matplotlib: pip install 'urdfkit[plot]'") from e
+        raise MissingDependencyError(
+            "`plot` needs matplotlib: pip install 'urdfkit[plot]'", param="plot") from e
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
 
@@ -35,11 +36,12 @@ def _pyplot() -> Any:
 def check_plot_path(path: str | Path) -> None:
     """Refuse, before the run starts, a plot path that is not a PNG or a missing matplotlib."""
     if Path(path).suffix.lower() != ".png":
-        raise ParameterError(f"--plot must end in .png, got {str(path)!r}")
+        raise ParameterError(f"`plot` must end in .png, got {str(path)!r}", param="plot")
     import importlib.util
 
     if importlib.util.find_spec("matplotlib") is None:
-        raise MissingDependencyError("--plot needs matplotlib: pip install 'urdfkit[plot]'")
+        raise MissingDependencyError(
+            "`plot` needs matplotlib: pip install 'urdfkit[plot]'", param="plot")
 
 
 def plot_bytes(result: DriveResult) -> bytes:

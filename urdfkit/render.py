@@ -95,18 +95,23 @@ class RenderOptions:
             raise ParameterError("no view given")
         for v in self.views:
             if v not in VIEWS:
-                raise ParameterError(f"unknown view {v!r}; choose from {', '.join(VIEWS)}")
+                from .suggest import hint
+
+                raise ParameterError(f"unknown view {v!r}{hint(v, VIEWS)} (choose from "
+                                     f"{', '.join(VIEWS)})", param="views")
         if len(self.views) not in (1, 4):
-            raise ParameterError("give one view, or four for a 2x2 grid (--views all)")
+            raise ParameterError("give one view, or four for a 2x2 grid (`views`)",
+                                 param="views")
         if not (16 <= self.width <= 8192 and 16 <= self.height <= 8192):
-            raise ParameterError(f"--size {self.width}x{self.height}: each side must be "
-                                 "16..8192 pixels")
+            raise ParameterError(f"`size` {self.width}x{self.height}: each side must be "
+                                 "16..8192 pixels", param="size")
         if self.ground not in GROUNDS:
-            raise ParameterError(f"unknown ground {self.ground!r}; choose from "
+            raise ParameterError(f"unknown `ground` {self.ground!r}; choose from "
                                  f"{', '.join(GROUNDS)}")
         for name, value in self.joints.items():
             if not math.isfinite(value):
-                raise ParameterError(f"--joints {name}: position must be a finite number")
+                raise ParameterError(f"`joints` {name}: position must be a finite number",
+                                     param="joints")
 
 
 @dataclass
@@ -196,7 +201,8 @@ def parse_size(text: str) -> tuple[int, int]:
             raise ValueError
         return int(w), int(h)
     except ValueError:
-        raise ParameterError(f"--size expects WIDTHxHEIGHT such as 800x600, got {text!r}") from None
+        raise ParameterError(f"`size` expects WIDTHxHEIGHT such as 800x600, got {text!r}",
+                             param="size") from None
 
 
 def parse_joint_positions(items: Sequence[str] | None) -> dict[str, float]:
@@ -205,11 +211,12 @@ def parse_joint_positions(items: Sequence[str] | None) -> dict[str, float]:
 
     flat = [part for item in items or [] for part in item.split(",") if part.strip()]
     out: dict[str, float] = {}
-    for name, value in parse_assignments(flat, "--joints").items():
+    for name, value in parse_assignments(flat, "joints").items():
         try:
             out[name] = float(value)
         except ValueError:
-            raise ParameterError(f"--joints {name}: {value!r} is not a number") from None
+            raise ParameterError(f"`joints` {name}: {value!r} is not a number",
+                                 param="joints") from None
     return out
 
 
@@ -466,16 +473,19 @@ def _pose(p: Any, c: int, body: int, by_name: Mapping[str, Any], joints: Mapping
     for name, value in joints.items():
         info = by_name.get(name)
         if info is None:
+            from .suggest import hint
+
             known = ", ".join(movable) or "none"
-            raise ParameterError(f"--joints: no joint named {name!r} (movable joints: {known})",
-                                 file=file)
+            raise ParameterError(f"`joints`: no joint named {name!r}{hint(name, movable)} "
+                                 f"(movable joints: {known})", file=file, param="joints")
         if info[2] != _JOINT_FIXED and info[2] not in (0, 1):
             kind = pybullet_joint_type(info[2]).lower()
-            raise ParameterError(f"--joints {name}: {kind} joints take more than one position; "
+            raise ParameterError(f"`joints` {name}: {kind} joints take more than one position; "
                                  "only revolute, continuous and prismatic joints can be posed",
-                                 file=file)
+                                 file=file, param="joints")
         if info[2] == _JOINT_FIXED:
-            raise ParameterError(f"--joints {name}: a fixed joint cannot move", file=file)
+            raise ParameterError(f"`joints` {name}: a fixed joint cannot move", file=file,
+                                 param="joints")
         lower, upper = info[8], info[9]
         # Continuous joints come back as revolute with lower=0 > upper=-1: no limits.
         if lower <= upper and not lower <= value <= upper:

@@ -36,11 +36,14 @@ def locate(name: str | Path) -> Path:
         if path.is_dir():
             raise InputError("is a directory, not a URDF file", file=name)
         return path
-    if not path.is_absolute():
-        data = pybullet_data_path()
-        if data is not None and (data / path).is_file():
-            return data / path
-    raise InputError("no such file (looked in the current folder and in pybullet_data)",
+    data = None if path.is_absolute() else pybullet_data_path()
+    if data is not None and (data / path).is_file():
+        return data / path
+    from .suggest import files
+
+    close = files(str(name), data)
+    more = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
+    raise InputError(f"no such file (looked in the current folder and in pybullet_data){more}",
                      file=name)
 
 
@@ -50,9 +53,10 @@ def parse_packages(items: list[str] | None) -> dict[str, Path]:
     for item in items or []:
         name, sep, path = item.partition("=")
         if not sep or not name or not path:
-            raise ParameterError(f"--package expects NAME=PATH, got {item!r}")
+            raise ParameterError(f"`packages` expects NAME=PATH, got {item!r}", param="packages")
         if not Path(path).is_dir():
-            raise ParameterError(f"--package {name}: folder {path!r} does not exist")
+            raise ParameterError(f"`packages` {name}: folder {path!r} does not exist",
+                                 param="packages")
         out[name] = Path(path).resolve()
     return out
 
@@ -148,5 +152,5 @@ def open_input(name: str | Path, packages: list[str] | None = None,
         # Only now: catalog pulls in the builder model (~15 ms), which plain loads never need.
         from .catalog import parse_assignments
 
-        args = dict(parse_assignments(xacro_args, "--arg"))
+        args = dict(parse_assignments(xacro_args, "xacro_args"))
     return resolve(name, packages=parse_packages(packages), xacro_args=args)

@@ -162,6 +162,21 @@ class _HasGet(Protocol):
     def get(self, key: str, default: Any = ...) -> Any: ...
 
 
+def finite(value: Any) -> float:
+    """``value`` as a finite float, or ValueError saying what it was.
+
+    The one number check of the library: the builder wraps the error in a ModelError, the
+    run configurations in a ParameterError naming their parameter.
+    """
+    try:
+        x = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"expected a number, got {value!r}") from None
+    if not math.isfinite(x):
+        raise ValueError(f"expected a finite number, got {value!r}")
+    return x
+
+
 def numbers(text: str | None) -> list[float] | None:
     """The whitespace-separated numbers in ``text``; None when absent or malformed.
 

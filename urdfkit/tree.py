@@ -70,17 +70,23 @@ class TreeNode:
             yield node
             stack.extend(reversed(node.children))
 
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON form, nested."""
-        out: dict[str, Any] = {}
-        stack: list[tuple[TreeNode, dict[str, Any]]] = [(self, out)]
+    def to_flat_dict(self) -> dict[str, Any]:
+        """The JSON form, flat: links depth-first, joints in PyBullet's index order.
+
+        Each joint names its ``parent`` and ``child`` link, so the tree is rebuilt with one
+        dict; flat, the JSON stays linear in size however deep the chain (nested and
+        indented, a 1000-link chain costs megabytes of indentation).
+        """
+        links: list[str] = []
+        joints: list[dict[str, Any]] = []
+        stack: list[tuple[TreeNode, str | None]] = [(self, None)]
         while stack:
-            node, d = stack.pop()
-            d["link"] = node.link
-            d["joint"] = node.joint.to_dict() if node.joint is not None else None
-            d["children"] = [{} for _ in node.children]
-            stack.extend(zip(node.children, d["children"], strict=True))
-        return out
+            node, parent = stack.pop()
+            links.append(node.link)
+            if node.joint is not None:
+                joints.append({**node.joint.to_dict(), "parent": parent, "child": node.link})
+            stack.extend((child, node.link) for child in reversed(node.children))
+        return {"base_link": self.link, "links": links, "joints": joints}
 
 
 def kinematic_tree(root: etree._Element) -> TreeNode:

@@ -77,8 +77,8 @@ def resolve_uri(uri: str, base: Path, packages: Mapping[str, Path] | None = None
                           f"file's folder or the {PYBULLET_SEARCH_DEPTH} above it")
         found = (packages or {}).get(pkg) or find_package(pkg, base)
         if found is None:
-            return Target(None, pkg, f"package {pkg!r} not found near the file; pass "
-                          f"--package {pkg}=PATH")
+            return Target(None, pkg, f"package {pkg!r} not found near the file; map it with "
+                          f"`packages` ({pkg}=PATH)")
         return Target(found / rest, pkg)
     if uri.startswith("file://"):
         uri = uri[len("file://"):]

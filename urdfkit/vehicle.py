@@ -46,7 +46,7 @@ _PRISMATIC = 1  # p.JOINT_PRISMATIC
 
 
 class DrivetrainError(ParameterError):
-    """The model has no wheels, or ``--wheels``/``--hinges`` name joints it does not have."""
+    """The model has no wheels, or ``wheels``/``hinges`` name joints it does not have."""
 
 
 @dataclass
@@ -135,17 +135,21 @@ def _pick(spec: Sequence[str | int], names: dict[int, str], movable: list[int],
             key = int(key)
         if isinstance(key, int):
             if key not in names:
-                raise DrivetrainError(f"{what}: no joint with index {key} (the model has "
-                                      f"joints 0..{len(names) - 1})")
+                raise DrivetrainError(f"`{what}`: no joint with index {key} (the model has "
+                                      f"joints 0..{len(names) - 1})", param=what)
             out.append(key)
         elif key in by_name:
             out.append(by_name[key])
         else:
+            from .suggest import hint
+
             known = ", ".join(names.values()) or "none"
-            raise DrivetrainError(f"{what}: no joint named {key!r}; joints: {known}")
+            raise DrivetrainError(f"`{what}`: no joint named {key!r}"
+                                  f"{hint(str(key), names.values())} (joints: {known})",
+                                  param=what)
         if out[-1] not in movable:
-            raise DrivetrainError(f"{what}: joint {names[out[-1]]!r} is fixed and cannot be "
-                                  "driven")
+            raise DrivetrainError(f"`{what}`: joint {names[out[-1]]!r} is fixed and cannot "
+                                  "be driven", param=what)
     return out
 
 
@@ -177,15 +181,15 @@ def detect_drivetrain(p: Any, body: int, client: int,
     forward = _rotate(base_orn, (1.0, 0.0, 0.0))
 
     if wheels is not None:
-        wheel_list = _pick(wheels, names, movable, "--wheels")
+        wheel_list = _pick(wheels, names, movable, "wheels")
     else:
         wheel_list = [j for j in movable if _is_continuous(infos[j])
                       and abs(axes[j][2]) < HORIZONTAL_TOLERANCE]
     if not wheel_list:
         raise DrivetrainError("no wheels found: a wheel is a continuous joint about a "
-                              "horizontal axis; name them with --wheels")
+                              "horizontal axis; name them with `wheels`")
     if hinges is not None:
-        hinge_list = _pick(hinges, names, movable, "--hinges")
+        hinge_list = _pick(hinges, names, movable, "hinges")
     else:
         wheel_set = set(wheel_list)
 

@@ -180,7 +180,8 @@ def check_writable(path: str | Path, *, force: bool = False) -> Path:
     if path.is_dir():
         raise OutputError("is a directory", file=path)
     if path.exists() and not force:
-        raise OutputError("exists; pass --force to overwrite it", file=path)
+        raise OutputError("exists; pass `force=True` to overwrite it", file=path,
+                          param="force")
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise OutputError(f"folder {folder} does not exist", file=path)
@@ -212,7 +213,8 @@ def atomic_write(path: str | Path, data: bytes, *, force: bool = False) -> Path:
             f.flush()
             os.fsync(f.fileno())
         if not force and path.exists():
-            raise OutputError("exists; pass --force to overwrite it", file=path)
+            raise OutputError("exists; pass `force=True` to overwrite it", file=path,
+                          param="force")
         os.replace(tmp, path)
     except BaseException:
         try:

@@ -1,0 +1,417 @@
+"""Presentation in one room: every line urdfkit prints is shaped here.
+
+``cli.py`` parses options, calls the library, and hands the result to one function of this
+module. Tables, trees, key/value blocks, progress bars, number formats, JSON and the one-line
+error and warning printers all live here, so every command looks and pipes alike:
+
+- On a terminal, output is styled with rich (imported only then: ~25 ms).
+- Piped (CI logs, ``| grep``, ``> file``) it is plain aligned text with every column a wide
+  terminal would show: nothing is truncated, wrapped or hidden, and rich is not imported.
+- JSON is plain ``json.dumps``: valid whatever the terminal, linear in the size of the data,
+  and non-finite numbers become ``null`` with a diagnostic instead of invalid JSON.
+"""
+
+from __future__ import annotations
+
+import gc
+import json
+import math
+import os
+import sys
+from collections.abc import Callable, Iterable, Sequence
+from typing import Any
+
+Part = str | tuple[str, str]
+"""A piece of a line: plain text, or ``(text, rich style)``."""
+
+Column = tuple[str, int, str]
+"""(header, priority, justify) of a fitted table column; see :func:`table`."""
+
+LEVEL_STYLE = {"error": "bold red", "warning": "yellow", "info": "cyan"}
+
+
+# --------------------------------------------------------------------------- streams
+
+
+def styled(stream: Any) -> bool:
+    """Whether ``stream`` gets colours: a terminal, or FORCE_COLOR set (NO_COLOR wins)."""
+    if os.environ.get("NO_COLOR"):
+        return False
+    try:
+        tty = stream.isatty()
+    except (AttributeError, ValueError):
+        tty = False
+    return tty or bool(os.environ.get("FORCE_COLOR"))
+
+
+def console(stderr: bool = False) -> Any:
+    """A rich Console on stdout (or stderr). Only called when styling is wanted."""
+    if "rich.console" not in sys.modules:
+        # Importing rich allocates tens of thousands of objects, and each full collection
+        # that triggers would re-scan everything loaded before (numpy, pybullet, ...), which
+        # lives until exit anyway: freeze it first, as main() does at start-up (~4 ms).
+        gc.freeze()
+    from rich.console import Console
+
+    return Console(stderr=stderr, highlight=False)
+
+
+def _write(stream: Any, text: str) -> None:
+    stream.write(text)
+    stream.flush()
+
+
+def line(*parts: Part, stderr: bool = False) -> None:
+    """Print one line made of plain strings and ``(text, rich style)`` pairs.
+
+    On a terminal rich styles it; elsewhere it is written as plain text, which is what rich
+    would print there too, without paying for the import. User text needs no markup escaping:
+    it never passes through rich's markup parser.
+    """
+    stream = sys.stderr if stderr else sys.stdout
+    if styled(stream):
+        from rich.text import Text
+
+        console(stderr).print(Text.assemble(*parts), soft_wrap=True)
+    else:
+        _write(stream, "".join(p if isinstance(p, str) else p[0] for p in parts) + "\n")
+
+
+def error(message: str) -> None:
+    """The one error line: ``urdfkit: error: <message>`` on stderr."""
+    line(("urdfkit: error:", "bold red"), " ", _one_line(message), stderr=True)
+
+
+def bug(exc: BaseException) -> None:
+    """The line for an internal error: says it is a bug and how to see the traceback."""
+    line(("urdfkit: internal error (a bug in urdfkit):", "bold red"), " ",
+         _one_line(f"{type(exc).__name__}: {exc}"),
+         " (rerun with URDFKIT_DEBUG=1 for the traceback, and please report it)", stderr=True)
+
+
+def warn(message: str) -> None:
+    """A warning line on stderr."""
+    line(("urdfkit: warning:", "yellow"), " ", _one_line(message), stderr=True)
+
+
+def note(message: str, *, stderr: bool = True) -> None:
+    """A dim line: context that is not a warning (detected wheels, hidden columns, ...)."""
+    line((message, "dim"), stderr=stderr)
+
+
+def wrote(path: Any, detail: str = "") -> None:
+    """``wrote FILE (detail)`` on stderr, so stdout stays the command's output."""
+    line("wrote ", (str(path), "bold"), f" ({detail})" if detail else "", stderr=True)
+
+
+def interrupted(message: str = "interrupted") -> None:
+    """The yellow ``urdfkit: interrupted`` line (Ctrl-C, SIGTERM, SIGHUP)."""
+    line((f"urdfkit: {message}", "yellow"), stderr=True)
+
+
+def diagnostics(lines: Iterable[str]) -> None:
+    """PyBullet's own messages, captured from its C stdout, as warnings."""
+    for text in lines:
+        warn(f"pybullet: {text}")
+
+
+def _one_line(text: str) -> str:
+    # A message must stay one line whatever it quotes (a file name with a newline, a
+    # multi-line xacro error): escape what would break it.
+    return text.replace("\r", "\\r").replace("\n", " | ")
+
+
+# --------------------------------------------------------------------------- numbers
+
+
+def num(x: float) -> str:
+    """A compact number: 4 significant digits, no ``-0``."""
+    s = f"{x:.4g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def nums(v: Iterable[float]) -> str:
+    """Numbers formatted by :func:`num`, space-separated."""
+    return " ".join(num(x) for x in v)
+
+
+def fixed(x: float, digits: int = 3) -> str:
+    """Fixed decimals, without a ``-`` on a value that rounds to zero."""
+    text = f"{x:.{digits}f}"
+    return text[1:] if text.startswith("-") and not text.strip("-0.") else text
+
+
+# --------------------------------------------------------------------------- JSON
+
+
+def _finite(data: Any, path: str, bad: list[str]) -> Any:
+    if isinstance(data, float):
+        if math.isfinite(data):
+            return data
+        bad.append(path or "$")
+        return None
+    if isinstance(data, dict):
+        return {k: _finite(v, f"{path}.{k}" if path else str(k), bad) for k, v in data.items()}
+    if isinstance(data, list | tuple):
+        return [_finite(v, f"{path}[{i}]", bad) for i, v in enumerate(data)]
+    return data
+
+
+def json_text(data: Any) -> str:
+    """``data`` as JSON that always parses.
+
+    NaN and infinities (from a file that holds them, or a simulation that blew up) are not
+    JSON: they become ``null``, and a diagnostic naming where they were is added to the
+    object's ``diagnostics`` list (created if needed) and printed as a warning. The common
+    case pays one ``json.dumps``; only output that holds such numbers is walked.
+    """
+    try:
+        return json.dumps(data, indent=2, allow_nan=False)
+    except ValueError:
+        pass
+    bad: list[str] = []
+    clean = _finite(data, "", bad)
+    message = (f"{len(bad)} non-finite number(s) written as null (first at {bad[0]})"
+               if bad else "")
+    if bad:
+        warn(message)
+        if isinstance(clean, dict):
+            clean["diagnostics"] = [*clean.get("diagnostics", []), message]
+    return json.dumps(clean, indent=2, allow_nan=False)
+
+
+def print_json(data: Any) -> None:
+    """One JSON document on stdout (plain print, not rich: it must parse anywhere)."""
+    _write(sys.stdout, json_text(data) + "\n")
+
+
+# --------------------------------------------------------------------------- tables
+
+
+def terminal_width() -> int:
+    """$COLUMNS, else the terminal stdout is on, else the one stderr is on, else 80."""
+    try:
+        return int(os.environ["COLUMNS"])
+    except (KeyError, ValueError):
+        pass
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            return os.get_terminal_size(stream.fileno()).columns
+        except (AttributeError, OSError, ValueError):
+            continue
+    return 80
+
+
+def table(title: str, columns: Sequence[Column], rows: Sequence[Sequence[str]],
+          show_all: bool = False) -> None:
+    """A table of the columns that fit, most important first; nothing lost when piped.
+
+    ``columns`` holds (header, priority, justify): priority 0 always shows, then 1, 2, ...
+    join while they fit the terminal; 9 shows only with ``show_all``. On a terminal the
+    columns left out are announced in one dim line. With ``show_all`` and too little width,
+    each row becomes a block of "field value" lines instead, so nothing is squeezed.
+
+    Piped, every column a wide terminal would show (all but priority 9, unless
+    ``show_all``) is printed as plain aligned text: no truncation, no box drawing, no rich.
+    """
+    tty = styled(sys.stdout)
+    width = terminal_width() if tty else sys.maxsize
+    needed = [max([len(h), *(len(r[i]) for r in rows)]) + 3
+              for i, (h, _, _) in enumerate(columns)]
+    blocks = show_all and sum(needed) > width
+    keep: list[int] = []
+    used = 0
+    for i in sorted(range(len(columns)), key=lambda i: columns[i][1]):
+        prio = columns[i][1]
+        if not (show_all or prio == 0 or (prio < 9 and used + needed[i] <= width)):
+            break  # a column of this priority does not fit: drop all less important ones
+        keep.append(i)
+        used += needed[i]
+    keep.sort()
+    if not tty:
+        _plain_table(title, columns, rows, keep)
+        return
+    _rich_table(title, columns, rows, keep, blocks)
+    hidden = [columns[i][0] for i in range(len(columns)) if i not in keep]
+    if hidden and not show_all:
+        note(f"{len(hidden)} column(s) hidden: --all or a wider terminal", stderr=False)
+
+
+def _plain_table(title: str, columns: Sequence[Column], rows: Sequence[Sequence[str]],
+                 keep: list[int]) -> None:
+    grid = [[columns[i][0] for i in keep], *([r[i] for i in keep] for r in rows)]
+    widths = [max(len(cells[k]) for cells in grid) for k in range(len(keep))]
+    out = [title] if title else []
+    for cells in grid:
+        padded = [cell.rjust(w) if columns[i][2] == "right" else cell.ljust(w)
+                  for i, cell, w in zip(keep, cells, widths, strict=True)]
+        out.append("  ".join(padded).rstrip())
+    _write(sys.stdout, "\n".join(out) + "\n")
+
+
+def _rich_table(title: str, columns: Sequence[Column], rows: Sequence[Sequence[str]],
+                keep: list[int], blocks: bool) -> None:
+    from rich.table import Table
+    from rich.text import Text
+
+    heading = Text(title)
+    heading.stylize("bold", 0, max(title.find(":"), 0))  # the robot's name
+    if blocks:
+        from rich.console import Group
+
+        parts: list[Any] = [heading]
+        for r in rows:
+            block = Table(show_header=False, show_edge=False, box=None, padding=(0, 1))
+            block.add_column(style="bold")
+            block.add_column()
+            for (header, _, _), cell in zip(columns, r, strict=False):
+                block.add_row(Text(header), Text(cell))
+            parts += ["", block]
+        console().print(Group(*parts))
+        return
+    grid = Table(title=heading if title else None, title_justify="left", show_edge=False,
+                 header_style="bold")
+    for i in keep:
+        header, _, justify = columns[i]
+        # Text, not str: no markup or emoji parsing (rich's emoji table alone costs ~2 ms).
+        grid.add_column(Text(header), justify=justify)  # type: ignore[arg-type]
+    for r in rows:
+        grid.add_row(*(Text(r[i]) for i in keep))
+    console().print(grid)
+
+
+def fields(title: Sequence[Part], rows: Sequence[tuple[str, str]]) -> None:
+    """A block of aligned ``key  value`` lines under a title line (info, drive)."""
+    line(*title)
+    width = max((len(k) for k, _ in rows), default=0)
+    for key, value in rows:
+        line("  ", (f"{key:<{width}}", "cyan"), "  ", value)
+
+
+# --------------------------------------------------------------------------- trees
+
+
+def tree(root: Any, robot: str) -> None:
+    """The kinematic tree (:class:`urdfkit.tree.TreeNode`), one line per link.
+
+    Piped, it is indented text that holds every joint however deep the chain; on a
+    terminal, a rich tree with guide lines.
+    """
+
+    def label(node: Any) -> str:
+        j = node.joint
+        if j is None:
+            return node.link
+        extra = f" axis {nums(j.axis)}" if j.axis is not None else ""
+        if j.limit is not None:
+            extra += f" [{num(j.limit[0])} .. {num(j.limit[1])}]"
+        return f"[{j.index}] {j.name} ({j.type}{extra}) -> {node.link}"
+
+    if not styled(sys.stdout):
+        # The guide lines rich draws, written directly: every joint, however deep.
+        out = [f"{root.link} ({robot})"]
+        stack = [(child, "", k == len(root.children) - 1)
+                 for k, child in reversed(list(enumerate(root.children)))]
+        while stack:  # iterative: chains are deeper than Python's recursion limit
+            node, prefix, last = stack.pop()
+            out.append(f"{prefix}{'└── ' if last else '├── '}{label(node)}")
+            below = prefix + ("    " if last else "│   ")
+            stack.extend((child, below, k == len(node.children) - 1)
+                         for k, child in reversed(list(enumerate(node.children))))
+        _write(sys.stdout, "\n".join(out) + "\n")
+        return
+    from rich.text import Text
+    from rich.tree import Tree
+
+    def styled_label(node: Any) -> Text:
+        text = Text(label(node))
+        if node.joint is not None:
+            close = text.plain.index("]") + 1
+            text.stylize("dim", 0, close)
+            text.stylize("cyan", close + 1, close + 1 + len(node.joint.name))
+        text.stylize("bold", len(text.plain) - len(node.link))
+        return text
+
+    top = Tree(Text.assemble(styled_label(root), (f" ({robot})", "dim")))
+    stack2: list[tuple[Any, Any]] = [(root, top)]
+    while stack2:
+        node, branch = stack2.pop()
+        stack2.extend((child, branch.add(styled_label(child))) for child in node.children)
+    console().print(top)
+
+
+# --------------------------------------------------------------------------- check
+
+
+def check_report(result: Any) -> None:
+    """``urdfkit check``'s text: findings grouped by file, then one summary line.
+
+    Piped it is written as plain lines in one go (no rich), so text costs about what
+    ``--json`` costs over thousands of files.
+    """
+    s = result.summary()
+    colour = "red" if s["error"] else ("yellow" if s["warning"] else "green")
+    summary = (f"{s['files']} file(s) checked: {s['error']} error(s), {s['warning']} "
+               f"warning(s), {s['info']} note(s); {s['files_with_errors']} file(s) with errors")
+    if not styled(sys.stdout):
+        out: list[str] = []
+        for fr in result.files:
+            if fr.findings:
+                out.append(_one_line(fr.file))
+                out += [f"  {f.line if f.line is not None else '-':>5}  {f.level:<7}  {f.code}  "
+                        f"{_one_line(f.message)}" for f in fr.findings]
+        out.append(summary)
+        _write(sys.stdout, "\n".join(out) + "\n")
+        return
+    from rich.text import Text
+
+    screen = console()
+    for fr in result.files:
+        if not fr.findings:
+            continue
+        screen.print(Text(_one_line(fr.file), style="bold"), soft_wrap=True)
+        for f in fr.findings:
+            where = f"{f.line:>5}" if f.line is not None else "    -"
+            screen.print(Text.assemble(f"  {where}  ", (f"{f.level:<7}", LEVEL_STYLE[f.level]),
+                                       "  ", (f.code, "dim"), "  ", _one_line(f.message)),
+                         soft_wrap=True)
+    screen.print(Text(summary, style=colour), soft_wrap=True)
+
+
+# --------------------------------------------------------------------------- progress
+
+
+def progress(label: str, unit: str, enabled: bool = True
+             ) -> tuple[Callable[[int, int], None] | None, Callable[[], None]]:
+    """A progress callback that shows a bar on stderr once a run looks longer than ~1 s.
+
+    Returns ``(update(done, total), stop())``; ``update`` is None when not ``enabled`` or
+    when stdout or stderr is not a terminal (a bar in a log file is noise).
+    """
+    if not (enabled and sys.stdout.isatty() and sys.stderr.isatty()):
+        return None, lambda: None
+    import time
+
+    state: dict[str, Any] = {"start": time.perf_counter(), "bar": None, "task": None}
+
+    def update(done: int, total: int) -> None:
+        bar = state["bar"]
+        if bar is None:
+            elapsed = time.perf_counter() - state["start"]
+            if elapsed < 0.25 or elapsed * total / max(done, 1) < 1.0:
+                return
+            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+            bar = Progress(TextColumn(label), BarColumn(),
+                           TextColumn("{task.completed:,}/{task.total:,} " + unit),
+                           TimeRemainingColumn(), console=console(stderr=True), transient=True)
+            state["task"] = bar.add_task(label, total=total)
+            bar.start()
+            state["bar"] = bar
+        bar.update(state["task"], completed=done)
+
+    def stop() -> None:
+        if state["bar"] is not None:
+            state["bar"].stop()
+
+    return update, stop
