@@ -12,7 +12,6 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit import cli
 from urdfkit import present as show
 from urdfkit.cli import app
 from urdfkit.inspect import JOINT_INFO_FIELDS

@@ -22,3 +22,13 @@ def test_wheel_ships_templates_as_package_data(tmp_path: Path) -> None:
         assert f"urdfkit/templates/{template.name}" in names
     assert "urdfkit/py.typed" in names
     assert "urdfkit/cli.py" in names
+    # Every command on a plain install: sim (pydantic) and render (Pillow) need no extra;
+    # yourdfpy (trimesh, scipy, ...) is a test tool, not a runtime dependency.
+    with zipfile.ZipFile(wheel) as zf:
+        meta = next(n for n in zf.namelist() if n.endswith(".dist-info/METADATA"))
+        requires = [line.split(":", 1)[1].strip() for line in
+                    zf.read(meta).decode().splitlines() if line.startswith("Requires-Dist:")]
+    core = {r.split(";")[0].split(">")[0].split("<")[0].split("=")[0].strip().lower()
+            for r in requires if "extra ==" not in r}
+    assert {"pybullet", "lxml", "typer", "pydantic", "pillow", "xacro"} <= core
+    assert "yourdfpy" not in core and "matplotlib" not in core

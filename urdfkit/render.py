@@ -189,7 +189,8 @@ def _pillow() -> Any:
         from PIL import Image
     except ImportError as e:
         raise MissingDependencyError(
-            "rendering needs Pillow: pip install 'urdfkit[render]'") from e
+            "rendering needs Pillow, which urdfkit installs; reinstall it: "
+            "pip install --force-reinstall pillow") from e
     return Image
 
 

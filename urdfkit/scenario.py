@@ -31,7 +31,7 @@ OBSERVATION_FIELDS = (
     "base_ang_vel_body_frame",
 )
 
-_INSTALL_HINT = "pip install 'urdfkit[scenario]'"
+_INSTALL_HINT = "urdfkit installs it; reinstall it: pip install --force-reinstall pydantic"
 
 
 @functools.cache

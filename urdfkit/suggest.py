@@ -15,13 +15,27 @@ ROBOT_SUFFIXES = (".urdf", ".xacro", ".urdf.xacro")
 
 
 def close(word: str, choices: Iterable[str], n: int = 3, cutoff: float = 0.6) -> list[str]:
-    """The up to ``n`` choices closest to ``word``, best first (case-insensitive)."""
-    options = list(dict.fromkeys(choices))
+    """The up to ``n`` choices closest to ``word``, best first (case-insensitive).
+
+    Runners-up are kept only when nearly as close as the best, so a typo gets one answer
+    and a real ambiguity gets a few.
+    """
     by_lower: dict[str, str] = {}
-    for c in options:
+    for c in choices:
         by_lower.setdefault(c.lower(), c)
-    found = difflib.get_close_matches(word.lower(), list(by_lower), n=n, cutoff=cutoff)
-    return [by_lower[f] for f in found]
+    key = word.lower()
+    scored = []
+    for lower, original in by_lower.items():
+        m = difflib.SequenceMatcher(None, key, lower)
+        if m.real_quick_ratio() >= cutoff and m.quick_ratio() >= cutoff:
+            ratio = m.ratio()
+            if ratio >= cutoff:
+                scored.append((ratio, original))
+    scored.sort(key=lambda t: -t[0])
+    if not scored:
+        return []
+    best = scored[0][0]
+    return [name for ratio, name in scored[:n] if ratio >= best - 0.05]
 
 
 def hint(word: str, choices: Iterable[str], n: int = 3) -> str:
