@@ -274,7 +274,8 @@ def test_missing_pillow_says_what_to_install(monkeypatch: pytest.MonkeyPatch,
     import sys
 
     monkeypatch.setitem(sys.modules, "PIL", None)  # makes `from PIL import ...` fail
-    with pytest.raises(MissingDependencyError, match=r"reinstall it: pip install --force-reinstall pillow"):
+    with pytest.raises(MissingDependencyError,
+                           match=r"reinstall it: pip install --force-reinstall pillow"):
         render_file(simplecar_urdf, RenderOptions(**SMALL))
 
 

@@ -222,7 +222,8 @@ def test_missing_pydantic_says_what_to_install(monkeypatch: pytest.MonkeyPatch) 
     sc.schema.cache_clear()
     monkeypatch.setitem(sys.modules, "pydantic", None)  # makes `import pydantic` fail
     try:
-        with pytest.raises(MissingDependencyError, match=r"reinstall it: pip install --force-reinstall pydantic"):
+        with pytest.raises(MissingDependencyError,
+                           match=r"reinstall it: pip install --force-reinstall pydantic"):
             sc.parse_scenario(copy.deepcopy(example()))
     finally:
         sc.schema.cache_clear()
