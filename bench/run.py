@@ -35,7 +35,7 @@ BENCH = Path(__file__).resolve().parent
 sys.path.insert(0, str(BENCH))
 
 #: Section modules under bench/, each with ``cases(ctx) -> list[Case]``.
-SECTIONS = ["inspect_bench", "build_bench"]
+SECTIONS = ["inspect_bench", "build_bench", "output_bench"]
 
 
 @dataclass
@@ -56,6 +56,7 @@ class Case:
         name: Label in the report; baselines are referred to by it.
         argv: The command.
         goals: (baseline name, highest acceptable ratio) pairs; empty for a baseline.
+        ok: Exit statuses that count as success (``check`` exits 1 on findings).
     """
 
     name: str
@@ -63,6 +64,7 @@ class Case:
     goals: list[tuple[str, float]] = field(default_factory=list)
     times: list[float] = field(default_factory=list)
     terminal: bool = False
+    ok: tuple[int, ...] = (0,)
 
 
 #: Size of the pseudo-terminal that ``terminal`` cases write to: a common laptop window.
@@ -98,7 +100,7 @@ def time_once(case: Case) -> float:
         returncode = child.wait()
         elapsed = time.perf_counter() - start
         os.close(master)
-    if returncode != 0:
+    if returncode not in case.ok:
         raise SystemExit(f"bench: command failed ({returncode}): {' '.join(case.argv)}")
     return elapsed
 
