@@ -207,3 +207,25 @@ def test_sigterm_and_sighup_stop_a_drive_like_ctrl_c(tmp_path: Path, sig: int) -
     assert rows[0].startswith("t,x,y") and len(rows) > 10  # every complete row kept
     assert all(len(r.split(",")) == len(rows[0].split(",")) for r in rows)
     assert "final position" in stdout
+
+
+# --------------------------------------------------------------------------- file names
+
+
+@pytest.mark.parametrize("command", [["joints", "--json"], ["links", "--json"],
+                                     ["info", "--json"], ["tree", "--json"], ["info"],
+                                     ["tree"]])
+def test_file_names_that_are_not_utf8_load(tmp_path: Path, simplecar_urdf: Path,
+                                           command: list[str]) -> None:
+    # A name from another locale: Python keeps the byte 0xff as a surrogate, which PyBullet
+    # cannot take; urdfkit loads a copy with a clean name and shows the name escaped.
+    name = os.fsdecode(bytes(tmp_path) + b"/car\xff.urdf")
+    Path(name).write_bytes(simplecar_urdf.read_bytes())
+    proc = subprocess.run([sys.executable, "-m", "urdfkit", command[0], name, *command[1:]],
+                          capture_output=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    if "--json" in command:
+        doc = json.loads(proc.stdout)
+        assert doc["robot"] == "simplecar"
+    else:
+        assert b"simplecar" in proc.stdout and b"Traceback" not in proc.stderr

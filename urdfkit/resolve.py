@@ -47,6 +47,14 @@ def locate(name: str | Path) -> Path:
                      file=name)
 
 
+def _utf8(text: str) -> bool:
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
 def parse_packages(items: list[str] | None) -> dict[str, Path]:
     """Parse repeated ``--package NAME=PATH`` options."""
     out: dict[str, Path] = {}
@@ -128,7 +136,9 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
         tree = parse_xml(read_bytes(source), display)
     guard(tree, display)
     root = tree.getroot()
-    needs_copy = source.suffix == ".xacro"
+    # PyBullet takes paths as UTF-8 text: a file name that is not (bytes from another locale,
+    # kept by Python as surrogates) is loaded from a copy with a clean name.
+    needs_copy = source.suffix == ".xacro" or not _utf8(str(source))
     has_packages = any((el.get("filename") or "").startswith(("package://", "file://"))
                        for el in root.iter(*FILE_TAGS))
     if has_packages or needs_copy:
@@ -136,9 +146,15 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
         import tempfile  # here, not at the top: most loads need no copy
 
         tmp = tempfile.TemporaryDirectory(prefix="urdfkit-")
-        load_path = Path(tmp.name) / (source.name.removesuffix(".xacro") or "robot.urdf")
+        name = source.name.removesuffix(".xacro") if _utf8(source.name) else "robot.urdf"
+        load_path = Path(tmp.name) / (name or "robot.urdf")
         if load_path.suffix != ".urdf":
             load_path = load_path.with_suffix(load_path.suffix + ".urdf")
+        for el in root.iter(*FILE_TAGS):
+            if not _utf8(el.get("filename") or ""):
+                tmp.cleanup()
+                raise InputError("PyBullet cannot open a mesh whose path is not valid UTF-8: "
+                                 f"{el.get('filename')!r}", file=display, line=el.sourceline)
         load_path.write_bytes(to_bytes(root))
         return Resolved(display, source, load_path, tree, tmp)
     return Resolved(display, source, source, tree)
