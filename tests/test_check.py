@@ -48,7 +48,9 @@ CASES = [
     ("U104", doc(A, link("b%n") + "<!--HERE-->", joint(child="b%n"))),
     ("U105", doc('<material name="m"><color rgba="1 0 0 1"/></material>',
                  '<material name="m"><!--HERE--><color rgba="1 0 0 1"/></material>', A)),
-    ("U106", doc(A, link("b" * 1001) + "<!--HERE-->", joint(child="b" * 1001))),
+    ("U106", doc(A, link("b", "", "") + "\n" + joint("é" * 632) + "<!--HERE-->")),
+    ("U107", doc(A, B, joint("j%s%n") + "<!--HERE-->")),
+    ("U108", doc(A, link("ロ" * 334) + "<!--HERE-->", joint(child="ロ" * 334))),
     ("U201", doc(A, B, '<joint name="j" type="fixed"><!--HERE--><child link="b"/></joint>')),
     ("U202", doc(A, B, '<joint name="j" type="fixed"><parent link="a"/>\n'
                        '<child link="ghost"/><!--HERE--></joint>')),
@@ -100,6 +102,8 @@ CASES = [
     ("U702", doc(link("a", body='<visual><geometry>\n<mesh filename="package://nopkg/m.stl"/>'
                                 '<!--HERE-->\n</geometry></visual>'))),
     ("U703", doc(link("a", body='<visual><geometry>\n<mesh filename="r2d2.urdf"/>'
+                                '<!--HERE-->\n</geometry></visual>'))),
+    ("U704", doc(link("a", body='<visual><geometry>\n<mesh filename="."/>'
                                 '<!--HERE-->\n</geometry></visual>'))),
     ("U801", doc(link("a", body=BOX + "\n<colision/><!--HERE-->\n"))),
     ("U802", doc(link("a", body='<collision><geometry>\n<box size="1 1 1" colour="red"/>'

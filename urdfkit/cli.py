@@ -35,7 +35,7 @@ from .errors import UrdfkitError
 FLAGS = {
     "params": "--set", "template_params": "--set", "xacro_args": "--arg",
     "packages": "--package", "types": "--type", "urdf": "--urdf", "force=True": "--force",
-    "force": "--force", "joints": "--joints", "views": "--views",
+    "force": "--force", "joints": "--joints", "views": "--views", "guard=False": "--no-guard",
 }
 
 DEBUG_ENV = "URDFKIT_DEBUG"
@@ -43,7 +43,7 @@ DEBUG_ENV = "URDFKIT_DEBUG"
 
 def flag_message(message: str) -> str:
     """A library message with its backquoted parameter names shown as CLI flags."""
-    return re.sub(r"`([A-Za-z_][\w]*(?:=True)?)`",
+    return re.sub(r"`([A-Za-z_][\w]*(?:=True|=False)?)`",
                   lambda m: FLAGS.get(m.group(1), "--" + m.group(1).replace("_", "-")),
                   message)
 
@@ -178,6 +178,10 @@ PackageOpt = Annotated[list[str] | None, typer.Option(
     help="Where package://NAME/ points (repeatable); else found by walking up from the file.")]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
 FixedBaseOpt = Annotated[bool, typer.Option("--fixed-base", help="Pin the root link to the world.")]
+NoGuardOpt = Annotated[bool, typer.Option(
+    "--no-guard", help="Lift the guard's refusals that are stricter than PyBullet ('%' in a "
+    "joint name, names over 1000 bytes); each is printed as a warning. What crashes PyBullet "
+    "stays refused.")]
 
 
 @app.command(epilog=_examples(
@@ -245,15 +249,23 @@ FileArg = Annotated[str, typer.Argument(
     help="A .urdf or .xacro file; a bare name is also looked up in pybullet_data.")]
 
 
+def _open(file: str, package: list[str] | None, arg: list[str] | None, no_guard: bool) -> Any:
+    from .resolve import open_input
+
+    resolved = open_input(file, package, arg, guard=not no_guard)
+    for w in resolved.warnings:
+        show.warn(w)
+    return resolved
+
+
 def _inspect(file: str, package: list[str] | None, arg: list[str] | None, *,
              fixed_base: bool = False, inertia_from_file: bool = False,
-             links: bool = False, info: bool = False) -> Any:
+             links: bool = False, info: bool = False, no_guard: bool = False) -> Any:
     from .report import inspect_file
-    from .resolve import open_input
     from .session import LoadOptions
 
     options = LoadOptions(fixed_base=fixed_base, inertia_from_file=inertia_from_file)
-    with open_input(file, package, arg) as resolved:
+    with _open(file, package, arg, no_guard) as resolved:
         return inspect_file(resolved, options, links=links, info=info)
 
 
@@ -269,6 +281,7 @@ def joints(
     fixed_base: FixedBaseOpt = False,
     package: PackageOpt = None,
     arg: ArgOpt = None,
+    no_guard: NoGuardOpt = False,
 ) -> None:
     """Every joint as PyBullet's getJointInfo sees it, decoded: index, type, limits, axis.
 
@@ -277,7 +290,7 @@ def joints(
     """
     from .inspect import filter_joints
 
-    report = _inspect(file, package, arg, fixed_base=fixed_base)
+    report = _inspect(file, package, arg, fixed_base=fixed_base, no_guard=no_guard)
     rows = filter_joints(report.joints, movable=movable, types=joint_type or ())
     if as_json:
         show.print_json({**report.header(), "joints": [j.to_dict() for j in rows],
@@ -324,6 +337,7 @@ def links(
     fixed_base: FixedBaseOpt = False,
     package: PackageOpt = None,
     arg: ArgOpt = None,
+    no_guard: NoGuardOpt = False,
 ) -> None:
     """Each link's getDynamicsInfo (mass, friction, inertia) beside what the file says.
 
@@ -331,7 +345,7 @@ def links(
     inertia from the collision shapes, and a link without <inertial> gets 1 kg.
     """
     report = _inspect(file, package, arg, fixed_base=fixed_base,
-                      inertia_from_file=inertia_from_file, links=True)
+                      inertia_from_file=inertia_from_file, links=True, no_guard=no_guard)
     if as_json:
         show.print_json({**report.header(), "inertia_from_file": inertia_from_file,
                          "links": [link.to_dict() for link in report.links],
@@ -381,19 +395,19 @@ def tree(
         "--output", "-o", help="Write the graph: .dot/.gv as DOT text, .svg/.png/.pdf drawn "
         "by Graphviz `dot` (implies --dot).")] = None,
     force: ForceOpt = False,
+    no_guard: NoGuardOpt = False,
 ) -> None:
     """The kinematic tree: links, and the joints between them with type, axis and index.
 
     Read from the file alone; PyBullet is not loaded. [n] is the index PyBullet will give
     the joint. --json is flat: every joint with its parent and child link, in index order.
     """
-    from .resolve import open_input
     from .tree import kinematic_tree
 
     if dot or output is not None:
-        _tree_dot(file, package, arg, output, force, as_json)  # see "# ---- render"
+        _tree_dot(file, package, arg, output, force, as_json, no_guard)  # see "# ---- render"
         return
-    with open_input(file, package, arg) as resolved:
+    with _open(file, package, arg, no_guard) as resolved:
         root = kinematic_tree(resolved.root)
         robot = resolved.robot_name
     if as_json:
@@ -411,9 +425,10 @@ def info(
     fixed_base: FixedBaseOpt = False,
     package: PackageOpt = None,
     arg: ArgOpt = None,
+    no_guard: NoGuardOpt = False,
 ) -> None:
     """The robot at a glance: links, joints by type, DOF, total mass, bounding box."""
-    report = _inspect(file, package, arg, fixed_base=fixed_base, info=True)
+    report = _inspect(file, package, arg, fixed_base=fixed_base, info=True, no_guard=no_guard)
     s = report.summary
     if as_json:
         show.print_json({**report.header(), **s.to_dict(), "diagnostics": report.diagnostics})
@@ -532,6 +547,7 @@ def drive(
     gui: Annotated[bool, typer.Option(
         "--gui", help="Open the PyBullet GUI with Steering and Throttle sliders.")] = False,
     as_json: JsonOpt = False,
+    no_guard: NoGuardOpt = False,
 ) -> None:
     """Drive a car headless at a fixed throttle and steer, and report where it went.
 
@@ -569,7 +585,7 @@ def drive(
         packages=package, xacro_args=arg, seconds=10.0 if seconds is None else seconds,
         steps=steps, time_step=time_step, throttle=throttle, steer=steer, max_force=max_force,
         wheels=_split_joints(wheels), hinges=_split_joints(hinges), sample_every=sample_every,
-        gui=gui)
+        gui=gui, guard=not no_guard)
     with Scenario(config) as sc:
         t = sc.drivetrain
 
@@ -657,6 +673,7 @@ def render(
     force: ForceOpt = False,
     package: PackageOpt = None,
     arg: ArgOpt = None,
+    no_guard: NoGuardOpt = False,
 ) -> None:
     """Draw a robot to a PNG, headless (PyBullet's TinyRenderer: no GPU, no display)."""
     from . import render as rendering
@@ -674,7 +691,8 @@ def render(
     out = output if output is not None else f"{Path(file).name.split('.')[0] or 'robot'}.png"
     if out != "-":  # refuse before the work, not after it
         rendering.check_output(out, force=force)
-    picture = rendering.render_file(file, options, packages=package, xacro_args=arg)
+    picture = rendering.render_file(file, options, packages=package, xacro_args=arg,
+                                    guard=not no_guard)
     for w in picture.warnings:
         show.warn(w)
     if out == "-":
@@ -690,17 +708,16 @@ def render(
 
 
 def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
-              output: str | None, force: bool, as_json: bool) -> None:
+              output: str | None, force: bool, as_json: bool, no_guard: bool) -> None:
     """``tree --dot`` / ``tree -o graph.svg``: the kinematic graph as DOT text or a drawing."""
     from .errors import ParameterError
     from .graph import check_output, dot_graph, write_graph
-    from .resolve import open_input
 
     if as_json:
         raise ParameterError("--json and --dot/-o are different outputs; choose one")
     if output is not None and output != "-":
         check_output(output, force=force)
-    with open_input(file, package, arg) as resolved:
+    with _open(file, package, arg, no_guard) as resolved:
         text = dot_graph(resolved.root)
     if output is None or output == "-":
         sys.stdout.write(text)

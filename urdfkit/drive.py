@@ -88,6 +88,8 @@ class DriveConfig:
         gravity: Vertical gravity (m/s^2).
         base_position: Where the car's base starts.
         gui: Open the PyBullet GUI with Steering and Throttle sliders.
+        guard: False lifts the guard's refusals that are stricter than PyBullet (they become
+            warnings); crash classes are refused either way.
     """
 
     urdf: str | None = None
@@ -107,6 +109,7 @@ class DriveConfig:
     gravity: float = -10.0
     base_position: tuple[float, float, float] = (0.0, 0.0, 0.1)
     gui: bool = False
+    guard: bool = True
 
     def check(self) -> None:
         """Refuse values that would make the run meaningless (exit 2 in the CLI)."""
@@ -419,7 +422,9 @@ class Scenario:
             return s.load_urdf(self._builtin(builtin, params), options, display=builtin)
         from .resolve import open_input
 
-        with open_input(name, self.config.packages, self.config.xacro_args) as res:
+        with open_input(name, self.config.packages, self.config.xacro_args,
+                        guard=self.config.guard) as res:
+            self.warnings.extend(res.warnings)
             return s.load_urdf(res.load_path, options, display=res.name)
 
     def _open(self) -> None:

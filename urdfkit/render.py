@@ -705,13 +705,19 @@ def render(resolved: Any, options: RenderOptions | None = None) -> Rendering:
 
 def render_file(name: str | Path, options: RenderOptions | None = None, *,
                 packages: list[str] | None = None,
-                xacro_args: list[str] | None = None) -> Rendering:
-    """Resolve (xacro, package://, pybullet_data, guard) and render a robot file."""
+                xacro_args: list[str] | None = None, guard: bool = True) -> Rendering:
+    """Resolve (xacro, package://, pybullet_data, guard) and render a robot file.
+
+    ``guard=False`` lifts the guard's stricter-than-PyBullet refusals; they come back as
+    warnings of the rendering.
+    """
     from .resolve import open_input
 
     _pillow()  # fail before expanding xacro when Pillow is missing
-    with open_input(name, packages, xacro_args) as resolved:
-        return render(resolved, options)
+    with open_input(name, packages, xacro_args, guard=guard) as resolved:
+        picture = render(resolved, options)
+        picture.warnings[:0] = resolved.warnings
+        return picture
 
 
 def check_output(path: str | Path, *, force: bool = False) -> Path:

@@ -24,8 +24,9 @@ from lxml import etree
 from .errors import InputError, ParameterError
 from .expand import expand_xacro
 from .spec import FILE_TAGS
-from .uris import pybullet_data_path, resolve_uri
-from .validate import guard
+from .uris import not_a_file, pybullet_data_path, resolve_uri
+from .validate import STRICTER, Finding
+from .validate import guard as run_guard
 from .xmlio import parse_xml, read_bytes, to_bytes
 
 
@@ -45,6 +46,11 @@ def locate(name: str | Path) -> Path:
     more = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
     raise InputError(f"no such file (looked in the current folder and in pybullet_data){more}",
                      file=name)
+
+
+def where(f: Finding) -> str:
+    """``file:line`` of a finding."""
+    return f.file if f.line is None else f"{f.file}:{f.line}"
 
 
 def _utf8(text: str) -> bool:
@@ -85,6 +91,7 @@ class Resolved:
     load_path: Path
     tree: etree._ElementTree
     _tmp: Any = field(default=None, repr=False)  # a TemporaryDirectory, when we made a copy
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def root(self) -> etree._Element:
@@ -124,9 +131,33 @@ def _rewrite_files(root: etree._Element, base: Path, packages: Mapping[str, Path
                                fn.startswith("file://") else target.path.resolve()))
 
 
+def _refuse_special_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
+                          name: str) -> None:
+    """Refuse meshes and textures PyBullet would hang or abort on (never opening them)."""
+    for el in root.iter(*FILE_TAGS):
+        fn = el.get("filename")
+        if not fn:
+            continue
+        target = resolve_uri(fn, base, packages)
+        if target.path is None:
+            continue  # an unknown package: _rewrite_files says so
+        why = not_a_file(target.path)
+        if why is None or why == "missing":
+            continue  # missing: PyBullet warns and draws nothing, as check's U701 says
+        fate = ("hangs reading it" if "FIFO" in why or "device" in why else
+                "aborts on it" if why == "a directory" else "cannot read it")
+        raise InputError(f"<{el.tag} filename={fn!r}>: {target.path} is {why}; PyBullet "
+                         f"{fate}", file=name, line=el.sourceline)
+
+
 def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
-            xacro_args: Mapping[str, str] | None = None) -> Resolved:
-    """Locate, expand, parse, guard and package-resolve a URDF for loading."""
+            xacro_args: Mapping[str, str] | None = None, guard: bool = True) -> Resolved:
+    """Locate, expand, parse, guard and package-resolve a URDF for loading.
+
+    With ``guard=False`` the guard's refusals that are stricter than PyBullet (see
+    :data:`urdfkit.validate.LIFTABLE_CODES`) become :attr:`Resolved.warnings`; whatever
+    crashes PyBullet is refused either way.
+    """
     display = str(name)
     source = locate(name)
     if source.suffix == ".xacro":
@@ -134,8 +165,10 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
         tree = parse_xml(data, display)
     else:
         tree = parse_xml(read_bytes(source), display)
-    guard(tree, display)
+    lifted = [f"{where(f)}: let through without the guard ({f.code}): "
+              f"{f.message.removesuffix(STRICTER)}" for f in run_guard(tree, display, strict=guard)]
     root = tree.getroot()
+    _refuse_special_files(root, source.resolve().parent, packages or {}, display)
     # PyBullet takes paths as UTF-8 text: a file name that is not (bytes from another locale,
     # kept by Python as surrogates) is loaded from a copy with a clean name.
     needs_copy = source.suffix == ".xacro" or not _utf8(str(source))
@@ -156,12 +189,12 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
                 raise InputError("PyBullet cannot open a mesh whose path is not valid UTF-8: "
                                  f"{el.get('filename')!r}", file=display, line=el.sourceline)
         load_path.write_bytes(to_bytes(root))
-        return Resolved(display, source, load_path, tree, tmp)
-    return Resolved(display, source, source, tree)
+        return Resolved(display, source, load_path, tree, tmp, warnings=lifted)
+    return Resolved(display, source, source, tree, warnings=lifted)
 
 
 def open_input(name: str | Path, packages: list[str] | None = None,
-               xacro_args: list[str] | None = None) -> Resolved:
+               xacro_args: list[str] | None = None, guard: bool = True) -> Resolved:
     """:func:`resolve` with the raw ``--package NAME=PATH`` and ``--arg k:=v`` option lists."""
     args: dict[str, str] = {}
     if xacro_args:
@@ -169,4 +202,4 @@ def open_input(name: str | Path, packages: list[str] | None = None,
         from .catalog import parse_assignments
 
         args = dict(parse_assignments(xacro_args, "xacro_args"))
-    return resolve(name, packages=parse_packages(packages), xacro_args=args)
+    return resolve(name, packages=parse_packages(packages), xacro_args=args, guard=guard)

@@ -152,8 +152,17 @@ SCHEMA: dict[str, tuple[frozenset[str], frozenset[str]]] = {
 MAX_STATE_LINKS = 128
 #: Bodies with more links than this are refused before loading: PyBullet takes minutes.
 MAX_LOADABLE_LINKS = 1000
-#: Longest link or joint name the guard lets through; PyBullet 3.2.7 segfaults from 1264.
-MAX_NAME_LENGTH = 1000
+#: Longest name (in UTF-8 bytes) of a link, joint, material or robot the guard lets through.
+#: PyBullet's fixed buffers count bytes: 700 characters of 'é' are 1,400 bytes.
+MAX_NAME_BYTES = 1000
+#: The name lengths (UTF-8 bytes) at which PyBullet 3.2.7 segfaults, measured in a subprocess
+#: (tests/test_guard.py keeps the table and re-measures it): a joint name in loadURDF, a link
+#: name in loadURDF, a robot name in getBodyInfo (it loads, then the query crashes).
+CRASH_NAME_BYTES = {"joint": 1264, "link": 2288, "robot": 1042}
+#: Where a '%' in a name segfaults PyBullet 3.2.7: it quotes a link's name as printf's format
+#: string in the warning for a link without <inertial>. Joint, material and robot names with
+#: '%' load, and the guard's refusal of them can be lifted.
+CRASH_PERCENT_TAGS = frozenset({"link"})
 
 # --------------------------------------------------------------------------- numbers
 

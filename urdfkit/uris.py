@@ -86,6 +86,37 @@ def resolve_uri(uri: str, base: Path, packages: Mapping[str, Path] | None = None
     return Target(path if path.is_absolute() else base / path)
 
 
+def not_a_file(path: Path) -> str | None:
+    """Why ``path`` cannot be read as a mesh or texture, or None if it is a regular file.
+
+    Only ``stat`` is called, never ``open``: opening a FIFO blocks forever, reading a device
+    never ends, and PyBullet does both (a directory makes it abort with std::bad_alloc).
+    ``"missing"`` means nothing is there (PyBullet then warns and draws nothing).
+    """
+    import errno
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "missing"
+    except OSError as e:
+        reasons = {errno.ENAMETOOLONG: "a path component is longer than the file system "
+                   "allows", errno.EACCES: "permission denied", errno.ELOOP: "a symlink loop",
+                   errno.ENOTDIR: "missing"}
+        return reasons.get(e.errno or 0, os.strerror(e.errno or 0) or type(e).__name__)
+    except ValueError:  # an embedded NUL byte
+        return "the path holds a NUL byte"
+    if stat.S_ISREG(mode):
+        return None
+    for test, what in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return what
+    return "not a regular file"
+
+
 def _is_file(path: Path) -> bool:
     try:
         return os.path.isfile(path)

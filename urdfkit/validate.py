@@ -11,7 +11,6 @@ error as an :class:`~urdfkit.errors.InputError`. Every command that loads a file
 from __future__ import annotations
 
 import math
-import os
 import sys
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import asdict, dataclass
@@ -21,11 +20,13 @@ from lxml import etree
 
 from .errors import InputError
 from .spec import (
+    CRASH_NAME_BYTES,
+    CRASH_PERCENT_TAGS,
     FILE_TAGS,
     JOINT_TYPES,
     LIMITED_JOINT_TYPES,
     MAX_LOADABLE_LINKS,
-    MAX_NAME_LENGTH,
+    MAX_NAME_BYTES,
     MAX_STATE_LINKS,
     NUMERIC,
     OPAQUE,
@@ -37,7 +38,7 @@ from .spec import (
 )
 from .spec import attr_float as _num
 from .spec import attr_vec as _vec
-from .uris import pybullet_data_path, resolve_uri
+from .uris import not_a_file, pybullet_data_path, resolve_uri
 
 LEVELS = ("info", "warning", "error")
 
@@ -107,7 +108,18 @@ def _elements(root: etree._Element, tag: str) -> Iterator[etree._Element]:
 
 def _label(el: etree._Element) -> str:
     name = el.get("name")
-    return f"<{el.tag} name={name!r}>" if name is not None else f"<{el.tag}>"
+    if name is None:
+        return f"<{el.tag}>"
+    if len(name) > 60:  # a 3,000-character name would drown the message
+        return f"<{el.tag} name={name[:40]!r}... ({len(name)} characters)>"
+    return f"<{el.tag} name={name!r}>"
+
+
+#: Lifted by ``guard=False`` (``--no-guard``): refusals where the guard is stricter than
+#: PyBullet 3.2.7, which loads such files. Everything else the guard refuses crashes PyBullet
+#: or is not URDF at all, and stays refused.
+LIFTABLE_CODES = frozenset({"U107", "U108"})
+STRICTER = " (PyBullet 3.2.7 loads this, but the guard refuses it; `guard=False` lifts it)"
 
 
 # --------------------------------------------------------------------------- structural rules
@@ -133,23 +145,48 @@ def _check_name(el: etree._Element, r: Report) -> str | None:
     if name is None or not name.strip():
         r.add("U101", "error", f"<{el.tag}> has no name; give it a unique name=\"...\"", el)
         return None
-    if "%" in name:
-        # PyBullet passes names into printf as the format string: "%s" reads garbage, "%n"
-        # writes memory. It crashes the process.
-        r.add("U104", "error", f"{_label(el)} contains '%', which crashes PyBullet "
-              "(it uses names as printf formats); rename it", el)
-    if len(name) > MAX_NAME_LENGTH and el.tag in ("link", "joint"):
-        # Measured on PyBullet 3.2.7: a 1264-character joint name or a 2288-character link
-        # name overflows a fixed buffer in its URDF importer and segfaults the process.
-        r.add("U106", "error", f"<{el.tag}> name is {len(name)} characters long; PyBullet "
-              f"crashes on long names: keep names under {MAX_NAME_LENGTH} characters", el)
+    _check_percent(el, name, r)
+    _check_length(el, name, r)
     return name
 
 
+def _check_percent(el: etree._Element, name: str, r: Report) -> None:
+    if "%" not in name:
+        return
+    # PyBullet passes some names into printf as the format string: "%s" reads garbage, "%n"
+    # writes memory. Measured on 3.2.7: a link name crashes it; joint, material and robot
+    # names load, but any diagnostic that quotes them is one format string away from a crash.
+    if el.tag in CRASH_PERCENT_TAGS:
+        r.add("U104", "error", f"{_label(el)} contains '%', which crashes PyBullet "
+              "(it uses names as printf formats); rename it", el)
+    else:
+        r.add("U107", "error", f"{_label(el)} contains '%', which PyBullet may use as a "
+              "printf format; rename it" + STRICTER, el)
+
+
+def _check_length(el: etree._Element, name: str, r: Report) -> None:
+    size = len(name.encode("utf-8", "surrogatepass"))
+    if size <= MAX_NAME_BYTES:
+        return
+    # PyBullet's buffers count UTF-8 bytes, not characters: 700 'é' are 1,400 bytes.
+    crash = CRASH_NAME_BYTES.get(el.tag)
+    what = f"<{el.tag}> name is {size} bytes long ({len(name)} characters)"
+    if crash is not None and size >= crash:
+        r.add("U106", "error", f"{what}; PyBullet crashes on {el.tag} names from {crash} bytes: "
+              f"keep names under {MAX_NAME_BYTES} bytes", el)
+    else:
+        r.add("U108", "error", f"{what}; keep names under {MAX_NAME_BYTES} bytes, as PyBullet's "
+              "fixed-size buffers are not much larger" + STRICTER, el)
+
+
 def rule_names(root: etree._Element, r: Report) -> None:
-    """U101-U106: links, joints and materials are named, uniquely, without '%', not too long."""
+    """U101-U108: links, joints and materials are named, uniquely, without '%', not too long."""
     if root.tag != "robot":
         return
+    robot_name = root.get("name")
+    if robot_name:  # a missing robot name is U002
+        _check_percent(root, robot_name, r)
+        _check_length(root, robot_name, r)
     for tag, code in (("link", "U102"), ("joint", "U103")):
         seen: dict[str, etree._Element] = {}
         for el in _elements(root, tag):
@@ -295,8 +332,9 @@ def rule_joints(root: etree._Element, r: Report) -> None:
         limit = j.find("limit")
         if jtype in LIMITED_JOINT_TYPES:
             if limit is None:
-                r.add("U302", "error", f"{_label(j)} is {jtype} but has no <limit>; add <limit "
-                      "lower=... upper=... effort=... velocity=...>", j)
+                r.add("U302", "error", f"{_label(j)} is {jtype} but has no <limit>, which the "
+                      "URDF spec requires and PyBullet refuses; add <limit lower=... upper=... "
+                      "effort=... velocity=...>", j)
             else:
                 missing = [a for a in ("effort", "velocity") if limit.get(a) is None]
                 if missing:
@@ -504,7 +542,12 @@ def rule_meshes(root: etree._Element, r: Report) -> None:
         if target.path is None:
             r.add("U702", "error", f"<{el.tag} filename={fn!r}>: {target.problem}", el)
             continue
-        if os.path.isfile(target.path):
+        why = not_a_file(target.path)
+        if why is None:
+            continue
+        if why != "missing":
+            r.add("U704", "error", f"<{el.tag} filename={fn!r}>: {target.path} is {why}; "
+                  "PyBullet hangs, aborts or fails on it", el)
             continue
         data = pybullet_data_path()
         if target.package is None and data is not None and (data / fn).is_file():
@@ -568,8 +611,8 @@ GUARD_RULES: tuple[Rule, ...] = (rule_document, rule_names, rule_tree, rule_link
 #: values (limits, sizes, masses, inertia) are ``check`` findings: PyBullet loads such files,
 #: and pybullet_data ships some, so the loading commands still load them.
 GUARD_CODES = frozenset({"U001", "U002", "U003", "U101", "U102", "U103", "U104", "U105",
-                         "U106", "U201", "U202", "U203", "U204", "U205", "U206", "U207",
-                         "U209", "U301", "U302", "U502"})
+                         "U106", "U107", "U108", "U201", "U202", "U203", "U204", "U205",
+                         "U206", "U207", "U209", "U301", "U302", "U502"})
 
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_numbers, rule_mass,
@@ -585,9 +628,11 @@ CODES: dict[str, str] = {
     "U101": "link, joint or material without a name",
     "U102": "duplicate link name",
     "U103": "duplicate joint name",
-    "U104": "'%' in a name (crashes PyBullet)",
+    "U104": "'%' in a link name (crashes PyBullet)",
     "U105": "duplicate material name",
-    "U106": "link or joint name over 1000 characters (crashes PyBullet)",
+    "U106": "name at PyBullet's crash length (joint 1264, link 2288, robot 1042 bytes)",
+    "U107": "'%' in a joint, material or robot name (refused; --no-guard lifts it)",
+    "U108": "name over 1000 bytes (refused; --no-guard lifts it)",
     "U201": "joint without <parent> or <child>",
     "U202": "joint refers to a missing link",
     "U203": "joint joins a link to itself",
@@ -620,6 +665,7 @@ CODES: dict[str, str] = {
     "U701": "mesh or texture file not found",
     "U702": "package:// package not found",
     "U703": "mesh found only through pybullet_data's search path",
+    "U704": "mesh or texture is a directory, FIFO, device or unreadable",
     "U801": "unknown tag",
     "U802": "unknown attribute",
     "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
@@ -645,8 +691,20 @@ def guard_findings(root: etree._Element, file: str) -> list[Finding]:
     return [f for f in run_rules(root, file, GUARD_RULES) if f.code in GUARD_CODES]
 
 
-def guard(tree: etree._ElementTree | etree._Element, file: str) -> None:
-    """Raise :class:`InputError` for the first finding every command refuses."""
+def guard(tree: etree._ElementTree | etree._Element, file: str, *,
+          strict: bool = True) -> list[Finding]:
+    """Raise :class:`InputError` for the first finding every command refuses.
+
+    With ``strict=False`` (``--no-guard``), the refusals in :data:`LIFTABLE_CODES`, where the
+    guard is stricter than PyBullet, are returned instead, for the caller to show as warnings;
+    everything that crashes PyBullet is still refused. Nothing is skipped silently.
+    """
     root = tree.getroot() if isinstance(tree, etree._ElementTree) else tree
+    lifted = []
     for f in guard_findings(root, file):
-        raise InputError(f.message, file=f.file, line=f.line)
+        if not strict and f.code in LIFTABLE_CODES:
+            lifted.append(f)
+            continue
+        raise InputError(f.message, file=f.file, line=f.line,
+                         param="guard" if f.code in LIFTABLE_CODES else None)
+    return lifted
