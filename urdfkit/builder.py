@@ -44,6 +44,9 @@ from .spec import (
     finite,
     matmul,
     rpy_to_matrix,
+    solid_inertia,
+    solid_volume,
+    sym_eigenvalues,
     transpose,
 )
 from .xmlio import atomic_write, fmt_float, fmt_vec, load_xml, parse_xml, to_bytes
@@ -239,29 +242,12 @@ class Inertia(_Element):
     @property
     def principal_moments(self) -> tuple[float, float, float]:
         """Eigenvalues of the tensor, ascending (closed form for symmetric 3x3)."""
-        return _sym_eigenvalues(self.matrix)
+        return sym_eigenvalues(self.matrix)
 
 
-def _sym_eigenvalues(m: Matrix3) -> tuple[float, float, float]:
-    # Closed form (Smith 1961) for a real symmetric 3x3 matrix; no numpy on this path.
-    p1 = m[0][1] ** 2 + m[0][2] ** 2 + m[1][2] ** 2
-    q = (m[0][0] + m[1][1] + m[2][2]) / 3
-    if p1 == 0:
-        return tuple(sorted((m[0][0], m[1][1], m[2][2])))  # type: ignore[return-value]
-    p2 = sum((m[i][i] - q) ** 2 for i in range(3)) + 2 * p1
-    p = math.sqrt(p2 / 6)
-    b = [[(m[i][j] - (q if i == j else 0)) / p for j in range(3)] for i in range(3)]
-    det_b = (
-        b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1])
-        - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
-        + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0])
-    )
-    r = max(-1.0, min(1.0, det_b / 2))
-    phi = math.acos(r) / 3
-    e1 = q + 2 * p * math.cos(phi)
-    e3 = q + 2 * p * math.cos(phi + 2 * math.pi / 3)
-    e2 = 3 * q - e1 - e3
-    return tuple(sorted((e1, e2, e3)))  # type: ignore[return-value]
+def _principal(moments: Vec3) -> Inertia:
+    ixx, iyy, izz = moments
+    return Inertia(ixx=ixx, iyy=iyy, izz=izz)
 
 
 @dataclass(eq=False)
@@ -274,14 +260,11 @@ class Box(_Element):
     @property
     def volume(self) -> float:
         """Volume in m^3."""
-        x, y, z = self.size
-        return x * y * z
+        return solid_volume("box", self.size)
 
     def inertia(self, mass: float) -> Inertia:
         """Solid-box inertia about its centre, in its own frame."""
-        x, y, z = self.size
-        k = mass / 12
-        return Inertia(ixx=k * (y * y + z * z), iyy=k * (x * x + z * z), izz=k * (x * x + y * y))
+        return _principal(solid_inertia("box", self.size, mass))
 
 
 @dataclass(eq=False)
@@ -295,13 +278,11 @@ class Cylinder(_Element):
     @property
     def volume(self) -> float:
         """Volume in m^3."""
-        return math.pi * self.radius**2 * self.length
+        return solid_volume("cylinder", (self.radius, self.length))
 
     def inertia(self, mass: float) -> Inertia:
         """Solid-cylinder inertia about its centre, in its own frame (axis z)."""
-        r, h = self.radius, self.length
-        radial = mass * (3 * r * r + h * h) / 12
-        return Inertia(ixx=radial, iyy=radial, izz=mass * r * r / 2)
+        return _principal(solid_inertia("cylinder", (self.radius, self.length), mass))
 
 
 @dataclass(eq=False)
@@ -314,12 +295,11 @@ class Sphere(_Element):
     @property
     def volume(self) -> float:
         """Volume in m^3."""
-        return 4 / 3 * math.pi * self.radius**3
+        return solid_volume("sphere", (self.radius,))
 
     def inertia(self, mass: float) -> Inertia:
         """Solid-sphere inertia about its centre."""
-        i = 2 / 5 * mass * self.radius**2
-        return Inertia(ixx=i, iyy=i, izz=i)
+        return _principal(solid_inertia("sphere", (self.radius,), mass))
 
 
 @dataclass(eq=False)
@@ -336,21 +316,11 @@ class Capsule(_Element):
     @property
     def volume(self) -> float:
         """Volume in m^3."""
-        r, h = self.radius, self.length
-        return math.pi * r * r * h + 4 / 3 * math.pi * r**3
+        return solid_volume("capsule", (self.radius, self.length))
 
     def inertia(self, mass: float) -> Inertia:
         """Solid-capsule inertia about its centre (axis z), uniform density."""
-        r, h = self.radius, self.length
-        v_cyl, v_caps = math.pi * r * r * h, 4 / 3 * math.pi * r**3
-        m_cyl = mass * v_cyl / (v_cyl + v_caps)
-        m_caps = mass - m_cyl
-        # The two hemispheres form a sphere split in half and pushed apart by h: each half's
-        # centre of mass sits 3r/8 from its flat face, so h/2 + 3r/8 from the capsule centre.
-        radial = (m_cyl * (3 * r * r + h * h) / 12
-                  + m_caps * (2 * r * r / 5 + h * h / 4 + 3 * h * r / 8))
-        axial = m_cyl * r * r / 2 + m_caps * 2 * r * r / 5
-        return Inertia(ixx=radial, iyy=radial, izz=axial)
+        return _principal(solid_inertia("capsule", (self.radius, self.length), mass))
 
 
 @dataclass(eq=False)

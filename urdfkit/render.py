@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from . import style
-from .errors import EngineError, MissingDependencyError, OutputError, ParameterError
+from .errors import EngineError, InputError, MissingDependencyError, OutputError, ParameterError
 from .spec import attr_vec, pybullet_joint_type, rpy_to_matrix, vector
 
 #: The views, as (direction from target to camera, camera up vector). URDF: x forward, z up.
@@ -50,6 +50,9 @@ VIEWS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] 
 #: Order of the panels of ``--views all``: a 2x2 grid.
 ALL_VIEWS = ("iso", "front", "side", "top")
 GROUNDS = ("grid", "plane", "none")
+#: The largest robot (bounding-box side, m) render frames: beyond, camera distances and grid
+#: steps overflow or lose all precision (a 1e308 m box once ended in an OverflowError).
+MAX_EXTENT = 1e5
 #: Render this many times larger, then downsample: TinyRenderer has no antialiasing.
 SUPERSAMPLE = 2
 #: Vertical field of view in degrees; narrow enough that perspective does not distort.
@@ -415,6 +418,12 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
     except p.error as e:
         raise EngineError(f"PyBullet cannot report this body's state ({e})",
                           file=resolved.name) from None
+    extent = float(np.max(hi - lo)) if np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) \
+        else math.inf
+    if not extent <= MAX_EXTENT:  # also catches NaN
+        raise InputError(f"the robot spans {extent:.3g} m as loaded, too large to frame and "
+                         f"draw (at most {MAX_EXTENT:g} m); check its sizes and origins "
+                         "(urdfkit check)", file=resolved.name)
     return _Scene(session, body, lo, hi, frames, axes)
 
 

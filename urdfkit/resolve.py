@@ -33,10 +33,11 @@ from .xmlio import parse_xml, read_bytes, to_bytes
 def locate(name: str | Path) -> Path:
     """Find a file as given, else in pybullet_data; refuse folders."""
     path = Path(name).expanduser()
-    if path.exists():
-        if path.is_dir():
-            raise InputError("is a directory, not a URDF file", file=name)
+    why = not_a_file(path)
+    if why is None:
         return path
+    if why != "missing":
+        raise InputError(f"is {why}, not a URDF file", file=name)
     data = None if path.is_absolute() else pybullet_data_path()
     if data is not None and (data / path).is_file():
         return data / path

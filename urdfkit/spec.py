@@ -294,6 +294,75 @@ def rotate_back(m: Matrix3, v: Sequence[float]) -> Vec3:
             m[0][2] * v[0] + m[1][2] * v[1] + m[2][2] * v[2])
 
 
+# --------------------------------------------------------------------------- solids
+# Plain-float formulas on which the builder (derived <inertia>) and check (plausibility of a
+# file's <inertia>) agree. Floats overflow to inf here, never to OverflowError: ``x * x``, not
+# ``x ** 2``, so a 1e308 in a file becomes a finding, not a traceback.
+
+#: Shapes whose solid volume and inertia have closed forms, with the sizes they take.
+SOLIDS = {"box": ("x", "y", "z"), "cylinder": ("radius", "length"), "sphere": ("radius",),
+          "capsule": ("radius", "length")}
+
+
+def solid_volume(kind: str, dims: Sequence[float]) -> float:
+    """Volume (m^3) of a solid box (x, y, z), cylinder or capsule (radius, length), sphere."""
+    if kind == "box":
+        return dims[0] * dims[1] * dims[2]
+    r = dims[0]
+    ball = 4 / 3 * math.pi * r * r * r
+    if kind == "sphere":
+        return ball
+    tube = math.pi * r * r * dims[1]
+    return tube if kind == "cylinder" else tube + ball
+
+
+def solid_inertia(kind: str, dims: Sequence[float], mass: float) -> Vec3:
+    """Principal moments (ixx, iyy, izz) about the centre, in the shape's frame (axis z)."""
+    if kind == "box":
+        x, y, z = dims
+        k = mass / 12
+        return (k * (y * y + z * z), k * (x * x + z * z), k * (x * x + y * y))
+    r = dims[0]
+    if kind == "sphere":
+        i = 2 / 5 * mass * r * r
+        return (i, i, i)
+    h = dims[1]
+    if kind == "cylinder":
+        radial = mass * (3 * r * r + h * h) / 12
+        return (radial, radial, mass * r * r / 2)
+    v_tube, v_caps = math.pi * r * r * h, 4 / 3 * math.pi * r * r * r
+    m_tube = mass * v_tube / (v_tube + v_caps)
+    m_caps = mass - m_tube
+    # The two hemispheres form a sphere split in half and pushed apart by h: each half's
+    # centre of mass sits 3r/8 from its flat face, so h/2 + 3r/8 from the capsule centre.
+    radial = (m_tube * (3 * r * r + h * h) / 12
+              + m_caps * (2 * r * r / 5 + h * h / 4 + 3 * h * r / 8))
+    return (radial, radial, m_tube * r * r / 2 + m_caps * 2 * r * r / 5)
+
+
+def sym_eigenvalues(m: Sequence[Sequence[float]]) -> Vec3:
+    """Eigenvalues of a real symmetric 3x3 matrix, ascending (closed form, Smith 1961)."""
+    p1 = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2]
+    q = (m[0][0] + m[1][1] + m[2][2]) / 3
+    if p1 == 0:
+        a, b, c = sorted((m[0][0], m[1][1], m[2][2]))
+        return (a, b, c)
+    p2 = sum((m[i][i] - q) * (m[i][i] - q) for i in range(3)) + 2 * p1
+    p = math.sqrt(p2 / 6)
+    b_ = [[(m[i][j] - (q if i == j else 0)) / p for j in range(3)] for i in range(3)]
+    det_b = (
+        b_[0][0] * (b_[1][1] * b_[2][2] - b_[1][2] * b_[2][1])
+        - b_[0][1] * (b_[1][0] * b_[2][2] - b_[1][2] * b_[2][0])
+        + b_[0][2] * (b_[1][0] * b_[2][1] - b_[1][1] * b_[2][0])
+    )
+    r = max(-1.0, min(1.0, det_b / 2)) if math.isfinite(det_b) else 0.0
+    phi = math.acos(r) / 3
+    e1 = q + 2 * p * math.cos(phi)
+    e3 = q + 2 * p * math.cos(phi + 2 * math.pi / 3)
+    lo, mid, hi = sorted((e1, 3 * q - e1 - e3, e3))
+    return (lo, mid, hi)
+
+
 # --------------------------------------------------------------------------- joint order
 
 K = TypeVar("K", bound=Hashable)

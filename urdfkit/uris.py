@@ -101,12 +101,12 @@ def not_a_file(path: Path) -> str | None:
     except FileNotFoundError:
         return "missing"
     except OSError as e:
-        reasons = {errno.ENAMETOOLONG: "a path component is longer than the file system "
-                   "allows", errno.EACCES: "permission denied", errno.ELOOP: "a symlink loop",
-                   errno.ENOTDIR: "missing"}
-        return reasons.get(e.errno or 0, os.strerror(e.errno or 0) or type(e).__name__)
+        reasons = {errno.ENAMETOOLONG: "a path with a component longer than the file system "
+                   "allows", errno.EACCES: "unreadable (permission denied on the way)",
+                   errno.ELOOP: "a symlink loop", errno.ENOTDIR: "missing"}
+        return reasons.get(e.errno or 0, f"unreadable ({os.strerror(e.errno or 0)})")
     except ValueError:  # an embedded NUL byte
-        return "the path holds a NUL byte"
+        return "a path holding a NUL byte"
     if stat.S_ISREG(mode):
         return None
     for test, what in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -33,8 +33,12 @@ from .spec import (
     SCHEMA,
     SHAPE_SIZES,
     SHAPES,
+    SOLIDS,
     extension_note,
     numbers,
+    solid_inertia,
+    solid_volume,
+    sym_eigenvalues,
 )
 from .spec import attr_float as _num
 from .spec import attr_vec as _vec
@@ -453,8 +457,6 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
     Tolerance as in Drake's ``RotationalInertia::CouldBePhysicallyValid``:
     ``eps = 10 * DBL_EPSILON * max(1, trace / 2)``, on the principal moments.
     """
-    from .builder import _sym_eigenvalues
-
     noted = False
     for link in _elements(root, "link"):
         inertial = link.find("inertial")
@@ -472,7 +474,7 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
             continue
         trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
         eps = 10 * _DBL_EPSILON * max(1.0, trace / 2)
-        a, b, c = _sym_eigenvalues(tensor)  # type: ignore[arg-type]
+        a, b, c = sym_eigenvalues(tensor)
         if a < -eps:
             r.add("U603", "error", f"inertia of {_label(link)} is not positive definite "
                   f"(principal moments {a:.4g}, {b:.4g}, {c:.4g}); every principal moment must "
@@ -494,40 +496,37 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
 
 
 def _shape_trace(link: etree._Element, mass: float | None) -> float | None:
-    """Trace of the inertia of the link's primitive collision shapes, or None if unknown."""
+    """Trace of the inertia of the link's solid collision shapes, or None if unknown.
+
+    Plain floats (spec's formulas), no model objects. The trace does not change under
+    rotation, so a shape's orientation does not matter; the parallel-axis theorem adds
+    2 m |d|^2 per shape for its offset d from the common centre of mass.
+    """
     if mass is None or mass <= 0:
         return None
-    from .builder import Box, Cylinder, Inertial, Origin, Sphere
-    from .errors import ModelError
-
-    shapes = []
+    parts = []
     for col in link.findall("collision"):
         shape = next((c for c in col.iterfind("geometry/*") if c.tag in SHAPES), None)
-        if shape is None:
-            return None
-        origin = col.find("origin")
-        # Missing or malformed values go in as None on purpose: the model's constructors
-        # check every value as it is set and raise ModelError, handled below.
-        try:
-            o = Origin(xyz=_vec(origin, "xyz", 3) or (0, 0, 0),  # type: ignore[arg-type]
-                       rpy=_vec(origin, "rpy", 3) or (0, 0, 0))  # type: ignore[arg-type]
-            if shape.tag == "box":
-                g: object = Box(size=_vec(shape, "size", 3))  # type: ignore[arg-type]
-            elif shape.tag == "cylinder":
-                g = Cylinder(radius=_num(shape, "radius"),  # type: ignore[arg-type]
-                             length=_num(shape, "length"))  # type: ignore[arg-type]
-            elif shape.tag == "sphere":
-                g = Sphere(radius=_num(shape, "radius"))  # type: ignore[arg-type]
-            else:
-                return None  # meshes, capsules, planes: no volume without loading them
-        except ModelError:
-            return None
-        shapes.append((g, o))
-    if not shapes:
+        if shape is None or shape.tag not in SOLIDS or shape.tag == "capsule":
+            return None  # meshes, planes: no volume without loading them
+        raw: Sequence[float | None] | None = (
+            _vec(shape, "size", 3) if shape.tag == "box"
+            else [_num(shape, attr) for attr in SOLIDS[shape.tag]])
+        xyz = _vec(col.find("origin"), "xyz", 3, (0.0, 0.0, 0.0))
+        dims = [d for d in raw or () if d is not None and math.isfinite(d) and d > 0]
+        if xyz is None or raw is None or len(dims) != len(raw):
+            return None  # U401/U501 say why
+        parts.append((solid_volume(shape.tag, dims), shape.tag, dims, xyz))
+    total = sum(v for v, *_ in parts)
+    if not parts or not 0 < total < math.inf:
         return None
-    tensor = Inertial.from_shapes(mass, shapes).inertia  # type: ignore[arg-type]
-    assert tensor is not None
-    return tensor.ixx + tensor.iyy + tensor.izz
+    com = [sum(v * xyz[i] for v, _, _, xyz in parts) / total for i in range(3)]
+    trace = 0.0
+    for volume, kind, dims, xyz in parts:
+        m = mass * volume / total
+        d2 = sum((xyz[i] - com[i]) * (xyz[i] - com[i]) for i in range(3))
+        trace += sum(solid_inertia(kind, dims, m)) + 2 * m * d2
+    return trace if math.isfinite(trace) else None
 
 
 def rule_meshes(root: etree._Element, r: Report) -> None:
