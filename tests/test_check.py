@@ -42,6 +42,7 @@ CASES = [
     ("U001", '<model name="m"><!--HERE-->\n<link name="a"/>\n</model>\n'),
     ("U002", '<robot><!--HERE-->\n' + A + "\n</robot>\n"),
     ("U003", '<robot name="r"><!--HERE-->\n</robot>\n'),
+    ("U005", doc(link("a", body="<x>" * 97 + "<!--HERE-->" + "</x>" * 97))),
     ("U101", doc(A, '<link><!--HERE-->' + INERTIAL + "</link>")),
     ("U102", doc(A, B, J, link("b") + "<!--HERE-->")),
     ("U103", doc(A, B, link("c"), J, joint("j", "b", "c") + "<!--HERE-->")),
@@ -105,6 +106,14 @@ CASES = [
                                 '<!--HERE-->\n</geometry></visual>'))),
     ("U704", doc(link("a", body='<visual><geometry>\n<mesh filename="."/>'
                                 '<!--HERE-->\n</geometry></visual>'))),
+    ("U504", doc(link("a", body='<visual><geometry><box size="1 1 1"/>\n<origin xyz="1 0 0"/>'
+                                '<!--HERE-->\n</geometry></visual>'))),
+    ("U505", doc(link("a", body='<visual><geometry>\n<origin xyz="1 0 0"/><!--HERE-->'
+                                '<box size="1 1 1"/>\n</geometry></visual>'))),
+    ("U506", doc(link("a", body='\n<visual><!--HERE--><origin xyz="1 0 0"/></visual>'))),
+    ("U609", doc(link("a", '<inertial><!--HERE--><mass value="1"/>\n</inertial>'))),
+    ("U610", doc(link("a", '<inertial><mass value="1"/>\n<inertia ixx="0.1" ixy="0" ixz="0" '
+                           'iyy="0.1" iyz="0"/><!--HERE-->\n</inertial>'))),
     ("U801", doc(link("a", body=BOX + "\n<colision/><!--HERE-->\n"))),
     ("U802", doc(link("a", body='<collision><geometry>\n<box size="1 1 1" colour="red"/>'
                                 '<!--HERE-->\n</geometry></collision>'))),
@@ -228,7 +237,8 @@ def test_folder_is_searched_recursively_and_xacro_expanded(tmp_path: Path) -> No
     (tmp_path / "car.urdf.xacro").write_text(
         '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
         '<xacro:property name="m" value="2"/>\n'
-        '<link name="a"><inertial><mass value="${m * -1}"/></inertial></link>\n</robot>\n')
+        '<link name="a"><inertial><mass value="${m * -1}"/><inertia ixx="1" ixy="0" ixz="0" '
+        'iyy="1" iyz="0" izz="1"/></inertial></link>\n</robot>\n')
     result = check_paths([tmp_path], jobs=1)
     names = [Path(f.file).name for f in result.files]
     assert sorted(names) == ["car.urdf.xacro", "r.urdf"]

@@ -52,6 +52,8 @@ ACCEPTED = {
     "planar joint": robot("planar", joint_inner='<axis xyz="0 0 1"/>'),
     "revolute joint": robot("revolute", joint_inner=LIMIT),
     "continuous joint": robot("continuous", joint_inner='<axis xyz="0 1 0"/>'),
+    # PyBullet ignores an <origin> after the shape; check warns (U504), nobody refuses.
+    "origin after the shape": robot(shape='<box size="0.1 0.1 0.1"/><origin xyz="0 0 1"/>'),
 }
 # Not URDF by the spec: PyBullet refuses these or silently misreads them (it keeps the first of
 # two shapes), so every command refuses them.
@@ -60,6 +62,10 @@ REFUSED = {
     "unknown shape": robot(shape='<cone radius="0.1" length="0.2"/>'),
     "two shapes": robot(shape='<box size="1 1 1"/><sphere radius="1"/>'),
     "revolute without limit": robot("revolute", joint_inner='<axis xyz="0 0 1"/>'),
+    "origin before the shape": robot(shape='<origin xyz="0 0 1"/><box size="0.1 0.1 0.1"/>'),
+    "inertia missing a component": robot().replace('izz="0.01"', "", 1),
+    "inertial without inertia": robot().replace(
+        '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>', "", 1),
 }
 # URDF with a wrong value: check reports an error, the model and build refuse to write it, and
 # the loading commands still load it, as PyBullet does (pybullet_data's laikago has zero-radius

@@ -849,9 +849,13 @@ def _write_origin(parent: etree._Element, origin: Origin) -> None:
 def _parse_geometry(ctx: _Ctx, el: etree._Element | None, owner: etree._Element) -> Geometry:
     if el is None:
         raise ctx.error(owner, f"<{owner.tag}> has no <geometry>")
-    shapes = [c for c in el if isinstance(c.tag, str)]
-    if len(shapes) != 1:
-        raise ctx.error(el, f"<geometry> must hold exactly one shape, found {len(shapes)}")
+    elements = [c for c in el if isinstance(c.tag, str)]
+    # PyBullet reads the first element as the shape and ignores what follows it (an <origin>
+    # misplaced there, say); anything else is not one shape.
+    shapes = [c for c in elements if c.tag != "origin"]
+    if len(shapes) != 1 or elements[0] is not shapes[0]:
+        raise ctx.error(el, f"<geometry> must hold exactly one shape, first, found "
+                        f"{', '.join(f'<{c.tag}>' for c in elements) or 'nothing'}")
     s = shapes[0]
     cls = SHAPE_CLASSES.get(s.tag)
     if cls is None:
@@ -905,12 +909,10 @@ def _parse_inertial(ctx: _Ctx, el: etree._Element) -> Inertial:
     if mass_el is None:
         raise ctx.error(el, "<inertial> has no <mass>")
     inertia_el = el.find("inertia")
-    inertia = None
-    if inertia_el is not None:
-        inertia = ctx.build(inertia_el, Inertia, **{
-            k: ctx.num(inertia_el, k, required=False) or 0.0
-            for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-        })
+    if inertia_el is None:  # PyBullet refuses the file; the model derives inertia only in code
+        raise ctx.error(el, "<inertial> has no <inertia>")
+    inertia = ctx.build(inertia_el, Inertia, **{
+        k: ctx.num(inertia_el, k) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")})
     return ctx.build(el, Inertial, mass=ctx.num(mass_el, "value"), inertia=inertia,
                      origin=_parse_origin(ctx, el.find("origin")))
 

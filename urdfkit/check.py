@@ -10,6 +10,7 @@ loaded: checking is pure lxml, which is what makes it safe on hostile input and 
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -86,33 +87,52 @@ def parse_codes(items: Sequence[str] | None, option: str) -> tuple[str, ...]:
     return tuple(out)
 
 
-def discover(paths: Iterable[str | Path]) -> list[tuple[str, Path]]:
-    """Expand the command-line paths into ``(display name, path)`` pairs, sorted per folder.
+def discover(paths: Iterable[str | Path]) -> list[tuple[str, Path, str | None]]:
+    """Expand the command-line paths into ``(display name, path, problem)`` triples.
 
-    A folder is searched recursively; a folder whose own name ends in ``.urdf`` or ``.xacro``
-    is listed as a file (and then reported as not being one), because that is what its name
-    claims.
+    A folder is walked with ``os.scandir`` (not following symlinked folders, so a link loop
+    cannot trap the walk), entries sorted per folder. Every entry named ``*.urdf`` or
+    ``*.xacro`` is listed whatever it is (a FIFO, a device, a folder): reading reports what it
+    really is. A folder that cannot be listed comes back with its ``problem``, to be reported,
+    never skipped.
 
     Raises:
-        ParameterError: a path does not exist (exit code 2: the invocation is unusable).
+        ParameterError: a path given on the command line does not exist (exit code 2).
     """
-    out: list[tuple[str, Path]] = []
-    seen: set[Path] = set()
+    out: list[tuple[str, Path, str | None]] = []
+    seen: set[str] = set()
 
-    def add(display: str, path: Path) -> None:
-        key = path.absolute()
+    def add(display: str, path: Path, problem: str | None = None) -> None:
+        key = os.path.abspath(path)
         if key not in seen:
             seen.add(key)
-            out.append((display, path))
+            out.append((display, path, problem))
 
     for item in paths:
         path = Path(item)
-        if not path.exists() and not path.is_symlink():
+        if not os.path.lexists(path):
             raise ParameterError(f"{item}: no such file or folder")
         if path.is_dir() and path.suffix not in SUFFIXES:
-            found = [p for p in path.rglob("*") if p.suffix in SUFFIXES]
-            for p in sorted(found):
-                add(str(p), p)
+            stack = [str(path)]
+            while stack:
+                folder = stack.pop()
+                try:
+                    with os.scandir(folder) as it:
+                        entries = sorted(it, key=lambda e: e.name)
+                except OSError as e:
+                    add(folder, Path(folder), f"cannot list this folder: {e.strerror}")
+                    continue
+                subdirs = []
+                for entry in entries:
+                    try:
+                        is_dir = entry.is_dir(follow_symlinks=False)
+                    except OSError:
+                        is_dir = False
+                    if entry.name.endswith(SUFFIXES):
+                        add(entry.path, Path(entry.path))
+                    elif is_dir:
+                        subdirs.append(entry.path)
+                stack.extend(reversed(subdirs))
         else:
             add(str(item), path)
     return out
@@ -122,7 +142,13 @@ def _read(path: Path, display: str) -> bytes:
     from .expand import expand_xacro
     from .xmlio import read_bytes
 
-    if path.suffix == ".xacro" and not path.is_dir():
+    if path.suffix == ".xacro":
+        from .uris import not_a_file
+
+        why = not_a_file(path)
+        if why is not None:  # never hand xacro a FIFO to block on
+            raise InputError(f"is {why}, not a regular file; urdfkit reads only regular files"
+                             if why != "missing" else "no such file", file=display)
         return expand_xacro(path, display=display)
     return read_bytes(path)
 
@@ -154,9 +180,40 @@ def check_file(display: str, path: str | Path,
     return result
 
 
-def _check_one(job: tuple[str, str, dict[str, str]]) -> FileResult:
-    display, path, packages = job
+def _check_one(job: tuple[str, str, str | None, dict[str, str]]) -> FileResult:
+    display, path, problem, packages = job
+    if problem is not None:
+        return FileResult(display, [Finding("U000", "error", problem, display)])
     return check_file(display, path, {k: Path(v) for k, v in packages.items()})
+
+
+def _worker_init() -> None:
+    """Pool workers die with their parent and never hold the caller's stdout open."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C for everyone
+    for sig in (signal.SIGTERM, signal.SIGHUP):  # the pool ends workers with SIGTERM: just die
+        signal.signal(sig, signal.SIG_DFL)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)  # a `check ... | cat` pipe ends when the parent does
+    os.close(devnull)
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG: killed when the parent dies
+        except (OSError, AttributeError):  # pragma: no cover - no prctl
+            pass
+        if os.getppid() == 1:  # the parent died before prctl: do not linger
+            os._exit(1)
+
+
+def default_jobs() -> int:
+    """Worker processes for ``check``: the cores this process may run on."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(1, len(os.sched_getaffinity(0)))
+    return os.cpu_count() or 1
 
 
 def _keep(code: str, select: tuple[str, ...], ignore: tuple[str, ...]) -> bool:
@@ -170,23 +227,30 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
                 jobs: int | None = None) -> CheckResult:
     """Check every file under ``paths``, over ``jobs`` processes (default: every core).
 
+    Workers are killed with the parent (Ctrl-C, SIGTERM, even SIGKILL on Linux) and never
+    hold its stdout.
+
     Raises:
-        ParameterError: a path does not exist.
+        ParameterError: a path does not exist, or ``jobs`` is not positive.
     """
+    if jobs is not None and (isinstance(jobs, bool) or jobs < 1):
+        raise ParameterError(f"`jobs` must be 1 or more, got {jobs!r}", param="jobs")
     files = discover(paths)
     pkgs = {k: str(v) for k, v in (packages or {}).items()}
-    work = [(display, str(path), pkgs) for display, path in files]
-    workers = jobs or len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") \
-        else (jobs or os.cpu_count() or 1)
-    if len(work) < _PARALLEL_MIN or workers <= 1:
+    work = [(display, str(path), problem, pkgs) for display, path, problem in files]
+    workers = min(jobs or default_jobs(), max(1, len(work) // _PARALLEL_MIN))
+    if workers <= 1:
         results = [_check_one(w) for w in work]
     else:
-        from concurrent.futures import ProcessPoolExecutor
+        import multiprocessing
 
         # Large chunks: a URDF takes about a millisecond to check, less than a round trip.
         chunk = max(1, len(work) // (workers * 4))
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            results = list(pool.map(_check_one, work, chunksize=chunk))
+        context = multiprocessing.get_context("fork" if sys.platform.startswith("linux")
+                                              else "spawn")
+        # The with block terminates the workers on the way out, normal or not (Ctrl-C).
+        with context.Pool(workers, initializer=_worker_init) as pool:
+            results = pool.map(_check_one, work, chunksize=chunk)
     sel, ign = tuple(select), tuple(ignore)
     for fr in results:
         fr.findings = [f for f in fr.findings if _keep(f.code, sel, ign)]

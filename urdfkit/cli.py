@@ -472,6 +472,8 @@ def check(
     ignore: Annotated[list[str] | None, typer.Option(
         "--ignore", metavar="CODES", help="Drop these codes or prefixes, comma-separated.")]
     = None,
+    jobs: Annotated[int | None, typer.Option(
+        "--jobs", "-j", min=1, help="Worker processes.", show_default="every core")] = None,
 ) -> None:
     """Check URDF files for errors PyBullet crashes on, physics mistakes and typos.
 
@@ -489,7 +491,7 @@ def check(
                              f"{hint(fail_on, ('error', 'warning', 'info'))}", param="fail_on")
     result = check_paths(paths, packages=parse_packages(package),
                          select=parse_codes(select, "`select`"),
-                         ignore=parse_codes(ignore, "`ignore`"))
+                         ignore=parse_codes(ignore, "`ignore`"), jobs=jobs)
     if as_json:
         show.print_json(result.to_dict())
     else:

@@ -57,7 +57,13 @@ def console(stderr: bool = False) -> Any:
 
 
 def _write(stream: Any, text: str) -> None:
-    stream.write(text)
+    try:
+        stream.write(text)
+    except UnicodeEncodeError:
+        # A file name that is not UTF-8 (kept by Python as surrogates), or a terminal whose
+        # encoding lacks a character: escape it rather than fail.
+        encoding = getattr(stream, "encoding", None) or "utf-8"
+        stream.write(text.encode(encoding, "backslashreplace").decode(encoding))
     stream.flush()
 
 

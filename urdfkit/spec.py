@@ -152,6 +152,9 @@ SCHEMA: dict[str, tuple[frozenset[str], frozenset[str]]] = {
 MAX_STATE_LINKS = 128
 #: Bodies with more links than this are refused before loading: PyBullet takes minutes.
 MAX_LOADABLE_LINKS = 1000
+#: Deepest element nesting PyBullet 3.2.7's XML parser (tinyxml2) reads, <robot> counting 1:
+#: one level more and loadURDF fails ("Cannot load URDF file").
+MAX_XML_DEPTH = 98
 #: Longest name (in UTF-8 bytes) of a link, joint, material or robot the guard lets through.
 #: PyBullet's fixed buffers count bytes: 700 characters of 'é' are 1,400 bytes.
 MAX_NAME_BYTES = 1000

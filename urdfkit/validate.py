@@ -28,6 +28,7 @@ from .spec import (
     MAX_LOADABLE_LINKS,
     MAX_NAME_BYTES,
     MAX_STATE_LINKS,
+    MAX_XML_DEPTH,
     NUMERIC,
     OPAQUE,
     SCHEMA,
@@ -130,6 +131,18 @@ STRICTER = " (PyBullet 3.2.7 loads this, but the guard refuses it; `guard=False`
 # These are the rules PyBullet crashes on when they are broken; the guard runs exactly these.
 
 
+def _depth(root: etree._Element) -> tuple[int, etree._Element]:
+    """The deepest nesting level (root = 1) and an element at it; iterative, linear."""
+    best = (1, root)
+    stack = [(root, 1)]
+    while stack:
+        el, level = stack.pop()
+        if level > best[0]:
+            best = (level, el)
+        stack.extend((c, level + 1) for c in el if isinstance(c.tag, str))
+    return best
+
+
 def rule_document(root: etree._Element, r: Report) -> None:
     """U001-U003: root is <robot>, has a name, and has links."""
     if root.tag != "robot":
@@ -137,6 +150,10 @@ def rule_document(root: etree._Element, r: Report) -> None:
         return
     if not root.get("name"):
         r.add("U002", "error", "<robot> has no name attribute; add name=\"...\"", root)
+    deepest = _depth(root)
+    if deepest[0] > MAX_XML_DEPTH:
+        r.add("U005", "error", f"elements are nested {deepest[0]} deep; PyBullet's XML parser "
+              f"stops at {MAX_XML_DEPTH} and refuses the file", deepest[1])
     if next(_elements(root, "link"), None) is None:
         soft = next(_elements(root, "deformable"), None) is not None
         r.add("U003", "error", "<robot> has no <link>; a robot needs at least one link" +
@@ -369,8 +386,22 @@ def rule_joints(root: etree._Element, r: Report) -> None:
 
 
 def rule_geometry(root: etree._Element, r: Report) -> None:
-    """U501-U503: one shape per <geometry>, positive sizes, meshes have a filename."""
+    """U501-U506: one shape per <geometry>, first; positive sizes; meshes have a filename."""
+    for link in _elements(root, "link"):
+        for part in link:
+            if part.tag in ("visual", "collision") and part.find("geometry") is None:
+                r.add("U506", "error", f"<{part.tag}> of {_label(link)} has no <geometry>, "
+                      "which PyBullet refuses; add one or remove the element", part)
     for geom in root.iter("geometry"):
+        elements = [c for c in geom if isinstance(c.tag, str)]
+        if elements and elements[0].tag not in SHAPES and any(c.tag in SHAPES for c in elements):
+            r.add("U505", "error", f"<{elements[0].tag}> comes before the shape in <geometry>; "
+                  "PyBullet reads the first element as the shape and refuses the file",
+                  elements[0])
+        for c in elements:
+            if c.tag == "origin":
+                r.add("U504", "warning", "<origin> inside <geometry> is ignored by PyBullet; put "
+                      "it in the enclosing <visual> or <collision>", c)
         shapes = [c for c in geom if isinstance(c.tag, str) and c.tag in SHAPES]
         if len(shapes) != 1:
             owner = geom.getparent()
@@ -449,6 +480,25 @@ def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | 
         return None
     ixx, ixy, ixz, iyy, iyz, izz = vals
     return ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))  # type: ignore[return-value]
+
+
+def rule_inertial(root: etree._Element, r: Report) -> None:
+    """U609-U610: <inertial> has an <inertia> with all six components (PyBullet refuses less)."""
+    for link in _elements(root, "link"):
+        inertial = link.find("inertial")
+        if inertial is None:
+            continue
+        inertia = inertial.find("inertia")
+        if inertia is None:
+            r.add("U609", "error", f"<inertial> of {_label(link)} has no <inertia>, which "
+                  "PyBullet refuses; add <inertia ixx=... iyy=... izz=... ixy ixz iyz>",
+                  inertial)
+            continue
+        missing = [a for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz") if inertia.get(a) is None]
+        if missing:
+            r.add("U610", "error", f"<inertia> of {_label(link)} has no {', '.join(missing)}, "
+                  "which PyBullet refuses; give all six components (0 for products of inertia "
+                  "of a symmetric body)", inertia)
 
 
 def rule_inertia(root: etree._Element, r: Report) -> None:
@@ -602,16 +652,17 @@ def rule_portability(root: etree._Element, r: Report) -> None:
 #: The guard also runs rule_joints and rule_geometry, but refuses only what is not URDF by
 #: the one spec (see GUARD_CODES); their value findings are for ``check``.
 GUARD_RULES: tuple[Rule, ...] = (rule_document, rule_names, rule_tree, rule_link_limit,
-                                 rule_joints, rule_geometry)
+                                 rule_joints, rule_geometry, rule_inertial)
 
 #: The error codes every command refuses: what crashes PyBullet, and what is not URDF at all
 #: (an unknown joint type or shape, a <geometry> without exactly one shape, a revolute or
 #: prismatic joint without <limit>), which PyBullet refuses or silently misreads. Errors in
 #: values (limits, sizes, masses, inertia) are ``check`` findings: PyBullet loads such files,
 #: and pybullet_data ships some, so the loading commands still load them.
-GUARD_CODES = frozenset({"U001", "U002", "U003", "U101", "U102", "U103", "U104", "U105",
+GUARD_CODES = frozenset({"U001", "U002", "U003", "U005", "U101", "U102", "U103", "U104", "U105",
                          "U106", "U107", "U108", "U201", "U202", "U203", "U204", "U205",
-                         "U206", "U207", "U209", "U301", "U302", "U502"})
+                         "U206", "U207", "U209", "U301", "U302", "U502", "U505", "U506",
+                         "U609", "U610"})
 
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_numbers, rule_mass,
@@ -621,6 +672,7 @@ ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_numbers, rule
 CODES: dict[str, str] = {
     "U000": "file unreadable or not well-formed XML",
     "U004": "XML quirk PyBullet tolerates but other parsers refuse",
+    "U005": "elements nested deeper than PyBullet's XML parser reads (98 levels)",
     "U001": "root element is not <robot>",
     "U002": "<robot> has no name",
     "U003": "no <link>",
@@ -653,6 +705,9 @@ CODES: dict[str, str] = {
     "U501": "missing or non-positive shape size",
     "U502": "<geometry> without exactly one shape",
     "U503": "mesh without filename",
+    "U504": "<origin> inside <geometry> (ignored by PyBullet)",
+    "U505": "<geometry> whose first element is not the shape",
+    "U506": "<visual> or <collision> without <geometry>",
     "U601": "negative or missing mass",
     "U602": "moving link with mass 0",
     "U603": "inertia not positive definite",
@@ -661,6 +716,8 @@ CODES: dict[str, str] = {
     "U606": "link without <inertial>",
     "U607": "file inertia ignored without URDF_USE_INERTIA_FROM_FILE",
     "U608": "singular inertia (a zero principal moment) with positive mass",
+    "U609": "<inertial> without <inertia>",
+    "U610": "<inertia> missing a component",
     "U701": "mesh or texture file not found",
     "U702": "package:// package not found",
     "U703": "mesh found only through pybullet_data's search path",

@@ -34,27 +34,56 @@ def _parser() -> etree.XMLParser:
 
 
 def read_bytes(path: str | Path) -> bytes:
-    """Read a file for parsing, refusing folders, oversized and unreadable files."""
+    """Read a regular file for parsing: never a FIFO, device, socket or folder; never too much.
+
+    The file is opened non-blocking (a FIFO would otherwise wait forever for a writer), then
+    ``fstat`` on the open descriptor decides: only a regular file is read. The size cap counts
+    bytes as they are read, never trusting ``st_size`` (0 for /dev/zero behind a symlink).
+    """
+    import errno
+    import stat
+
     path = Path(path)
-    if path.is_dir():
-        raise InputError("is a directory, not a URDF file", file=path)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
     try:
-        size = path.stat().st_size
+        fd = os.open(path, flags)
     except FileNotFoundError:
         raise InputError("no such file", file=path) from None
+    except IsADirectoryError:
+        raise InputError("is a directory, not a URDF file", file=path) from None
     except OSError as e:
-        raise InputError(f"cannot read: {e.strerror}", file=path) from None
-    if size > MAX_FILE_BYTES:
-        raise InputError(
-            f"file is {size / 1e6:.0f} MB; urdfkit refuses files over "
-            f"{MAX_FILE_BYTES // (1024 * 1024)} MiB",
-            file=path,
-        )
+        what = {errno.ENAMETOOLONG: "a path component is longer than the file system allows",
+                errno.EACCES: "permission denied", errno.ELOOP: "a symlink loop"}
+        raise InputError(f"cannot read: {what.get(e.errno or 0, e.strerror)}",
+                         file=path) from None
+    except ValueError:  # a NUL byte in the name
+        raise InputError("cannot read: the path holds a NUL byte", file=path) from None
     try:
-        with open(path, "rb") as f:
-            return f.read()
-    except OSError as e:
-        raise InputError(f"cannot read: {e.strerror}", file=path) from None
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            kind = ("a directory" if stat.S_ISDIR(mode) else "a FIFO (named pipe)"
+                    if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or
+                    stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else "special")
+            raise InputError(f"is {kind}, not a regular file; urdfkit reads only regular "
+                             "files", file=path)
+        chunks, size = [], 0
+        while True:
+            try:
+                chunk = os.read(fd, 1 << 20)
+            except BlockingIOError:  # pragma: no cover - regular files never block
+                continue
+            except OSError as e:
+                raise InputError(f"cannot read: {e.strerror}", file=path) from None
+            if not chunk:
+                break
+            size += len(chunk)
+            if size > MAX_FILE_BYTES:
+                raise InputError(f"file is over {MAX_FILE_BYTES // (1024 * 1024)} MiB; urdfkit "
+                                 "refuses larger files", file=path)
+            chunks.append(chunk)
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
 
 
 #: An XML declaration anywhere near the start of a file.
