@@ -13,10 +13,8 @@ import time
 from pathlib import Path
 
 import pytest
-from typer.testing import CliRunner
 
 from urdfkit.check import check_paths
-from urdfkit.cli import app
 
 GOOD = Path(__file__).parent / "golden" / "simplecar.urdf"
 
