@@ -131,16 +131,15 @@ STRICTER = " (PyBullet 3.2.7 loads this, but the guard refuses it; `guard=False`
 # These are the rules PyBullet crashes on when they are broken; the guard runs exactly these.
 
 
-def _depth(root: etree._Element) -> tuple[int, etree._Element]:
-    """The deepest nesting level (root = 1) and an element at it; iterative, linear."""
-    best = (1, root)
-    stack = [(root, 1)]
-    while stack:
-        el, level = stack.pop()
-        if level > best[0]:
-            best = (level, el)
-        stack.extend((c, level + 1) for c in el if isinstance(c.tag, str))
-    return best
+#: An XPath that finds the elements one level below what PyBullet's XML parser reads: a path
+#: step per level, evaluated in C, pruned at every leaf (linear, and ~free on real files).
+_TOO_DEEP = etree.XPath("/*" * (MAX_XML_DEPTH + 1))
+
+
+def _too_deep(root: etree._Element) -> etree._Element | None:
+    """The first element nested deeper than PyBullet reads, or None."""
+    found = _TOO_DEEP(root)
+    return found[0] if isinstance(found, list) and found else None
 
 
 def rule_document(root: etree._Element, r: Report) -> None:
@@ -150,10 +149,10 @@ def rule_document(root: etree._Element, r: Report) -> None:
         return
     if not root.get("name"):
         r.add("U002", "error", "<robot> has no name attribute; add name=\"...\"", root)
-    deepest = _depth(root)
-    if deepest[0] > MAX_XML_DEPTH:
-        r.add("U005", "error", f"elements are nested {deepest[0]} deep; PyBullet's XML parser "
-              f"stops at {MAX_XML_DEPTH} and refuses the file", deepest[1])
+    deep = _too_deep(root)
+    if deep is not None:
+        r.add("U005", "error", f"elements are nested more than {MAX_XML_DEPTH} deep; PyBullet's "
+              "XML parser stops there and refuses the file", deep)
     if next(_elements(root, "link"), None) is None:
         soft = next(_elements(root, "deformable"), None) is not None
         r.add("U003", "error", "<robot> has no <link>; a robot needs at least one link" +
@@ -326,20 +325,47 @@ def _walk(root: etree._Element) -> Iterator[etree._Element]:
                 stack.append(child)
 
 
-def rule_numbers(root: etree._Element, r: Report) -> None:
-    """U401-U402: every number parses and is finite; vectors have the right length."""
-    for el in _walk(root):
-        for attr, text in el.attrib.items():
-            n = NUMERIC.get((el.tag, attr))
-            if n is None:
-                continue
-            vals = numbers(text)
-            if vals is None or not all(math.isfinite(v) for v in (vals or [])):
-                r.add("U401", "error", f"<{el.tag} {attr}={text!r}>: expected "
-                      f"{'a finite number' if n == 1 else f'{n} finite numbers'}", el)
-            elif len(vals) != n:
-                r.add("U402", "error", f"<{el.tag} {attr}={text!r}>: expected {n} numbers, got "
-                      f"{len(vals)}", el)
+def rule_elements(root: etree._Element, r: Report) -> None:
+    """U401-U402 and U801-U802, in one pass over the tree.
+
+    Numbers parse, are finite and have the right length; tags and attributes are known
+    (typos, or extensions PyBullet ignores). The walk is lxml's own (C) iteration; the
+    subtrees :func:`_walk` skips (opaque and namespaced ones) are collected first.
+    """
+    skip: set[etree._Element] = set()
+    numeric, schema, finite = NUMERIC.get, SCHEMA.get, math.isfinite
+    for el in root.iter(etree.Element):
+        tag = el.tag
+        if tag in OPAQUE or tag.startswith("{"):
+            if el not in skip:
+                skip.update(el.iter())
+            continue
+        if skip and el in skip:
+            continue
+        known = schema(tag)
+        for attr, text in el.items():
+            n = numeric((tag, attr))
+            if n is not None:
+                try:
+                    vals = [float(x) for x in text.split()]
+                except ValueError:
+                    vals = None
+                if vals is None or not all(map(finite, vals)):
+                    r.add("U401", "error", f"<{tag} {attr}={text!r}>: expected "
+                          f"{'a finite number' if n == 1 else f'{n} finite numbers'}", el)
+                elif len(vals) != n:
+                    r.add("U402", "error", f"<{tag} {attr}={text!r}>: expected {n} numbers, "
+                          f"got {len(vals)}", el)
+            if known is not None and attr not in known[0] and not attr.startswith("{"):
+                r.add("U802", "warning", f"<{tag}> has unknown attribute {attr!r}; PyBullet "
+                      "ignores it", el)
+        if known is not None:
+            children = known[1]
+            for child in el.iterchildren(etree.Element):
+                ctag = child.tag
+                if ctag not in children and not ctag.startswith("{"):
+                    r.add("U801", "warning", f"<{ctag}> is not known inside <{tag}>; "
+                          "PyBullet ignores it", child)
 
 
 def rule_joints(root: etree._Element, r: Report) -> None:
@@ -607,24 +633,6 @@ def rule_meshes(root: etree._Element, r: Report) -> None:
         r.add("U701", "error", f"<{el.tag} filename={fn!r}>: file not found ({target.path})", el)
 
 
-def rule_schema(root: etree._Element, r: Report) -> None:
-    """U801-U802: unknown tags and attributes (typos, or extensions PyBullet ignores)."""
-    for el in _walk(root):
-        known = SCHEMA.get(el.tag)
-        if known is None:
-            continue
-        attrs, children = known
-        for attr in el.attrib:
-            if attr not in attrs and not attr.startswith("{"):
-                r.add("U802", "warning", f"<{el.tag}> has unknown attribute {attr!r}; PyBullet "
-                      "ignores it", el)
-        for child in el:
-            if isinstance(child.tag, str) and not child.tag.startswith("{") \
-                    and child.tag not in children:
-                r.add("U801", "warning", f"<{child.tag}> is not known inside <{el.tag}>; "
-                      "PyBullet ignores it", child)
-
-
 def rule_link_limit(root: etree._Element, r: Report) -> None:
     """U209: refuse bodies so large that loading and stepping them takes minutes."""
     n = sum(1 for _ in _elements(root, "link"))
@@ -665,8 +673,8 @@ GUARD_CODES = frozenset({"U001", "U002", "U003", "U005", "U101", "U102", "U103",
                          "U609", "U610"})
 
 #: Every rule ``urdfkit check`` runs, in order.
-ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_numbers, rule_mass,
-                               rule_inertia, rule_meshes, rule_schema, rule_portability)
+ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
+                               rule_inertia, rule_meshes, rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
