@@ -138,7 +138,7 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, Path, str | None]]:
     return out
 
 
-def _read(path: Path, display: str) -> bytes:
+def _read(path: Path, display: str, no_exec: bool = False) -> bytes:
     from .expand import expand_xacro
     from .xmlio import read_bytes
 
@@ -149,23 +149,31 @@ def _read(path: Path, display: str) -> bytes:
         if why is not None:  # never hand xacro a FIFO to block on
             raise InputError(f"is {why}, not a regular file; urdfkit reads only regular files"
                              if why != "missing" else "no such file", file=display)
-        return expand_xacro(path, display=display)
+        return expand_xacro(path, display=display, no_exec=no_exec)
     return read_bytes(path)
 
 
 def check_file(display: str, path: str | Path,
-               packages: Mapping[str, Path] | None = None) -> FileResult:
-    """Run every rule on one file; any failure to read it becomes a ``U000`` finding."""
+               packages: Mapping[str, Path] | None = None, no_exec: bool = False) -> FileResult:
+    """Run every rule on one file; any failure to read it becomes a ``U000`` finding.
+
+    With ``no_exec`` (or URDFKIT_NO_EXEC set) a xacro file is not expanded: it gets one
+    ``U006`` warning saying so, and is otherwise unchecked.
+    """
     from lxml import etree
 
+    from .expand import XacroNotExpanded
     from .xmlio import parse_xml, tolerate_quirks
 
     path = Path(path)
     result = FileResult(display)
     try:
-        data = _read(path, display)
+        data = _read(path, display, no_exec)
         _, quirks = tolerate_quirks(data)
         tree = parse_xml(data, display)
+    except XacroNotExpanded as e:
+        result.findings.append(Finding("U006", "warning", e.message, display))
+        return result
     except InputError as e:
         result.findings.append(Finding("U000", "error", e.message, display, e.line))
         return result
@@ -180,11 +188,11 @@ def check_file(display: str, path: str | Path,
     return result
 
 
-def _check_one(job: tuple[str, str, str | None, dict[str, str]]) -> FileResult:
-    display, path, problem, packages = job
+def _check_one(job: tuple[str, str, str | None, dict[str, str], bool]) -> FileResult:
+    display, path, problem, packages, no_exec = job
     if problem is not None:
         return FileResult(display, [Finding("U000", "error", problem, display)])
-    return check_file(display, path, {k: Path(v) for k, v in packages.items()})
+    return check_file(display, path, {k: Path(v) for k, v in packages.items()}, no_exec)
 
 
 def _worker_init() -> None:
@@ -224,7 +232,7 @@ def _keep(code: str, select: tuple[str, ...], ignore: tuple[str, ...]) -> bool:
 
 def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | None = None,
                 select: Sequence[str] = (), ignore: Sequence[str] = (),
-                jobs: int | None = None) -> CheckResult:
+                jobs: int | None = None, no_exec: bool = False) -> CheckResult:
     """Check every file under ``paths``, over ``jobs`` processes (default: every core).
 
     Workers are killed with the parent (Ctrl-C, SIGTERM, even SIGKILL on Linux) and never
@@ -237,7 +245,7 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
         raise ParameterError(f"`jobs` must be 1 or more, got {jobs!r}", param="jobs")
     files = discover(paths)
     pkgs = {k: str(v) for k, v in (packages or {}).items()}
-    work = [(display, str(path), problem, pkgs) for display, path, problem in files]
+    work = [(display, str(path), problem, pkgs, no_exec) for display, path, problem in files]
     workers = min(jobs or default_jobs(), max(1, len(work) // _PARALLEL_MIN))
     if workers <= 1:
         results = [_check_one(w) for w in work]

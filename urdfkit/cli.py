@@ -474,6 +474,10 @@ def check(
     = None,
     jobs: Annotated[int | None, typer.Option(
         "--jobs", "-j", min=1, help="Worker processes.", show_default="every core")] = None,
+    no_exec: Annotated[bool, typer.Option(
+        "--no-exec", help="Treat xacro as untrusted: do not expand it (xacro runs Python); "
+        "each xacro file gets a U006 warning instead. URDFKIT_NO_EXEC=1 does the same.")]
+    = False,
 ) -> None:
     """Check URDF files for errors PyBullet crashes on, physics mistakes and typos.
 
@@ -491,7 +495,7 @@ def check(
                              f"{hint(fail_on, ('error', 'warning', 'info'))}", param="fail_on")
     result = check_paths(paths, packages=parse_packages(package),
                          select=parse_codes(select, "`select`"),
-                         ignore=parse_codes(ignore, "`ignore`"), jobs=jobs)
+                         ignore=parse_codes(ignore, "`ignore`"), jobs=jobs, no_exec=no_exec)
     if as_json:
         show.print_json(result.to_dict())
     else:

@@ -1,15 +1,32 @@
-"""Expanding xacro: a user's xacro file is code, so it runs in a child process.
+"""Expanding xacro: a user's xacro file is code, so it runs in a contained child process.
 
-xacro's ``${}`` expressions evaluate Python. :func:`expand_xacro` runs
-:mod:`urdfkit._xacro_worker` in a subprocess with a timeout and returns the URDF bytes; no
-xacro code ever runs inside urdfkit itself.
+xacro's ``${}`` expressions evaluate Python, and xacro's own restrictions are bypassed with a
+generator-frame walk that reaches ``os.system``. :func:`expand_xacro` therefore never runs
+xacro inside urdfkit. It runs :mod:`urdfkit._xacro_worker`:
+
+- in a session and process group of its own, killed as a group on timeout, and after it
+  finishes (its background children with it);
+- as a child subreaper, so a grandchild that daemonizes (``setsid``, double fork) is
+  re-parented to the worker, which kills every descendant before it exits;
+- under resource limits: address space (:data:`XACRO_MEMORY`), CPU seconds (the timeout), no
+  core dumps;
+- with its output written to temp files, never to a pipe a background grandchild could hold
+  open (which would make urdfkit wait the full timeout);
+- and its error messages are scrubbed of the values of ``$(env VAR)`` variables.
+
+It is containment of runaway and accidental harm, not a security sandbox: xacro code still
+runs as the user, with the user's files and network. ``URDFKIT_NO_EXEC=1`` (or ``check
+--no-exec``) refuses to run it at all; see docs/security.md.
 """
 
 from __future__ import annotations
 
 import os
+import re
+import signal
 import subprocess
 import sys
+import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -17,28 +34,154 @@ from .errors import InputError
 
 #: Seconds a xacro expansion may take before it is killed.
 XACRO_TIMEOUT = float(os.environ.get("URDFKIT_XACRO_TIMEOUT", "20"))
+#: Address space a xacro worker may map (bytes).
+XACRO_MEMORY = 2 * 1024**3
+#: Set to 1 (true, yes) to refuse executing xacro anywhere (CI over untrusted repositories).
+NO_EXEC_ENV = "URDFKIT_NO_EXEC"
+
+
+class XacroNotExpanded(InputError):
+    """xacro was not expanded because executing it is disabled."""
+
+
+def execution_allowed(no_exec: bool = False) -> bool:
+    """Whether xacro may run: not with ``no_exec``, nor with URDFKIT_NO_EXEC set."""
+    return not no_exec and os.environ.get(NO_EXEC_ENV, "").strip().lower() not in (
+        "1", "true", "yes", "on")
+
+
+_ENV_REF = re.compile(rb"\$\((?:opt)?env\s+([A-Za-z_][A-Za-z0-9_]*)")
+_XACRO_NS = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro")
+
+
+def _secrets(source: bytes) -> dict[str, str]:
+    """Environment values an error message must not show.
+
+    Those the file reads with ``$(env VAR)``/``$(optenv VAR)``, and any long value without a
+    slash or a space (a token, a key).
+    """
+    names = {m.decode() for m in _ENV_REF.findall(source)}
+    out = {n: os.environ[n] for n in names if os.environ.get(n)}
+    out.update({k: v for k, v in os.environ.items() if len(v) >= 12 and "/" not in v
+                and " " not in v})
+    return out
+
+
+def redact(message: str, secrets: Mapping[str, str]) -> str:
+    """``message`` with every secret value replaced by ``$NAME``."""
+    for name, value in sorted(secrets.items(), key=lambda kv: -len(kv[1])):
+        if value and value in message:
+            message = message.replace(value, f"${name}")
+    return message
+
+
+def check_args(source: bytes, args: Mapping[str, str], display: str) -> None:
+    """Refuse ``--arg`` names the file does not declare (xacro would ignore them silently).
+
+    Only decided when the file includes nothing: an included file may declare more args.
+    """
+    if not args:
+        return
+    from lxml import etree
+
+    from .xmlio import parse_xml
+
+    try:
+        root = parse_xml(source, display).getroot()
+    except InputError:
+        return  # xacro will say what is wrong with the XML
+    declared, includes = set(), False
+    for el in root.iter(etree.Element):
+        q = etree.QName(el)
+        if q.namespace in _XACRO_NS:
+            if q.localname == "arg" and el.get("name"):
+                declared.add(el.get("name"))
+            elif q.localname == "include":
+                includes = True
+    if includes:
+        return
+    from .errors import ParameterError
+    from .suggest import hint
+
+    for name in args:
+        if name not in declared:
+            known = ", ".join(sorted(declared)) or "none"
+            raise ParameterError(f"`xacro_args`: {name!r} is not an argument of this file"
+                                 f"{hint(name, declared)} (its <xacro:arg>s: {known})",
+                                 file=display, param="xacro_args")
 
 
 def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
-                 timeout: float | None = None, display: str | None = None) -> bytes:
-    """Expand a xacro file in a subprocess; return the URDF bytes.
+                 timeout: float | None = None, display: str | None = None,
+                 no_exec: bool = False) -> bytes:
+    """Expand a xacro file in a contained subprocess; return the URDF bytes.
 
     Raises:
+        XacroNotExpanded: executing xacro is disabled (``no_exec`` or URDFKIT_NO_EXEC).
+        ParameterError: an argument the file does not declare.
         InputError: xacro failed, or ran longer than ``timeout`` seconds.
     """
     name = display or str(path)
-    # Absolute, because the worker runs in the file's folder (for its relative includes).
-    cmd = [sys.executable, "-m", "urdfkit._xacro_worker", str(Path(path).resolve())]
-    cmd += [f"{k}:={v}" for k, v in (args or {}).items()]
+    if not execution_allowed(no_exec):
+        raise XacroNotExpanded(f"not expanded: executing xacro is disabled ({NO_EXEC_ENV} or "
+                               "--no-exec); xacro files run Python code", file=name)
+    source_path = Path(path).resolve()
+    from .xmlio import read_bytes
+
+    source = read_bytes(source_path)
+    check_args(source, args or {}, name)
     limit = XACRO_TIMEOUT if timeout is None else timeout
+    secrets = _secrets(source)
+    with tempfile.TemporaryDirectory(prefix="urdfkit-xacro-") as tmp:
+        out, err = Path(tmp) / "out.urdf", Path(tmp) / "err.txt"
+        # Absolute, because the worker runs in the file's folder (for its relative includes).
+        cmd = [sys.executable, "-m", "urdfkit._xacro_worker", str(out), str(err),
+               f"{limit:g}", str(XACRO_MEMORY), str(source_path)]
+        cmd += [f"{k}:={v}" for k, v in (args or {}).items()]
+        with open(os.devnull, "rb") as stdin, open(err, "ab") as log:
+            proc = subprocess.Popen(cmd, stdin=stdin, stdout=log, stderr=log,
+                                    cwd=str(source_path.parent), start_new_session=True)
+            try:
+                code = proc.wait(timeout=limit)
+            except subprocess.TimeoutExpired:
+                _stop(proc)
+                raise InputError(f"xacro expansion took longer than {limit:g} s and was "
+                                 "stopped", file=name) from None
+            except BaseException:  # Ctrl-C, SIGTERM: take the worker down with us
+                _stop(proc)
+                raise
+            finally:
+                _kill_group(proc.pid)  # background children left in its group
+        if code != 0:
+            lines = [ln for ln in err.read_text("utf-8", "replace").splitlines() if ln.strip()]
+            if code < 0:
+                why = {int(signal.SIGKILL): "was killed (out of memory, or its CPU limit)",
+                       int(signal.SIGXCPU): "ran out of CPU time",
+                       int(signal.SIGSEGV): "crashed"}.get(-code, f"died of signal {-code}")
+                msg = f"the xacro worker {why}"
+            else:
+                msg = lines[-1] if lines else f"exited with code {code}"
+            if "MemoryError" in msg or "Cannot allocate memory" in msg:
+                msg = f"ran out of memory (limit {XACRO_MEMORY // 1024**2} MiB): {msg}"
+            raise InputError(f"xacro failed: {redact(msg, secrets)}", file=name)
+        return out.read_bytes()
+
+
+def _kill_group(pgid: int) -> None:
     try:
-        proc = subprocess.run(cmd, capture_output=True, timeout=limit, stdin=subprocess.DEVNULL,
-                              cwd=str(Path(path).resolve().parent))
+        os.killpg(pgid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
+def _stop(proc: subprocess.Popen[bytes]) -> None:
+    """SIGTERM first (the worker then kills its descendants), SIGKILL the group after 1 s."""
+    try:
+        os.killpg(proc.pid, signal.SIGTERM)
+    except (ProcessLookupError, PermissionError):
+        return
+    try:
+        proc.wait(timeout=1.0)
     except subprocess.TimeoutExpired:
-        raise InputError(f"xacro expansion took longer than {limit:g} s and was stopped",
-                         file=name) from None
-    if proc.returncode != 0:
-        lines = [ln for ln in proc.stderr.decode("utf-8", "replace").splitlines() if ln.strip()]
-        msg = lines[0] if lines else f"exited with code {proc.returncode}"
-        raise InputError(f"xacro failed: {msg}", file=name)
-    return proc.stdout
+        _kill_group(proc.pid)
+        proc.wait()

@@ -1,0 +1,161 @@
+"""xacro is code: expansion runs contained (time, memory, process group, daemons, pipes,
+secrets), and can be refused outright (--no-exec, URDFKIT_NO_EXEC)."""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from urdfkit.check import check_paths
+from urdfkit.cli import app
+from urdfkit.errors import InputError, ParameterError
+from urdfkit.expand import NO_EXEC_ENV, XacroNotExpanded, execution_allowed, expand_xacro
+
+runner = CliRunner()
+
+
+def xacro_file(tmp_path: Path, expr: str, name: str = "r.urdf.xacro", head: str = "") -> Path:
+    """A robot whose link name is the xacro expression ``expr`` (escaped for XML)."""
+    text = expr.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+    path = tmp_path / name
+    path.write_text(f'<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">{head}'
+                    f'<link name="${{{text}}}"/></robot>')
+    return path
+
+
+def shell(command: str) -> str:
+    """A xacro expression that escapes xacro's restricted eval to os.system: it walks from a
+    running generator's frame up to xacro's module globals. xacro's guard does not stop it;
+    urdfkit's containment must hold anyway."""
+    return ("[[x['os'].system(" + repr(command) + ") for x in h] for k in [0] if "
+            "(h := (h.gi_frame.f_back.f_back.f_back.f_back.f_globals for _ in [1]))][0]")
+
+
+def alive(pid: int) -> bool:
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    return "State:\tZ" not in status
+
+
+def test_the_escape_is_real(tmp_path: Path) -> None:
+    # Without this, the containment tests below would prove nothing.
+    marker = tmp_path / "ran"
+    path = xacro_file(tmp_path, shell(f"touch {marker}"))
+    expand_xacro(path, timeout=20)
+    assert marker.exists()
+
+
+def test_a_runaway_expansion_is_stopped_quickly(tmp_path: Path) -> None:
+    path = xacro_file(tmp_path, "[x for x in python.range(10**12) if x < 0]")
+    start = time.monotonic()
+    with pytest.raises(InputError, match="longer than 1 s and was stopped"):
+        expand_xacro(path, timeout=1.0)
+    assert time.monotonic() - start < 4.0
+
+
+def test_a_background_child_holding_the_output_does_not_delay_us(tmp_path: Path) -> None:
+    pidfile = tmp_path / "bg.pid"
+    path = xacro_file(tmp_path, shell(f"sleep 30 & echo $! > {pidfile}"))
+    start = time.monotonic()
+    data = expand_xacro(path, timeout=20)
+    assert time.monotonic() - start < 8.0  # not the 20 s timeout, nor the 30 s sleep
+    assert b"<robot" in data
+    deadline = time.monotonic() + 3
+    pid = int(pidfile.read_text())
+    while alive(pid) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not alive(pid)
+
+
+def test_a_daemonized_grandchild_does_not_outlive_the_expansion(tmp_path: Path) -> None:
+    # setsid leaves the worker's process group and session, and the shell that started it
+    # exits at once: the sleep is re-parented, as a daemon would be. (xacro reads "$$" itself,
+    # so the daemon is found by its unique command line.)
+    marker = b"sleep\x0030.4242"
+    path = xacro_file(tmp_path, shell("setsid sleep 30.4242 > /dev/null 2>&1 < /dev/null &"))
+
+    def daemons() -> list[int]:
+        found = []
+        for pid in filter(str.isdigit, os.listdir("/proc")):
+            try:
+                if Path(f"/proc/{pid}/cmdline").read_bytes().startswith(marker) \
+                        and alive(int(pid)):
+                    found.append(int(pid))
+            except OSError:
+                continue
+        return found
+
+    assert daemons() == []
+    expand_xacro(path, timeout=20)
+    deadline = time.monotonic() + 3
+    while daemons() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert daemons() == []
+
+
+def test_memory_is_limited(tmp_path: Path) -> None:
+    path = xacro_file(tmp_path, "len([0] * (4 * 1024**3 // 8))")  # a 4 GiB list
+    with pytest.raises(InputError, match="xacro failed"):
+        expand_xacro(path, timeout=20)
+
+
+def test_env_values_never_reach_messages(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("ROBOT_TOKEN", "hunter2-very-secret")
+    path = xacro_file(tmp_path, "1 / 0", head='<xacro:property name="t" '
+                      'value="$(env ROBOT_TOKEN)"/><link name="${t + t.nope}"/>')
+    with pytest.raises(InputError) as e:
+        expand_xacro(path, timeout=20)
+    assert "hunter2" not in str(e.value)
+
+
+def test_unknown_arg_names_get_a_suggestion(tmp_path: Path) -> None:
+    path = tmp_path / "arm.urdf.xacro"
+    path.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                    '<xacro:arg name="wheel_radius" default="1"/>'
+                    '<link name="a$(arg wheel_radius)"/></robot>')
+    with pytest.raises(ParameterError, match="did you mean 'wheel_radius'"):
+        expand_xacro(path, {"wheel_radiu": "2"}, timeout=20)
+    code = runner.invoke(app, ["tree", str(path), "--arg", "wheel_radiu:=2"])
+    assert code.exit_code == 2 and "--arg: 'wheel_radiu'" in code.stderr
+    assert b'name="a2"' in expand_xacro(path, {"wheel_radius": "2"}, timeout=20)
+
+
+# --------------------------------------------------------------------------- no exec
+
+
+def test_no_exec_refuses_to_run_anything(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    marker = tmp_path / "ran"
+    path = xacro_file(tmp_path, shell(f"touch {marker}"))
+    assert execution_allowed()
+    with pytest.raises(XacroNotExpanded):
+        expand_xacro(path, no_exec=True)
+    monkeypatch.setenv(NO_EXEC_ENV, "1")
+    assert not execution_allowed()
+    with pytest.raises(XacroNotExpanded):
+        expand_xacro(path)
+    result = runner.invoke(app, ["joints", str(path)])
+    assert result.exit_code == 2 and "executing xacro is disabled" in result.stderr
+    assert not marker.exists()
+
+
+def test_check_no_exec_reports_each_xacro(tmp_path: Path) -> None:
+    marker = tmp_path / "ran"
+    xacro_file(tmp_path, shell(f"touch {marker}"))
+    result = check_paths([tmp_path], no_exec=True, jobs=1)
+    (finding,) = result.findings
+    assert finding.code == "U006" and finding.level == "warning"
+    assert not marker.exists()
+    cli = runner.invoke(app, ["check", str(tmp_path), "--no-exec", "--json"])
+    assert [f["code"] for f in json.loads(cli.stdout)["findings"]] == ["U006"]
+    assert not marker.exists()
+    env = runner.invoke(app, ["check", str(tmp_path), "--json"], env={NO_EXEC_ENV: "yes"})
+    assert [f["code"] for f in json.loads(env.stdout)["findings"]] == ["U006"]
+    assert not marker.exists()
+    os.environ.pop(NO_EXEC_ENV, None)
