@@ -271,7 +271,7 @@ def test_plot_is_a_png(runner: CliRunner, tmp_path: Path) -> None:
         (["--time-step", "0"], "--time-step must be in"),
         (["--wheels", "nope"], "--wheels: no joint named 'nope'"),
         (["--trajectory", "out.txt"], "--trajectory must end in .csv or .jsonl"),
-        (["--plot", "out.jpg"], "--plot must end in .png"),
+        (["--plot", "out.jpg"], "out.jpg: the plot must end in .png"),
         (["--urdf", "no_such_car.urdf"], "no such file"),
     ],
 )

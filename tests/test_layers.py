@@ -17,7 +17,7 @@ PACKAGE = Path(urdfkit.__file__).parent
 LAYERS: dict[str, int] = {}
 for floor, names in enumerate([
     # spec and model
-    "errors spec style templatedir _xacro_worker suggest xmlio builder catalog",
+    "errors spec style templatedir _xacro_worker suggest output xmlio builder catalog",
     # sources: files, packages, xacro, and the guard every loader calls
     "uris expand validate resolve",
     # the engine session

@@ -170,12 +170,12 @@ def test_cli_tree_dot_stdout_and_file(simplecar_urdf: Path, tmp_path: Path) -> N
 
 def test_cli_tree_dot_errors(simplecar_urdf: Path, tmp_path: Path) -> None:
     res = runner.invoke(app, ["tree", str(simplecar_urdf), "-o", str(tmp_path / "g.txt")])
-    assert res.exit_code == 2 and "unknown graph format" in res.output
+    assert res.exit_code == 2 and "the graph must end in .dot or .gv" in res.output
     res = runner.invoke(app, ["tree", str(simplecar_urdf), "--dot", "--json"])
     assert res.exit_code == 2 and "choose one" in res.output
     bad = tmp_path / "bad.urdf"
     bad.write_text("<robot name='x'><link name='a'/><link name='b'/></robot>")
     res = runner.invoke(app, ["tree", str(bad), "--dot"])
     assert res.exit_code == 2 and "bad.urdf" in res.output and "root links" in res.output
-    with pytest.raises(OutputError, match="unknown graph format"):
+    with pytest.raises(OutputError, match="the graph must end in"):
         write_graph("digraph {}", tmp_path / "g")

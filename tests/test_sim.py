@@ -426,7 +426,7 @@ def test_parquet_needs_pyarrow_or_says_how_to_get_it(tmp_path: Path,
 
 
 def test_unknown_output_format(tmp_path: Path, rows: list[dict[str, Any]]) -> None:
-    with pytest.raises(OutputError, match="unknown output format '.xlsx'"):
+    with pytest.raises(OutputError, match="the rows file must end in .jsonl or .csv or .parquet"):
         write_rows(tmp_path / "o.xlsx", rows, force=False)
     with pytest.raises(OutputError):
         rows_to_bytes(rows, ".txt")

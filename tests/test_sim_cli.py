@@ -74,7 +74,7 @@ def test_bad_output_format_fails_before_the_run(runner: CliRunner, tmp_path: Pat
     result = runner.invoke(app, ["sim", str(EXAMPLES / "two_cars.json"), "-o",
                                  str(tmp_path / "rows.xlsx")])
     assert result.exit_code == 2
-    assert "unknown output format '.xlsx'" in result.stderr
+    assert "rows.xlsx: the rows file must end in .jsonl" in result.stderr
 
 
 def test_validation_error_names_the_path_and_exits_2(runner: CliRunner, tmp_path: Path) -> None:

@@ -9,9 +9,10 @@ from .builder import Robot
 from .catalog import TEMPLATES, build_template, parse_assignments
 from .errors import InputError, ParameterError
 from .expand import expand_xacro
+from .output import atomic_write
 from .resolve import locate
 from .validate import ALL_RULES, guard, run_rules
-from .xmlio import atomic_write, parse_xml, to_bytes
+from .xmlio import parse_xml, to_bytes
 
 
 @dataclass

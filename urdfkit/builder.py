@@ -33,6 +33,7 @@ from typing import Any, ClassVar
 from lxml import etree
 
 from .errors import ModelError
+from .output import atomic_write
 from .spec import (
     JOINT_TYPES,
     LIMITED_JOINT_TYPES,
@@ -49,7 +50,7 @@ from .spec import (
     sym_eigenvalues,
     transpose,
 )
-from .xmlio import atomic_write, fmt_float, fmt_vec, load_xml, parse_xml, to_bytes
+from .xmlio import fmt_float, fmt_vec, load_xml, parse_xml, to_bytes
 
 __all__ = ["JOINT_TYPES", "LIMITED_JOINT_TYPES", "rpy_to_matrix"]  # re-exported from spec
 

@@ -571,16 +571,14 @@ def drive(
                              "headless", param="gui")
     # Check the outputs before a long run, not after it.
     if trajectory is not None:
-        from .xmlio import check_writable
+        from .output import check_output
 
         trajectory_format(trajectory)
-        check_writable(trajectory, force=force)
+        check_output(trajectory, force=force)
     if plot is not None:
         from .plot import check_plot_path
-        from .xmlio import check_writable
 
-        check_plot_path(plot)
-        check_writable(plot, force=force)
+        check_plot_path(plot, force=force)
     params = None
     if set_:
         from .catalog import parse_assignments  # imports the builder: only when needed

@@ -202,7 +202,7 @@ def trajectory_format(path: str | Path) -> str:
 
 def write_trajectory(traj: Trajectory, path: str | Path, *, force: bool = False) -> Path:
     """Write the trajectory atomically as CSV or JSON lines (by suffix)."""
-    from .xmlio import atomic_write
+    from .output import atomic_write
 
     return atomic_write(path, traj.to_bytes(trajectory_format(path)), force=force)
 

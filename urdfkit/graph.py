@@ -21,7 +21,9 @@ from lxml import etree
 
 from . import style
 from .errors import MissingDependencyError, OutputError
-from .xmlio import atomic_write, fmt_float, fmt_vec
+from .output import atomic_write
+from .output import check_output as _check_output
+from .xmlio import fmt_float, fmt_vec
 
 #: Output suffixes written as DOT text; the others are rendered by the ``dot`` program.
 DOT_SUFFIXES = (".dot", ".gv")
@@ -122,14 +124,8 @@ def render_dot(dot: str, fmt: str, timeout: float = DOT_TIMEOUT) -> bytes:
 
 def check_output(path: str | Path, *, force: bool = False) -> Path:
     """Refuse an output path early: unknown suffix, or an existing file without ``force``."""
-    path = Path(path)
-    if path.suffix.lower() not in DOT_SUFFIXES + RENDERED_SUFFIXES:
-        known = ", ".join(DOT_SUFFIXES + RENDERED_SUFFIXES)
-        raise OutputError(f"unknown graph format {path.suffix or '(none)'}; name the output "
-                          f"with one of {known}", file=path)
-    from .xmlio import check_writable
-
-    return check_writable(path, force=force)
+    return _check_output(path, force=force, suffixes=DOT_SUFFIXES + RENDERED_SUFFIXES,
+                         what="the graph")
 
 
 def write_graph(dot: str, path: str | Path, *, force: bool = False) -> Path:

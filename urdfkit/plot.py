@@ -14,8 +14,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from . import style
-from .errors import MissingDependencyError, ParameterError
-from .xmlio import atomic_write
+from .errors import MissingDependencyError
+from .output import atomic_write, check_output
 
 if TYPE_CHECKING:
     from .drive import DriveResult
@@ -33,10 +33,12 @@ def _pyplot() -> Any:
     return plt
 
 
-def check_plot_path(path: str | Path) -> None:
-    """Refuse, before the run starts, a plot path that is not a PNG or a missing matplotlib."""
-    if Path(path).suffix.lower() != ".png":
-        raise ParameterError(f"`plot` must end in .png, got {str(path)!r}", param="plot")
+def check_plot_path(path: str | Path, *, force: bool = False) -> None:
+    """Refuse, before the run starts, a bad plot path or a missing matplotlib.
+
+    Bad: not a PNG, or not writable (see :func:`urdfkit.output.check_output`).
+    """
+    check_output(path, force=force, suffixes=(".png",), what="the plot")
     import importlib.util
 
     if importlib.util.find_spec("matplotlib") is None:
@@ -98,5 +100,5 @@ def plot_bytes(result: DriveResult) -> bytes:
 
 def write_plot(result: DriveResult, path: str | Path, *, force: bool = False) -> Path:
     """Draw the drive to a PNG file, atomically."""
-    check_plot_path(path)
+    check_plot_path(path, force=force)
     return atomic_write(path, plot_bytes(result), force=force)

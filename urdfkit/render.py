@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from . import style
-from .errors import EngineError, InputError, MissingDependencyError, OutputError, ParameterError
+from .errors import EngineError, InputError, MissingDependencyError, ParameterError
 from .spec import attr_vec, pybullet_joint_type, rpy_to_matrix, vector
 
 #: The views, as (direction from target to camera, camera up vector). URDF: x forward, z up.
@@ -734,17 +734,15 @@ def check_output(path: str | Path, *, force: bool = False) -> Path:
 
     The CLI calls this before rendering, so a refused path costs nothing.
     """
-    path = Path(path)
-    if path.suffix.lower() != ".png":
-        raise OutputError("urdfkit render writes PNG; name the output *.png", file=path)
-    from .xmlio import check_writable
+    from .output import check_output as check
 
-    return check_writable(path, force=force)
+    return check(path, force=force, suffixes=(".png",), what="the picture (urdfkit render "
+                 "writes PNG)")
 
 
 def write_png(rendering: Rendering, path: str | Path, *, force: bool = False) -> Path:
     """Write the picture atomically; refuses to replace a file unless ``force``."""
     path = check_output(path, force=force)
-    from .xmlio import atomic_write
+    from .output import atomic_write
 
     return atomic_write(path, rendering.png_bytes(), force=force)

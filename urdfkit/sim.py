@@ -745,14 +745,10 @@ def _pyarrow() -> Any:
 
 def check_output(path: str | Path, *, force: bool) -> None:
     """Refuse a bad ``--out`` before simulating: unknown format, existing file, no pyarrow."""
-    out = Path(path)
-    if out.suffix.lower() not in OUTPUT_FORMATS:
-        raise OutputError(f"unknown output format {out.suffix or '(none)'!r}; use "
-                          f"{', '.join(OUTPUT_FORMATS)}", file=path)
-    from .xmlio import check_writable
+    from .output import check_output as check
 
-    check_writable(path, force=force)
-    if out.suffix.lower() == ".parquet":
+    check(path, force=force, suffixes=OUTPUT_FORMATS, what="the rows file")
+    if Path(path).suffix.lower() == ".parquet":
         _pyarrow()
 
 
@@ -779,7 +775,7 @@ def rows_to_bytes(rows: Sequence[Mapping[str, Any]], fmt: str) -> bytes:
 
 def write_rows(path: str | Path, rows: Sequence[Mapping[str, Any]], *, force: bool) -> Path:
     """Write rows in the format the suffix names, atomically; never replace without ``force``."""
-    from .xmlio import atomic_write
+    from .output import atomic_write
 
     check_output(path, force=force)
     return atomic_write(path, rows_to_bytes(rows, Path(path).suffix.lower()), force=force)

@@ -197,63 +197,6 @@ def to_bytes(root: etree._Element) -> bytes:
     return b'<?xml version="1.0" encoding="utf-8"?>\n' + body
 
 
-def check_writable(path: str | Path, *, force: bool = False) -> Path:
-    """Refuse an output path that is a folder, exists (without ``force``), or has no folder.
-
-    Commands that work for a while before writing (drive, sim, render) call this first, so
-    a run never ends in a refusal; :func:`atomic_write` calls it again at write time.
-    """
-    from .errors import OutputError
-
-    path = Path(path)
-    if path.is_dir():
-        raise OutputError("is a directory", file=path)
-    if path.exists() and not force:
-        raise OutputError("exists; pass `force=True` to overwrite it", file=path,
-                          param="force")
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise OutputError(f"folder {folder} does not exist", file=path)
-    return path
-
-
-def atomic_write(path: str | Path, data: bytes, *, force: bool = False) -> Path:
-    """Write ``data`` to ``path`` atomically: a temp file in the same folder, then rename.
-
-    Refuses to replace an existing file unless ``force`` is set, so nothing is lost.
-    """
-    from .errors import OutputError
-
-    path = check_writable(path, force=force)
-    folder = path.parent if str(path.parent) else Path(".")
-    import tempfile
-
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    except OSError as e:
-        raise OutputError(f"cannot write: {e.strerror}", file=path) from None
-    try:
-        # mkstemp makes the file 0600; give it the mode a plain open() would have.
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        if not force and path.exists():
-            raise OutputError("exists; pass `force=True` to overwrite it", file=path,
-                          param="force")
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-    return path
-
-
 # --------------------------------------------------------------------------- reading values
 
 
