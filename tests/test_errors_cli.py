@@ -229,3 +229,31 @@ def test_file_names_that_are_not_utf8_load(tmp_path: Path, simplecar_urdf: Path,
         assert doc["robot"] == "simplecar"
     else:
         assert b"simplecar" in proc.stdout and b"Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".jsonl"])
+def test_sigterm_keeps_the_rows_a_sim_streamed(tmp_path: Path, suffix: str) -> None:
+    scenario = tmp_path / "long.json"
+    scenario.write_text(json.dumps({
+        "duration": 100000.0, "record": {"every": 24},
+        "robots": [{"name": "car", "template": "simplecar",
+                    "drive": [{"until": 100000.0, "throttle": 5, "steer": 0.2}]}]}))
+    out = tmp_path / f"rows{suffix}"
+    proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "sim", str(scenario), "-o",
+                             str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    time.sleep(3.0)
+    proc.send_signal(signal.SIGTERM)
+    _, stderr = proc.communicate(timeout=30)
+    assert proc.returncode == 130, stderr
+    assert "interrupted" in stderr and "Traceback" not in stderr
+    lines = out.read_text().splitlines()
+    assert len(lines) > 5
+    if suffix == ".jsonl":
+        rows = [json.loads(line) for line in lines]  # every line a complete row
+        assert [r["step"] for r in rows] == [24 * i for i in range(len(rows))]
+    else:
+        width = len(lines[0].split(","))
+        assert lines[0].startswith("t,step,robot") and all(
+            len(line.split(",")) == width for line in lines)
+    assert not list(tmp_path.glob(".rows*.tmp"))  # the temp file became the file

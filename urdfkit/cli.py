@@ -601,15 +601,17 @@ def drive(
         for w in sc.warnings:
             show.warn(w)
         progress, stop = show.progress("driving", "steps", enabled=not as_json)
+        written = []
         try:
-            result = sc.run(progress)
+            if trajectory is None:
+                result = sc.run(progress)
+            else:
+                from .drive import drive_to_file
+
+                result, path = drive_to_file(sc, trajectory, force=force, progress=progress)
+                written.append(path)
         finally:
             stop()
-    written = []
-    if trajectory is not None:
-        from .drive import write_trajectory
-
-        written.append(write_trajectory(result.trajectory, trajectory, force=force))
     if plot is not None:
         from .plot import write_plot
 
@@ -755,20 +757,27 @@ def sim(
 
     if out is not None:
         simulation.check_output(out, force=force)  # fail before the run, not after it
+    written = None
     with simulation.Simulation.from_file(scenario) as s:
-        result = s.run()
+        if out is None:
+            result = s.run()
+        else:
+            result, written = simulation.run_to_file(s, out, force=force)
     rows = result.to_dicts()
-    written = None if out is None else simulation.write_rows(out, rows, force=force)
     summaries = simulation.summarize(result)
     if as_json:
         data: dict[str, Any] = {
             "scenario": scenario, "time_step": result.time_step, "steps": result.steps,
             "duration": result.steps * result.time_step, "rows": len(rows),
             "robots": [x.to_dict() for x in summaries],
-            "out": None if written is None else str(written)}
+            "out": None if written is None else str(written),
+            "interrupted": result.interrupted}
         if written is None:
             data["observations"] = rows
         show.print_json(data)
+        if result.interrupted:
+            show.interrupted("interrupted; the rows cover the steps simulated")
+            raise typer.Exit(130)
         return
     fixed = show.fixed
     show.table(f"sim {scenario}: {result.steps:,} steps of {result.time_step:.5g} s", [
@@ -782,6 +791,9 @@ def sim(
             show.line((x.robot, "cyan"), f" final joints: {joints}")
     if written is not None:
         show.wrote(written, f"{len(rows):,} rows")
+    if result.interrupted:
+        show.interrupted("interrupted; the rows cover the steps simulated")
+        raise typer.Exit(130)
 
 
 def _command_name(info: Any) -> str:

@@ -173,22 +173,37 @@ class Trajectory:
 
     def to_bytes(self, fmt: str) -> bytes:
         """The trajectory as ``.csv`` or ``.jsonl`` bytes (deterministic: fixed precision)."""
+        return self.header_bytes(fmt) + self.rows_bytes(self.rows, fmt)
+
+    def header_bytes(self, fmt: str) -> bytes:
+        """What comes before the rows: the CSV header line; nothing for JSON lines."""
+        _check_format(fmt)
+        if fmt != ".csv":
+            return b""
+        buf = io.StringIO()
+        csv.writer(buf, lineterminator="\n").writerow(self.columns)
+        return buf.getvalue().encode("utf-8")
+
+    def rows_bytes(self, rows: list[tuple[float, ...]], fmt: str) -> bytes:
+        """Rows as CSV lines or JSON lines (non-finite values as empty / null)."""
         from .xmlio import fmt_float
 
-        cells = [[fmt_float(v) for v in row] for row in self.rows]
+        _check_format(fmt)
+        cells = [[fmt_float(v) if math.isfinite(v) else "" for v in row] for row in rows]
         if fmt == ".csv":
             buf = io.StringIO()
-            w = csv.writer(buf, lineterminator="\n")
-            w.writerow(self.columns)
-            w.writerows(cells)
+            csv.writer(buf, lineterminator="\n").writerows(cells)
             return buf.getvalue().encode("utf-8")
-        if fmt == ".jsonl":
-            lines = ("{" + ", ".join(f"{json.dumps(k)}: {v}"
-                                     for k, v in zip(self.columns, row, strict=False))
-                     + "}\n" for row in cells)
-            return "".join(lines).encode("utf-8")
+        lines = ("{" + ", ".join(f"{json.dumps(k)}: {v or 'null'}"
+                                 for k, v in zip(self.columns, row, strict=False))
+                 + "}\n" for row in cells)
+        return "".join(lines).encode("utf-8")
+
+
+def _check_format(fmt: str) -> None:
+    if fmt not in TRAJECTORY_FORMATS:
         raise ParameterError(f"trajectory format must be one of {', '.join(TRAJECTORY_FORMATS)}"
-                             f", got {fmt or 'no suffix'!r}")
+                             f", got {fmt or 'no suffix'!r}", param="trajectory")
 
 
 def trajectory_format(path: str | Path) -> str:
@@ -198,6 +213,22 @@ def trajectory_format(path: str | Path) -> str:
         raise ParameterError(f"`trajectory` must end in {' or '.join(TRAJECTORY_FORMATS)}",
                              param="trajectory")
     return suffix
+
+
+def drive_to_file(scenario: Scenario, path: str | Path, *, force: bool = False,
+                  progress: ProgressFn | None = None) -> tuple[DriveResult, Path]:
+    """Run ``scenario`` (opened), streaming its trajectory to ``path`` as it is sampled.
+
+    On Ctrl-C (SIGTERM, SIGHUP in the CLI) the file holds every sample taken so far.
+    """
+    from .output import StreamingFile
+
+    fmt = trajectory_format(path)
+    with StreamingFile(path, force=force, keep_on_interrupt=True) as out:
+        out.write(Trajectory(scenario.columns).header_bytes(fmt))
+        traj = Trajectory(scenario.columns)
+        result = scenario.run(progress, sink=lambda row: out.write(traj.rows_bytes([row], fmt)))
+    return result, out.path
 
 
 def write_trajectory(traj: Trajectory, path: str | Path, *, force: bool = False) -> Path:
@@ -491,7 +522,8 @@ class Scenario:
 
         return sample
 
-    def run(self, progress: ProgressFn | None = None) -> DriveResult:
+    def run(self, progress: ProgressFn | None = None,
+            sink: Callable[[tuple[float, ...]], None] | None = None) -> DriveResult:
         """Drive for the configured number of steps and measure the run.
 
         Ctrl-C ends the loop early; the result then covers what was simulated, with
@@ -499,6 +531,7 @@ class Scenario:
 
         Args:
             progress: Called as ``progress(done, total)`` after every sample.
+            sink: Called with each trajectory sample as it is taken (to stream it to disk).
         """
         assert self.session is not None
         c, s, train = self.config, self.session, self.drivetrain
@@ -506,7 +539,14 @@ class Scenario:
         disable_default_motors(p, body, client, train.passive)
         apply_drive(p, body, client, train, c.throttle, self.steer, c.max_force)
         total, period, dt = c.total_steps, c.sample_period, c.time_step
-        sample = self._sampler()
+        take = self._sampler()
+
+        def sample(t: float) -> tuple[float, ...]:
+            row = take(t)
+            if sink is not None:
+                sink(row)
+            return row
+
         rows = [sample(0.0)]
         step = p.stepSimulation
         done = 0

@@ -26,7 +26,7 @@ import math
 import random
 import tempfile
 from collections import deque
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -193,12 +193,15 @@ class SimResult:
         ideal: The true observations at the same steps.
         time_step: Physics time step, s.
         steps: Physics steps taken.
+        interrupted: Ctrl-C (or SIGTERM in the CLI) ended the run early; the rows cover the
+            steps simulated.
     """
 
     rows: list[Observation]
     ideal: list[Observation]
     time_step: float
     steps: int
+    interrupted: bool = False
 
     def to_dicts(self) -> list[dict[str, Any]]:
         """The reported rows as JSON-ready dicts."""
@@ -614,6 +617,11 @@ class Simulation:
             base_ang_vel_body_frame=list(rotate_back(matrix, ang)), contacts=contacts,
             joint_forces=forces)
 
+    def _observe_one(self, robot: str, ideal: bool = False) -> Observation:
+        out = self.observe(robot, ideal=ideal)
+        assert isinstance(out, Observation)
+        return out
+
     def observe(self, robot: str | None = None, *, ideal: bool = False
                 ) -> Observation | dict[str, Observation]:
         """The observation now: as reported (delay, then noise) or ``ideal``.
@@ -655,11 +663,14 @@ class Simulation:
                 changes[name] = [v + b.rng.gauss(0.0, std) for v in value]
         return obs._replace(**changes)
 
-    def run(self, duration: float | None = None) -> SimResult:
+    def run(self, duration: float | None = None,
+            sink: Callable[[list[Observation]], None] | None = None) -> SimResult:
         """Step to ``duration`` (default: the scenario's), recording every ``record.every``.
 
         Rows are taken at every step that is a multiple of ``record.every``, the starting
-        state included when the run starts at step 0.
+        state included when the run starts at step 0. ``sink`` gets each batch of rows (one
+        per robot) as it is recorded, to stream them to disk. Ctrl-C ends the run early with
+        ``interrupted`` set; the rows so far are kept.
         """
         end = self.total_steps if duration is None else \
             self.step_count + max(0, round(duration / self.time_step))
@@ -668,17 +679,27 @@ class Simulation:
         ideal: list[Observation] = []
 
         def record() -> None:
-            for name in self.bodies:
-                rows.append(self.observe(name))  # type: ignore[arg-type]
-                ideal.append(self.observe(name, ideal=True))  # type: ignore[arg-type]
+            batch = [self._observe_one(name) for name in self.bodies]
+            ideal.extend(self._observe_one(name, ideal=True) for name in self.bodies)
+            rows.extend(batch)
+            if sink is not None:
+                sink(batch)
 
-        if self.step_count % every == 0:
-            record()
-        while self.step_count < end:
-            self.step(min(every - self.step_count % every, end - self.step_count))
+        interrupted = False
+        try:
             if self.step_count % every == 0:
                 record()
-        return SimResult(rows, ideal, self.time_step, self.step_count)
+            while self.step_count < end:
+                self.step(min(every - self.step_count % every, end - self.step_count))
+                if self.step_count % every == 0:
+                    record()
+        except KeyboardInterrupt:
+            interrupted = True
+        # A batch cut short by the interrupt is dropped: every robot has the same rows.
+        kept = min(len(rows), len(ideal))
+        whole = kept - kept % max(1, len(self.bodies))
+        return SimResult(rows[:whole], ideal[:whole], self.time_step, self.step_count,
+                         interrupted)
 
 
 # --------------------------------------------------------------------------- summary
@@ -752,18 +773,41 @@ def check_output(path: str | Path, *, force: bool) -> None:
         _pyarrow()
 
 
-def rows_to_bytes(rows: Sequence[Mapping[str, Any]], fmt: str) -> bytes:
-    """Serialise rows as ``.jsonl`` (nested), ``.csv`` or ``.parquet`` (flattened)."""
-    if fmt == ".jsonl":
-        return "".join(json.dumps(r, allow_nan=False) + "\n" for r in rows).encode("utf-8")
-    flat = [flatten(r) for r in rows]
-    columns = _columns(flat)
-    if fmt == ".csv":
+class RowText:
+    """Rows as ``.jsonl`` (nested) or ``.csv`` (flattened) text, batch by batch.
+
+    The CSV columns are those of the first batch (every robot's first row): the robot set
+    and each robot's fields are fixed for a run.
+    """
+
+    def __init__(self, fmt: str):
+        if fmt not in (".jsonl", ".csv"):
+            raise OutputError(f"{fmt!r} cannot be written row by row; use .jsonl or .csv")
+        self.fmt = fmt
+        self.columns: list[str] | None = None
+
+    def encode(self, rows: Sequence[Mapping[str, Any]]) -> bytes:
+        """The text of ``rows`` (with the CSV header before the first batch)."""
+        if self.fmt == ".jsonl":
+            return "".join(json.dumps(r, allow_nan=False) + "\n" for r in rows).encode("utf-8")
+        flat = [flatten(r) for r in rows]
         text = io.StringIO()
-        writer = csv.DictWriter(text, fieldnames=columns, lineterminator="\n")
-        writer.writeheader()
+        header = self.columns is None
+        if self.columns is None:
+            self.columns = _columns(flat)
+        writer = csv.DictWriter(text, fieldnames=self.columns, lineterminator="\n")
+        if header:
+            writer.writeheader()
         writer.writerows(flat)
         return text.getvalue().encode("utf-8")
+
+
+def rows_to_bytes(rows: Sequence[Mapping[str, Any]], fmt: str) -> bytes:
+    """Serialise rows as ``.jsonl`` (nested), ``.csv`` or ``.parquet`` (flattened)."""
+    if fmt in (".jsonl", ".csv"):
+        return RowText(fmt).encode(rows)
+    flat = [flatten(r) for r in rows]
+    columns = _columns(flat)
     if fmt == ".parquet":
         pa = _pyarrow()
         table = pa.table({c: [r.get(c) for r in flat] for c in columns})
@@ -779,3 +823,25 @@ def write_rows(path: str | Path, rows: Sequence[Mapping[str, Any]], *, force: bo
 
     check_output(path, force=force)
     return atomic_write(path, rows_to_bytes(rows, Path(path).suffix.lower()), force=force)
+
+
+def run_to_file(simulation: Simulation, path: str | Path, *, force: bool = False,
+                duration: float | None = None) -> tuple[SimResult, Path]:
+    """Run ``simulation``, writing its rows to ``path`` as they are recorded.
+
+    ``.jsonl`` and ``.csv`` are streamed: on Ctrl-C (SIGTERM, SIGHUP in the CLI) the file
+    holds every complete row so far. ``.parquet`` is written at the end. Nothing is replaced
+    without ``force``.
+    """
+    from .output import StreamingFile
+
+    check_output(path, force=force)
+    fmt = Path(path).suffix.lower()
+    if fmt not in (".jsonl", ".csv"):
+        result = simulation.run(duration)
+        return result, write_rows(path, result.to_dicts(), force=force)
+    text = RowText(fmt)
+    with StreamingFile(path, force=force, keep_on_interrupt=True) as out:
+        result = simulation.run(duration, sink=lambda batch: out.write(
+            text.encode([r.to_dict() for r in batch])))
+    return result, out.path
