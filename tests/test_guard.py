@@ -174,3 +174,28 @@ def test_raw_pybullet_still_behaves_as_recorded(workdir: Path) -> None:
     mismatched = [(c.name, c.raw, got) for (_, c), got in zip(files, outcomes, strict=True)
                   if got != c.raw]
     assert mismatched == []
+
+
+def test_an_oversized_body_is_refused_before_the_tree_is_built(tmp_path: Path) -> None:
+    # 280,000 links took 10 s and 720 MB to parse before the refusal; now it is a streaming
+    # count with constant memory. Peak memory is the check (time is too noisy here).
+    n = 280_000
+    path = tmp_path / "chain.urdf"
+    with path.open("w") as f:
+        f.write('<robot name="chain">')
+        f.writelines(f'<link name="l{i}"/>' for i in range(n))
+        f.writelines(f'<joint name="j{i}" type="fixed"><parent link="l{i - 1}"/>'
+                     f'<child link="l{i}"/></joint>' for i in range(1, n))
+        f.write("</robot>")
+    code = ("import resource, sys\n"
+            "from urdfkit.cli import main\n"
+            "sys.argv = ['urdfkit', *sys.argv[1:]]\n"
+            "try:\n    main()\nexcept SystemExit as e:\n"
+            "    print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, e.code)\n")
+    for command in (["tree"], ["joints", "--json"], ["check", "--json"]):
+        done = subprocess.run([sys.executable, "-c", code, command[0], str(path), *command[1:]],
+                              capture_output=True, text=True, timeout=120)
+        peak_kb, exit_code = done.stdout.split()[-2:]
+        assert exit_code == ("1" if command[0] == "check" else "2"), done.stderr
+        assert "280000 links" in (done.stderr + done.stdout)
+        assert int(peak_kb) < 250_000, (command, peak_kb)  # was 720 MB

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import InputError, ParameterError
-from .validate import ALL_RULES, CODES, LEVELS, Finding, run_rules
+from .validate import ALL_RULES, CODES, LEVELS, Finding, refuse_oversized, run_rules
 
 #: File suffixes a folder search picks up.
 SUFFIXES = (".urdf", ".xacro")
@@ -169,13 +169,15 @@ def check_file(display: str, path: str | Path,
     result = FileResult(display)
     try:
         data = _read(path, display, no_exec)
+        refuse_oversized(data, display)
         _, quirks = tolerate_quirks(data)
         tree = parse_xml(data, display)
     except XacroNotExpanded as e:
         result.findings.append(Finding("U006", "warning", e.message, display))
         return result
     except InputError as e:
-        result.findings.append(Finding("U000", "error", e.message, display, e.line))
+        code = getattr(e, "code", "U000")  # U209 for a body refused before parsing
+        result.findings.append(Finding(code, "error", e.message, display, e.line))
         return result
     except (OSError, ValueError, etree.LxmlError) as e:  # belt and braces: never crash a sweep
         result.findings.append(Finding("U000", "error", f"cannot check: {e}", display))

@@ -25,7 +25,7 @@ from .errors import InputError, ParameterError
 from .expand import expand_xacro
 from .spec import FILE_TAGS
 from .uris import not_a_file, pybullet_data_path, resolve_uri
-from .validate import STRICTER, Finding
+from .validate import STRICTER, Finding, refuse_oversized
 from .validate import guard as run_guard
 from .xmlio import parse_xml, read_bytes, to_bytes
 
@@ -165,7 +165,9 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
         data = expand_xacro(source, xacro_args, display=display)
         tree = parse_xml(data, display)
     else:
-        tree = parse_xml(read_bytes(source), display)
+        data = read_bytes(source)
+        refuse_oversized(data, display)  # before a tree of 280,000 links is built
+        tree = parse_xml(data, display)
     lifted = [f"{where(f)}: let through without the guard ({f.code}): "
               f"{f.message.removesuffix(STRICTER)}" for f in run_guard(tree, display, strict=guard)]
     root = tree.getroot()
