@@ -117,38 +117,34 @@ class Resolved:
         self.close()
 
 
-def _rewrite_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
-                   name: str) -> None:
-    """Point every file reference at an absolute path, for PyBullet (see :mod:`urdfkit.uris`)."""
+def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path], name: str,
+                 rewrite: bool) -> None:
+    """Check every file reference; with ``rewrite``, point each at an absolute path.
+
+    Meshes and textures PyBullet would hang or abort on (folders, FIFOs, devices) are
+    refused, by ``stat`` alone, never opened. A missing file is left to PyBullet, which warns
+    and draws nothing (check says U701). An unknown ``package://`` is refused when the file
+    must be rewritten for PyBullet (see :mod:`urdfkit.uris`).
+    """
     for el in root.iter(*FILE_TAGS):
         fn = el.get("filename")
         if not fn:
             continue
         target = resolve_uri(fn, base, packages)
         if target.path is None:
-            raise InputError(f"cannot resolve {fn!r}: {target.problem}", file=name,
-                             line=el.sourceline)
-        el.set("filename", str(target.path if target.package is not None or
-                               fn.startswith("file://") else target.path.resolve()))
-
-
-def _refuse_special_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
-                          name: str) -> None:
-    """Refuse meshes and textures PyBullet would hang or abort on (never opening them)."""
-    for el in root.iter(*FILE_TAGS):
-        fn = el.get("filename")
-        if not fn:
+            if rewrite:
+                raise InputError(f"cannot resolve {fn!r}: {target.problem}", file=name,
+                                 line=el.sourceline)
             continue
-        target = resolve_uri(fn, base, packages)
-        if target.path is None:
-            continue  # an unknown package: _rewrite_files says so
         why = not_a_file(target.path)
-        if why is None or why == "missing":
-            continue  # missing: PyBullet warns and draws nothing, as check's U701 says
-        fate = ("hangs reading it" if "FIFO" in why or "device" in why else
-                "aborts on it" if why == "a directory" else "cannot read it")
-        raise InputError(f"<{el.tag} filename={fn!r}>: {target.path} is {why}; PyBullet "
-                         f"{fate}", file=name, line=el.sourceline)
+        if why is not None and why != "missing":
+            fate = ("hangs reading it" if "FIFO" in why or "device" in why else
+                    "aborts on it" if why == "a directory" else "cannot read it")
+            raise InputError(f"<{el.tag} filename={fn!r}>: {target.path} is {why}; PyBullet "
+                             f"{fate}", file=name, line=el.sourceline)
+        if rewrite:
+            el.set("filename", str(target.path if target.package is not None or
+                                   fn.startswith("file://") else target.path.resolve()))
 
 
 def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
@@ -171,14 +167,14 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
     lifted = [f"{where(f)}: let through without the guard ({f.code}): "
               f"{f.message.removesuffix(STRICTER)}" for f in run_guard(tree, display, strict=guard)]
     root = tree.getroot()
-    _refuse_special_files(root, source.resolve().parent, packages or {}, display)
     # PyBullet takes paths as UTF-8 text: a file name that is not (bytes from another locale,
     # kept by Python as surrogates) is loaded from a copy with a clean name.
     needs_copy = source.suffix == ".xacro" or not _utf8(str(source))
     has_packages = any((el.get("filename") or "").startswith(("package://", "file://"))
                        for el in root.iter(*FILE_TAGS))
+    _check_files(root, source.resolve().parent, packages or {}, display,
+                 rewrite=has_packages or needs_copy)
     if has_packages or needs_copy:
-        _rewrite_files(root, source.resolve().parent, packages or {}, display)
         import tempfile  # here, not at the top: most loads need no copy
 
         tmp = tempfile.TemporaryDirectory(prefix="urdfkit-")
