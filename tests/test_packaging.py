@@ -30,5 +30,5 @@ def test_wheel_ships_templates_as_package_data(tmp_path: Path) -> None:
                     zf.read(meta).decode().splitlines() if line.startswith("Requires-Dist:")]
     core = {r.split(";")[0].split(">")[0].split("<")[0].split("=")[0].strip().lower()
             for r in requires if "extra ==" not in r}
-    assert {"pybullet", "lxml", "typer", "pydantic", "pillow", "xacro"} <= core
+    assert {"pybullet", "numpy", "lxml", "typer", "pydantic", "pillow", "xacro"} <= core
     assert "yourdfpy" not in core and "matplotlib" not in core
