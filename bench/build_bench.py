@@ -13,7 +13,7 @@ from urdfkit.catalog import build_template
 
 def cases(ctx: Context) -> list[Case]:
     car = ctx.tmp / "car.urdf"
-    build_template("simplecar").write(car)
+    build_template("simplecar").write(car, force=True)  # inspect_bench may have written it
     joints = "urdfkit joints car.urdf --json"
     return [
         Case(joints, [*ctx.urdfkit, "joints", str(car), "--json"]),

@@ -90,7 +90,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="urdfkit-bench-") as tmp:
         folder = Path(tmp)
         car, plane = folder / "simplecar.urdf", folder / "simpleplane.urdf"
-        build_template("simplecar").write(car)
+        build_template("simplecar").write(car, force=True)  # another section may have written it
         build_template("simpleplane").write(plane)
         script = folder / "baseline.py"
         script.write_text(BASELINE)
