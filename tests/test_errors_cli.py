@@ -257,3 +257,49 @@ def test_sigterm_keeps_the_rows_a_sim_streamed(tmp_path: Path, suffix: str) -> N
         assert lines[0].startswith("t,step,robot") and all(
             len(line.split(",")) == width for line in lines)
     assert not list(tmp_path.glob(".rows*.tmp"))  # the temp file became the file
+
+
+def test_a_mesh_path_component_over_255_characters_is_one_line(tmp_path: Path,
+                                                               simplecar_urdf: Path) -> None:
+    text = simplecar_urdf.read_text().replace(
+        "<visual>", f'<visual><geometry><mesh filename="{"d" * 300}/m.stl"/></geometry>'
+                    "</visual><visual>", 1)
+    path = tmp_path / "long.urdf"
+    path.write_text(text)
+    code, _, err = invoke("joints", str(path))
+    assert code == 2
+    assert "longer than the file system allows" in one_error_line(err)
+    result = runner.invoke(app, ["check", str(path), "--json"])
+    assert result.exit_code == 1
+    assert "U704" in [f["code"] for f in json.loads(result.stdout)["findings"]]
+
+
+def test_a_path_through_a_folder_you_cannot_enter_is_one_line(simplecar_urdf: Path) -> None:
+    import shutil
+    import tempfile
+
+    as_root = os.geteuid() == 0
+    setpriv = shutil.which("setpriv")
+    if as_root and setpriv is None:
+        pytest.skip("running as root (which enters anything) and setpriv is not available")
+    base = Path(tempfile.mkdtemp(dir="/tmp"))
+    try:
+        base.chmod(0o755)
+        locked = base / "locked"
+        locked.mkdir()
+        shutil.copy(simplecar_urdf, locked / "car.urdf")
+        (base / "car.urdf").write_text(simplecar_urdf.read_text().replace(
+            "<visual>", '<visual><geometry><mesh filename="locked/m.stl"/></geometry>'
+                        "</visual><visual>", 1))
+        locked.chmod(0)
+        prefix = [setpriv, "--reuid=65534", "--regid=65534", "--clear-groups"] if as_root else []
+        for target, fragment in ((locked / "car.urdf", "permission denied"),
+                                 (base / "car.urdf", "permission denied")):
+            done = subprocess.run([*prefix, sys.executable, "-m", "urdfkit", "joints",
+                                   str(target)], capture_output=True, text=True, timeout=60,
+                                  env={**os.environ, "HOME": "/tmp"})
+            assert done.returncode == 2, done.stderr
+            assert fragment in one_error_line(done.stderr)
+    finally:
+        (base / "locked").chmod(0o755)
+        shutil.rmtree(base)
