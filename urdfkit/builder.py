@@ -246,65 +246,59 @@ class Inertia(_Element):
         return sym_eigenvalues(self.matrix)
 
 
-def _principal(moments: Vec3) -> Inertia:
-    ixx, iyy, izz = moments
-    return Inertia(ixx=ixx, iyy=iyy, izz=izz)
+class _Solid(_Element):
+    """A shape with a closed-form volume and solid inertia (spec.solid_*), by its tag."""
+
+    def _dims(self) -> tuple[float, ...]:
+        raise NotImplementedError
+
+    @property
+    def volume(self) -> float:
+        """Volume in m^3."""
+        return solid_volume(self._tag, self._dims())
+
+    def inertia(self, mass: float) -> Inertia:
+        """Solid inertia about the centre, in the shape's own frame (axis z)."""
+        ixx, iyy, izz = solid_inertia(self._tag, self._dims(), mass)
+        return Inertia(ixx=ixx, iyy=iyy, izz=izz)
 
 
 @dataclass(eq=False)
-class Box(_Element):
+class Box(_Solid):
     """A box centred on its origin; ``size`` is the full extent along x, y, z."""
 
     _tag = "box"
     size: Vec3 = _checked(check=_vector(3, _positive))
 
-    @property
-    def volume(self) -> float:
-        """Volume in m^3."""
-        return solid_volume("box", self.size)
-
-    def inertia(self, mass: float) -> Inertia:
-        """Solid-box inertia about its centre, in its own frame."""
-        return _principal(solid_inertia("box", self.size, mass))
+    def _dims(self) -> tuple[float, ...]:
+        return tuple(self.size)
 
 
 @dataclass(eq=False)
-class Cylinder(_Element):
+class Cylinder(_Solid):
     """A cylinder centred on its origin, its axis along the local z axis."""
 
     _tag = "cylinder"
     radius: float = _checked(check=_positive)
     length: float = _checked(check=_positive)
 
-    @property
-    def volume(self) -> float:
-        """Volume in m^3."""
-        return solid_volume("cylinder", (self.radius, self.length))
-
-    def inertia(self, mass: float) -> Inertia:
-        """Solid-cylinder inertia about its centre, in its own frame (axis z)."""
-        return _principal(solid_inertia("cylinder", (self.radius, self.length), mass))
+    def _dims(self) -> tuple[float, ...]:
+        return (self.radius, self.length)
 
 
 @dataclass(eq=False)
-class Sphere(_Element):
+class Sphere(_Solid):
     """A sphere centred on its origin."""
 
     _tag = "sphere"
     radius: float = _checked(check=_positive)
 
-    @property
-    def volume(self) -> float:
-        """Volume in m^3."""
-        return solid_volume("sphere", (self.radius,))
-
-    def inertia(self, mass: float) -> Inertia:
-        """Solid-sphere inertia about its centre."""
-        return _principal(solid_inertia("sphere", (self.radius,), mass))
+    def _dims(self) -> tuple[float, ...]:
+        return (self.radius,)
 
 
 @dataclass(eq=False)
-class Capsule(_Element):
+class Capsule(_Solid):
     """A capsule (PyBullet extension): a cylinder of ``length`` capped by two hemispheres.
 
     Its axis is the local z axis and ``length`` excludes the caps, as in PyBullet.
@@ -314,14 +308,8 @@ class Capsule(_Element):
     radius: float = _checked(check=_positive)
     length: float = _checked(check=_positive)
 
-    @property
-    def volume(self) -> float:
-        """Volume in m^3."""
-        return solid_volume("capsule", (self.radius, self.length))
-
-    def inertia(self, mass: float) -> Inertia:
-        """Solid-capsule inertia about its centre (axis z), uniform density."""
-        return _principal(solid_inertia("capsule", (self.radius, self.length), mass))
+    def _dims(self) -> tuple[float, ...]:
+        return (self.radius, self.length)
 
 
 @dataclass(eq=False)
