@@ -11,6 +11,7 @@ Usage: ``python tests/fuzz/driver.py JOBS.json RESULTS.jsonl``; JOBS holds
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -46,11 +47,9 @@ def run_one(workdir: str, argv: list[str], timeout: float) -> dict[str, object]:
             traceback.print_exc()
             code = 98
         finally:
-            try:
+            with contextlib.suppress(BaseException):
                 sys.stdout.flush()
                 sys.stderr.flush()
-            except BaseException:  # noqa: BLE001
-                pass
             os._exit(code)
     deadline = start + timeout
     status, hang = None, False

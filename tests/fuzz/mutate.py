@@ -193,16 +193,13 @@ def seeds(extra: list[Path] | None = None) -> dict[str, bytes]:
     """Our own robot fixtures, plus real robots from pybullet_data (read, never copied)."""
     here = Path(__file__).parent.parent / "fixtures" / "robots"
     out = {p.name: p.read_bytes() for p in sorted(here.rglob("*.urdf"))}
-    try:
-        import pybullet_data
+    from urdfkit.uris import pybullet_data_path
 
-        data = Path(pybullet_data.getDataPath())
-        for rel in ("r2d2.urdf", "racecar/racecar.urdf", "kuka_iiwa/model.urdf",
-                    "quadruped/minitaur.urdf", "humanoid/humanoid.urdf"):
-            if (data / rel).is_file():
-                out[rel] = (data / rel).read_bytes()
-    except ImportError:  # pragma: no cover
-        pass
+    data = pybullet_data_path()
+    for rel in ("r2d2.urdf", "racecar/racecar.urdf", "kuka_iiwa/model.urdf",
+                "quadruped/minitaur.urdf", "humanoid/humanoid.urdf"):
+        if data is not None and (data / rel).is_file():
+            out[rel] = (data / rel).read_bytes()
     for p in extra or []:
         out[p.name] = p.read_bytes()
     from urdfkit.xmlio import tolerate_quirks
