@@ -205,10 +205,15 @@ def numbers(text: str | None) -> list[float] | None:
 
 def vector(text: str | None, n: int) -> tuple[float, ...] | None:
     """Exactly ``n`` finite numbers from ``text``, else None (missing, malformed, wrong length)."""
-    vals = numbers(text)
-    if vals is None or len(vals) != n or not all(math.isfinite(v) for v in vals):
+    if text is None:
         return None
-    return tuple(vals)
+    try:
+        vals = tuple(map(float, text.split()))
+    except ValueError:
+        return None
+    if len(vals) != n or not all(map(math.isfinite, vals)):
+        return None
+    return vals
 
 
 def attr_vec(el: _HasGet | None, attr: str, n: int,
@@ -222,8 +227,14 @@ def attr_vec(el: _HasGet | None, attr: str, n: int,
 
 def attr_float(el: _HasGet | None, attr: str, default: float | None = None) -> float | None:
     """One finite number from attribute ``attr`` of ``el``, else ``default``."""
-    v = attr_vec(el, attr, 1)
-    return default if v is None else v[0]
+    text = el.get(attr) if el is not None else None
+    if text is None:
+        return default
+    try:  # the common case, one plain number, without splitting (checks are a hot path)
+        x = float(text)
+    except ValueError:
+        return default
+    return x if math.isfinite(x) else default
 
 
 # --------------------------------------------------------------------------- rotations

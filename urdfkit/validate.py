@@ -45,6 +45,7 @@ from .spec import (
 from .spec import attr_float as _num
 from .spec import attr_vec as _vec
 from .uris import not_a_file, pybullet_data_path, resolve_uri
+from .xmlio import children
 
 LEVELS = ("info", "warning", "error")
 
@@ -108,8 +109,7 @@ class Report:
 Rule = Callable[[etree._Element, Report], None]
 
 
-def _elements(root: etree._Element, tag: str) -> Iterator[etree._Element]:
-    return (c for c in root if isinstance(c.tag, str) and c.tag == tag)
+_elements = children
 
 
 def _label(el: etree._Element) -> str:
@@ -334,18 +334,29 @@ def rule_elements(root: etree._Element, r: Report) -> None:
     subtrees :func:`_walk` skips (opaque and namespaced ones) are collected first.
     """
     skip: set[etree._Element] = set()
-    numeric, schema, finite = NUMERIC.get, SCHEMA.get, math.isfinite
+    by_tag, schema, finite = _NUMERIC_BY_TAG.get, SCHEMA.get, math.isfinite
     for el in root.iter(etree.Element):
         tag = el.tag
-        if tag in OPAQUE or tag.startswith("{"):
-            if el not in skip:
-                skip.update(el.iter())
-            continue
         if skip and el in skip:
             continue
+        if tag[0] == "{":  # namespaced (xacro leftovers, extensions): not ours to judge
+            skip.update(el.iter())
+            continue
+        parent = el.getparent()
+        if parent is not None:
+            around = schema(parent.tag)
+            if around is not None and tag not in around[1]:
+                r.add("U801", "warning", f"<{tag}> is not known inside <{parent.tag}>; "
+                      "PyBullet ignores it", el)
+        if tag in OPAQUE:  # its contents are another tool's (gazebo, transmission, ...)
+            skip.update(el.iter())
+            continue
         known = schema(tag)
+        numeric = by_tag(tag)
+        if known is None and numeric is None:
+            continue
         for attr, text in el.items():
-            n = numeric((tag, attr))
+            n = numeric.get(attr) if numeric is not None else None
             if n is not None:
                 try:
                     vals = [float(x) for x in text.split()]
@@ -357,16 +368,15 @@ def rule_elements(root: etree._Element, r: Report) -> None:
                 elif len(vals) != n:
                     r.add("U402", "error", f"<{tag} {attr}={text!r}>: expected {n} numbers, "
                           f"got {len(vals)}", el)
-            if known is not None and attr not in known[0] and not attr.startswith("{"):
+            if known is not None and attr not in known[0] and attr[0] != "{":
                 r.add("U802", "warning", f"<{tag}> has unknown attribute {attr!r}; PyBullet "
                       "ignores it", el)
-        if known is not None:
-            children = known[1]
-            for child in el.iterchildren(etree.Element):
-                ctag = child.tag
-                if ctag not in children and not ctag.startswith("{"):
-                    r.add("U801", "warning", f"<{ctag}> is not known inside <{tag}>; "
-                          "PyBullet ignores it", child)
+
+
+#: NUMERIC by tag: {tag: {attribute: how many numbers}}, for one lookup per element.
+_NUMERIC_BY_TAG: dict[str, dict[str, int]] = {}
+for (_tag, _attr), _n in NUMERIC.items():
+    _NUMERIC_BY_TAG.setdefault(_tag, {})[_attr] = _n
 
 
 def rule_joints(root: etree._Element, r: Report) -> None:
