@@ -752,7 +752,7 @@ CODES: dict[str, str] = {
     "U103": "duplicate joint name",
     "U104": "'%' in a link name (crashes PyBullet)",
     "U105": "duplicate material name",
-    "U106": "name at PyBullet's crash length (joint 1264, link 2288, robot 1042 bytes)",
+    "U106": "name near PyBullet's crash length (joint 1200, link 2200, robot 1024 bytes)",
     "U107": "'%' in a joint, material or robot name (refused; --no-guard lifts it)",
     "U108": "name over 1000 bytes (refused; --no-guard lifts it)",
     "U201": "joint without <parent> or <child>",
