@@ -17,9 +17,9 @@ PACKAGE = Path(urdfkit.__file__).parent
 LAYERS: dict[str, int] = {}
 for floor, names in enumerate([
     # spec and model
-    "errors spec style templatedir _xacro_worker suggest output xmlio builder catalog",
+    "errors spec style templatedir suggest output xmlio builder catalog",
     # sources: files, packages, xacro, and the guard every loader calls
-    "uris expand validate resolve",
+    "uris _xacro_worker expand validate resolve",
     # the engine session
     "session",
     # run and draw

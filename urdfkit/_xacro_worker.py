@@ -5,7 +5,12 @@ a child process that limits itself (memory, CPU, core dumps), adopts any descend
 to daemonize (child subreaper), and kills all its descendants before it exits or when told to
 stop (SIGTERM).
 
-Usage: ``python -m urdfkit._xacro_worker OUT ERR TIMEOUT MEMORY FILE [name:=value ...]``
+``$(find NAME)`` is answered without ROS: a stand-in ``ament_index_python`` module looks the
+package up in the :class:`~urdfkit.uris.PackageIndex` the parent passed (``--package``,
+``--package-path``, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH), then above the file.
+
+Usage: ``python -m urdfkit._xacro_worker OUT ERR TIMEOUT MEMORY PACKAGES_JSON FILE
+[name:=value ...]``
 """
 
 from __future__ import annotations
@@ -88,13 +93,52 @@ def _stop(signum: int, _frame: object) -> None:
     os._exit(128 + signum)
 
 
+#: Packages $(find) could not locate, for the error line (xacro garbles the exception text).
+MISSING: list[str] = []
+
+
+class PackageNotFoundError(KeyError):
+    """The stand-in for ament_index_python's: a package $(find) cannot locate."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else "package not found"
+
+
+def _install_find(packages_json: str, source: str) -> None:
+    """Make ``$(find NAME)`` work without ROS (xacro imports ament_index_python for it)."""
+    import json
+    import types
+    from pathlib import Path
+
+    from urdfkit.uris import PackageIndex, find_package
+
+    index = PackageIndex.from_json(json.loads(packages_json))
+    base = Path(source).resolve().parent
+
+    def get_package_share_directory(name: str) -> str:
+        found = index.get(name) or find_package(name, base)
+        if found is None:
+            MISSING.append(name)
+            raise PackageNotFoundError(name)
+        return str(found)
+
+    module = types.ModuleType("ament_index_python.packages")
+    module.get_package_share_directory = get_package_share_directory  # type: ignore[attr-defined]
+    module.PackageNotFoundError = PackageNotFoundError  # type: ignore[attr-defined]
+    parent = types.ModuleType("ament_index_python")
+    parent.packages = module  # type: ignore[attr-defined]
+    sys.modules.setdefault("ament_index_python", parent)
+    sys.modules.setdefault("ament_index_python.packages", module)
+
+
 def main(argv: list[str]) -> int:
     """Expand FILE with ``name:=value`` mappings into OUT; errors go to ERR (last line)."""
-    if len(argv) < 5:
+    if len(argv) < 6:
         print(__doc__, file=sys.stderr)
         return 2
-    out, _err, timeout, memory, source, *items = argv
+    out, _err, timeout, memory, packages, source, *items = argv
     _limits(float(timeout), int(memory))
+    _install_find(packages, source)
     _subreaper()
     signal.signal(signal.SIGTERM, _stop)
     mappings = {}
@@ -113,14 +157,44 @@ def main(argv: list[str]) -> int:
         print("MemoryError: the expansion needed more memory than its limit", file=sys.stderr)
         return 1
     except BaseException as e:  # xacro raises bare Exceptions and SystemExit
+        if MISSING:
+            name = MISSING[-1]
+            print(f"$(find {name}): package {name!r} not found; give its folder with "
+                  f"`packages` ({name}=PATH) or a folder holding it with `package_paths` (or "
+                  "set ROS_PACKAGE_PATH)", file=sys.stderr)
+            return 1
         msg = str(e).strip().splitlines()
         print(msg[0] if msg else type(e).__name__, file=sys.stderr)
         return 1
     finally:
         _kill_descendants()
+    unknown = sorted(set(mappings) - _declared_args([source, *xacro.all_includes]))
+    if unknown:
+        from urdfkit.suggest import hint
+
+        declared = sorted(_declared_args([source, *xacro.all_includes]))
+        print(f"`xacro_args`: {unknown[0]!r} is not an argument of this file or its includes"
+              f"{hint(unknown[0], declared)} (its <xacro:arg>s: {', '.join(declared) or 'none'})",
+              file=sys.stderr)
+        return 3  # urdfkit.expand.BAD_ARGS
     with open(out, "wb") as f:
         f.write(data)
     return 0
+
+
+def _declared_args(files: list[str]) -> set[str]:
+    """The names of every ``<xacro:arg>`` in the files xacro read (the file and includes)."""
+    import re
+
+    pattern = re.compile(rb"<xacro:arg\s[^>]*?name\s*=\s*[\"']([^\"']+)[\"']")
+    names: set[str] = set()
+    for path in set(files):
+        try:
+            with open(path, "rb") as f:
+                names.update(m.decode("utf-8", "replace") for m in pattern.findall(f.read()))
+        except OSError:
+            continue
+    return names
 
 
 if __name__ == "__main__":

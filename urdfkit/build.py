@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,8 +28,13 @@ class BuildResult:
 
 
 def build(target: str, params: list[str] | None = None,
-          xacro_args: list[str] | None = None) -> BuildResult:
-    """Build ``target``: a built-in template name, or a path to a ``.xacro`` file."""
+          xacro_args: list[str] | None = None,
+          packages: Mapping[str, Path] | None = None) -> BuildResult:
+    """Build ``target``: a built-in template name, or a path to a ``.xacro`` file.
+
+    ``packages`` (a :class:`~urdfkit.uris.PackageIndex` or ``NAME: PATH`` pairs) answers the
+    file's ``$(find NAME)`` and ``package://NAME`` references, as in every loading command.
+    """
     if target in TEMPLATES:
         if xacro_args:
             raise ParameterError("`xacro_args` are for xacro files, not templates",
@@ -55,7 +61,8 @@ def build(target: str, params: list[str] | None = None,
         if source.suffix != ".xacro":
             raise InputError("build takes a template name or a .xacro file; this file is "
                              "already URDF", file=target)
-        expanded = expand_xacro(source, parse_assignments(xacro_args, "xacro_args"), display=target)
+        expanded = expand_xacro(source, parse_assignments(xacro_args, "xacro_args"),
+                                display=target, packages=packages)
         tree = parse_xml(expanded, target)
         guard(tree, target)
         robot = Robot.from_string(expanded, file=target)
@@ -67,7 +74,7 @@ def build(target: str, params: list[str] | None = None,
         base = source.resolve().parent
     # The same rules `urdfkit check` runs: what build writes, check accepts.
     tree = parse_xml(data, name)
-    errors = [f for f in run_rules(tree.getroot(), name, ALL_RULES, base=base)
+    errors = [f for f in run_rules(tree.getroot(), name, ALL_RULES, base=base, packages=packages)
               if f.level == "error"]
     if errors:
         raise InputError(f"the built URDF is invalid: {errors[0].message} ({errors[0].code})",

@@ -138,7 +138,8 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, Path, str | None]]:
     return out
 
 
-def _read(path: Path, display: str, no_exec: bool = False) -> bytes:
+def _read(path: Path, display: str, no_exec: bool = False,
+          packages: Mapping[str, Path] | None = None) -> bytes:
     from .expand import expand_xacro
     from .xmlio import read_bytes
 
@@ -149,7 +150,7 @@ def _read(path: Path, display: str, no_exec: bool = False) -> bytes:
         if why is not None:  # never hand xacro a FIFO to block on
             raise InputError(f"is {why}, not a regular file; urdfkit reads only regular files"
                              if why != "missing" else "no such file", file=display)
-        return expand_xacro(path, display=display, no_exec=no_exec)
+        return expand_xacro(path, display=display, no_exec=no_exec, packages=packages)
     return read_bytes(path)
 
 
@@ -168,7 +169,7 @@ def check_file(display: str, path: str | Path,
     path = Path(path)
     result = FileResult(display)
     try:
-        data = _read(path, display, no_exec)
+        data = _read(path, display, no_exec, packages)
         refuse_oversized(data, display)
         _, quirks = tolerate_quirks(data)
         tree = parse_xml(data, display)

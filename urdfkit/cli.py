@@ -34,7 +34,8 @@ from .errors import UrdfkitError
 #: A parameter not listed maps to ``--`` plus its name with dashes.
 FLAGS = {
     "params": "--set", "template_params": "--set", "xacro_args": "--arg",
-    "packages": "--package", "types": "--type", "urdf": "--urdf", "force=True": "--force",
+    "packages": "--package", "package_paths": "--package-path", "types": "--type",
+    "urdf": "--urdf", "force=True": "--force",
     "force": "--force", "joints": "--joints", "views": "--views", "guard=False": "--no-guard",
 }
 
@@ -176,6 +177,10 @@ ForceOpt = Annotated[bool, typer.Option("--force", "-f", help="Overwrite an exis
 PackageOpt = Annotated[list[str] | None, typer.Option(
     "--package", "-p", metavar="NAME=PATH",
     help="Where package://NAME/ points (repeatable); else found by walking up from the file.")]
+PackagePathOpt = Annotated[list[str] | None, typer.Option(
+    "--package-path", metavar="DIR",
+    help="A folder searched for ROS packages (package.xml) for package:// and $(find) "
+    "(repeatable); ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are searched too.")]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
 FixedBaseOpt = Annotated[bool, typer.Option("--fixed-base", help="Pin the root link to the world.")]
 NoGuardOpt = Annotated[bool, typer.Option(
@@ -196,6 +201,8 @@ def build(
     set_: SetOpt = None,
     arg: ArgOpt = None,
     force: ForceOpt = False,
+    package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
 ) -> None:
     """Build a URDF from a template or a xacro file, check it, and write it atomically.
 
@@ -203,8 +210,10 @@ def build(
     Python code, so only expand files you trust (see docs/security.md).
     """
     from . import build as building
+    from .resolve import parse_packages
 
-    result = building.build(target, params=set_, xacro_args=arg)
+    result = building.build(target, params=set_, xacro_args=arg,
+                            packages=parse_packages(package, package_path))
     out = output if output is not None else result.default_output
     if out == "-":
         sys.stdout.buffer.write(result.data)
@@ -249,10 +258,11 @@ FileArg = Annotated[str, typer.Argument(
     help="A .urdf or .xacro file; a bare name is also looked up in pybullet_data.")]
 
 
-def _open(file: str, package: list[str] | None, arg: list[str] | None, no_guard: bool) -> Any:
+def _open(file: str, package: list[str] | None, arg: list[str] | None, no_guard: bool,
+          package_path: list[str] | None = None) -> Any:
     from .resolve import open_input
 
-    resolved = open_input(file, package, arg, guard=not no_guard)
+    resolved = open_input(file, package, arg, guard=not no_guard, package_paths=package_path)
     for w in resolved.warnings:
         show.warn(w)
     return resolved
@@ -260,12 +270,13 @@ def _open(file: str, package: list[str] | None, arg: list[str] | None, no_guard:
 
 def _inspect(file: str, package: list[str] | None, arg: list[str] | None, *,
              fixed_base: bool = False, inertia_from_file: bool = False,
-             links: bool = False, info: bool = False, no_guard: bool = False) -> Any:
+             links: bool = False, info: bool = False, no_guard: bool = False,
+             package_path: list[str] | None = None) -> Any:
     from .report import inspect_file
     from .session import LoadOptions
 
     options = LoadOptions(fixed_base=fixed_base, inertia_from_file=inertia_from_file)
-    with _open(file, package, arg, no_guard) as resolved:
+    with _open(file, package, arg, no_guard, package_path) as resolved:
         return inspect_file(resolved, options, links=links, info=info)
 
 
@@ -280,6 +291,7 @@ def joints(
     joint_type: TypeOpt = None,
     fixed_base: FixedBaseOpt = False,
     package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
     arg: ArgOpt = None,
     no_guard: NoGuardOpt = False,
 ) -> None:
@@ -290,7 +302,8 @@ def joints(
     """
     from .inspect import filter_joints
 
-    report = _inspect(file, package, arg, fixed_base=fixed_base, no_guard=no_guard)
+    report = _inspect(file, package, arg, fixed_base=fixed_base, no_guard=no_guard,
+                      package_path=package_path)
     rows = filter_joints(report.joints, movable=movable, types=joint_type or ())
     if as_json:
         show.print_json({**report.header(), "joints": [j.to_dict() for j in rows],
@@ -336,6 +349,7 @@ def links(
              "and recomputes it from the collision shapes.")] = False,
     fixed_base: FixedBaseOpt = False,
     package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
     arg: ArgOpt = None,
     no_guard: NoGuardOpt = False,
 ) -> None:
@@ -345,7 +359,8 @@ def links(
     inertia from the collision shapes, and a link without <inertial> gets 1 kg.
     """
     report = _inspect(file, package, arg, fixed_base=fixed_base,
-                      inertia_from_file=inertia_from_file, links=True, no_guard=no_guard)
+                      inertia_from_file=inertia_from_file, links=True, no_guard=no_guard,
+                      package_path=package_path)
     if as_json:
         show.print_json({**report.header(), "inertia_from_file": inertia_from_file,
                          "links": [link.to_dict() for link in report.links],
@@ -388,6 +403,7 @@ def tree(
     file: FileArg,
     as_json: JsonOpt = False,
     package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
     arg: ArgOpt = None,
     dot: Annotated[bool, typer.Option(
         "--dot", help="Print the graph as Graphviz DOT (links boxes, joints edges).")] = False,
@@ -405,9 +421,9 @@ def tree(
     from .tree import kinematic_tree
 
     if dot or output is not None:
-        _tree_dot(file, package, arg, output, force, as_json, no_guard)  # see "# ---- render"
+        _tree_dot(file, package, arg, output, force, as_json, no_guard, package_path)
         return
-    with _open(file, package, arg, no_guard) as resolved:
+    with _open(file, package, arg, no_guard, package_path) as resolved:
         root = kinematic_tree(resolved.root)
         robot = resolved.robot_name
     if as_json:
@@ -424,11 +440,13 @@ def info(
     as_json: JsonOpt = False,
     fixed_base: FixedBaseOpt = False,
     package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
     arg: ArgOpt = None,
     no_guard: NoGuardOpt = False,
 ) -> None:
     """The robot at a glance: links, joints by type, DOF, total mass, bounding box."""
-    report = _inspect(file, package, arg, fixed_base=fixed_base, info=True, no_guard=no_guard)
+    report = _inspect(file, package, arg, fixed_base=fixed_base, info=True, no_guard=no_guard,
+                      package_path=package_path)
     s = report.summary
     if as_json:
         show.print_json({**report.header(), **s.to_dict(), "diagnostics": report.diagnostics})
@@ -466,6 +484,7 @@ def check(
         "--fail-on", metavar="error|warning|info",
         help="Exit 1 when a finding is at or above this level.")] = "error",
     package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
     select: Annotated[list[str] | None, typer.Option(
         "--select", metavar="CODES",
         help="Only these codes or prefixes, comma-separated (e.g. U2,U601).")] = None,
@@ -493,7 +512,7 @@ def check(
 
         raise ParameterError(f"`fail_on` expects error, warning or info, got {fail_on!r}"
                              f"{hint(fail_on, ('error', 'warning', 'info'))}", param="fail_on")
-    result = check_paths(paths, packages=parse_packages(package),
+    result = check_paths(paths, packages=parse_packages(package, package_path),
                          select=parse_codes(select, "`select`"),
                          ignore=parse_codes(ignore, "`ignore`"), jobs=jobs, no_exec=no_exec)
     if as_json:
@@ -537,6 +556,7 @@ def drive(
     set_: SetOpt = None,
     arg: ArgOpt = None,
     package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
     wheels: Annotated[list[str] | None, typer.Option(
         metavar="JOINTS", help="Wheel joints (names or indices, comma-separated) instead of "
         "the detected ones.")] = None,
@@ -589,7 +609,7 @@ def drive(
         packages=package, xacro_args=arg, seconds=10.0 if seconds is None else seconds,
         steps=steps, time_step=time_step, throttle=throttle, steer=steer, max_force=max_force,
         wheels=_split_joints(wheels), hinges=_split_joints(hinges), sample_every=sample_every,
-        gui=gui, guard=not no_guard)
+        gui=gui, guard=not no_guard, package_paths=package_path)
     with Scenario(config) as sc:
         t = sc.drivetrain
 
@@ -678,6 +698,7 @@ def render(
         "--json", help="Print what was drawn (cameras, bounding box) as JSON.")] = False,
     force: ForceOpt = False,
     package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
     arg: ArgOpt = None,
     no_guard: NoGuardOpt = False,
 ) -> None:
@@ -698,7 +719,7 @@ def render(
     if out != "-":  # refuse before the work, not after it
         rendering.check_output(out, force=force)
     picture = rendering.render_file(file, options, packages=package, xacro_args=arg,
-                                    guard=not no_guard)
+                                    guard=not no_guard, package_paths=package_path)
     for w in picture.warnings:
         show.warn(w)
     if out == "-":
@@ -714,7 +735,8 @@ def render(
 
 
 def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
-              output: str | None, force: bool, as_json: bool, no_guard: bool) -> None:
+              output: str | None, force: bool, as_json: bool, no_guard: bool,
+              package_path: list[str] | None) -> None:
     """``tree --dot`` / ``tree -o graph.svg``: the kinematic graph as DOT text or a drawing."""
     from .errors import ParameterError
     from .graph import check_output, dot_graph, write_graph
@@ -723,7 +745,7 @@ def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
         raise ParameterError("--json and --dot/-o are different outputs; choose one")
     if output is not None and output != "-":
         check_output(output, force=force)
-    with _open(file, package, arg, no_guard) as resolved:
+    with _open(file, package, arg, no_guard, package_path) as resolved:
         text = dot_graph(resolved.root)
     if output is None or output == "-":
         sys.stdout.write(text)

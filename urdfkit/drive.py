@@ -90,6 +90,7 @@ class DriveConfig:
         gui: Open the PyBullet GUI with Steering and Throttle sliders.
         guard: False lifts the guard's refusals that are stricter than PyBullet (they become
             warnings); crash classes are refused either way.
+        package_paths: Folders searched for ROS packages (``package.xml``).
     """
 
     urdf: str | None = None
@@ -110,6 +111,7 @@ class DriveConfig:
     base_position: tuple[float, float, float] = (0.0, 0.0, 0.1)
     gui: bool = False
     guard: bool = True
+    package_paths: list[str] | None = None
 
     def check(self) -> None:
         """Refuse values that would make the run meaningless (exit 2 in the CLI)."""
@@ -454,7 +456,7 @@ class Scenario:
         from .resolve import open_input
 
         with open_input(name, self.config.packages, self.config.xacro_args,
-                        guard=self.config.guard) as res:
+                        guard=self.config.guard, package_paths=self.config.package_paths) as res:
             self.warnings.extend(res.warnings)
             return s.load_urdf(res.load_path, options, display=res.name)
 

@@ -36,6 +36,8 @@ from .errors import InputError
 XACRO_TIMEOUT = float(os.environ.get("URDFKIT_XACRO_TIMEOUT", "20"))
 #: Address space a xacro worker may map (bytes).
 XACRO_MEMORY = 2 * 1024**3
+#: The worker's exit status for an argument no file declares (xacro would ignore it silently).
+BAD_ARGS = 3
 #: Set to 1 (true, yes) to refuse executing xacro anywhere (CI over untrusted repositories).
 NO_EXEC_ENV = "URDFKIT_NO_EXEC"
 
@@ -75,50 +77,18 @@ def redact(message: str, secrets: Mapping[str, str]) -> str:
     return message
 
 
-def check_args(source: bytes, args: Mapping[str, str], display: str) -> None:
-    """Refuse ``--arg`` names the file does not declare (xacro would ignore them silently).
-
-    Only decided when the file includes nothing: an included file may declare more args.
-    """
-    if not args:
-        return
-    from lxml import etree
-
-    from .xmlio import parse_xml
-
-    try:
-        root = parse_xml(source, display).getroot()
-    except InputError:
-        return  # xacro will say what is wrong with the XML
-    declared, includes = set(), False
-    for el in root.iter(etree.Element):
-        q = etree.QName(el)
-        if q.namespace in _XACRO_NS:
-            if q.localname == "arg" and el.get("name"):
-                declared.add(el.get("name"))
-            elif q.localname == "include":
-                includes = True
-    if includes:
-        return
-    from .errors import ParameterError
-    from .suggest import hint
-
-    for name in args:
-        if name not in declared:
-            known = ", ".join(sorted(declared)) or "none"
-            raise ParameterError(f"`xacro_args`: {name!r} is not an argument of this file"
-                                 f"{hint(name, declared)} (its <xacro:arg>s: {known})",
-                                 file=display, param="xacro_args")
-
-
 def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
                  timeout: float | None = None, display: str | None = None,
-                 no_exec: bool = False) -> bytes:
+                 no_exec: bool = False, packages: Mapping[str, Path] | None = None) -> bytes:
     """Expand a xacro file in a contained subprocess; return the URDF bytes.
+
+    ``$(find NAME)`` resolves without ROS through ``packages`` (a
+    :class:`~urdfkit.uris.PackageIndex`, or plain ``NAME: PATH`` pairs), then the environment's
+    ROS_PACKAGE_PATH and AMENT_PREFIX_PATH, then by walking up from the file.
 
     Raises:
         XacroNotExpanded: executing xacro is disabled (``no_exec`` or URDFKIT_NO_EXEC).
-        ParameterError: an argument the file does not declare.
+        ParameterError: an argument neither the file nor its includes declare.
         InputError: xacro failed, or ran longer than ``timeout`` seconds.
     """
     name = display or str(path)
@@ -129,14 +99,18 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
     from .xmlio import read_bytes
 
     source = read_bytes(source_path)
-    check_args(source, args or {}, name)
     limit = XACRO_TIMEOUT if timeout is None else timeout
     secrets = _secrets(source)
     with tempfile.TemporaryDirectory(prefix="urdfkit-xacro-") as tmp:
         out, err = Path(tmp) / "out.urdf", Path(tmp) / "err.txt"
         # Absolute, because the worker runs in the file's folder (for its relative includes).
+        import json
+
+        from .uris import PackageIndex
+
+        index = packages if isinstance(packages, PackageIndex) else PackageIndex(packages)
         cmd = [sys.executable, "-m", "urdfkit._xacro_worker", str(out), str(err),
-               f"{limit:g}", str(XACRO_MEMORY), str(source_path)]
+               f"{limit:g}", str(XACRO_MEMORY), json.dumps(index.to_json()), str(source_path)]
         cmd += [f"{k}:={v}" for k, v in (args or {}).items()]
         with open(os.devnull, "rb") as stdin, open(err, "ab") as log:
             proc = subprocess.Popen(cmd, stdin=stdin, stdout=log, stderr=log,
@@ -152,6 +126,12 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
                 raise
             finally:
                 _kill_group(proc.pid)  # background children left in its group
+        if code == BAD_ARGS:
+            from .errors import ParameterError
+
+            lines = err.read_text("utf-8", "replace").strip().splitlines()
+            raise ParameterError(lines[-1] if lines else "unknown xacro argument", file=name,
+                                 param="xacro_args")
         if code != 0:
             lines = [ln for ln in err.read_text("utf-8", "replace").splitlines() if ln.strip()]
             if code < 0:
@@ -163,7 +143,8 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
                 msg = lines[-1] if lines else f"exited with code {code}"
             if "MemoryError" in msg or "Cannot allocate memory" in msg:
                 msg = f"ran out of memory (limit {XACRO_MEMORY // 1024**2} MiB): {msg}"
-            raise InputError(f"xacro failed: {redact(msg, secrets)}", file=name)
+            raise InputError(f"xacro failed: {redact(msg, secrets)}", file=name,
+                             param="packages" if "`packages`" in msg else None)
         return out.read_bytes()
 
 

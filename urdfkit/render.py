@@ -714,7 +714,8 @@ def render(resolved: Any, options: RenderOptions | None = None) -> Rendering:
 
 def render_file(name: str | Path, options: RenderOptions | None = None, *,
                 packages: list[str] | None = None,
-                xacro_args: list[str] | None = None, guard: bool = True) -> Rendering:
+                xacro_args: list[str] | None = None, guard: bool = True,
+                package_paths: list[str] | None = None) -> Rendering:
     """Resolve (xacro, package://, pybullet_data, guard) and render a robot file.
 
     ``guard=False`` lifts the guard's stricter-than-PyBullet refusals; they come back as
@@ -723,7 +724,8 @@ def render_file(name: str | Path, options: RenderOptions | None = None, *,
     from .resolve import open_input
 
     _pillow()  # fail before expanding xacro when Pillow is missing
-    with open_input(name, packages, xacro_args, guard=guard) as resolved:
+    with open_input(name, packages, xacro_args, guard=guard,
+                    package_paths=package_paths) as resolved:
         picture = render(resolved, options)
         picture.warnings[:0] = resolved.warnings
         return picture

@@ -24,7 +24,7 @@ from lxml import etree
 from .errors import InputError, ParameterError
 from .expand import expand_xacro
 from .spec import FILE_TAGS
-from .uris import not_a_file, pybullet_data_path, resolve_uri
+from .uris import PackageIndex, not_a_file, pybullet_data_path, resolve_uri
 from .validate import STRICTER, Finding, refuse_oversized
 from .validate import guard as run_guard
 from .xmlio import parse_xml, read_bytes, to_bytes
@@ -62,8 +62,13 @@ def _utf8(text: str) -> bool:
     return True
 
 
-def parse_packages(items: list[str] | None) -> dict[str, Path]:
-    """Parse repeated ``--package NAME=PATH`` options."""
+def parse_packages(items: list[str] | None,
+                   package_paths: list[str] | None = None) -> PackageIndex:
+    """Where packages are, as a :class:`urdfkit.uris.PackageIndex`.
+
+    ``NAME=PATH`` items (``--package``) first, then ``package_paths`` (``--package-path``),
+    then ROS_PACKAGE_PATH and AMENT_PREFIX_PATH.
+    """
     out: dict[str, Path] = {}
     for item in items or []:
         name, sep, path = item.partition("=")
@@ -73,7 +78,11 @@ def parse_packages(items: list[str] | None) -> dict[str, Path]:
             raise ParameterError(f"`packages` {name}: folder {path!r} does not exist",
                                  param="packages")
         out[name] = Path(path).resolve()
-    return out
+    for folder in package_paths or []:
+        if not Path(folder).is_dir():
+            raise ParameterError(f"`package_paths`: folder {folder!r} does not exist",
+                                 param="package_paths")
+    return PackageIndex(out, [str(Path(p).resolve()) for p in package_paths or []])
 
 
 @dataclass
@@ -158,7 +167,7 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
     display = str(name)
     source = locate(name)
     if source.suffix == ".xacro":
-        data = expand_xacro(source, xacro_args, display=display)
+        data = expand_xacro(source, xacro_args, display=display, packages=packages)
         tree = parse_xml(data, display)
     else:
         data = read_bytes(source)
@@ -193,7 +202,8 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
 
 
 def open_input(name: str | Path, packages: list[str] | None = None,
-               xacro_args: list[str] | None = None, guard: bool = True) -> Resolved:
+               xacro_args: list[str] | None = None, guard: bool = True,
+               package_paths: list[str] | None = None) -> Resolved:
     """:func:`resolve` with the raw ``--package NAME=PATH`` and ``--arg k:=v`` option lists."""
     args: dict[str, str] = {}
     if xacro_args:
@@ -201,4 +211,5 @@ def open_input(name: str | Path, packages: list[str] | None = None,
         from .catalog import parse_assignments
 
         args = dict(parse_assignments(xacro_args, "xacro_args"))
-    return resolve(name, packages=parse_packages(packages), xacro_args=args, guard=guard)
+    return resolve(name, packages=parse_packages(packages, package_paths), xacro_args=args,
+                   guard=guard)

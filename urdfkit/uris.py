@@ -14,7 +14,8 @@ folders above it.
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+import re
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,6 +30,95 @@ def pybullet_data_path() -> Path | None:
     except ImportError:  # pragma: no cover - ships with pybullet
         return None
     return Path(pybullet_data.getDataPath())
+
+
+_PACKAGE_NAME = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
+#: Folders a package search never descends into (build trees, VCS, caches).
+_SKIP_DIRS = frozenset({".git", ".hg", ".svn", "build", "install", "log", "__pycache__",
+                        "node_modules", ".venv", "venv"})
+
+
+def package_xml_name(folder: str) -> str | None:
+    """The ``<name>`` in ``folder/package.xml``, or None."""
+    try:
+        with open(os.path.join(folder, "package.xml"), "rb") as f:
+            head = f.read(65536)
+    except OSError:
+        return None
+    m = _PACKAGE_NAME.search(head)
+    return m.group(1).decode("utf-8", "replace") if m else None
+
+
+class PackageIndex(Mapping[str, Path]):
+    """Where ROS packages are, without ROS, in the order a user expects.
+
+    1. ``explicit``: ``NAME=PATH`` pairs (``--package``);
+    2. ``search``: folders searched recursively for a ``package.xml`` whose ``<name>`` is the
+       package (``--package-path``);
+    3. ``ROS_PACKAGE_PATH`` (searched the same way) and ``AMENT_PREFIX_PATH``
+       (``PREFIX/share/NAME``), unless ``env`` is False.
+
+    :func:`resolve_uri` and xacro's ``$(find NAME)`` then fall back to walking up from the
+    file (:func:`find_package`). Folders are scanned once, lazily, on the first lookup that
+    the explicit pairs do not answer; a package folder is not searched further down.
+    """
+
+    def __init__(self, explicit: Mapping[str, Path] | None = None,
+                 search: Sequence[str | Path] = (), env: bool = True):
+        self.explicit = {k: Path(v) for k, v in (explicit or {}).items()}
+        self.search = [str(p) for p in search]
+        if env:
+            self.search += [p for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep)
+                            if p]
+            self.search += [os.path.join(p, "share") for p in
+                            os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+        self._found: dict[str, Path] | None = None
+
+    def _scan(self) -> dict[str, Path]:
+        if self._found is None:
+            found: dict[str, Path] = {}
+            for root in self.search:
+                stack = [root]
+                while stack:
+                    folder = stack.pop()
+                    name = package_xml_name(folder)
+                    if name is not None:
+                        found.setdefault(name, Path(folder))
+                        continue  # packages do not nest
+                    try:
+                        with os.scandir(folder) as it:
+                            subdirs = sorted(e.path for e in it if e.name not in _SKIP_DIRS
+                                             and not e.name.startswith(".")
+                                             and e.is_dir(follow_symlinks=False))
+                    except OSError:
+                        continue
+                    stack.extend(reversed(subdirs))
+            self._found = found
+        return self._found
+
+    def __getitem__(self, name: str) -> Path:
+        if name in self.explicit:
+            return self.explicit[name]
+        return self._scan()[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter({**self._scan(), **self.explicit})
+
+    def __len__(self) -> int:
+        return len({**self._scan(), **self.explicit})
+
+    def to_json(self) -> dict[str, object]:
+        """What a subprocess needs to rebuild this index (the xacro worker)."""
+        return {"explicit": {k: str(v) for k, v in self.explicit.items()},
+                "search": self.search}
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, object]) -> PackageIndex:
+        """The inverse of :meth:`to_json` (the environment was read by the parent)."""
+        explicit = data.get("explicit") or {}
+        search = data.get("search") or []
+        assert isinstance(explicit, Mapping) and isinstance(search, list)
+        return cls(explicit, search, env=False)
 
 
 def find_package(name: str, start: Path) -> Path | None:

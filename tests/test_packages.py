@@ -1,0 +1,117 @@
+"""ROS description packages without ROS: $(find) across packages, yaml limits, args, and
+package:// meshes, found through --package, --package-path, ROS_PACKAGE_PATH and
+AMENT_PREFIX_PATH (fixtures in tests/fixtures/packages, modelled on ur_description)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from urdfkit.cli import app
+from urdfkit.uris import PackageIndex
+
+runner = CliRunner()
+PACKAGES = Path(__file__).parent / "fixtures" / "packages"
+
+
+@pytest.fixture
+def workspaces(tmp_path: Path) -> tuple[Path, Path]:
+    """The arm in one workspace, the macros it $(find)s in another: no walking up finds them."""
+    arm_ws, macros_ws = tmp_path / "arm_ws" / "src", tmp_path / "macros_ws"
+    shutil.copytree(PACKAGES / "arm_like_description", arm_ws / "arm_like_description")
+    shutil.copytree(PACKAGES / "common_macros", macros_ws / "nested" / "common_macros")
+    return arm_ws / "arm_like_description" / "urdf" / "arm.urdf.xacro", macros_ws
+
+
+def joints(args: list[str], env: dict[str, str] | None = None) -> dict[str, object]:
+    result = runner.invoke(app, ["joints", *args, "--json"], env=env)
+    assert result.exit_code == 0, result.stderr
+    return json.loads(result.stdout)
+
+
+def test_find_fails_with_one_line_saying_how_to_fix(workspaces: tuple[Path, Path]) -> None:
+    arm, _ = workspaces
+    result = runner.invoke(app, ["joints", str(arm)], env={"ROS_PACKAGE_PATH": "",
+                                                             "AMENT_PREFIX_PATH": ""})
+    assert result.exit_code == 2
+    (line,) = result.stderr.strip().splitlines()
+    assert line.startswith(f"urdfkit: error: {arm}: xacro failed: $(find common_macros)")
+    assert "--package (common_macros=PATH)" in line and "--package-path" in line
+
+
+@pytest.mark.parametrize("how", ["package-path", "package", "ROS_PACKAGE_PATH",
+                                 "AMENT_PREFIX_PATH"])
+def test_find_resolves_without_ros(workspaces: tuple[Path, Path], tmp_path: Path,
+                                   how: str) -> None:
+    arm, macros_ws = workspaces
+    env = {"ROS_PACKAGE_PATH": "", "AMENT_PREFIX_PATH": ""}
+    args = [str(arm)]
+    if how == "package-path":
+        args += ["--package-path", str(macros_ws)]
+    elif how == "package":
+        args += ["--package", f"common_macros={macros_ws / 'nested' / 'common_macros'}"]
+    elif how == "ROS_PACKAGE_PATH":
+        env["ROS_PACKAGE_PATH"] = str(macros_ws)
+    else:  # an install prefix: PREFIX/share/NAME
+        share = tmp_path / "prefix" / "share"
+        shutil.copytree(macros_ws / "nested" / "common_macros", share / "common_macros")
+        env["AMENT_PREFIX_PATH"] = str(tmp_path / "prefix")
+    doc = joints(args, env)
+    by_name = {j["jointName"]: j for j in doc["joints"]}  # type: ignore[union-attr]
+    assert list(by_name) == ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"]
+    # Limits come from config/joint_limits.yaml through xacro.load_yaml.
+    assert (by_name["elbow_joint"]["jointLowerLimit"],
+            by_name["elbow_joint"]["jointUpperLimit"]) == (-2.8, 2.8)
+    assert by_name["elbow_joint"]["jointMaxForce"] == 28.0
+
+
+def test_args_with_defaults_and_a_typo(workspaces: tuple[Path, Path]) -> None:
+    arm, macros_ws = workspaces
+    doc = joints([str(arm), "--package-path", str(macros_ws), "--arg", "prefix:=left_"])
+    assert doc["base_link"] == "left_base_link"
+    result = runner.invoke(app, ["joints", str(arm), "--package-path", str(macros_ws),
+                                 "--arg", "prefx:=left_"])
+    assert result.exit_code == 2
+    assert "--arg: 'prefx' is not an argument of this file or its includes; did you mean " \
+           "'prefix'?" in result.stderr
+
+
+def test_meshes_through_package_uris_load_check_and_render(workspaces: tuple[Path, Path],
+                                                           tmp_path: Path) -> None:
+    arm, macros_ws = workspaces
+    info = runner.invoke(app, ["info", str(arm), "--package-path", str(macros_ws), "--json"])
+    assert info.exit_code == 0, info.stderr
+    assert "cannot" not in info.stderr  # PyBullet found and read every mesh
+    assert json.loads(info.stdout)["links"] == 4
+    checked = runner.invoke(app, ["check", str(arm.parent.parent), "--package-path",
+                                  str(macros_ws), "--json"])
+    findings = json.loads(checked.stdout)["findings"]
+    assert not [f for f in findings if f["level"] == "error"], findings
+    picture = tmp_path / "arm.png"
+    drawn = runner.invoke(app, ["render", str(arm), "--package-path", str(macros_ws), "-o",
+                                str(picture), "--size", "160x120"])
+    assert drawn.exit_code == 0, drawn.stderr
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    built = tmp_path / "arm.urdf"
+    made = runner.invoke(app, ["build", str(arm), "--package-path", str(macros_ws), "-o",
+                               str(built), "--arg", "use_mesh:=false"])
+    assert made.exit_code == 0, made.stderr
+    assert "package://" not in built.read_text() and "<box" in built.read_text()
+
+
+def test_the_index_finds_packages_once_and_in_order(tmp_path: Path) -> None:
+    for where, version in (("a", "1"), ("b", "2")):
+        pkg = tmp_path / where / "deep" / "pkg"
+        pkg.mkdir(parents=True)
+        (pkg / "package.xml").write_text(f"<package><name>pkg</name><version>{version}"
+                                         "</version></package>")
+    index = PackageIndex({}, [str(tmp_path / "b"), str(tmp_path / "a")], env=False)
+    assert index["pkg"] == tmp_path / "b" / "deep" / "pkg"  # the first search path wins
+    explicit = PackageIndex({"pkg": tmp_path / "a"}, [str(tmp_path / "b")], env=False)
+    assert explicit["pkg"] == tmp_path / "a"
+    assert PackageIndex.from_json(index.to_json())["pkg"] == index["pkg"]
+    assert index.get("nope") is None
