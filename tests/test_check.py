@@ -114,6 +114,8 @@ CASES = [
     ("U609", doc(link("a", '<inertial><!--HERE--><mass value="1"/>\n</inertial>'))),
     ("U610", doc(link("a", '<inertial><mass value="1"/>\n<inertia ixx="0.1" ixy="0" ixz="0" '
                            'iyy="0.1" iyz="0"/><!--HERE-->\n</inertial>'))),
+    ("U705", doc(link("a", body='<visual><geometry>\n<mesh filename="robot.urdf"/>'
+                                '<!--HERE-->\n</geometry></visual>'))),
     ("U801", doc(link("a", body=BOX + "\n<colision/><!--HERE-->\n"))),
     ("U802", doc(link("a", body='<collision><geometry>\n<box size="1 1 1" colour="red"/>'
                                 '<!--HERE-->\n</geometry></collision>'))),

@@ -115,3 +115,45 @@ def test_the_index_finds_packages_once_and_in_order(tmp_path: Path) -> None:
     assert explicit["pkg"] == tmp_path / "a"
     assert PackageIndex.from_json(index.to_json())["pkg"] == index["pkg"]
     assert index.get("nope") is None
+
+
+@pytest.mark.parametrize(("mesh", "expected"), [
+    ("gone.stl", "file not found"), ("notes.ply", "PyBullet reads .stl, .obj, .dae meshes"),
+    ("package://nopkg/m.stl", "package 'nopkg' not found")])
+def test_meshes_pybullet_cannot_load_are_one_line_before_it_sees_them(
+        tmp_path: Path, mesh: str, expected: str) -> None:
+    (tmp_path / "notes.ply").write_text("ply\n")
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r">\n<link name="a">\n<visual><geometry>\n'
+                    f'<mesh filename="{mesh}"/>\n</geometry></visual></link>\n</robot>\n')
+    for command in ("joints", "render"):
+        result = runner.invoke(app, [command, str(urdf), *(["-o", "-"] if command == "render"
+                                                              else [])])
+        assert result.exit_code == 2
+        (line,) = result.stderr.strip().splitlines()
+        assert line.startswith(f"urdfkit: error: {urdf}:4: <mesh filename=")
+        assert expected in line and "b3Error" not in line
+
+
+def test_a_mesh_pybullet_finds_on_its_search_path_loads(tmp_path: Path) -> None:
+    # `p.loadURDF` after setAdditionalSearchPath(pybullet_data) finds "duck.obj" there.
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r"><link name="a"><collision><geometry>'
+                    '<mesh filename="duck.obj"/></geometry></collision></link></robot>')
+    result = runner.invoke(app, ["info", str(urdf), "--json"])
+    assert result.exit_code == 0, result.stderr
+    size = json.loads(result.stdout)["aabb"]["size"]
+    assert max(size) > 0.05  # the duck's extent, not an empty body
+    checked = runner.invoke(app, ["check", str(urdf), "--json"])
+    assert "U703" in [f["code"] for f in json.loads(checked.stdout)["findings"]]
+
+
+def test_findings_in_xacro_input_claim_no_false_line(tmp_path: Path) -> None:
+    path = tmp_path / "r.urdf.xacro"
+    path.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+                    '<xacro:property name="m" value="-2"/>\n\n\n'
+                    '<link name="a"><inertial><mass value="${m}"/><inertia ixx="1" ixy="0" '
+                    'ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>\n</robot>\n')
+    result = runner.invoke(app, ["check", str(path), "--json"])
+    (finding,) = [f for f in json.loads(result.stdout)["findings"] if f["code"] == "U601"]
+    assert finding["line"] is None and "<link name='a'>" in finding["message"]

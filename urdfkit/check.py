@@ -9,6 +9,7 @@ loaded: checking is pure lxml, which is what makes it safe on hostile input and 
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import sys
 from collections.abc import Iterable, Mapping, Sequence
@@ -185,8 +186,13 @@ def check_file(display: str, path: str | Path,
         return result
     result.findings.extend(Finding("U004", "warning", note, display, line)
                            for line, note in quirks)
-    result.findings.extend(run_rules(tree.getroot(), display, ALL_RULES,
-                                     base=path.absolute().parent, packages=packages))
+    found = run_rules(tree.getroot(), display, ALL_RULES, base=path.absolute().parent,
+                      packages=packages)
+    if path.suffix == ".xacro":
+        # Lines of xacro's output are not lines of the file the user wrote: none, not a false
+        # one (each message names its element).
+        found = [dataclasses.replace(f, line=None) for f in found]
+    result.findings.extend(found)
     result.findings.sort(key=lambda f: f.line or 0)
     return result
 

@@ -23,9 +23,9 @@ from lxml import etree
 
 from .errors import InputError, ParameterError
 from .expand import expand_xacro
-from .spec import FILE_TAGS
-from .uris import PackageIndex, not_a_file, pybullet_data_path, resolve_uri
-from .validate import STRICTER, Finding, refuse_oversized
+from .spec import FILE_SHAPES, FILE_TAGS
+from .uris import PackageIndex, not_a_file, pybullet_data_path
+from .validate import STRICTER, Finding, reference, refuse_oversized
 from .validate import guard as run_guard
 from .xmlio import parse_xml, read_bytes, to_bytes
 
@@ -126,34 +126,32 @@ class Resolved:
         self.close()
 
 
-def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path], name: str,
-                 rewrite: bool) -> None:
-    """Check every file reference; with ``rewrite``, point each at an absolute path.
+def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
+                 name: str) -> bool:
+    """Refuse what PyBullet cannot load, and point every reference at an absolute path.
 
-    Meshes and textures PyBullet would hang or abort on (folders, FIFOs, devices) are
-    refused, by ``stat`` alone, never opened. A missing file is left to PyBullet, which warns
-    and draws nothing (check says U701). An unknown ``package://`` is refused when the file
-    must be rewritten for PyBullet (see :mod:`urdfkit.uris`).
+    Returns whether PyBullet needs the rewritten copy: a ``package://`` or ``file://``
+    reference, or a mesh found only in pybullet_data.
+
+    Each reference is judged by :func:`urdfkit.validate.reference`, the rule ``check`` runs:
+    a missing or unreadable mesh, a folder/FIFO/device, a format PyBullet does not read, an
+    unknown package is one line naming the file and the URDF line, before PyBullet sees it
+    (which would fail with "Could not parse visual element", hang or abort). A missing
+    texture is left to PyBullet, which warns and draws without it.
     """
+    changed = False
     for el in root.iter(*FILE_TAGS):
         fn = el.get("filename")
         if not fn:
             continue
-        target = resolve_uri(fn, base, packages)
-        if target.path is None:
-            if rewrite:
-                raise InputError(f"cannot resolve {fn!r}: {target.problem}", file=name,
-                                 line=el.sourceline)
-            continue
-        why = not_a_file(target.path)
-        if why is not None and why != "missing":
-            fate = ("hangs reading it" if "FIFO" in why or "device" in why else
-                    "aborts on it" if why == "a directory" else "cannot read it")
-            raise InputError(f"<{el.tag} filename={fn!r}>: {target.path} is {why}; PyBullet "
-                             f"{fate}", file=name, line=el.sourceline)
-        if rewrite:
-            el.set("filename", str(target.path if target.package is not None or
-                                   fn.startswith("file://") else target.path.resolve()))
+        ref = reference(el.tag, fn.strip(), base, packages)
+        if ref.level == "error" and ref.code is not None and (
+                el.tag in FILE_SHAPES or ref.code in ("U702", "U704")):
+            raise InputError(ref.message, file=name, line=el.sourceline)
+        if ref.load_path is not None:
+            changed |= ref.code == "U703" or fn.startswith(("package://", "file://"))
+            el.set("filename", str(ref.load_path.resolve()))
+    return changed
 
 
 def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
@@ -168,22 +166,29 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
     source = locate(name)
     if source.suffix == ".xacro":
         data = expand_xacro(source, xacro_args, display=display, packages=packages)
-        tree = parse_xml(data, display)
+        try:
+            return _resolve_tree(source, display, parse_xml(data, display), packages, guard)
+        except InputError as e:
+            # Lines of xacro's output are not lines of the file the user wrote: say none
+            # rather than a false one (the message names the element).
+            raise type(e)(e.message, file=e.file, param=e.param) from None
     else:
         data = read_bytes(source)
         refuse_oversized(data, display)  # before a tree of 280,000 links is built
-        tree = parse_xml(data, display)
+        return _resolve_tree(source, display, parse_xml(data, display), packages, guard)
+
+
+def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
+                  packages: Mapping[str, Path] | None, guard: bool) -> Resolved:
     lifted = [f"{where(f)}: let through without the guard ({f.code}): "
               f"{f.message.removesuffix(STRICTER)}" for f in run_guard(tree, display, strict=guard)]
     root = tree.getroot()
     # PyBullet takes paths as UTF-8 text: a file name that is not (bytes from another locale,
     # kept by Python as surrogates) is loaded from a copy with a clean name.
     needs_copy = source.suffix == ".xacro" or not _utf8(str(source))
-    has_packages = any((el.get("filename") or "").startswith(("package://", "file://"))
-                       for el in root.iter(*FILE_TAGS))
-    _check_files(root, source.resolve().parent, packages or {}, display,
-                 rewrite=has_packages or needs_copy)
-    if has_packages or needs_copy:
+    needs_copy = _check_files(root, source.resolve().parent, packages or {}, display) \
+        or needs_copy
+    if needs_copy:
         import tempfile  # here, not at the top: most loads need no copy
 
         tmp = tempfile.TemporaryDirectory(prefix="urdfkit-")

@@ -63,6 +63,9 @@ SHAPE_SIZES: dict[str, tuple[str, ...]] = {
 FILE_SHAPES = ("mesh", "cdf")
 #: Elements whose ``filename`` attribute names a file to load.
 FILE_TAGS = ("mesh", "cdf", "texture")
+#: Mesh formats PyBullet 3.2.7's URDF importer reads (any case); with any other suffix, or a
+#: missing mesh file, loadURDF fails ("Cannot load URDF file").
+MESH_FORMATS = (".stl", ".obj", ".dae")
 
 #: PyBullet's extensions to URDF, with what to tell a user who needs portable files.
 EXTENSIONS: dict[str, str] = {

@@ -30,6 +30,7 @@ from .spec import (
     MAX_NAME_BYTES,
     MAX_STATE_LINKS,
     MAX_XML_DEPTH,
+    MESH_FORMATS,
     NUMERIC,
     OPAQUE,
     SCHEMA,
@@ -616,32 +617,63 @@ def _shape_trace(link: etree._Element, mass: float | None) -> float | None:
     return trace if math.isfinite(trace) else None
 
 
+@dataclass(frozen=True)
+class Reference:
+    """What a ``filename`` attribute points at, and what is wrong with it, if anything.
+
+    Attributes:
+        path: The file it means (for loading: ``load_path`` is what PyBullet must be given).
+        code, level, message: The finding, or ``code`` None when the file is fine.
+    """
+
+    path: Path | None
+    load_path: Path | None
+    code: str | None = None
+    level: str = "error"
+    message: str = ""
+
+
+def reference(tag: str, fn: str, base: Path, packages: Mapping[str, Path] | None) -> Reference:
+    """Resolve and judge one file reference: the one rule check and the loaders share.
+
+    U702 unknown package, U704 not a regular file (folder, FIFO, device, unreadable), U701
+    missing, U703 found only in pybullet_data (which ``p.loadURDF`` searches once a user adds
+    it to the search path, so loaders point PyBullet there), U705 a mesh format PyBullet does
+    not read.
+    """
+    label = f"<{tag} filename={fn!r}>"
+    target = resolve_uri(fn, base, packages)
+    if target.path is None:
+        return Reference(None, None, "U702", "error", f"{label}: {target.problem}")
+    path = target.path
+    why = not_a_file(path)
+    if why == "missing":
+        data = pybullet_data_path()
+        if target.package is None and data is not None and not_a_file(data / fn) is None:
+            return Reference(path, data / fn, "U703", "warning", f"{label}: not beside the "
+                             "file, found only in pybullet_data's search path; make the path "
+                             "relative to the file")
+        return Reference(path, None, "U701", "error", f"{label}: file not found ({path}); "
+                         "PyBullet refuses a URDF whose mesh is missing")
+    if why is not None:
+        return Reference(path, None, "U704", "error", f"{label}: {path} is {why}; PyBullet "
+                         "hangs, aborts or fails on it")
+    if tag == "mesh" and path.suffix.lower() not in MESH_FORMATS:
+        return Reference(path, None, "U705", "error", f"{label}: PyBullet reads "
+                         f"{', '.join(MESH_FORMATS)} meshes, not {path.suffix or 'this file'}")
+    return Reference(path, path)
+
+
 def rule_meshes(root: etree._Element, r: Report) -> None:
-    """U701-U702: mesh and texture files exist, through package:// and relative paths."""
+    """U701-U705: mesh and texture files exist, are files, in formats PyBullet reads."""
     if r.base is None:
         return
     for el in root.iter(*FILE_TAGS):
         fn = (el.get("filename") or "").strip()
-        if not fn:
-            continue
-        target = resolve_uri(fn, r.base, r.packages)
-        if target.path is None:
-            r.add("U702", "error", f"<{el.tag} filename={fn!r}>: {target.problem}", el)
-            continue
-        why = not_a_file(target.path)
-        if why is None:
-            continue
-        if why != "missing":
-            r.add("U704", "error", f"<{el.tag} filename={fn!r}>: {target.path} is {why}; "
-                  "PyBullet hangs, aborts or fails on it", el)
-            continue
-        data = pybullet_data_path()
-        if target.package is None and data is not None and (data / fn).is_file():
-            # PyBullet finds it only after setAdditionalSearchPath(pybullet_data.getDataPath()).
-            r.add("U703", "warning", f"<{el.tag} filename={fn!r}>: not beside the file, found "
-                  "only in pybullet_data's search path; make the path relative to the file", el)
-            continue
-        r.add("U701", "error", f"<{el.tag} filename={fn!r}>: file not found ({target.path})", el)
+        if fn:
+            ref = reference(el.tag, fn, r.base, r.packages)
+            if ref.code is not None:
+                r.add(ref.code, ref.level, ref.message, el)
 
 
 def _too_many_links(n: int) -> str:
@@ -793,6 +825,7 @@ CODES: dict[str, str] = {
     "U702": "package:// package not found",
     "U703": "mesh found only through pybullet_data's search path",
     "U704": "mesh or texture is a directory, FIFO, device or unreadable",
+    "U705": "mesh in a format PyBullet does not read (it reads .stl, .obj, .dae)",
     "U801": "unknown tag",
     "U802": "unknown attribute",
     "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
