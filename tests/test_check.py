@@ -116,6 +116,17 @@ CASES = [
                            'iyy="0.1" iyz="0"/><!--HERE-->\n</inertial>'))),
     ("U705", doc(link("a", body='<visual><geometry>\n<mesh filename="robot.urdf"/>'
                                 '<!--HERE-->\n</geometry></visual>'))),
+    ("U308", doc(A, B, joint(inner='<axis xyz="0 0 1"/>\n<limit effort="1" velocity="1"/>'
+                                   '<!--HERE-->\n'))),
+    ("U611", doc(link("a", '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" '
+                           'iyy="0" iyz="0" izz="0"/></inertial>') + "<!--HERE-->", B, J)),
+    ("U706", doc(link("a", body='<visual><geometry><box size="1 1 1"/></geometry>\n'
+                                '<material name="steel"/><!--HERE-->\n</visual>'))),
+    ("U707", doc('<material name="m">\n<texture/><!--HERE-->\n</material>', A)),
+    ("U708", doc(link("a", body='<visual><geometry>\n<mesh filename="package:///robot.urdf"/>'
+                                '<!--HERE-->\n</geometry></visual>'))),
+    ("U709", doc(A, B, J, '<transmission name="t"><type>x</type>\n<joint name="ghost"/>'
+                          '<!--HERE-->\n</transmission>')),
     ("U801", doc(link("a", body=BOX + "\n<colision/><!--HERE-->\n"))),
     ("U802", doc(link("a", body='<collision><geometry>\n<box size="1 1 1" colour="red"/>'
                                 '<!--HERE-->\n</geometry></collision>'))),

@@ -93,7 +93,7 @@ def extension_note(kind: str, name: str) -> str | None:
 # --------------------------------------------------------------------------- the document
 
 #: Subtrees urdfkit does not look into: ROS/Gazebo extensions and PyBullet's soft bodies.
-OPAQUE = ("gazebo", "transmission", "deformable")
+OPAQUE = ("gazebo", "transmission", "deformable", "ros2_control")
 #: PyBullet's ``<contact>`` children, each with a ``value``.
 CONTACT_VALUES = ("lateral_friction", "rolling_friction", "spinning_friction", "restitution",
                   "stiffness", "damping", "contact_cfm", "contact_erp", "inertia_scaling",

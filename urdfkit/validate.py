@@ -510,6 +510,26 @@ def rule_mass(root: etree._Element, r: Report) -> None:
         if total == 0:
             r.add("U602", "error", f"{_label(links[name])} moves (joint {j.get('name')!r} is "
                   f"{j.get('type')}) but has mass 0; give it a mass > 0", links[name])
+    children = {c.get("link") for j in _elements(root, "joint") for c in j.findall("child")}
+    roots = [link for name, link in links.items() if name not in children]
+    if len(roots) == 1 and _mass_of(roots[0]) == 0:
+        # The base moves with everything fixed to it, as a moving link does.
+        base, total, stack, seen = roots[0], 0.0, [roots[0].get("name", "")], set()
+        while stack:
+            n = stack.pop()
+            if n in seen or n not in links:
+                continue
+            seen.add(n)
+            total += max(0.0, _mass_of(links[n]) or 0.0)
+            stack.extend(fixed_children.get(n, []))
+        if total == 0:
+            static = not moving
+            r.add("U611", "info" if static else "warning",
+                  f"root {_label(base)} has mass 0: PyBullet makes the base static, fixed where "
+                  "it is loaded" + (" (right for a static object such as ground)" if static
+                                    else "; right for an arm bolted to the world, wrong for a "
+                                    "robot that should fall or drive: give the base a mass"),
+                  base)
 
 
 def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | None:
@@ -518,6 +538,46 @@ def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | 
         return None
     ixx, ixy, ixz, iyy, iyz, izz = vals
     return ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))  # type: ignore[return-value]
+
+
+def rule_references(root: etree._Element, r: Report) -> None:
+    """U308, U706-U708: references that lead nowhere, and limits PyBullet reads differently.
+
+    A ``<material name>`` used but never defined, a ``<transmission>`` naming a missing joint,
+    an empty ``<texture/>``, ``package:///`` without a package name, and a revolute or
+    prismatic ``<limit>`` without lower/upper (PyBullet: unlimited; the URDF spec: 0..0).
+    """
+    defined = {m.get("name") for m in root.iter("material")
+               if m.find("color") is not None or m.find("texture") is not None}
+    for m in root.iter("material"):
+        parent = m.getparent()
+        if (parent is not None and parent.tag == "visual" and m.get("name")
+                and m.find("color") is None and m.find("texture") is None
+                and m.get("name") not in defined):
+            r.add("U706", "warning", f"<material name={m.get('name')!r}> is used but never "
+                  "defined with a <color> or <texture>; PyBullet draws the default colour", m)
+    for t in root.iter("texture"):
+        if not (t.get("filename") or "").strip():
+            r.add("U707", "warning", "<texture> without a filename; remove it or name the "
+                  "image", t)
+    for el in root.iter(*FILE_TAGS):
+        if (el.get("filename") or "").strip().startswith("package:///"):
+            r.add("U708", "info", f"<{el.tag} filename={el.get('filename')!r}>: package:/// "
+                  "has no package name; PyBullet and urdfkit look the path up beside the file "
+                  "and in the five folders above, ROS tools refuse it", el)
+    joints = {j.get("name") for j in _elements(root, "joint")}
+    for t in root.iter("transmission"):
+        for j in t.iter("joint"):
+            if j.get("name") and j.get("name") not in joints:
+                r.add("U709", "warning", f"<transmission name={t.get('name')!r}> names joint "
+                      f"{j.get('name')!r}, which does not exist", j)
+    for j in _elements(root, "joint"):
+        limit = j.find("limit")
+        if (j.get("type") in LIMITED_JOINT_TYPES and limit is not None
+                and (limit.get("lower") is None or limit.get("upper") is None)):
+            missing = " and ".join(a for a in ("lower", "upper") if limit.get(a) is None)
+            r.add("U308", "warning", f"<limit> of {_label(j)} has no {missing}: PyBullet reads "
+                  "it as unlimited, the URDF spec (and ROS) as 0; give both", limit)
 
 
 def rule_inertial(root: etree._Element, r: Report) -> None:
@@ -768,7 +828,7 @@ GUARD_CODES = frozenset({"U001", "U002", "U003", "U005", "U101", "U102", "U103",
 
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
-                               rule_inertia, rule_meshes, rule_portability)
+                               rule_inertia, rule_meshes, rule_references, rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -803,6 +863,7 @@ CODES: dict[str, str] = {
     "U305": "zero joint axis",
     "U306": "joint axis not unit length",
     "U307": "mimic refers to a missing joint",
+    "U308": "revolute/prismatic <limit> without lower or upper (PyBullet: unlimited)",
     "U401": "number does not parse or is not finite",
     "U402": "vector of the wrong length",
     "U501": "missing or non-positive shape size",
@@ -821,11 +882,16 @@ CODES: dict[str, str] = {
     "U608": "singular inertia (a zero principal moment) with positive mass",
     "U609": "<inertial> without <inertia>",
     "U610": "<inertia> missing a component",
+    "U611": "mass-0 root link: PyBullet makes the base static",
     "U701": "mesh or texture file not found",
     "U702": "package:// package not found",
     "U703": "mesh found only through pybullet_data's search path",
     "U704": "mesh or texture is a directory, FIFO, device or unreadable",
     "U705": "mesh in a format PyBullet does not read (it reads .stl, .obj, .dae)",
+    "U706": "material used but never defined",
+    "U707": "<texture> without a filename",
+    "U708": "package:/// without a package name",
+    "U709": "transmission names a missing joint",
     "U801": "unknown tag",
     "U802": "unknown attribute",
     "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
