@@ -311,3 +311,43 @@ def test_cli_json(tmp_path: Path) -> None:
                  "message": f["message"]}
     assert data["summary"] == {"files": 2, "files_with_errors": 1, "error": 1, "warning": 0,
                                "info": 0}
+
+
+def test_inertia_messages_read_like_a_fix(tmp_path: Path) -> None:
+    inertial = ('<inertial><mass value="2"/><inertia ixx="{}" ixy="0" ixz="0" iyy="0.1" '
+                'iyz="0" izz="{}"/></inertial>')
+    path = tmp_path / "r.urdf"
+    path.write_text(doc(
+        link("a", inertial.format("0.1", "-4.2e-22"),
+             '<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>'),
+        link("b", inertial.format("0.01", "0.5"),
+             '<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>'),
+        link("c", inertial.format("0.1", "0.1"),
+             '<collision><geometry><sphere radius="0.001"/></geometry></collision>'),
+        joint("j1", "a", "b", "fixed", ""), joint("j2", "b", "c", "fixed", "")))
+    by_code = {(f.code, f.message.split("'")[1]): f.message
+               for f in check_paths([path], jobs=1).findings if f.code in ("U604", "U605", "U608")}
+    # Round-off prints as 0, and the message says what would pass.
+    singular = by_code[("U608", "a")]
+    assert "principal moments 0, 0.1, 0.1" in singular and "e-22" not in singular
+    assert "imply a trace of 0.04, e.g. ixx=iyy=izz=0.01333 with products 0" in singular
+    triangle = by_code[("U604", "b")]
+    assert "lower the largest to at most 0.11" in triangle
+    # A 1 mm sphere is a placeholder: the message blames the stub, not the units.
+    stub = by_code[("U605", "c")]
+    assert "stubs (largest size 0.002 m)" in stub and "units" not in stub
+
+
+def test_repeated_findings_are_grouped_in_text_and_kept_in_json(tmp_path: Path) -> None:
+    bare = [f'<link name="l{i}"/>' for i in range(7)]
+    joints = [joint(f"j{i}", "l0", f"l{i}", "fixed", "") for i in range(1, 7)]
+    (tmp_path / "many.urdf").write_text(doc(*bare, *joints))
+    (tmp_path / "a.urdf").write_text(doc(A))
+    (tmp_path / "b.urdf").write_text(doc(A))
+    text = CliRunner().invoke(app, ["check", str(tmp_path)]).stdout
+    assert text.count("U606  <link name=") == 3
+    assert "... and 4 more U606 in this file (--json lists every one)" in text
+    doc_json = json.loads(CliRunner().invoke(app, ["check", str(tmp_path), "--json"]).stdout)
+    codes = [f["code"] for f in doc_json["findings"]]
+    assert codes.count("U606") == 7
+    assert codes.count("U607") == 1  # the same advice for every file, said once per run

@@ -21,6 +21,8 @@ from .validate import ALL_RULES, CODES, LEVELS, Finding, refuse_oversized, run_r
 
 #: File suffixes a folder search picks up.
 SUFFIXES = (".urdf", ".xacro")
+#: Findings that say the same thing of every file: reported once per run, on the first file.
+ONCE_PER_RUN = frozenset({"U607"})
 #: Below this many files a process pool costs more than it saves.
 _PARALLEL_MIN = 8
 
@@ -269,6 +271,15 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
         with context.Pool(workers, initializer=_worker_init) as pool:
             results = pool.map(_check_one, work, chunksize=chunk)
     sel, ign = tuple(select), tuple(ignore)
+    noted = False
     for fr in results:
-        fr.findings = [f for f in fr.findings if _keep(f.code, sel, ign)]
+        kept = []
+        for f in fr.findings:
+            if f.code in ONCE_PER_RUN:  # the same advice for every file: say it once
+                if noted:
+                    continue
+                noted = True
+            if _keep(f.code, sel, ign):
+                kept.append(f)
+        fr.findings = kept
     return CheckResult(results)

@@ -364,8 +364,12 @@ def check_report(result: Any) -> None:
         for fr in result.files:
             if fr.findings:
                 out.append(_one_line(fr.file))
-                out += [f"  {f.line if f.line is not None else '-':>5}  {f.level:<7}  {f.code}  "
-                        f"{_one_line(f.message)}" for f in fr.findings]
+                for f, more in _grouped(fr.findings):
+                    if more:
+                        out.append(f"  {'':>5}  {f.level:<7}  {f.code}  {more}")
+                    else:
+                        out.append(f"  {f.line if f.line is not None else '-':>5}  "
+                                   f"{f.level:<7}  {f.code}  {_one_line(f.message)}")
         out.append(summary)
         _write(sys.stdout, "\n".join(out) + "\n")
         return
@@ -376,12 +380,39 @@ def check_report(result: Any) -> None:
         if not fr.findings:
             continue
         screen.print(Text(_one_line(fr.file), style="bold"), soft_wrap=True)
-        for f in fr.findings:
-            where = f"{f.line:>5}" if f.line is not None else "    -"
+        for f, more in _grouped(fr.findings):
+            where = f"{f.line:>5}" if f.line is not None and not more else "    -"
             screen.print(Text.assemble(f"  {where}  ", (f"{f.level:<7}", LEVEL_STYLE[f.level]),
-                                       "  ", (f.code, "dim"), "  ", _one_line(f.message)),
+                                       "  ", (f.code, "dim"), "  ",
+                                       (more, "dim") if more else _one_line(f.message)),
                          soft_wrap=True)
     screen.print(Text(summary, style=colour), soft_wrap=True)
+
+
+#: Text output shows this many findings of one code per file, then one line for the rest.
+GROUP_AFTER = 3
+
+
+def _grouped(findings: Sequence[Any]) -> list[tuple[Any, str]]:
+    """Findings to print: ``(finding, "")`` for each one shown.
+
+    A code seen more than GROUP_AFTER times in a file shows its first ones, then
+    ``(next, summary)`` for the rest (--json keeps them all).
+    """
+    count: dict[str, int] = {}
+    for f in findings:
+        count[f.code] = count.get(f.code, 0) + 1
+    shown: dict[str, int] = {}
+    out: list[tuple[Any, str]] = []
+    for f in findings:
+        n = shown.get(f.code, 0)
+        shown[f.code] = n + 1
+        if n < GROUP_AFTER or count[f.code] == GROUP_AFTER + 1:
+            out.append((f, ""))
+        elif n == GROUP_AFTER:
+            rest = count[f.code] - GROUP_AFTER
+            out.append((f, f"... and {rest} more {f.code} in this file (--json lists every one)"))
+    return out
 
 
 # --------------------------------------------------------------------------- progress

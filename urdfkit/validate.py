@@ -623,28 +623,50 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
         trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
         eps = 10 * _DBL_EPSILON * max(1.0, trace / 2)
         a, b, c = sym_eigenvalues(tensor)
+        moments = _moments((a, b, c), max(abs(a), abs(b), abs(c)))
+        shapes = _shape_trace(link, mass)
+        fix = (f"; its collision shapes and mass imply a trace of {shapes[0]:.4g}, e.g. "
+               f"ixx=iyy=izz={shapes[0] / 3:.4g} with products 0"
+               if shapes and shapes[1] >= STUB_SIZE else "")
         if a < -eps:
             r.add("U603", "error", f"inertia of {_label(link)} is not positive definite "
-                  f"(principal moments {a:.4g}, {b:.4g}, {c:.4g}); every principal moment must "
-                  "be > 0", inertia)
+                  f"(principal moments {moments}); every principal moment must be > 0{fix}",
+                  inertia)
             continue
         if mass is not None and mass > 0 and a <= eps:
             r.add("U608", "warning", f"inertia of {_label(link)} is singular (principal moments "
-                  f"{a:.4g}, {b:.4g}, {c:.4g}): a point or a thin rod, not a solid; with "
-                  "URDF_USE_INERTIA_FROM_FILE the solver may blow up", inertia)
+                  f"{moments}): a point or a thin rod, not a solid; with "
+                  f"URDF_USE_INERTIA_FROM_FILE the solver may blow up{fix}", inertia)
         if a + b < c - eps:
             r.add("U604", "error", f"inertia of {_label(link)} violates the triangle inequality: "
-                  f"principal moments {a:.4g} + {b:.4g} < {c:.4g}; no rigid body has it", inertia)
+                  f"principal moments {moments} (the two smaller sum to less than the largest); "
+                  f"no rigid body has it: lower the largest to at most {a + b:.4g}{fix}",
+                  inertia)
             continue
-        expected = _shape_trace(link, mass)
-        if expected and trace > 0 and not 0.1 <= trace / expected <= 10:
-            r.add("U605", "warning", f"inertia of {_label(link)} is {trace / expected:.3g} times "
-                  f"what its collision shapes and mass {mass:g} kg imply; check the units "
-                  "and the mass", inertia)
+        if shapes and trace > 0 and not 0.1 <= trace / shapes[0] <= 10:
+            ratio = f"inertia of {_label(link)} is {trace / shapes[0]:.3g} times what its " \
+                    f"collision shapes and mass {mass:g} kg imply"
+            if shapes[1] < STUB_SIZE:
+                r.add("U605", "warning", f"{ratio}, but those shapes are stubs (largest size "
+                      f"{shapes[1]:.3g} m): PyBullet recomputes inertia from them unless loaded "
+                      "with URDF_USE_INERTIA_FROM_FILE; give real collision shapes", inertia)
+            else:
+                r.add("U605", "warning", f"{ratio}; check the units and the mass", inertia)
 
 
-def _shape_trace(link: etree._Element, mass: float | None) -> float | None:
-    """Trace of the inertia of the link's solid collision shapes, or None if unknown.
+#: Collision shapes smaller than this (m, largest size) are placeholders, not the body.
+STUB_SIZE = 0.01
+
+
+def _moments(values: Sequence[float], scale: float) -> str:
+    """Principal moments for a message: round-off (-4.2e-22 beside 0.1) printed as 0."""
+    return ", ".join("0" if abs(v) <= 1e-9 * scale else f"{v:.4g}" for v in values)
+
+
+def _shape_trace(link: etree._Element, mass: float | None) -> tuple[float, float] | None:
+    """Trace of the inertia of the link's solid collision shapes, and their largest size.
+
+    None if unknown (no mass, a mesh, a malformed size).
 
     Plain floats (spec's formulas), no model objects. The trace does not change under
     rotation, so a shape's orientation does not matter; the parallel-axis theorem adds
@@ -674,7 +696,9 @@ def _shape_trace(link: etree._Element, mass: float | None) -> float | None:
         m = mass * volume / total
         d2 = sum((xyz[i] - com[i]) * (xyz[i] - com[i]) for i in range(3))
         trace += sum(solid_inertia(kind, dims, m)) + 2 * m * d2
-    return trace if math.isfinite(trace) else None
+    largest = max(max(dims) if kind == "box" else max([2 * dims[0], *dims[1:]])
+                  for _, kind, dims, _ in parts)
+    return (trace, largest) if math.isfinite(trace) else None
 
 
 @dataclass(frozen=True)
