@@ -157,3 +157,23 @@ def test_findings_in_xacro_input_claim_no_false_line(tmp_path: Path) -> None:
     result = runner.invoke(app, ["check", str(path), "--json"])
     (finding,) = [f for f in json.loads(result.stdout)["findings"] if f["code"] == "U601"]
     assert finding["line"] is None and "<link name='a'>" in finding["message"]
+
+
+def test_env_substitutions_work_and_ros_only_ones_say_so(tmp_path: Path) -> None:
+    ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+    env_file = tmp_path / "env.urdf.xacro"
+    env_file.write_text(f'<robot name="r" {ns}><link name="a_$(env ROBOT_SIDE)_'
+                        '$(optenv ROBOT_NOPE dflt)"/></robot>')
+    result = runner.invoke(app, ["tree", str(env_file), "--json"], env={"ROBOT_SIDE": "left"})
+    assert result.exit_code == 0, result.stderr
+    assert json.loads(result.stdout)["base_link"] == "a_left_dflt"
+    ros = tmp_path / "ros.urdf.xacro"
+    ros.write_text(f'<robot name="r" {ns}><link name="a$(exec rospack list)"/></robot>')
+    result = runner.invoke(app, ["tree", str(ros)])
+    assert result.exit_code == 2
+    (line,) = result.stderr.strip().splitlines()
+    assert f"{ros}: xacro failed: $(exec rospack list) is a ROS substitution" in line
+    broken = tmp_path / "broken.urdf.xacro"
+    broken.write_text(f'<robot name="r" {ns}><link name="${{1/0}}"/></robot>')
+    (line,) = runner.invoke(app, ["tree", str(broken)]).stderr.strip().splitlines()
+    assert line.endswith("xacro failed: division by zero (when evaluating expression '1/0')")

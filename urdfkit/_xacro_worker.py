@@ -163,8 +163,7 @@ def main(argv: list[str]) -> int:
                   f"`packages` ({name}=PATH) or a folder holding it with `package_paths` (or "
                   "set ROS_PACKAGE_PATH)", file=sys.stderr)
             return 1
-        msg = str(e).strip().splitlines()
-        print(msg[0] if msg else type(e).__name__, file=sys.stderr)
+        print(_message(e), file=sys.stderr)
         return 1
     finally:
         _kill_descendants()
@@ -180,6 +179,33 @@ def main(argv: list[str]) -> int:
     with open(out, "wb") as f:
         f.write(data)
     return 0
+
+
+#: xacro's substitutions that work without ROS (urdfkit answers $(find) itself).
+SUBSTITUTIONS = ("find", "arg", "env", "optenv", "dirname")
+
+
+def _message(e: BaseException) -> str:
+    """One line for a xacro failure: the inner error, without xacro's class-name wrapping."""
+    import re
+
+    lines = [ln.strip() for ln in str(e).strip().splitlines() if ln.strip()]
+    if not lines:
+        return type(e).__name__
+    # xacro prefixes the inner exception's class and repeats its text: keep it once.
+    text = re.sub(r"^<class '[\w.]+'>: ", "", lines[0])
+    inner = str(getattr(e, "exc", "") or "").strip()
+    if inner and text.startswith(inner) and len(text) > len(inner):
+        text = inner
+    context = next((ln for ln in lines[1:] if ln.startswith(("when evaluating", "when "
+                                                             "instantiating"))), None)
+    if context:
+        text = f"{text} ({context})"
+    unknown = re.search(r"Unknown substitution command \[([^\]]*)\]", text)
+    if unknown:
+        return (f"$({unknown.group(1)}) is a ROS substitution urdfkit cannot run; without ROS "
+                f"only {', '.join(f'$({s})' for s in SUBSTITUTIONS)} work")
+    return text
 
 
 def _declared_args(files: list[str]) -> set[str]:
