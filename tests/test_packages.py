@@ -177,3 +177,15 @@ def test_env_substitutions_work_and_ros_only_ones_say_so(tmp_path: Path) -> None
     broken.write_text(f'<robot name="r" {ns}><link name="${{1/0}}"/></robot>')
     (line,) = runner.invoke(app, ["tree", str(broken)]).stderr.strip().splitlines()
     assert line.endswith("xacro failed: division by zero (when evaluating expression '1/0')")
+
+
+def test_check_over_a_workspace_with_macro_libraries_and_args(workspaces: tuple[Path, Path]
+                                                              ) -> None:
+    arm, macros_ws = workspaces
+    result = runner.invoke(app, ["check", str(arm.parents[2]), str(macros_ws), "--package-path",
+                                 str(macros_ws), "--arg", "prefix:=right_", "--json"])
+    doc = json.loads(result.stdout)
+    by_file = {Path(f["file"]).name: f for f in doc["findings"] if f["code"] == "U007"}
+    assert set(by_file) == {"macros.xacro"}  # a library of macros, not a broken robot
+    assert by_file["macros.xacro"]["level"] == "info"
+    assert result.exit_code == 0, doc["findings"]  # no errors anywhere, the arg applied

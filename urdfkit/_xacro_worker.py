@@ -137,6 +137,8 @@ def main(argv: list[str]) -> int:
         print(__doc__, file=sys.stderr)
         return 2
     out, _err, timeout, memory, packages, source, *items = argv
+    lenient = "--lenient-args" in items
+    items = [i for i in items if i != "--lenient-args"]
     _limits(float(timeout), int(memory))
     _install_find(packages, source)
     _subreaper()
@@ -168,7 +170,7 @@ def main(argv: list[str]) -> int:
     finally:
         _kill_descendants()
     unknown = sorted(set(mappings) - _declared_args([source, *xacro.all_includes]))
-    if unknown:
+    if unknown and not lenient:
         from urdfkit.suggest import hint
 
         declared = sorted(_declared_args([source, *xacro.all_includes]))
@@ -201,6 +203,12 @@ def _message(e: BaseException) -> str:
                                                              "instantiating"))), None)
     if context:
         text = f"{text} ({context})"
+    undefined = re.match(r"Undefined substitution argument (\S+)", text)
+    if undefined:
+        name = undefined.group(1)
+        return (f"$(arg {name}) has no value where it is used (the root element's attributes "
+                f"are read before its <xacro:arg> defaults); give it with `xacro_args` "
+                f"({name}:=VALUE)")
     unknown = re.search(r"Unknown substitution command \[([^\]]*)\]", text)
     if unknown:
         return (f"$({unknown.group(1)}) is a ROS substitution urdfkit cannot run; without ROS "

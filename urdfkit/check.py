@@ -142,7 +142,8 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, Path, str | None]]:
 
 
 def _read(path: Path, display: str, no_exec: bool = False,
-          packages: Mapping[str, Path] | None = None) -> bytes:
+          packages: Mapping[str, Path] | None = None,
+          xacro_args: Mapping[str, str] | None = None) -> bytes:
     from .expand import expand_xacro
     from .xmlio import read_bytes
 
@@ -153,12 +154,14 @@ def _read(path: Path, display: str, no_exec: bool = False,
         if why is not None:  # never hand xacro a FIFO to block on
             raise InputError(f"is {why}, not a regular file; urdfkit reads only regular files"
                              if why != "missing" else "no such file", file=display)
-        return expand_xacro(path, display=display, no_exec=no_exec, packages=packages)
+        return expand_xacro(path, xacro_args, display=display, no_exec=no_exec,
+                            packages=packages, strict_args=False)
     return read_bytes(path)
 
 
 def check_file(display: str, path: str | Path,
-               packages: Mapping[str, Path] | None = None, no_exec: bool = False) -> FileResult:
+               packages: Mapping[str, Path] | None = None, no_exec: bool = False,
+               xacro_args: Mapping[str, str] | None = None) -> FileResult:
     """Run every rule on one file; any failure to read it becomes a ``U000`` finding.
 
     With ``no_exec`` (or URDFKIT_NO_EXEC set) a xacro file is not expanded: it gets one
@@ -172,7 +175,7 @@ def check_file(display: str, path: str | Path,
     path = Path(path)
     result = FileResult(display)
     try:
-        data = _read(path, display, no_exec, packages)
+        data = _read(path, display, no_exec, packages, xacro_args)
         refuse_oversized(data, display)
         _, quirks = tolerate_quirks(data)
         tree = parse_xml(data, display)
@@ -188,6 +191,11 @@ def check_file(display: str, path: str | Path,
         return result
     result.findings.extend(Finding("U004", "warning", note, display, line)
                            for line, note in quirks)
+    if path.suffix == ".xacro" and _macro_library(tree.getroot()):
+        result.findings.append(Finding("U007", "info", "a xacro macro library (no links of its "
+                                       "own): checked through the files that include it",
+                                       display))
+        return result
     found = run_rules(tree.getroot(), display, ALL_RULES, base=path.absolute().parent,
                       packages=packages)
     if path.suffix == ".xacro":
@@ -199,11 +207,21 @@ def check_file(display: str, path: str | Path,
     return result
 
 
-def _check_one(job: tuple[str, str, str | None, dict[str, str], bool]) -> FileResult:
-    display, path, problem, packages, no_exec = job
+def _macro_library(root: object) -> bool:
+    """A xacro file that only defines macros: after expansion, no <link> and no name."""
+    from lxml import etree
+
+    assert isinstance(root, etree._Element)
+    return root.tag == "robot" and root.find("link") is None and not root.get("name")
+
+
+def _check_one(job: tuple[str, str, str | None, dict[str, str], bool, dict[str, str]]
+               ) -> FileResult:
+    display, path, problem, packages, no_exec, xacro_args = job
     if problem is not None:
         return FileResult(display, [Finding("U000", "error", problem, display)])
-    return check_file(display, path, {k: Path(v) for k, v in packages.items()}, no_exec)
+    return check_file(display, path, {k: Path(v) for k, v in packages.items()}, no_exec,
+                      xacro_args)
 
 
 def _worker_init() -> None:
@@ -243,7 +261,8 @@ def _keep(code: str, select: tuple[str, ...], ignore: tuple[str, ...]) -> bool:
 
 def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | None = None,
                 select: Sequence[str] = (), ignore: Sequence[str] = (),
-                jobs: int | None = None, no_exec: bool = False) -> CheckResult:
+                jobs: int | None = None, no_exec: bool = False,
+                xacro_args: Mapping[str, str] | None = None) -> CheckResult:
     """Check every file under ``paths``, over ``jobs`` processes (default: every core).
 
     Workers are killed with the parent (Ctrl-C, SIGTERM, even SIGKILL on Linux) and never
@@ -256,7 +275,9 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
         raise ParameterError(f"`jobs` must be 1 or more, got {jobs!r}", param="jobs")
     files = discover(paths)
     pkgs = {k: str(v) for k, v in (packages or {}).items()}
-    work = [(display, str(path), problem, pkgs, no_exec) for display, path, problem in files]
+    args = dict(xacro_args or {})
+    work = [(display, str(path), problem, pkgs, no_exec, args)
+            for display, path, problem in files]
     workers = min(jobs or default_jobs(), max(1, len(work) // _PARALLEL_MIN))
     if workers <= 1:
         results = [_check_one(w) for w in work]

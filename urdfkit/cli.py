@@ -493,6 +493,10 @@ def check(
     = None,
     jobs: Annotated[int | None, typer.Option(
         "--jobs", "-j", min=1, help="Worker processes.", show_default="every core")] = None,
+    arg: Annotated[list[str] | None, typer.Option(
+        "--arg", "-a", metavar="NAME:=VALUE",
+        help="xacro argument for every xacro file checked (repeatable; files that do not "
+        "declare it ignore it).")] = None,
     no_exec: Annotated[bool, typer.Option(
         "--no-exec", help="Treat xacro as untrusted: do not expand it (xacro runs Python); "
         "each xacro file gets a U006 warning instead. URDFKIT_NO_EXEC=1 does the same.")]
@@ -514,12 +518,21 @@ def check(
                              f"{hint(fail_on, ('error', 'warning', 'info'))}", param="fail_on")
     result = check_paths(paths, packages=parse_packages(package, package_path),
                          select=parse_codes(select, "`select`"),
-                         ignore=parse_codes(ignore, "`ignore`"), jobs=jobs, no_exec=no_exec)
+                         ignore=parse_codes(ignore, "`ignore`"), jobs=jobs, no_exec=no_exec,
+                         xacro_args=_xacro_args(arg))
     if as_json:
         show.print_json(result.to_dict())
     else:
         show.check_report(result)
     raise typer.Exit(result.exit_code(fail_on))
+
+
+def _xacro_args(items: list[str] | None) -> dict[str, str]:
+    if not items:
+        return {}
+    from .catalog import parse_assignments  # imports the builder: only when needed
+
+    return parse_assignments(items, "xacro_args")
 
 
 # ---- drive: a headless throttle/steer run (urdfkit/drive.py, vehicle.py, plot.py)

@@ -79,7 +79,8 @@ def redact(message: str, secrets: Mapping[str, str]) -> str:
 
 def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
                  timeout: float | None = None, display: str | None = None,
-                 no_exec: bool = False, packages: Mapping[str, Path] | None = None) -> bytes:
+                 no_exec: bool = False, packages: Mapping[str, Path] | None = None,
+                 strict_args: bool = True) -> bytes:
     """Expand a xacro file in a contained subprocess; return the URDF bytes.
 
     ``$(find NAME)`` resolves without ROS through ``packages`` (a
@@ -88,7 +89,8 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
 
     Raises:
         XacroNotExpanded: executing xacro is disabled (``no_exec`` or URDFKIT_NO_EXEC).
-        ParameterError: an argument neither the file nor its includes declare.
+        ParameterError: an argument neither the file nor its includes declare (unless not
+            ``strict_args``: check passes one set of args to every file of a tree).
         InputError: xacro failed, or ran longer than ``timeout`` seconds.
     """
     name = display or str(path)
@@ -112,6 +114,8 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
         cmd = [sys.executable, "-m", "urdfkit._xacro_worker", str(out), str(err),
                f"{limit:g}", str(XACRO_MEMORY), json.dumps(index.to_json()), str(source_path)]
         cmd += [f"{k}:={v}" for k, v in (args or {}).items()]
+        if not strict_args:
+            cmd.append("--lenient-args")
         with open(os.devnull, "rb") as stdin, open(err, "ab") as log:
             proc = subprocess.Popen(cmd, stdin=stdin, stdout=log, stderr=log,
                                     cwd=str(source_path.parent), start_new_session=True)
@@ -143,8 +147,9 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
                 msg = lines[-1] if lines else f"exited with code {code}"
             if "MemoryError" in msg or "Cannot allocate memory" in msg:
                 msg = f"ran out of memory (limit {XACRO_MEMORY // 1024**2} MiB): {msg}"
+            named = re.search(r"`(\w+)`", msg)  # a parameter the message names, for the CLI
             raise InputError(f"xacro failed: {redact(msg, secrets)}", file=name,
-                             param="packages" if "`packages`" in msg else None)
+                             param=named.group(1) if named else None)
         return out.read_bytes()
 
 
