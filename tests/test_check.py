@@ -35,6 +35,7 @@ def doc(*lines: str, name: str = "r") -> str:
 
 
 A, B = link("a"), link("b")
+MESHES = Path(__file__).parent / "fixtures" / "meshes"
 J = joint()
 
 # (code, document); the finding must be on the line that holds <!--HERE-->.
@@ -120,6 +121,10 @@ CASES = [
                                    '<!--HERE-->\n'))),
     ("U611", doc(link("a", '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" '
                            'iyy="0" iyz="0" izz="0"/></inertial>') + "<!--HERE-->", B, J)),
+    ("U612", doc(link("a", '<inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" '
+                           'iyy="0.1" iyz="0" izz="0.1"/></inertial>',
+                      f'<collision><geometry>\n<mesh filename="{MESHES / "open_triangle.stl"}"/>'
+                      '<!--HERE-->\n</geometry></collision>'))),
     ("U706", doc(link("a", body='<visual><geometry><box size="1 1 1"/></geometry>\n'
                                 '<material name="steel"/><!--HERE-->\n</visual>'))),
     ("U707", doc('<material name="m">\n<texture/><!--HERE-->\n</material>', A)),
@@ -351,3 +356,20 @@ def test_repeated_findings_are_grouped_in_text_and_kept_in_json(tmp_path: Path) 
     codes = [f["code"] for f in doc_json["findings"]]
     assert codes.count("U606") == 7
     assert codes.count("U607") == 1  # the same advice for every file, said once per run
+
+
+@pytest.mark.parametrize(("scale", "ixx", "flagged"), [
+    (0.2, 0.1 * 0.04 / 6 * 1, False),  # a 0.2 m cube of 0.1 kg: I = m a^2 / 6
+    (0.2, 0.5, True),                  # 750x the cube's: flagged
+    (200.0, 0.1 * 0.04 / 6, True),     # a mesh in millimetres (200 m across): flagged
+])
+def test_inertia_is_judged_against_collision_meshes(tmp_path: Path, scale: float, ixx: float,
+                                                    flagged: bool) -> None:
+    inertial = (f'<inertial><mass value="0.1"/><inertia ixx="{ixx}" ixy="0" ixz="0" '
+                f'iyy="{ixx}" iyz="0" izz="{ixx}"/></inertial>')
+    mesh = (f'<collision><geometry><mesh filename="{MESHES / "unit_cube.stl"}" '
+            f'scale="{scale} {scale} {scale}"/></geometry></collision>')
+    path = tmp_path / "r.urdf"
+    path.write_text(doc(link("a", inertial, mesh)))
+    codes = [f.code for f in check_paths([path], jobs=1).findings]
+    assert ("U605" in codes) == flagged, codes

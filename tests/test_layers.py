@@ -19,7 +19,7 @@ for floor, names in enumerate([
     # spec and model
     "errors spec style templatedir suggest output xmlio builder catalog",
     # sources: files, packages, xacro, and the guard every loader calls
-    "uris _xacro_worker expand validate resolve",
+    "uris meshes _xacro_worker expand validate resolve",
     # the engine session
     "session",
     # run and draw

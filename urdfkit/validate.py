@@ -39,6 +39,8 @@ from .spec import (
     SOLIDS,
     extension_note,
     numbers,
+    rotate,
+    rpy_to_matrix,
     solid_inertia,
     solid_volume,
     sym_eigenvalues,
@@ -624,7 +626,7 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
         eps = 10 * _DBL_EPSILON * max(1.0, trace / 2)
         a, b, c = sym_eigenvalues(tensor)
         moments = _moments((a, b, c), max(abs(a), abs(b), abs(c)))
-        shapes = _shape_trace(link, mass)
+        shapes = _shape_trace(link, mass, r)
         fix = (f"; its collision shapes and mass imply a trace of {shapes[0]:.4g}, e.g. "
                f"ixx=iyy=izz={shapes[0] / 3:.4g} with products 0"
                if shapes and shapes[1] >= STUB_SIZE else "")
@@ -663,42 +665,84 @@ def _moments(values: Sequence[float], scale: float) -> str:
     return ", ".join("0" if abs(v) <= 1e-9 * scale else f"{v:.4g}" for v in values)
 
 
-def _shape_trace(link: etree._Element, mass: float | None) -> tuple[float, float] | None:
-    """Trace of the inertia of the link's solid collision shapes, and their largest size.
+def _shape_trace(link: etree._Element, mass: float | None,
+                 r: Report | None = None) -> tuple[float, float] | None:
+    """Trace of the inertia of the link's collision solids, and their largest size.
 
-    None if unknown (no mass, a mesh, a malformed size).
-
-    Plain floats (spec's formulas), no model objects. The trace does not change under
-    rotation, so a shape's orientation does not matter; the parallel-axis theorem adds
-    2 m |d|^2 per shape for its offset d from the common centre of mass.
+    Primitive shapes use spec's closed forms; STL and OBJ meshes (with ``scale``) are read
+    by :mod:`urdfkit.meshes` when ``r`` knows the file's folder. The trace does not change
+    under rotation, so only each part's offset matters: the parallel-axis theorem adds
+    2 m |d|^2 per part for its offset d from the common centre of mass. None if unknown (no
+    mass, a capsule or plane, a mesh that cannot be read or is not closed, a bad size).
     """
     if mass is None or mass <= 0:
         return None
-    parts = []
+    # (volume, trace per unit density about the part's own centre, centre in the link, size)
+    parts: list[tuple[float, float, tuple[float, ...], float]] = []
     for col in link.findall("collision"):
         shape = next((c for c in col.iterfind("geometry/*") if c.tag in SHAPES), None)
-        if shape is None or shape.tag not in SOLIDS or shape.tag == "capsule":
-            return None  # meshes, planes: no volume without loading them
+        origin = col.find("origin")
+        xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
+        rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
+        if shape is None or xyz is None or rpy is None:
+            return None
+        if shape.tag == "mesh":
+            part = _mesh_part(shape, xyz, rpy, r)
+            if part is None:
+                return None
+            parts.append(part)
+            continue
+        if shape.tag not in SOLIDS or shape.tag == "capsule":
+            return None  # planes, SDFs: no volume
         raw: Sequence[float | None] | None = (
             _vec(shape, "size", 3) if shape.tag == "box"
             else [_num(shape, attr) for attr in SOLIDS[shape.tag]])
-        xyz = _vec(col.find("origin"), "xyz", 3, (0.0, 0.0, 0.0))
         dims = [d for d in raw or () if d is not None and math.isfinite(d) and d > 0]
-        if xyz is None or raw is None or len(dims) != len(raw):
+        if raw is None or len(dims) != len(raw):
             return None  # U401/U501 say why
-        parts.append((solid_volume(shape.tag, dims), shape.tag, dims, xyz))
-    total = sum(v for v, *_ in parts)
+        volume = solid_volume(shape.tag, dims)
+        size = max(dims) if shape.tag == "box" else max([2 * dims[0], *dims[1:]])
+        parts.append((volume, sum(solid_inertia(shape.tag, dims, volume)), xyz, size))
+    total = sum(p[0] for p in parts)
     if not parts or not 0 < total < math.inf:
         return None
-    com = [sum(v * xyz[i] for v, _, _, xyz in parts) / total for i in range(3)]
+    com = [sum(v * c[i] for v, _, c, _ in parts) / total for i in range(3)]
     trace = 0.0
-    for volume, kind, dims, xyz in parts:
+    for volume, own, centre, _ in parts:
         m = mass * volume / total
-        d2 = sum((xyz[i] - com[i]) * (xyz[i] - com[i]) for i in range(3))
-        trace += sum(solid_inertia(kind, dims, m)) + 2 * m * d2
-    largest = max(max(dims) if kind == "box" else max([2 * dims[0], *dims[1:]])
-                  for _, kind, dims, _ in parts)
+        d2 = sum((centre[i] - com[i]) * (centre[i] - com[i]) for i in range(3))
+        trace += own * m / volume + 2 * m * d2
+    largest = max(p[3] for p in parts)
     return (trace, largest) if math.isfinite(trace) else None
+
+
+def _mesh_part(shape: etree._Element, xyz: Sequence[float], rpy: Sequence[float],
+               r: Report | None) -> tuple[float, float, tuple[float, ...], float] | None:
+    """A collision mesh as (volume, trace per unit density, centre in the link, size)."""
+    fn = (shape.get("filename") or "").strip()
+    if r is None or r.base is None or not fn:
+        return None
+    ref = reference("mesh", fn, r.base, r.packages)
+    scale = _vec(shape, "scale", 3, (1.0, 1.0, 1.0))
+    if ref.load_path is None or scale is None:
+        return None
+    from .meshes import properties
+
+    props = properties(ref.load_path, (scale[0], scale[1], scale[2]))
+    if props is None:
+        return None
+    if not props.closed:
+        r.add("U612", "warning", f"collision mesh {fn!r} is not closed (some edges do not "
+              "join two triangles): it has no volume, so its inertia cannot be derived and "
+              "PyBullet's recomputed inertia is unreliable; close it or give <inertia> and load "
+              "with URDF_USE_INERTIA_FROM_FILE", shape)
+        return None
+    if props.volume <= 0:
+        return None
+    centre = rotate(rpy_to_matrix(rpy), props.com)
+    t = props.inertia
+    return (props.volume, t[0][0] + t[1][1] + t[2][2],
+            tuple(xyz[i] + centre[i] for i in range(3)), max(props.extent))
 
 
 @dataclass(frozen=True)
@@ -908,6 +952,7 @@ CODES: dict[str, str] = {
     "U609": "<inertial> without <inertia>",
     "U610": "<inertia> missing a component",
     "U611": "mass-0 root link: PyBullet makes the base static",
+    "U612": "collision mesh not closed: no volume, inertia cannot be derived",
     "U701": "mesh or texture file not found",
     "U702": "package:// package not found",
     "U703": "mesh found only through pybullet_data's search path",
