@@ -140,9 +140,11 @@ def _solid(vertices: Any, faces: Any, scale: tuple[float, float, float]) -> Mesh
     moments = (second * det[:, None, None]).sum(axis=0) / 120.0  # integral of x_i x_j
     about_com = moments - volume * np.outer(com, com)
     tensor = np.trace(about_com) * np.eye(3) - about_com
-    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]),
-                    axis=1)
-    _, counts = np.unique(edges, axis=0, return_counts=True)
+    # Closed: every undirected edge in exactly two triangles (one int64 key per edge: a 1-D
+    # sort, not a row-wise unique, which is ten times slower).
+    ends = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]).astype(np.int64)
+    keys = ends.min(axis=1) * (int(faces.max()) + 1) + ends.max(axis=1)
+    _, counts = np.unique(keys, return_counts=True)
     used = v[np.unique(faces)]
     extent = used.max(axis=0) - used.min(axis=0)
     return MeshProperties(float(volume), tuple(float(x) for x in com),  # type: ignore[arg-type]
