@@ -497,10 +497,8 @@ def rule_mass(root: etree._Element, r: Report) -> None:
         elif mass is not None and mass < 0:
             r.add("U601", "error", f"{_label(link)} has negative mass {mass:g}; mass must be "
                   ">= 0", mass_el)
-    for name, j in moving:
-        if name not in links:
-            continue
-        # The link moves with everything fixed to it: it is massless only if all of them are.
+    def rigid_mass(name: str) -> float:
+        # A link moves with everything fixed to it: it is massless only if all of them are.
         total, stack, seen = 0.0, [name], set()
         while stack:
             n = stack.pop()
@@ -509,29 +507,21 @@ def rule_mass(root: etree._Element, r: Report) -> None:
             seen.add(n)
             total += max(0.0, _mass_of(links[n]) or 0.0)
             stack.extend(fixed_children.get(n, []))
-        if total == 0:
+        return total
+
+    for name, j in moving:
+        if name in links and rigid_mass(name) == 0:
             r.add("U602", "error", f"{_label(links[name])} moves (joint {j.get('name')!r} is "
                   f"{j.get('type')}) but has mass 0; give it a mass > 0", links[name])
     children = {c.get("link") for j in _elements(root, "joint") for c in j.findall("child")}
     roots = [link for name, link in links.items() if name not in children]
-    if len(roots) == 1 and _mass_of(roots[0]) == 0:
-        # The base moves with everything fixed to it, as a moving link does.
-        base, total, stack, seen = roots[0], 0.0, [roots[0].get("name", "")], set()
-        while stack:
-            n = stack.pop()
-            if n in seen or n not in links:
-                continue
-            seen.add(n)
-            total += max(0.0, _mass_of(links[n]) or 0.0)
-            stack.extend(fixed_children.get(n, []))
-        if total == 0:
-            static = not moving
-            r.add("U611", "info" if static else "warning",
-                  f"root {_label(base)} has mass 0: PyBullet makes the base static, fixed where "
-                  "it is loaded" + (" (right for a static object such as ground)" if static
-                                    else "; right for an arm bolted to the world, wrong for a "
-                                    "robot that should fall or drive: give the base a mass"),
-                  base)
+    if len(roots) == 1 and rigid_mass(roots[0].get("name", "")) == 0:
+        base, static = roots[0], not moving
+        r.add("U611", "info" if static else "warning",
+              f"root {_label(base)} has mass 0: PyBullet makes the base static, fixed where it "
+              "is loaded" + (" (right for a static object such as ground)" if static
+                             else "; right for an arm bolted to the world, wrong for a robot "
+                             "that should fall or drive: give the base a mass"), base)
 
 
 def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | None:
