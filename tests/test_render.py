@@ -432,3 +432,22 @@ def test_visual_bounds_match_pybullet_aabb(tmp_path: Path) -> None:
     lo, hi = ours[2]
     assert np.allclose((lo + hi) / 2, (np.array(boxes[2][0]) + boxes[2][1]) / 2, atol=1e-6)
     assert np.allclose(hi - lo, 0.3)
+
+
+def test_up_axis_stands_a_y_up_model_upright(tmp_path: Path) -> None:
+    # A tower modelled Y-up (as CAD and graphics exports are) lies down unless told.
+    urdf = tmp_path / "tower.urdf"
+    urdf.write_text('<robot name="tower"><link name="a"><inertial><mass value="1"/><inertia '
+                    'ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>'
+                    '<visual><geometry><box size="0.1 1 0.1"/></geometry></visual><collision>'
+                    '<geometry><box size="0.1 1 0.1"/></geometry></collision></link></robot>')
+    sizes = {}
+    for up in ("z", "y", "x"):
+        picture = render_file(urdf, RenderOptions(**{**SMALL, "up": up}))
+        lo, hi = picture.aabb
+        sizes[up] = [round(h - lo_, 3) for lo_, h in zip(lo, hi, strict=True)]
+    assert sizes["z"] == [0.1, 1.0, 0.1]  # as written: along y, lying on the ground
+    assert sizes["y"] == [0.1, 0.1, 1.0]  # stood up: its +y is the world's +z
+    assert sizes["x"] == [0.1, 1.0, 0.1]  # its x is short: turning x up changes little here
+    with pytest.raises(ParameterError, match="`up` must be one of z, y, x"):
+        RenderOptions(up="w")

@@ -707,6 +707,9 @@ def render(
         "--collision", help="Draw the collision shapes instead of the visuals.")] = False,
     frames: Annotated[bool, typer.Option(
         "--frames", help="Mark link frames (x red, y green, z blue) and joint axes.")] = False,
+    up: Annotated[str, typer.Option(
+        "--up", metavar="z|y|x", help="The model's up axis: y stands up a Y-up model (CAD "
+        "and graphics exports) that would otherwise lie down.")] = "z",
     as_json: Annotated[bool, typer.Option(
         "--json", help="Print what was drawn (cameras, bounding box) as JSON.")] = False,
     force: ForceOpt = False,
@@ -727,7 +730,8 @@ def render(
         chosen = tuple(v.strip() for v in views.split(",") if v.strip())
     options = rendering.RenderOptions(
         views=chosen, width=width, height=height, ground=ground,
-        joints=rendering.parse_joint_positions(joints), collision=collision, frames=frames)
+        joints=rendering.parse_joint_positions(joints), collision=collision, frames=frames,
+        up=up)
     out = output if output is not None else f"{Path(file).name.split('.')[0] or 'robot'}.png"
     if out != "-":  # refuse before the work, not after it
         rendering.check_output(out, force=force)

@@ -34,7 +34,7 @@ from typing import Any
 
 from . import style
 from .errors import EngineError, InputError, MissingDependencyError, ParameterError
-from .spec import attr_vec, pybullet_joint_type, rpy_to_matrix, vector
+from .spec import UP_AXES, attr_vec, pybullet_joint_type, rpy_to_matrix, vector
 
 #: The views, as (direction from target to camera, camera up vector). URDF: x forward, z up.
 #: ``front`` looks at the robot's face (+x), ``side`` at its right flank (-y), so the robot
@@ -82,6 +82,7 @@ class RenderOptions:
         collision: Draw the collision shapes instead of the visuals.
         frames: Mark link frames (RGB = xyz) and joint axes.
         labels: Write the view name into each panel (default: only for several views).
+        up: The model's up axis (``z``, ``y`` or ``x``); it is turned onto the world's +Z.
     """
 
     views: tuple[str, ...] = ("iso",)
@@ -92,8 +93,12 @@ class RenderOptions:
     collision: bool = False
     frames: bool = False
     labels: bool | None = None
+    up: str = "z"
 
     def __post_init__(self) -> None:
+        if self.up not in UP_AXES:
+            raise ParameterError(f"`up` must be one of {', '.join(UP_AXES)}, got {self.up!r}",
+                                 param="up")
         if not self.views:
             raise ParameterError("no view given")
         for v in self.views:
@@ -376,7 +381,7 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
 
     p, c = session.p, session.client
     # Fixed base: nothing is simulated, and the robot must stay exactly where it is posed.
-    opts = LoadOptions(fixed_base=True)
+    opts = LoadOptions(fixed_base=True, base_orientation=UP_AXES[o.up])
     if o.collision:
         # Make TinyRenderer draw the collision shapes: with this flag PyBullet builds the
         # visual shapes from <collision> (see the module docstring).

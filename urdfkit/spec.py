@@ -244,6 +244,12 @@ def attr_float(el: _HasGet | None, attr: str, default: float | None = None) -> f
 
 # --------------------------------------------------------------------------- rotations
 
+_HALF = math.sqrt(0.5)
+#: Base orientations (x, y, z, w) that stand a model up whose "up" is the given axis (many
+#: CAD-exported and graphics models are Y-up): that axis is turned onto the world's +Z.
+UP_AXES: dict[str, tuple[float, float, float, float]] = {
+    "z": (0.0, 0.0, 0.0, 1.0), "y": (_HALF, 0.0, 0.0, _HALF), "x": (0.0, -_HALF, 0.0, _HALF)}
+
 Vec3 = tuple[float, float, float]
 Matrix3 = tuple[Vec3, Vec3, Vec3]
 
