@@ -191,6 +191,17 @@ def test_shell_completion() -> None:
 # --------------------------------------------------------------------------- signals
 
 
+def wait_for_rows(folder: Path, proc: subprocess.Popen[str], timeout: float = 60.0) -> None:
+    """Wait until the run streams rows (its temp file grows), however slow the machine."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        assert proc.poll() is None, "the run ended before it was signalled"
+        if any(p.stat().st_size > 20_000 for p in folder.glob(".*.tmp")):
+            return
+        time.sleep(0.05)
+    pytest.fail("the run wrote no rows in time")
+
+
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
 def test_sigterm_and_sighup_stop_a_drive_like_ctrl_c(tmp_path: Path, sig: int) -> None:
     out = tmp_path / "run.csv"
@@ -198,7 +209,7 @@ def test_sigterm_and_sighup_stop_a_drive_like_ctrl_c(tmp_path: Path, sig: int) -
                              "--trajectory", str(out)], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 30
-    time.sleep(2.5)  # past the imports and the load: the run loop is going
+    wait_for_rows(tmp_path, proc)  # past the imports and the load: the run loop is going
     proc.send_signal(sig)
     stdout, stderr = proc.communicate(timeout=max(1.0, deadline - time.monotonic()))
     assert proc.returncode == 130, stderr
@@ -242,7 +253,7 @@ def test_sigterm_keeps_the_rows_a_sim_streamed(tmp_path: Path, suffix: str) -> N
     proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "sim", str(scenario), "-o",
                              str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True)
-    time.sleep(3.0)
+    wait_for_rows(tmp_path, proc)
     proc.send_signal(signal.SIGTERM)
     _, stderr = proc.communicate(timeout=30)
     assert proc.returncode == 130, stderr
