@@ -18,6 +18,7 @@ from urdfkit.cli import app
 from urdfkit.errors import MissingDependencyError, OutputError, ParameterError
 from urdfkit.render import (
     ALL_VIEWS,
+    Camera,
     RenderOptions,
     frame_view,
     parse_joint_positions,
@@ -110,11 +111,23 @@ def test_golden_image(simplecar_urdf: Path) -> None:
     assert (delta > 48).mean() < 0.01, (delta > 48).mean()
 
 
+def _project(cam: Camera, points: list[tuple[float, float, float]]
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel x, y of world points, with a reported camera and PyBullet's own matrices."""
+    from urdfkit.session import import_pybullet
+
+    p = import_pybullet()
+    view = np.array(p.computeViewMatrix(cam.eye, cam.target, cam.up)).reshape(4, 4).T
+    proj = np.array(p.computeProjectionMatrixFOV(cam.fov_deg, 320 / 240, 0.01, 100)
+                    ).reshape(4, 4).T
+    clip = np.array([[*pt, 1.0] for pt in points]) @ (proj @ view).T
+    return (clip[:, 0] / clip[:, 3] + 1) / 2 * 320, (1 - clip[:, 1] / clip[:, 3]) / 2 * 240
+
+
 def test_camera_metadata_reproduces_the_projection(tmp_path: Path) -> None:
     """A plain box seen from the top: its top face, projected with the reported camera,
     must coincide with the box's pixels (so --frames and the grid land where TinyRenderer
     draws)."""
-    from urdfkit.session import import_pybullet
 
     box = tmp_path / "box.urdf"
     box.write_text('<robot name="box"><link name="b"><visual><geometry><box size="0.4 0.2 0.1"/>'
@@ -122,15 +135,7 @@ def test_camera_metadata_reproduces_the_projection(tmp_path: Path) -> None:
                    '</visual><collision><geometry><box size="0.4 0.2 0.1"/></geometry>'
                    '</collision></link></robot>')
     r = render_file(box, RenderOptions(views=("top",), ground="none", **SMALL))
-    cam = r.cameras[0]
-    p = import_pybullet()
-    view = np.array(p.computeViewMatrix(cam.eye, cam.target, cam.up)).reshape(4, 4).T
-    proj = np.array(p.computeProjectionMatrixFOV(cam.fov_deg, 320 / 240, 0.01, 100)) \
-        .reshape(4, 4).T
-    top = np.array([[x, y, 0.05, 1] for x in (-0.2, 0.2) for y in (-0.1, 0.1)])
-    clip = top @ (proj @ view).T
-    px = (clip[:, 0] / clip[:, 3] + 1) / 2 * 320
-    py = (1 - clip[:, 1] / clip[:, 3]) / 2 * 240
+    px, py = _project(r.cameras[0], [(x, y, 0.05) for x in (-0.2, 0.2) for y in (-0.1, 0.1)])
     ys, xs = np.nonzero(_ink(r.image))
     assert abs(xs.min() - px.min()) < 2.5 and abs(xs.max() + 1 - px.max()) < 2.5
     assert abs(ys.min() - py.min()) < 2.5 and abs(ys.max() + 1 - py.max()) < 2.5
@@ -458,7 +463,6 @@ def test_up_axis_stands_a_y_up_model_upright(tmp_path: Path) -> None:
 def test_a_white_robot_keeps_its_shape_on_the_white_background(tmp_path: Path) -> None:
     """A white box's lit top face is as white as the background; only the outline keeps it:
     the inked pixels must reach the top corner of the box, projected with the camera."""
-    from urdfkit.session import import_pybullet
 
     urdf = tmp_path / "white.urdf"
     urdf.write_text('<robot name="w"><material name="white"><color rgba="1 1 1 1"/></material>'
@@ -466,13 +470,7 @@ def test_a_white_robot_keeps_its_shape_on_the_white_background(tmp_path: Path) -
                     '<material name="white"/></visual><collision><geometry><box '
                     'size="0.5 0.5 0.5"/></geometry></collision></link></robot>')
     r = render_file(urdf, RenderOptions(ground="none", **SMALL))
-    cam = r.cameras[0]
-    p = import_pybullet()
-    view = np.array(p.computeViewMatrix(cam.eye, cam.target, cam.up)).reshape(4, 4).T
-    proj = np.array(p.computeProjectionMatrixFOV(cam.fov_deg, 320 / 240, 0.01, 100)) \
-        .reshape(4, 4).T
-    top = np.array([[x, y, 0.25, 1] for x in (-0.25, 0.25) for y in (-0.25, 0.25)])
-    clip = top @ (proj @ view).T
-    highest = ((1 - clip[:, 1] / clip[:, 3]) / 2 * 240).min()
+    _, py = _project(r.cameras[0], [(x, y, 0.25) for x in (-0.25, 0.25) for y in (-0.25, 0.25)])
+    highest = py.min()
     ys, _ = np.nonzero(np.abs(r.image.astype(int) - WHITE).sum(axis=2) > 60)
     assert abs(ys.min() - highest) < 3, (ys.min(), highest)
