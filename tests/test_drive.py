@@ -314,3 +314,13 @@ def test_builtin_template_cache_holds_the_built_template(_private_cache: Path,
     monkeypatch.setenv("URDFKIT_CACHE_DIR", "")
     assert builtin_file("simplecar") is None  # caching off: drive builds into a temp folder
     assert drive(DriveConfig(steps=5)).steps == 5
+
+
+def test_up_is_checked_and_stands_the_car() -> None:
+    with pytest.raises(ParameterError, match="`up` must be one of z, y, x"):
+        DriveConfig(up="w").check()
+    # simplecar is Z-up: told it is Y-up, it is loaded on its side, its wheel axes vertical,
+    # and no joint is a wheel any more (wheels are judged in the pose at load time).
+    assert drive(DriveConfig(steps=240)).distance > 0.3
+    with pytest.raises(ParameterError, match="no wheels found"):
+        drive(DriveConfig(steps=240, up="y"))

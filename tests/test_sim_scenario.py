@@ -227,3 +227,25 @@ def test_missing_pydantic_says_what_to_install(monkeypatch: pytest.MonkeyPatch) 
             sc.parse_scenario(copy.deepcopy(example()))
     finally:
         sc.schema.cache_clear()
+
+
+def test_up_stands_a_y_up_robot_before_its_orientation(tmp_path: Path) -> None:
+    from urdfkit.session import import_pybullet
+    from urdfkit.spec import UP_AXES, quat_mul
+
+    p = import_pybullet()
+    # quat_mul agrees with PyBullet's own composition.
+    a, b = p.getQuaternionFromEuler((0.1, -0.4, 2.0)), UP_AXES["y"]
+    _, composed = p.multiplyTransforms((0, 0, 0), a, (0, 0, 0), b)
+    assert quat_mul(a, b) == pytest.approx(composed, abs=1e-6)  # PyBullet computes in float32
+    urdf = tmp_path / "tower.urdf"
+    urdf.write_text('<robot name="tower"><link name="a"><inertial><mass value="1"/><inertia '
+                    'ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>'
+                    '<collision><geometry><box size="0.1 1 0.1"/></geometry></collision>'
+                    '</link></robot>')
+    doc = {"duration": 0.01, "robots": [{"urdf": str(urdf), "base": "fixed", "up": "y",
+                                         "orientation_rpy": [0, 0, 0.5]}]}
+    with Simulation(doc) as s:
+        row = s.run().rows[0]
+    expected = quat_mul(p.getQuaternionFromEuler((0, 0, 0.5)), UP_AXES["y"])
+    assert row.base_orientation == pytest.approx(expected, abs=1e-6)

@@ -587,6 +587,8 @@ def drive(
         "--gui", help="Open the PyBullet GUI with Steering and Throttle sliders.")] = False,
     as_json: JsonOpt = False,
     no_guard: NoGuardOpt = False,
+    up: Annotated[str, typer.Option(
+        "--up", metavar="z|y|x", help="The car's up axis: y stands up a Y-up model.")] = "z",
 ) -> None:
     """Drive a car headless at a fixed throttle and steer, and report where it went.
 
@@ -622,7 +624,7 @@ def drive(
         packages=package, xacro_args=arg, seconds=10.0 if seconds is None else seconds,
         steps=steps, time_step=time_step, throttle=throttle, steer=steer, max_force=max_force,
         wheels=_split_joints(wheels), hinges=_split_joints(hinges), sample_every=sample_every,
-        gui=gui, guard=not no_guard, package_paths=package_path)
+        gui=gui, guard=not no_guard, package_paths=package_path, up=up)
     with Scenario(config) as sc:
         t = sc.drivetrain
 

@@ -34,7 +34,7 @@ from typing import Any
 
 from .errors import ParameterError
 from .session import LoadOptions, Session, quiet_stdout
-from .spec import finite
+from .spec import UP_AXES, finite
 from .vehicle import (
     Drivetrain,
     DrivetrainError,
@@ -91,6 +91,7 @@ class DriveConfig:
         guard: False lifts the guard's refusals that are stricter than PyBullet (they become
             warnings); crash classes are refused either way.
         package_paths: Folders searched for ROS packages (``package.xml``).
+        up: The car's up axis (``z``, ``y`` or ``x``), turned onto the world's +Z.
     """
 
     urdf: str | None = None
@@ -112,6 +113,7 @@ class DriveConfig:
     gui: bool = False
     guard: bool = True
     package_paths: list[str] | None = None
+    up: str = "z"
 
     def check(self) -> None:
         """Refuse values that would make the run meaningless (exit 2 in the CLI)."""
@@ -137,6 +139,9 @@ class DriveConfig:
             raise ParameterError(f"`max_force` must be >= 0, got {self.max_force:g}",
                                  param="max_force")
         self.gravity = _finite("gravity", self.gravity)
+        if self.up not in UP_AXES:
+            raise ParameterError(f"`up` must be one of {', '.join(UP_AXES)}, got {self.up!r}",
+                                 param="up")
         if self.sample_every is not None and (isinstance(self.sample_every, bool)
                                               or self.sample_every < 1):
             raise ParameterError(f"`sample_every` must be >= 1, got {self.sample_every!r}",
@@ -469,7 +474,8 @@ class Scenario:
         self._load(s, c.plane, "simpleplane", LoadOptions(fixed_base=True))
         # Flags: implicit cylinders (smooth wheels) and the file's own inertia; see module doc.
         self.body = self._load(s, c.urdf, "simplecar", LoadOptions(
-            base_position=c.base_position, inertia_from_file=True, implicit_cylinder=True),
+            base_position=c.base_position, base_orientation=UP_AXES[c.up],
+            inertia_from_file=True, implicit_cylinder=True),
             c.template_params)
         car = c.urdf or "simplecar"
         s.require_state_queries(self.body, car)

@@ -145,6 +145,7 @@ def schema() -> SimpleNamespace:
         position: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
         orientation_rpy: vec3 | None = None
         orientation_quat: vec4 | None = None
+        up: Literal["z", "y", "x"] = "z"
         base: Literal["floating", "fixed"] = "floating"
         inertia_from_file: bool = True
         self_collision: bool = False

@@ -34,7 +34,7 @@ from typing import Any
 from .errors import EngineError, InputError, MissingDependencyError, OutputError, ParameterError
 from .scenario import OBSERVATION_FIELDS, load_scenario, parse_scenario
 from .session import LoadOptions, Session
-from .spec import quat_to_matrix, rotate_back
+from .spec import UP_AXES, quat_mul, quat_to_matrix, rotate_back
 
 _REVOLUTE, _PRISMATIC, _FIXED = 0, 1, 4  # p.JOINT_* values
 #: Joint types with one degree of freedom: what getJointState can report.
@@ -328,6 +328,8 @@ class Simulation:
             orientation = tuple(q / norm for q in cfg.orientation_quat)
         else:
             orientation = tuple(p.getQuaternionFromEuler(cfg.orientation_rpy or (0, 0, 0)))
+        # A Y-up (or X-up) model is first stood up, then turned as the scenario says.
+        orientation = quat_mul(orientation, UP_AXES[cfg.up])
         options = LoadOptions(fixed_base=cfg.base == "fixed",
                               inertia_from_file=cfg.inertia_from_file,
                               self_collision=cfg.self_collision,

@@ -254,6 +254,14 @@ Vec3 = tuple[float, float, float]
 Matrix3 = tuple[Vec3, Vec3, Vec3]
 
 
+def quat_mul(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float, float]:
+    """The quaternion product a * b (x, y, z, w): rotate by ``b`` first, then by ``a``."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz)
+
+
 def rpy_to_matrix(rpy: Sequence[float]) -> Matrix3:
     """Rotation matrix of URDF roll-pitch-yaw (fixed axes X, Y, Z): ``R = Rz(y) Ry(p) Rx(r)``."""
     r, p, y = rpy
