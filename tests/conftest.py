@@ -12,6 +12,14 @@ from urdfkit.catalog import build_template
 TESTS = Path(__file__).parent
 
 
+@pytest.fixture(scope="session", autouse=True)
+def private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """The suite's own urdfkit cache folder: never the user's ~/.cache (CLI subprocesses too)."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("URDFKIT_CACHE_DIR", str(tmp_path_factory.mktemp("urdfkit-cache")))
+        yield
+
+
 @pytest.fixture(scope="session")
 def simplecar_urdf(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """simplecar.urdf built with default parameters, in a temp folder."""

@@ -17,7 +17,7 @@ PACKAGE = Path(urdfkit.__file__).parent
 LAYERS: dict[str, int] = {}
 for floor, names in enumerate([
     # spec and model
-    "errors spec style templatedir suggest output xmlio builder catalog",
+    "errors spec style templatedir suggest output cache xmlio builder catalog",
     # sources: files, packages, xacro, and the guard every loader calls
     "uris meshes _xacro_worker expand validate resolve",
     # the engine session

@@ -24,7 +24,6 @@ import csv
 import io
 import json
 import math
-import os
 import tempfile
 import time
 from collections.abc import Callable, Mapping
@@ -32,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .cache import cache_dir, write_entry
 from .errors import ParameterError
 from .session import LoadOptions, Session, quiet_stdout
 from .spec import UP_AXES, finite
@@ -368,15 +368,6 @@ class DriveResult:
 ProgressFn = Callable[[int, int], None]
 
 
-def cache_dir() -> Path | None:
-    """Where built default templates are cached; ``URDFKIT_CACHE_DIR=""`` turns caching off."""
-    env = os.environ.get("URDFKIT_CACHE_DIR")
-    if env is not None:
-        return Path(env) if env else None
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "urdfkit"
-
-
 def builtin_file(name: str) -> Path | None:
     """A built-in template, built with default parameters, from the cache (built on a miss).
 
@@ -407,15 +398,7 @@ def builtin_file(name: str) -> Path | None:
     from .catalog import build_template
 
     data = build_template(name).to_bytes()
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=folder)
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)  # atomic: concurrent runs never see half a file
-    except OSError:
-        return None
-    return path
+    return path if write_entry(path, data) else None
 
 
 class Scenario:

@@ -5,19 +5,26 @@ an STL (binary or ASCII) or OBJ file, applies ``<mesh scale>``, and returns the 
 centre of mass and inertia per unit density by the signed-tetrahedron method (each triangle
 with the origin spans a tetrahedron; summed with signs, they give the closed solid's
 integrals). It also says whether the surface is closed (every edge shared by exactly two
-triangles), since a mesh with holes has no meaningful volume. Results are cached by the
-file's content hash: a tree of robots sharing meshes reads each mesh once per process.
-COLLADA (.dae) is not read: checks skip those meshes.
+triangles), since a mesh with holes has no meaningful volume.
+
+Reading and integrating a mesh costs far more than checking the URDF that names it, so the
+integrals are kept, unscaled, in urdfkit's cache (:mod:`urdfkit.cache`), keyed by the file's
+absolute path, size, modification time and inode: a second ``check`` of the same robots reads
+no mesh. Any ``scale`` is applied to the integrals in closed form. COLLADA (.dae) is not read:
+checks skip those meshes.
 """
 
 from __future__ import annotations
 
 import hashlib
+import os
 import re
 import struct
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from .cache import cache_dir, read_entry, write_entry
 
 #: Largest mesh file read for checks; bigger ones are skipped (checks must stay fast).
 MAX_MESH_BYTES = 16 * 1024 * 1024
@@ -51,29 +58,132 @@ class MeshProperties:
         return (t[0][0] + t[1][1] + t[2][2]) * mass / self.volume
 
 
-_CACHE: dict[tuple[str, tuple[float, ...]], MeshProperties | None] = {}
+@dataclass(frozen=True)
+class Integrals:
+    """A mesh's volume integrals as read, unscaled and signed (what the cache keeps).
+
+    Attributes:
+        volume: Signed volume (negative when the triangles face inward).
+        first: Integrals of x, y, z over the solid.
+        second: Integrals of xx, yy, zz, xy, xz, yz over the solid.
+        low, high: Corners of the bounding box of the vertices the triangles use.
+        closed, triangles: As in :class:`MeshProperties`.
+    """
+
+    volume: float
+    first: tuple[float, float, float]
+    second: tuple[float, float, float, float, float, float]
+    low: tuple[float, float, float]
+    high: tuple[float, float, float]
+    closed: bool
+    triangles: int
+
+    _FORMAT = struct.Struct("<16d?I")
+
+    def pack(self) -> bytes:
+        """The cache entry's bytes."""
+        return b"M1" + self._FORMAT.pack(self.volume, *self.first, *self.second, *self.low,
+                                         *self.high, self.closed, self.triangles)
+
+    @classmethod
+    def unpack(cls, data: bytes) -> Integrals:
+        """Read a cache entry; ValueError if it is not one."""
+        if len(data) != 2 + cls._FORMAT.size or data[:2] != b"M1":
+            raise ValueError("not a mesh cache entry")
+        v = cls._FORMAT.unpack_from(data, 2)
+        return cls(v[0], v[1:4], v[4:10], v[10:13], v[13:16], v[16], v[17])
+
+    def scaled(self, scale: tuple[float, float, float]) -> MeshProperties | None:
+        """The solid under ``<mesh scale>``: integrals scale as powers of each factor."""
+        sx, sy, sz = scale
+        det = sx * sy * sz
+        if det == 0:
+            return None
+        volume = self.volume * det
+        first = [f * k * det for f, k in zip(self.first, scale, strict=True)]
+        xx, yy, zz, xy, xz, yz = self.second
+        m = [[xx * sx * sx, xy * sx * sy, xz * sx * sz],
+             [xy * sx * sy, yy * sy * sy, yz * sy * sz],
+             [xz * sx * sz, yz * sy * sz, zz * sz * sz]]
+        sign = -1.0 if volume < 0 else 1.0  # inward triangles: the same solid, inside out
+        volume *= sign
+        com = [sign * f / volume if volume else 0.0 for f in first]
+        about = [[sign * det * m[i][j] - volume * com[i] * com[j] for j in range(3)]
+                 for i in range(3)]
+        trace = about[0][0] + about[1][1] + about[2][2]
+        tensor = tuple(tuple((trace if i == j else 0.0) - about[i][j] for j in range(3))
+                       for i in range(3))
+        extent = tuple(abs(k) * (h - lo) for k, lo, h in zip(scale, self.low, self.high,
+                                                                      strict=True))
+        return MeshProperties(volume, (com[0], com[1], com[2]), tensor,
+                              extent, self.closed, self.triangles)  # type: ignore[arg-type]
+
+
+_MEMORY: dict[str, Integrals | None] = {}
+_MISSING = object()
 
 
 def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
                ) -> MeshProperties | None:
     """Mass properties of an STL or OBJ mesh, or None if unreadable, unsupported or empty."""
+    suffix = path.suffix.lower()
+    if suffix not in (".stl", ".obj"):
+        return None
     try:
-        if path.stat().st_size > MAX_MESH_BYTES:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    if st.st_size > MAX_MESH_BYTES:
+        return None
+    key = f"{os.path.abspath(path)}\0{st.st_size}\0{st.st_mtime_ns}\0{st.st_ino}"
+    found = _MEMORY.get(key, _MISSING)
+    if found is _MISSING:
+        found = _MEMORY[key] = _integrals(path, suffix, key)
+    assert found is None or isinstance(found, Integrals)
+    return found.scaled(scale) if found is not None else None
+
+
+def _integrals(path: Path, suffix: str, key: str) -> Integrals | None:
+    folder = cache_dir()
+    entry = (folder / "meshes-1" / hashlib.sha1(key.encode("utf-8", "surrogateescape")
+                                                ).hexdigest()) if folder else None
+    if entry is not None:
+        data = read_entry(entry)
+        if data == b"M1-":
             return None
-        data = path.read_bytes()
+        if data is not None:
+            try:
+                return Integrals.unpack(data)
+            except (ValueError, struct.error):
+                pass  # a damaged entry: read the mesh again and rewrite it
+    found = read_integrals(path, suffix)
+    if entry is not None:
+        write_entry(entry, found.pack() if found is not None else b"M1-")
+    return found
+
+
+def read_integrals(path: Path, suffix: str | None = None) -> Integrals | None:
+    """Read a mesh and integrate it (no cache); None if unreadable, unsupported or empty."""
+    import numpy as np
+
+    suffix = (suffix or path.suffix).lower()
+    try:
+        with open(path, "rb") as f:
+            data = f.read(MAX_MESH_BYTES + 1)
     except OSError:
         return None
-    key = (hashlib.sha1(data).hexdigest(), tuple(scale))
-    if key not in _CACHE:
-        suffix = path.suffix.lower()
-        try:
-            vertices, faces = (_stl(data) if suffix == ".stl" else _obj(data) if suffix == ".obj"
-                               else (None, None))
-        except (ValueError, struct.error, IndexError):
-            vertices, faces = None, None
-        _CACHE[key] = (None if vertices is None or faces is None or len(faces) == 0
-                       else _solid(vertices, faces, scale))
-    return _CACHE[key]
+    if len(data) > MAX_MESH_BYTES:
+        return None
+    try:
+        vertices, faces = (_stl(data) if suffix == ".stl" else _obj(data) if suffix == ".obj"
+                           else (None, None))
+    except (ValueError, struct.error, IndexError, OverflowError):
+        return None
+    if (vertices is None or faces is None or len(faces) == 0 or len(vertices) == 0
+            or faces.min() < 0 or faces.max() >= len(vertices)
+            or not np.isfinite(vertices).all()):
+        return None
+    return _solid(vertices, faces)
 
 
 def _stl(data: bytes) -> tuple[Any, Any]:
@@ -99,55 +209,80 @@ def _weld(corners: Any) -> tuple[Any, Any]:
     return unique, index.reshape(-1, 3)
 
 
-_OBJ_VERTEX = re.compile(rb"^v[ \t]+(\S+)[ \t]+(\S+)[ \t]+(\S+)", re.M)
-_OBJ_FACE = re.compile(rb"^f[ \t]+([^\r\n]+)", re.M)
-_OBJ_TRIANGLE = re.compile(rb"^f[ \t]+(-?\d+)\S*[ \t]+(-?\d+)\S*[ \t]+(-?\d+)\S*[ \t]*\r?$",
-                           re.M)
+_OBJ_INDEX_TAIL = re.compile(rb"/\S*")  # "7/3/2" -> "7": texture and normal indices go
+
+
+def _numbers(lines: list[bytes], dtype: Any, per_line: int) -> Any:
+    """The numbers after each line's keyword, ``per_line`` of them per line.
+
+    The common case (every line holds exactly ``per_line`` numbers) is parsed in one C call;
+    anything else (vertex colours, polygons, junk) line by line, which raises ValueError on
+    text that is not a number.
+    """
+    import warnings
+
+    import numpy as np
+
+    joined = b" ".join(line.split(None, 1)[1] if b" " in line or b"\t" in line else b""
+                       for line in lines)
+    if dtype is not float and b"/" in joined:
+        joined = _OBJ_INDEX_TAIL.sub(b"", joined)
+    with warnings.catch_warnings():  # numpy warns when it stops early: counted below
+        warnings.simplefilter("ignore", DeprecationWarning)
+        values = np.fromstring(joined, dtype=dtype, sep=" ")
+    if values.size == per_line * len(lines):
+        return values.reshape(-1, per_line)
+    raise ValueError("irregular")
 
 
 def _obj(data: bytes) -> tuple[Any, Any]:
     import numpy as np
 
-    vertices = np.array(_OBJ_VERTEX.findall(data), dtype=float).reshape(-1, 3)
+    lines = data.split(b"\n")
+    vlines = [ln for ln in lines if ln[:2] in (b"v ", b"v\t")]
+    flines = [ln for ln in lines if ln[:2] in (b"f ", b"f\t")]
+    try:
+        vertices = _numbers(vlines, float, 3)
+    except ValueError:  # "v x y z w" or "v x y z r g b": the first three are the position
+        vertices = np.array([[float(x) for x in ln.split()[1:4]] for ln in vlines],
+                            dtype=float).reshape(-1, 3)
     count = len(vertices)
-    lines = _OBJ_FACE.findall(data)
-    triangles = _OBJ_TRIANGLE.findall(data)
-    if len(triangles) == len(lines):  # the common case, all triangles: no Python loop
-        tri = np.array(triangles, dtype=float).astype(int).reshape(-1, 3)
-        return vertices, np.where(tri > 0, tri - 1, count + tri)
-    faces: list[tuple[int, int, int]] = []
-    for line in lines:
-        idx = [int(p.split(b"/", 1)[0]) for p in line.split()]
-        idx = [i - 1 if i > 0 else count + i for i in idx]
-        faces += [(idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
-    return vertices, np.array(faces, dtype=int).reshape(-1, 3)
+    try:
+        tri = _numbers(flines, np.int64, 3)
+    except ValueError:  # polygons: fans of triangles
+        faces: list[tuple[int, int, int]] = []
+        for line in flines:
+            idx = [int(p.split(b"/", 1)[0]) for p in line.split()[1:]]
+            faces += [(idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
+        tri = np.array(faces, dtype=np.int64).reshape(-1, 3)
+    return vertices, np.where(tri > 0, tri - 1, count + tri)  # 1-based; negative: from the end
 
 
-def _solid(vertices: Any, faces: Any, scale: tuple[float, float, float]) -> MeshProperties:
+def _solid(vertices: Any, faces: Any) -> Integrals:
     import numpy as np
 
-    v = vertices * np.asarray(scale, dtype=float)
-    a, b, c = v[faces[:, 0]], v[faces[:, 1]], v[faces[:, 2]]
+    p = vertices[faces.T]  # (corner, triangle, xyz)
+    a, b, c = p
     det = np.einsum("ij,ij->i", a, np.cross(b, c))  # 6 x signed tetrahedron volumes
-    volume = det.sum() / 6.0
-    if volume < 0:  # inward-facing triangles: the same solid, turned inside out
-        det, volume = -det, -volume
-    com = ((a + b + c) * det[:, None]).sum(axis=0) / (24.0 * volume) if volume else np.zeros(3)
-    # Second moments of each tetrahedron (origin, a, b, c) about the origin.
     s = a + b + c
-    second = (np.einsum("ij,ik->ijk", a, a) + np.einsum("ij,ik->ijk", b, b)
-              + np.einsum("ij,ik->ijk", c, c) + np.einsum("ij,ik->ijk", s, s))
-    moments = (second * det[:, None, None]).sum(axis=0) / 120.0  # integral of x_i x_j
-    about_com = moments - volume * np.outer(com, com)
-    tensor = np.trace(about_com) * np.eye(3) - about_com
-    # Closed: every undirected edge in exactly two triangles (one int64 key per edge: a 1-D
-    # sort, not a row-wise unique, which is ten times slower).
-    ends = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]).astype(np.int64)
-    keys = ends.min(axis=1) * (int(faces.max()) + 1) + ends.max(axis=1)
-    _, counts = np.unique(keys, return_counts=True)
-    used = v[np.unique(faces)]
-    extent = used.max(axis=0) - used.min(axis=0)
-    return MeshProperties(float(volume), tuple(float(x) for x in com),  # type: ignore[arg-type]
-                          tuple(tuple(float(x) for x in row) for row in tensor),
-                          tuple(float(x) for x in extent),  # type: ignore[arg-type]
-                          bool((counts == 2).all()), int(len(faces)))
+    # Second moments of each tetrahedron (origin, a, b, c): (aa' + bb' + cc' + ss') det / 120.
+    q = p.transpose(2, 0, 1).reshape(3, -1)
+    second = ((q * np.tile(det, 3)) @ q.T + (s.T * det) @ s) / 120.0
+    first = s.T @ det / 24.0
+    # Closed: every undirected edge in exactly two triangles. Sorted corners give each edge
+    # one int64 key; sorted keys must then come in equal pairs, each pair unlike the next.
+    e = np.sort(faces, axis=1).astype(np.int64)
+    n = int(e[:, 2].max()) + 1
+    keys = np.sort(np.concatenate([e[:, 0] * n + e[:, 1], e[:, 1] * n + e[:, 2],
+                                   e[:, 0] * n + e[:, 2]]))
+    closed = bool(len(keys) % 2 == 0 and (keys[0::2] == keys[1::2]).all()
+                  and (keys[2::2] != keys[1:-1:2]).all())
+    used = np.zeros(len(vertices), dtype=bool)
+    used[faces.ravel()] = True
+    corners = vertices[used]
+    low, high = corners.min(axis=0), corners.max(axis=0)
+    return Integrals(float(det.sum()) / 6.0, (float(first[0]), float(first[1]), float(first[2])),
+                     (float(second[0, 0]), float(second[1, 1]), float(second[2, 2]),
+                      float(second[0, 1]), float(second[0, 2]), float(second[1, 2])),
+                     (float(low[0]), float(low[1]), float(low[2])),
+                     (float(high[0]), float(high[1]), float(high[2])), closed, len(faces))

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import re
 import sys
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -95,6 +95,16 @@ class Report:
         self.base = base
         self.packages = dict(packages or {})
         self.findings: list[Finding] = []
+        self._references: dict[tuple[str, str], Reference] = {}
+
+    def reference(self, tag: str, fn: str) -> Reference:
+        """:func:`reference` from this file's folder, judged once per file (several rules ask)."""
+        assert self.base is not None
+        key = (tag, fn)
+        ref = self._references.get(key)
+        if ref is None:
+            ref = self._references[key] = reference(tag, fn, self.base, self.packages)
+        return ref
 
     def add(self, code: str, level: str, message: str, el: etree._Element | None = None,
             line: int | None = None) -> None:
@@ -317,47 +327,23 @@ def rule_link_count(root: etree._Element, r: Report) -> None:
 _DBL_EPSILON = sys.float_info.epsilon
 
 
-def _walk(root: etree._Element) -> Iterator[etree._Element]:
-    """Every element urdfkit checks: skips comments, namespaced tags and opaque subtrees."""
-    stack = [root]
-    while stack:
-        el = stack.pop()
-        yield el
-        for child in reversed(el):
-            if isinstance(child.tag, str) and not child.tag.startswith("{") \
-                    and child.tag not in OPAQUE:
-                stack.append(child)
-
-
 def rule_elements(root: etree._Element, r: Report) -> None:
     """U401-U402 and U801-U802, in one pass over the tree.
 
     Numbers parse, are finite and have the right length; tags and attributes are known
-    (typos, or extensions PyBullet ignores). The walk is lxml's own (C) iteration; the
-    subtrees :func:`_walk` skips (opaque and namespaced ones) are collected first.
+    (typos, or extensions PyBullet ignores). Comments, namespaced elements (xacro leftovers,
+    extensions) and opaque subtrees (another tool's: gazebo, transmission, ...) are skipped
+    whole. Each parent checks its own children's tags, so no element asks for its parent.
     """
-    skip: set[etree._Element] = set()
-    by_tag, schema, finite = _NUMERIC_BY_TAG.get, SCHEMA.get, math.isfinite
-    for el in root.iter(etree.Element):
-        tag = el.tag
-        if skip and el in skip:
-            continue
-        if tag[0] == "{":  # namespaced (xacro leftovers, extensions): not ours to judge
-            skip.update(el.iter())
-            continue
-        parent = el.getparent()
-        if parent is not None:
-            around = schema(parent.tag)
-            if around is not None and tag not in around[1]:
-                r.add("U801", "warning", f"<{tag}> is not known inside <{parent.tag}>; "
-                      "PyBullet ignores it", el)
-        if tag in OPAQUE:  # its contents are another tool's (gazebo, transmission, ...)
-            skip.update(el.iter())
-            continue
-        known = schema(tag)
-        numeric = by_tag(tag)
-        if known is None and numeric is None:
-            continue
+    tag = root.tag
+    if isinstance(tag, str) and tag[0] != "{" and tag not in OPAQUE:
+        _elements_below(root, tag, r)
+
+
+def _elements_below(el: etree._Element, tag: str, r: Report) -> None:
+    known = SCHEMA.get(tag)
+    numeric = _NUMERIC_BY_TAG.get(tag)
+    if known is not None or numeric is not None:
         for attr, text in el.items():
             n = numeric.get(attr) if numeric is not None else None
             if n is not None:
@@ -365,7 +351,7 @@ def rule_elements(root: etree._Element, r: Report) -> None:
                     vals = [float(x) for x in text.split()]
                 except ValueError:
                     vals = None
-                if vals is None or not all(map(finite, vals)):
+                if vals is None or not all(map(math.isfinite, vals)):
                     r.add("U401", "error", f"<{tag} {attr}={text!r}>: expected "
                           f"{'a finite number' if n == 1 else f'{n} finite numbers'}", el)
                 elif len(vals) != n:
@@ -374,6 +360,16 @@ def rule_elements(root: etree._Element, r: Report) -> None:
             if known is not None and attr not in known[0] and attr[0] != "{":
                 r.add("U802", "warning", f"<{tag}> has unknown attribute {attr!r}; PyBullet "
                       "ignores it", el)
+    allowed = known[1] if known is not None else None
+    for child in el:
+        ctag = child.tag
+        if not isinstance(ctag, str) or ctag[0] == "{":
+            continue  # comments, processing instructions, namespaced elements
+        if allowed is not None and ctag not in allowed:
+            r.add("U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
+                  "ignores it", child)
+        if ctag not in OPAQUE:
+            _elements_below(child, ctag, r)
 
 
 #: NUMERIC by tag: {tag: {attribute: how many numbers}}, for one lookup per element.
@@ -712,7 +708,7 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rpy: Sequence[float]
     fn = (shape.get("filename") or "").strip()
     if r is None or r.base is None or not fn:
         return None
-    ref = reference("mesh", fn, r.base, r.packages)
+    ref = r.reference("mesh", fn)
     scale = _vec(shape, "scale", 3, (1.0, 1.0, 1.0))
     if ref.load_path is None or scale is None:
         return None
@@ -789,7 +785,7 @@ def rule_meshes(root: etree._Element, r: Report) -> None:
     for el in root.iter(*FILE_TAGS):
         fn = (el.get("filename") or "").strip()
         if fn:
-            ref = reference(el.tag, fn, r.base, r.packages)
+            ref = r.reference(el.tag, fn)
             if ref.code is not None:
                 r.add(ref.code, ref.level, ref.message, el)
 
