@@ -9,6 +9,7 @@ lifts.
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -200,3 +201,31 @@ def test_an_oversized_body_is_refused_before_the_tree_is_built(tmp_path: Path) -
         assert exit_code == ("1" if command[0] == "check" else "2"), done.stderr
         assert "280000 links" in (done.stderr + done.stdout)
         assert int(peak_kb) < 250_000, (command, peak_kb)  # was 720 MB
+
+
+def one_line_robot(cut: int) -> str:
+    """One line where ``<inertial>`` of link b straddles byte ``cut`` (a comment pads it)."""
+    head = ('<robot name="r"><link name="a"><visual><geometry><box size="1 1 1"/></geometry>'
+            '</visual></link>')
+    tail = ('<link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" '
+            'iyy="1" iyz="0" izz="1"/></inertial></link><joint name="j" type="fixed">'
+            '<parent link="a"/><child link="b"/></joint></robot>')
+    pad = cut - len(head) - len('<link name="b"><ine') - len("<!---->")
+    return head + "<!--" + "x" * pad + "-->" + tail
+
+
+@pytest.mark.parametrize("cut", [8191, 16382])  # PyBullet breaks lines every 8191 bytes
+def test_a_line_pybullet_breaks_is_loaded_from_a_formatted_copy(tmp_path: Path,
+                                                                 cut: int) -> None:
+    broken, control = tmp_path / "broken.urdf", tmp_path / "control.urdf"
+    broken.write_text(one_line_robot(cut))
+    control.write_text(one_line_robot(600))  # the same robot, no break in a name
+    assert raw_outcome(broken) == "error" and raw_outcome(control) == "loads"
+    ours = CliRunner().invoke(app, ["joints", str(broken), "--json"])
+    assert ours.exit_code == 0, ours.stderr
+    theirs = CliRunner().invoke(app, ["joints", str(control), "--json"])
+    assert json.loads(ours.stdout)["joints"] == json.loads(theirs.stdout)["joints"]
+    found = json.loads(CliRunner().invoke(app, ["check", str(broken), "--json"]).stdout)
+    assert [f["line"] for f in found["findings"] if f["code"] == "U008"] == [1]
+    assert not [f for f in json.loads(CliRunner().invoke(
+        app, ["check", str(control), "--json"]).stdout)["findings"] if f["code"] == "U008"]

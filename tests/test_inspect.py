@@ -171,3 +171,27 @@ def test_quat_to_rpy_matches_pybullet(pb) -> None:
     for rpy in [(0.1, -0.4, 2.0), (0, 0, 0), (3.0, 0.2, -1.0), (0, math.pi / 2 - 1e-6, 0)]:
         q = p.getQuaternionFromEuler(rpy)
         assert quat_to_rpy(q) == pytest.approx(p.getEulerFromQuaternion(q), abs=1e-6)
+
+
+def test_a_session_reloads_a_file_edited_since_it_loaded_it(tmp_path: Path, pb) -> None:
+    from urdfkit.session import Session
+
+    def write(child: str) -> None:
+        path.write_text(f'<robot name="r"><link name="a"/><link name="{child}"/><joint name="j" '
+                        f'type="fixed"><parent link="a"/><child link="{child}"/></joint>'
+                        '</robot>')
+
+    path = tmp_path / "r.urdf"
+    # Raw PyBullet keeps the first version for the client's life (its file cache).
+    p, client = pb
+    write("first")
+    p.getJointInfo(p.loadURDF(str(path), physicsClientId=client), 0, physicsClientId=client)
+    write("second")
+    raw = p.loadURDF(str(path), physicsClientId=client)
+    assert p.getJointInfo(raw, 0, physicsClientId=client)[12] == b"first"
+    with Session() as s:
+        write("first")
+        assert s.p.getJointInfo(s.load_urdf(path), 0, physicsClientId=s.client)[12] == b"first"
+        write("second")
+        body = s.load_urdf(path)
+        assert s.p.getJointInfo(body, 0, physicsClientId=s.client)[12] == b"second"

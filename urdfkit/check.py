@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import InputError, ParameterError
+from .spec import PYBULLET_LINE_BYTES
 from .validate import ALL_RULES, CODES, LEVELS, Finding, refuse_oversized, run_rules
 
 #: File suffixes a folder search picks up.
@@ -170,7 +171,7 @@ def check_file(display: str, path: str | Path,
     from lxml import etree
 
     from .expand import XacroNotExpanded
-    from .xmlio import parse_xml, tolerate_quirks
+    from .xmlio import long_line, parse_xml, tolerate_quirks
 
     path = Path(path)
     result = FileResult(display)
@@ -191,6 +192,13 @@ def check_file(display: str, path: str | Path,
         return result
     result.findings.extend(Finding("U004", "warning", note, display, line)
                            for line, note in quirks)
+    too_long = long_line(data) if path.suffix != ".xacro" else None
+    if too_long is not None:
+        result.findings.append(Finding(
+            "U008", "warning", f"line {too_long[0]} is {too_long[1]} bytes long: PyBullet reads "
+            f"lines in {PYBULLET_LINE_BYTES}-byte pieces and breaks them there, so p.loadURDF "
+            "refuses or misreads the file when a break falls inside a name (urdfkit loads a "
+            "reformatted copy); put one element per line", display, too_long[0]))
     if path.suffix == ".xacro" and _macro_library(tree.getroot()):
         result.findings.append(Finding("U007", "info", "a xacro macro library (no links of its "
                                        "own): checked through the files that include it",

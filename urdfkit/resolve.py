@@ -23,11 +23,11 @@ from lxml import etree
 
 from .errors import InputError, ParameterError
 from .expand import expand_xacro
-from .spec import FILE_SHAPES, FILE_TAGS
+from .spec import FILE_SHAPES, FILE_TAGS, PYBULLET_LINE_BYTES
 from .uris import PackageIndex, not_a_file, pybullet_data_path
 from .validate import STRICTER, Finding, reference, refuse_oversized
 from .validate import guard as run_guard
-from .xmlio import parse_xml, read_bytes, to_bytes
+from .xmlio import long_line, parse_xml, read_bytes, to_bytes
 
 
 def locate(name: str | Path) -> Path:
@@ -167,7 +167,8 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
     if source.suffix == ".xacro":
         data = expand_xacro(source, xacro_args, display=display, packages=packages)
         try:
-            return _resolve_tree(source, display, parse_xml(data, display), packages, guard)
+            return _resolve_tree(source, display, parse_xml(data, display), packages, guard,
+                                 copy=True)
         except InputError as e:
             # Lines of xacro's output are not lines of the file the user wrote: say none
             # rather than a false one (the message names the element).
@@ -175,17 +176,21 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
     else:
         data = read_bytes(source)
         refuse_oversized(data, display)  # before a tree of 280,000 links is built
-        return _resolve_tree(source, display, parse_xml(data, display), packages, guard)
+        # PyBullet breaks lines over 8191 bytes (and may then refuse or misread the file): it
+        # gets a reformatted copy, one element per line.
+        return _resolve_tree(source, display, parse_xml(data, display), packages, guard,
+                             copy=long_line(data) is not None)
 
 
 def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
-                  packages: Mapping[str, Path] | None, guard: bool) -> Resolved:
+                  packages: Mapping[str, Path] | None, guard: bool,
+                  copy: bool = False) -> Resolved:
     lifted = [f"{where(f)}: let through without the guard ({f.code}): "
               f"{f.message.removesuffix(STRICTER)}" for f in run_guard(tree, display, strict=guard)]
     root = tree.getroot()
     # PyBullet takes paths as UTF-8 text: a file name that is not (bytes from another locale,
     # kept by Python as surrogates) is loaded from a copy with a clean name.
-    needs_copy = source.suffix == ".xacro" or not _utf8(str(source))
+    needs_copy = copy or not _utf8(str(source))
     needs_copy = _check_files(root, source.resolve().parent, packages or {}, display) \
         or needs_copy
     if needs_copy:
@@ -201,7 +206,20 @@ def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
                 tmp.cleanup()
                 raise InputError("PyBullet cannot open a mesh whose path is not valid UTF-8: "
                                  f"{el.get('filename')!r}", file=display, line=el.sourceline)
-        load_path.write_bytes(to_bytes(root))
+        body = to_bytes(root)
+        if long_line(body) is not None:  # a long comment is harmless, but costs nothing to drop
+            for comment in list(root.iter(etree.Comment)):
+                parent = comment.getparent()
+                if parent is not None:
+                    parent.remove(comment)  # (lxml keeps the comment's tail text)
+            body = to_bytes(root)
+        too_long = long_line(body)
+        if too_long is not None:
+            tmp.cleanup()
+            raise InputError(f"an element of {too_long[1]} bytes on one line even when "
+                             f"formatted; PyBullet breaks lines every {PYBULLET_LINE_BYTES} "
+                             "bytes and misreads them: shorten its attributes", file=display)
+        load_path.write_bytes(body)
         return Resolved(display, source, load_path, tree, tmp, warnings=lifted)
     return Resolved(display, source, source, tree, warnings=lifted)
 

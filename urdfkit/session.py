@@ -195,6 +195,7 @@ class Session:
         self.gui = gui
         self.diagnostics: list[str] = []
         self.client = -1
+        self._loaded: dict[str, tuple[int, int, int]] = {}  # path -> (size, mtime_ns, inode)
         self.p: Any = import_pybullet()
         with quiet_stdout() as out:
             mode = self.p.GUI if gui else self.p.DIRECT
@@ -244,6 +245,7 @@ class Session:
         """
         o = options or LoadOptions()
         name = display or str(path)
+        self._forget_changed_files(str(path))
         try:
             return int(self.call(
                 "loadURDF", str(path), basePosition=o.base_position,
@@ -254,6 +256,23 @@ class Session:
             said = "; ".join(self.diagnostics[-3:])
             raise EngineError(f"PyBullet could not load it{': ' + said if said else ''}",
                               file=name) from None
+
+    def _forget_changed_files(self, path: str) -> None:
+        """Make PyBullet read a file again that changed since this client loaded it.
+
+        PyBullet caches every file it reads, by name, for the life of the client: loading a
+        URDF, editing it and loading it again gives the old robot (measured on 3.2.7). When
+        this session sees a path again with another size, time or inode, it turns that cache
+        off for the rest of the session (setPhysicsEngineParameter(enableFileCaching=0)).
+        """
+        try:
+            st = os.stat(path)
+        except OSError:
+            return
+        sig = (st.st_size, st.st_mtime_ns, st.st_ino)
+        if self._loaded.setdefault(path, sig) != sig:
+            self._loaded[path] = sig
+            self.call("setPhysicsEngineParameter", enableFileCaching=0)
 
     def require_state_queries(self, body: int, display: str) -> None:
         """Refuse bodies whose state PyBullet cannot report (128 links or more).

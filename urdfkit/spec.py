@@ -158,6 +158,12 @@ MAX_LOADABLE_LINKS = 1000
 #: Deepest element nesting PyBullet 3.2.7's XML parser (tinyxml2) reads, <robot> counting 1:
 #: one level more and loadURDF fails ("Cannot load URDF file").
 MAX_XML_DEPTH = 98
+
+#: PyBullet reads a URDF with ``fgets`` into an 8192-byte buffer and joins the pieces with
+#: newlines: a line longer than this is broken every 8191 bytes, and a break inside a tag or
+#: attribute name makes it refuse the file (or misread it). Measured on 3.2.7 with a tag
+#: straddling bytes 8191 and 16382 of one line.
+PYBULLET_LINE_BYTES = 8191
 #: Longest name (in UTF-8 bytes) of a link, joint, material or robot the guard lets through.
 #: PyBullet's fixed buffers count bytes: 700 characters of 'é' are 1,400 bytes.
 MAX_NAME_BYTES = 1000

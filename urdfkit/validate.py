@@ -891,6 +891,7 @@ CODES: dict[str, str] = {
     "U005": "elements nested deeper than PyBullet's XML parser reads (98 levels)",
     "U006": "xacro not expanded: executing it is disabled (--no-exec, URDFKIT_NO_EXEC)",
     "U007": "xacro macro library (no links of its own): checked through its includers",
+    "U008": "line longer than 8191 bytes: PyBullet breaks it and may misread the file",
     "U001": "root element is not <robot>",
     "U002": "<robot> has no name",
     "U003": "no <link>",

@@ -16,6 +16,7 @@ from pathlib import Path
 from lxml import etree
 
 from .errors import InputError
+from .spec import PYBULLET_LINE_BYTES
 
 #: Files larger than this are refused before parsing; real URDFs are far smaller.
 MAX_FILE_BYTES = 32 * 1024 * 1024
@@ -88,6 +89,21 @@ def read_bytes(path: str | Path) -> bytes:
 
 #: An XML declaration anywhere near the start of a file.
 _DECL = re.compile(rb"<\?xml\s[^>]*?\?>")
+
+
+_LONG_LINE = re.compile(rb"[^\n]{%d}" % (PYBULLET_LINE_BYTES + 1))
+
+
+def long_line(data: bytes) -> tuple[int, int] | None:
+    """The first line PyBullet would break (longer than PYBULLET_LINE_BYTES): (line, bytes)."""
+    if len(data) <= PYBULLET_LINE_BYTES:
+        return None
+    m = _LONG_LINE.search(data)
+    if m is None:
+        return None
+    start = data.rfind(b"\n", 0, m.start()) + 1
+    end = data.find(b"\n", m.start())
+    return data.count(b"\n", 0, m.start()) + 1, (len(data) if end < 0 else end) - start
 
 
 def tolerate_quirks(data: bytes) -> tuple[bytes, list[tuple[int, str]]]:
