@@ -403,7 +403,7 @@ def test_visual_bounds_match_pybullet_aabb(tmp_path: Path) -> None:
     """Our box around primitive visuals equals PyBullet's getAABB of identical collisions."""
     from lxml import etree
 
-    from urdfkit.render import _link_frames, _visual_bounds
+    from urdfkit.render import _visual_bounds, link_frames
     from urdfkit.session import LoadOptions, Session
 
     shapes = ['<box size="0.4 0.1 0.2"/>', '<cylinder radius="0.1" length="0.5"/>',
@@ -424,8 +424,8 @@ def test_visual_bounds_match_pybullet_aabb(tmp_path: Path) -> None:
     with Session() as s:
         body = s.load_urdf(path, LoadOptions(fixed_base=True))
         s.p.resetJointState(body, 1, 0.6, physicsClientId=s.client)
-        frames = _link_frames(s.p, s.client, body, 2)
         root = etree.parse(str(path)).getroot()
+        frames = link_frames(root, ["j1", "j2"], ((0, 0, 0), (0, 0, 0, 1)), {"j2": 0.6})
         ours = [_visual_bounds(root, {f"l{i}": frames[i]}) for i in range(3)]
         boxes = [s.p.getAABB(body, link, physicsClientId=s.client) for link in (-1, 0, 1)]
     # Bullet bounds a shape in a turned link by turning the shape's own box, so its AABB is
@@ -474,3 +474,58 @@ def test_a_white_robot_keeps_its_shape_on_the_white_background(tmp_path: Path) -
     highest = py.min()
     ys, _ = np.nonzero(np.abs(r.image.astype(int) - WHITE).sum(axis=2) > 60)
     assert abs(ys.min() - highest) < 3, (ys.min(), highest)
+
+
+@pytest.mark.parametrize("name", ["kuka_iiwa/model.urdf", "r2d2.urdf", "humanoid/humanoid.urdf",
+                                  "quadruped/minitaur.urdf", "franka_panda/panda.urdf"])
+def test_link_frames_equal_getlinkstate(name: str, pb) -> None:
+    # Forward kinematics from the file, no state query (which fails from 128 links): every
+    # frame must equal getLinkState's URDF link frame, posed and turned.
+    import pybullet_data
+
+    from urdfkit.render import link_frames
+    from urdfkit.spec import UP_AXES
+    from urdfkit.xmlio import parse_xml, read_bytes
+
+    p, c = pb
+    path = os.path.join(pybullet_data.getDataPath(), name)
+    base = ((0.3, -0.2, 0.1), UP_AXES["y"])
+    body = p.loadURDF(path, base[0], base[1], useFixedBase=True, physicsClientId=c)
+    rng = np.random.default_rng(3)
+    names, positions = [], {}
+    for j in range(p.getNumJoints(body, physicsClientId=c)):
+        info = p.getJointInfo(body, j, physicsClientId=c)
+        names.append(info[1].decode())
+        if info[2] in (p.JOINT_REVOLUTE, p.JOINT_PRISMATIC):
+            positions[names[-1]] = float(rng.uniform(-1, 1))
+            p.resetJointState(body, j, positions[names[-1]], physicsClientId=c)
+    frames = link_frames(parse_xml(read_bytes(Path(path)), path).getroot(), names, base, positions)
+    assert len(frames) == len(names) + 1
+    for j, (pos, rot) in enumerate(frames[1:]):
+        st = p.getLinkState(body, j, computeForwardKinematics=True, physicsClientId=c)
+        # PyBullet reports link states rounded to ~1e-7 (float32 on the way out).
+        assert np.allclose(pos, st[4], atol=1e-6), (name, j)
+        assert np.allclose(rot, np.reshape(p.getMatrixFromQuaternion(st[5]), (3, 3)),
+                           atol=1e-6), (name, j)
+
+
+def test_render_draws_a_body_of_130_links(tmp_path: Path) -> None:
+    # getLinkState fails from 128 links; render does not need it.
+    links = ['<link name="l0"><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual>'
+             '</link>']
+    joints = []
+    for i in range(1, 130):
+        links.append(f'<link name="l{i}"><visual><geometry><box size="0.05 0.05 0.05"/>'
+                     '</geometry></visual></link>')
+        joints.append(f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/>'
+                      f'<child link="l{i}"/><origin xyz="0.06 0 0" rpy="0 0 0.05"/>'
+                      '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+                      '</joint>')
+    path = tmp_path / "chain.urdf"
+    path.write_text('<robot name="c">\n' + "\n".join(links + joints) + "\n</robot>\n")
+    out = tmp_path / "chain.png"
+    result = CliRunner().invoke(app, ["render", str(path), "-o", str(out), "--size", "320x240",
+                                      "--joints", "j3=0.5"])
+    assert result.exit_code == 0, result.stderr
+    image = np.asarray(Image.open(out).convert("RGB"))
+    assert (np.abs(image.astype(int) - WHITE).sum(axis=2) > 60).sum() > 200  # drawn, not blank

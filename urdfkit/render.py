@@ -387,12 +387,11 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
         # visual shapes from <collision> (see the module docstring).
         opts.extra_flags = p.URDF_IGNORE_VISUAL_SHAPES
     body = session.load_urdf(resolved.load_path, opts, display=resolved.name)
-    session.require_state_queries(body, resolved.name)
     try:
         n = p.getNumJoints(body, physicsClientId=c)
         infos = [p.getJointInfo(body, j, physicsClientId=c) for j in range(n)]
         by_name = {i[1].decode("utf-8"): i for i in infos}
-        _pose(p, c, body, by_name, o.joints, warnings, resolved.name)
+        positions = _pose(p, c, body, by_name, o.joints, warnings, resolved.name)
         if o.collision:
             for link in range(-1, n):
                 session.call("changeVisualShape", body, link, rgbaColor=[*COLLISION_COLOR, 1.0])
@@ -404,7 +403,8 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
             # A link without collision shapes reports an empty or inverted box; skip it.
             if np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(b >= a):
                 lo, hi = np.minimum(lo, a), np.maximum(hi, b)
-        frames = _link_frames(p, c, body, n)
+        frames = link_frames(resolved.root, list(by_name),
+                             (opts.base_position, opts.base_orientation), positions)
         for pos, _ in frames:
             lo, hi = np.minimum(lo, pos), np.maximum(hi, pos)
         if not o.collision:
@@ -483,8 +483,10 @@ def _half_extent(geometry: Any, rot: Any) -> Any:
 
 
 def _pose(p: Any, c: int, body: int, by_name: Mapping[str, Any], joints: Mapping[str, float],
-          warnings: list[str], file: str) -> None:
+          warnings: list[str], file: str) -> dict[str, float]:
+    """Set the joint positions asked for; return them by joint name."""
     movable = [n for n, i in by_name.items() if i[2] != _JOINT_FIXED]
+    positions: dict[str, float] = {}
     for name, value in joints.items():
         info = by_name.get(name)
         if info is None:
@@ -507,26 +509,52 @@ def _pose(p: Any, c: int, body: int, by_name: Mapping[str, Any], joints: Mapping
             warnings.append(f"joint {name}: {value:g} is beyond its limits "
                             f"[{lower:g}, {upper:g}]")
         p.resetJointState(body, info[0], value, physicsClientId=c)
+        positions[name] = value
+    return positions
 
 
-def _link_frames(p: Any, c: int, body: int, n: int) -> list[tuple[Any, Any]]:
-    """World pose of every URDF link frame, base first (index 0 = link -1)."""
+def link_frames(root: Any, joint_names: Sequence[str],
+                base: tuple[Sequence[float], Sequence[float]],
+                positions: Mapping[str, float]) -> list[tuple[Any, Any]]:
+    """World pose (position, 3x3 rotation) of every URDF link frame, base first (link -1).
+
+    Forward kinematics from the file, with no PyBullet state query, so it works on bodies of
+    128 links or more, where getLinkState and getBasePositionAndOrientation fail: ``base`` is
+    the pose the body was loaded at (PyBullet places the root link frame there),
+    ``joint_names`` PyBullet's joint order (link j is joint j's child), ``positions`` the joint
+    positions set by name (others 0). Each link frame is its parent's times the joint's
+    ``<origin>`` times the motion along its ``<axis>``. Equal to getLinkState's worldLinkFrame
+    (tests/test_render.py).
+    """
     import numpy as np
 
-    def mat(q: Sequence[float]) -> Any:
-        return np.array(p.getMatrixFromQuaternion(q), dtype=float).reshape(3, 3)
+    from .spec import axis_angle_matrix, quat_to_matrix
 
-    # getBasePositionAndOrientation is the base's *inertial* frame; undo the local inertial
-    # offset to get the URDF base-link frame the joints are defined in.
-    pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=c)
-    dyn = p.getDynamicsInfo(body, -1, physicsClientId=c)
-    inv_pos, inv_orn = p.invertTransform(dyn[3], dyn[4])
-    bpos, born = p.multiplyTransforms(pos, orn, inv_pos, inv_orn)
-    out = [(np.array(bpos), mat(born))]
-    for link in range(n):
-        st = p.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=c)
-        # [4], [5]: worldLinkFramePosition/Orientation, the URDF link frame (= joint frame).
-        out.append((np.array(st[4]), mat(st[5])))
+    joints = {j.get("name"): j for j in root.iterchildren("joint")}
+    children = {(c.get("link") if (c := j.find("child")) is not None else None)
+                for j in joints.values()}
+    base_link = next((link.get("name") for link in root.iterchildren("link")
+                      if link.get("name") not in children), None)
+    frames: dict[str | None, tuple[Any, Any]] = {
+        base_link: (np.array(base[0], dtype=float), np.array(quat_to_matrix(base[1])))}
+    out = [frames[base_link]]
+    for name in joint_names:
+        j = joints[name]
+        parent, child = j.find("parent"), j.find("child")
+        ppos, prot = frames[parent.get("link") if parent is not None else None]
+        origin = j.find("origin")
+        xyz = np.array(attr_vec(origin, "xyz", 3, (0, 0, 0)))
+        rot = prot @ np.array(rpy_to_matrix(attr_vec(origin, "rpy", 3, (0, 0, 0))))  # type: ignore[arg-type]
+        pos = ppos + prot @ xyz
+        q = positions.get(name, 0.0)
+        axis = attr_vec(j.find("axis"), "xyz", 3, (1, 0, 0)) or (1.0, 0.0, 0.0)
+        if q and j.get("type") in ("revolute", "continuous"):
+            rot = rot @ np.array(axis_angle_matrix(axis, q))
+        elif q and j.get("type") == "prismatic":
+            unit = np.array(axis) / (np.linalg.norm(axis) or 1.0)
+            pos = pos + rot @ (unit * q)
+        frames[child.get("link") if child is not None else None] = (pos, rot)
+        out.append((pos, rot))
     return out
 
 

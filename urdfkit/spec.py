@@ -290,6 +290,19 @@ def quat_to_matrix(q: Sequence[float]) -> Matrix3:
     )
 
 
+def axis_angle_matrix(axis: Sequence[float], angle: float) -> Matrix3:
+    """Rotation by ``angle`` (rad) about ``axis`` (normalised here; zero gives identity)."""
+    norm = math.sqrt(sum(a * a for a in axis))
+    if norm == 0:
+        return ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    x, y, z = (a / norm for a in axis)
+    c, s = math.cos(angle), math.sin(angle)
+    t = 1 - c
+    return ((t * x * x + c, t * x * y - s * z, t * x * z + s * y),
+            (t * x * y + s * z, t * y * y + c, t * y * z - s * x),
+            (t * x * z - s * y, t * y * z + s * x, t * z * z + c))
+
+
 def quat_to_rpy(q: Sequence[float]) -> Vec3:
     """Roll, pitch, yaw (URDF's fixed-axis X-Y-Z convention) of a quaternion (x, y, z, w).
 
