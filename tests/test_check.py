@@ -125,6 +125,17 @@ CASES = [
                            'iyy="0.1" iyz="0" izz="0.1"/></inertial>',
                       f'<collision><geometry>\n<mesh filename="{MESHES / "open_triangle.stl"}"/>'
                       '<!--HERE-->\n</geometry></collision>'))),
+    # A 100 mm cube written in millimetres on an arm whose joints are 0.3 m apart.
+    ("U613", doc(A, B, link("c", body=f'<visual><geometry>\n<mesh filename='
+                                      f'"{MESHES / "cube_mm.obj"}"/><!--HERE-->\n'
+                                      '</geometry></visual>'),
+                 joint(inner='<origin xyz="0 0 0.3"/><axis xyz="0 0 1"/><limit lower="-1" '
+                             'upper="1" effort="1" velocity="1"/>'),
+                 joint("k", "b", "c", inner='<origin xyz="0.3 0 0"/><axis xyz="0 0 1"/><limit '
+                                           'lower="-1" upper="1" effort="1" velocity="1"/>'))),
+    ("U614", doc(A, link("b", body=f'<collision><geometry>\n<mesh filename='
+                                   f'"{MESHES / "l_bracket.obj"}" scale="0.1 0.1 0.1"/>'
+                                   '<!--HERE-->\n</geometry></collision>'), J)),
     ("U706", doc(link("a", body='<visual><geometry><box size="1 1 1"/></geometry>\n'
                                 '<material name="steel"/><!--HERE-->\n</visual>'))),
     ("U707", doc('<material name="m">\n<texture/><!--HERE-->\n</material>', A)),
@@ -374,3 +385,48 @@ def test_inertia_is_judged_against_collision_meshes(tmp_path: Path, scale: float
     path.write_text(doc(link("a", inertial, mesh)))
     codes = [f.code for f in check_paths([path], jobs=1).findings]
     assert ("U605" in codes) == flagged, codes
+
+
+def _codes(tmp_path: Path, text: str) -> list[str]:
+    path = tmp_path / "r.urdf"
+    path.write_text(text)
+    return [f.code for f in check_paths([path], jobs=1).findings]
+
+
+def test_concave_meshes_are_judged_on_moving_links_only(tmp_path: Path) -> None:
+    import pybullet_data
+
+    data = Path(pybullet_data.getDataPath())
+
+    def on(link_name: str, mesh: Path, scale: str = "0.1 0.1 0.1") -> str:
+        body = (f'<collision><geometry><mesh filename="{mesh}" scale="{scale}"/></geometry>'
+                '</collision>')
+        return doc(link("a", body=body if link_name == "a" else BOX),
+                   link("b", body=body if link_name == "b" else BOX), J)
+
+    assert "U614" in _codes(tmp_path, on("b", MESHES / "l_bracket.obj"))
+    assert "U614" not in _codes(tmp_path, on("a", MESHES / "l_bracket.obj"))  # the base
+    assert "U614" not in _codes(tmp_path, on("b", MESHES / "unit_cube.stl"))  # convex
+    # A V-HACD decomposition: concave overall, but PyBullet makes one hull per object.
+    assert "U614" not in _codes(tmp_path, on("b", data / "duck_vhacd.obj"))
+    assert "U614" in _codes(tmp_path, on("b", data / "torus" / "torus_textured.obj"))
+
+
+def test_millimetre_meshes_are_flagged_until_scaled(tmp_path: Path) -> None:
+    arm = [joint(inner='<origin xyz="0 0 0.3"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" '
+                       'effort="1" velocity="1"/>'),
+           joint("k", "b", "c", inner='<origin xyz="0.3 0 0"/><axis xyz="0 0 1"/><limit '
+                                      'lower="-1" upper="1" effort="1" velocity="1"/>')]
+
+    def mesh(scale: str) -> str:
+        return (f'<visual><geometry><mesh filename="{MESHES / "cube_mm.obj"}" scale="{scale}"/>'
+                '</geometry></visual>')
+
+    def with_scale(scale: str) -> str:
+        return doc(A, B, link("c", body=mesh(scale)), *arm)
+
+    assert "U613" in _codes(tmp_path, with_scale("1 1 1"))
+    assert "U613" not in _codes(tmp_path, with_scale("0.001 0.001 0.001"))  # 0.1 m: right
+    assert "U613" in _codes(tmp_path, with_scale("0.000001 0.000001 0.000001"))  # scaled twice
+    # Without two offset joints there is no scale to judge by.
+    assert "U613" not in _codes(tmp_path, doc(A, link("b", body=mesh("1 1 1")), J))

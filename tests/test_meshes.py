@@ -128,7 +128,7 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     path = tmp_path / "box.obj"
     path.write_text(box_obj((1.0, 2.0, 3.0)))
     check_box(meshes.properties(path), (1.0, 2.0, 3.0))
-    entries = list((tmp_path / "cache" / "meshes-1").iterdir())
+    entries = list((tmp_path / "cache" / "meshes-2").iterdir())
     assert len(entries) == 1
     # A new process (empty memory) reads the entry, not the mesh.
     monkeypatch.setattr(meshes, "_MEMORY", {})
@@ -146,12 +146,12 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     os.utime(path, ns=(1, 1))
     check_box(meshes.properties(path), (3.0, 2.0, 1.0))
     # A damaged entry is read past and rewritten.
-    for entry in (tmp_path / "cache" / "meshes-1").iterdir():
+    for entry in (tmp_path / "cache" / "meshes-2").iterdir():
         entry.write_bytes(b"garbage")
     monkeypatch.setattr(meshes, "_MEMORY", {})
     check_box(meshes.properties(path), (3.0, 2.0, 1.0))
-    good = [e for e in (tmp_path / "cache" / "meshes-1").iterdir()
-            if e.read_bytes().startswith(b"M1")]
+    good = [e for e in (tmp_path / "cache" / "meshes-2").iterdir()
+            if e.read_bytes().startswith(b"M2")]
     assert len(good) == 1  # the current key's, rewritten (the first box's stays unused)
 
 

@@ -41,6 +41,10 @@ class MeshProperties:
         extent: Size of the bounding box along x, y, z.
         closed: Every edge is shared by exactly two triangles.
         triangles: How many triangles.
+        concavity: How far (m, about, under non-uniform scale) the surface lies inside the
+            convex hull PyBullet collides with: the largest distance of a vertex in front of
+            the plane of a triangle of its own piece. 0 for a convex mesh.
+        pieces: Convex hulls PyBullet makes of it (one per ``o``/``g`` object of an OBJ).
     """
 
     volume: float
@@ -49,6 +53,8 @@ class MeshProperties:
     extent: tuple[float, float, float]
     closed: bool
     triangles: int
+    concavity: float = 0.0
+    pieces: int = 1
 
     def trace_for_mass(self, mass: float) -> float | None:
         """Trace of the inertia of this solid with ``mass``, or None without a volume."""
@@ -67,7 +73,8 @@ class Integrals:
         first: Integrals of x, y, z over the solid.
         second: Integrals of xx, yy, zz, xy, xz, yz over the solid.
         low, high: Corners of the bounding box of the vertices the triangles use.
-        closed, triangles: As in :class:`MeshProperties`.
+        closed, triangles, concavity, pieces: As in :class:`MeshProperties` (concavity
+            unscaled).
     """
 
     volume: float
@@ -77,21 +84,24 @@ class Integrals:
     high: tuple[float, float, float]
     closed: bool
     triangles: int
+    concavity: float = 0.0
+    pieces: int = 1
 
-    _FORMAT = struct.Struct("<16d?I")
+    _FORMAT = struct.Struct("<17d?II")
 
     def pack(self) -> bytes:
         """The cache entry's bytes."""
-        return b"M1" + self._FORMAT.pack(self.volume, *self.first, *self.second, *self.low,
-                                         *self.high, self.closed, self.triangles)
+        return _ENTRY + self._FORMAT.pack(self.volume, *self.first, *self.second, *self.low,
+                                          *self.high, self.concavity, self.closed,
+                                          self.triangles, self.pieces)
 
     @classmethod
     def unpack(cls, data: bytes) -> Integrals:
         """Read a cache entry; ValueError if it is not one."""
-        if len(data) != 2 + cls._FORMAT.size or data[:2] != b"M1":
+        if len(data) != len(_ENTRY) + cls._FORMAT.size or not data.startswith(_ENTRY):
             raise ValueError("not a mesh cache entry")
-        v = cls._FORMAT.unpack_from(data, 2)
-        return cls(v[0], v[1:4], v[4:10], v[10:13], v[13:16], v[16], v[17])
+        v = cls._FORMAT.unpack_from(data, len(_ENTRY))
+        return cls(v[0], v[1:4], v[4:10], v[10:13], v[13:16], v[17], v[18], v[16], v[19])
 
     def scaled(self, scale: tuple[float, float, float]) -> MeshProperties | None:
         """The solid under ``<mesh scale>``: integrals scale as powers of each factor."""
@@ -113,12 +123,16 @@ class Integrals:
         trace = about[0][0] + about[1][1] + about[2][2]
         tensor = tuple(tuple((trace if i == j else 0.0) - about[i][j] for j in range(3))
                        for i in range(3))
-        extent = tuple(abs(k) * (h - lo) for k, lo, h in zip(scale, self.low, self.high,
-                                                                      strict=True))
+        (x0, y0, z0), (x1, y1, z1) = self.low, self.high
+        extent = (abs(sx) * (x1 - x0), abs(sy) * (y1 - y0), abs(sz) * (z1 - z0))
         return MeshProperties(volume, (com[0], com[1], com[2]), tensor,
-                              extent, self.closed, self.triangles)  # type: ignore[arg-type]
+                              extent, self.closed, self.triangles,
+                              self.concavity * max(abs(sx), abs(sy), abs(sz)), self.pieces)
 
 
+#: Cache entries start with this; a new layout is a new prefix and a new folder.
+_ENTRY = b"M2"
+_FOLDER = "meshes-2"
 _MEMORY: dict[str, Integrals | None] = {}
 _MISSING = object()
 
@@ -145,11 +159,11 @@ def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
 def _integrals(path: Path, suffix: str, key: str) -> Integrals | None:
     folder = cache_dir()
-    entry = (folder / "meshes-1" / hashlib.sha1(key.encode("utf-8", "surrogateescape")
+    entry = (folder / _FOLDER / hashlib.sha1(key.encode("utf-8", "surrogateescape")
                                                 ).hexdigest()) if folder else None
     if entry is not None:
         data = read_entry(entry)
-        if data == b"M1-":
+        if data == _ENTRY + b"-":
             return None
         if data is not None:
             try:
@@ -158,7 +172,7 @@ def _integrals(path: Path, suffix: str, key: str) -> Integrals | None:
                 pass  # a damaged entry: read the mesh again and rewrite it
     found = read_integrals(path, suffix)
     if entry is not None:
-        write_entry(entry, found.pack() if found is not None else b"M1-")
+        write_entry(entry, found.pack() if found is not None else _ENTRY + b"-")
     return found
 
 
@@ -174,16 +188,21 @@ def read_integrals(path: Path, suffix: str | None = None) -> Integrals | None:
         return None
     if len(data) > MAX_MESH_BYTES:
         return None
+    starts: list[int] = []
     try:
-        vertices, faces = (_stl(data) if suffix == ".stl" else _obj(data) if suffix == ".obj"
-                           else (None, None))
+        if suffix == ".stl":
+            vertices, faces = _stl(data)
+        elif suffix == ".obj":
+            vertices, faces, starts = _obj(data)
+        else:
+            return None
     except (ValueError, struct.error, IndexError, OverflowError):
         return None
     if (vertices is None or faces is None or len(faces) == 0 or len(vertices) == 0
             or faces.min() < 0 or faces.max() >= len(vertices)
             or not np.isfinite(vertices).all()):
         return None
-    return _solid(vertices, faces)
+    return _solid(vertices, faces, starts)
 
 
 def _stl(data: bytes) -> tuple[Any, Any]:
@@ -235,12 +254,26 @@ def _numbers(lines: list[bytes], dtype: Any, per_line: int) -> Any:
     raise ValueError("irregular")
 
 
-def _obj(data: bytes) -> tuple[Any, Any]:
+def _obj(data: bytes) -> tuple[Any, Any, list[int]]:
+    """Vertices, triangles, and the first triangle of each ``o``/``g`` object after the first.
+
+    PyBullet collides with one convex hull per object of an OBJ (a V-HACD decomposition is
+    many convex objects in one file), so the objects matter to the concavity test.
+    """
     import numpy as np
 
-    lines = data.split(b"\n")
-    vlines = [ln for ln in lines if ln[:2] in (b"v ", b"v\t")]
-    flines = [ln for ln in lines if ln[:2] in (b"f ", b"f\t")]
+    vlines: list[bytes] = []
+    flines: list[bytes] = []
+    starts: list[int] = []  # f-line index where each object after the first begins
+    for ln in data.split(b"\n"):
+        head = ln[:2]
+        if head in (b"v ", b"v\t"):
+            vlines.append(ln)
+        elif head in (b"f ", b"f\t"):
+            flines.append(ln)
+        elif head in (b"o ", b"g ", b"o\t", b"g\t") and flines and (
+                not starts or starts[-1] != len(flines)):
+            starts.append(len(flines))
     try:
         vertices = _numbers(vlines, float, 3)
     except ValueError:  # "v x y z w" or "v x y z r g b": the first three are the position
@@ -249,16 +282,52 @@ def _obj(data: bytes) -> tuple[Any, Any]:
     count = len(vertices)
     try:
         tri = _numbers(flines, np.int64, 3)
-    except ValueError:  # polygons: fans of triangles
+    except ValueError:  # polygons: fans of triangles (object starts move to triangle counts)
         faces: list[tuple[int, int, int]] = []
+        first_triangle = []
         for line in flines:
+            first_triangle.append(len(faces))
             idx = [int(p.split(b"/", 1)[0]) for p in line.split()[1:]]
             faces += [(idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
         tri = np.array(faces, dtype=np.int64).reshape(-1, 3)
-    return vertices, np.where(tri > 0, tri - 1, count + tri)  # 1-based; negative: from the end
+        starts = [first_triangle[i] for i in starts]
+    # 1-based; negative counts from the end
+    return vertices, np.where(tri > 0, tri - 1, count + tri), starts
 
 
-def _solid(vertices: Any, faces: Any) -> Integrals:
+#: A mesh whose surface dips more than this fraction of its size inside its hull is concave.
+CONCAVE_FRACTION = 0.02
+#: Vertex-by-plane tests per piece for the concavity depth; bigger pieces test a sample of
+#: their triangles' planes (a concave mesh has many planes with vertices in front).
+_CONCAVITY_BUDGET = 4_000_000
+
+
+def _concavity(vertices: Any, faces: Any, starts: list[int]) -> float:
+    """Largest distance of a vertex in front of a triangle's plane, within each piece."""
+    import numpy as np
+
+    worst = 0.0
+    bounds = [0, *starts, len(faces)]
+    for lo, hi in zip(bounds, bounds[1:], strict=False):
+        f = faces[lo:hi]
+        if len(f) < 4:
+            continue
+        a, b, c = vertices[f.T]
+        normal = np.cross(b - a, c - a)
+        length = np.linalg.norm(normal, axis=1)
+        good = length > 0
+        normal = normal[good] / length[good, None]
+        if np.einsum("ij,ij->i", a, np.cross(b, c)).sum() < 0:
+            normal = -normal  # triangles facing inward: outward is the other side
+        offset = np.einsum("ij,ij->i", normal, a[good])
+        points = vertices[np.unique(f)]
+        step = max(1, -(-len(normal) * len(points) // _CONCAVITY_BUDGET))
+        depth = (points @ normal[::step].T - offset[::step]).max()
+        worst = max(worst, float(depth))
+    return worst
+
+
+def _solid(vertices: Any, faces: Any, starts: list[int] | None = None) -> Integrals:
     import numpy as np
 
     p = vertices[faces.T]  # (corner, triangle, xyz)
@@ -281,8 +350,10 @@ def _solid(vertices: Any, faces: Any) -> Integrals:
     used[faces.ravel()] = True
     corners = vertices[used]
     low, high = corners.min(axis=0), corners.max(axis=0)
+    starts = starts or []
     return Integrals(float(det.sum()) / 6.0, (float(first[0]), float(first[1]), float(first[2])),
                      (float(second[0, 0]), float(second[1, 1]), float(second[2, 2]),
                       float(second[0, 1]), float(second[0, 2]), float(second[1, 2])),
                      (float(low[0]), float(low[1]), float(low[2])),
-                     (float(high[0]), float(high[1]), float(high[2])), closed, len(faces))
+                     (float(high[0]), float(high[1]), float(high[2])), closed, len(faces),
+                     _concavity(vertices, faces, starts) if closed else 0.0, len(starts) + 1)

@@ -790,6 +790,81 @@ def rule_meshes(root: etree._Element, r: Report) -> None:
                 r.add(ref.code, ref.level, ref.message, el)
 
 
+#: A mesh this many times larger (or smaller) than the robot's typical joint spacing is in
+#: the wrong units (millimetres read as metres gives 1000x).
+UNITS_RATIO = 200.0
+
+
+def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
+    """U613-U614: meshes in the wrong units; concave collision meshes on links that move.
+
+    Units are judged against the robot's own scale: the median distance between joint
+    frames (a model with fewer than two offset joints has no scale, and is not judged).
+    PyBullet collides with the convex hull of a mesh (one per OBJ object), so a concave
+    collision mesh on a moving link touches where it has a dip; the root's rigid group is not
+    judged (a static or bolted base may use ``<collision concave="yes">`` instead).
+    """
+    if r.base is None:
+        return
+    from .meshes import CONCAVE_FRACTION, properties
+
+    offsets = sorted(math.sqrt(sum(x * x for x in xyz)) for j in _elements(root, "joint")
+                     if (xyz := _vec(j.find("origin"), "xyz", 3)) is not None and any(xyz))
+    spacing = offsets[len(offsets) // 2] if len(offsets) >= 2 else None
+    moving = _moving_links(root)
+    for link in _elements(root, "link"):
+        for part in link:
+            if part.tag not in ("visual", "collision"):
+                continue
+            mesh = part.find("geometry/mesh")
+            fn = (mesh.get("filename") or "").strip() if mesh is not None else ""
+            if not fn or (ref := r.reference("mesh", fn)).load_path is None:
+                continue
+            scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
+            props = properties(ref.load_path, (scale[0], scale[1], scale[2])) if scale else None
+            if props is None:
+                continue
+            size = max(props.extent)
+            if spacing and size > 0 and not 1 / UNITS_RATIO <= size / spacing <= UNITS_RATIO:
+                ratio = size / spacing
+                fix = ("probably in millimetres: add scale=\"0.001 0.001 0.001\"" if ratio > 1
+                       else "probably scaled twice, or in metres where millimetres were meant: "
+                       "check its scale")
+                r.add("U613", "warning", f"mesh {fn!r} of {_label(link)} is {size:.3g} m across, "
+                      f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
+                      f"{fix}", mesh)
+            if (part.tag == "collision" and link.get("name") in moving and props.closed
+                    and props.concavity > CONCAVE_FRACTION * size):
+                r.add("U614", "warning", f"collision mesh {fn!r} of moving {_label(link)} is "
+                      f"concave (it is {size:.3g} m across, and parts of it stand up to "
+                      f"{props.concavity:.3g} m in front of its own faces' planes): PyBullet "
+                      "collides with its convex hull, so contacts happen in mid-air over the "
+                      "dips; split it into convex parts (p.vhacd, or one OBJ object per part) "
+                      "or use primitives", mesh)
+
+
+def _moving_links(root: etree._Element) -> set[str]:
+    """Links outside the root's rigid group: each moves through a joint that is not fixed."""
+    below: dict[str, list[tuple[str, bool]]] = {}
+    children = set()
+    for j in _elements(root, "joint"):
+        parent, child = j.find("parent"), j.find("child")
+        if parent is None or child is None:
+            continue
+        below.setdefault(parent.get("link", ""), []).append(
+            (child.get("link", ""), j.get("type") == "fixed"))
+        children.add(child.get("link", ""))
+    names = [link.get("name", "") for link in _elements(root, "link")]
+    roots = [n for n in names if n not in children]
+    still, stack = set(), roots[:1]
+    while stack:
+        n = stack.pop()
+        if n not in still:
+            still.add(n)
+            stack.extend(c for c, fixed in below.get(n, ()) if fixed)
+    return set(names) - still
+
+
 def _too_many_links(n: int) -> str:
     return (f"{n} links: urdfkit refuses to load bodies with more than {MAX_LOADABLE_LINKS} "
             "links (PyBullet takes minutes on them and cannot query their state); split the "
@@ -882,7 +957,8 @@ GUARD_CODES = frozenset({"U001", "U002", "U003", "U005", "U101", "U102", "U103",
 
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
-                               rule_inertia, rule_meshes, rule_references, rule_portability)
+                               rule_inertia, rule_meshes, rule_mesh_shapes, rule_references,
+                               rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -940,6 +1016,8 @@ CODES: dict[str, str] = {
     "U610": "<inertia> missing a component",
     "U611": "mass-0 root link: PyBullet makes the base static",
     "U612": "collision mesh not closed: no volume, inertia cannot be derived",
+    "U613": "mesh in the wrong units (200x larger or smaller than the joint spacing)",
+    "U614": "concave collision mesh on a moving link (PyBullet collides with its hull)",
     "U701": "mesh or texture file not found",
     "U702": "package:// package not found",
     "U703": "mesh found only through pybullet_data's search path",
