@@ -6,6 +6,7 @@ import math
 import os
 from pathlib import Path
 
+import numpy as np
 import pybullet_data
 import pytest
 
@@ -171,3 +172,70 @@ def test_unwritable_cache_is_skipped(tmp_path: Path, monkeypatch: pytest.MonkeyP
     path = tmp_path / "box.obj"
     path.write_text(box_obj())
     check_box(meshes.properties(path), (1.0, 1.0, 1.0))
+
+
+def box_dae(*, unit: float = 0.001, up: str = "Y_UP", node: str = "") -> str:
+    """A 100 x 200 x 300 box in COLLADA (quads in a polylist), in ``unit`` metres per unit."""
+    size = (100.0, 200.0, 300.0)
+    corners = " ".join(f"{x * size[0]} {y * size[1]} {z * size[2]}" for x, y, z in CORNERS)
+    quads = " ".join(str(i - 1) for quad in QUADS for i in quad)
+    return f"""<?xml version="1.0"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit meter="{unit}" name="u"/><up_axis>{up}</up_axis></asset>
+  <library_geometries><geometry id="box"><mesh>
+    <source id="box-pos"><float_array id="box-pos-a" count="24">{corners}</float_array>
+      <technique_common><accessor source="#box-pos-a" count="8" stride="3"/></technique_common>
+    </source>
+    <vertices id="box-v"><input semantic="POSITION" source="#box-pos"/></vertices>
+    <polylist count="6"><input semantic="VERTEX" source="#box-v" offset="0"/>
+      <vcount>4 4 4 4 4 4</vcount><p>{quads}</p></polylist>
+    <lines count="1"><input semantic="VERTEX" source="#box-v" offset="0"/><p>0 1</p></lines>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="n">{node}<instance_geometry url="#box"/></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+"""
+
+
+def pybullet_aabb(p, client: int, mesh: Path, workdir: Path) -> tuple:  # type: ignore[no-untyped-def]
+    urdf = workdir / f"{mesh.stem}-probe.urdf"
+    urdf.write_text('<robot name="r"><link name="a"><inertial><mass value="1"/><inertia ixx="1" '
+                    'ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial><collision><geometry>'
+                    f'<mesh filename="{mesh}"/></geometry></collision></link></robot>')
+    body = p.loadURDF(str(urdf), physicsClientId=client)
+    return p.getAABB(body, -1, physicsClientId=client)
+
+
+@pytest.mark.parametrize("node", [
+    "",
+    '<translate>1000 0 0</translate>',
+    # PyBullet reads only the first <rotate> of a node: the second is ignored, as here.
+    '<translate>0 0 500</translate><rotate>0 0 1 90</rotate><rotate>1 0 0 90</rotate>',
+    '<matrix>1 0 0 0  0 0 -1 0  0 1 0 0  0 0 0 1</matrix>',
+])
+def test_dae_is_placed_as_pybullet_places_it(tmp_path: Path, node: str, pb) -> None:
+    path = tmp_path / "box.dae"
+    path.write_text(box_dae(node=node))
+    props = meshes.properties(path)
+    assert props is not None and props.closed
+    assert props.volume == pytest.approx(0.1 * 0.2 * 0.3)  # <unit meter="0.001">
+    assert sorted(props.extent) == pytest.approx([0.1, 0.2, 0.3])
+    p, client = pb
+    lo, hi = (np.array(v) for v in pybullet_aabb(p, client, path, tmp_path))
+    # PyBullet pads a hull with a collision margin (here 2 mm on each side).
+    centre = np.array(props.com)
+    assert (lo + hi) / 2 == pytest.approx(centre, abs=1e-6)
+    assert hi - lo - 0.004 == pytest.approx(props.extent, abs=1e-6)
+
+
+def test_real_dae_meshes_are_placed_as_pybullet_places_them(tmp_path: Path, pb) -> None:
+    # pybullet_data's racecar: Y_UP files (not turned), an inch-unit cone, a scene of nodes.
+    p, client = pb
+    for mesh in sorted((DATA / "racecar" / "meshes").glob("*.dae")):
+        vertices, faces = meshes._dae(mesh.read_bytes(), mesh)
+        used = vertices[np.unique(faces)]
+        lo, hi = (np.array(v) for v in pybullet_aabb(p, client, mesh, tmp_path))
+        assert used.min(axis=0) == pytest.approx(lo + 0.002, abs=1e-4), mesh.name
+        assert used.max(axis=0) == pytest.approx(hi - 0.002, abs=1e-4), mesh.name

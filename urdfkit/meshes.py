@@ -1,7 +1,7 @@
 """Mass properties of mesh files, for the mesh-aware physics checks (no trimesh needed).
 
 About half of the links of real robots collide only through meshes. :func:`properties` reads
-an STL (binary or ASCII) or OBJ file, applies ``<mesh scale>``, and returns the solid's volume,
+an STL (binary or ASCII), OBJ or COLLADA (.dae) file, placed as PyBullet places it, applies ``<mesh scale>``, and returns the solid's volume,
 centre of mass and inertia per unit density by the signed-tetrahedron method (each triangle
 with the origin spans a tetrahedron; summed with signs, they give the closed solid's
 integrals). It also says whether the surface is closed (every edge shared by exactly two
@@ -10,13 +10,13 @@ triangles), since a mesh with holes has no meaningful volume.
 Reading and integrating a mesh costs far more than checking the URDF that names it, so the
 integrals are kept, unscaled, in urdfkit's cache (:mod:`urdfkit.cache`), keyed by the file's
 absolute path, size, modification time and inode: a second ``check`` of the same robots reads
-no mesh. Any ``scale`` is applied to the integrals in closed form. COLLADA (.dae) is not read:
-checks skip those meshes.
+no mesh. Any ``scale`` is applied to the integrals in closed form.
 """
 
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 import re
 import struct
@@ -25,6 +25,8 @@ from pathlib import Path
 from typing import Any
 
 from .cache import cache_dir, read_entry, write_entry
+from .errors import InputError
+from .spec import axis_angle_matrix
 
 #: Largest mesh file read for checks; bigger ones are skipped (checks must stay fast).
 MAX_MESH_BYTES = 16 * 1024 * 1024
@@ -141,7 +143,7 @@ def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
                ) -> MeshProperties | None:
     """Mass properties of an STL or OBJ mesh, or None if unreadable, unsupported or empty."""
     suffix = path.suffix.lower()
-    if suffix not in (".stl", ".obj"):
+    if suffix not in (".stl", ".obj", ".dae"):
         return None
     try:
         st = os.stat(path)
@@ -194,9 +196,12 @@ def read_integrals(path: Path, suffix: str | None = None) -> Integrals | None:
             vertices, faces = _stl(data)
         elif suffix == ".obj":
             vertices, faces, starts = _obj(data)
+        elif suffix == ".dae":
+            vertices, faces = _dae(data, path)
         else:
             return None
-    except (ValueError, struct.error, IndexError, OverflowError):
+    except (ValueError, struct.error, IndexError, OverflowError, KeyError, InputError,
+            AttributeError, StopIteration, TypeError):
         return None
     if (vertices is None or faces is None or len(faces) == 0 or len(vertices) == 0
             or faces.min() < 0 or faces.max() >= len(vertices)
@@ -293,6 +298,119 @@ def _obj(data: bytes) -> tuple[Any, Any, list[int]]:
         starts = [first_triangle[i] for i in starts]
     # 1-based; negative counts from the end
     return vertices, np.where(tri > 0, tri - 1, count + tri), starts
+
+
+def _dae(data: bytes, path: Path) -> tuple[Any, Any]:
+    """Vertices and triangles of a COLLADA file, placed as PyBullet places them.
+
+    As PyBullet 3.2.7 reads it for collision: every ``<instance_geometry>`` of the scene's
+    visual scene, moved by its nodes' transforms (read PyBullet's way, see ``local``), then
+    scaled by ``<unit meter>``; ``<up_axis>`` is not applied. Checked against PyBullet's
+    getAABB of the same meshes in tests/test_meshes.py. Triangles, polylists and
+    polygons are read (fans for polygons); a geometry in any other primitive (strips) makes
+    the whole mesh unreadable rather than wrong. All one solid: PyBullet makes one hull.
+    """
+    import numpy as np
+
+    from .xmlio import parse_xml
+
+    root = parse_xml(data, path).getroot()
+    by_id = {el.get("id"): el for el in root.iter() if el.get("id")}
+
+    def ref(url: str | None) -> Any:
+        return by_id[(url or "").lstrip("#")]
+
+    def numbers(el: Any, dtype: Any = float) -> Any:
+        return np.array((el.text or "").split(), dtype=dtype)
+
+    def geometry(geom: Any) -> tuple[Any, Any]:
+        mesh = geom.find("{*}mesh")
+        if mesh is None:
+            raise ValueError("not a mesh")
+        verts = mesh.find("{*}vertices")
+        position = next(i for i in verts.iterfind("{*}input") if i.get("semantic") == "POSITION")
+        source = ref(position.get("source"))
+        accessor = source.find("{*}technique_common/{*}accessor")
+        stride = int(accessor.get("stride", "3")) if accessor is not None else 3
+        points = numbers(source.find("{*}float_array")).reshape(-1, stride)[:, :3]
+        tris = []
+        for prim in mesh:
+            tag = etree_local(prim.tag)
+            if tag in ("source", "vertices", "extra", "lines", "linestrips"):
+                continue  # edges hold no faces (PyBullet skips them too)
+            if tag not in ("triangles", "polylist", "polygons"):
+                raise ValueError(f"COLLADA <{tag}> is not read")
+            inputs = prim.findall("{*}input")
+            width = max(int(i.get("offset", "0")) for i in inputs) + 1
+            at = next(int(i.get("offset", "0")) for i in inputs if i.get("semantic") == "VERTEX")
+            polys = [numbers(p_, np.int64).reshape(-1, width)[:, at]
+                     for p_ in prim.iterfind("{*}p")]
+            if tag == "triangles":
+                tris.append(np.concatenate(polys).reshape(-1, 3) if polys else np.zeros((0, 3)))
+                continue
+            if tag == "polylist":
+                counts = numbers(prim.find("{*}vcount"), np.int64)
+                polys = np.split(polys[0], np.cumsum(counts)[:-1]) if polys else []
+            for poly in polys:
+                tris += [np.array([[poly[0], poly[k], poly[k + 1]]])
+                         for k in range(1, len(poly) - 1)]
+        faces = np.concatenate(tris).astype(np.int64) if tris else np.zeros((0, 3), np.int64)
+        return points, faces
+
+    def local(node: Any) -> Any:
+        # PyBullet reads only the first <matrix>, <translate>, <scale> and <rotate> of a node
+        # (its loop steps to the node's sibling, not the element's), and composes them in that
+        # order whatever the file's order: a second <rotate> is ignored (measured).
+        m = np.eye(4)
+        for kind in ("matrix", "translate", "scale", "rotate"):
+            t = node.find("{*}" + kind)
+            if t is None or not (t.text or "").strip():
+                continue
+            step = np.eye(4)
+            if kind == "matrix":
+                step = numbers(t).reshape(4, 4)
+            elif kind == "translate":
+                step[:3, 3] = numbers(t)[:3]
+            elif kind == "scale":
+                step = np.diag([*numbers(t)[:3], 1.0])
+            else:
+                x, y, z, deg = numbers(t)[:4]
+                step[:3, :3] = axis_angle_matrix((x, y, z), math.radians(deg))
+            m = m @ step
+        return m
+
+    placed: list[tuple[Any, Any]] = []
+
+    def walk(node: Any, above: Any, depth: int) -> None:
+        if depth > 64:
+            raise ValueError("nodes nested too deep")
+        here = above @ local(node)
+        placed.extend((here, ref(g.get("url"))) for g in node.iterfind("{*}instance_geometry"))
+        for child in node.iterfind("{*}node"):  # (<instance_node> is not read by PyBullet)
+            walk(child, here, depth + 1)
+
+    scene_ref = root.find("{*}scene/{*}instance_visual_scene")
+    if scene_ref is not None:
+        for node in ref(scene_ref.get("url")).iterfind("{*}node"):
+            walk(node, np.eye(4), 0)
+    unit = root.find("{*}asset/{*}unit")
+    world = np.eye(4) * float(unit.get("meter", "1") if unit is not None else 1.0)
+    world[3, 3] = 1.0
+    all_points, all_faces, count = [], [], 0
+    for transform, geom in placed:
+        points, faces = geometry(geom)
+        m = world @ transform
+        all_points.append(points @ m[:3, :3].T + m[:3, 3])
+        all_faces.append(faces + count)
+        count += len(points)
+    if not all_points:
+        raise ValueError("no geometry")
+    return np.concatenate(all_points), np.concatenate(all_faces)
+
+
+def etree_local(tag: Any) -> str:
+    """A tag without its namespace ("" for comments)."""
+    return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
 
 
 #: A mesh whose surface dips more than this fraction of its size inside its hull is concave.
