@@ -325,7 +325,7 @@ def test_cli_json(tmp_path: Path) -> None:
     assert {f["code"] for f in data["findings"]} == {"U102"}
     [f] = data["findings"]
     assert f == {"file": str(bad), "line": 3, "level": "error", "code": "U102",
-                 "message": f["message"]}
+                 "message": f["message"], "origin": None}
     assert data["summary"] == {"files": 2, "files_with_errors": 1, "error": 1, "warning": 0,
                                "info": 0}
 

@@ -189,3 +189,57 @@ def test_check_over_a_workspace_with_macro_libraries_and_args(workspaces: tuple[
     assert set(by_file) == {"macros.xacro"}  # a library of macros, not a broken robot
     assert by_file["macros.xacro"]["level"] == "info"
     assert result.exit_code == 0, doc["findings"]  # no errors anywhere, the arg applied
+
+
+def test_findings_in_xacro_input_name_where_the_element_was_written(tmp_path: Path) -> None:
+    ns = 'xmlns:xacro="http://wiki.ros.org/xacro"'  # ur_description's spelling of the URI
+    (tmp_path / "parts.xacro").write_text(
+        f'<robot {ns}>\n'
+        '  <xacro:macro name="part" params="prefix">\n'
+        '    <link name="${prefix}part">\n'
+        '      <inertial><mass value="-1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" '
+        'izz="1"/></inertial>\n'
+        '    </link>\n'
+        '  </xacro:macro>\n'
+        '</robot>\n')
+    main = tmp_path / "robot.urdf.xacro"
+    main.write_text(
+        f'<robot name="r" {ns}>\n'
+        '  <xacro:include filename="parts.xacro"/>\n'
+        '  <link name="base"><inertial><mass value="-2"/><inertia ixx="1" ixy="0" ixz="0" '
+        'iyy="1" iyz="0" izz="1"/></inertial></link>\n'
+        '  <xacro:part prefix="a_"/>\n'
+        '  <xacro:part prefix="b_"/>\n'
+        '  <joint name="ja" type="fixed"><parent link="base"/><child link="a_part"/></joint>\n'
+        '  <joint name="jb" type="fixed"><parent link="base"/><child link="b_part"/></joint>\n'
+        '</robot>\n')
+    result = runner.invoke(app, ["check", str(main), "--json", "--select", "U601"])
+    found = sorted((f["message"].split("'")[1], f["origin"], f["line"])
+                   for f in json.loads(result.stdout)["findings"])
+    parts = str(tmp_path / "parts.xacro")
+    # The mass element of each macro expansion was written on line 4 of parts.xacro.
+    assert found == [("a_part", f"{parts}:4", None), ("b_part", f"{parts}:4", None),
+                     ("base", f"{main}:3", None)]
+    text = runner.invoke(app, ["check", str(main), "--select", "U601"]).stdout
+    assert f"(written at {parts}:4)" in text
+    # The tags never reach an output: the expansion is plain URDF.
+    from urdfkit.expand import expand_xacro
+
+    expanded = expand_xacro(main)
+    assert b"urdfkit-origin" not in expanded and b"a_part" in expanded
+    assert len(expanded.origins) == expanded.count(b"<") - expanded.count(b"</") \
+        - expanded.count(b"<!--") - expanded.count(b"<?")
+
+
+def test_a_refusal_of_xacro_input_names_where_the_element_was_written(tmp_path: Path) -> None:
+    main = tmp_path / "robot.urdf.xacro"
+    main.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+                    '  <link name="a"/>\n'
+                    '  <link name="b"/>\n'
+                    '  <joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>\n'
+                    '  <joint name="j" type="fixed"><parent link="b"/><child link="a"/></joint>\n'
+                    '</robot>\n')
+    result = runner.invoke(app, ["joints", str(main)])
+    assert result.exit_code == 2
+    (line,) = result.stderr.strip().splitlines()
+    assert line.startswith(f"urdfkit: error: {main}: ") and f"(written at {main}:5)" in line

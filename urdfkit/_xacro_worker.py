@@ -9,6 +9,11 @@ stop (SIGTERM).
 package up in the :class:`~urdfkit.uris.PackageIndex` the parent passed (``--package``,
 ``--package-path``, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH), then above the file.
 
+Each element is tagged, as its file is read, with the file and line it was written on (an
+attribute in urdfkit's own namespace, which xacro copies like any other, including into
+every expansion of a macro). After expansion the tags are taken off and written, in
+document order, to ``OUT.origins`` (JSON): the true source of every element, for findings.
+
 Usage: ``python -m urdfkit._xacro_worker OUT ERR TIMEOUT MEMORY PACKAGES_JSON FILE
 [name:=value ...]``
 """
@@ -21,6 +26,61 @@ import signal
 import sys
 
 PR_SET_CHILD_SUBREAPER = 36
+
+#: The namespace of the source tags (never in the output).
+ORIGIN_NS = "urn:urdfkit:origin"
+ORIGIN_ATTR = "urdfkit-origin:at"
+#: Files read so far (an origin names one by its index here).
+FILES: list[str] = []
+
+
+def _tag_origins(xacro: object) -> None:
+    """Make xacro's file reader tag every element it reads with ``index:line``."""
+    from lxml import etree
+
+    original = xacro.parse  # type: ignore[attr-defined]
+    etree.register_namespace("urdfkit-origin", ORIGIN_NS)
+
+    def parse(inp: object, filename: str | None = None) -> object:
+        if inp is not None or not filename:
+            return original(inp, filename)
+        path = os.path.join(xacro.root_dir, filename)  # type: ignore[attr-defined]
+        try:
+            with open(path, "rb") as f:
+                text = f.read()
+            root = etree.fromstring(text, etree.XMLParser(
+                resolve_entities=False, no_network=True, strip_cdata=False,
+                remove_comments=False))
+        except (OSError, etree.XMLSyntaxError, ValueError):
+            return original(inp, filename)  # xacro says what is wrong, its own way
+        FILES.append(os.path.abspath(path))
+        index = len(FILES) - 1
+        for el in root.iter(etree.Element):
+            # xacro knows its own elements by the "xacro:" prefix (files use several URIs);
+            # they are instructions, and a macro call's attributes are its parameters.
+            ns = etree.QName(el).namespace or ""
+            if el.prefix != "xacro" and "xacro" not in ns:
+                el.set(f"{{{ORIGIN_NS}}}at", f"{index}:{el.sourceline}")
+        return original(etree.tostring(root, encoding="unicode"), filename)
+
+    xacro.parse = parse  # type: ignore[attr-defined]
+
+
+def _take_origins(doc: object) -> list[str | None]:
+    """Remove the source tags; return them in document order (None: untagged)."""
+    out: list[str | None] = []
+    stack = [doc.documentElement]  # type: ignore[attr-defined]
+    while stack:
+        el = stack.pop()
+        at = el.getAttributeNS(ORIGIN_NS, "at") if el.hasAttributeNS(ORIGIN_NS, "at") else ""
+        if at:
+            el.removeAttributeNS(ORIGIN_NS, "at")
+        out.append(at or None)
+        stack.extend(reversed([c for c in el.childNodes if c.nodeType == c.ELEMENT_NODE]))
+    for el in [doc.documentElement]:  # type: ignore[attr-defined]
+        if el.hasAttribute("xmlns:urdfkit-origin"):
+            el.removeAttribute("xmlns:urdfkit-origin")
+    return out
 
 
 def _limits(timeout: float, memory: int) -> None:
@@ -153,7 +213,9 @@ def main(argv: list[str]) -> int:
     try:
         import xacro
 
+        _tag_origins(xacro)
         doc = xacro.process_file(source, mappings=mappings)
+        origins = _take_origins(doc)
         data = doc.toxml(encoding="utf-8")
     except MemoryError:
         print("MemoryError: the expansion needed more memory than its limit", file=sys.stderr)
@@ -178,6 +240,10 @@ def main(argv: list[str]) -> int:
               f"{hint(unknown[0], declared)} (its <xacro:arg>s: {', '.join(declared) or 'none'})",
               file=sys.stderr)
         return 3  # urdfkit.expand.BAD_ARGS
+    import json
+
+    with open(out + ".origins", "w", encoding="utf-8") as f:
+        json.dump({"files": FILES, "origins": origins}, f)
     with open(out, "wb") as f:
         f.write(data)
     return 0

@@ -205,7 +205,7 @@ def check_file(display: str, path: str | Path,
                                        display))
         return result
     found = run_rules(tree.getroot(), display, ALL_RULES, base=path.absolute().parent,
-                      packages=packages)
+                      packages=packages, origins=getattr(data, "origins", None))
     if path.suffix == ".xacro":
         # Lines of xacro's output are not lines of the file the user wrote: none, not a false
         # one (each message names its element).

@@ -80,8 +80,8 @@ def redact(message: str, secrets: Mapping[str, str]) -> str:
 def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
                  timeout: float | None = None, display: str | None = None,
                  no_exec: bool = False, packages: Mapping[str, Path] | None = None,
-                 strict_args: bool = True) -> bytes:
-    """Expand a xacro file in a contained subprocess; return the URDF bytes.
+                 strict_args: bool = True) -> Expanded:
+    """Expand a xacro file in a contained subprocess; return the URDF bytes (with origins).
 
     ``$(find NAME)`` resolves without ROS through ``packages`` (a
     :class:`~urdfkit.uris.PackageIndex`, or plain ``NAME: PATH`` pairs), then the environment's
@@ -150,7 +150,45 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
             named = re.search(r"`(\w+)`", msg)  # a parameter the message names, for the CLI
             raise InputError(f"xacro failed: {redact(msg, secrets)}", file=name,
                              param=named.group(1) if named else None)
-        return out.read_bytes()
+        return Expanded(out.read_bytes(), _origins(Path(str(out) + ".origins")))
+
+
+class Expanded(bytes):
+    """xacro's output, and where each of its elements was written.
+
+    Attributes:
+        origins: For each element in document order, ``"file:line"`` of the source text it
+            came from (the macro body for an element a macro made; the path relative to the
+            current folder when below it), or None.
+    """
+
+    origins: list[str | None]
+
+    def __new__(cls, data: bytes, origins: list[str | None]) -> Expanded:  # noqa: D102
+        self = super().__new__(cls, data)
+        self.origins = origins
+        return self
+
+
+def _origins(path: Path) -> list[str | None]:
+    import json
+
+    try:
+        found = json.loads(path.read_text("utf-8"))
+        files = [_shown(f) for f in found["files"]]
+        out: list[str | None] = []
+        for at in found["origins"]:
+            index, _, line = (at or "").partition(":")
+            out.append(f"{files[int(index)]}:{int(line)}" if at else None)
+        return out
+    except (OSError, ValueError, KeyError, IndexError, TypeError):
+        return []
+
+
+def _shown(path: str) -> str:
+    """A path as a user would type it: relative to the current folder when below it."""
+    rel = os.path.relpath(path)
+    return path if rel.startswith("..") else rel
 
 
 def _kill_group(pgid: int) -> None:

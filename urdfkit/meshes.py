@@ -1,11 +1,12 @@
 """Mass properties of mesh files, for the mesh-aware physics checks (no trimesh needed).
 
 About half of the links of real robots collide only through meshes. :func:`properties` reads
-an STL (binary or ASCII), OBJ or COLLADA (.dae) file, placed as PyBullet places it, applies ``<mesh scale>``, and returns the solid's volume,
-centre of mass and inertia per unit density by the signed-tetrahedron method (each triangle
-with the origin spans a tetrahedron; summed with signs, they give the closed solid's
-integrals). It also says whether the surface is closed (every edge shared by exactly two
-triangles), since a mesh with holes has no meaningful volume.
+an STL (binary or ASCII), OBJ or COLLADA (.dae) file, placed as PyBullet places it, applies
+``<mesh scale>``, and returns the solid's volume, centre of mass and inertia per unit density
+by the signed-tetrahedron method (each triangle with the origin spans a tetrahedron; summed
+with signs, they give the closed solid's integrals). It also says whether the surface is
+closed (every edge shared by exactly two triangles), since a mesh with holes has no
+meaningful volume.
 
 Reading and integrating a mesh costs far more than checking the URDF that names it, so the
 integrals are kept, unscaled, in urdfkit's cache (:mod:`urdfkit.cache`), keyed by the file's

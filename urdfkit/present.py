@@ -369,7 +369,7 @@ def check_report(result: Any) -> None:
                         out.append(f"  {'':>5}  {f.level:<7}  {f.code}  {more}")
                     else:
                         out.append(f"  {f.line if f.line is not None else '-':>5}  "
-                                   f"{f.level:<7}  {f.code}  {_one_line(f.message)}")
+                                   f"{f.level:<7}  {f.code}  {_one_line(f.text)}")
         out.append(summary)
         _write(sys.stdout, "\n".join(out) + "\n")
         return
@@ -384,7 +384,7 @@ def check_report(result: Any) -> None:
             where = f"{f.line:>5}" if f.line is not None and not more else "    -"
             screen.print(Text.assemble(f"  {where}  ", (f"{f.level:<7}", LEVEL_STYLE[f.level]),
                                        "  ", (f.code, "dim"), "  ",
-                                       (more, "dim") if more else _one_line(f.message)),
+                                       (more, "dim") if more else _one_line(f.text)),
                          soft_wrap=True)
     screen.print(Text(summary, style=colour), soft_wrap=True)
 

@@ -165,13 +165,14 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
     display = str(name)
     source = locate(name)
     if source.suffix == ".xacro":
-        data = expand_xacro(source, xacro_args, display=display, packages=packages)
+        expanded = expand_xacro(source, xacro_args, display=display, packages=packages)
         try:
-            return _resolve_tree(source, display, parse_xml(data, display), packages, guard,
-                                 copy=True)
+            return _resolve_tree(source, display, parse_xml(expanded, display), packages,
+                                 guard, copy=True, origins=expanded.origins)
         except InputError as e:
             # Lines of xacro's output are not lines of the file the user wrote: say none
-            # rather than a false one (the message names the element).
+            # rather than a false one (the message names the element and, where recovered,
+            # the file and line it was written on).
             raise type(e)(e.message, file=e.file, param=e.param) from None
     else:
         data = read_bytes(source)
@@ -184,9 +185,10 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
 
 def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
                   packages: Mapping[str, Path] | None, guard: bool,
-                  copy: bool = False) -> Resolved:
+                  copy: bool = False, origins: list[str | None] | None = None) -> Resolved:
     lifted = [f"{where(f)}: let through without the guard ({f.code}): "
-              f"{f.message.removesuffix(STRICTER)}" for f in run_guard(tree, display, strict=guard)]
+              f"{f.message.removesuffix(STRICTER)}"
+              for f in run_guard(tree, display, strict=guard, origins=origins)]
     root = tree.getroot()
     # PyBullet takes paths as UTF-8 text: a file name that is not (bytes from another locale,
     # kept by Python as surrogates) is loaded from a copy with a clean name.

@@ -70,6 +70,7 @@ class Finding:
     message: str
     file: str
     line: int | None = None
+    origin: str | None = None
 
     def to_dict(self) -> dict[str, object]:
         """The JSON form."""
@@ -77,7 +78,12 @@ class Finding:
 
     def __str__(self) -> str:
         where = self.file if self.line is None else f"{self.file}:{self.line}"
-        return f"{where}: {self.level} {self.code}: {self.message}"
+        return f"{where}: {self.level} {self.code}: {self.text}"
+
+    @property
+    def text(self) -> str:
+        """The message, with where the element was written when that is another file."""
+        return f"{self.message} (written at {self.origin})" if self.origin else self.message
 
 
 class Report:
@@ -90,10 +96,12 @@ class Report:
     """
 
     def __init__(self, file: str, base: Path | None = None,
-                 packages: Mapping[str, Path] | None = None):
+                 packages: Mapping[str, Path] | None = None,
+                 origins: Mapping[etree._Element, str] | None = None):
         self.file = file
         self.base = base
         self.packages = dict(packages or {})
+        self.origins = origins
         self.findings: list[Finding] = []
         self._references: dict[tuple[str, str], Reference] = {}
 
@@ -111,7 +119,8 @@ class Report:
         """Record a finding; its line comes from ``el`` unless given."""
         if line is None and el is not None:
             line = el.sourceline
-        self.findings.append(Finding(code, level, message, self.file, line))
+        origin = self.origins.get(el) if self.origins is not None and el is not None else None
+        self.findings.append(Finding(code, level, message, self.file, line, origin))
 
     @property
     def errors(self) -> list[Finding]:
@@ -1035,37 +1044,54 @@ CODES: dict[str, str] = {
 
 def run_rules(root: etree._Element, file: str, rules: tuple[Rule, ...], *,
               base: Path | None = None,
-              packages: Mapping[str, Path] | None = None) -> list[Finding]:
+              packages: Mapping[str, Path] | None = None,
+              origins: Sequence[str | None] | None = None) -> list[Finding]:
     """Run ``rules`` over a document root and return the findings.
 
     ``base`` (the file's folder) and ``packages`` enable the rules that look at the file
-    system (meshes exist); without ``base`` they are skipped.
+    system (meshes exist); without ``base`` they are skipped. ``origins`` (xacro's, see
+    :class:`urdfkit.expand.Expanded`) give each finding the file and line its element was
+    written on.
     """
-    report = Report(file, base, packages)
+    report = Report(file, base, packages, origin_map(root, origins))
     for rule in rules:
         rule(root, report)
     return report.findings
 
 
-def guard_findings(root: etree._Element, file: str) -> list[Finding]:
+def origin_map(root: etree._Element, origins: Sequence[str | None] | None
+               ) -> dict[etree._Element, str] | None:
+    """Elements (document order) paired with their origins; None if they do not line up."""
+    if not origins:
+        return None
+    elements = list(root.iter(etree.Element))
+    if len(elements) != len(origins):
+        return None
+    return {el: at for el, at in zip(elements, origins, strict=True) if at}
+
+
+def guard_findings(root: etree._Element, file: str,
+                   origins: Sequence[str | None] | None = None) -> list[Finding]:
     """The findings that make every command refuse a document (codes in GUARD_CODES)."""
-    return [f for f in run_rules(root, file, GUARD_RULES) if f.code in GUARD_CODES]
+    return [f for f in run_rules(root, file, GUARD_RULES, origins=origins)
+            if f.code in GUARD_CODES]
 
 
 def guard(tree: etree._ElementTree | etree._Element, file: str, *,
-          strict: bool = True) -> list[Finding]:
+          strict: bool = True, origins: Sequence[str | None] | None = None) -> list[Finding]:
     """Raise :class:`InputError` for the first finding every command refuses.
 
     With ``strict=False`` (``--no-guard``), the refusals in :data:`LIFTABLE_CODES`, where the
     guard is stricter than PyBullet, are returned instead, for the caller to show as warnings;
     everything that crashes PyBullet is still refused. Nothing is skipped silently.
+    ``origins`` (xacro's) name where a refused element was written.
     """
     root = tree.getroot() if isinstance(tree, etree._ElementTree) else tree
     lifted = []
-    for f in guard_findings(root, file):
+    for f in guard_findings(root, file, origins):
         if not strict and f.code in LIFTABLE_CODES:
             lifted.append(f)
             continue
-        raise InputError(f.message, file=f.file, line=f.line,
+        raise InputError(f.text, file=f.file, line=f.line,
                          param="guard" if f.code in LIFTABLE_CODES else None)
     return lifted
