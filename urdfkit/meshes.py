@@ -234,7 +234,9 @@ def _weld(corners: Any) -> tuple[Any, Any]:
     return unique, index.reshape(-1, 3)
 
 
-_OBJ_INDEX_TAIL = re.compile(rb"/\S*")  # "7/3/2" -> "7": texture and normal indices go
+_OBJ_INDEX_TAIL = re.compile(rb"/\S*")
+_OBJ_OBJECT = re.compile(rb"^[og][ \t]", re.M)
+_OBJ_FACE_LINE = re.compile(rb"^f[ \t]", re.M)  # "7/3/2" -> "7": texture and normal indices go
 
 
 def _numbers(lines: list[bytes], dtype: Any, per_line: int) -> Any:
@@ -421,28 +423,30 @@ CONCAVE_FRACTION = 0.02
 _CONCAVITY_BUDGET = 4_000_000
 
 
-def _concavity(vertices: Any, faces: Any, starts: list[int]) -> float:
-    """Largest distance of a vertex in front of a triangle's plane, within each piece."""
+def _concavity(vertices: Any, faces: Any, starts: list[int], det: Any) -> float:
+    """Largest distance of a vertex in front of a triangle's plane, within each piece.
+
+    ``det`` is each triangle's signed-volume term (6 x its tetrahedron with the origin), whose
+    sum per piece says which side of its triangles is out.
+    """
     import numpy as np
 
+    a, b, c = vertices[faces.T]
+    normal = np.cross(b - a, c - a)
+    length = np.linalg.norm(normal, axis=1)
+    length[length == 0] = np.inf  # a degenerate triangle has no plane: it tests nothing
+    normal /= length[:, None]
+    offset = np.einsum("ij,ij->i", normal, a)
     worst = 0.0
     bounds = [0, *starts, len(faces)]
     for lo, hi in zip(bounds, bounds[1:], strict=False):
-        f = faces[lo:hi]
-        if len(f) < 4:
+        if hi - lo < 4:
             continue
-        a, b, c = vertices[f.T]
-        normal = np.cross(b - a, c - a)
-        length = np.linalg.norm(normal, axis=1)
-        good = length > 0
-        normal = normal[good] / length[good, None]
-        if np.einsum("ij,ij->i", a, np.cross(b, c)).sum() < 0:
-            normal = -normal  # triangles facing inward: outward is the other side
-        offset = np.einsum("ij,ij->i", normal, a[good])
-        points = vertices[np.unique(f)]
-        step = max(1, -(-len(normal) * len(points) // _CONCAVITY_BUDGET))
-        depth = (points @ normal[::step].T - offset[::step]).max()
-        worst = max(worst, float(depth))
+        sign = -1.0 if det[lo:hi].sum() < 0 else 1.0  # inward triangles: out is the other side
+        points = vertices[np.unique(faces[lo:hi])]
+        step = max(1, -(-(hi - lo) * len(points) // _CONCAVITY_BUDGET))
+        depth = sign * (points @ normal[lo:hi:step].T - offset[lo:hi:step])
+        worst = max(worst, float(depth.max()))
     return worst
 
 
@@ -475,4 +479,4 @@ def _solid(vertices: Any, faces: Any, starts: list[int] | None = None) -> Integr
                       float(second[0, 1]), float(second[0, 2]), float(second[1, 2])),
                      (float(low[0]), float(low[1]), float(low[2])),
                      (float(high[0]), float(high[1]), float(high[2])), closed, len(faces),
-                     _concavity(vertices, faces, starts) if closed else 0.0, len(starts) + 1)
+                     _concavity(vertices, faces, starts, det) if closed else 0.0, len(starts) + 1)
