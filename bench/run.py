@@ -57,6 +57,7 @@ class Case:
         argv: The command.
         goals: (baseline name, highest acceptable ratio) pairs; empty for a baseline.
         ok: Exit statuses that count as success (``check`` exits 1 on findings).
+        env: Extra environment variables for the command.
     """
 
     name: str
@@ -65,6 +66,7 @@ class Case:
     times: list[float] = field(default_factory=list)
     terminal: bool = False
     ok: tuple[int, ...] = (0,)
+    env: dict[str, str] = field(default_factory=dict)
 
 
 #: Size of the pseudo-terminal that ``terminal`` cases write to: a common laptop window.
@@ -75,7 +77,8 @@ def time_once(case: Case) -> float:
     """Wall time of one run; stdout goes to /dev/null, or to a pseudo-terminal."""
     if not case.terminal:
         start = time.perf_counter()
-        proc = subprocess.run(case.argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        proc = subprocess.run(case.argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                              env={**os.environ, **case.env})
         elapsed = time.perf_counter() - start
         returncode = proc.returncode
     else:
@@ -86,7 +89,8 @@ def time_once(case: Case) -> float:
         master, slave = pty.openpty()
         fcntl.ioctl(slave, termios.TIOCSWINSZ,
                     struct.pack("HHHH", TERMINAL_ROWS, TERMINAL_COLUMNS, 0, 0))
-        env = {k: v for k, v in os.environ.items() if k not in ("COLUMNS", "NO_COLOR")}
+        env = {k: v for k, v in {**os.environ, **case.env}.items()
+               if k not in ("COLUMNS", "NO_COLOR")}
         env["TERM"] = "xterm-256color"
         start = time.perf_counter()
         child = subprocess.Popen(case.argv, stdout=slave, stderr=subprocess.DEVNULL, env=env)
