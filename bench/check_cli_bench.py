@@ -16,9 +16,9 @@ from run import Case, Context
 
 
 def cases(ctx: Context) -> list[Case]:
-    import pybullet_data
-
     import tempfile
+
+    import pybullet_data
 
     data = pybullet_data.getDataPath()
     cache = {"URDFKIT_CACHE_DIR": tempfile.mkdtemp(prefix="urdfkit-bench-cache-")}
