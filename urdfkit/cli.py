@@ -547,20 +547,33 @@ def _split_joints(items: list[str] | None) -> list[str] | None:
 @app.command(epilog=_examples(
     "urdfkit drive --throttle 10 --steer 0.2",
     "urdfkit drive --urdf racecar/racecar.urdf --seconds 5 --json",
+    "urdfkit drive --urdf husky/husky.urdf --steer 0.5   # skid steer: 0.5 rad/s of yaw",
     "urdfkit drive --steer 0.3 --trajectory run.csv --plot run.png"))
 def drive(
     throttle: Annotated[float, typer.Option(
-        help="Target wheel speed, rad/s (VELOCITY_CONTROL on every wheel); negative reverses.")]
+        help="Wheel speed, rad/s: of a wheel on the car's centre line (each wheel turns as "
+        "its path needs); with --drivetrain locked, of every wheel. Negative reverses.")]
     = 10.0,
     steer: Annotated[float, typer.Option(
-        help="Steering angle, rad (POSITION_CONTROL on the hinges); positive turns left.")]
+        help="Steering angle, rad, of the kinematic bicycle model (hinges get Ackermann "
+        "angles); positive turns left. Without hinges (skid steer): the yaw rate, rad/s.")]
     = 0.0,
+    drivetrain: Annotated[str, typer.Option(
+        "--drivetrain", metavar="differential|rear|locked",
+        help="differential: every wheel at the speed its path needs; rear: rear wheels so, "
+        "fronts roll free; locked: every wheel at --throttle, as the tutorial.")]
+    = "differential",
+    tutorial: Annotated[bool, typer.Option(
+        "--tutorial", help="Reproduce the PyBullet tutorial's loop exactly: locked wheels, "
+        "PyBullet's default motor force, no load flags, car at 0 0 0.1 before the plane.")]
+    = False,
     seconds: Annotated[float | None, typer.Option(
         help="Simulated duration in seconds.", show_default="10")] = None,
     steps: Annotated[int | None, typer.Option(help="Number of physics steps instead.")] = None,
     time_step: Annotated[float, typer.Option(help="Physics time step, s.", show_default="1/240")]
     = 1.0 / 240.0,
-    max_force: Annotated[float, typer.Option(help="Wheel motor torque limit, N m.")] = 10.0,
+    max_force: Annotated[float | None, typer.Option(
+        help="Wheel motor torque limit, N m.", show_default="10")] = None,
     urdf: Annotated[str | None, typer.Option(
         help="Car to drive (.urdf/.xacro; pybullet_data names work).",
         show_default="the built-in simplecar")] = None,
@@ -600,6 +613,10 @@ def drive(
 
     if seconds is not None and steps is not None:
         raise ParameterError("give `seconds` or `steps`, not both", param="seconds")
+    if tutorial and (drivetrain != "differential" or max_force is not None):
+        raise ParameterError("`tutorial` fixes the drivetrain (locked) and the motor force "
+                             "(PyBullet's default); drop --drivetrain and --max-force",
+                             param="tutorial")
     if gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
                     or sys.platform in ("darwin", "win32")):
         raise ParameterError("`gui` needs a display (DISPLAY is not set); drop it to drive "
@@ -622,7 +639,9 @@ def drive(
     config = DriveConfig(
         urdf=urdf, plane=plane, template_params=params,
         packages=package, xacro_args=arg, seconds=10.0 if seconds is None else seconds,
-        steps=steps, time_step=time_step, throttle=throttle, steer=steer, max_force=max_force,
+        steps=steps, time_step=time_step, throttle=throttle, steer=steer,
+        max_force=10.0 if max_force is None else max_force, drivetrain=drivetrain,
+        tutorial=tutorial, keep_trajectory=plot is not None,
         wheels=_split_joints(wheels), hinges=_split_joints(hinges), sample_every=sample_every,
         gui=gui, guard=not no_guard, package_paths=package_path, up=up)
     with Scenario(config) as sc:
@@ -632,7 +651,7 @@ def drive(
             return ", ".join(t.joint_names[j] for j in joints) or "none"
 
         show.note(f"{sc.model}: wheels {names(t.wheels)}; hinges {names(t.hinges)}; "
-                  f"passive {names(t.passive)}")
+                  f"passive {names(t.passive)}; drivetrain {t.mode} ({t.steering} steering)")
         for w in sc.warnings:
             show.warn(w)
         progress, stop = show.progress("driving", "steps", enabled=not as_json)
@@ -662,23 +681,38 @@ def drive(
     if result.interrupted:
         show.interrupted("interrupted; the results cover the steps simulated")
         raise typer.Exit(130)
+    if result.problems:  # the run is physically suspect: a finding, for CI
+        raise typer.Exit(1)
 
 
 def _drive_summary(r: Any) -> None:
     x, y, z = r.final_position
-    turn = ("straight (no settled turn)" if r.turning_radius is None else
-            f"{r.turning_radius:.3f} m around ({r.turn_center[0]:.2f}, {r.turn_center[1]:.2f})")
+    bicycle = ("" if r.expected_radius is None
+               else f" (kinematic bicycle model: {r.expected_radius:.3f} m)")
+    turn = (f"none: {r.radius_note}{bicycle}" if r.turning_radius is None else
+            f"{r.turning_radius:.3f} m around ({r.turn_center[0]:.2f}, {r.turn_center[1]:.2f})"
+            f"{bicycle}")
+    sim = r.simulated
+    force = sim["wheel_force"]
+    flags = ", ".join(sim["load_flags"]) or "none"
+    unit = "rad/s of yaw" if r.drivetrain.steering == "skid" else "rad"
     show.fields([("drive", "bold"), f" {r.model}: throttle {r.throttle:g} rad/s, "
-                 f"steer {r.steer:g} rad"], [
+                 f"steer {r.steer:g} {unit}"], [
         ("final position", f"x {x:.3f}  y {y:.3f}  z {z:.3f} m"),
         ("final yaw", f"{r.final_yaw:.3f} rad ({r.final_yaw * 57.29577951308232:.1f} deg)"),
         ("heading change", f"{r.heading_change:.3f} rad"),
         ("distance", f"{r.distance:.3f} m along the path"),
         ("mean speed", f"{r.mean_speed:.3f} m/s"),
         ("turning radius", turn),
-        ("simulated", f"{r.sim_time:.3f} s in {r.steps:,} steps of {r.time_step:.5g} s"),
+        ("drivetrain", f"{sim['drivetrain']}, {sim['steering']} steering; wheel force "
+                       f"{force if isinstance(force, str) else f'{force:g} N m'}"),
+        ("load flags", flags),
+        ("simulated", f"{r.sim_time:.3f} s in {r.steps:,} steps of {r.time_step:.5g} s; link "
+                      f"damping {sim['link_damping']['linear']:g} (PyBullet's default)"),
         ("wall time", f"{r.wall_time:.3f} s (real-time factor {r.real_time_factor:.1f}x)"),
     ])
+    for problem in r.problems:
+        show.warn(problem)
 
 
 # ---- render: headless PNG pictures (urdfkit/render.py) and tree --dot (urdfkit/graph.py)

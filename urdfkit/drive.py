@@ -16,6 +16,15 @@ Load flags, chosen on purpose (see ``docs/drive.md``):
 Speed: motors are set once (PyBullet keeps a motor's target until it changes), the loop does
 nothing but ``stepSimulation`` between samples, and stdout is quieted once around the whole
 loop rather than per call. The physics step is the floor; see ``bench/drive_bench.py``.
+
+Memory: samples stream to the trajectory file as they are taken; the statistics (distance,
+heading, the circle fit over a bounded, evenly thinned set of settled samples) are kept as
+running sums, so a run's memory does not grow with its length unless the caller keeps the
+trajectory (``keep_trajectory``, for a plot).
+
+Sanity: the run watches itself (:class:`_Monitor`) and reports, as warnings, a car that left
+the ground or fell, flipped, got stuck, spun its wheels, has a static base or started inside
+the ground. ``--tutorial`` instead reproduces the PyBullet tutorial's loop exactly.
 """
 
 from __future__ import annotations
@@ -34,12 +43,14 @@ from typing import Any
 from .cache import cache_dir, write_entry
 from .errors import ParameterError
 from .session import LoadOptions, Session, quiet_stdout
-from .spec import UP_AXES, finite
+from .spec import UP_AXES, finite, quat_mul
 from .vehicle import (
+    DRIVETRAINS,
     Drivetrain,
     DrivetrainError,
     apply_drive,
-    detect_drivetrain,
+    clamp_steer,
+    detect_upright,
     disable_default_motors,
 )
 
@@ -52,6 +63,16 @@ SETTLED_FRACTION = 0.5
 MIN_TURN = 0.5
 #: Trajectory formats by file suffix.
 TRAJECTORY_FORMATS = (".csv", ".jsonl")
+#: A fitted circle counts only if the path stays this close to it (RMS, fraction of radius).
+CIRCLE_TOLERANCE = 0.02
+#: Settled samples kept for the circle fit; more are thinned evenly (memory stays flat).
+FIT_SAMPLES = 2048
+#: PyBullet's linear and angular damping of every link (drive does not change it).
+PYBULLET_LINK_DAMPING = 0.04
+#: The tutorial's start: the car's base 0.1 m up, loaded before the plane.
+TUTORIAL_START = (0.0, 0.0, 0.1)
+#: The built-in ground is at least this size (m), and larger when the run needs it.
+MIN_GROUND = 20.0
 
 BASE_COLUMNS = ("t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz")
 
@@ -79,14 +100,28 @@ class DriveConfig:
         seconds: Simulated duration; ignored when ``steps`` is given.
         steps: Number of physics steps.
         time_step: Physics time step (s).
-        throttle: Target wheel angular velocity (rad/s), positive = forward.
-        steer: Target steering angle (rad), positive = left (counter-clockwise from above).
-        max_force: Maximum wheel motor torque (N m).
+        throttle: Wheel angular velocity (rad/s), positive = forward: for ``differential``
+            and ``rear``, that of a wheel on the car's centre line at the rear axle (the others
+            turn as their paths need); for ``locked``, every wheel's.
+        steer: Steering angle (rad) of the kinematic bicycle model, positive = left
+            (counter-clockwise from above); for a skid-steered base (no hinges), the yaw rate
+            (rad/s).
+        max_force: Maximum wheel motor torque (N m); None: PyBullet's default (100000).
+        drivetrain: ``differential`` (every wheel at the speed its path needs, Ackermann
+            hinges), ``rear`` (rear wheels so, fronts roll free) or ``locked`` (the
+            tutorial's: every wheel at ``throttle``, hinges at ``steer``).
+        tutorial: Reproduce the PyBullet tutorial's loop exactly: ``locked``, PyBullet's
+            default motor force, no load flags, the car loaded before the plane at
+            (0, 0, 0.1).
+        base_rpy: Spawn tilt (roll, pitch, yaw in rad), after the up axis stands the car up.
+        keep_trajectory: Keep every sample in :attr:`DriveResult.trajectory` (for a plot);
+            else only the statistics are kept, and memory does not grow with the run.
         wheels: Joint names/indices to drive instead of the detected wheels.
         hinges: Joint names/indices to steer instead of the detected hinges.
         sample_every: Steps between trajectory samples; default: 20 samples per second.
         gravity: Vertical gravity (m/s^2).
-        base_position: Where the car's base starts.
+        base_position: Where the car's base starts; None: resting on the ground at the
+            origin (its lowest point just above the ground's top).
         gui: Open the PyBullet GUI with Steering and Throttle sliders.
         guard: False lifts the guard's refusals that are stricter than PyBullet (they become
             warnings); crash classes are refused either way.
@@ -104,12 +139,16 @@ class DriveConfig:
     time_step: float = 1.0 / 240.0
     throttle: float = 10.0
     steer: float = 0.0
-    max_force: float = 10.0
+    max_force: float | None = 10.0
+    drivetrain: str = "differential"
+    tutorial: bool = False
+    base_rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    keep_trajectory: bool = True
     wheels: list[str] | None = None
     hinges: list[str] | None = None
     sample_every: int | None = None
     gravity: float = -10.0
-    base_position: tuple[float, float, float] = (0.0, 0.0, 0.1)
+    base_position: tuple[float, float, float] | None = None
     gui: bool = False
     guard: bool = True
     package_paths: list[str] | None = None
@@ -134,10 +173,20 @@ class DriveConfig:
                                      param="seconds")
         self.throttle = _finite("throttle", self.throttle)
         self.steer = _finite("steer", self.steer)
-        self.max_force = _finite("max_force", self.max_force)
-        if self.max_force < 0:
-            raise ParameterError(f"`max_force` must be >= 0, got {self.max_force:g}",
-                                 param="max_force")
+        if self.max_force is not None:
+            self.max_force = _finite("max_force", self.max_force)
+            if self.max_force < 0:
+                raise ParameterError(f"`max_force` must be >= 0, got {self.max_force:g}",
+                                     param="max_force")
+        if self.drivetrain not in DRIVETRAINS:
+            raise ParameterError(f"`drivetrain` must be one of {', '.join(DRIVETRAINS)}, got "
+                                 f"{self.drivetrain!r}", param="drivetrain")
+        self.base_rpy = tuple(_finite("base_rpy", v) for v in self.base_rpy)  # type: ignore[assignment]
+        if self.base_position is not None:
+            self.base_position = tuple(  # type: ignore[assignment]
+                _finite("base_position", v) for v in self.base_position)
+        if self.tutorial:
+            self.drivetrain, self.max_force = "locked", None
         self.gravity = _finite("gravity", self.gravity)
         if self.up not in UP_AXES:
             raise ParameterError(f"`up` must be one of {', '.join(UP_AXES)}, got {self.up!r}",
@@ -302,19 +351,28 @@ class DriveResult:
         distance: Length of the base's path in the x-y plane (from the samples).
         mean_speed: ``distance / sim_time``.
         turning_radius: Radius of the circle fitted to the settled half of the path, when the
-            car turned at least :data:`MIN_TURN` rad there; else None.
+            car turned at least :data:`MIN_TURN` rad there and the path stays within
+            :data:`CIRCLE_TOLERANCE` of the circle; else None, and ``radius_note`` says why.
         turn_center: That circle's centre.
+        expected_radius: The kinematic bicycle model's radius for the base link's origin
+            (steered cars; None otherwise).
+        radius_note: Why there is no turning radius (None when there is one).
         sim_time: Simulated time.
         steps: Physics steps taken.
         time_step: The physics time step.
         wall_time: Wall-clock time of the stepping loop.
         real_time_factor: ``sim_time / wall_time``.
         throttle: The throttle applied (rad/s).
-        steer: The steer applied, after clamping (rad).
+        steer: The steer applied, after clamping (rad, or rad/s of yaw for skid steering).
         interrupted: Ctrl-C stopped the run early.
-        drivetrain: The wheels and hinges driven.
-        trajectory: The samples.
-        warnings: Things the user should know (a clamped steer, ...).
+        drivetrain: The wheels and hinges driven, and how.
+        simulated: What was simulated: load flags, forces, time step, damping, the start.
+        samples: How many samples were taken.
+        trajectory: The samples (None unless the run kept them).
+        warnings: Things the user should know (a clamped steer, ...), problems included.
+        problems: What makes the run physically suspect: left the ground, fell, flipped,
+            stuck, wheels slipping, static base, started inside the ground.
+        yaw_rate: Mean yaw rate over the settled half (rad/s).
     """
 
     model: str
@@ -334,23 +392,32 @@ class DriveResult:
     steer: float
     interrupted: bool
     drivetrain: Drivetrain
-    trajectory: Trajectory
+    trajectory: Trajectory | None
     warnings: list[str] = field(default_factory=list)
+    expected_radius: float | None = None
+    radius_note: str | None = None
+    simulated: dict[str, Any] = field(default_factory=dict)
+    samples: int = 0
+    problems: list[str] = field(default_factory=list)
+    yaw_rate: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form (the trajectory goes to its own file, not here)."""
-        def r(x: float) -> float:
-            return round(x, 6)
+        def r(x: float | None) -> float | None:
+            return None if x is None else round(x, 6)
 
         return {
             "model": self.model,
             "final_position": [r(v) for v in self.final_position],
             "final_yaw": r(self.final_yaw),
             "heading_change": r(self.heading_change),
+            "yaw_rate": r(self.yaw_rate),
             "distance": r(self.distance),
             "mean_speed": r(self.mean_speed),
-            "turning_radius": None if self.turning_radius is None else r(self.turning_radius),
+            "turning_radius": r(self.turning_radius),
             "turn_center": None if self.turn_center is None else [r(v) for v in self.turn_center],
+            "expected_radius": r(self.expected_radius),
+            "radius_note": self.radius_note,
             "sim_time": r(self.sim_time),
             "steps": self.steps,
             "time_step": self.time_step,
@@ -359,23 +426,143 @@ class DriveResult:
             "throttle": self.throttle,
             "steer": self.steer,
             "interrupted": self.interrupted,
-            "samples": len(self.trajectory.rows),
+            "samples": self.samples,
             "drivetrain": self.drivetrain.to_dict(),
+            "simulated": self.simulated,
             "warnings": self.warnings,
+            "problems": self.problems,
         }
+
+
+class _Stats:
+    """Running statistics of a drive, in memory that does not grow with the run."""
+
+    def __init__(self, settle_at: float):
+        self.settle_at = settle_at
+        self.distance = 0.0
+        self.first_yaw: float | None = None
+        self.yaw = 0.0  # unwrapped
+        self.settled_yaw: float | None = None
+        self.settled_t = 0.0
+        self.fit: list[tuple[float, float]] = []
+        self.stride = 1  # keep every stride-th settled sample
+        self.seen = 0
+        self.last: tuple[float, ...] | None = None
+        self.count = 0
+
+    def add(self, row: tuple[float, ...]) -> None:
+        t, x, y, yaw = row[0], row[1], row[2], row[6]
+        if self.last is None:
+            self.first_yaw = self.yaw = yaw
+        else:
+            self.distance += math.hypot(x - self.last[1], y - self.last[2])
+            d = yaw - self.last[6]
+            self.yaw += (d + math.pi) % (2 * math.pi) - math.pi
+        if t >= self.settle_at:
+            if self.settled_yaw is None:
+                self.settled_yaw, self.settled_t = self.yaw, t
+            if self.seen % self.stride == 0:
+                self.fit.append((x, y))
+                if len(self.fit) >= FIT_SAMPLES:  # thin evenly: every other one goes
+                    self.fit = self.fit[::2]
+                    self.stride *= 2
+            self.seen += 1
+        self.last = row
+        self.count += 1
+
+    def yaw_rate(self) -> float | None:
+        """Mean yaw rate over the settled half (rad/s), None before it."""
+        if self.settled_yaw is None or self.last is None or self.last[0] <= self.settled_t:
+            return None
+        return (self.yaw - self.settled_yaw) / (self.last[0] - self.settled_t)
+
+    def circle(self) -> tuple[Circle | None, str | None]:
+        """The settled path's circle, or None and why not."""
+        if self.settled_yaw is None or len(self.fit) < 5:
+            return None, "too few settled samples for a circle"
+        turned = abs(self.yaw - self.settled_yaw)
+        if turned < MIN_TURN:
+            return None, (f"straight: turned {turned:.2f} rad in the settled half (a circle "
+                          f"needs {MIN_TURN:g})")
+        c = fit_circle([p[0] for p in self.fit], [p[1] for p in self.fit])
+        if c is None:
+            return None, "the settled path fits no circle"
+        if c.rms > CIRCLE_TOLERANCE * c.radius:
+            return None, (f"not a circle: the settled path strays {c.rms:.3g} m RMS "
+                          f"({c.rms / c.radius:.0%}) from the best circle (r = "
+                          f"{c.radius:.3g} m)")
+        return c, None
+
+
+class _Monitor:
+    """Watches a run's samples for what makes it physically suspect (first time each)."""
+
+    def __init__(self, sc: Scenario):
+        self.problems: list[str] = []
+        self.seen: set[str] = set()
+        self.bounds = sc.ground_bounds
+        self.top = sc.ground_top
+        train = sc.drivetrain
+        self.wheel_cols = [(sc.columns.index(f"{train.joint_names[w]}_speed"),
+                           train.radius.get(w, train.reference_radius)) for w in train.driven]
+        self.stuck_since: float | None = None
+        if sc.static_base:  # said once already; its wheels spin in the air by design
+            self.wheel_cols = []
+        self.slip_sum = self.tread_sum = 0.0
+        self.settle_at = sc.config.total_steps * sc.config.time_step * SETTLED_FRACTION
+
+    def _once(self, key: str, message: str) -> None:
+        if key not in self.seen:
+            self.seen.add(key)
+            self.problems.append(message)
+
+    def add(self, row: tuple[float, ...]) -> None:
+        t, x, y, z, roll, pitch = row[0], row[1], row[2], row[3], row[4], row[5]
+        if self.bounds is not None:
+            x0, x1, y0, y1 = self.bounds
+            if not (x0 <= x <= x1 and y0 <= y <= y1):
+                self._once("left", f"left the ground at t = {t:.2f} s, at ({x:.2f}, {y:.2f}) "
+                           f"m (the ground spans x {x0:g}..{x1:g}, y {y0:g}..{y1:g})")
+        if self.top is not None and z < self.top - 1.0:
+            self._once("fell", f"fell: z = {z:.2f} m at t = {t:.2f} s, more than 1 m below "
+                       "the ground's top")
+        if math.cos(roll) * math.cos(pitch) < 0:
+            self._once("flipped", f"flipped over at t = {t:.2f} s")
+        if not self.wheel_cols or self.seen & {"left", "fell"}:
+            return  # off the ground, wheel and body speeds say nothing about traction
+        tread = sum(abs(row[i]) * r for i, r in self.wheel_cols) / len(self.wheel_cols)
+        body = math.hypot(row[7], row[8])
+        if tread > 0.1 and body < 0.05 * tread:
+            if self.stuck_since is None:
+                self.stuck_since = t
+            elif t - self.stuck_since >= 1.0:
+                self._once("stuck", f"stuck from t = {self.stuck_since:.2f} s: the wheels "
+                           f"turn ({tread:.2f} m/s at the tread) but the body does not move")
+        else:
+            self.stuck_since = None
+        if t >= self.settle_at:
+            self.slip_sum += abs(tread - body)
+            self.tread_sum += tread
+
+    def finish(self) -> list[str]:
+        if self.tread_sum > 0 and "stuck" not in self.seen \
+                and self.slip_sum / self.tread_sum > 0.3:
+            self._once("slip", f"wheels slipping: over the settled half the treads and the "
+                       f"body differ by {self.slip_sum / self.tread_sum:.0%} of the tread speed")
+        return self.problems
 
 
 ProgressFn = Callable[[int, int], None]
 
 
-def builtin_file(name: str) -> Path | None:
-    """A built-in template, built with default parameters, from the cache (built on a miss).
+def builtin_file(name: str, params: Mapping[str, str] | None = None) -> Path | None:
+    """A built-in template, built with ``params``, from the cache (built on a miss).
 
     Expanding simplecar with xacro and checking it through the builder costs ~0.07 s of CPU,
     as much as 400 physics steps, on every ``urdfkit drive``. The result depends only on the
-    template's source and the urdfkit version, which make the cache key; a stale or broken
-    entry can therefore not be hit. Returns None (build into a temp folder instead) when the
-    cache cannot be written. Nothing is ever written to the user's current folder.
+    template's source, the parameters and the urdfkit version, which make the cache key; a
+    stale or broken entry can therefore not be hit. Returns None (build into a temp folder
+    instead) when the cache cannot be written. Nothing is ever written to the user's folder.
     """
     import zlib
 
@@ -391,13 +578,15 @@ def builtin_file(name: str) -> Path | None:
         source = (template_dir() / f"{name}.urdf.xacro").read_bytes()
     except (OSError, TypeError):
         return None
-    key = f"{zlib.crc32(source):08x}{len(source):x}-{__version__}"
+    given = "".join(f"{k}={v};" for k, v in sorted((params or {}).items())).encode()
+    key = f"{zlib.crc32(source):08x}{len(source):x}-{zlib.crc32(given):08x}-{__version__}" \
+        if given else f"{zlib.crc32(source):08x}{len(source):x}-{__version__}"
     path = folder / f"{name}-{key}.urdf"
     if path.is_file():
         return path
     from .catalog import build_template
 
-    data = build_template(name).to_bytes()
+    data = build_template(name, params).to_bytes()
     return path if write_entry(path, data) else None
 
 
@@ -416,6 +605,8 @@ class Scenario:
         self.config = config
         self.model = config.urdf or "simplecar"
         self.warnings: list[str] = []
+        self.problems: list[str] = []
+        self.static_base = False
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
         self.session: Session | None = None
         try:
@@ -425,10 +616,9 @@ class Scenario:
             raise
 
     def _builtin(self, name: str, params: Mapping[str, str] | None) -> Path:
-        if not params:
-            cached = builtin_file(name)
-            if cached is not None:
-                return cached
+        cached = builtin_file(name, params)
+        if cached is not None:
+            return cached
         from .catalog import build_template
 
         if self._tmp is None:
@@ -454,31 +644,95 @@ class Scenario:
         p, client = s.p, s.client
         p.setGravity(0, 0, c.gravity, physicsClientId=client)
         p.setTimeStep(c.time_step, physicsClientId=client)
-        self._load(s, c.plane, "simpleplane", LoadOptions(fixed_base=True))
-        # Flags: implicit cylinders (smooth wheels) and the file's own inertia; see module doc.
-        self.body = self._load(s, c.urdf, "simplecar", LoadOptions(
-            base_position=c.base_position, base_orientation=UP_AXES[c.up],
-            inertia_from_file=True, implicit_cylinder=True),
-            c.template_params)
         car = c.urdf or "simplecar"
+        upright = UP_AXES[c.up]
+        spawn = quat_mul(p.getQuaternionFromEuler(c.base_rpy), upright)
+        start = c.base_position or (TUTORIAL_START if c.tutorial else (0.0, 0.0, 0.0))
+        # The tutorial's load: no flags. Otherwise implicit cylinders (smooth wheels) and the
+        # file's own inertia; see the module docstring.
+        flags = {"implicit_cylinder": False} if c.tutorial else {
+            "inertia_from_file": True, "implicit_cylinder": True}
+        self.flags = [] if c.tutorial else ["URDF_USE_IMPLICIT_CYLINDER",
+                                            "URDF_USE_INERTIA_FROM_FILE"]
+        # The car is loaded first (as the tutorial does), standing up where it starts; it is
+        # turned to its spawn tilt only after its wheels are found in its own frame.
+        self.body = self._load(s, c.urdf, "simplecar", LoadOptions(
+            base_position=start, base_orientation=upright, **flags), c.template_params)
         s.require_state_queries(self.body, car)
         try:
-            self.drivetrain = train = detect_drivetrain(p, self.body, client, c.wheels, c.hinges)
+            self.drivetrain = train = detect_upright(p, self.body, client, upright, c.wheels,
+                                                     c.hinges, c.drivetrain)
         except DrivetrainError as e:
             raise DrivetrainError(e.message, file=car, param=e.param) from None
-        self.steer = c.steer
-        if train.hinges:
-            lo, hi = train.steer_range()
-            if not lo <= c.steer <= hi:
-                self.steer = min(max(c.steer, lo), hi)
-                self.warnings.append(f"steer {c.steer:g} rad is beyond the hinge limits "
-                                     f"[{lo:g}, {hi:g}]; clamped to {self.steer:g}")
-        elif c.steer != 0:
+        if spawn != upright:
+            p.resetBasePositionAndOrientation(self.body, start, spawn, physicsClientId=client)
+        # The tutorial loads its plane as it is (a mass-0 box: static either way).
+        self.plane = self._load(s, c.plane, "simpleplane", LoadOptions(
+            fixed_base=not c.tutorial, implicit_cylinder=not c.tutorial), self._ground_params())
+        self.ground_top, self.ground_bounds = self._ground()
+        if c.base_position is None and not c.tutorial:
+            self._rest_on_ground(start)
+        self._check_start()
+        self.steer, note = clamp_steer(train, c.steer)
+        if note:
+            self.warnings.append(note)
+        if not train.hinges and c.steer != 0 and train.steering != "skid":
             self.warnings.append("the model has no steering hinges; steer is ignored")
         self.columns = list(BASE_COLUMNS)
         for j in train.wheels + train.hinges:
             name = train.joint_names[j]
             self.columns += [f"{name}_angle", f"{name}_speed"]
+
+    def _ground_params(self) -> dict[str, str] | None:
+        """The built-in ground's size: at least 20 m, and room for the whole run."""
+        c, train = self.config, self.drivetrain
+        if c.plane is not None or c.tutorial:
+            return None
+        reach = abs(c.throttle) * train.reference_radius * c.total_steps * c.time_step
+        size = max(MIN_GROUND, math.ceil(2 * (reach + 5.0)))
+        return None if size == MIN_GROUND else {"size": str(size)}
+
+    def _ground(self) -> tuple[float | None, tuple[float, float, float, float] | None]:
+        """The ground's top z and its x-y extent (None where unbounded, as a GEOM_PLANE)."""
+        assert self.session is not None
+        p, client = self.session.p, self.session.client
+        lo, hi = p.getAABB(self.plane, -1, physicsClientId=client)
+        top = hi[2] if abs(hi[2]) < 1e6 else None
+        bounds = (lo[0], hi[0], lo[1], hi[1]) if max(map(abs, (*lo[:2], *hi[:2]))) < 1e6 \
+            else None
+        return top, bounds
+
+    def _rest_on_ground(self, start: tuple[float, float, float]) -> None:
+        """Lower or raise the car until its lowest point is 1 mm above the ground's top."""
+        assert self.session is not None
+        p, client = self.session.p, self.session.client
+        n = p.getNumJoints(self.body, physicsClientId=client)
+        lowest = min(p.getAABB(self.body, link, physicsClientId=client)[0][2]
+                     for link in range(-1, n))
+        top = self.ground_top if self.ground_top is not None else 0.0
+        pos, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=client)
+        p.resetBasePositionAndOrientation(self.body, (pos[0], pos[1], pos[2] + top + 0.001
+                                                      - lowest), orn, physicsClientId=client)
+
+    def _check_start(self) -> None:
+        """A static base, or a start inside the ground, make the run meaningless: say so."""
+        assert self.session is not None
+        p, client = self.session.p, self.session.client
+        self.problems = []
+        self.static_base = p.getDynamicsInfo(self.body, -1, physicsClientId=client)[0] == 0
+        if self.static_base:
+            self.problems.append("static base: the root link has mass 0, so PyBullet fixes it "
+                                 "where it is loaded and the car cannot move; give it a mass")
+        points = p.getClosestPoints(self.body, self.plane, 0.0, physicsClientId=client)
+        depth = min((pt[8] for pt in points), default=0.0)
+        if depth < -0.005:
+            if self.config.tutorial:  # the tutorial's own start: reproduced, and said
+                self.warnings.append(f"the tutorial's start is {-depth * 1000:.0f} mm inside "
+                                     "the ground (the contact pushes the car out at once)")
+            else:
+                self.problems.append(f"started inside the ground: {-depth * 1000:.0f} mm deep "
+                                     "(the contact pushes it out with a jolt); leave "
+                                     "`base_position` unset to rest it on the ground")
 
     def close(self) -> None:
         """Disconnect and remove the temp folder."""
@@ -513,6 +767,20 @@ class Scenario:
 
         return sample
 
+    def simulated(self) -> dict[str, Any]:
+        """What this run simulates, beyond the robot: for the summary and JSON."""
+        c = self.config
+        return {
+            "drivetrain": self.drivetrain.mode, "steering": self.drivetrain.steering,
+            "wheel_force": "PyBullet default (100000 N m)" if c.max_force is None
+            else c.max_force,
+            "hinge_force": STEER_FORCE_NOTE if self.drivetrain.hinges else None,
+            "load_flags": self.flags, "time_step": c.time_step, "gravity": c.gravity,
+            "link_damping": {"linear": PYBULLET_LINK_DAMPING,
+                             "angular": PYBULLET_LINK_DAMPING, "note": "PyBullet's default"},
+            "tutorial": c.tutorial,
+        }
+
     def run(self, progress: ProgressFn | None = None,
             sink: Callable[[tuple[float, ...]], None] | None = None) -> DriveResult:
         """Drive for the configured number of steps and measure the run.
@@ -531,14 +799,20 @@ class Scenario:
         apply_drive(p, body, client, train, c.throttle, self.steer, c.max_force)
         total, period, dt = c.total_steps, c.sample_period, c.time_step
         take = self._sampler()
+        stats = _Stats(SETTLED_FRACTION * total * dt)
+        monitor = _Monitor(self)
+        traj = Trajectory(self.columns) if c.keep_trajectory else None
 
-        def sample(t: float) -> tuple[float, ...]:
+        def sample(t: float) -> None:
             row = take(t)
+            stats.add(row)
+            monitor.add(row)
+            if traj is not None:
+                traj.rows.append(row)
             if sink is not None:
                 sink(row)
-            return row
 
-        rows = [sample(0.0)]
+        sample(0.0)
         step = p.stepSimulation
         done = 0
         interrupted = False
@@ -557,7 +831,7 @@ class Scenario:
                             step(client)
                     done += n
                     if done % period == 0 or done == total:
-                        rows.append(sample(done * dt))
+                        sample(done * dt)
                     if progress is not None:
                         progress(done, total)
             except KeyboardInterrupt:
@@ -568,37 +842,51 @@ class Scenario:
                 interrupted = True  # the GUI window was closed
         wall = time.perf_counter() - start
         s.diagnostics.extend(out.lines)
-        if rows[-1][0] != done * dt:
-            rows.append(sample(done * dt))
-        return self._result(Trajectory(self.columns, rows), done, wall, interrupted)
+        assert stats.last is not None
+        if stats.last[0] != done * dt:
+            sample(done * dt)
+        return self._result(stats, monitor, traj, done, wall, interrupted)
 
-    def _result(self, traj: Trajectory, done: int, wall: float,
-                interrupted: bool) -> DriveResult:
+    def _result(self, stats: _Stats, monitor: _Monitor, traj: Trajectory | None, done: int,
+                wall: float, interrupted: bool) -> DriveResult:
         c = self.config
-        xs, ys, yaws = traj.column("x"), traj.column("y"), traj.column("yaw")
-        distance = sum(math.hypot(x1 - x0, y1 - y0)
-                       for x0, y0, x1, y1 in zip(xs, ys, xs[1:], ys[1:], strict=False))
-        unwrapped = [yaws[0]]
-        for a in yaws[1:]:
-            d = a - unwrapped[-1]
-            unwrapped.append(unwrapped[-1] + (d + math.pi) % (2 * math.pi) - math.pi)
         sim_time = done * c.time_step
-        settled = [i for i, t in enumerate(traj.column("t")) if t >= SETTLED_FRACTION * sim_time]
-        radius = center = None
-        if len(settled) >= 5 and abs(unwrapped[-1] - unwrapped[settled[0]]) >= MIN_TURN:
-            circle = fit_circle([xs[i] for i in settled], [ys[i] for i in settled])
-            if circle is not None:
-                radius, center = circle.radius, circle.center
-        last = traj.rows[-1]
+        circle, note = stats.circle()
+        problems = self.problems + monitor.finish()
+        rate = stats.yaw_rate()
+        train = self.drivetrain
+        warnings = list(self.warnings)
+        if train.steering == "skid" and self.steer and rate is not None:
+            share = rate / self.steer
+            if share < 0.1:
+                problems.append(f"skid steering turned at {rate:.3g} rad/s of the "
+                                f"{self.steer:g} commanded: the motors cannot scrub the body "
+                                "round; raise `max_force`")
+            elif share < 0.9:
+                warnings.append(f"skid steering turns at {rate:.3g} rad/s, {share:.0%} of the "
+                                f"{self.steer:g} commanded: skid-steered wheels slip sideways "
+                                "(command more yaw rate for more turn)")
+        last = stats.last
+        assert last is not None
+        expected = self.drivetrain.bicycle_radius(self.steer) \
+            if self.drivetrain.mode != "locked" else None
         return DriveResult(
             model=self.model, final_position=(last[1], last[2], last[3]), final_yaw=last[6],
-            heading_change=unwrapped[-1] - unwrapped[0], distance=distance,
-            mean_speed=distance / sim_time if sim_time > 0 else 0.0,
-            turning_radius=radius, turn_center=center, sim_time=sim_time, steps=done,
-            time_step=c.time_step, wall_time=wall,
+            heading_change=stats.yaw - (stats.first_yaw or 0.0), distance=stats.distance,
+            mean_speed=stats.distance / sim_time if sim_time > 0 else 0.0,
+            turning_radius=None if circle is None else circle.radius,
+            turn_center=None if circle is None else circle.center, sim_time=sim_time,
+            steps=done, time_step=c.time_step, wall_time=wall,
             real_time_factor=sim_time / wall if wall > 0 else math.inf,
             throttle=c.throttle, steer=self.steer, interrupted=interrupted,
-            drivetrain=self.drivetrain, trajectory=traj, warnings=list(self.warnings))
+            drivetrain=self.drivetrain, trajectory=traj,
+            warnings=warnings + problems, expected_radius=expected, yaw_rate=rate,
+            radius_note=note, simulated=self.simulated(), samples=stats.count,
+            problems=problems)
+
+
+#: How the hinges are driven, for the report.
+STEER_FORCE_NOTE = "PyBullet default (100000 N m), POSITION_CONTROL"
 
 
 class _GuiControls:

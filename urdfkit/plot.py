@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from . import style
-from .errors import MissingDependencyError
+from .errors import MissingDependencyError, ParameterError
 from .output import atomic_write, check_output
 
 if TYPE_CHECKING:
@@ -50,6 +50,9 @@ def plot_bytes(result: DriveResult) -> bytes:
     """Draw the path and speed of a drive as PNG bytes."""
     plt = _pyplot()
     traj = result.trajectory
+    if traj is None:
+        raise ParameterError("a plot needs the drive's samples: run it with "
+                             "`keep_trajectory=True`", param="keep_trajectory")
     t, xs, ys = traj.column("t"), traj.column("x"), traj.column("y")
     yaws = traj.column("yaw")
     speed = [math.hypot(vx, vy)

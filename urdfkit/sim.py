@@ -378,13 +378,14 @@ class Simulation:
                 active_joint(f"{path}.motor.joints", n) for n in names]
 
         if cfg.drive is not None:
-            from .vehicle import detect_drivetrain
+            from .vehicle import detect_upright
 
             v = cfg.vehicle
-            # Detection judges axes from the pose at load time: before any reset or step.
+            # Detection judges axes in the base frame, at load time: before any step.
             try:
-                b.train = detect_drivetrain(p, body, client, wheels=v.wheels if v else None,
-                                            hinges=v.hinges if v else None)
+                b.train = detect_upright(p, body, client, UP_AXES[cfg.up],
+                                         wheels=v.wheels if v else None,
+                                         hinges=v.hinges if v else None)
             except ParameterError as e:
                 raise self._error(f"{path}.vehicle" if v else f"{path}.drive", e.message) \
                     from None
@@ -494,13 +495,12 @@ class Simulation:
 
                 disable_default_motors(p, b.body, client, [j.index for j in b.active])
             if cmd is not None and cmd.kind == "drive":
-                from .vehicle import apply_drive
+                from .vehicle import apply_drive, clamp_steer
 
-                lo, hi = b.train.steer_range()
                 max_force = b.config.vehicle.max_force if b.config.vehicle else 10.0
                 # Motors persist in PyBullet: set once per change of command.
                 apply_drive(p, b.body, client, b.train, cmd.throttle,
-                            min(max(cmd.steer, lo), hi), max_force)
+                            clamp_steer(b.train, cmd.steer)[0], max_force)
             elif cmd is not None and not b.servo:
                 self._apply_motors(b, cmd)
             b.applied = cmd

@@ -1,20 +1,27 @@
-"""Which joints of a loaded body are wheels and steering hinges, and driving them.
+"""Which joints of a loaded body are wheels and steering hinges, and how to drive them.
 
-Detection works on the body PyBullet loaded, not on the XML, so it sees exactly the joint
-indices the motors are addressed by:
+Detection works on the body PyBullet loaded (so it sees exactly the joint indices the motors
+are addressed by), in the **base frame**: the caller stands the body upright for it (see
+:func:`detect_drivetrain`), so a car spawned tilted is judged as the car it is.
 
-- a **wheel** is a continuous joint (PyBullet reports those as ``JOINT_REVOLUTE`` with
-  ``lower=0, upper=-1``; a revolute joint whose range covers a full turn counts too) whose
-  axis is horizontal in the world at load time;
-- a **steering hinge** is a revolute joint about a vertical axis with at least one wheel
-  somewhere below it in the tree;
-- every other movable joint is **passive**: its default velocity motor is switched off, or
+- A **wheel** is a continuous joint (PyBullet reports those as ``JOINT_REVOLUTE`` with
+  ``lower=0, upper=-1``; a revolute joint whose range covers a full turn counts too) about an
+  axis roughly horizontal in the base frame, whose link is **round about that axis** (its
+  collision shapes, cylinder, sphere or mesh, reach the same radius all the way round) and
+  **touches the ground** (its lowest point is the robot's lowest point). An arm's wrist and a
+  quadruped's knee are none of these.
+- A **steering hinge** is a revolute joint about an axis vertical in the base frame that
+  carries a wheel.
+- Every other movable joint is **passive**: its default velocity motor is switched off, or
   PyBullet would hold it still like a brake.
 
-PyBullet gives a joint's axis in the child link's frame. To know whether it is horizontal we
-need that frame's world orientation at load time: ``getLinkState``'s ``worldLinkFrameOrientation``,
-or, composed from ``getJointInfo``'s ``parentFrameOrn`` and ``getDynamicsInfo``'s
-local inertial frame only when ``getLinkState`` fails (bodies with 128 links or more).
+Driving (:class:`Drivetrain`) follows the kinematic bicycle model: with steer angle ``d`` the
+car turns about the point on the rear axle's line at ``R = L / tan d`` (``L`` the wheelbase,
+from the detected geometry). Each hinge gets its Ackermann angle for that point (equal angles
+when the hinges share a pivot, as simplecar's do), and in the ``differential`` drivetrain each
+wheel turns at the speed its own path needs (an ideal electronic differential). Without
+hinges, wheels are driven as a skid-steered base: ``steer`` is then the yaw rate (rad/s), and
+each side's speed differs by it times the track.
 
 Signs are part of detection. Positive throttle means "forward along the base's x axis" and
 positive steer means "left, counter-clockwise seen from above", whatever way each joint's axis
@@ -24,25 +31,39 @@ points in the file: racecar.urdf's wheel axes point along -y, simplecar's along 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 from .errors import ParameterError
 from .spec import quat_to_matrix, rotate
 
-#: |axis . z| below this is "horizontal" (about 11 degrees of tilt allowed).
+#: |axis . up| below this is "horizontal" (about 11 degrees of tilt allowed).
 HORIZONTAL_TOLERANCE = 0.2
-#: |axis . z| above this is "vertical".
+#: |axis . up| above this is "vertical".
 VERTICAL_TOLERANCE = 0.98
+#: A wheel is round: in every one of this many sectors around its axis, its shapes reach...
+ROUND_SECTORS = 12
+#: ...at least this fraction of its radius.
+ROUND_FRACTION = 0.9
+#: A wheel's lowest point is within this fraction of its radius of the robot's lowest point.
+GROUND_FRACTION = 0.25
 
 #: Hinge motor force (N m): PyBullet's own default for POSITION_CONTROL, which the tutorial
 #: relies on. With the wheel force (10) instead, one hinge of simplecar stalls at 0.02 rad of
 #: a 0.2 rad target while the tyres scrub: steering would silently not happen.
 STEER_FORCE = 100000.0
+#: PyBullet's default motor force when ``setJointMotorControl2`` is not given one.
+PYBULLET_DEFAULT_FORCE = 100000.0
+
+#: How the wheels are driven (see docs/drive.md).
+DRIVETRAINS = ("differential", "rear", "locked")
 
 _REVOLUTE = 0  # p.JOINT_REVOLUTE
 _PRISMATIC = 1  # p.JOINT_PRISMATIC
+_SPHERE, _BOX, _CYLINDER, _MESH, _CAPSULE = 2, 3, 4, 5, 7  # p.GEOM_*
+
+Vec = tuple[float, float, float]
 
 
 class DrivetrainError(ParameterError):
@@ -51,20 +72,27 @@ class DrivetrainError(ParameterError):
 
 @dataclass
 class Drivetrain:
-    """The driven joints of a body.
+    """The driven joints of a body, their geometry in the base frame, and how to drive them.
 
     Attributes:
-        wheels: Joints driven with VELOCITY_CONTROL (continuous joints about a horizontal axis).
-        hinges: Steering joints (revolute about a vertical axis, carrying wheels), driven with
-            POSITION_CONTROL.
+        wheels: Wheel joints (VELOCITY_CONTROL).
+        hinges: Steering joints (POSITION_CONTROL).
         passive: Other movable joints; their default motors are switched off.
-        joint_names: Name of every joint index above.
+        joint_names: Name of every joint index.
         hinge_limits: ``(lower, upper)`` of each hinge, in the steer convention (positive =
             left); ``(-inf, inf)`` when the joint has no limits.
-        wheel_signs: ``+1`` or ``-1`` per wheel: the factor that turns "forward" throttle into
-            that joint's target velocity.
-        hinge_signs: ``+1`` or ``-1`` per hinge: the factor that turns "left" steer into that
-            joint's target position.
+        wheel_signs: ``+1`` or ``-1`` per wheel: the factor that turns "forward" into that
+            joint's velocity.
+        hinge_signs: ``+1`` or ``-1`` per hinge: the factor that turns "left" into that
+            joint's position.
+        mode: ``differential``, ``rear`` or ``locked`` (see :data:`DRIVETRAINS`).
+        radius: Each wheel's rolling radius (m).
+        contact: Each wheel's contact point (x forward, y left of :attr:`forward`) from the
+            base link's origin, hinges at 0.
+        carried_by: The hinge each wheel hangs from, if any.
+        pivot: Each hinge's pivot (x, y) in the base frame.
+        forward: The direction "forward" (x, y components in the base frame): the way the
+            wheels roll that is closest to the base's +x (+y when they roll along y).
     """
 
     wheels: list[int]
@@ -74,6 +102,118 @@ class Drivetrain:
     hinge_limits: dict[int, tuple[float, float]]
     wheel_signs: dict[int, float] = field(default_factory=dict)
     hinge_signs: dict[int, float] = field(default_factory=dict)
+    mode: str = "differential"
+    radius: dict[int, float] = field(default_factory=dict)
+    contact: dict[int, tuple[float, float]] = field(default_factory=dict)
+    carried_by: dict[int, int | None] = field(default_factory=dict)
+    pivot: dict[int, tuple[float, float]] = field(default_factory=dict)
+    forward: tuple[float, float] = (1.0, 0.0)
+
+    # ---- geometry
+
+    @property
+    def steering(self) -> str:
+        """``ackermann`` (steered by hinges) or ``skid`` (by left/right speed difference)."""
+        return "ackermann" if self.hinges else "skid"
+
+    @property
+    def rear_x(self) -> float:
+        """The rear axle's x: the mean of the wheels no hinge carries (all, if none)."""
+        fixed = [self.contact[w][0] for w in self.wheels
+                 if self.carried_by.get(w) is None and w in self.contact]
+        xs = fixed or [self.contact[w][0] for w in self.wheels if w in self.contact]
+        return sum(xs) / len(xs) if xs else 0.0
+
+    @property
+    def wheelbase(self) -> float | None:
+        """Mean distance from the rear axle to the hinge pivots (None without hinges)."""
+        pivots = [self.pivot[h][0] for h in self.hinges if h in self.pivot]
+        if not pivots:
+            return None
+        return sum(pivots) / len(pivots) - self.rear_x
+
+    @property
+    def track(self) -> float:
+        """Distance between the left-most and right-most wheel contacts."""
+        ys = [self.contact[w][1] for w in self.wheels if w in self.contact]
+        return max(ys) - min(ys) if ys else 0.0
+
+    @property
+    def reference_radius(self) -> float:
+        """The radius of a wheel on the car's centre line: the driven wheels' mean."""
+        rs = [self.radius[w] for w in self.driven if w in self.radius]
+        return sum(rs) / len(rs) if rs else 1.0
+
+    @property
+    def driven(self) -> list[int]:
+        """The wheels the drivetrain powers (``rear``: those no hinge carries)."""
+        if self.mode == "rear" and self.hinges:
+            return [w for w in self.wheels if self.carried_by.get(w) is None]
+        return list(self.wheels)
+
+    @property
+    def free(self) -> list[int]:
+        """Wheels that roll free (``rear``: the steered ones)."""
+        driven = set(self.driven)
+        return [w for w in self.wheels if w not in driven]
+
+    def turn_center(self, steer: float) -> tuple[float, float] | None:
+        """The instantaneous centre of rotation (x, y) in the base frame, None if straight."""
+        if self.steering == "skid" or steer == 0 or not self.wheelbase:
+            return None
+        return (self.rear_x, self.wheelbase / math.tan(steer))
+
+    def bicycle_radius(self, steer: float) -> float | None:
+        """The kinematic bicycle model's turning radius of the base link's origin (m)."""
+        c = self.turn_center(steer)
+        return None if c is None else math.hypot(c[0], c[1])
+
+    def hinge_angles(self, steer: float) -> dict[int, float]:
+        """Each hinge's angle for ``steer`` (the bicycle model's angle; positive = left)."""
+        c = self.turn_center(steer)
+        out: dict[int, float] = {}
+        for h in self.hinges:
+            if c is None or h not in self.pivot:
+                out[h] = steer
+                continue
+            px, py = self.pivot[h]
+            lateral = c[1] - py
+            out[h] = math.atan((px - c[0]) / lateral) if lateral else math.copysign(
+                math.pi / 2, steer)
+        return out
+
+    def wheel_speeds(self, throttle: float, steer: float) -> dict[int, float]:
+        """Each driven wheel's angular speed (rad/s, positive = forward).
+
+        ``throttle`` is the angular speed of a wheel of :attr:`reference_radius` on the car's
+        centre line (at the rear axle); ``locked`` gives every wheel ``throttle``.
+        """
+        if self.mode == "locked":
+            return {w: throttle for w in self.wheels}
+        speed = throttle * self.reference_radius  # m/s of the rear axle's centre
+        out: dict[int, float] = {}
+        if self.steering == "skid":
+            for w in self.driven:
+                y = self.contact.get(w, (0.0, 0.0))[1]
+                out[w] = (speed - steer * y) / self.radius.get(w, self.reference_radius)
+            return out
+        c = self.turn_center(steer)
+        angles = self.hinge_angles(steer)
+        for w in self.driven:
+            r = self.radius.get(w, self.reference_radius)
+            if c is None or w not in self.contact:
+                out[w] = speed / r
+                continue
+            x, y = self.contact[w]
+            h = self.carried_by.get(w)
+            if h is not None and h in self.pivot:  # the wheel swings about its hinge
+                px, py = self.pivot[h]
+                a = angles[h]
+                dx, dy = x - px, y - py
+                x, y = px + dx * math.cos(a) - dy * math.sin(a), py + dx * math.sin(a) \
+                    + dy * math.cos(a)
+            out[w] = speed * math.hypot(x - c[0], y - c[1]) / abs(c[1]) / r
+        return out
 
     def steer_range(self) -> tuple[float, float]:
         """The steer angles every hinge can reach (the intersection of their limits)."""
@@ -83,41 +223,24 @@ class Drivetrain:
         return lo, hi
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON form: names keyed by joint index."""
+        """The JSON form: names keyed by joint index, and the geometry driving used."""
         def named(joints: list[int]) -> list[dict[str, Any]]:
             return [{"index": j, "name": self.joint_names[j]} for j in joints]
 
-        return {"wheels": named(self.wheels), "hinges": named(self.hinges),
-                "passive": named(self.passive)}
+        def r(x: float) -> float:
+            return round(x, 6)
 
-
-def _rotate(orn: Sequence[float], v: Sequence[float]) -> tuple[float, float, float]:
-    return rotate(quat_to_matrix(orn), v)
-
-
-def _link_orientations(p: Any, body: int, client: int, infos: list[tuple[Any, ...]]
-                       ) -> list[tuple[float, ...]]:
-    """World orientation of each link's URDF frame (= its joint frame) at load time."""
-    try:
-        return [tuple(p.getLinkState(body, j, computeForwardKinematics=True,
-                                     physicsClientId=client)[5]) for j in range(len(infos))]
-    except p.error:
-        pass
-    # getLinkState fails on bodies with 128 links or more: compose the frames ourselves.
-    # Measured on PyBullet 3.2.7: getJointInfo's parentFrameOrn is the *inverse* of the URDF
-    # <origin rpy> (racecar.urdf's rpy="1.5708 0 0" comes back as -90 degrees about x), while
-    # getLinkState agrees with the file; hence the invertTransform.
-    _, base_com_orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
-    com: dict[int, tuple[float, ...]] = {-1: tuple(base_com_orn)}
-    frames: list[tuple[float, ...]] = []
-    for j, info in enumerate(infos):
-        _, joint_orn = p.invertTransform((0, 0, 0), info[15])
-        _, link_orn = p.multiplyTransforms((0, 0, 0), com[info[16]], (0, 0, 0), joint_orn)
-        frames.append(tuple(link_orn))
-        dyn = p.getDynamicsInfo(body, j, physicsClientId=client)
-        _, com_orn = p.multiplyTransforms((0, 0, 0), link_orn, (0, 0, 0), dyn[4])
-        com[j] = tuple(com_orn)
-    return frames
+        return {
+            "mode": self.mode, "steering": self.steering,
+            "wheels": [{**named([w])[0], "radius": r(self.radius[w]) if w in self.radius
+                        else None, "contact": [r(v) for v in self.contact[w]]
+                        if w in self.contact else None, "driven": w in self.driven}
+                       for w in self.wheels],
+            "hinges": named(self.hinges), "passive": named(self.passive),
+            "forward": [r(v) for v in self.forward],
+            "wheelbase": None if self.wheelbase is None else r(self.wheelbase),
+            "track": r(self.track),
+        }
 
 
 def _is_continuous(info: tuple[Any, ...]) -> bool:
@@ -153,13 +276,102 @@ def _pick(spec: Sequence[str | int], names: dict[int, str], movable: list[int],
     return out
 
 
+def _shape_points(p: Any, body: int, link: int, client: int) -> list[Vec]:
+    """Points outlining a link's collision shapes, in world coordinates.
+
+    Meshes (and cylinders PyBullet turned into meshes) give their vertices; implicit
+    cylinders, capsules, spheres and boxes are outlined from their dimensions.
+    """
+    st = p.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=client)
+    com_pos, com_rot = st[0], quat_to_matrix(st[1])
+    out: list[Vec] = []
+    for k, shape in enumerate(p.getCollisionShapeData(body, link, physicsClientId=client)):
+        kind, dims, pos, orn = shape[2], shape[3], shape[5], shape[6]
+        local: list[Vec] = []
+        if kind == _MESH:
+            try:
+                count, verts = p.getMeshData(body, link, collisionShapeIndex=k,
+                                             physicsClientId=client)
+            except p.error:
+                count, verts = 0, []
+            if count:  # already in the link's inertial frame
+                out += [_add(com_pos, rotate(com_rot, v)) for v in verts]
+            continue
+        if kind == _SPHERE:
+            r = dims[0]
+            local = [(r * x, r * y, r * z) for x, y, z in _SPHERE_DIRECTIONS]
+        elif kind in (_CYLINDER, _CAPSULE):
+            length, r = dims[0], dims[1]
+            local = [(r * math.cos(a), r * math.sin(a), z)
+                     for a in (2 * math.pi * i / 24 for i in range(24))
+                     for z in (-length / 2, length / 2)]
+        elif kind == _BOX:
+            hx, hy, hz = (d / 2 for d in dims)
+            local = [(sx * hx, sy * hy, sz * hz) for sx in (-1, 1) for sy in (-1, 1)
+                     for sz in (-1, 1)]
+        shape_rot = quat_to_matrix(orn)
+        for v in local:
+            in_com = _add(pos, rotate(shape_rot, v))
+            out.append(_add(com_pos, rotate(com_rot, in_com)))
+    return out
+
+
+_SPHERE_DIRECTIONS = [(math.cos(a) * math.cos(b), math.sin(a) * math.cos(b), math.sin(b))
+                      for a in (2 * math.pi * i / 12 for i in range(12))
+                      for b in (-math.pi / 3, 0.0, math.pi / 3)] + [(0, 0, 1), (0, 0, -1)]
+
+
+def _add(a: Sequence[float], b: Sequence[float]) -> Vec:
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def _sub(a: Sequence[float], b: Sequence[float]) -> Vec:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _dot(a: Sequence[float], b: Sequence[float]) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _unit(a: Sequence[float]) -> Vec:
+    n = math.sqrt(_dot(a, a)) or 1.0
+    return (a[0] / n, a[1] / n, a[2] / n)
+
+
+def _roundness(points: list[Vec], origin: Vec, axis: Vec) -> tuple[float, float, Vec] | None:
+    """``(radius, worst sector fraction, centre on the axis)`` of points about an axis."""
+    if not points:
+        return None
+    # Two directions perpendicular to the axis.
+    helper = (1.0, 0.0, 0.0) if abs(axis[0]) < 0.9 else (0.0, 1.0, 0.0)
+    u = _unit(_sub(helper, tuple(axis[i] * _dot(helper, axis) for i in range(3))))
+    v = (axis[1] * u[2] - axis[2] * u[1], axis[2] * u[0] - axis[0] * u[2],
+         axis[0] * u[1] - axis[1] * u[0])
+    reach = [0.0] * ROUND_SECTORS
+    along = 0.0
+    for pt in points:
+        d = _sub(pt, origin)
+        along += _dot(d, axis)
+        a, b = _dot(d, u), _dot(d, v)
+        sector = int((math.atan2(b, a) + math.pi) / (2 * math.pi) * ROUND_SECTORS) \
+            % ROUND_SECTORS
+        reach[sector] = max(reach[sector], math.hypot(a, b))
+    radius = max(reach)
+    if radius <= 0:
+        return None
+    mean = along / len(points)
+    return radius, min(reach) / radius, _add(origin, tuple(axis[i] * mean for i in range(3)))
+
+
 def detect_drivetrain(p: Any, body: int, client: int,
                       wheels: Sequence[str | int] | None = None,
-                      hinges: Sequence[str | int] | None = None) -> Drivetrain:
-    """Find the wheels, steering hinges and passive joints of a freshly loaded body.
+                      hinges: Sequence[str | int] | None = None,
+                      mode: str = "differential") -> Drivetrain:
+    """Find the wheels, steering hinges and passive joints of a body standing upright.
 
-    Call it before the first ``stepSimulation``: "horizontal" and "vertical" are judged from
-    the pose at load time, with every joint at zero.
+    Call it before the first ``stepSimulation``, with every joint at zero and the base in its
+    upright orientation (the caller turns it to the spawn pose afterwards): "horizontal",
+    "vertical" and "touches the ground" are judged in the base frame.
 
     Args:
         p: The pybullet module.
@@ -167,68 +379,176 @@ def detect_drivetrain(p: Any, body: int, client: int,
         client: The physics client id.
         wheels: Joint names or indices to drive instead of the detected wheels.
         hinges: Joint names or indices to steer instead of the detected hinges.
+        mode: The drivetrain (see :data:`DRIVETRAINS`).
 
     Raises:
         DrivetrainError: no wheels were found (or given), or a name/index is unknown.
     """
+    if mode not in DRIVETRAINS:
+        raise DrivetrainError(f"`drivetrain` must be one of {', '.join(DRIVETRAINS)}, got "
+                              f"{mode!r}", param="drivetrain")
     n = p.getNumJoints(body, physicsClientId=client)
     infos = [p.getJointInfo(body, j, physicsClientId=client) for j in range(n)]
     names = {j: info[1].decode("utf-8", "replace") for j, info in enumerate(infos)}
     movable = [j for j, info in enumerate(infos) if info[2] in (_REVOLUTE, _PRISMATIC)]
-    frames = _link_orientations(p, body, client, infos)
-    axes = {j: _rotate(frames[j], infos[j][13]) for j in movable}
-    _, base_orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
-    forward = _rotate(base_orn, (1.0, 0.0, 0.0))
+    states = {j: p.getLinkState(body, j, computeForwardKinematics=True, physicsClientId=client)
+              for j in movable}
+    origin = {j: tuple(states[j][4]) for j in movable}
+    axes = {j: _unit(rotate(quat_to_matrix(states[j][5]), infos[j][13])) for j in movable}
+    base_pos, base_orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
+    dyn = p.getDynamicsInfo(body, -1, physicsClientId=client)
+    inv_pos, inv_orn = p.invertTransform(dyn[3], dyn[4])
+    base_link, base_link_orn = p.multiplyTransforms(base_pos, base_orn, inv_pos, inv_orn)
+    base_rot = quat_to_matrix(base_link_orn)
+    base_x, base_y = rotate(base_rot, (1.0, 0.0, 0.0)), rotate(base_rot, (0.0, 1.0, 0.0))
+    lowest = min(p.getAABB(body, link, physicsClientId=client)[0][2]
+                 for link in range(-1, n))
 
+    shapes: dict[int, tuple[float, float, Vec] | None] = {}
+
+    def round_about(j: int) -> tuple[float, float, Vec] | None:
+        if j not in shapes:
+            shapes[j] = _roundness(_shape_points(p, body, j, client), origin[j], axes[j])
+        return shapes[j]
+
+    rejected: list[str] = []
     if wheels is not None:
         wheel_list = _pick(wheels, names, movable, "wheels")
     else:
-        wheel_list = [j for j in movable if _is_continuous(infos[j])
-                      and abs(axes[j][2]) < HORIZONTAL_TOLERANCE]
+        wheel_list = []
+        for j in movable:
+            if not _is_continuous(infos[j]):
+                continue
+            if abs(axes[j][2]) >= HORIZONTAL_TOLERANCE:
+                rejected.append(f"{names[j]} (its axis is not horizontal)")
+                continue
+            shape = round_about(j)
+            if shape is None:
+                rejected.append(f"{names[j]} (its link has no collision shape to roll on)")
+                continue
+            size, fraction, centre = shape
+            if fraction < ROUND_FRACTION:
+                rejected.append(f"{names[j]} (its link is not round about the joint axis)")
+                continue
+            bottom = centre[2] - size * math.sqrt(max(0.0, 1 - axes[j][2] ** 2))
+            if bottom - lowest > max(GROUND_FRACTION * size, 0.005):
+                rejected.append(f"{names[j]} ({bottom - lowest:.2f} m above the robot's "
+                                "lowest point)")
+                continue
+            wheel_list.append(j)
     if not wheel_list:
-        raise DrivetrainError("no wheels found: a wheel is a continuous joint about a "
-                              "horizontal axis; name them with `wheels`")
+        why = f"; turning joints that are not wheels: {', '.join(rejected[:4])}" \
+            if rejected else ""
+        raise DrivetrainError("no wheels found: a wheel is a continuous joint (or one with a "
+                              "full turn of range) about a horizontal axis, whose link is "
+                              f"round about it and touches the ground{why}. An arm or a "
+                              "legged robot has none; name wheels with `wheels` (and "
+                              "steering joints with `hinges`)", param="wheels")
+    wheel_set = set(wheel_list)
+
+    def hinge_of(w: int, candidates: Sequence[int]) -> int | None:
+        k = infos[w][16]
+        while k >= 0:
+            if k in candidates:
+                return k
+            k = infos[k][16]
+        return None
+
     if hinges is not None:
         hinge_list = _pick(hinges, names, movable, "hinges")
     else:
-        wheel_set = set(wheel_list)
-
-        def carries_wheel(j: int) -> bool:
-            for w in wheel_set:
-                k = infos[w][16]
-                while k >= 0:
-                    if k == j:
-                        return True
-                    k = infos[k][16]
-            return False
-
-        hinge_list = [j for j in movable if j not in wheel_set and infos[j][2] == _REVOLUTE
-                      and abs(axes[j][2]) > VERTICAL_TOLERANCE and carries_wheel(j)]
-    overlap = set(wheel_list) & set(hinge_list)
+        verticals = [j for j in movable if j not in wheel_set and infos[j][2] == _REVOLUTE
+                     and abs(axes[j][2]) > VERTICAL_TOLERANCE]
+        hinge_list = [j for j in verticals if any(hinge_of(w, [j]) == j for w in wheel_list)]
+    overlap = wheel_set & set(hinge_list)
     if overlap:
-        raise DrivetrainError(f"joint {names[min(overlap)]!r} cannot be both a wheel and a hinge")
+        raise DrivetrainError(f"joint {names[min(overlap)]!r} cannot be both a wheel and a hinge",
+                              param="hinges")
 
+    forward = _forward([axes[w] for w in wheel_list], base_x, base_y)
+    left = (-forward[1], forward[0], 0.0)
+
+    def planar(pt: Sequence[float]) -> tuple[float, float]:
+        d = _sub(pt, base_link)
+        return (_dot(d, forward), _dot(d, left))
+
+    radius: dict[int, float] = {}
+    contact: dict[int, tuple[float, float]] = {}
     wheel_signs: dict[int, float] = {}
     for j in wheel_list:
-        a = axes.get(j, (0.0, 1.0, 0.0))
-        # A wheel spinning positively about axis a moves the car along a x z.
+        shape = round_about(j)
+        if shape is not None:
+            radius[j] = shape[0]
+            contact[j] = planar(shape[2])
+        else:  # a named wheel without collision shapes: its height above the ground
+            radius[j] = max(origin[j][2] - lowest, 1e-3)
+            contact[j] = planar(origin[j])
+        a = axes[j]
+        # A wheel spinning positively about axis a moves the car along a x up.
         along = a[1] * forward[0] - a[0] * forward[1]
         wheel_signs[j] = -1.0 if along < 0 else 1.0
     hinge_signs: dict[int, float] = {}
     hinge_limits: dict[int, tuple[float, float]] = {}
+    pivot: dict[int, tuple[float, float]] = {}
     for j in hinge_list:
-        sign = -1.0 if axes.get(j, (0.0, 0.0, 1.0))[2] < 0 else 1.0
+        sign = -1.0 if axes[j][2] < 0 else 1.0
         hinge_signs[j] = sign
+        pivot[j] = planar(origin[j])
         lower, upper = infos[j][8], infos[j][9]
         if lower > upper:
             hinge_limits[j] = (-math.inf, math.inf)
         else:
             ends = sorted((lower * sign, upper * sign))
             hinge_limits[j] = (ends[0], ends[1])
-    driven = set(wheel_list) | set(hinge_list)
+    carried_by = {w: hinge_of(w, hinge_list) for w in wheel_list}
+    driven = wheel_set | set(hinge_list)
     passive = [j for j in movable if j not in driven]
-    return Drivetrain(wheel_list, hinge_list, passive, names, hinge_limits,
-                      wheel_signs, hinge_signs)
+    in_base = (_dot(forward, base_x), _dot(forward, base_y))
+    return Drivetrain(wheel_list, hinge_list, passive, names, hinge_limits, wheel_signs,
+                      hinge_signs, mode, radius, contact, carried_by, pivot, in_base)
+
+
+def _forward(wheel_axes: list[Vec], base_x: Vec, base_y: Vec) -> Vec:
+    """The horizontal direction the wheels roll in that is closest to the base's +x.
+
+    Wheels that roll along the base's y (r2d2's do) drive along +y: forward can only be a
+    direction the wheels roll in.
+    """
+    flat_x = _unit((base_x[0], base_x[1], 0.0))
+    ref = wheel_axes[0]
+    total = [0.0, 0.0]
+    for a in wheel_axes:
+        s = 1.0 if a[0] * ref[0] + a[1] * ref[1] >= 0 else -1.0
+        total[0] += s * a[0]
+        total[1] += s * a[1]
+    if math.hypot(*total) < 1e-9:
+        return flat_x
+    roll = _unit((-total[1], total[0], 0.0))  # up x axis: perpendicular in the ground plane
+    along_x = _dot(roll, flat_x)
+    if abs(along_x) >= 0.1:
+        return roll if along_x > 0 else (-roll[0], -roll[1], 0.0)
+    flat_y = (base_y[0], base_y[1], 0.0)
+    return roll if _dot(roll, flat_y) > 0 else (-roll[0], -roll[1], 0.0)
+
+
+def detect_upright(p: Any, body: int, client: int, upright: Sequence[float],
+                   wheels: Sequence[str | int] | None = None,
+                   hinges: Sequence[str | int] | None = None,
+                   mode: str = "differential") -> Drivetrain:
+    """:func:`detect_drivetrain` with the base turned to ``upright`` (a quaternion) meanwhile.
+
+    A body spawned tilted (or upside down) is stood up where it is for detection, so its
+    wheels are judged in its own frame, then put back exactly as it was.
+    """
+    pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
+    turned = any(abs(a - b) > 1e-12 for a, b in zip(orn, upright, strict=True))
+    if turned:
+        p.resetBasePositionAndOrientation(body, pos, list(upright), physicsClientId=client)
+    try:
+        return detect_drivetrain(p, body, client, wheels, hinges, mode)
+    finally:
+        if turned:
+            p.resetBasePositionAndOrientation(body, pos, orn, physicsClientId=client)
 
 
 def disable_default_motors(p: Any, body: int, client: int, joints: Sequence[int]) -> None:
@@ -246,7 +566,8 @@ def disable_default_motors(p: Any, body: int, client: int, joints: Sequence[int]
 
 
 def apply_drive(p: Any, body: int, client: int, train: Drivetrain, throttle: float,
-                steer: float, max_force: float, steer_force: float = STEER_FORCE) -> None:
+                steer: float, max_force: float | None, steer_force: float = STEER_FORCE
+                ) -> None:
     """Set the wheel and hinge motors once; PyBullet keeps them until they are changed.
 
     Args:
@@ -254,19 +575,52 @@ def apply_drive(p: Any, body: int, client: int, train: Drivetrain, throttle: flo
         body: The body id.
         client: The physics client id.
         train: What :func:`detect_drivetrain` found.
-        throttle: Target wheel angular velocity, rad/s (positive = forward).
-        steer: Target hinge angle, rad (positive = left). Callers clamp it to
-            :meth:`Drivetrain.steer_range` first.
-        max_force: Maximum torque (N m) of every wheel motor.
+        throttle: Wheel angular velocity, rad/s (positive = forward): see
+            :meth:`Drivetrain.wheel_speeds`.
+        steer: Steer angle, rad (positive = left), or the yaw rate (rad/s) of a skid-steered
+            base. Callers clamp it to :meth:`Drivetrain.steer_range` first.
+        max_force: Maximum torque (N m) of every wheel motor; None: PyBullet's default.
         steer_force: Maximum torque (N m) of every hinge motor.
     """
-    if train.wheels:
+    speeds = train.wheel_speeds(throttle, steer)
+    force = PYBULLET_DEFAULT_FORCE if max_force is None else max_force
+    driven = [w for w in train.wheels if w in speeds]
+    if driven:
         p.setJointMotorControlArray(
-            body, train.wheels, p.VELOCITY_CONTROL,
-            targetVelocities=[throttle * train.wheel_signs.get(j, 1.0) for j in train.wheels],
-            forces=[max_force] * len(train.wheels), physicsClientId=client)
+            body, driven, p.VELOCITY_CONTROL,
+            targetVelocities=[speeds[w] * train.wheel_signs.get(w, 1.0) for w in driven],
+            forces=[force] * len(driven), physicsClientId=client)
+    disable_default_motors(p, body, client, train.free)
     if train.hinges:
+        angles = train.hinge_angles(steer) if train.mode != "locked" else \
+            dict.fromkeys(train.hinges, steer)
         p.setJointMotorControlArray(
             body, train.hinges, p.POSITION_CONTROL,
-            targetPositions=[steer * train.hinge_signs.get(j, 1.0) for j in train.hinges],
+            targetPositions=[angles[h] * train.hinge_signs.get(h, 1.0) for h in train.hinges],
             forces=[steer_force] * len(train.hinges), physicsClientId=client)
+
+
+def clamp_steer(train: Drivetrain, steer: float) -> tuple[float, str | None]:
+    """The steer that keeps every hinge within its limits, and a warning if it changed."""
+    if train.steering == "skid" or not train.hinges:
+        return steer, None
+    lo, hi = train.steer_range()
+    clamped = min(max(steer, lo), hi)
+    # Ackermann turns the inner hinge further than the bicycle angle: keep it in its limits.
+    for _ in range(60):
+        angles = train.hinge_angles(clamped)
+        if all(train.hinge_limits[h][0] - 1e-9 <= a <= train.hinge_limits[h][1] + 1e-9
+               for h, a in angles.items()):
+            break
+        clamped *= 0.98
+    if clamped == steer:
+        return steer, None
+    return clamped, (f"steer {steer:g} rad is beyond what the hinges reach (limits "
+                     f"[{lo:g}, {hi:g}]); clamped to {clamped:.4g}")
+
+
+def describe(train: Drivetrain, max_force: float | None) -> Mapping[str, Any]:
+    """What the drive does, for the summary and JSON."""
+    return {"mode": train.mode, "steering": train.steering,
+            "wheel_force": PYBULLET_DEFAULT_FORCE if max_force is None else max_force,
+            "hinge_force": STEER_FORCE}
