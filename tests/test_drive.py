@@ -199,6 +199,7 @@ def test_leaving_the_ground_and_a_static_base_are_reported(tmp_path: Path) -> No
     problems = json.loads(result.stdout)["problems"]
     assert problems[0].startswith("left the ground at t = 10.")
     assert any(p.startswith("fell:") for p in problems)
+    assert any(p.startswith("flipped over at t = ") for p in problems)  # it tumbles off
     # The built-in ground grows with the run instead.
     assert drive(DriveConfig(seconds=30, keep_trajectory=False)).problems == []
     static = tmp_path / "static.urdf"
@@ -470,3 +471,26 @@ def test_up_is_checked_and_stands_the_car() -> None:
     assert drive(DriveConfig(steps=240)).distance > 0.3
     with pytest.raises(ParameterError, match="no wheels found"):
         drive(DriveConfig(steps=240, up="y"))
+
+
+@pytest.mark.parametrize(("friction", "problem"), [
+    ("0.001", "stuck from t = "),  # ice: the wheels spin, the car stays
+    ("0.02", "wheels slipping: "),  # the car creeps at half its tread speed
+    ("1", None),
+])
+def test_stuck_and_slipping_wheels_are_reported(tmp_path: Path, friction: str,
+                                                problem: str | None) -> None:
+    plane = tmp_path / "plane.urdf"
+    build_template("simpleplane", {"lateral_friction": friction}).write(plane)
+    r = drive(DriveConfig(plane=str(plane), seconds=4, keep_trajectory=False))
+    if problem is None:
+        assert r.problems == []
+    else:
+        assert [p[:len(problem)] for p in r.problems] == [problem]
+
+
+def test_naming_only_the_wheels_keeps_the_steering() -> None:
+    r = drive(DriveConfig(wheels=["1", "3", "4", "5"], steer=0.2, seconds=8,
+                          keep_trajectory=False))
+    assert r.drivetrain.hinges == [0, 2]
+    assert r.turning_radius == pytest.approx(bicycle_radius(0.2), rel=0.02)
