@@ -66,6 +66,9 @@ def schema() -> SimpleNamespace:
         gravity: vec3 = Field(default_factory=lambda: [0.0, 0.0, -9.81])
         solver_iterations: Annotated[int, Field(ge=1)] = 50
         cone_friction: bool = True
+        # None: PyBullet's own 0.04 on every link (an undamped pendulum needs 0).
+        linear_damping: non_negative | None = None
+        angular_damping: non_negative | None = None
 
     class Ground(Model):
         template: str | None = None

@@ -103,6 +103,18 @@ class Observation:
         data = {**self.__dict__, **changes}
         return Observation(**data)
 
+    def copy(self) -> Observation:
+        """A copy whose dicts and lists are its own: changing it changes nothing else."""
+        return Observation(**{k: _copied(v) for k, v in self.__dict__.items()})
+
+
+def _copied(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _copied(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return list(value)
+    return value
+
 
 # --------------------------------------------------------------------------- robots
 
@@ -158,6 +170,8 @@ class _Body:
     applied: _Command | None = None
     override: _Command | None = None
     reported: tuple[int, Observation] | None = None
+    loaded: tuple[str, LoadOptions] | None = None  # the file PyBullet loaded, and how
+    changes: list[tuple[int, dict[str, Any]]] = field(default_factory=list)  # set_* calls
 
     def joint(self, name: str) -> JointSpec:
         for j in self.joints:
@@ -256,6 +270,10 @@ class Simulation:
 
     def close(self) -> None:
         """Disconnect the client and remove temp files (safe to call twice)."""
+        shadows: dict[str, tuple[Session, int]] = self.__dict__.get("_shadows", {})
+        for shadow in shadows.values():
+            shadow[0].close()
+        shadows.clear()
         if hasattr(self, "session"):
             self.session.close()
         for r in self._resolved:
@@ -299,8 +317,18 @@ class Simulation:
         for i, robot in enumerate(self.config.robots):
             self.bodies[robot.name] = self._add_robot(i, robot)
         self._check_record()
+        if ph.linear_damping is not None or ph.angular_damping is not None:
+            damping = {k: v for k, v in (("linearDamping", ph.linear_damping),
+                                         ("angularDamping", ph.angular_damping))
+                       if v is not None}
+            for b in self.bodies.values():
+                for link in range(-1, len(b.joints)):
+                    p.changeDynamics(b.body, link, physicsClientId=client, **damping)
         for b in self.bodies.values():
             b.history.append(self._measure(b))
+        # The starting state, for reset() in place (restoreState is ~100x cheaper than a new
+        # Simulation).
+        self._start_state = p.saveState(physicsClientId=client)
 
     def _load(self, path: str, template: str | None, params: Mapping[str, Any],
               urdf: str | None, options: LoadOptions) -> int:
@@ -335,6 +363,7 @@ class Simulation:
                               self_collision=cfg.self_collision,
                               base_position=tuple(cfg.position), base_orientation=orientation)
         body = self._load(path, cfg.template, cfg.params, cfg.urdf, options)
+        loaded = (str(self._resolved[-1].load_path), options)
         try:
             # getBasePositionAndOrientation, getJointStates... all fail on 128+ link bodies.
             self.session.require_state_queries(body, cfg.name)
@@ -349,9 +378,9 @@ class Simulation:
         active = [j for j in joints if j.active]
         links = {p.getBodyInfo(body, physicsClientId=client)[0].decode("utf-8", "replace"): -1}
         links.update({j.child_link: j.index for j in joints})
-        seed = self.config.seed * 1_000_003 + i
+        seed = self._robot_seed(self.config.seed, i)
         b = _Body(cfg.name, path, cfg, body, joints, active, links, {}, {},
-                  random.Random(seed), deque(maxlen=cfg.delay + 1))
+                  random.Random(seed), deque(maxlen=cfg.delay + 1), loaded=loaded)
 
         def active_joint(where: str, name: str) -> JointSpec:
             try:
@@ -501,8 +530,9 @@ class Simulation:
                 # Motors persist in PyBullet: set once per change of command.
                 apply_drive(p, b.body, client, b.train, cmd.throttle,
                             clamp_steer(b.train, cmd.steer)[0], max_force)
-            elif cmd is not None and not b.servo:
-                self._apply_motors(b, cmd)
+            elif cmd is not None and not b.servo and not (cmd.kind == "joints"
+                                                          and cmd.mode == "torque"):
+                self._apply_motors(b, cmd)  # (torques below: PyBullet adds up repeated ones)
             b.applied = cmd
         if cmd is not None and cmd.kind == "joints" and cmd.mode == "torque" and not b.servo:
             self._apply_motors(b, cmd)  # torques last one step only
@@ -629,7 +659,8 @@ class Simulation:
         """The observation now: as reported (delay, then noise) or ``ideal``.
 
         For the first ``delay`` steps a delayed robot reports its initial state. Asking twice
-        at the same step returns the same noisy values.
+        at the same step returns the same noisy values. What is returned is a copy: changing
+        it changes no later observation.
 
         Args:
             robot: One robot's name; default: all, as a dict keyed by name.
@@ -640,14 +671,312 @@ class Simulation:
                     for name in self.bodies}
         b = self._body(robot)
         if ideal:
-            return b.history[-1]
-        if b.reported is not None and b.reported[0] == self.step_count:
-            return b.reported[1]
-        # history holds the last delay+1 observations; its oldest is the delayed one.
-        source = b.history[0]
-        obs = self._add_noise(b, source._replace(t=self.t, step=self.step_count))
-        b.reported = (self.step_count, obs)
-        return obs
+            return b.history[-1].copy()
+        if b.reported is None or b.reported[0] != self.step_count:
+            # history holds the last delay+1 observations; its oldest is the delayed one.
+            source = b.history[0]
+            b.reported = (self.step_count,
+                          self._add_noise(b, source._replace(t=self.t, step=self.step_count)))
+        # A copy: a caller changing what it got must not change later observations.
+        return b.reported[1].copy()
+
+    # ---- reset in place
+
+    @staticmethod
+    def _robot_seed(seed: int, i: int) -> int:
+        return seed * 1_000_003 + i
+
+    def reset(self, seed: int | None = None) -> None:
+        """Go back to the starting state in place, deterministically.
+
+        Positions, velocities and contacts come back through PyBullet's saveState and
+        restoreState; time, observation history, delays, commands and noise generators
+        (reseeded with ``seed``, default the scenario's) start over, so the same seed and the
+        same actions give the same observations. Changes made with the ``set_*`` methods
+        stay: they change the robot, not its state.
+        """
+        p, client = self.session.p, self.session.client
+        p.restoreState(self._start_state, physicsClientId=client)
+        self.step_count = 0
+        base_seed = self.config.seed if seed is None else seed
+        from .vehicle import disable_default_motors
+
+        for i, b in enumerate(self.bodies.values()):
+            b.rng = random.Random(self._robot_seed(base_seed, i))
+            b.history.clear()
+            b.previous_velocities = {}
+            b.applied = b.override = None
+            b.reported = None
+            disable_default_motors(p, b.body, client, [j.index for j in b.active])
+            b.history.append(self._measure(b))
+
+    # ---- state, kinematics and dynamics of one robot (SimInterface's, in Python's manners)
+
+    def robot_names(self) -> list[str]:
+        """Robot names, in scenario order."""
+        return list(self.bodies)
+
+    def joint_positions(self, robot: str) -> dict[str, float]:
+        """True joint positions now (measured frame: offsets and directions applied)."""
+        return dict(self._body(robot).history[-1].motor_angles)
+
+    def joint_velocities(self, robot: str) -> dict[str, float]:
+        """True joint velocities now (measured frame)."""
+        return dict(self._body(robot).history[-1].motor_velocities)
+
+    def motor_torques(self, robot: str) -> dict[str, float]:
+        """The torque each joint's motor applied in the last step (measured frame).
+
+        PyBullet's applied motor torque for position and velocity motors; for the servo model
+        and torque commands, the torque it was given.
+        """
+        b = self._body(robot)
+        p, client = self.session.p, self.session.client
+        states = p.getJointStates(b.body, [j.index for j in b.active], physicsClientId=client)
+        return {j.name: st[3] * b.directions.get(j.name, 1.0)
+                for j, st in zip(b.active, states, strict=True)}
+
+    def link_pose(self, robot: str, link: str) -> tuple[list[float], list[float]]:
+        """World position and orientation (x, y, z, w) of a link's URDF frame."""
+        b = self._body(robot)
+        p, client = self.session.p, self.session.client
+        index = b.links.get(link)
+        if index is None:
+            from .suggest import hint
+
+            raise ParameterError(f"`link`: {robot} has no link named {link!r}"
+                                 f"{hint(link, b.links)}", param="link")
+        if index == -1:
+            pos, orn = p.getBasePositionAndOrientation(b.body, physicsClientId=client)
+            dyn = p.getDynamicsInfo(b.body, -1, physicsClientId=client)
+            inv = p.invertTransform(dyn[3], dyn[4])
+            pos, orn = p.multiplyTransforms(pos, orn, inv[0], inv[1])
+        else:
+            st = p.getLinkState(b.body, index, computeForwardKinematics=True,
+                                physicsClientId=client)
+            pos, orn = st[4], st[5]
+        return list(pos), list(orn)
+
+    def dynamics_joints(self, robot: str) -> list[str]:
+        """The joints the dynamics quantities are ordered by (PyBullet's order).
+
+        The movable joints; a floating base adds 6 base coordinates before them in
+        :meth:`mass_matrix`.
+        """
+        return [j.name for j in self._dynamics_joints(self._body(robot))]
+
+    def _dynamics_joints(self, b: _Body) -> list[JointSpec]:
+        movable = [j for j in b.joints if j.type != _FIXED]
+        odd = [j.name for j in movable if not j.active]
+        if odd:
+            raise ParameterError(f"{b.name}: the dynamics need 1-DOF joints; {odd[0]!r} is not",
+                                 param="robot")
+        return movable
+
+    def _physical_state(self, b: _Body) -> tuple[list[float], list[float]]:
+        p, client = self.session.p, self.session.client
+        states = p.getJointStates(b.body, [j.index for j in self._dynamics_joints(b)],
+                                  physicsClientId=client)
+        return [float(st[0]) for st in states], [float(st[1]) for st in states]
+
+    def _fixed(self, b: _Body, what: str) -> None:
+        p, client = self.session.p, self.session.client
+        moving_base = b.config.base != "fixed" and \
+            p.getDynamicsInfo(b.body, -1, physicsClientId=client)[0] > 0
+        if moving_base:
+            raise ParameterError(f"{b.name}: {what} needs a fixed base (PyBullet's "
+                                 "calculateInverseDynamics does not take a floating one); "
+                                 "use base = \"fixed\"", param="robot")
+
+    def _model(self, b: _Body) -> tuple[Any, int, int]:
+        """``(p, client, body)`` of the robot's dynamics model, as the robot is now.
+
+        PyBullet builds the model its calculateMassMatrix, calculateInverseDynamics and
+        calculateJacobian use once, at the first call, and never updates it: a mass changed
+        later is ignored (measured on 3.2.7). So the dynamics run on a copy of the robot in a
+        client of their own, rebuilt after every ``set_mass``/``set_inertia``.
+        """
+        shadows: dict[str, tuple[Session, int]] = self.__dict__.setdefault("_shadows", {})
+        if b.name not in shadows:
+            assert b.loaded is not None
+            s = Session()
+            try:
+                ph = self.config.physics
+                s.p.setGravity(*ph.gravity, physicsClientId=s.client)
+                body = s.load_urdf(b.loaded[0], b.loaded[1], display=b.name)
+                for link, values in b.changes:
+                    s.p.changeDynamics(body, link, physicsClientId=s.client, **values)
+            except BaseException:
+                s.close()
+                raise
+            shadows[b.name] = (s, body)
+        s, body = shadows[b.name]
+        return s.p, s.client, body
+
+    def _changed(self, b: _Body, link: int, values: dict[str, Any]) -> None:
+        """Remember a change to a robot's mass properties; its dynamics model is stale."""
+        b.changes.append((link, values))
+        shadow = self.__dict__.get("_shadows", {}).pop(b.name, None)
+        if shadow is not None:
+            shadow[0].close()
+
+    def mass_matrix(self, robot: str) -> Any:
+        """The joint-space mass matrix M(q) now (numpy, PyBullet's calculateMassMatrix).
+
+        Physical joint coordinates, in :meth:`dynamics_joints` order; a floating base puts its
+        6 coordinates first, as PyBullet does.
+        """
+        import numpy as np
+
+        b = self._body(robot)
+        q, _ = self._physical_state(b)
+        p, client, body = self._model(b)
+        return np.array(p.calculateMassMatrix(body, q, physicsClientId=client))
+
+    def coriolis_and_gravity(self, robot: str) -> Any:
+        """C(q, qd) qd + g(q) now: the torques that hold the current motion (numpy)."""
+        import numpy as np
+
+        b = self._body(robot)
+        self._fixed(b, "coriolis_and_gravity")
+        q, qd = self._physical_state(b)
+        p, client, body = self._model(b)
+        return np.array(p.calculateInverseDynamics(body, q, qd, [0.0] * len(q),
+                                                   physicsClientId=client))
+
+    def gravity_torques(self, robot: str) -> Any:
+        """g(q) now: the torques that hold the robot still against gravity (numpy)."""
+        import numpy as np
+
+        b = self._body(robot)
+        self._fixed(b, "gravity_torques")
+        q, _ = self._physical_state(b)
+        p, client, body = self._model(b)
+        zero = [0.0] * len(q)
+        return np.array(p.calculateInverseDynamics(body, q, zero, zero,
+                                                   physicsClientId=client))
+
+    def forward_dynamics(self, robot: str, tau: Sequence[float]) -> Any:
+        """The joint accelerations ``tau`` would cause now, without contacts (numpy).
+
+        qdd = M^-1 (tau - C qd - g).
+        """
+        import numpy as np
+
+        b = self._body(robot)
+        torque = np.asarray(tau, dtype=float)
+        n = len(self._dynamics_joints(b))
+        if torque.shape != (n,):
+            raise ParameterError(f"`tau` needs {n} torques, one per dynamics joint of "
+                                 f"{robot}, got {torque.shape}", param="tau")
+        return np.linalg.solve(self.mass_matrix(robot), torque - self.coriolis_and_gravity(robot))
+
+    def jacobian(self, robot: str, link: str, point: Sequence[float] = (0.0, 0.0, 0.0)
+                 ) -> Any:
+        """The 6 x n Jacobian (linear rows, then angular) of a point of a link now (numpy).
+
+        ``point`` is in the link's URDF frame (the joint frame): PyBullet 3.2.7's
+        calculateJacobian takes it so, whatever its docs say of the centre of mass (measured:
+        the point (0, 0, 0) of a pendulum's bob link is on the hinge, J = 0).
+        """
+        import numpy as np
+
+        b = self._body(robot)
+        index = b.links.get(link)
+        if index is None or index == -1:
+            raise ParameterError(f"`link`: {robot} has no moving link named {link!r}",
+                                 param="link")
+        q, qd = self._physical_state(b)
+        p, client, body = self._model(b)
+        lin, ang = p.calculateJacobian(body, index, list(point), q, qd, [0.0] * len(q),
+                                       physicsClientId=client)
+        return np.vstack([np.array(lin), np.array(ang)])
+
+    # ---- setters: the robot's physical parameters
+
+    def _link_index(self, b: _Body, link: str) -> int:
+        if link not in b.links:
+            from .suggest import hint
+
+            raise ParameterError(f"`link`: {b.name} has no link named {link!r}"
+                                 f"{hint(link, b.links)}", param="link")
+        return b.links[link]
+
+    def _change(self, target: str, link: str | None, **values: Any) -> None:
+        p, client = self.session.p, self.session.client
+        if target == "ground":
+            if self.ground is None:
+                raise ParameterError("the scenario has no ground", param="robot")
+            p.changeDynamics(self.ground, -1, physicsClientId=client, **values)
+            return
+        b = self._body(target)
+        links = [self._link_index(b, link)] if link is not None else \
+            [-1, *range(len(b.joints))]
+        for index in links:
+            p.changeDynamics(b.body, index, physicsClientId=client, **values)
+
+    def set_mass(self, robot: str, link: str, mass: float) -> None:
+        """A link's mass, kg; its inertia scales with it (the same body, heavier).
+
+        PyBullet's changeDynamics(mass=...) alone throws the inertia away and recomputes it
+        from the collision shapes (a link without any gets ~1e-6): not what "heavier" means.
+        """
+        b = self._body(robot)
+        index = self._link_index(b, link)
+        p, client = self.session.p, self.session.client
+        info = p.getDynamicsInfo(b.body, index, physicsClientId=client)
+        old, diagonal = info[0], info[2]
+        scaled = [float(v) * float(mass) / old for v in diagonal] if old > 0 else None
+        for values in ({"mass": float(mass)},
+                       {"localInertiaDiagonal": scaled} if scaled is not None else {}):
+            if values:
+                p.changeDynamics(b.body, index, physicsClientId=client, **values)
+                self._changed(b, index, values)
+
+    def set_inertia(self, robot: str, link: str, diagonal: Sequence[float]) -> None:
+        """A link's principal moments of inertia, kg m^2 (in its inertial frame)."""
+        b = self._body(robot)
+        index = self._link_index(b, link)
+        values = {"localInertiaDiagonal": [float(v) for v in diagonal]}
+        p, client = self.session.p, self.session.client
+        p.changeDynamics(b.body, index, physicsClientId=client, **values)
+        self._changed(b, index, values)
+
+    def set_friction(self, robot: str, link: str | None, lateral: float) -> None:
+        """Lateral friction of a link (every link when ``link`` is None).
+
+        Robot ``"ground"`` is the floor.
+        """
+        self._change(robot, link, lateralFriction=float(lateral))
+
+    def set_restitution(self, robot: str, link: str | None, restitution: float) -> None:
+        """Restitution (bounciness) of a link, or of the floor with robot ``"ground"``."""
+        self._change(robot, link, restitution=float(restitution))
+
+    def set_joint_damping(self, robot: str, joint: str, damping: float) -> None:
+        """PyBullet's joint damping of one joint (N m s/rad)."""
+        b = self._body(robot)
+        try:
+            spec = b.joint(joint)
+        except KeyError:
+            raise ParameterError(f"`joint`: {robot} has no joint named {joint!r}",
+                                 param="joint") from None
+        p, client = self.session.p, self.session.client
+        p.changeDynamics(b.body, spec.index, jointDamping=float(damping),
+                         physicsClientId=client)
+
+    def set_link_damping(self, robot: str, linear: float, angular: float) -> None:
+        """Every link's linear and angular velocity damping (PyBullet's default is 0.04)."""
+        self._change(robot, None, linearDamping=float(linear), angularDamping=float(angular))
+
+    def set_time_step(self, time_step: float) -> None:
+        """The physics time step, s (times already recorded keep theirs)."""
+        if not 0 < time_step <= 1:
+            raise ParameterError(f"`time_step` must be in (0, 1], got {time_step!r}",
+                                 param="time_step")
+        p, client = self.session.p, self.session.client
+        p.setTimeStep(time_step, physicsClientId=client)
+        self.time_step = float(time_step)
 
     def _add_noise(self, b: _Body, obs: Observation) -> Observation:
         noise = b.config.noise

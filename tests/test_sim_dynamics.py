@@ -1,0 +1,164 @@
+"""Simulation's state, dynamics and reset (SimInterface's capabilities) against physics."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from urdfkit.errors import ParameterError
+from urdfkit.sim import Simulation
+
+M, L, INERTIA = 2.0, 0.5, 0.01  # bob mass (kg), rod length (m), inertia about its centre
+G = 9.81
+
+
+def pendulum(tmp_path: Path) -> Path:
+    """A pendulum: a massless rod of length L about y, a bob of mass M and inertia INERTIA."""
+    path = tmp_path / "pendulum.urdf"
+    path.write_text(f"""<robot name="pendulum">
+  <link name="base"><inertial><mass value="1"/>
+    <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="bob"><inertial><origin xyz="0 0 -{L}"/><mass value="{M}"/>
+    <inertia ixx="{INERTIA}" ixy="0" ixz="0" iyy="{INERTIA}" iyz="0" izz="{INERTIA}"/>
+  </inertial></link>
+  <joint name="hinge" type="continuous"><parent link="base"/><child link="bob"/>
+    <axis xyz="0 1 0"/></joint>
+</robot>
+""")
+    return path
+
+
+def scenario(urdf: Path, q0: float = 0.5, qd0: float = 0.0, damping: float | None = 0.0,
+             **robot: Any) -> dict[str, Any]:
+    physics: dict[str, Any] = {"gravity": [0, 0, -G]}
+    if damping is not None:
+        physics.update(linear_damping=damping, angular_damping=damping)
+    return {"physics": physics, "duration": 1.0, "robots": [{
+        "name": "p", "urdf": str(urdf), "base": "fixed",
+        "initial_joints": {"hinge": {"position": q0, "velocity": qd0}}, **robot}]}
+
+
+@pytest.mark.parametrize("q", [0.0, 0.5, -1.2, 2.5])
+def test_mass_matrix_and_gravity_torque_of_a_pendulum(tmp_path: Path, q: float) -> None:
+    with Simulation(scenario(pendulum(tmp_path), q0=q)) as sim:
+        assert sim.dynamics_joints("p") == ["hinge"]
+        assert sim.mass_matrix("p") == pytest.approx(np.array([[M * L * L + INERTIA]]), rel=1e-9)
+        # Holding the bob still takes m g l sin q (q about +y swings it towards -x).
+        assert sim.gravity_torques("p") == pytest.approx([M * G * L * math.sin(q)], abs=1e-9)
+
+
+def test_forward_dynamics_matches_one_step_of_the_simulation(tmp_path: Path) -> None:
+    tau = 3.0
+    with Simulation(scenario(pendulum(tmp_path), q0=0.7, qd0=1.5)) as sim:
+        qdd = sim.forward_dynamics("p", [tau])
+        # M qdd + C qd + g = tau, by the formula too: C qd is 0 for a single joint.
+        assert qdd[0] == pytest.approx((tau - M * G * L * math.sin(0.7)) / (M * L * L + INERTIA))
+        assert sim.coriolis_and_gravity("p") == pytest.approx(sim.gravity_torques("p"))
+        qd0 = sim.joint_velocities("p")["hinge"]
+        sim.set_joint_targets("p", {"hinge": tau}, mode="torque")
+        sim.step()
+        measured = (sim.joint_velocities("p")["hinge"] - qd0) / sim.time_step
+    # PyBullet integrates semi-implicitly: the velocity after one step is qd0 + qdd dt.
+    assert measured == pytest.approx(qdd[0], rel=1e-6)
+
+
+def test_jacobian_of_the_bob_is_the_derivative_of_its_position(tmp_path: Path) -> None:
+    q = 0.9
+    with Simulation(scenario(pendulum(tmp_path), q0=q)) as sim:
+        jac = sim.jacobian("p", "bob", (0.0, 0.0, -L))  # the bob's centre, in the link frame
+        assert not sim.jacobian("p", "bob")[:3].any()  # the link frame's origin: the hinge
+        # The bob's centre is at (-L sin q, 0, -L cos q) from the hinge.
+        assert jac[:3, 0] == pytest.approx([-L * math.cos(q), 0.0, L * math.sin(q)], abs=1e-9)
+        assert jac[3:, 0] == pytest.approx([0.0, 1.0, 0.0], abs=1e-9)
+        pos, orn = sim.link_pose("p", "bob")
+        assert pos == pytest.approx([0.0, 0.0, 0.0], abs=1e-6)  # the link frame is the hinge
+        # (PyBullet reports link states rounded to ~1e-7.)
+        assert orn == pytest.approx([0.0, math.sin(q / 2), 0.0, math.cos(q / 2)], abs=1e-6)
+
+
+def test_damping_is_pybullets_unless_set(tmp_path: Path) -> None:
+    def amplitude_after(seconds: float, damping: float | None) -> float:
+        with Simulation({**scenario(pendulum(tmp_path), q0=0.5, damping=damping),
+                         "duration": seconds}) as sim:
+            peak = 0.0
+            for _ in range(round(seconds / sim.time_step)):
+                sim.step()
+                if sim.t > seconds - 2.0:  # the last two swings
+                    peak = max(peak, abs(sim.joint_positions("p")["hinge"]))
+            return peak
+
+    # Without damping energy is kept; with PyBullet's 0.04 on every link a quarter of the
+    # amplitude is gone in 10 s (the brief's 40% is for a longer pendulum).
+    assert amplitude_after(10.0, 0.0) == pytest.approx(0.5, rel=0.01)
+    assert amplitude_after(10.0, None) < 0.8 * 0.5
+
+
+def test_reset_in_place_is_deterministic(tmp_path: Path) -> None:
+    spec = scenario(pendulum(tmp_path), q0=0.3, qd0=0.2,
+                    noise={"motor_angles": 0.01}, delay=2)
+
+    def episode(sim: Simulation) -> list[dict[str, Any]]:
+        rows = []
+        for k in range(60):
+            sim.set_joint_targets("p", {"hinge": math.sin(k / 10)}, mode="torque")
+            sim.step()
+            rows.append(sim.observe("p").to_dict())  # type: ignore[union-attr]
+        return rows
+
+    with Simulation(spec) as sim:
+        first = episode(sim)
+        sim.reset()
+        assert sim.t == 0.0 and sim.joint_positions("p")["hinge"] == pytest.approx(0.3)
+        again = episode(sim)
+        sim.reset(seed=7)
+        other_noise = episode(sim)
+    assert again == first
+    assert other_noise != first  # a new seed draws new noise...
+    with Simulation({**spec, "seed": 7}) as fresh:
+        assert episode(fresh) == other_noise  # ...the same as a new Simulation with that seed
+
+
+def test_observations_are_copies(tmp_path: Path) -> None:
+    with Simulation(scenario(pendulum(tmp_path), delay=1)) as sim:
+        got = sim.observe("p")
+        got.motor_angles["hinge"] = 99.0  # type: ignore[union-attr]
+        sim.step()
+        assert sim.observe("p").motor_angles["hinge"] != 99.0  # type: ignore[union-attr]
+        ideal = sim.observe("p", ideal=True)
+        ideal.motor_angles.clear()  # type: ignore[union-attr]
+        assert sim.joint_positions("p") != {}
+
+
+def test_setters_change_the_physics(tmp_path: Path) -> None:
+    with Simulation(scenario(pendulum(tmp_path), q0=0.5)) as sim:
+        assert sim.mass_matrix("p")[0, 0] == pytest.approx(M * L * L + INERTIA)
+        # PyBullet's own dynamics model would keep the first mass; ours follows changes.
+        sim.set_mass("p", "bob", 2 * M)
+        assert sim.gravity_torques("p") == pytest.approx([2 * M * G * L * math.sin(0.5)])
+        assert sim.mass_matrix("p")[0, 0] == pytest.approx(2 * M * L * L + 2 * INERTIA)  # scaled
+        sim.set_inertia("p", "bob", [0.05, 0.05, 0.05])
+        assert sim.mass_matrix("p")[0, 0] == pytest.approx(2 * M * L * L + 0.05)
+        # And the simulation moves by them: one step from rest, qdd = -g(q) / M.
+        qd0 = sim.joint_velocities("p")["hinge"]
+        expected = -(2 * M * G * L * math.sin(0.5)) / (2 * M * L * L + 0.05)
+        sim.step()
+        assert (sim.joint_velocities("p")["hinge"] - qd0) / sim.time_step == \
+            pytest.approx(expected, rel=1e-6)
+        sim.set_time_step(0.002)
+        assert sim.time_step == 0.002
+        with pytest.raises(ParameterError, match="no link named 'bobb'"):
+            sim.set_mass("p", "bobb", 1.0)
+        with pytest.raises(ParameterError, match="time_step"):
+            sim.set_time_step(0.0)
+
+
+def test_floating_bases_get_a_mass_matrix_but_no_inverse_dynamics(tmp_path: Path) -> None:
+    with Simulation(scenario(pendulum(tmp_path), base="floating")) as sim:
+        assert sim.mass_matrix("p").shape == (7, 7)  # 6 base coordinates, then the hinge
+        with pytest.raises(ParameterError, match="needs a fixed base"):
+            sim.gravity_torques("p")
+    assert sim.robot_names() == ["p"]
