@@ -162,3 +162,25 @@ def test_floating_bases_get_a_mass_matrix_but_no_inverse_dynamics(tmp_path: Path
         with pytest.raises(ParameterError, match="needs a fixed base"):
             sim.gravity_torques("p")
     assert sim.robot_names() == ["p"]
+
+
+def test_robots_are_measured_only_when_an_observation_is_due(tmp_path: Path,
+                                                             monkeypatch: pytest.MonkeyPatch
+                                                             ) -> None:
+    spec = {**scenario(pendulum(tmp_path), q0=1.0), "duration": 0.5}
+    with Simulation({**spec, "record": {"every": 1}}) as sim:
+        every_step = [r.to_dict() for r in sim.run().rows]
+    calls = []
+    original = Simulation._measure
+
+    def counted(self: Simulation, b: Any) -> Any:
+        calls.append(self.step_count)
+        return original(self, b)
+
+    monkeypatch.setattr(Simulation, "_measure", counted)
+    with Simulation({**spec, "record": {"every": 10}}) as sim:
+        sparse = [r.to_dict() for r in sim.run().rows]
+    # 120 steps: the start and 12 rows, not 121 measurements.
+    assert calls == list(range(0, 121, 10))
+    # The same values as measuring every step, accelerations (over one step) included.
+    assert sparse == every_step[::10]

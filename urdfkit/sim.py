@@ -105,15 +105,15 @@ class Observation:
 
     def copy(self) -> Observation:
         """A copy whose dicts and lists are its own: changing it changes nothing else."""
-        return Observation(**{k: _copied(v) for k, v in self.__dict__.items()})
-
-
-def _copied(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {k: _copied(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return list(value)
-    return value
+        c, f = self.contacts, self.joint_forces
+        return Observation(
+            self.t, self.step, self.robot, dict(self.motor_angles),
+            dict(self.motor_velocities), dict(self.motor_accelerations),
+            list(self.base_position), list(self.base_orientation), list(self.base_lin_vel),
+            list(self.base_ang_vel), list(self.base_lin_vel_body_frame),
+            list(self.base_ang_vel_body_frame),
+            None if c is None else {k: dict(v) for k, v in c.items()},
+            None if f is None else {k: list(v) for k, v in f.items()})
 
 
 # --------------------------------------------------------------------------- robots
@@ -167,6 +167,7 @@ class _Body:
     contact_links: dict[str, int] = field(default_factory=dict)
     force_joints: dict[str, int] = field(default_factory=dict)
     previous_velocities: dict[str, float] = field(default_factory=dict)
+    previous_step: int = -1  # the step previous_velocities were taken at
     applied: _Command | None = None
     override: _Command | None = None
     reported: tuple[int, Observation] | None = None
@@ -595,15 +596,47 @@ class Simulation:
     # ---- stepping and measuring
 
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` physics steps, applying every robot's controller before each."""
+        """Advance ``n`` physics steps, applying every robot's controller before each.
+
+        Robots are measured only when an observation is due: every step for a robot with a
+        ``delay`` (its history is what it reports), and otherwise when asked (``observe``,
+        a recorded row); the step before a recorded row keeps the joint velocities, so the
+        row's accelerations are over one step, as before.
+        """
         p, client = self.session.p, self.session.client
+        every = self.config.record.every
+        bodies = list(self.bodies.values())
+        delayed = [b for b in bodies if b.config.delay > 0]
+        lazy = [b for b in bodies if b.config.delay == 0 and b.active]
+        # Robots with nothing to command (no schedule, override, servo or standing command)
+        # cost nothing per step.
+        controlled = [b for b in bodies if b.override is not None or b.applied is not None
+                      or b.servo or b.config.drive or b.config.joints]
         for _ in range(n):
-            for b in self.bodies.values():
+            for b in controlled:
                 self._control(b)
             p.stepSimulation(physicsClientId=client)
             self.step_count += 1
-            for b in self.bodies.values():
+            for b in delayed:
                 b.history.append(self._measure(b))
+            # The step before a row (unless a row is taken now, which keeps them anyway).
+            if lazy and (self.step_count + 1) % every == 0 and self.step_count % every:
+                for b in lazy:
+                    self._keep_velocities(b)
+
+    def _keep_velocities(self, b: _Body) -> None:
+        """Remember the joint velocities now, for the next measurement's accelerations."""
+        p, client = self.session.p, self.session.client
+        states = p.getJointStates(b.body, [j.index for j in b.active], physicsClientId=client)
+        b.previous_velocities = {spec.name: st[1] * b.directions.get(spec.name, 1.0)
+                                 for spec, st in zip(b.active, states, strict=True)}
+        b.previous_step = self.step_count
+
+    def _fresh(self, b: _Body) -> Observation:
+        """The true observation at this step, measuring it now if it was not yet."""
+        if b.history[-1].step != self.step_count:
+            b.history.append(self._measure(b))
+        return b.history[-1]
 
     def _measure(self, b: _Body) -> Observation:
         """The true observation now, in the measured joint frame."""
@@ -618,14 +651,17 @@ class Simulation:
         if b.active:
             states = p.getJointStates(b.body, [j.index for j in b.active],
                                       physicsClientId=client)
-            first = not b.previous_velocities
+            # Over the time since the velocities were last taken (one step, when recording).
+            span = (self.step_count - b.previous_step) * self.time_step
+            first = not b.previous_velocities or span <= 0
             for spec, state in zip(b.active, states, strict=True):
                 sign = b.directions.get(spec.name, 1.0)
                 angles[spec.name] = (state[0] - b.offsets.get(spec.name, 0.0)) * sign
                 velocities[spec.name] = state[1] * sign
                 accelerations[spec.name] = 0.0 if first else \
-                    (velocities[spec.name] - b.previous_velocities[spec.name]) / self.time_step
+                    (velocities[spec.name] - b.previous_velocities[spec.name]) / span
             b.previous_velocities = dict(velocities)
+            b.previous_step = self.step_count
         if b.force_joints:
             forces = {}
             for name, index in b.force_joints.items():
@@ -670,6 +706,7 @@ class Simulation:
             return {name: self.observe(name, ideal=ideal)  # type: ignore[misc]
                     for name in self.bodies}
         b = self._body(robot)
+        self._fresh(b)
         if ideal:
             return b.history[-1].copy()
         if b.reported is None or b.reported[0] != self.step_count:
@@ -705,6 +742,7 @@ class Simulation:
             b.rng = random.Random(self._robot_seed(base_seed, i))
             b.history.clear()
             b.previous_velocities = {}
+            b.previous_step = -1
             b.applied = b.override = None
             b.reported = None
             disable_default_motors(p, b.body, client, [j.index for j in b.active])
@@ -718,11 +756,11 @@ class Simulation:
 
     def joint_positions(self, robot: str) -> dict[str, float]:
         """True joint positions now (measured frame: offsets and directions applied)."""
-        return dict(self._body(robot).history[-1].motor_angles)
+        return dict(self._fresh(self._body(robot)).motor_angles)
 
     def joint_velocities(self, robot: str) -> dict[str, float]:
         """True joint velocities now (measured frame)."""
-        return dict(self._body(robot).history[-1].motor_velocities)
+        return dict(self._fresh(self._body(robot)).motor_velocities)
 
     def motor_torques(self, robot: str) -> dict[str, float]:
         """The torque each joint's motor applied in the last step (measured frame).

@@ -1,0 +1,119 @@
+"""Issue 15's two speed goals for `urdfkit.sim.Simulation`, measured in one process.
+
+1. ``reset()`` in place against building a new Simulation (goal: at most 1/5 of it).
+2. Stepping and recording as a scenario asks (a quadruped-like robot with 12 joints, a row
+   every 10 steps) against a hand-written PyBullet loop that makes the same queries: per row
+   the base pose and velocity and the joint states, plus the joint velocities the step
+   before (for the accelerations). Goal: at most 1.05x.
+
+Repetitions alternate the two sides so machine load hits both; CPU time (process_time),
+medians. Not a unit test: figures go in bench/README.md.
+
+Usage: python bench/sim_bench.py [--steps 20000] [--repeat 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from pathlib import Path
+
+ROBOT = Path(__file__).resolve().parent.parent / "tests" / "fixtures" / "robots" / \
+    "quadruped_like.urdf"
+
+
+def scenario(steps: int, every: int) -> dict:
+    return {"physics": {"gravity": [0, 0, -9.81]}, "duration": steps / 240.0,
+            "record": {"every": every},
+            "robots": [{"name": "q", "urdf": str(ROBOT), "position": [0, 0, 0.6]}],
+            "ground": "simpleplane"}
+
+
+def hand_loop(steps: int, every: int) -> float:
+    """The same physics and the same queries, written against PyBullet directly."""
+    import tempfile
+
+    import pybullet as p
+
+    from urdfkit.catalog import build_template
+    from urdfkit.session import quiet_stdout
+
+    with tempfile.TemporaryDirectory() as tmp:
+        plane = Path(tmp) / "plane.urdf"
+        build_template("simpleplane").write(plane)
+        with quiet_stdout():
+            c = p.connect(p.DIRECT)
+        p.setTimeStep(1 / 240, physicsClientId=c)
+        p.setGravity(0, 0, -9.81, physicsClientId=c)
+        p.setPhysicsEngineParameter(numSolverIterations=50, enableConeFriction=1,
+                                    physicsClientId=c)
+        p.loadURDF(str(plane), useFixedBase=True, physicsClientId=c)
+        body = p.loadURDF(str(ROBOT), [0, 0, 0.6], flags=p.URDF_USE_INERTIA_FROM_FILE
+                          | p.URDF_USE_IMPLICIT_CYLINDER, physicsClientId=c)
+        joints = [j for j in range(p.getNumJoints(body, physicsClientId=c))
+                  if p.getJointInfo(body, j, physicsClientId=c)[2] in (0, 1)]
+        p.setJointMotorControlArray(body, joints, p.VELOCITY_CONTROL, forces=[0] * len(joints),
+                                    physicsClientId=c)
+        rows = []
+        start = time.process_time()
+        for k in range(1, steps + 1):
+            p.stepSimulation(physicsClientId=c)
+            if (k + 1) % every == 0:
+                before = [s[1] for s in p.getJointStates(body, joints, physicsClientId=c)]
+            if k % every == 0:
+                pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=c)
+                lin, ang = p.getBaseVelocity(body, physicsClientId=c)
+                states = p.getJointStates(body, joints, physicsClientId=c)
+                rows.append((pos, orn, lin, ang, [s[0] for s in states],
+                             [(s[1] - b) * 240 for s, b in zip(states, before, strict=True)]))
+        cpu = time.process_time() - start
+        p.disconnect(physicsClientId=c)
+    return cpu
+
+
+def ours(steps: int, every: int) -> float:
+    from urdfkit.sim import Simulation
+
+    with Simulation(scenario(steps, every)) as sim:
+        start = time.process_time()
+        sim.run()
+        return time.process_time() - start
+
+
+def reset_cost(repeat: int) -> tuple[float, float]:
+    from urdfkit.sim import Simulation
+
+    builds, resets = [], []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        sim = Simulation(scenario(240, 10))
+        builds.append(time.perf_counter() - start)
+        sim.run()
+        start = time.perf_counter()
+        sim.reset()
+        resets.append(time.perf_counter() - start)
+        sim.close()
+    return statistics.median(builds), statistics.median(resets)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--steps", type=int, default=20000)
+    ap.add_argument("--repeat", type=int, default=5)
+    a = ap.parse_args()
+    build, reset = reset_cost(a.repeat)
+    print(f"new Simulation {build * 1000:.1f} ms, reset() in place {reset * 1000:.2f} ms: "
+          f"{reset / build:.3f} (goal <= 0.2)")
+    mine, theirs = [], []
+    for _ in range(a.repeat):
+        mine.append(ours(a.steps, 10))
+        theirs.append(hand_loop(a.steps, 10))
+    m, t = statistics.median(mine), statistics.median(theirs)
+    print(f"{a.steps} steps, a row every 10: Simulation.run {m:.3f} s CPU, hand loop {t:.3f} s: "
+          f"{m / t:.3f} (goal <= 1.05)")
+    return 0 if reset / build <= 0.2 and m / t <= 1.05 else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
