@@ -184,3 +184,53 @@ def test_robots_are_measured_only_when_an_observation_is_due(tmp_path: Path,
     assert calls == list(range(0, 121, 10))
     # The same values as measuring every step, accelerations (over one step) included.
     assert sparse == every_step[::10]
+
+
+def test_sim_out_streams_with_flat_memory(tmp_path: Path) -> None:
+    import json
+    import subprocess
+    import sys
+    from concurrent.futures import ThreadPoolExecutor
+
+    urdf = pendulum(tmp_path)
+
+    def peak(steps: int) -> tuple[int, int]:
+        doc = tmp_path / f"s{steps}.json"
+        doc.write_text(json.dumps({**scenario(urdf), "duration": steps / 240.0}))
+        out = tmp_path / f"rows{steps}.jsonl"
+        code = ("import sys\n"
+                "from urdfkit.cli import main\n"
+                "sys.argv = ['urdfkit', 'sim', *sys.argv[1:]]\n"
+                "try:\n    main()\nexcept SystemExit:\n    pass\n"
+                "print('PEAK', next(int(line.split()[1]) for line in open('/proc/self/status')\n"
+                "                   if line.startswith('VmHWM:')))\n")
+        done = subprocess.run([sys.executable, "-c", code, str(doc), "-o", str(out), "--json"],
+                              capture_output=True, text=True, timeout=300)
+        with out.open() as f:
+            rows = sum(1 for _ in f)
+        assert json.loads(done.stdout.split("PEAK")[0])["rows"] == rows
+        return int(done.stdout.split("PEAK")[-1]), rows
+
+    with ThreadPoolExecutor(2) as pool:
+        (small, small_rows), (big, big_rows) = pool.map(peak, (10_000, 100_000))
+    assert (small_rows, big_rows) == (10_001, 100_001)
+    assert big - small < 8 * 1024, (small, big)  # KiB: 90k more rows, under 8 MB more
+
+
+def test_parquet_streams_in_row_groups(tmp_path: Path) -> None:
+    pq = pytest.importorskip("pyarrow.parquet")
+    from urdfkit import sim as simulation
+
+    spec = {**scenario(pendulum(tmp_path)), "duration": 50 / 240}
+    with Simulation(spec) as a, Simulation(spec) as b:
+        simulation.PARQUET_ROWS, saved = 16, simulation.PARQUET_ROWS
+        try:
+            result, path = simulation.run_to_file(a, tmp_path / "rows.parquet")
+        finally:
+            simulation.PARQUET_ROWS = saved
+        rows = b.run().to_dicts()
+    table = pq.read_table(path)
+    assert result.row_count == table.num_rows == len(rows) == 51
+    assert pq.ParquetFile(path).num_row_groups == 4  # 16 + 16 + 16 + 3
+    assert table.column("motor_angles.hinge").to_pylist() == \
+        [r["motor_angles"]["hinge"] for r in rows]

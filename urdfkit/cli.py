@@ -843,7 +843,7 @@ def sim(
     if as_json:
         data: dict[str, Any] = {
             "scenario": scenario, "time_step": result.time_step, "steps": result.steps,
-            "duration": result.steps * result.time_step, "rows": len(rows),
+            "duration": result.steps * result.time_step, "rows": result.row_count,
             "robots": [x.to_dict() for x in summaries],
             "out": None if written is None else str(written),
             "interrupted": result.interrupted}
@@ -865,7 +865,7 @@ def sim(
             joints = ", ".join(f"{k} {fixed(v)}" for k, v in x.final_joints.items())
             show.line((x.robot, "cyan"), f" final joints: {joints}")
     if written is not None:
-        show.wrote(written, f"{len(rows):,} rows")
+        show.wrote(written, f"{result.row_count:,} rows")
     if result.interrupted:
         show.interrupted("interrupted; the rows cover the steps simulated")
         raise typer.Exit(130)

@@ -210,6 +210,8 @@ class SimResult:
         steps: Physics steps taken.
         interrupted: Ctrl-C (or SIGTERM in the CLI) ended the run early; the rows cover the
             steps simulated.
+        row_count: Rows recorded (also when the run kept none: ``keep=False``).
+        summaries: Per robot: start, end, distance, top speed, final joints.
     """
 
     rows: list[Observation]
@@ -217,6 +219,8 @@ class SimResult:
     time_step: float
     steps: int
     interrupted: bool = False
+    row_count: int = 0
+    summaries: list[RobotSummary] = field(default_factory=list)
 
     def to_dicts(self) -> list[dict[str, Any]]:
         """The reported rows as JSON-ready dicts."""
@@ -1033,24 +1037,32 @@ class Simulation:
         return obs._replace(**changes)
 
     def run(self, duration: float | None = None,
-            sink: Callable[[list[Observation]], None] | None = None) -> SimResult:
+            sink: Callable[[list[Observation]], None] | None = None, *,
+            keep: bool = True) -> SimResult:
         """Step to ``duration`` (default: the scenario's), recording every ``record.every``.
 
         Rows are taken at every step that is a multiple of ``record.every``, the starting
         state included when the run starts at step 0. ``sink`` gets each batch of rows (one
-        per robot) as it is recorded, to stream them to disk. Ctrl-C ends the run early with
-        ``interrupted`` set; the rows so far are kept.
+        per robot) as it is recorded, to stream them to disk; with ``keep=False`` the result
+        then holds no rows, only their count and the per-robot summary, so a run's memory
+        does not grow with its length. Ctrl-C ends the run early with ``interrupted`` set;
+        the rows so far are kept.
         """
         end = self.total_steps if duration is None else \
             self.step_count + max(0, round(duration / self.time_step))
         every = self.config.record.every
         rows: list[Observation] = []
         ideal: list[Observation] = []
+        summary = _Summary()
 
         def record() -> None:
             batch = [self._observe_one(name) for name in self.bodies]
-            ideal.extend(self._observe_one(name, ideal=True) for name in self.bodies)
-            rows.extend(batch)
+            truth = [self._observe_one(name, ideal=True) for name in self.bodies]
+            # Only whole batches count: an interrupt above drops this one entirely.
+            if keep:
+                rows.extend(batch)
+                ideal.extend(truth)
+            summary.add(truth)
             if sink is not None:
                 sink(batch)
 
@@ -1064,11 +1076,43 @@ class Simulation:
                     record()
         except KeyboardInterrupt:
             interrupted = True
-        # A batch cut short by the interrupt is dropped: every robot has the same rows.
         kept = min(len(rows), len(ideal))
         whole = kept - kept % max(1, len(self.bodies))
         return SimResult(rows[:whole], ideal[:whole], self.time_step, self.step_count,
-                         interrupted)
+                         interrupted, summary.rows, summary.robots())
+
+
+class _Summary:
+    """Per robot, from the true rows as they come: first, last, count, top speed."""
+
+    def __init__(self) -> None:
+        self.first: dict[str, Observation] = {}
+        self.last: dict[str, Observation] = {}
+        self.count: dict[str, int] = {}
+        self.top: dict[str, float] = {}
+        self.rows = 0
+
+    def add(self, truth: list[Observation]) -> None:
+        for r in truth:
+            self.first.setdefault(r.robot, r)
+            self.last[r.robot] = r
+            self.count[r.robot] = self.count.get(r.robot, 0) + 1
+            self.top[r.robot] = max(self.top.get(r.robot, 0.0), math.hypot(*r.base_lin_vel))
+        self.rows += len(truth)
+
+    def robots(self) -> list[RobotSummary]:
+        out = []
+        for name, first in self.first.items():
+            last = self.last[name]
+            x, y, z, w = last.base_orientation
+            heading = math.degrees(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
+            out.append(RobotSummary(
+                robot=name, rows=self.count[name], start=list(first.base_position),
+                end=list(last.base_position),
+                distance=math.dist(first.base_position, last.base_position),
+                top_speed=self.top[name], heading_deg=heading,
+                final_joints=dict(last.motor_angles)))
+        return out
 
 
 # --------------------------------------------------------------------------- summary
@@ -1076,21 +1120,7 @@ class Simulation:
 
 def summarize(result: SimResult) -> list[RobotSummary]:
     """Per robot: where it started and ended, how far and fast it went, its final joints."""
-    by_robot: dict[str, list[Observation]] = {}
-    for row in result.ideal:
-        by_robot.setdefault(row.robot, []).append(row)
-    out = []
-    for name, rows in by_robot.items():
-        first, last = rows[0], rows[-1]
-        x, y, z, w = last.base_orientation
-        heading = math.degrees(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
-        out.append(RobotSummary(
-            robot=name, rows=len(rows), start=list(first.base_position),
-            end=list(last.base_position),
-            distance=math.dist(first.base_position, last.base_position),
-            top_speed=max(math.hypot(*r.base_lin_vel) for r in rows),
-            heading_deg=heading, final_joints=dict(last.motor_angles)))
-    return out
+    return list(result.summaries)
 
 
 # --------------------------------------------------------------------------- writers
@@ -1198,19 +1228,83 @@ def run_to_file(simulation: Simulation, path: str | Path, *, force: bool = False
                 duration: float | None = None) -> tuple[SimResult, Path]:
     """Run ``simulation``, writing its rows to ``path`` as they are recorded.
 
-    ``.jsonl`` and ``.csv`` are streamed: on Ctrl-C (SIGTERM, SIGHUP in the CLI) the file
-    holds every complete row so far. ``.parquet`` is written at the end. Nothing is replaced
-    without ``force``.
+    Every format streams: ``.jsonl`` and ``.csv`` row by row, ``.parquet`` in row groups of
+    :data:`PARQUET_ROWS`. The result keeps no rows (their count and the summary only), so
+    memory does not grow with the run. On Ctrl-C (SIGTERM, SIGHUP in the CLI) the file holds
+    every complete row so far (a parquet file gets its footer). Nothing is replaced without
+    ``force``.
     """
     from .output import StreamingFile
 
     check_output(path, force=force)
     fmt = Path(path).suffix.lower()
-    if fmt not in (".jsonl", ".csv"):
-        result = simulation.run(duration)
-        return result, write_rows(path, result.to_dicts(), force=force)
+    if fmt == ".parquet":
+        return _run_to_parquet(simulation, path, force=force, duration=duration)
     text = RowText(fmt)
     with StreamingFile(path, force=force, keep_on_interrupt=True) as out:
         result = simulation.run(duration, sink=lambda batch: out.write(
-            text.encode([r.to_dict() for r in batch])))
+            text.encode([r.to_dict() for r in batch])), keep=False)
     return result, out.path
+
+
+#: Rows per parquet row group when streaming.
+PARQUET_ROWS = 4096
+
+
+def _run_to_parquet(simulation: Simulation, path: str | Path, *, force: bool,
+                    duration: float | None) -> tuple[SimResult, Path]:
+    from .output import StreamingFile
+
+    pa = _pyarrow()
+    import pyarrow.parquet as pq
+
+    buffer: list[dict[str, Any]] = []
+    columns: list[str] = []
+    writer: Any = None
+    with StreamingFile(path, force=force, keep_on_interrupt=True) as out:
+        sink = _ByteSink(out)
+
+        def flush() -> None:
+            nonlocal writer
+            table = pa.table({c: [r.get(c) for r in buffer] for c in columns})
+            if writer is None:
+                writer = pq.ParquetWriter(pa.PythonFile(sink, mode="w"), table.schema)
+            writer.write_table(table)
+            buffer.clear()
+
+        def take(batch: list[Observation]) -> None:
+            flat = [flatten(r.to_dict()) for r in batch]
+            if not columns:
+                columns.extend(_columns(flat))
+            buffer.extend(flat)
+            if len(buffer) >= PARQUET_ROWS:
+                flush()
+
+        result = simulation.run(duration, sink=take, keep=False)
+        if buffer or writer is None:
+            flush()
+        writer.close()  # the footer: a complete file, interrupted or not
+    return result, out.path
+
+
+class _ByteSink:
+    """The file-like face pyarrow writes through, onto a StreamingFile."""
+
+    def __init__(self, out: Any):
+        self.out = out
+        self.closed = False
+        self.position = 0
+
+    def write(self, data: bytes) -> int:
+        self.out.write(bytes(data))
+        self.position += len(data)
+        return len(data)
+
+    def tell(self) -> int:
+        return self.position
+
+    def flush(self) -> None:
+        pass
+
+    def close(self) -> None:
+        self.closed = True
