@@ -341,9 +341,19 @@ class Simulation:
         from .resolve import open_input
 
         if template is not None:
-            folder = Path(self._tmp.name) / f"{len(self._resolved)}"
-            folder.mkdir()
-            name = str(build_template(template, params).write(folder / f"{template}.urdf"))
+            from .drive import builtin_file
+
+            # Built templates are cached as drive's are (key: source, parameters, version).
+            text = {k: v if isinstance(v, str) else
+                    " ".join(map(str, v)) if isinstance(v, (list, tuple)) else str(v)
+                    for k, v in params.items()}
+            cached = builtin_file(template, text)
+            if cached is not None:
+                name = str(cached)
+            else:
+                folder = Path(self._tmp.name) / f"{len(self._resolved)}"
+                folder.mkdir()
+                name = str(build_template(template, params).write(folder / f"{template}.urdf"))
             display = f"{path}: template {template}"
         else:
             assert urdf is not None
