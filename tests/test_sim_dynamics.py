@@ -234,3 +234,52 @@ def test_parquet_streams_in_row_groups(tmp_path: Path) -> None:
     assert pq.ParquetFile(path).num_row_groups == 4  # 16 + 16 + 16 + 3
     assert table.column("motor_angles.hinge").to_pylist() == \
         [r["motor_angles"]["hinge"] for r in rows]
+
+
+def test_base_velocity_rack_and_link_dynamics(tmp_path: Path) -> None:
+    urdf = pendulum(tmp_path)
+    # A free body in zero gravity keeps its initial velocity: x = v t.
+    free = {"physics": {"gravity": [0, 0, 0], "linear_damping": 0, "angular_damping": 0},
+            "duration": 0.5, "robots": [{"name": "p", "urdf": str(urdf),
+                                         "base_velocity": [1.0, 0.0, 0.0],
+                                         "base_angular_velocity": [0.0, 0.0, 0.5]}]}
+    with Simulation(free) as sim:
+        sim.run()
+        obs = sim.observe("p", ideal=True)
+        assert obs.base_position[0] == pytest.approx(0.5, rel=1e-3)  # type: ignore[union-attr]
+        assert obs.base_ang_vel[2] == pytest.approx(0.5, rel=1e-3)  # type: ignore[union-attr]
+        sim.reset()
+        assert sim.observe("p", ideal=True).base_lin_vel[0] == pytest.approx(1.0)  # type: ignore[union-attr]
+    # On a rack the base hangs where it starts under gravity; its joints still swing.
+    rack = {**scenario(urdf, q0=0.5), "robots": [{
+        "name": "p", "urdf": str(urdf), "base": "on_rack", "position": [0, 0, 1.0],
+        "initial_joints": {"hinge": 0.5},
+        "link_dynamics": {"bob": {"lateral_friction": 0.3, "restitution": 0.2}}}],
+        "record": {"motor_torques": True, "link_poses": ["bob"]}}
+    with Simulation(rack) as sim:
+        rows = sim.run().to_dicts()
+        p, client = sim.session.p, sim.session.client
+        info = p.getDynamicsInfo(sim.bodies["p"].body, 0, physicsClientId=client)
+    assert rows[-1]["base_position"] == pytest.approx([0, 0, 1.0], abs=1e-3)
+    assert rows[-1]["motor_angles"]["hinge"] < 0.4  # it swung
+    assert info[1] == pytest.approx(0.3) and info[5] == pytest.approx(0.2)
+    # The link pose row follows the bob's frame (at the hinge, turned by the swing).
+    pose = rows[-1]["link_poses"]["bob"]
+    q = rows[-1]["motor_angles"]["hinge"]
+    assert pose["position"] == pytest.approx([0, 0, 1.0], abs=1e-3)
+    assert pose["orientation"] == pytest.approx([0, math.sin(q / 2), 0, math.cos(q / 2)],
+                                                abs=1e-4)
+    assert rows[-1]["motor_torques"] == {"hinge": 0.0}  # no motor: it swings free
+
+
+def test_recorded_motor_torque_holds_the_pendulum_against_gravity(tmp_path: Path) -> None:
+    spec = {**scenario(pendulum(tmp_path), q0=0.5), "duration": 2.0,
+            "record": {"every": 48, "motor_torques": True}}
+    spec["robots"][0]["joints"] = [{"until": 2.0, "mode": "position",
+                                    "targets": {"hinge": 0.5}, "max_force": 50}]
+    with Simulation(spec) as sim:
+        rows = sim.run().to_dicts()
+    # Held still at 0.5 rad, the motor supplies the gravity torque (the sign: it pushes back).
+    assert rows[-1]["motor_angles"]["hinge"] == pytest.approx(0.5, abs=1e-3)
+    assert abs(rows[-1]["motor_torques"]["hinge"]) == pytest.approx(M * G * L * math.sin(0.5),
+                                                                    rel=0.01)

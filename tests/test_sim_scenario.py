@@ -91,7 +91,7 @@ def mutate(path: str, value: Any) -> dict[str, Any]:
     ("robots.0.position", [0, 1], "robots[0].position: expected 3 numbers, got 2"),
     ("robots.1.orientation_quat", [0, 0, 1],
      "robots[1].orientation_quat: expected 4 numbers, got 3"),
-    ("robots.0.base", "welded", "robots[0].base: expected 'floating' or 'fixed'"),
+    ("robots.0.base", "welded", "robots[0].base: expected 'floating', 'fixed' or 'on_rack'"),
     ("physics.solver_iterations", 2.5, "physics.solver_iterations: expected an integer"),
     ("physics.cone_friction", "yes", "physics.cone_friction: expected true or false"),
     ("record.every", 0, "record.every: must be >= 1"),

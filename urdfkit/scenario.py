@@ -90,6 +90,14 @@ def schema() -> SimpleNamespace:
         every: Annotated[int, Field(ge=1)] = 1
         contact_links: list[str] = Field(default_factory=list)
         joint_forces: list[str] = Field(default_factory=list)
+        motor_torques: bool = False
+        link_poses: list[str] = Field(default_factory=list)
+
+    class LinkDynamics(Model):
+        lateral_friction: non_negative | None = None
+        restitution: non_negative | None = None
+        rolling_friction: non_negative | None = None
+        spinning_friction: non_negative | None = None
 
     class DriveSegment(Model):
         until: positive
@@ -149,7 +157,10 @@ def schema() -> SimpleNamespace:
         orientation_rpy: vec3 | None = None
         orientation_quat: vec4 | None = None
         up: Literal["z", "y", "x"] = "z"
-        base: Literal["floating", "fixed"] = "floating"
+        base: Literal["floating", "fixed", "on_rack"] = "floating"
+        base_velocity: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+        base_angular_velocity: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+        link_dynamics: dict[str, LinkDynamics] = Field(default_factory=dict)
         inertia_from_file: bool = True
         self_collision: bool = False
         initial_joints: dict[str, InitialJoint] = Field(default_factory=dict)
@@ -194,7 +205,7 @@ def schema() -> SimpleNamespace:
     return SimpleNamespace(
         Scenario=Scenario, Physics=Physics, Ground=Ground, Record=Record, Robot=Robot,
         DriveSegment=DriveSegment, Vehicle=Vehicle, JointSegment=JointSegment, Motor=Motor,
-        InitialJoint=InitialJoint, Noise=Noise,
+        InitialJoint=InitialJoint, Noise=Noise, LinkDynamics=LinkDynamics,
     )
 
 

@@ -70,6 +70,10 @@ class Observation:
         base_ang_vel_body_frame: ``base_ang_vel`` rotated into the base frame.
         contacts: For ``record.contact_links``: ``{link: {"normal_force", "count"}}``.
         joint_forces: For ``record.joint_forces``: reaction ``[fx, fy, fz, mx, my, mz]``.
+        motor_torques: With ``record.motor_torques``: the torque each joint's motor applied in
+            the last step (measured frame).
+        link_poses: For ``record.link_poses``: each link's URDF frame, ``{"position",
+            "orientation"}`` (world; quaternion x, y, z, w).
     """
 
     t: float
@@ -86,6 +90,8 @@ class Observation:
     base_ang_vel_body_frame: list[float]
     contacts: dict[str, dict[str, float]] | None = None
     joint_forces: dict[str, list[float]] | None = None
+    motor_torques: dict[str, float] | None = None
+    link_poses: dict[str, dict[str, list[float]]] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON row (optional fields only when recorded)."""
@@ -97,6 +103,12 @@ class Observation:
             row["contacts"] = {k: dict(v) for k, v in self.contacts.items()}
         if self.joint_forces is not None:
             row["joint_forces"] = {k: list(v) for k, v in self.joint_forces.items()}
+        if self.motor_torques is not None:
+            row["motor_torques"] = dict(self.motor_torques)
+        if self.link_poses is not None:
+            row["link_poses"] = {k: {"position": list(v["position"]),
+                                     "orientation": list(v["orientation"])}
+                                 for k, v in self.link_poses.items()}
         return row
 
     def _replace(self, **changes: Any) -> Observation:
@@ -105,7 +117,7 @@ class Observation:
 
     def copy(self) -> Observation:
         """A copy whose dicts and lists are its own: changing it changes nothing else."""
-        c, f = self.contacts, self.joint_forces
+        c, f, tq, lp = self.contacts, self.joint_forces, self.motor_torques, self.link_poses
         return Observation(
             self.t, self.step, self.robot, dict(self.motor_angles),
             dict(self.motor_velocities), dict(self.motor_accelerations),
@@ -113,7 +125,11 @@ class Observation:
             list(self.base_ang_vel), list(self.base_lin_vel_body_frame),
             list(self.base_ang_vel_body_frame),
             None if c is None else {k: dict(v) for k, v in c.items()},
-            None if f is None else {k: list(v) for k, v in f.items()})
+            None if f is None else {k: list(v) for k, v in f.items()},
+            None if tq is None else dict(tq),
+            None if lp is None else {k: {"position": list(v["position"]),
+                                         "orientation": list(v["orientation"])}
+                                     for k, v in lp.items()})
 
 
 # --------------------------------------------------------------------------- robots
@@ -166,6 +182,7 @@ class _Body:
     servo: list[JointSpec] = field(default_factory=list)
     contact_links: dict[str, int] = field(default_factory=dict)
     force_joints: dict[str, int] = field(default_factory=dict)
+    pose_links: list[str] = field(default_factory=list)
     previous_velocities: dict[str, float] = field(default_factory=dict)
     previous_step: int = -1  # the step previous_velocities were taken at
     applied: _Command | None = None
@@ -438,6 +455,25 @@ class Simulation:
 
         # PyBullet holds every joint with a velocity motor (target 0) until told otherwise.
         disable_default_motors(p, body, client, [j.index for j in active])
+        if any(cfg.base_velocity) or any(cfg.base_angular_velocity):
+            p.resetBaseVelocity(body, cfg.base_velocity, cfg.base_angular_velocity,
+                                physicsClientId=client)
+        if cfg.base == "on_rack":
+            # Held in the air where it starts (simulation_and_control's rack): a fixed
+            # constraint between the base and the world; its joints still move.
+            pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
+            p.createConstraint(body, -1, -1, -1, p.JOINT_FIXED, [0, 0, 0], [0, 0, 0],
+                               pos, childFrameOrientation=orn, physicsClientId=client)
+        for link, dyn in cfg.link_dynamics.items():
+            if link not in b.links:
+                raise self._error(f"{path}.link_dynamics.{link}",
+                                  f"{cfg.name} has no link named {link!r}")
+            values = {key: value for key, value in (
+                ("lateralFriction", dyn.lateral_friction), ("restitution", dyn.restitution),
+                ("rollingFriction", dyn.rolling_friction),
+                ("spinningFriction", dyn.spinning_friction)) if value is not None}
+            if values:
+                p.changeDynamics(body, b.links[link], physicsClientId=client, **values)
         for name, init in cfg.initial_joints.items():
             spec = active_joint(f"{path}.initial_joints.{name}", name)
             p.resetJointState(body, spec.index, self._to_physical(b, name, init.position),
@@ -455,6 +491,13 @@ class Simulation:
                                                                 f"{link!r}")
             for b in found:
                 b.contact_links[link] = b.links[link]
+        for i, link in enumerate(rec.link_poses):
+            found = [b for b in self.bodies.values() if link in b.links]
+            if not found:
+                raise self._error(f"record.link_poses[{i}]", f"no robot has a link named "
+                                                             f"{link!r}")
+            for b in found:
+                b.pose_links.append(link)
         for i, name in enumerate(rec.joint_forces):
             found = [b for b in self.bodies.values() if any(j.name == name for j in b.joints)]
             if not found:
@@ -662,9 +705,13 @@ class Simulation:
         velocities: dict[str, float] = {}
         accelerations: dict[str, float] = {}
         forces: dict[str, list[float]] | None = None
+        torques: dict[str, float] | None = None
         if b.active:
             states = p.getJointStates(b.body, [j.index for j in b.active],
                                       physicsClientId=client)
+            if self.config.record.motor_torques:
+                torques = {spec.name: st[3] * b.directions.get(spec.name, 1.0)
+                           for spec, st in zip(b.active, states, strict=True)}
             # Over the time since the velocities were last taken (one step, when recording).
             span = (self.step_count - b.previous_step) * self.time_step
             first = not b.previous_velocities or span <= 0
@@ -691,13 +738,19 @@ class Simulation:
                 points = p.getContactPoints(physicsClientId=client, **kwargs)
                 contacts[link] = {"normal_force": float(sum(pt[9] for pt in points)),
                                   "count": len(points)}
+        poses = None
+        if b.pose_links:
+            poses = {}
+            for link in b.pose_links:
+                at, turn = self.link_pose(b.name, link)
+                poses[link] = {"position": at, "orientation": turn}
         return Observation(
             t=self.t, step=self.step_count, robot=b.name, motor_angles=angles,
             motor_velocities=velocities, motor_accelerations=accelerations,
             base_position=list(pos), base_orientation=list(orn), base_lin_vel=list(lin),
             base_ang_vel=list(ang), base_lin_vel_body_frame=list(rotate_back(matrix, lin)),
             base_ang_vel_body_frame=list(rotate_back(matrix, ang)), contacts=contacts,
-            joint_forces=forces)
+            joint_forces=forces, motor_torques=torques, link_poses=poses)
 
     def _observe_one(self, robot: str, ideal: bool = False) -> Observation:
         out = self.observe(robot, ideal=ideal)
