@@ -283,3 +283,57 @@ def test_recorded_motor_torque_holds_the_pendulum_against_gravity(tmp_path: Path
     assert rows[-1]["motor_angles"]["hinge"] == pytest.approx(0.5, abs=1e-3)
     assert abs(rows[-1]["motor_torques"]["hinge"]) == pytest.approx(M * G * L * math.sin(0.5),
                                                                     rel=0.01)
+
+
+def servo_run(tmp_path: Path, motor: dict[str, Any], seconds: float, q0: float = 0.0,
+              segment: dict[str, Any] | None = None, gravity: float = G,
+              **robot: Any) -> list[dict[str, Any]]:
+    spec = scenario(pendulum(tmp_path), q0=q0, motor=motor, **robot)
+    spec["physics"]["gravity"] = [0, 0, -gravity]
+    spec["duration"] = seconds
+    if segment is not None:
+        spec["robots"][0]["joints"] = [{"until": seconds, **segment}]
+    with Simulation(spec) as sim:
+        return sim.run().to_dicts()
+
+
+def test_servo_gains_per_joint_and_desired_velocity(tmp_path: Path) -> None:
+    hold = {"mode": "position", "targets": {"hinge": 0.3}}
+    held = servo_run(tmp_path, {"kp": {"hinge": 400.0}, "kd": {"hinge": 20.0}}, 2.0,
+                     segment=hold)
+    assert held[-1]["motor_angles"]["hinge"] == pytest.approx(0.3, abs=0.03)
+    with pytest.raises(Exception, match=r"motor\.kp\.elbow"):
+        servo_run(tmp_path, {"kp": {"elbow": 1.0}}, 0.1)
+    # kp 0, kd 5: pure velocity tracking of the segment's desired velocity (no gravity).
+    track = {"mode": "position", "targets": {"hinge": 0.0}, "velocities": {"hinge": 1.0}}
+    rows = servo_run(tmp_path, {"kp": 0.0, "kd": 5.0}, 2.0, segment=track, gravity=0.0)
+    assert rows[-1]["motor_velocities"]["hinge"] == pytest.approx(1.0, rel=0.01)
+
+
+def test_rotor_inertia_slows_the_swing_as_the_formula_says(tmp_path: Path) -> None:
+    def period(inertia: float) -> float:
+        rows = servo_run(tmp_path, {"inertia": inertia}, 6.0, q0=0.1)
+        ts = [r["t"] for r in rows]
+        qs = [r["motor_angles"]["hinge"] for r in rows]
+        ups = [ts[k] for k in range(1, len(qs)) if qs[k - 1] < 0 <= qs[k]]
+        return (ups[-1] - ups[0]) / (len(ups) - 1)
+
+    j = 0.5
+    # Small swings: T = 2 pi sqrt((m l^2 + I + J) / (m g l)).
+    for rotor in (0.0, j):
+        expected = 2 * math.pi * math.sqrt((M * L * L + INERTIA + rotor) / (M * G * L))
+        assert period(rotor) == pytest.approx(expected, rel=0.02)
+
+
+def test_a_servo_on_the_measured_state_feels_the_delay(tmp_path: Path) -> None:
+    motor = {"kp": 200.0, "kd": 2.0}
+    step = {"mode": "position", "targets": {"hinge": 0.5}}
+    true = servo_run(tmp_path, motor, 1.0, segment=step)
+    same = servo_run(tmp_path, {**motor, "measured_state": True}, 1.0, segment=step)
+    assert same == true  # no delay, no noise: what it reports is the truth
+
+    def overshoot(rows: list[dict[str, Any]]) -> float:
+        return max(r["motor_angles"]["hinge"] for r in rows) - 0.5
+
+    late = servo_run(tmp_path, {**motor, "measured_state": True}, 1.0, segment=step, delay=12)
+    assert overshoot(late) > 2 * overshoot(true)  # 50 ms late, the PD loop overshoots more

@@ -113,15 +113,21 @@ def schema() -> SimpleNamespace:
         until: positive
         mode: Literal["position", "velocity", "torque"] = "position"
         targets: dict[str, float]
+        # Position mode: the velocity to track alongside each position (default 0).
+        velocities: dict[str, float] = Field(default_factory=dict)
         max_force: positive | None = None
 
     class Motor(Model):
-        kp: non_negative = 0.0
-        kd: non_negative = 0.0
+        # One gain for every joint, or joint name -> gain (joints not named get 0).
+        kp: non_negative | dict[str, non_negative] = 0.0
+        kd: non_negative | dict[str, non_negative] = 0.0
         viscous_friction: non_negative = 0.0
         stiffness: non_negative = 0.0
+        inertia: non_negative = 0.0  # rotor inertia reflected to the joint, kg m^2
         max_torque: positive | None = None
         joints: list[str] | None = None
+        # The servo reads what the robot reports (delayed, noisy), as on a real robot.
+        measured_state: bool = False
 
     class InitialJoint(Model):
         position: float = 0.0

@@ -161,6 +161,7 @@ class _Command:
     mode: str = "position"
     targets: dict[str, float] = field(default_factory=dict)
     max_force: float | None = None
+    velocities: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass
@@ -437,6 +438,10 @@ class Simulation:
             names = cfg.motor.joints
             b.servo = active if names is None else [
                 active_joint(f"{path}.motor.joints", n) for n in names]
+            for gain in ("kp", "kd"):
+                for name in getattr(cfg.motor, gain) if isinstance(
+                        getattr(cfg.motor, gain), dict) else ():
+                    active_joint(f"{path}.motor.{gain}.{name}", name)
 
         if cfg.drive is not None:
             from .vehicle import detect_upright
@@ -568,7 +573,7 @@ class Simulation:
             segs = b.config.joints
             seg = next((s for s in segs if t < s.until - 1e-9), segs[-1])
             return _Command("joints", mode=seg.mode, targets=dict(seg.targets),
-                            max_force=seg.max_force)
+                            max_force=seg.max_force, velocities=dict(seg.velocities))
         return None
 
     def _control(self, b: _Body) -> None:
@@ -612,6 +617,7 @@ class Simulation:
             if cmd.mode == "position":
                 p.setJointMotorControl2(b.body, spec.index, p.POSITION_CONTROL,
                                         targetPosition=self._to_physical(b, name, target),
+                                        targetVelocity=cmd.velocities.get(name, 0.0) * sign,
                                         physicsClientId=client, **kwargs)
             else:
                 p.setJointMotorControl2(b.body, spec.index, p.VELOCITY_CONTROL,
@@ -619,30 +625,50 @@ class Simulation:
                                         physicsClientId=client, **kwargs)
 
     def _apply_servo(self, b: _Body, cmd: _Command | None) -> None:
-        """The servo model: a PD law plus viscous friction and a spring, as joint torques.
+        """The servo model: a PD law plus viscous friction, a spring and rotor inertia.
 
-        torque = -kp (q - q_des) - kd (qd - qd_des) - b qd - k q, clipped to the effort limit.
-        A position target sets q_des (qd_des = 0); a velocity target sets qd_des and drops the
-        kp term; a torque target is added as is. Joints without a target feel only friction and
-        the spring.
+        torque = -kp (q - q_des) - kd (qd - qd_des) - b qd - k q - J qdd, clipped to the
+        effort limit, per joint (``kp``/``kd`` may differ per joint). A position target sets
+        q_des and qd_des (the segment's ``velocities``, default 0); a velocity target sets
+        qd_des and drops the kp term; a torque target is added as is. Joints without a target
+        feel only friction, the spring and the inertia. With ``measured_state`` the law reads
+        the reported state (delayed, noisy) instead of the true one, as a real robot's servo
+        does; ``qdd`` is the last measured acceleration.
         """
         p, client = self.session.p, self.session.client
         m = b.config.motor
         indices = [j.index for j in b.servo]
-        states = p.getJointStates(b.body, indices, physicsClientId=client)
+        if m.measured_state:
+            seen = self._observe_one(b.name)
+            state_of = {spec.name: (self._to_physical(b, spec.name, seen.motor_angles[spec.name]),
+                                    seen.motor_velocities[spec.name]
+                                    * b.directions.get(spec.name, 1.0))
+                        for spec in b.servo}
+            qdds = seen.motor_accelerations
+        else:
+            states = p.getJointStates(b.body, indices, physicsClientId=client)
+            state_of = {spec.name: (st[0], st[1])
+                        for spec, st in zip(b.servo, states, strict=True)}
+            qdds = self._fresh(b).motor_accelerations if m.inertia else {}
         torques = []
         targets = cmd.targets if cmd is not None and cmd.kind == "joints" else {}
+        velocities = cmd.velocities if cmd is not None and cmd.kind == "joints" else {}
         mode = cmd.mode if cmd is not None else "position"
-        for spec, state in zip(b.servo, states, strict=True):
-            q, qd = state[0], state[1]
+        for spec in b.servo:
+            q, qd = state_of[spec.name]
+            sign = b.directions.get(spec.name, 1.0)
+            kp = m.kp.get(spec.name, 0.0) if isinstance(m.kp, dict) else m.kp
+            kd = m.kd.get(spec.name, 0.0) if isinstance(m.kd, dict) else m.kd
             tau = -m.viscous_friction * qd - m.stiffness * q
+            if m.inertia:
+                tau -= m.inertia * qdds.get(spec.name, 0.0) * sign
             if spec.name in targets:
-                sign = b.directions.get(spec.name, 1.0)
                 target = targets[spec.name]
                 if mode == "position":
-                    tau += -m.kp * (q - self._to_physical(b, spec.name, target)) - m.kd * qd
+                    tau += -kp * (q - self._to_physical(b, spec.name, target)) \
+                        - kd * (qd - velocities.get(spec.name, 0.0) * sign)
                 elif mode == "velocity":
-                    tau += -m.kd * (qd - target * sign)
+                    tau += -kd * (qd - target * sign)
                 else:
                     tau += target * sign
             limit = m.max_torque or (spec.effort if spec.effort > 0 else math.inf)
