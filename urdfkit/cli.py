@@ -693,7 +693,8 @@ def _drive_summary(r: Any) -> None:
             f"{r.turning_radius:.3f} m around ({r.turn_center[0]:.2f}, {r.turn_center[1]:.2f})"
             f"{bicycle}")
     sim = r.simulated
-    force = sim["wheel_force"]
+    force = (f"PyBullet's default ({sim['wheel_force']:g} N m)" if sim["wheel_force_default"]
+             else f"{sim['wheel_force']:g} N m")
     flags = ", ".join(sim["load_flags"]) or "none"
     unit = "rad/s of yaw" if r.drivetrain.steering == "skid" else "rad"
     show.fields([("drive", "bold"), f" {r.model}: throttle {r.throttle:g} rad/s, "
@@ -705,7 +706,7 @@ def _drive_summary(r: Any) -> None:
         ("mean speed", f"{r.mean_speed:.3f} m/s"),
         ("turning radius", turn),
         ("drivetrain", f"{sim['drivetrain']}, {sim['steering']} steering; wheel force "
-                       f"{force if isinstance(force, str) else f'{force:g} N m'}"),
+                       f"{force}"),
         ("load flags", flags),
         ("simulated", f"{r.sim_time:.3f} s in {r.steps:,} steps of {r.time_step:.5g} s; link "
                       f"damping {sim['link_damping']['linear']:g} (PyBullet's default)"),

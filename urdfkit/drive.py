@@ -46,6 +46,8 @@ from .session import LoadOptions, Session, quiet_stdout
 from .spec import UP_AXES, finite, quat_mul
 from .vehicle import (
     DRIVETRAINS,
+    PYBULLET_DEFAULT_FORCE,
+    STEER_FORCE,
     Drivetrain,
     DrivetrainError,
     apply_drive,
@@ -772,9 +774,10 @@ class Scenario:
         c = self.config
         return {
             "drivetrain": self.drivetrain.mode, "steering": self.drivetrain.steering,
-            "wheel_force": "PyBullet default (100000 N m)" if c.max_force is None
-            else c.max_force,
-            "hinge_force": STEER_FORCE_NOTE if self.drivetrain.hinges else None,
+            # N m; PyBullet's default when no cap is given (the tutorial's).
+            "wheel_force": PYBULLET_DEFAULT_FORCE if c.max_force is None else c.max_force,
+            "wheel_force_default": c.max_force is None,
+            "hinge_force": STEER_FORCE if self.drivetrain.hinges else None,
             "load_flags": self.flags, "time_step": c.time_step, "gravity": c.gravity,
             "link_damping": {"linear": PYBULLET_LINK_DAMPING,
                              "angular": PYBULLET_LINK_DAMPING, "note": "PyBullet's default"},
@@ -883,10 +886,6 @@ class Scenario:
             warnings=warnings + problems, expected_radius=expected, yaw_rate=rate,
             radius_note=note, simulated=self.simulated(), samples=stats.count,
             problems=problems)
-
-
-#: How the hinges are driven, for the report.
-STEER_FORCE_NOTE = "PyBullet default (100000 N m), POSITION_CONTROL"
 
 
 class _GuiControls:

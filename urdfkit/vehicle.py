@@ -31,7 +31,7 @@ points in the file: racecar.urdf's wheel axes point along -y, simplecar's along 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -617,10 +617,3 @@ def clamp_steer(train: Drivetrain, steer: float) -> tuple[float, str | None]:
         return steer, None
     return clamped, (f"steer {steer:g} rad is beyond what the hinges reach (limits "
                      f"[{lo:g}, {hi:g}]); clamped to {clamped:.4g}")
-
-
-def describe(train: Drivetrain, max_force: float | None) -> Mapping[str, Any]:
-    """What the drive does, for the summary and JSON."""
-    return {"mode": train.mode, "steering": train.steering,
-            "wheel_force": PYBULLET_DEFAULT_FORCE if max_force is None else max_force,
-            "hinge_force": STEER_FORCE}
