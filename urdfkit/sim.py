@@ -486,22 +486,21 @@ class Simulation:
                               physicsClientId=client)
         return b
 
+    def _having_link(self, where: str, link: str) -> list[_Body]:
+        """The robots with a link of that name; an error naming ``where`` if none has one."""
+        found = [b for b in self.bodies.values() if link in b.links]
+        if not found:
+            raise self._error(where, f"no robot has a link named {link!r}")
+        return found
+
     def _check_record(self) -> None:
         p, client = self.session.p, self.session.client
         rec = self.config.record
         for i, link in enumerate(rec.contact_links):
-            found = [b for b in self.bodies.values() if link in b.links]
-            if not found:
-                raise self._error(f"record.contact_links[{i}]", f"no robot has a link named "
-                                                                f"{link!r}")
-            for b in found:
+            for b in self._having_link(f"record.contact_links[{i}]", link):
                 b.contact_links[link] = b.links[link]
         for i, link in enumerate(rec.link_poses):
-            found = [b for b in self.bodies.values() if link in b.links]
-            if not found:
-                raise self._error(f"record.link_poses[{i}]", f"no robot has a link named "
-                                                             f"{link!r}")
-            for b in found:
+            for b in self._having_link(f"record.link_poses[{i}]", link):
                 b.pose_links.append(link)
         for i, name in enumerate(rec.joint_forces):
             found = [b for b in self.bodies.values() if any(j.name == name for j in b.joints)]
