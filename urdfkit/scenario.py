@@ -30,6 +30,9 @@ OBSERVATION_FIELDS = (
     "base_orientation", "base_lin_vel", "base_ang_vel", "base_lin_vel_body_frame",
     "base_ang_vel_body_frame",
 )
+#: The noise fields of joint-keyed values, and of base 3-vectors.
+JOINT_NOISE_FIELDS = ("motor_angles", "motor_velocities", "motor_accelerations", "motor_torques")
+MODES = ("position", "velocity", "torque")
 
 _INSTALL_HINT = "urdfkit installs it; reinstall it: pip install --force-reinstall pydantic"
 
@@ -92,6 +95,8 @@ def schema() -> SimpleNamespace:
         joint_forces: list[str] = Field(default_factory=list)
         motor_torques: bool = False
         link_poses: list[str] = Field(default_factory=list)
+        # Feet: link names, or label -> link name ({"FL": "fl_foot", ...}).
+        feet: list[str] | dict[str, str] = Field(default_factory=list)
 
     class LinkDynamics(Model):
         lateral_friction: non_negative | None = None
@@ -109,9 +114,12 @@ def schema() -> SimpleNamespace:
         hinges: list[str] | None = None
         max_force: positive = 10.0
 
+    Mode = Literal["position", "velocity", "torque"]
+
     class JointSegment(Model):
         until: positive
-        mode: Literal["position", "velocity", "torque"] = "position"
+        # One mode for every target, or joint name -> mode (every target named).
+        mode: Mode | dict[str, Mode] = "position"
         targets: dict[str, float]
         # Position mode: the velocity to track alongside each position (default 0).
         velocities: dict[str, float] = Field(default_factory=dict)
@@ -121,10 +129,14 @@ def schema() -> SimpleNamespace:
         # One gain for every joint, or joint name -> gain (joints not named get 0).
         kp: non_negative | dict[str, non_negative] = 0.0
         kd: non_negative | dict[str, non_negative] = 0.0
-        viscous_friction: non_negative = 0.0
-        stiffness: non_negative = 0.0
+        viscous_friction: non_negative | dict[str, non_negative] = 0.0
+        stiffness: non_negative | dict[str, non_negative] = 0.0
+        # The friction and spring torques multiplied by the joint-space mass matrix M(q)
+        # (simulation_and_control's servo): the coefficients are then accelerations' gains.
+        scale_by_mass_matrix: bool = False
         inertia: non_negative = 0.0  # rotor inertia reflected to the joint, kg m^2
-        max_torque: positive | None = None
+        # None: the joint's effort limit; "unlimited": no clip.
+        max_torque: positive | Literal["unlimited"] | None = None
         joints: list[str] | None = None
         # The servo reads what the robot reports (delayed, noisy), as on a real robot.
         measured_state: bool = False
@@ -143,16 +155,22 @@ def schema() -> SimpleNamespace:
                 raise ValueError("expected a number, or an object with position and velocity")
             return data
 
+    per_joint = non_negative | dict[str, non_negative]
+    per_axis = non_negative | Annotated[list[non_negative], Field(min_length=3, max_length=3)]
+
     class Noise(Model):
-        motor_angles: non_negative = 0.0
-        motor_velocities: non_negative = 0.0
-        motor_accelerations: non_negative = 0.0
-        base_position: non_negative = 0.0
-        base_orientation: non_negative = 0.0
-        base_lin_vel: non_negative = 0.0
-        base_ang_vel: non_negative = 0.0
-        base_lin_vel_body_frame: non_negative = 0.0
-        base_ang_vel_body_frame: non_negative = 0.0
+        # Standard deviations: one for every joint, or joint name -> value (others 0) ...
+        motor_angles: per_joint = 0.0
+        motor_velocities: per_joint = 0.0
+        motor_accelerations: per_joint = 0.0
+        motor_torques: per_joint = 0.0
+        # ... one for every axis, or [x, y, z]; base_orientation: a rotation's roll, pitch, yaw.
+        base_position: per_axis = 0.0
+        base_orientation: per_axis = 0.0
+        base_lin_vel: per_axis = 0.0
+        base_ang_vel: per_axis = 0.0
+        base_lin_vel_body_frame: per_axis = 0.0
+        base_ang_vel_body_frame: per_axis = 0.0
 
     class Robot(Model):
         name: Annotated[str, Field(min_length=1)] | None = None
@@ -163,12 +181,19 @@ def schema() -> SimpleNamespace:
         orientation_rpy: vec3 | None = None
         orientation_quat: vec4 | None = None
         up: Literal["z", "y", "x"] = "z"
+        # What position/orientation place: the root link's URDF frame, or its centre of mass
+        # (PyBullet's base frame, as resetBasePositionAndOrientation takes it).
+        pose_frame: Literal["link", "com"] = "link"
         base: Literal["floating", "fixed", "on_rack"] = "floating"
         base_velocity: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
         base_angular_velocity: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
         link_dynamics: dict[str, LinkDynamics] = Field(default_factory=dict)
         inertia_from_file: bool = True
+        implicit_cylinder: bool = True
         self_collision: bool = False
+        # None: physics.linear_damping / angular_damping.
+        linear_damping: non_negative | None = None
+        angular_damping: non_negative | None = None
         initial_joints: dict[str, InitialJoint] = Field(default_factory=dict)
         drive: list[DriveSegment] | None = None
         vehicle: Vehicle | None = None
@@ -178,6 +203,8 @@ def schema() -> SimpleNamespace:
         motor_directions: dict[str, Literal[1, -1]] = Field(default_factory=dict)
         noise: Noise | None = None
         delay: Annotated[int, Field(ge=0)] = 0
+        # Simulation.history keeps the last N reported observations, one per physics step.
+        history: Annotated[int, Field(ge=1, le=100_000)] = 1
 
     class Scenario(Model):
         physics: Physics = Field(default_factory=Physics)
@@ -509,4 +536,14 @@ def check(scenario: Any) -> None:
                 if not segments:
                     raise _fail(scenario, f"{path}.{key}", "needs at least one segment")
                 _check_segments(scenario, f"{path}.{key}", segments)
+        for k, seg in enumerate(robot.joints or []):
+            if isinstance(seg.mode, dict):
+                where = f"{path}.joints[{k}].mode"
+                missing = [name for name in seg.targets if name not in seg.mode]
+                if missing:
+                    raise _fail(scenario, where, f"no mode for target {missing[0]!r}: with a "
+                                                 "mode per joint, every target needs one")
+                extra = [name for name in seg.mode if name not in seg.targets]
+                if extra:
+                    raise _fail(scenario, f"{where}.{extra[0]}", "not a target of this segment")
 

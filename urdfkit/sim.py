@@ -20,6 +20,7 @@ servo model read the true joint state.
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import json
 import math
@@ -32,9 +33,9 @@ from pathlib import Path
 from typing import Any
 
 from .errors import EngineError, InputError, MissingDependencyError, OutputError, ParameterError
-from .scenario import OBSERVATION_FIELDS, load_scenario, parse_scenario
+from .scenario import JOINT_NOISE_FIELDS, OBSERVATION_FIELDS, load_scenario, parse_scenario
 from .session import LoadOptions, Session
-from .spec import UP_AXES, quat_mul, quat_to_matrix, rotate_back
+from .spec import UP_AXES, quat_mul, quat_to_matrix, rotate_back, rpy_to_quat
 
 _REVOLUTE, _PRISMATIC, _FIXED = 0, 1, 4  # p.JOINT_* values
 #: Joint types with one degree of freedom: what getJointState can report.
@@ -74,6 +75,11 @@ class Observation:
             the last step (measured frame).
         link_poses: For ``record.link_poses``: each link's URDF frame, ``{"position",
             "orientation"}`` (world; quaternion x, y, z, w).
+        feet: For ``record.feet``: per foot (its label, else its link name), the contact
+            force the foot feels from everything but its own robot: ``{"contact": 0 or 1,
+            "normal": N (summed), "world": [fx, fy, fz] (the normal forces, world frame),
+            "local": the same in the foot link's frame, "friction_world": the lateral
+            friction forces, world frame}``.
     """
 
     t: float
@@ -92,6 +98,7 @@ class Observation:
     joint_forces: dict[str, list[float]] | None = None
     motor_torques: dict[str, float] | None = None
     link_poses: dict[str, dict[str, list[float]]] | None = None
+    feet: dict[str, dict[str, Any]] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON row (optional fields only when recorded)."""
@@ -109,6 +116,8 @@ class Observation:
             row["link_poses"] = {k: {"position": list(v["position"]),
                                      "orientation": list(v["orientation"])}
                                  for k, v in self.link_poses.items()}
+        if self.feet is not None:
+            row["feet"] = _copy_feet(self.feet)
         return row
 
     def _replace(self, **changes: Any) -> Observation:
@@ -117,7 +126,8 @@ class Observation:
 
     def copy(self) -> Observation:
         """A copy whose dicts and lists are its own: changing it changes nothing else."""
-        c, f, tq, lp = self.contacts, self.joint_forces, self.motor_torques, self.link_poses
+        c, f, tq, lp, ft = (self.contacts, self.joint_forces, self.motor_torques,
+                            self.link_poses, self.feet)
         return Observation(
             self.t, self.step, self.robot, dict(self.motor_angles),
             dict(self.motor_velocities), dict(self.motor_accelerations),
@@ -129,7 +139,13 @@ class Observation:
             None if tq is None else dict(tq),
             None if lp is None else {k: {"position": list(v["position"]),
                                          "orientation": list(v["orientation"])}
-                                     for k, v in lp.items()})
+                                     for k, v in lp.items()},
+            None if ft is None else _copy_feet(ft))
+
+
+def _copy_feet(feet: Mapping[str, Mapping[str, Any]]) -> dict[str, dict[str, Any]]:
+    return {k: {key: list(x) if isinstance(x, list) else x for key, x in v.items()}
+            for k, v in feet.items()}
 
 
 # --------------------------------------------------------------------------- robots
@@ -158,10 +174,21 @@ class _Command:
     kind: str  # "drive" or "joints"
     throttle: float = 0.0
     steer: float = 0.0
-    mode: str = "position"
+    mode: str | dict[str, str] = "position"  # one for all targets, or per joint
     targets: dict[str, float] = field(default_factory=dict)
     max_force: float | None = None
     velocities: dict[str, float] = field(default_factory=dict)
+
+    def mode_of(self, joint: str) -> str:
+        """The control mode of one target joint."""
+        return self.mode if isinstance(self.mode, str) else self.mode.get(joint, "position")
+
+    @property
+    def any_torque(self) -> bool:
+        """Whether some target is a torque (re-applied every step: torques last one step)."""
+        if isinstance(self.mode, str):
+            return self.mode == "torque" and self.kind == "joints"
+        return "torque" in self.mode.values()
 
 
 @dataclass
@@ -191,6 +218,10 @@ class _Body:
     reported: tuple[int, Observation] | None = None
     loaded: tuple[str, LoadOptions] | None = None  # the file PyBullet loaded, and how
     changes: list[tuple[int, dict[str, Any]]] = field(default_factory=list)  # set_* calls
+    feet: dict[str, int] = field(default_factory=dict)  # label -> link index
+    kp: float | dict[str, float] = 0.0  # the servo's gains (set_motor_gains changes them)
+    kd: float | dict[str, float] = 0.0
+    reports: deque[Observation] | None = None  # the last N reported, with history N > 1
 
     def joint(self, name: str) -> JointSpec:
         for j in self.joints:
@@ -246,6 +277,10 @@ class SimResult:
 
 
 # --------------------------------------------------------------------------- the simulation
+
+
+def _first(*values: float | None) -> float | None:
+    return next((v for v in values if v is not None), None)
 
 
 class Simulation:
@@ -340,13 +375,15 @@ class Simulation:
         for i, robot in enumerate(self.config.robots):
             self.bodies[robot.name] = self._add_robot(i, robot)
         self._check_record()
-        if ph.linear_damping is not None or ph.angular_damping is not None:
-            damping = {k: v for k, v in (("linearDamping", ph.linear_damping),
-                                         ("angularDamping", ph.angular_damping))
-                       if v is not None}
-            for b in self.bodies.values():
-                for link in range(-1, len(b.joints)):
-                    p.changeDynamics(b.body, link, physicsClientId=client, **damping)
+        for b in self.bodies.values():
+            # A robot's own damping, else the scenario's, else PyBullet's 0.04. PyBullet keeps
+            # one value per body (measured: setting any link's sets the whole body's).
+            damping = {key: value for key, value in (
+                ("linearDamping", _first(b.config.linear_damping, ph.linear_damping)),
+                ("angularDamping", _first(b.config.angular_damping, ph.angular_damping)))
+                if value is not None}
+            if damping:
+                p.changeDynamics(b.body, -1, physicsClientId=client, **damping)
         for b in self.bodies.values():
             b.history.append(self._measure(b))
         # The starting state, for reset() in place (restoreState is ~100x cheaper than a new
@@ -393,9 +430,14 @@ class Simulation:
         orientation = quat_mul(orientation, UP_AXES[cfg.up])
         options = LoadOptions(fixed_base=cfg.base == "fixed",
                               inertia_from_file=cfg.inertia_from_file,
+                              implicit_cylinder=cfg.implicit_cylinder,
                               self_collision=cfg.self_collision,
                               base_position=tuple(cfg.position), base_orientation=orientation)
         body = self._load(path, cfg.template, cfg.params, cfg.urdf, options)
+        if cfg.pose_frame == "com":
+            # The pose is the base's centre of mass, as resetBasePositionAndOrientation takes it.
+            p.resetBasePositionAndOrientation(body, cfg.position, orientation,
+                                              physicsClientId=client)
         loaded = (str(self._resolved[-1].load_path), options)
         try:
             # getBasePositionAndOrientation, getJointStates... all fail on 128+ link bodies.
@@ -413,7 +455,10 @@ class Simulation:
         links.update({j.child_link: j.index for j in joints})
         seed = self._robot_seed(self.config.seed, i)
         b = _Body(cfg.name, path, cfg, body, joints, active, links, {}, {},
-                  random.Random(seed), deque(maxlen=cfg.delay + 1), loaded=loaded)
+                  random.Random(seed), deque(maxlen=max(cfg.delay, cfg.history - 1) + 1),
+                  loaded=loaded)
+        if cfg.history > 1:
+            b.reports = deque(maxlen=cfg.history)
 
         def active_joint(where: str, name: str) -> JointSpec:
             try:
@@ -438,10 +483,16 @@ class Simulation:
             names = cfg.motor.joints
             b.servo = active if names is None else [
                 active_joint(f"{path}.motor.joints", n) for n in names]
-            for gain in ("kp", "kd"):
+            for gain in ("kp", "kd", "viscous_friction", "stiffness"):
                 for name in getattr(cfg.motor, gain) if isinstance(
                         getattr(cfg.motor, gain), dict) else ():
                     active_joint(f"{path}.motor.{gain}.{name}", name)
+            b.kp, b.kd = cfg.motor.kp, cfg.motor.kd
+        if cfg.noise is not None:
+            for key in JOINT_NOISE_FIELDS:
+                value = getattr(cfg.noise, key)
+                for name in value if isinstance(value, dict) else ():
+                    active_joint(f"{path}.noise.{key}.{name}", name)
 
         if cfg.drive is not None:
             from .vehicle import detect_upright
@@ -502,6 +553,13 @@ class Simulation:
         for i, link in enumerate(rec.link_poses):
             for b in self._having_link(f"record.link_poses[{i}]", link):
                 b.pose_links.append(link)
+        feet = rec.feet.items() if isinstance(rec.feet, dict) else \
+            ((link, link) for link in rec.feet)
+        for i, (label, link) in enumerate(feet):
+            where = f"record.feet.{label}" if isinstance(rec.feet, dict) else \
+                f"record.feet[{i}]"
+            for b in self._having_link(where, link):
+                b.feet[label] = b.links[link]
         for i, name in enumerate(rec.joint_forces):
             found = [b for b in self.bodies.values() if any(j.name == name for j in b.joints)]
             if not found:
@@ -571,7 +629,8 @@ class Simulation:
         if b.config.joints is not None:
             segs = b.config.joints
             seg = next((s for s in segs if t < s.until - 1e-9), segs[-1])
-            return _Command("joints", mode=seg.mode, targets=dict(seg.targets),
+            mode = dict(seg.mode) if isinstance(seg.mode, dict) else seg.mode
+            return _Command("joints", mode=mode, targets=dict(seg.targets),
                             max_force=seg.max_force, velocities=dict(seg.velocities))
         return None
 
@@ -592,28 +651,33 @@ class Simulation:
                 # Motors persist in PyBullet: set once per change of command.
                 apply_drive(p, b.body, client, b.train, cmd.throttle,
                             clamp_steer(b.train, cmd.steer)[0], max_force)
-            elif cmd is not None and not b.servo and not (cmd.kind == "joints"
-                                                          and cmd.mode == "torque"):
-                self._apply_motors(b, cmd)  # (torques below: PyBullet adds up repeated ones)
+            elif cmd is not None and not b.servo:
+                self._apply_motors(b, cmd, torque=False)  # motors persist: set on change
             b.applied = cmd
-        if cmd is not None and cmd.kind == "joints" and cmd.mode == "torque" and not b.servo:
-            self._apply_motors(b, cmd)  # torques last one step only
+        if cmd is not None and cmd.any_torque and not b.servo:
+            self._apply_motors(b, cmd, torque=True)  # torques last one step only
         if b.servo:
             self._apply_servo(b, cmd)
 
-    def _apply_motors(self, b: _Body, cmd: _Command) -> None:
-        """PyBullet's own motors for a ``joints`` command (no servo model)."""
+    def _apply_motors(self, b: _Body, cmd: _Command, *, torque: bool) -> None:
+        """PyBullet's own motors for a ``joints`` command (no servo model).
+
+        ``torque``: the torque targets (every step), else the position and velocity ones.
+        """
         p, client = self.session.p, self.session.client
         for name, target in cmd.targets.items():
+            mode = cmd.mode_of(name)
+            if (mode == "torque") != torque:
+                continue
             spec = b.joint(name)
             sign = b.directions.get(name, 1.0)
-            if cmd.mode == "torque":
+            if mode == "torque":
                 p.setJointMotorControl2(b.body, spec.index, p.TORQUE_CONTROL,
                                         force=target * sign, physicsClientId=client)
                 continue
             force = cmd.max_force or (spec.effort if spec.effort > 0 else None)
             kwargs: dict[str, Any] = {} if force is None else {"force": force}
-            if cmd.mode == "position":
+            if mode == "position":
                 p.setJointMotorControl2(b.body, spec.index, p.POSITION_CONTROL,
                                         targetPosition=self._to_physical(b, name, target),
                                         targetVelocity=cmd.velocities.get(name, 0.0) * sign,
@@ -626,54 +690,82 @@ class Simulation:
     def _apply_servo(self, b: _Body, cmd: _Command | None) -> None:
         """The servo model: a PD law plus viscous friction, a spring and rotor inertia.
 
-        torque = -kp (q - q_des) - kd (qd - qd_des) - b qd - k q - J qdd, clipped to the
-        effort limit, per joint (``kp``/``kd`` may differ per joint). A position target sets
-        q_des and qd_des (the segment's ``velocities``, default 0); a velocity target sets
-        qd_des and drops the kp term; a torque target is added as is. Joints without a target
-        feel only friction, the spring and the inertia. With ``measured_state`` the law reads
-        the reported state (delayed, noisy) instead of the true one, as a real robot's servo
-        does; ``qdd`` is the last measured acceleration.
+        In the measured frame (offsets and directions applied), per joint::
+
+            tau = -kp (q - q_des) - kd (qd - qd_des) + e - J qdd,   e = -b qd - k q
+
+        clipped to the effort limit (or ``max_torque``; not at all when "unlimited"). With
+        ``scale_by_mass_matrix`` the friction and spring terms are ``M(q) e`` instead of
+        ``e`` (simulation_and_control's servo; M over the servo joints, at the true state).
+        A position target sets q_des and qd_des (the segment's ``velocities``, default 0); a
+        velocity target sets qd_des and drops the kp term; a torque target is added as is.
+        Joints without a target feel only friction, the spring and the inertia. With
+        ``measured_state`` the law reads the reported state (delayed, noisy) instead of the
+        true one, as a real robot's servo does; ``qdd`` is the last measured acceleration.
         """
         p, client = self.session.p, self.session.client
         m = b.config.motor
         indices = [j.index for j in b.servo]
         if m.measured_state:
             seen = self._observe_one(b.name)
-            state_of = {spec.name: (self._to_physical(b, spec.name, seen.motor_angles[spec.name]),
-                                    seen.motor_velocities[spec.name]
-                                    * b.directions.get(spec.name, 1.0))
-                        for spec in b.servo}
+            state_of = {spec.name: (seen.motor_angles[spec.name],
+                                    seen.motor_velocities[spec.name]) for spec in b.servo}
             qdds = seen.motor_accelerations
         else:
             states = p.getJointStates(b.body, indices, physicsClientId=client)
-            state_of = {spec.name: (st[0], st[1])
-                        for spec, st in zip(b.servo, states, strict=True)}
+            state_of = {}
+            for spec, st in zip(b.servo, states, strict=True):
+                sign = b.directions.get(spec.name, 1.0)
+                state_of[spec.name] = ((st[0] - b.offsets.get(spec.name, 0.0)) * sign,
+                                       st[1] * sign)
             qdds = self._fresh(b).motor_accelerations if m.inertia else {}
+
+        def per_joint(value: float | dict[str, float], name: str) -> float:
+            return value.get(name, 0.0) if isinstance(value, dict) else value
+
+        extra = [-per_joint(m.viscous_friction, spec.name) * state_of[spec.name][1]
+                 - per_joint(m.stiffness, spec.name) * state_of[spec.name][0]
+                 for spec in b.servo]
+        if m.scale_by_mass_matrix and any(extra):
+            extra = self._times_mass_matrix(b, extra)
         torques = []
         targets = cmd.targets if cmd is not None and cmd.kind == "joints" else {}
         velocities = cmd.velocities if cmd is not None and cmd.kind == "joints" else {}
-        mode = cmd.mode if cmd is not None else "position"
-        for spec in b.servo:
+        for spec, tau in zip(b.servo, extra, strict=True):
             q, qd = state_of[spec.name]
-            sign = b.directions.get(spec.name, 1.0)
-            kp = m.kp.get(spec.name, 0.0) if isinstance(m.kp, dict) else m.kp
-            kd = m.kd.get(spec.name, 0.0) if isinstance(m.kd, dict) else m.kd
-            tau = -m.viscous_friction * qd - m.stiffness * q
             if m.inertia:
-                tau -= m.inertia * qdds.get(spec.name, 0.0) * sign
+                tau -= m.inertia * qdds.get(spec.name, 0.0)
             if spec.name in targets:
                 target = targets[spec.name]
+                mode = cmd.mode_of(spec.name) if cmd is not None else "position"
+                kd = per_joint(b.kd, spec.name)
                 if mode == "position":
-                    tau += -kp * (q - self._to_physical(b, spec.name, target)) \
-                        - kd * (qd - velocities.get(spec.name, 0.0) * sign)
+                    tau += -per_joint(b.kp, spec.name) * (q - target) \
+                        - kd * (qd - velocities.get(spec.name, 0.0))
                 elif mode == "velocity":
-                    tau += -kd * (qd - target * sign)
+                    tau += -kd * (qd - target)
                 else:
-                    tau += target * sign
-            limit = m.max_torque or (spec.effort if spec.effort > 0 else math.inf)
-            torques.append(min(max(tau, -limit), limit))
+                    tau += target
+            limit = math.inf if m.max_torque == "unlimited" else \
+                m.max_torque or (spec.effort if spec.effort > 0 else math.inf)
+            tau = min(max(tau, -limit), limit)
+            torques.append(tau * b.directions.get(spec.name, 1.0))
         p.setJointMotorControlArray(b.body, indices, p.TORQUE_CONTROL, forces=torques,
                                     physicsClientId=client)
+
+    def _times_mass_matrix(self, b: _Body, vector: list[float]) -> list[float]:
+        """``D M D v`` for the servo joints: M(q) at the true state, in the measured frame."""
+        dyn = self._dynamics_joints(b)
+        q, _ = self._physical_state(b)
+        p, client, body = self._model(b)
+        matrix = p.calculateMassMatrix(body, q, physicsClientId=client)
+        skip = len(matrix) - len(dyn)  # a floating base's 6 coordinates come first
+        where = {j.name: skip + k for k, j in enumerate(dyn)}
+        rows = [where[spec.name] for spec in b.servo]
+        signs = [b.directions.get(spec.name, 1.0) for spec in b.servo]
+        return [signs[i] * math.fsum(matrix[r][c] * signs[k] * vector[k]
+                                     for k, c in enumerate(rows))
+                for i, r in enumerate(rows)]
 
     # ---- stepping and measuring
 
@@ -681,15 +773,15 @@ class Simulation:
         """Advance ``n`` physics steps, applying every robot's controller before each.
 
         Robots are measured only when an observation is due: every step for a robot with a
-        ``delay`` (its history is what it reports), and otherwise when asked (``observe``,
-        a recorded row); the step before a recorded row keeps the joint velocities, so the
-        row's accelerations are over one step, as before.
+        ``delay`` or a ``history`` (what they report comes from it), and otherwise when asked
+        (``observe``, a recorded row); the step before a recorded row keeps the joint
+        velocities, so the row's accelerations are over one step, as before.
         """
         p, client = self.session.p, self.session.client
         every = self.config.record.every
         bodies = list(self.bodies.values())
-        delayed = [b for b in bodies if b.config.delay > 0]
-        lazy = [b for b in bodies if b.config.delay == 0 and b.active]
+        delayed = [b for b in bodies if b.config.delay > 0 or b.reports is not None]
+        lazy = [b for b in bodies if b not in delayed and b.active]
         # Robots with nothing to command (no schedule, override, servo or standing command)
         # cost nothing per step.
         controlled = [b for b in bodies if b.override is not None or b.applied is not None
@@ -701,6 +793,8 @@ class Simulation:
             self.step_count += 1
             for b in delayed:
                 b.history.append(self._measure(b))
+                if b.reports is not None:
+                    self._report(b)
             # The step before a row (unless a row is taken now, which keeps them anyway).
             if lazy and (self.step_count + 1) % every == 0 and self.step_count % every:
                 for b in lazy:
@@ -763,6 +857,7 @@ class Simulation:
                 points = p.getContactPoints(physicsClientId=client, **kwargs)
                 contacts[link] = {"normal_force": float(sum(pt[9] for pt in points)),
                                   "count": len(points)}
+        feet = self._feet(b) if b.feet else None
         poses = None
         if b.pose_links:
             poses = {}
@@ -775,7 +870,35 @@ class Simulation:
             base_position=list(pos), base_orientation=list(orn), base_lin_vel=list(lin),
             base_ang_vel=list(ang), base_lin_vel_body_frame=list(rotate_back(matrix, lin)),
             base_ang_vel_body_frame=list(rotate_back(matrix, ang)), contacts=contacts,
-            joint_forces=forces, motor_torques=torques, link_poses=poses)
+            joint_forces=forces, motor_torques=torques, link_poses=poses, feet=feet)
+
+    def _feet(self, b: _Body) -> dict[str, dict[str, Any]]:
+        """Each foot's contact forces from everything but its own robot (world and local)."""
+        p, client = self.session.p, self.session.client
+        out: dict[str, dict[str, Any]] = {}
+        for label, index in b.feet.items():
+            normal = [0.0, 0.0, 0.0]
+            friction = [0.0, 0.0, 0.0]
+            total = 0.0
+            count = 0
+            for pt in p.getContactPoints(bodyA=b.body, linkIndexA=index,
+                                         physicsClientId=client):
+                if pt[2] == b.body:
+                    continue  # self-contact: not a ground reaction
+                count += 1
+                total += pt[9]
+                # contactNormalOnB points from B to A: the push on the foot (A).
+                for k in range(3):
+                    normal[k] += pt[9] * pt[7][k]
+                    friction[k] += pt[10] * pt[11][k] + pt[12] * pt[13][k]
+            if index == -1:  # the URDF frame, not the centre of mass
+                orn = self.link_pose(b.name, next(k for k, v in b.links.items() if v == -1))[1]
+            else:
+                orn = p.getLinkState(b.body, index, physicsClientId=client)[5]
+            local = rotate_back(quat_to_matrix(orn), normal)
+            out[label] = {"contact": int(count > 0), "normal": total, "world": normal,
+                          "local": list(local), "friction_world": friction}
+        return out
 
     def _observe_one(self, robot: str, ideal: bool = False) -> Observation:
         out = self.observe(robot, ideal=ideal)
@@ -801,13 +924,35 @@ class Simulation:
         self._fresh(b)
         if ideal:
             return b.history[-1].copy()
+        # A copy: a caller changing what it got must not change later observations.
+        return self._report(b).copy()
+
+    def _report(self, b: _Body) -> Observation:
+        """What the robot reports now (delay, then noise); the same object all this step."""
         if b.reported is None or b.reported[0] != self.step_count:
-            # history holds the last delay+1 observations; its oldest is the delayed one.
-            source = b.history[0]
+            self._fresh(b)
+            # history ends with the current observation; the delayed one is `delay` before.
+            source = b.history[max(0, len(b.history) - 1 - b.config.delay)]
             b.reported = (self.step_count,
                           self._add_noise(b, source._replace(t=self.t, step=self.step_count)))
-        # A copy: a caller changing what it got must not change later observations.
-        return b.reported[1].copy()
+            if b.reports is not None:
+                b.reports.append(b.reported[1])
+        return b.reported[1]
+
+    def history(self, robot: str, *, ideal: bool = False) -> list[Observation]:
+        """The robot's last ``history`` observations, one per physics step, oldest first.
+
+        Reported ones (delay, noise) unless ``ideal``. Fewer at the start of a run; copies.
+        """
+        b = self._body(robot)
+        n = b.config.history
+        if ideal:
+            self._fresh(b)
+            return [o.copy() for o in list(b.history)[-n:]]
+        self._report(b)
+        if b.reports is None:
+            return [b.reported[1].copy()] if b.reported is not None else []
+        return [o.copy() for o in b.reports]
 
     # ---- reset in place
 
@@ -815,7 +960,8 @@ class Simulation:
     def _robot_seed(seed: int, i: int) -> int:
         return seed * 1_000_003 + i
 
-    def reset(self, seed: int | None = None) -> None:
+    def reset(self, seed: int | None = None,
+              overrides: Mapping[str, Mapping[str, Any]] | None = None) -> None:
         """Go back to the starting state in place, deterministically.
 
         Positions, velocities and contacts come back through PyBullet's saveState and
@@ -823,8 +969,23 @@ class Simulation:
         (reseeded with ``seed``, default the scenario's) start over, so the same seed and the
         same actions give the same observations. Changes made with the ``set_*`` methods
         stay: they change the robot, not its state.
+
+        Args:
+            seed: Reseeds the noise; default: the scenario's ``seed``.
+            overrides: Per robot name, a different start for this episode, with the
+                scenario's keys and meanings: ``initial_joints`` (joint -> position, or ->
+                ``{"position", "velocity"}``; measured frame), ``position`` and
+                ``orientation_rpy`` or ``orientation_quat`` (in the robot's ``pose_frame``),
+                ``base_velocity`` and ``base_angular_velocity``. What is not given is the
+                scenario's start.
+
+        Raises:
+            ParameterError: an unknown robot, key or joint, or a value of the wrong shape;
+                nothing is reset then.
         """
         p, client = self.session.p, self.session.client
+        plans = {self._body(robot).name: self._reset_plan(self._body(robot), changes)
+                 for robot, changes in (overrides or {}).items()}
         p.restoreState(self._start_state, physicsClientId=client)
         self.step_count = 0
         base_seed = self.config.seed if seed is None else seed
@@ -833,12 +994,84 @@ class Simulation:
         for i, b in enumerate(self.bodies.values()):
             b.rng = random.Random(self._robot_seed(base_seed, i))
             b.history.clear()
+            if b.reports is not None:
+                b.reports.clear()
             b.previous_velocities = {}
             b.previous_step = -1
             b.applied = b.override = None
             b.reported = None
             disable_default_motors(p, b.body, client, [j.index for j in b.active])
+            for call in plans.get(b.name, ()):
+                call()
             b.history.append(self._measure(b))
+
+    def _reset_plan(self, b: _Body, changes: Mapping[str, Any]) -> list[Callable[[], None]]:
+        """The PyBullet calls that start ``b`` as ``changes`` says, checked before any runs."""
+        p, client = self.session.p, self.session.client
+        known = ("initial_joints", "position", "orientation_rpy", "orientation_quat",
+                 "base_velocity", "base_angular_velocity")
+        for key in changes:
+            if key not in known:
+                raise ParameterError(f"`overrides`: unknown key {key!r} for {b.name}; known "
+                                     f"keys: {', '.join(known)}", param="overrides")
+
+        def vector(key: str, size: int) -> list[float] | None:
+            value = changes.get(key)
+            if value is None:
+                return None
+            try:
+                out = [float(v) for v in value]
+            except (TypeError, ValueError):
+                out = []
+            if len(out) != size or not all(math.isfinite(v) for v in out):
+                raise ParameterError(f"`overrides`: {b.name}.{key} needs {size} finite "
+                                     "numbers", param="overrides")
+            return out
+
+        calls: list[Callable[[], None]] = []
+        for name, value in (changes.get("initial_joints") or {}).items():
+            spec = next((j for j in b.active if j.name == name), None)
+            if spec is None:
+                raise ParameterError(f"`overrides`: {b.name} has no active joint named "
+                                     f"{name!r}", param="overrides")
+            position, velocity = (value.get("position", 0.0), value.get("velocity", 0.0)) \
+                if isinstance(value, Mapping) else (value, 0.0)
+            q = self._to_physical(b, name, float(position))
+            qd = float(velocity) * b.directions.get(name, 1.0)
+            calls.append(functools.partial(p.resetJointState, b.body, spec.index, q, qd,
+                                           physicsClientId=client))
+        position = vector("position", 3)
+        rpy = vector("orientation_rpy", 3)
+        quat = vector("orientation_quat", 4)
+        if rpy is not None and quat is not None:
+            raise ParameterError(f"`overrides`: give {b.name} orientation_rpy or "
+                                 "orientation_quat, not both", param="overrides")
+        if position is not None or rpy is not None or quat is not None:
+            cfg = b.config
+            if quat is None:
+                quat = list(rpy_to_quat(*rpy)) if rpy is not None else \
+                    list(cfg.orientation_quat) if cfg.orientation_quat is not None else \
+                    list(rpy_to_quat(*(cfg.orientation_rpy or (0.0, 0.0, 0.0))))
+            norm = math.sqrt(math.fsum(v * v for v in quat))
+            if norm < 1e-12:
+                raise ParameterError(f"`overrides`: {b.name}.orientation_quat must not be all "
+                                     "zeros", param="overrides")
+            orn = quat_mul([v / norm for v in quat], UP_AXES[cfg.up])
+            at = position if position is not None else list(cfg.position)
+            if cfg.pose_frame == "link":
+                # resetBasePositionAndOrientation places the centre of mass.
+                dyn = p.getDynamicsInfo(b.body, -1, physicsClientId=client)
+                at, orn = p.multiplyTransforms(at, orn, dyn[3], dyn[4])
+            calls.append(lambda: p.resetBasePositionAndOrientation(
+                b.body, at, orn, physicsClientId=client))
+        lin = vector("base_velocity", 3)
+        ang = vector("base_angular_velocity", 3)
+        if lin is not None or ang is not None:
+            velocity = (lin if lin is not None else list(b.config.base_velocity),
+                        ang if ang is not None else list(b.config.base_angular_velocity))
+            calls.append(lambda: p.resetBaseVelocity(b.body, *velocity,
+                                                     physicsClientId=client))
+        return calls
 
     # ---- state, kinematics and dynamics of one robot (SimInterface's, in Python's manners)
 
@@ -1099,6 +1332,32 @@ class Simulation:
         """Every link's linear and angular velocity damping (PyBullet's default is 0.04)."""
         self._change(robot, None, linearDamping=float(linear), angularDamping=float(angular))
 
+    def set_motor_gains(self, robot: str, kp: float | Mapping[str, float] | None = None,
+                        kd: float | Mapping[str, float] | None = None) -> None:
+        """The servo's position and velocity gains: one for every joint, or per joint name.
+
+        A gain not given keeps its value. Needs the robot's ``motor`` table (the servo).
+        """
+        b = self._body(robot)
+        if not b.servo:
+            raise ParameterError(f"`robot`: {robot} has no servo model; give it a 'motor' "
+                                 "table in the scenario", param="robot")
+        names = {j.name for j in b.servo}
+        for label, gain in (("kp", kp), ("kd", kd)):
+            if gain is None:
+                continue
+            values = dict(gain) if isinstance(gain, Mapping) else {"": gain}
+            for name, value in values.items():
+                if name and name not in names:
+                    raise ParameterError(f"`{label}`: {robot}'s servo drives no joint named "
+                                         f"{name!r}", param=label)
+                if not (isinstance(value, (int, float)) and math.isfinite(value)
+                        and value >= 0):
+                    raise ParameterError(f"`{label}` must be a finite number >= 0, got "
+                                         f"{value!r}", param=label)
+            setattr(b, label, {k: float(v) for k, v in values.items()}
+                    if isinstance(gain, Mapping) else float(gain))
+
     def set_time_step(self, time_step: float) -> None:
         """The physics time step, s (times already recorded keep theirs)."""
         if not 0 < time_step <= 1:
@@ -1109,19 +1368,33 @@ class Simulation:
         self.time_step = float(time_step)
 
     def _add_noise(self, b: _Body, obs: Observation) -> Observation:
+        """Independent Gaussian samples on the reported fields (standard deviations).
+
+        Joint fields take one value for every joint or one per joint; base vectors one for
+        every axis or one per axis. ``base_orientation`` is turned by a random rotation
+        (roll, pitch, yaw drawn with those deviations), so it stays a unit quaternion.
+        """
         noise = b.config.noise
         if noise is None:
             return obs
+        gauss = b.rng.gauss
         changes: dict[str, Any] = {}
-        for name in OBSERVATION_FIELDS:
+        for name in (*OBSERVATION_FIELDS, "motor_torques"):
             std = getattr(noise, name)
-            if std <= 0:
-                continue
             value = getattr(obs, name)
+            if value is None or not std:
+                continue
             if isinstance(value, dict):
-                changes[name] = {k: v + b.rng.gauss(0.0, std) for k, v in value.items()}
+                changes[name] = {k: v + gauss(0.0, std.get(k, 0.0) if isinstance(std, dict)
+                                              else std) for k, v in value.items()}
+                continue
+            axes = std if isinstance(std, list) else [std] * 3
+            if name == "base_orientation":
+                turn = rpy_to_quat(*(gauss(0.0, a) if a > 0 else 0.0 for a in axes))
+                changes[name] = list(quat_mul(turn, value))
             else:
-                changes[name] = [v + b.rng.gauss(0.0, std) for v in value]
+                changes[name] = [v + (gauss(0.0, a) if a > 0 else 0.0)
+                                 for v, a in zip(value, axes, strict=True)]
         return obs._replace(**changes)
 
     def run(self, duration: float | None = None,

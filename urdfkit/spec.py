@@ -280,6 +280,15 @@ def rpy_to_matrix(rpy: Sequence[float]) -> Matrix3:
     )
 
 
+def rpy_to_quat(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
+    """Quaternion (x, y, z, w) of roll-pitch-yaw, as PyBullet's ``getQuaternionFromEuler``."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+
+
 def quat_to_matrix(q: Sequence[float]) -> Matrix3:
     """Rotation matrix of a unit quaternion (x, y, z, w), PyBullet's order."""
     x, y, z, w = q
