@@ -813,14 +813,27 @@ def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
 
 @app.command(epilog=_examples(
     "urdfkit sim scenario.toml", "urdfkit sim scenario.toml -o rows.csv",
-    "urdfkit sim scenario.json --json"))
+    "urdfkit sim scenario.json --json", "urdfkit sim scenario.toml --gui",
+    "urdfkit sim configs/robot.json   # a simulation_and_control config, as it is",
+    "urdfkit sim convert configs/robot.json -o scenario.toml"))
 def sim(
     scenario: Annotated[str, typer.Argument(
         help="A scenario file (.json or .toml): robots, controllers, physics. See "
-             "docs/scenario.md.")],
+             "docs/scenario.md. A simulation_and_control config runs as it is. Or the word "
+             "convert, then a simulation_and_control config: write it as a native scenario.",
+        metavar="SCENARIO")],
+    config: Annotated[str | None, typer.Argument(
+        help="With convert: the simulation_and_control config (.json).",
+        show_default=False)] = None,
     out: Annotated[str | None, typer.Option(
         "--out", "-o", metavar="FILE",
-        help="Write the observation rows to FILE.jsonl, FILE.csv or FILE.parquet.")] = None,
+        help="Write the observation rows to FILE.jsonl, FILE.csv or FILE.parquet (with "
+             "convert: the scenario to FILE.toml; default standard output).")] = None,
+    gui: Annotated[bool, typer.Option(
+        "--gui", help="Watch the run in PyBullet's GUI window, in real time (needs a "
+                      "display).")] = False,
+    real_time: Annotated[bool, typer.Option(
+        "--real-time", help="Pace the steps to the wall clock.")] = False,
     as_json: JsonOpt = False,
     force: ForceOpt = False,
 ) -> None:
@@ -830,15 +843,37 @@ def sim(
     too when there is no --out).
     """
     from . import sim as simulation
+    from .errors import ParameterError
 
+    if scenario == "convert":
+        if config is None:
+            raise ParameterError("convert needs the simulation_and_control config: "
+                                 "urdfkit sim convert conf.json -o scenario.toml",
+                                 param="scenario")
+        if gui or real_time or as_json:
+            raise ParameterError("convert writes a file; --gui, --real-time and --json do not "
+                                 "apply", param="scenario")
+        _sim_convert(config, out, force)
+        return
+    if config is not None:
+        raise ParameterError(f"one scenario at a time; got {scenario!r} and {config!r} (to "
+                             "convert a config: urdfkit sim convert conf.json)",
+                             param="scenario")
+    if gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+                    or sys.platform in ("darwin", "win32")):
+        raise ParameterError("`gui` needs a display (DISPLAY is not set); drop it to run "
+                             "headless", param="gui")
     if out is not None:
         simulation.check_output(out, force=force)  # fail before the run, not after it
     written = None
-    with simulation.Simulation.from_file(scenario) as s:
+    with simulation.Simulation.from_file(scenario, gui=gui) as s:
+        for note in s.config.notes:
+            show.warn(note)
         if out is None:
-            result = s.run()
+            result = s.run(real_time=real_time or gui)
         else:
-            result, written = simulation.run_to_file(s, out, force=force)
+            result, written = simulation.run_to_file(s, out, force=force,
+                                                     real_time=real_time or gui)
     rows = result.to_dicts()
     summaries = simulation.summarize(result)
     if as_json:
@@ -870,6 +905,35 @@ def sim(
     if result.interrupted:
         show.interrupted("interrupted; the rows cover the steps simulated")
         raise typer.Exit(130)
+
+
+def _sim_convert(config: str, out: str | None, force: bool) -> None:
+    """``sim convert``: a simulation_and_control config as a native TOML scenario."""
+    from . import sac
+    from .errors import InputError
+    from .output import atomic_write, check_output
+    from .scenario import read_document
+
+    if out is not None and out != "-":
+        check_output(out, force=force, suffixes=(".toml",), what="the scenario")
+    data = read_document(config)
+    if not sac.is_config(data):
+        raise InputError("not a simulation_and_control config (no sim, robot_pybullet, "
+                         "env_pybullet or robot_pin section); it is already a scenario",
+                         file=config)
+    imported = sac.convert(data, source=config)
+    from .scenario import parse_scenario
+
+    parse_scenario(imported.scenario, source=config)  # what is written must load
+    for note in imported.notes:
+        show.warn(note)
+    if out is None or out == "-":
+        sys.stdout.write(sac.to_toml(imported, source=config, out_dir=None))
+        sys.stdout.flush()
+        return
+    text = sac.to_toml(imported, source=config, out_dir=Path(out).parent)
+    show.wrote(atomic_write(out, text.encode("utf-8"), force=force),
+               f"{len(imported.scenario['robots'])} robot(s)")
 
 
 def _command_name(info: Any) -> str:

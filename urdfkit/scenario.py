@@ -216,6 +216,12 @@ def schema() -> SimpleNamespace:
 
         _source: str | None = PrivateAttr(default=None)
         _base_dir: Path = PrivateAttr(default_factory=Path.cwd)
+        _notes: list[str] = PrivateAttr(default_factory=list)
+
+        @property
+        def notes(self) -> list[str]:
+            """What importing a simulation_and_control config had to say (warnings)."""
+            return self._notes
 
         @property
         def source(self) -> str | None:
@@ -447,8 +453,21 @@ def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
 
 
 def load_scenario(path: str | Path) -> Any:
-    """Read and validate a scenario file (``.json`` or ``.toml``)."""
-    return parse_scenario(read_document(path), source=path)
+    """Read and validate a scenario file (``.json`` or ``.toml``).
+
+    A simulation_and_control config (top-level ``sim``, ``robot_pybullet``, ...) is mapped
+    onto a native scenario first (:mod:`urdfkit.sac`); its notes are the scenario's
+    ``notes``.
+    """
+    data = read_document(path)
+    from . import sac
+
+    if not sac.is_config(data):
+        return parse_scenario(data, source=path)
+    imported = sac.convert(data, source=path)
+    scenario = parse_scenario(imported.scenario, source=path)
+    scenario._notes = list(imported.notes)
+    return scenario
 
 
 def _fail(scenario: Any, path: str, message: str) -> InputError:
@@ -547,3 +566,72 @@ def check(scenario: Any) -> None:
                 if extra:
                     raise _fail(scenario, f"{where}.{extra[0]}", "not a target of this segment")
 
+
+
+# --------------------------------------------------------------------------- writing TOML
+
+_BARE_KEY = __import__("re").compile(r"^[A-Za-z0-9_-]+$")
+
+
+def _toml_key(key: str) -> str:
+    return key if _BARE_KEY.match(key) else json.dumps(key, ensure_ascii=False)
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            raise ValueError("NaN has no place in a scenario")
+        return ("inf" if value > 0 else "-inf") if math.isinf(value) else repr(value)
+    if isinstance(value, str):
+        # A JSON string is a TOML basic string (the same escapes).
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, Mapping):
+        return "{" + ", ".join(f"{_toml_key(k)} = {_toml_value(v)}"
+                               for k, v in value.items()) + "}"
+    raise ValueError(f"cannot write {type(value).__name__} to TOML")
+
+
+def _is_table(value: Any) -> bool:
+    return isinstance(value, Mapping) and bool(value) and \
+        any(isinstance(v, Mapping) for v in value.values()) or \
+        isinstance(value, Mapping) and len(value) > 4
+
+
+def to_toml(document: Mapping[str, Any], header: Sequence[str] = ()) -> str:
+    """A scenario document as TOML text (``tomllib.loads`` gives the document back).
+
+    Sub-tables get their own ``[section]`` when they nest or are long; small flat ones stay
+    inline. ``header`` lines become comments at the top.
+    """
+    lines = [f"# {h}" if h else "#" for h in header]
+
+    def emit(path: list[str], table: Mapping[str, Any], array: bool) -> None:
+        def section(v: Any) -> bool:  # the top level's tables always get a [section]
+            return _is_table(v) or not path and isinstance(v, Mapping) and bool(v)
+
+        plain = [(k, v) for k, v in table.items()
+                 if not section(v) and not (isinstance(v, list) and v
+                                            and all(isinstance(x, Mapping) for x in v))]
+        tables = [(k, v) for k, v in table.items() if section(v)]
+        arrays = [(k, v) for k, v in table.items() if isinstance(v, list) and v
+                  and all(isinstance(x, Mapping) for x in v)]
+        if path:
+            name = ".".join(_toml_key(p) for p in path)
+            lines.append("")
+            lines.append(f"[[{name}]]" if array else f"[{name}]")
+        for k, v in plain:
+            lines.append(f"{_toml_key(k)} = {_toml_value(v)}")
+        for k, v in tables:
+            emit([*path, k], v, False)
+        for k, items in arrays:
+            for item in items:
+                emit([*path, k], item, True)
+
+    emit([], document, False)
+    return "\n".join(lines).lstrip("\n") + "\n"

@@ -26,6 +26,7 @@ import json
 import math
 import random
 import tempfile
+import time
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -290,13 +291,14 @@ class Simulation:
         config: A validated scenario (:func:`urdfkit.scenario.load_scenario`) or the plain
             dict of one, which is validated here.
         base_dir: Where relative ``urdf`` paths of a dict ``config`` are resolved.
+        gui: Open PyBullet's GUI window to watch the run (needs a display).
 
     Raises:
         InputError: the scenario is invalid, or names a joint or link a robot lacks.
         EngineError: PyBullet refused a file.
     """
 
-    def __init__(self, config: Any, *, base_dir: str | Path | None = None):
+    def __init__(self, config: Any, *, base_dir: str | Path | None = None, gui: bool = False):
         if isinstance(config, Mapping):
             config = parse_scenario(config, base_dir=base_dir)
         self.config = config
@@ -306,7 +308,7 @@ class Simulation:
         self.bodies: dict[str, _Body] = {}
         self._resolved: list[Any] = []
         self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-sim-")
-        self.session = Session()
+        self.session = Session(gui=gui)
         try:
             self._setup()
         except BaseException:
@@ -314,9 +316,13 @@ class Simulation:
             raise
 
     @classmethod
-    def from_file(cls, path: str | Path) -> Simulation:
-        """Load and validate a ``.json`` or ``.toml`` scenario and set it up."""
-        return cls(load_scenario(path))
+    def from_file(cls, path: str | Path, *, gui: bool = False) -> Simulation:
+        """Load and validate a ``.json`` or ``.toml`` scenario and set it up.
+
+        A simulation_and_control config is imported (:mod:`urdfkit.sac`); what the import
+        had to say is in ``simulation.config.notes``.
+        """
+        return cls(load_scenario(path), gui=gui)
 
     # ---- lifecycle
 
@@ -1399,7 +1405,7 @@ class Simulation:
 
     def run(self, duration: float | None = None,
             sink: Callable[[list[Observation]], None] | None = None, *,
-            keep: bool = True) -> SimResult:
+            keep: bool = True, real_time: bool = False) -> SimResult:
         """Step to ``duration`` (default: the scenario's), recording every ``record.every``.
 
         Rows are taken at every step that is a multiple of ``record.every``, the starting
@@ -1407,7 +1413,8 @@ class Simulation:
         per robot) as it is recorded, to stream them to disk; with ``keep=False`` the result
         then holds no rows, only their count and the per-robot summary, so a run's memory
         does not grow with its length. Ctrl-C ends the run early with ``interrupted`` set;
-        the rows so far are kept.
+        the rows so far are kept, as they are when the GUI window is closed. ``real_time``
+        paces the steps to the wall clock (to watch the run in the GUI).
         """
         end = self.total_steps if duration is None else \
             self.step_count + max(0, round(duration / self.time_step))
@@ -1428,15 +1435,28 @@ class Simulation:
                 sink(batch)
 
         interrupted = False
+        p, client = self.session.p, self.session.client
+        # Real time: at most a 60th of a second of simulated time between two waits.
+        chunk = max(1, round(1 / 60 / self.time_step)) if real_time else end
+        start_wall, start_step = time.perf_counter(), self.step_count
         try:
             if self.step_count % every == 0:
                 record()
             while self.step_count < end:
-                self.step(min(every - self.step_count % every, end - self.step_count))
+                self.step(min(every - self.step_count % every, end - self.step_count, chunk))
                 if self.step_count % every == 0:
                     record()
+                if real_time:
+                    ahead = start_wall + (self.step_count - start_step) * self.time_step \
+                        - time.perf_counter()
+                    if ahead > 0:
+                        time.sleep(ahead)
         except KeyboardInterrupt:
             interrupted = True
+        except p.error:
+            if not self.session.gui or p.isConnected(physicsClientId=client):
+                raise
+            interrupted = True  # the GUI window was closed
         kept = min(len(rows), len(ideal))
         whole = kept - kept % max(1, len(self.bodies))
         return SimResult(rows[:whole], ideal[:whole], self.time_step, self.step_count,
@@ -1586,7 +1606,8 @@ def write_rows(path: str | Path, rows: Sequence[Mapping[str, Any]], *, force: bo
 
 
 def run_to_file(simulation: Simulation, path: str | Path, *, force: bool = False,
-                duration: float | None = None) -> tuple[SimResult, Path]:
+                duration: float | None = None, real_time: bool = False
+                ) -> tuple[SimResult, Path]:
     """Run ``simulation``, writing its rows to ``path`` as they are recorded.
 
     Every format streams: ``.jsonl`` and ``.csv`` row by row, ``.parquet`` in row groups of
@@ -1600,11 +1621,12 @@ def run_to_file(simulation: Simulation, path: str | Path, *, force: bool = False
     check_output(path, force=force)
     fmt = Path(path).suffix.lower()
     if fmt == ".parquet":
-        return _run_to_parquet(simulation, path, force=force, duration=duration)
+        return _run_to_parquet(simulation, path, force=force, duration=duration,
+                               real_time=real_time)
     text = RowText(fmt)
     with StreamingFile(path, force=force, keep_on_interrupt=True) as out:
         result = simulation.run(duration, sink=lambda batch: out.write(
-            text.encode([r.to_dict() for r in batch])), keep=False)
+            text.encode([r.to_dict() for r in batch])), keep=False, real_time=real_time)
     return result, out.path
 
 
@@ -1613,7 +1635,7 @@ PARQUET_ROWS = 4096
 
 
 def _run_to_parquet(simulation: Simulation, path: str | Path, *, force: bool,
-                    duration: float | None) -> tuple[SimResult, Path]:
+                    duration: float | None, real_time: bool) -> tuple[SimResult, Path]:
     from .output import StreamingFile
 
     pa = _pyarrow()
@@ -1641,7 +1663,7 @@ def _run_to_parquet(simulation: Simulation, path: str | Path, *, force: bool,
             if len(buffer) >= PARQUET_ROWS:
                 flush()
 
-        result = simulation.run(duration, sink=take, keep=False)
+        result = simulation.run(duration, sink=take, keep=False, real_time=real_time)
         if buffer or writer is None:
             flush()
         writer.close()  # the footer: a complete file, interrupted or not
