@@ -893,14 +893,17 @@ class Simulation:
                     continue  # self-contact: not a ground reaction
                 count += 1
                 total += pt[9]
-                # contactNormalOnB points from B to A: the push on the foot (A).
+                # contactNormalOnB points from B to A: the push on the foot (A). The lateral
+                # friction directions are those of the force on B (measured: a box sliding
+                # along +x reads +mu m g), so the foot feels their opposite.
                 for k in range(3):
                     normal[k] += pt[9] * pt[7][k]
-                    friction[k] += pt[10] * pt[11][k] + pt[12] * pt[13][k]
+                    friction[k] -= pt[10] * pt[11][k] + pt[12] * pt[13][k]
             if index == -1:  # the URDF frame, not the centre of mass
                 orn = self.link_pose(b.name, next(k for k, v in b.links.items() if v == -1))[1]
             else:
-                orn = p.getLinkState(b.body, index, physicsClientId=client)[5]
+                orn = p.getLinkState(b.body, index, computeForwardKinematics=True,
+                                     physicsClientId=client)[5]
             local = rotate_back(quat_to_matrix(orn), normal)
             out[label] = {"contact": int(count > 0), "normal": total, "world": normal,
                           "local": list(local), "friction_world": friction}
