@@ -223,6 +223,9 @@ class _Body:
     kp: float | dict[str, float] = 0.0  # the servo's gains (set_motor_gains changes them)
     kd: float | dict[str, float] = 0.0
     reports: deque[Observation] | None = None  # the last N reported, with history N > 1
+    # Torques given in TORQUE_CONTROL for the coming step (physical frame): PyBullet reports
+    # 0 as a torque-controlled joint's applied torque.
+    torques: dict[str, float] = field(default_factory=dict)
 
     def joint(self, name: str) -> JointSpec:
         for j in self.joints:
@@ -650,6 +653,7 @@ class Simulation:
                 from .vehicle import disable_default_motors
 
                 disable_default_motors(p, b.body, client, [j.index for j in b.active])
+                b.torques.clear()
             if cmd is not None and cmd.kind == "drive":
                 from .vehicle import apply_drive, clamp_steer
 
@@ -680,6 +684,7 @@ class Simulation:
             if mode == "torque":
                 p.setJointMotorControl2(b.body, spec.index, p.TORQUE_CONTROL,
                                         force=target * sign, physicsClientId=client)
+                b.torques[name] = target * sign
                 continue
             force = cmd.max_force or (spec.effort if spec.effort > 0 else None)
             kwargs: dict[str, Any] = {} if force is None else {"force": force}
@@ -758,6 +763,7 @@ class Simulation:
             torques.append(tau * b.directions.get(spec.name, 1.0))
         p.setJointMotorControlArray(b.body, indices, p.TORQUE_CONTROL, forces=torques,
                                     physicsClientId=client)
+        b.torques.update(zip((spec.name for spec in b.servo), torques, strict=True))
 
     def _times_mass_matrix(self, b: _Body, vector: list[float]) -> list[float]:
         """``D M D v`` for the servo joints: M(q) at the true state, in the measured frame."""
@@ -835,7 +841,8 @@ class Simulation:
             states = p.getJointStates(b.body, [j.index for j in b.active],
                                       physicsClientId=client)
             if self.config.record.motor_torques:
-                torques = {spec.name: st[3] * b.directions.get(spec.name, 1.0)
+                torques = {spec.name: b.torques.get(spec.name, st[3])
+                           * b.directions.get(spec.name, 1.0)
                            for spec, st in zip(b.active, states, strict=True)}
             # Over the time since the velocities were last taken (one step, when recording).
             span = (self.step_count - b.previous_step) * self.time_step
@@ -1010,6 +1017,7 @@ class Simulation:
             b.applied = b.override = None
             b.reported = None
             disable_default_motors(p, b.body, client, [j.index for j in b.active])
+            b.torques.clear()
             for call in plans.get(b.name, ()):
                 call()
             b.history.append(self._measure(b))
@@ -1105,7 +1113,8 @@ class Simulation:
         b = self._body(robot)
         p, client = self.session.p, self.session.client
         states = p.getJointStates(b.body, [j.index for j in b.active], physicsClientId=client)
-        return {j.name: st[3] * b.directions.get(j.name, 1.0)
+        # PyBullet reports 0 for a torque-controlled joint: the torque given is the answer.
+        return {j.name: b.torques.get(j.name, st[3]) * b.directions.get(j.name, 1.0)
                 for j, st in zip(b.active, states, strict=True)}
 
     def link_pose(self, robot: str, link: str) -> tuple[list[float], list[float]]:

@@ -1,0 +1,155 @@
+"""The native scenario's newer keys: modes per joint, history, reset overrides, gains, damping.
+
+Each is checked against what PyBullet or physics says should happen.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from urdfkit.errors import InputError, ParameterError
+from urdfkit.sim import Simulation
+
+ROOT = Path(__file__).parent.parent
+PENDULUM = str(ROOT / "examples" / "pendulum.urdf")
+QUADRUPED = str(ROOT / "tests" / "fixtures" / "robots" / "quadruped_like.urdf")
+
+
+def _pendulum(**robot: object) -> dict:
+    return {"physics": {"time_step": 0.001}, "duration": 1.0,
+            "robots": [{"name": "pendulum", "urdf": PENDULUM, "base": "fixed",
+                        "initial_joints": {"hinge": 0.5}, **robot}]}
+
+
+def test_one_segment_drives_each_joint_in_its_own_mode():
+    doc = {"physics": {"time_step": 1 / 240, "gravity": [0, 0, 0]}, "robots": [{
+        "name": "q", "urdf": QUADRUPED, "base": "fixed", "joints": [{
+            "until": 5.0, "max_force": 30.0,
+            "mode": {"FR_hip_joint": "position", "FR_thigh_joint": "velocity",
+                     "FR_calf_joint": "torque"},
+            "targets": {"FR_hip_joint": 0.3, "FR_thigh_joint": 1.5, "FR_calf_joint": 0.2}}]}]}
+    with Simulation(doc) as s:
+        s.step(240)
+        q = s.joint_positions("q")
+        qd = s.joint_velocities("q")
+        torques = s.motor_torques("q")
+    assert q["FR_hip_joint"] == pytest.approx(0.3, abs=1e-3)  # held at its target
+    assert qd["FR_thigh_joint"] == pytest.approx(1.5, rel=1e-3)  # turning at its speed
+    assert torques["FR_calf_joint"] == pytest.approx(0.2)  # the torque, every step
+
+
+def test_a_mode_per_joint_needs_every_target():
+    doc = _pendulum(joints=[{"until": 1.0, "mode": {"other": "torque"},
+                             "targets": {"hinge": 0.1}}])
+    with pytest.raises(InputError, match=r"robots\[0\].joints\[0\].mode: no mode for target "
+                                         "'hinge'"):
+        Simulation(doc)
+
+
+def test_history_keeps_the_last_n_steps_in_order():
+    with Simulation(_pendulum(history=5, noise={"motor_angles": 0.01})) as s:
+        assert [o.step for o in s.history("pendulum")] == [0]
+        truth = []
+        for _ in range(12):
+            s.step()
+            truth.append(s.observe("pendulum", ideal=True).motor_angles["hinge"])
+        seen = s.history("pendulum")
+        ideal = s.history("pendulum", ideal=True)
+        assert [o.step for o in seen] == list(range(8, 13))
+        assert [o.motor_angles["hinge"] for o in ideal] == truth[-5:]
+        # Reported entries are the noisy ones observe() gave, and stay so.
+        assert seen[-1].motor_angles == s.observe("pendulum").motor_angles
+        assert np.std([a.motor_angles["hinge"] - b.motor_angles["hinge"]
+                       for a, b in zip(seen, ideal, strict=True)]) > 0
+        seen[-1].motor_angles["hinge"] = 99.0  # a copy
+        assert s.history("pendulum")[-1].motor_angles["hinge"] != 99.0
+
+
+def test_reset_overrides_start_an_episode_elsewhere():
+    with Simulation(_pendulum()) as s:
+        s.step(100)
+        s.reset(overrides={"pendulum": {"initial_joints": {"hinge": {"position": -0.2,
+                                                                     "velocity": 1.0}}}})
+        assert s.joint_positions("pendulum")["hinge"] == pytest.approx(-0.2)
+        assert s.joint_velocities("pendulum")["hinge"] == pytest.approx(1.0)
+        assert s.t == 0.0
+        s.reset()  # the scenario's start again
+        assert s.joint_positions("pendulum")["hinge"] == pytest.approx(0.5)
+        with pytest.raises(ParameterError, match="unknown key 'speed'"):
+            s.reset(overrides={"pendulum": {"speed": 1}})
+        with pytest.raises(ParameterError, match="no active joint named 'elbow'"):
+            s.reset(overrides={"pendulum": {"initial_joints": {"elbow": 1.0}}})
+
+
+def test_reset_overrides_move_a_floating_base_in_its_pose_frame():
+    doc = {"robots": [{"name": "q", "urdf": QUADRUPED, "position": [0, 0, 1]}]}
+    with Simulation(doc) as s:
+        s.reset(overrides={"q": {"position": [1.0, 2.0, 0.5], "orientation_rpy": [0, 0, 1.0],
+                                 "base_velocity": [0.5, 0, 0]}})
+        at, turn = s.link_pose("q", "base")
+        assert at == pytest.approx([1.0, 2.0, 0.5], abs=1e-9)
+        assert 2 * math.atan2(turn[2], turn[3]) == pytest.approx(1.0)
+        assert s.observe("q", ideal=True).base_lin_vel == pytest.approx([0.5, 0, 0])
+
+
+def test_set_motor_gains_changes_the_servo_torque():
+    doc = _pendulum(motor={"kp": 10.0}, physics={"time_step": 0.001, "gravity": [0, 0, 0]},
+                    joints=[{"until": 1.0, "targets": {"hinge": 0.0}}])
+    doc["physics"] = doc["robots"][0].pop("physics")
+    with Simulation(doc) as s:
+        s.step()
+        first = s.motor_torques("pendulum")["hinge"]
+        s.reset()
+        s.set_motor_gains("pendulum", kp={"hinge": 40.0})
+        s.step()
+        assert first == pytest.approx(-10.0 * 0.5)
+        assert s.motor_torques("pendulum")["hinge"] == pytest.approx(-40.0 * 0.5)
+        with pytest.raises(ParameterError, match="drives no joint named 'x'"):
+            s.set_motor_gains("pendulum", kd={"x": 1.0})
+
+
+def test_a_robots_own_zero_damping_keeps_an_undamped_swing():
+    # PyBullet's 0.04 link damping costs a pendulum ~40% of its amplitude in 10 s.
+    def amplitude_after(**robot: object) -> float:
+        doc = _pendulum(**robot)
+        doc["physics"]["time_step"] = 1 / 240
+        with Simulation(doc) as s:
+            s.step(240 * 9)
+            peak = 0.0
+            for _ in range(240):
+                s.step()
+                peak = max(peak, abs(s.joint_positions("pendulum")["hinge"]))
+        return peak
+
+    assert amplitude_after(linear_damping=0.0, angular_damping=0.0) == \
+        pytest.approx(0.5, rel=0.01)
+    assert amplitude_after() < 0.4
+
+
+def test_pose_frame_com_places_the_centre_of_mass():
+    # pendulum.urdf's base has its centre of mass 0.5 m above its frame.
+    with Simulation(_pendulum(position=[0, 0, 1.5], pose_frame="com")) as s:
+        assert s.observe("pendulum", ideal=True).base_position == pytest.approx([0, 0, 1.5])
+        assert s.link_pose("pendulum", "base_link")[0] == pytest.approx([0, 0, 1.0])
+
+
+def test_noise_per_joint_and_per_axis():
+    doc = _pendulum(noise={"motor_angles": {"hinge": 0.02}, "base_position": [0.0, 0.1, 0.0],
+                           "base_orientation": [0.0, 0.0, 0.05]})
+    with Simulation(doc) as s:
+        angles, ys, xs, yaws = [], [], [], []
+        for _ in range(2000):
+            s.step()
+            seen, true = s.observe("pendulum"), s.observe("pendulum", ideal=True)
+            angles.append(seen.motor_angles["hinge"] - true.motor_angles["hinge"])
+            xs.append(seen.base_position[0] - true.base_position[0])
+            ys.append(seen.base_position[1] - true.base_position[1])
+            q = seen.base_orientation
+            yaws.append(2 * math.atan2(q[2], q[3]))
+    assert np.std(angles) == pytest.approx(0.02, rel=0.05)
+    assert np.std(ys) == pytest.approx(0.1, rel=0.05) and max(map(abs, xs)) == 0.0
+    assert np.std(yaws) == pytest.approx(0.05, rel=0.05)
