@@ -17,13 +17,13 @@ PACKAGE = Path(urdfkit.__file__).parent
 LAYERS: dict[str, int] = {}
 for floor, names in enumerate([
     # spec and model
-    "errors spec style templatedir suggest output cache xmlio builder catalog",
+    "errors spec style templatedir suggest output cache xmlio tomlio builder catalog",
     # sources: files, packages, xacro, and the guard every loader calls
     "uris meshes _xacro_worker expand validate resolve",
     # the engine session
     "session",
     # run and draw
-    "inspect body tree report graph vehicle drive scenario sim render plot check build",
+    "inspect body tree report graph vehicle drive sac scenario sim render plot check build",
     # presentation and the command line
     "present cli __main__",
 ]):

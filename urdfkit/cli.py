@@ -812,9 +812,8 @@ def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
 
 
 @app.command(epilog=_examples(
-    "urdfkit sim scenario.toml", "urdfkit sim scenario.toml -o rows.csv",
-    "urdfkit sim scenario.json --json", "urdfkit sim scenario.toml --gui",
-    "urdfkit sim configs/robot.json   # a simulation_and_control config, as it is",
+    "urdfkit sim scenario.toml -o rows.csv", "urdfkit sim scenario.toml --gui",
+    "urdfkit sim configs/robot.json   # a simulation_and_control config",
     "urdfkit sim convert configs/robot.json -o scenario.toml"))
 def sim(
     scenario: Annotated[str, typer.Argument(

@@ -528,7 +528,7 @@ def to_toml(imported: Imported, *, source: str | Path, out_dir: str | Path | Non
     The notes head the file as comments, so what the import follows or drops stays said.
     """
     from . import __version__
-    from .scenario import to_toml as write
+    from .tomlio import dumps as write
 
     document = dict(imported.scenario)
     if out_dir is not None:
