@@ -949,8 +949,9 @@ class Simulation:
             self._fresh(b)
             # history ends with the current observation; the delayed one is `delay` before.
             source = b.history[max(0, len(b.history) - 1 - b.config.delay)]
-            b.reported = (self.step_count,
-                          self._add_noise(b, source._replace(t=self.t, step=self.step_count)))
+            if b.config.delay or b.config.noise is not None:
+                source = self._add_noise(b, source._replace(t=self.t, step=self.step_count))
+            b.reported = (self.step_count, source)
             if b.reports is not None:
                 b.reports.append(b.reported[1])
         return b.reported[1]
@@ -1435,9 +1436,12 @@ class Simulation:
         ideal: list[Observation] = []
         summary = _Summary()
 
+        bodies = list(self.bodies.values())
+
         def record() -> None:
-            batch = [self._observe_one(name) for name in self.bodies]
-            truth = [self._observe_one(name, ideal=True) for name in self.bodies]
+            # As observe() gives them (copies), without its per-call lookups.
+            truth = [self._fresh(b).copy() for b in bodies]
+            batch = [self._report(b).copy() for b in bodies]
             # Only whole batches count: an interrupt above drops this one entirely.
             if keep:
                 rows.extend(batch)
