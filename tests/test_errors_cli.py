@@ -172,6 +172,15 @@ def test_every_help_ends_with_examples(command: str) -> None:
     assert 2 <= tail.count(f"$ urdfkit {command}") <= 4
 
 
+def test_help_text_reflows_and_keeps_its_words() -> None:
+    # rich keeps a docstring's line breaks; the help must read as whole paragraphs.
+    _, out, _ = invoke("drive", "--help", env={"COLUMNS": "300"})
+    assert "Wheels (continuous joints about a horizontal axis) and steering hinges (revolute " \
+        "joints about a vertical axis that carry wheels) are detected." in out
+    _, out, _ = invoke("tree", "--help", env={"COLUMNS": "300"})
+    assert "[n] is the index PyBullet will give the joint." in out
+
+
 def test_help_keeps_brackets_and_shows_readable_defaults() -> None:
     _, out, _ = invoke("drive", "--help", env={"COLUMNS": "160"})
     assert "urdfkit[plot]" in out

@@ -413,9 +413,9 @@ def tree(
     force: ForceOpt = False,
     no_guard: NoGuardOpt = False,
 ) -> None:
-    """The kinematic tree: links, and the joints between them with type, axis and index.
+    r"""The kinematic tree: links, and the joints between them with type, axis and index.
 
-    Read from the file alone; PyBullet is not loaded. [n] is the index PyBullet will give
+    Read from the file alone; PyBullet is not loaded. \[n] is the index PyBullet will give
     the joint. --json is flat: every joint with its parent and child link, in index order.
     """
     from .tree import kinematic_tree
@@ -933,6 +933,19 @@ def _sim_convert(config: str, out: str | None, force: bool) -> None:
     text = sac.to_toml(imported, source=config, out_dir=Path(out).parent)
     show.wrote(atomic_write(out, text.encode("utf-8"), force=force),
                f"{len(imported.scenario['robots'])} robot(s)")
+
+
+def _reflow(doc: str) -> str:
+    """A docstring's paragraphs each on one line: rich help keeps single line breaks."""
+    return "\n\n".join(" ".join(line.strip() for line in para.splitlines())
+                       for para in doc.strip().split("\n\n"))
+
+
+for _info in app.registered_commands:
+    if _info.help is None and _info.callback is not None and _info.callback.__doc__:
+        import inspect
+
+        _info.help = _reflow(inspect.cleandoc(_info.callback.__doc__))
 
 
 def _command_name(info: Any) -> str:
