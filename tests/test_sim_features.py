@@ -153,3 +153,67 @@ def test_noise_per_joint_and_per_axis():
     assert np.std(angles) == pytest.approx(0.02, rel=0.05)
     assert np.std(ys) == pytest.approx(0.1, rel=0.05) and max(map(abs, xs)) == 0.0
     assert np.std(yaws) == pytest.approx(0.05, rel=0.05)
+
+
+# --------------------------------------------------------------------------- dry joint friction
+
+HOLD = 1.0 * 9.81 * 0.5 * math.sin(0.5)  # the bob's gravity torque at q = 0.5: 2.35 N m
+
+
+@pytest.mark.parametrize(("friction", "holds"), [(1.1 * HOLD, True), (0.9 * HOLD, False)])
+def test_joint_friction_holds_the_pendulum_only_above_its_gravity_torque(friction, holds):
+    with Simulation(_pendulum(joint_friction={"hinge": friction})) as s:
+        s.step(1000)
+        q = s.joint_positions("pendulum")["hinge"]
+    if holds:
+        assert q == pytest.approx(0.5, abs=1e-4)
+    else:
+        assert q < 0.45
+
+
+def test_joint_friction_works_alongside_torque_commands_and_stays_across_reset():
+    # Friction 3 N m against gravity's 2.35: a +2 N m push leaves 0.35 (held), a -2 N m one
+    # adds up to 4.35 (slips).
+    with Simulation(_pendulum()) as s:
+        s.set_joint_friction("pendulum", "hinge", 3.0)
+        s.set_joint_targets("pendulum", {"hinge": 2.0}, mode="torque")
+        s.step(500)
+        assert s.joint_positions("pendulum")["hinge"] == pytest.approx(0.5, abs=1e-4)
+        s.set_joint_targets("pendulum", {"hinge": -2.0}, mode="torque")
+        s.step(500)
+        assert s.joint_positions("pendulum")["hinge"] < 0.4
+        s.reset()
+        s.step(500)  # no command: friction alone holds it
+        assert s.joint_positions("pendulum")["hinge"] == pytest.approx(0.5, abs=1e-4)
+        s.set_joint_friction("pendulum", "hinge", 0.0)
+        s.step(200)
+        assert s.joint_positions("pendulum")["hinge"] < 0.45
+
+
+def test_a_position_command_owns_the_motor_and_friction_returns_after_it():
+    with Simulation(_pendulum(joint_friction={"hinge": 3.0})) as s:
+        s.set_joint_targets("pendulum", {"hinge": 0.2}, mode="position")
+        s.step(1000)
+        assert s.joint_positions("pendulum")["hinge"] == pytest.approx(0.2, abs=2e-3)
+        s.set_joint_friction("pendulum", "hinge", 3.5)  # does not take the motor over
+        s.step(100)
+        assert s.joint_positions("pendulum")["hinge"] == pytest.approx(0.2, abs=2e-3)
+        s.set_joint_targets("pendulum", {"hinge": 0.0}, mode="torque")
+        s.reset(overrides={"pendulum": {"initial_joints": {"hinge": 0.5}}})
+        s.set_joint_targets("pendulum", {"hinge": -0.9}, mode="torque")
+        s.step(500)  # 2.35 + 0.9 = 3.25: held by the 3.5 set during the command, not by 3
+        assert s.joint_positions("pendulum")["hinge"] == pytest.approx(0.5, abs=1e-4)
+
+
+def test_joint_friction_refuses_bad_names_and_values():
+    with pytest.raises(InputError, match=r"robots\[0\].joint_friction.elbow: .*'elbow'"):
+        Simulation(_pendulum(joint_friction={"elbow": 1.0}))
+    with pytest.raises(InputError, match=r"joint_friction.hinge"):
+        Simulation(_pendulum(joint_friction={"hinge": -1.0}))
+    with Simulation(_pendulum()) as s:
+        with pytest.raises(ParameterError, match="no joint named 'elbow'"):
+            s.set_joint_friction("pendulum", "elbow", 1.0)
+        with pytest.raises(ParameterError, match=">= 0"):
+            s.set_joint_friction("pendulum", "hinge", -1.0)
+        with pytest.raises(ParameterError, match=">= 0"):
+            s.set_joint_friction("pendulum", "hinge", math.nan)

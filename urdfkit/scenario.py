@@ -194,6 +194,8 @@ def schema() -> SimpleNamespace:
         # None: physics.linear_damping / angular_damping.
         linear_damping: non_negative | None = None
         angular_damping: non_negative | None = None
+        # Dry (Coulomb) friction per joint, N m or N: PyBullet's joint motor at velocity 0.
+        joint_friction: dict[str, non_negative] = Field(default_factory=dict)
         initial_joints: dict[str, InitialJoint] = Field(default_factory=dict)
         drive: list[DriveSegment] | None = None
         vehicle: Vehicle | None = None

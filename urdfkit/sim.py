@@ -226,6 +226,7 @@ class _Body:
     # Torques given in TORQUE_CONTROL for the coming step (physical frame): PyBullet reports
     # 0 as a torque-controlled joint's applied torque.
     torques: dict[str, float] = field(default_factory=dict)
+    dry_friction: dict[int, float] = field(default_factory=dict)  # joint index -> N m or N
 
     def joint(self, name: str) -> JointSpec:
         for j in self.joints:
@@ -516,10 +517,10 @@ class Simulation:
                 raise self._error(f"{path}.vehicle" if v else f"{path}.drive", e.message) \
                     from None
 
-        from .vehicle import disable_default_motors
-
+        for name, friction in cfg.joint_friction.items():
+            b.dry_friction[active_joint(f"{path}.joint_friction.{name}", name).index] = friction
         # PyBullet holds every joint with a velocity motor (target 0) until told otherwise.
-        disable_default_motors(p, body, client, [j.index for j in active])
+        self._free(b)
         if any(cfg.base_velocity) or any(cfg.base_angular_velocity):
             p.resetBaseVelocity(body, cfg.base_velocity, cfg.base_angular_velocity,
                                 physicsClientId=client)
@@ -650,9 +651,7 @@ class Simulation:
             if b.applied is not None:
                 # Free every joint before the new command: a position motor set by the last
                 # segment would otherwise keep fighting a torque command.
-                from .vehicle import disable_default_motors
-
-                disable_default_motors(p, b.body, client, [j.index for j in b.active])
+                self._free(b)
                 b.torques.clear()
             if cmd is not None and cmd.kind == "drive":
                 from .vehicle import apply_drive, clamp_steer
@@ -661,6 +660,8 @@ class Simulation:
                 # Motors persist in PyBullet: set once per change of command.
                 apply_drive(p, b.body, client, b.train, cmd.throttle,
                             clamp_steer(b.train, cmd.steer)[0], max_force)
+                if b.dry_friction:  # apply_drive frees the undriven wheels
+                    self._free(b, [i for i in b.train.free if i in b.dry_friction])
             elif cmd is not None and not b.servo:
                 self._apply_motors(b, cmd, torque=False)  # motors persist: set on change
             b.applied = cmd
@@ -668,6 +669,21 @@ class Simulation:
             self._apply_motors(b, cmd, torque=True)  # torques last one step only
         if b.servo:
             self._apply_servo(b, cmd)
+
+    def _free(self, b: _Body, indices: Sequence[int] | None = None) -> None:
+        """Switch PyBullet's velocity motors to their joints' dry friction (0: free).
+
+        A velocity motor with target 0 and a force limit is Coulomb friction: it holds the
+        joint against up to that much torque and slows it by that much when it moves. It
+        works alongside TORQUE_CONTROL (the servo); PyBullet's position and velocity
+        commands use the same motor and replace it while they drive the joint.
+        """
+        p, client = self.session.p, self.session.client
+        joints = [j.index for j in b.active] if indices is None else list(indices)
+        if joints:
+            p.setJointMotorControlArray(
+                b.body, joints, p.VELOCITY_CONTROL, targetVelocities=[0.0] * len(joints),
+                forces=[b.dry_friction.get(j, 0.0) for j in joints], physicsClientId=client)
 
     def _apply_motors(self, b: _Body, cmd: _Command, *, torque: bool) -> None:
         """PyBullet's own motors for a ``joints`` command (no servo model).
@@ -1006,8 +1022,6 @@ class Simulation:
         p.restoreState(self._start_state, physicsClientId=client)
         self.step_count = 0
         base_seed = self.config.seed if seed is None else seed
-        from .vehicle import disable_default_motors
-
         for i, b in enumerate(self.bodies.values()):
             b.rng = random.Random(self._robot_seed(base_seed, i))
             b.history.clear()
@@ -1017,7 +1031,7 @@ class Simulation:
             b.previous_step = -1
             b.applied = b.override = None
             b.reported = None
-            disable_default_motors(p, b.body, client, [j.index for j in b.active])
+            self._free(b)
             b.torques.clear()
             for call in plans.get(b.name, ()):
                 call()
@@ -1346,6 +1360,40 @@ class Simulation:
         p, client = self.session.p, self.session.client
         p.changeDynamics(b.body, spec.index, jointDamping=float(damping),
                          physicsClientId=client)
+
+    def set_joint_friction(self, robot: str, joint: str, friction: float) -> None:
+        """A joint's dry (Coulomb) friction, N m (N for a prismatic joint); 0 removes it.
+
+        The joint holds against up to ``friction`` of torque and is slowed by that much when
+        it moves (PyBullet's joint motor at velocity 0 with that force limit). While a
+        PyBullet position or velocity command drives the joint (a ``joints`` segment without
+        a ``motor`` table, or a car's wheels and hinges), that command owns the motor; the
+        friction comes back when it ends. It stays across ``reset()``.
+        """
+        b = self._body(robot)
+        try:
+            spec = b.joint(joint)
+        except KeyError:
+            raise ParameterError(f"`joint`: {robot} has no joint named {joint!r}",
+                                 param="joint") from None
+        if spec not in b.active:
+            raise ParameterError(f"`joint`: {joint} of {robot} is fixed", param="joint")
+        if not (isinstance(friction, (int, float)) and math.isfinite(friction)
+                and friction >= 0):
+            raise ParameterError(f"`friction` must be a finite number >= 0, got {friction!r}",
+                                 param="friction")
+        b.dry_friction[spec.index] = float(friction)
+        if not self._motor_driven(b, spec):
+            self._free(b, [spec.index])
+
+    def _motor_driven(self, b: _Body, spec: JointSpec) -> bool:
+        """Whether a PyBullet position or velocity command holds this joint's motor now."""
+        cmd = b.applied
+        if cmd is None or b.servo:
+            return False
+        if cmd.kind == "drive":
+            return b.train is not None and spec.index in (*b.train.wheels, *b.train.hinges)
+        return spec.name in cmd.targets and cmd.mode_of(spec.name) != "torque"
 
     def set_link_damping(self, robot: str, linear: float, angular: float) -> None:
         """Every link's linear and angular velocity damping (PyBullet's default is 0.04)."""
