@@ -212,8 +212,9 @@ class _Body:
     contact_links: dict[str, int] = field(default_factory=dict)
     force_joints: dict[str, int] = field(default_factory=dict)
     pose_links: list[str] = field(default_factory=list)
-    previous_velocities: dict[str, float] = field(default_factory=dict)
-    previous_step: int = -1  # the step previous_velocities were taken at
+    # The active joints' physical velocities when last taken, and the step they were taken at.
+    previous_velocities: list[float] | None = None
+    previous_step: int = -1
     applied: _Command | None = None
     override: _Command | None = None
     reported: tuple[int, Observation] | None = None
@@ -227,6 +228,13 @@ class _Body:
     # 0 as a torque-controlled joint's applied torque.
     torques: dict[str, float] = field(default_factory=dict)
     dry_friction: dict[int, float] = field(default_factory=dict)  # joint index -> N m or N
+
+    @functools.cached_property
+    def frame(self) -> tuple[list[int], list[str], list[float], list[float]]:
+        """The active joints' indices, names, directions and offsets, in order (fixed)."""
+        return ([j.index for j in self.active], [j.name for j in self.active],
+                [self.directions.get(j.name, 1.0) for j in self.active],
+                [self.offsets.get(j.name, 0.0) for j in self.active])
 
     def joint(self, name: str) -> JointSpec:
         for j in self.joints:
@@ -259,7 +267,8 @@ class SimResult:
 
     Attributes:
         rows: Reported observations (noise and delay applied), in time order.
-        ideal: The true observations at the same steps.
+        ideal: The true observations at the same steps (for a robot without noise or
+            delay, the very objects in ``rows``: what it reports is the truth).
         time_step: Physics time step, s.
         steps: Physics steps taken.
         interrupted: Ctrl-C (or SIGTERM in the CLI) ended the run early; the rows cover the
@@ -831,9 +840,8 @@ class Simulation:
     def _keep_velocities(self, b: _Body) -> None:
         """Remember the joint velocities now, for the next measurement's accelerations."""
         p, client = self.session.p, self.session.client
-        states = p.getJointStates(b.body, [j.index for j in b.active], physicsClientId=client)
-        b.previous_velocities = {spec.name: st[1] * b.directions.get(spec.name, 1.0)
-                                 for spec, st in zip(b.active, states, strict=True)}
+        states = p.getJointStates(b.body, b.frame[0], physicsClientId=client)
+        b.previous_velocities = [st[1] for st in states]
         b.previous_step = self.step_count
 
     def _fresh(self, b: _Body) -> Observation:
@@ -854,22 +862,24 @@ class Simulation:
         forces: dict[str, list[float]] | None = None
         torques: dict[str, float] | None = None
         if b.active:
-            states = p.getJointStates(b.body, [j.index for j in b.active],
-                                      physicsClientId=client)
+            indices, names, signs, offsets = b.frame
+            states = p.getJointStates(b.body, indices, physicsClientId=client)
             if self.config.record.motor_torques:
-                torques = {spec.name: b.torques.get(spec.name, st[3])
-                           * b.directions.get(spec.name, 1.0)
-                           for spec, st in zip(b.active, states, strict=True)}
+                torques = {n: b.torques.get(n, st[3]) * s
+                           for n, st, s in zip(names, states, signs, strict=True)}
+            qd = [st[1] for st in states]
+            angles = {n: (st[0] - o) * s
+                      for n, st, s, o in zip(names, states, signs, offsets, strict=True)}
+            velocities = {n: v * s for n, v, s in zip(names, qd, signs, strict=True)}
             # Over the time since the velocities were last taken (one step, when recording).
             span = (self.step_count - b.previous_step) * self.time_step
-            first = not b.previous_velocities or span <= 0
-            for spec, state in zip(b.active, states, strict=True):
-                sign = b.directions.get(spec.name, 1.0)
-                angles[spec.name] = (state[0] - b.offsets.get(spec.name, 0.0)) * sign
-                velocities[spec.name] = state[1] * sign
-                accelerations[spec.name] = 0.0 if first else \
-                    (velocities[spec.name] - b.previous_velocities[spec.name]) / span
-            b.previous_velocities = dict(velocities)
+            before = b.previous_velocities
+            if before is None or span <= 0:
+                accelerations = dict.fromkeys(names, 0.0)
+            else:
+                accelerations = {n: (v - v0) * s / span for n, v, v0, s
+                                 in zip(names, qd, before, signs, strict=True)}
+            b.previous_velocities = qd
             b.previous_step = self.step_count
         if b.force_joints:
             forces = {}
@@ -1027,7 +1037,7 @@ class Simulation:
             b.history.clear()
             if b.reports is not None:
                 b.reports.clear()
-            b.previous_velocities = {}
+            b.previous_velocities = None
             b.previous_step = -1
             b.applied = b.override = None
             b.reported = None
@@ -1487,9 +1497,13 @@ class Simulation:
         bodies = list(self.bodies.values())
 
         def record() -> None:
-            # As observe() gives them (copies), without its per-call lookups.
-            truth = [self._fresh(b).copy() for b in bodies]
-            batch = [self._report(b).copy() for b in bodies]
+            # As observe() gives them (copies), without its per-call lookups; one copy when
+            # what a robot reports is its true state.
+            truth = [self._fresh(b) for b in bodies]
+            batch = [self._report(b) for b in bodies]
+            for k, (seen, true) in enumerate(zip(batch, truth, strict=True)):
+                batch[k] = seen.copy()
+                truth[k] = batch[k] if seen is true else true.copy()
             # Only whole batches count: an interrupt above drops this one entirely.
             if keep:
                 rows.extend(batch)
