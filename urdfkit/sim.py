@@ -219,7 +219,9 @@ class _Body:
     override: _Command | None = None
     reported: tuple[int, Observation] | None = None
     loaded: tuple[str, LoadOptions] | None = None  # the file PyBullet loaded, and how
-    changes: list[tuple[int, dict[str, Any]]] = field(default_factory=list)  # set_* calls
+    # set_* changes to mass properties, (link, changeDynamics key) -> the latest value, in the
+    # order first made (mass before the inertia it rescales): bounded however often it is set.
+    changes: dict[tuple[int, str], Any] = field(default_factory=dict)
     feet: dict[str, int] = field(default_factory=dict)  # label -> link index
     kp: float | dict[str, float] = 0.0  # the servo's gains (set_motor_gains changes them)
     kd: float | dict[str, float] = 0.0
@@ -1210,8 +1212,8 @@ class Simulation:
                 ph = self.config.physics
                 s.p.setGravity(*ph.gravity, physicsClientId=s.client)
                 body = s.load_urdf(b.loaded[0], b.loaded[1], display=b.name)
-                for link, values in b.changes:
-                    s.p.changeDynamics(body, link, physicsClientId=s.client, **values)
+                for (link, key), value in b.changes.items():
+                    s.p.changeDynamics(body, link, physicsClientId=s.client, **{key: value})
             except BaseException:
                 s.close()
                 raise
@@ -1221,7 +1223,8 @@ class Simulation:
 
     def _changed(self, b: _Body, link: int, values: dict[str, Any]) -> None:
         """Remember a change to a robot's mass properties; its dynamics model is stale."""
-        b.changes.append((link, values))
+        for key, value in values.items():
+            b.changes[(link, key)] = value
         shadow = self.__dict__.get("_shadows", {}).pop(b.name, None)
         if shadow is not None:
             shadow[0].close()
