@@ -617,8 +617,9 @@ def drive(
         raise ParameterError("`tutorial` fixes the drivetrain (locked) and the motor force "
                              "(PyBullet's default); drop --drivetrain and --max-force",
                              param="tutorial")
-    if gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-                    or sys.platform in ("darwin", "win32")):
+    from .session import has_display
+
+    if gui and not has_display():
         raise ParameterError("`gui` needs a display (DISPLAY is not set); drop it to drive "
                              "headless", param="gui")
     # Check the outputs before a long run, not after it.
@@ -858,8 +859,9 @@ def sim(
         raise ParameterError(f"one scenario at a time; got {scenario!r} and {config!r} (to "
                              "convert a config: urdfkit sim convert conf.json)",
                              param="scenario")
-    if gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-                    or sys.platform in ("darwin", "win32")):
+    from .session import has_display
+
+    if gui and not has_display():
         raise ParameterError("`gui` needs a display (DISPLAY is not set); drop it to run "
                              "headless", param="gui")
     if out is not None:

@@ -172,6 +172,35 @@ def schema() -> SimpleNamespace:
         base_lin_vel_body_frame: per_axis = 0.0
         base_ang_vel_body_frame: per_axis = 0.0
 
+    span = Annotated[list[float], Field(min_length=2, max_length=2)]
+
+    class Randomize(Model):
+        # Drawn anew at every ScenarioEnv reset, uniformly in [low, high]:
+        initial_joints: dict[str, span] = Field(default_factory=dict)  # measured frame
+        position: Annotated[list[span], Field(min_length=3, max_length=3)] | None = None
+        yaw: span | None = None  # rad, added to orientation_rpy's yaw
+        lateral_friction: dict[str, span] = Field(default_factory=dict)  # link -> mu
+        mass_scale: dict[str, span] = Field(default_factory=dict)  # link -> factor
+
+        @model_validator(mode="after")
+        def _ranges(self) -> Randomize:
+            groups: list[tuple[str, Any, float | None]] = [
+                ("initial_joints", self.initial_joints, None),
+                ("lateral_friction", self.lateral_friction, 0.0),
+                ("mass_scale", self.mass_scale, 1e-9)]
+            for label, table, floor in groups:
+                for key, (lo, hi) in table.items():
+                    if lo > hi:
+                        raise ValueError(f"{label}.{key}: low {lo} is above high {hi}")
+                    if floor is not None and lo < floor:
+                        raise ValueError(f"{label}.{key}: must be "
+                                         f"{'> 0' if floor else '>= 0'}, got {lo}")
+            for label, pair in (("yaw", self.yaw), *(
+                    (f"position[{i}]", r) for i, r in enumerate(self.position or []))):
+                if pair is not None and pair[0] > pair[1]:
+                    raise ValueError(f"{label}: low {pair[0]} is above high {pair[1]}")
+            return self
+
     class Robot(Model):
         name: Annotated[str, Field(min_length=1)] | None = None
         template: str | None = None
@@ -207,6 +236,8 @@ def schema() -> SimpleNamespace:
         delay: Annotated[int, Field(ge=0)] = 0
         # Simulation.history keeps the last N reported observations, one per physics step.
         history: Annotated[int, Field(ge=1, le=100_000)] = 1
+        # Per-episode randomisation, used by urdfkit.gym.ScenarioEnv's reset.
+        randomize: Randomize | None = None
 
     class Scenario(Model):
         physics: Physics = Field(default_factory=Physics)
@@ -247,6 +278,7 @@ def schema() -> SimpleNamespace:
         Scenario=Scenario, Physics=Physics, Ground=Ground, Record=Record, Robot=Robot,
         DriveSegment=DriveSegment, Vehicle=Vehicle, JointSegment=JointSegment, Motor=Motor,
         InitialJoint=InitialJoint, Noise=Noise, LinkDynamics=LinkDynamics,
+        Randomize=Randomize,
     )
 
 

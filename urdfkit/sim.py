@@ -35,7 +35,7 @@ from typing import Any
 
 from .errors import EngineError, InputError, MissingDependencyError, OutputError, ParameterError
 from .scenario import JOINT_NOISE_FIELDS, OBSERVATION_FIELDS, load_scenario, parse_scenario
-from .session import LoadOptions, Session
+from .session import LoadOptions, Session, prime_resets, restore_clean
 from .spec import UP_AXES, quat_mul, quat_to_matrix, rotate_back, rpy_to_quat
 
 _REVOLUTE, _PRISMATIC, _FIXED = 0, 1, 4  # p.JOINT_* values
@@ -410,6 +410,7 @@ class Simulation:
         # The starting state, for reset() in place (restoreState is ~100x cheaper than a new
         # Simulation).
         self._start_state = p.saveState(physicsClientId=client)
+        prime_resets(p, client, self._start_state, [b.body for b in self.bodies.values()])
 
     def _load(self, path: str, template: str | None, params: Mapping[str, Any],
               urdf: str | None, options: LoadOptions) -> int:
@@ -528,6 +529,19 @@ class Simulation:
                 raise self._error(f"{path}.vehicle" if v else f"{path}.drive", e.message) \
                     from None
 
+        if cfg.randomize is not None:
+            r = cfg.randomize
+            for name in r.initial_joints:
+                active_joint(f"{path}.randomize.initial_joints.{name}", name)
+            for label, table in (("lateral_friction", r.lateral_friction),
+                                 ("mass_scale", r.mass_scale)):
+                for link in table:
+                    if link not in b.links:
+                        raise self._error(f"{path}.randomize.{label}.{link}",
+                                          f"{cfg.name} has no link named {link!r}")
+            if r.yaw is not None and cfg.orientation_quat is not None:
+                raise self._error(f"{path}.randomize.yaw", "needs the start given as "
+                                  "orientation_rpy, not orientation_quat")
         for name, friction in cfg.joint_friction.items():
             b.dry_friction[active_joint(f"{path}.joint_friction.{name}", name).index] = friction
         # PyBullet holds every joint with a velocity motor (target 0) until told otherwise.
@@ -1031,7 +1045,7 @@ class Simulation:
         p, client = self.session.p, self.session.client
         plans = {self._body(robot).name: self._reset_plan(self._body(robot), changes)
                  for robot, changes in (overrides or {}).items()}
-        p.restoreState(self._start_state, physicsClientId=client)
+        restore_clean(p, client, self._start_state, [b.body for b in self.bodies.values()])
         self.step_count = 0
         base_seed = self.config.seed if seed is None else seed
         for i, b in enumerate(self.bodies.values()):

@@ -1,0 +1,650 @@
+"""Gymnasium environments: ``urdfkit/SimpleDriving-v0`` and :class:`ScenarioEnv`.
+
+``import urdfkit.gym`` registers ``urdfkit/SimpleDriving-v0``; without the import,
+``gymnasium.make("urdfkit.gym:urdfkit/SimpleDriving-v0")`` imports it first. ``docs/gym.md``
+describes both environments, where the tutorial's choices were odd, and the figures.
+
+- :class:`SimpleDrivingEnv` is the task of the PyBullet tutorial's part 2 ("Creating OpenAI Gym
+  Environments with PyBullet", ``SimpleDriving-v0``): drive urdfkit's simplecar to a goal on
+  simpleplane. Same spaces, reward, throttle model and time step; a client of its own, an
+  in-place reset, and a lean step (what the tutorial calls, minus the repeats).
+- :class:`ScenarioEnv` turns any urdfkit scenario into an environment through
+  :class:`~urdfkit.sim.Simulation`: the action space comes from the robot's controller, the
+  observation from its (noisy, delayed) observations, and ``reset`` restores in place, with the
+  per-episode randomisation the scenario's ``randomize`` tables ask for.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from .errors import MissingDependencyError, ParameterError
+
+try:
+    import gymnasium as gym
+    import numpy as np
+    from gymnasium import spaces
+except ImportError as e:  # pragma: no cover - the [gym] extra installs it
+    raise MissingDependencyError("urdfkit.gym needs gymnasium: pip install 'urdfkit[gym]'") \
+        from e
+
+from .session import LoadOptions, Session, prime_resets, restore_clean
+
+__all__ = ["SIMPLE_DRIVING_ID", "ScenarioEnv", "SimpleDrivingEnv"]
+
+SIMPLE_DRIVING_ID = "urdfkit/SimpleDriving-v0"
+
+#: The tutorial's joint indices of simplecar (urdfkit's template keeps its joint order).
+_HINGES = (0, 2)
+_WHEELS = (1, 3, 4, 5)
+
+
+def _finite_pair(action: Any) -> tuple[float, float]:
+    try:
+        a, b = action
+        first, second = float(a), float(b)
+    except (TypeError, ValueError):
+        raise ValueError(f"expected an action of two numbers (throttle, steer), got "
+                         f"{action!r}") from None
+    if not (math.isfinite(first) and math.isfinite(second)):
+        raise ValueError(f"the action must be finite, got ({first}, {second})")
+    return first, second
+
+
+class SimpleDrivingEnv(gym.Env):
+    """Drive the tutorial car to a goal: the tutorial's ``SimpleDriving-v0``, in Gymnasium 1.x.
+
+    Action: ``Box([0, -0.6], [1, 0.6])``, throttle and steering angle (rad), clipped to those
+    bounds. The throttle drives a wheel speed integrated as the tutorial does
+    (``dv/dt = 20 throttle - v (0.01 v + 0.2)``, never below 0), commanded to all four wheels
+    with a 1.2 N m motor; the steering angle goes to both hinges (whose limits are 0.5 rad).
+
+    Observation (float32): car x, y, cos(yaw), sin(yaw), velocity x, y (world), goal x, y.
+
+    Reward: the decrease in distance to the goal, clipped at 0; reaching it (within 1 m)
+    gives 50 instead and ends the episode, as does leaving ``|x|, |y| < 10``. The registered
+    id truncates at 250 steps (8.3 s), the tutorial's training length.
+
+    Args:
+        render_mode: ``"rgb_array"`` (TinyRenderer frames) or ``"human"`` (PyBullet's GUI,
+            paced to real time).
+        camera: ``"chase"`` (the tutorial's camera on the car, looking ahead) or
+            ``"overview"`` (the arena from above).
+        width, height: Frame size of ``rgb_array``.
+        implicit_cylinder: Roll on true cylinders (``URDF_USE_IMPLICIT_CYLINDER``); off by
+            default, as in the tutorial: it costs about 1.35x per physics step.
+    """
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 30}
+
+    TIME_STEP = 1.0 / 30.0
+    GRAVITY = -10.0
+    C_THROTTLE = 20.0
+    C_ROLLING = 0.2
+    C_DRAG = 0.01
+    WHEEL_FORCE = 1.2
+    ARENA = 10.0
+    GOAL_RADIUS = 1.0
+    GOAL_BONUS = 50.0
+
+    def __init__(self, render_mode: str | None = None, *, camera: str = "chase",
+                 width: int = 320, height: int = 240, implicit_cylinder: bool = False):
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ParameterError(f"render_mode must be one of "
+                                 f"{', '.join(self.metadata['render_modes'])} or None, got "
+                                 f"{render_mode!r}", param="render_mode")
+        if camera not in ("chase", "overview"):
+            raise ParameterError(f"camera must be chase or overview, got {camera!r}",
+                                 param="camera")
+        if not (isinstance(width, int) and isinstance(height, int) and width > 0
+                and height > 0):
+            raise ParameterError(f"width and height must be positive integers, got "
+                                 f"{width!r} x {height!r}", param="width")
+        self.render_mode = render_mode
+        self.camera = camera
+        self.width, self.height = width, height
+        self.action_space = spaces.Box(np.array([0.0, -0.6], dtype=np.float32),
+                                       np.array([1.0, 0.6], dtype=np.float32))
+        # The tutorial's bounds, except two: the observation that ends an episode by leaving
+        # the arena lies past +-10, by up to one step's travel at the 5 m/s bound; the goal
+        # is drawn within +-9.
+        edge = self.ARENA + 5.0 * self.TIME_STEP
+        self.observation_space = spaces.Box(
+            np.array([-edge, -edge, -1, -1, -5, -5, -9, -9], dtype=np.float32),
+            np.array([edge, edge, 1, 1, 5, 5, 9, 9], dtype=np.float32))
+        self._session = Session(gui=render_mode == "human")
+        try:
+            self._setup(implicit_cylinder)
+        except BaseException:
+            self._session.close()
+            raise
+        self.goal = (0.0, 0.0)
+        self._speed = 0.0
+        self._steer: float | None = None
+        self._previous_distance = 0.0
+        self._last_frame = 0.0
+
+    def _setup(self, implicit_cylinder: bool) -> None:
+        from .drive import builtin_file
+
+        s = self._session
+        p, c = s.p, s.client
+        self._p, self._client = p, c
+        p.setTimeStep(self.TIME_STEP, physicsClientId=c)
+        p.setGravity(0, 0, self.GRAVITY, physicsClientId=c)
+        plane, car = builtin_file("simpleplane"), builtin_file("simplecar")
+        if plane is None or car is None:  # no writable cache: build into a temp folder
+            import tempfile
+
+            from .catalog import build_template
+
+            self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-gym-")
+            plane = build_template("simpleplane").write(Path(self._tmp.name) / "plane.urdf")
+            car = build_template("simplecar").write(Path(self._tmp.name) / "car.urdf")
+        s.load_urdf(plane, LoadOptions(fixed_base=True), display="simpleplane")
+        self.car = s.load_urdf(car, LoadOptions(
+            base_position=(0.0, 0.0, 0.1), inertia_from_file=True,
+            implicit_cylinder=implicit_cylinder), display="simplecar")
+        # The goal marker: a green post, seen by the cameras, touched by nothing.
+        shape = p.createVisualShape(p.GEOM_CYLINDER, radius=0.5, length=1.0,
+                                    rgbaColor=[0.0, 0.925, 0.0, 1.0], physicsClientId=c)
+        self.goal_marker = p.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1,
+                                             baseVisualShapeIndex=shape,
+                                             basePosition=[0.0, 0.0, 0.5], physicsClientId=c)
+        self._start = p.saveState(physicsClientId=c)
+        prime_resets(p, c, self._start, [self.car])
+
+    # ---- the Gymnasium API
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
+              ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Start an episode: the car at rest at the origin, a new goal.
+
+        The goal is drawn as the tutorial draws it, from ``np_random``: x and y each from
+        ``[5, 9]`` or ``[-9, -5]``, with equal chance. ``options={"goal": (x, y)}`` sets it.
+        """
+        super().reset(seed=seed)
+        p, c = self._p, self._client
+        restore_clean(p, c, self._start, [self.car])
+        goal = (options or {}).get("goal")
+        if goal is not None:
+            gx, gy = _finite_pair(goal)
+        else:
+            # The tutorial's uniform(-5, -9), which numpy's Generator refuses (low > high):
+            # -uniform(5, 9) is the same draw.
+            rng = self.np_random
+            gx = rng.uniform(5, 9) if rng.integers(2) else -rng.uniform(5, 9)
+            gy = rng.uniform(5, 9) if rng.integers(2) else -rng.uniform(5, 9)
+        self.goal = (float(gx), float(gy))
+        p.resetBasePositionAndOrientation(self.goal_marker, [gx, gy, 0.5], [0, 0, 0, 1],
+                                          physicsClientId=c)
+        self._speed = 0.0
+        self._steer = None
+        obs = self._observe()
+        self._previous_distance = math.hypot(obs[0] - gx, obs[1] - gy)
+        if self.render_mode == "human":
+            self._last_frame = time.perf_counter()
+        return obs, {"distance": self._previous_distance}
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """Apply (throttle, steer) for one 1/30 s physics step.
+
+        Raises:
+            ValueError: an action that is not two finite numbers.
+        """
+        throttle, steer = _finite_pair(action)
+        throttle = min(max(throttle, 0.0), 1.0)
+        steer = max(min(steer, 0.6), -0.6)
+        p, c, car = self._p, self._client, self.car
+        if steer != self._steer:  # position motors persist: set on change
+            p.setJointMotorControlArray(car, _HINGES, p.POSITION_CONTROL,
+                                        targetPositions=[steer, steer], physicsClientId=c)
+            self._steer = steer
+        v = self._speed
+        v += self.TIME_STEP * (self.C_THROTTLE * throttle - v * (v * self.C_DRAG
+                                                                 + self.C_ROLLING))
+        self._speed = v = max(v, 0.0)
+        force = self.WHEEL_FORCE
+        p.setJointMotorControlArray(car, _WHEELS, p.VELOCITY_CONTROL,
+                                    targetVelocities=[v, v, v, v],
+                                    forces=[force, force, force, force], physicsClientId=c)
+        p.stepSimulation(physicsClientId=c)
+        obs = self._observe()
+        x, y = float(obs[0]), float(obs[1])
+        gx, gy = self.goal
+        distance = math.hypot(x - gx, y - gy)
+        reward = max(self._previous_distance - distance, 0.0)
+        self._previous_distance = distance
+        reached = False
+        terminated = True
+        if not (-self.ARENA < x < self.ARENA and -self.ARENA < y < self.ARENA):
+            pass
+        elif distance < self.GOAL_RADIUS:
+            reached = True
+            reward = self.GOAL_BONUS
+        else:
+            terminated = False
+        if self.render_mode == "human":
+            self._follow_in_gui(x, y)
+        return obs, reward, terminated, False, {"distance": distance, "is_success": reached}
+
+    def _observe(self) -> np.ndarray:
+        p, c = self._p, self._client
+        pos, (qx, qy, qz, qw) = p.getBasePositionAndOrientation(self.car, physicsClientId=c)
+        lin = p.getBaseVelocity(self.car, physicsClientId=c)[0]
+        # cos and sin of PyBullet's yaw, atan2(b, a), without the angle.
+        a = qw * qw + qx * qx - qy * qy - qz * qz
+        b = 2.0 * (qx * qy + qw * qz)
+        h = math.hypot(a, b)
+        cos, sin = (a / h, b / h) if h > 0 else (1.0, 0.0)
+        return np.array((pos[0], pos[1], cos, sin, lin[0], lin[1], *self.goal),
+                        dtype=np.float32)
+
+    def render(self) -> np.ndarray | None:
+        """An ``rgb_array`` frame (height x width x 3, uint8); None in ``human`` mode."""
+        if self.render_mode != "rgb_array":
+            return None
+        p, c = self._p, self._client
+        pos, orn = p.getBasePositionAndOrientation(self.car, physicsClientId=c)
+        if self.camera == "chase":
+            # The tutorial's camera: at the car, 0.2 m up, looking along its heading.
+            m = p.getMatrixFromQuaternion(orn)
+            ahead = (m[0], m[3], m[6])
+            up = (m[2], m[5], m[8])
+            eye = (pos[0], pos[1], 0.2)
+            view = p.computeViewMatrix(eye, [e + f for e, f in zip(eye, ahead, strict=True)],
+                                       up, physicsClientId=c)
+            fov = 80.0
+        else:
+            view = p.computeViewMatrix((0.0, -13.0, 17.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0),
+                                       physicsClientId=c)
+            fov = 60.0
+        proj = p.computeProjectionMatrixFOV(fov, self.width / self.height, 0.01, 100.0,
+                                            physicsClientId=c)
+        image = p.getCameraImage(self.width, self.height, view, proj,
+                                 renderer=p.ER_TINY_RENDERER, physicsClientId=c)[2]
+        return np.asarray(image, dtype=np.uint8).reshape(self.height, self.width, 4)[
+            :, :, :3].copy()
+
+    def _follow_in_gui(self, x: float, y: float) -> None:
+        p, c = self._p, self._client
+        p.resetDebugVisualizerCamera(4.0, -40.0, -35.0, [x, y, 0.0], physicsClientId=c)
+        wait = self._last_frame + self.TIME_STEP - time.perf_counter()
+        if wait > 0:
+            time.sleep(wait)
+        self._last_frame = time.perf_counter()
+
+    def close(self) -> None:
+        """Disconnect the client (safe to call twice)."""
+        self._session.close()
+        tmp = self.__dict__.pop("_tmp", None)
+        if tmp is not None:
+            tmp.cleanup()
+
+
+# --------------------------------------------------------------------------- ScenarioEnv
+
+#: The observation fields a flat observation takes by default: joints, and a floating base.
+JOINT_FIELDS = ("motor_angles", "motor_velocities")
+BASE_FIELDS = ("base_position", "base_orientation", "base_lin_vel", "base_ang_vel")
+#: Fallback action bounds when the URDF gives no limit (documented in docs/gym.md).
+DEFAULT_VELOCITY = 10.0
+DEFAULT_TORQUE = 10.0
+DEFAULT_THROTTLE = 20.0
+
+
+class ScenarioEnv(gym.Env):
+    """Any urdfkit scenario as a Gymnasium environment (see ``docs/gym.md``).
+
+    The agent commands one robot (``robot``; default the only one with a controller). Its
+    action space follows the scenario's controller: for ``drive``, ``[throttle, steer]``
+    (wheel rad/s, rad); for ``joints``, one value per joint the segments command, in each
+    joint's mode (position within its limits, velocity, or torque), in scenario order. A
+    robot with a ``motor`` table and no segments takes positions for every servo joint.
+
+    The observation is the robot's reported observation (the scenario's noise and delay
+    apply), flattened to float32 in the order :attr:`observation_names` gives, or a
+    ``Dict`` of the fields with ``observation="dict"``.
+
+    Args:
+        scenario: A scenario file, a scenario dict, or a :class:`~urdfkit.sim.Simulation`
+            (which the environment then owns and closes).
+        robot: The robot the agent drives.
+        reward: ``reward(obs) -> float``, given the reported :class:`~urdfkit.sim.Observation`
+            after each step (named fields: ``obs.motor_angles["knee"]``); default 0.
+        terminated: ``terminated(obs) -> bool``; default never.
+        max_episode_steps: Truncation; default the scenario's duration.
+        frame_skip: Physics steps per environment step (the action holds through them).
+        render_mode: ``"rgb_array"`` or ``"human"`` (a GUI window).
+        observation: ``"flat"`` or ``"dict"``.
+        fields: The observation fields to include; default the joints' angles and
+            velocities, plus the base pose and velocities for a floating base.
+        action_bounds: Per action name (joint, ``throttle`` or ``steer``), ``(low, high)``
+            instead of the defaults.
+    """
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 30}
+
+    def __init__(self, scenario: Any, robot: str | None = None,
+                 reward: Callable[[Any], float] | None = None,
+                 terminated: Callable[[Any], bool] | None = None,
+                 max_episode_steps: int | None = None, frame_skip: int = 1,
+                 render_mode: str | None = None, *, observation: str = "flat",
+                 fields: Sequence[str] | None = None,
+                 action_bounds: Mapping[str, tuple[float, float]] | None = None,
+                 width: int = 320, height: int = 240):
+        from .sim import OBSERVATION_FIELDS, Simulation
+
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ParameterError(f"render_mode must be rgb_array, human or None, got "
+                                 f"{render_mode!r}", param="render_mode")
+        if observation not in ("flat", "dict"):
+            raise ParameterError(f"observation must be flat or dict, got {observation!r}",
+                                 param="observation")
+        if not isinstance(frame_skip, int) or frame_skip < 1:
+            raise ParameterError(f"frame_skip must be an integer >= 1, got {frame_skip!r}",
+                                 param="frame_skip")
+        for name, fn in (("reward", reward), ("terminated", terminated)):
+            if fn is not None and not callable(fn):
+                raise ParameterError(f"{name} must be a callable taking the observation",
+                                     param=name)
+        gui = render_mode == "human"
+        if isinstance(scenario, Simulation):
+            if gui and not scenario.session.gui:
+                raise ParameterError("render_mode='human' needs a Simulation made with "
+                                     "gui=True", param="render_mode")
+            self.sim = scenario
+        elif isinstance(scenario, Mapping):
+            self.sim = Simulation(scenario, gui=gui)
+        else:
+            self.sim = Simulation.from_file(scenario, gui=gui)
+        try:
+            self.robot = self._pick_robot(robot)
+            self._build_action_space(dict(action_bounds or {}))
+            b = self.sim.bodies[self.robot]
+            chosen = list(fields) if fields is not None else [
+                *JOINT_FIELDS, *(BASE_FIELDS if b.config.base == "floating" else ())]
+            for f in chosen:
+                if f not in OBSERVATION_FIELDS:
+                    raise ParameterError(f"no observation field {f!r}; known: "
+                                         f"{', '.join(OBSERVATION_FIELDS)}", param="fields")
+            self.fields = chosen
+            self._build_observation_space(observation)
+            self._randomize = self._randomize_plan()
+        except BaseException:
+            self.sim.close()
+            raise
+        self.reward_fn = reward
+        self.terminated_fn = terminated
+        self.frame_skip = frame_skip
+        self.render_mode = render_mode
+        self.width, self.height = width, height
+        duration_steps = self.sim.total_steps
+        self.max_episode_steps = max_episode_steps if max_episode_steps is not None else \
+            max(1, round(duration_steps / frame_skip))
+        self._steps = 0
+
+    # ---- construction
+
+    def _pick_robot(self, robot: str | None) -> str:
+        names = self.sim.robot_names()
+        if robot is not None:
+            if robot not in names:
+                raise ParameterError(f"no robot named {robot!r}; robots: {', '.join(names)}",
+                                     param="robot")
+            return robot
+        driven = [n for n in names if self._controller(self.sim.bodies[n].config)]
+        if len(driven) == 1:
+            return driven[0]
+        if not driven:
+            raise ParameterError("no robot has a controller (drive or joints segments, or a "
+                                 "motor table) for the agent to command", param="robot")
+        raise ParameterError(f"several robots have controllers ({', '.join(driven)}); say "
+                             "which one the agent drives with robot=...", param="robot")
+
+    @staticmethod
+    def _controller(cfg: Any) -> str | None:
+        if cfg.drive is not None:
+            return "drive"
+        if cfg.joints is not None or cfg.motor is not None:
+            return "joints"
+        return None
+
+    def _build_action_space(self, bounds: dict[str, tuple[float, float]]) -> None:
+        b = self.sim.bodies[self.robot]
+        cfg = b.config
+        p, client = self.sim.session.p, self.sim.session.client
+        self.controller = self._controller(cfg)
+        names: list[str] = []
+        lows: list[float] = []
+        highs: list[float] = []
+        self.modes: dict[str, str] = {}
+
+        def default(name: str) -> tuple[float, float]:
+            if name in bounds:
+                return bounds.pop(name)
+            spec = b.joint(name)
+            info = p.getJointInfo(b.body, spec.index, physicsClientId=client)
+            lower, upper, effort, velocity = info[8], info[9], info[10], info[11]
+            mode = self.modes[name]
+            sign = b.directions.get(name, 1.0)
+            offset = b.offsets.get(name, 0.0)
+            if mode == "position":
+                if lower < upper:  # measured frame: (q - offset) * direction
+                    ends = sorted(((lower - offset) * sign, (upper - offset) * sign))
+                    return ends[0], ends[1]
+                if spec.type == p.JOINT_REVOLUTE:
+                    return -math.pi, math.pi
+                raise ParameterError(f"{name} has no position limits; give its range in "
+                                     "action_bounds", param="action_bounds")
+            if mode == "velocity":
+                v = velocity if velocity > 0 else DEFAULT_VELOCITY
+                return -v, v
+            motor = cfg.motor
+            limit = effort if effort > 0 else \
+                motor.max_torque if motor is not None and isinstance(motor.max_torque, float) \
+                else DEFAULT_TORQUE
+            return -limit, limit
+
+        if self.controller == "drive":
+            from .vehicle import clamp_steer
+
+            train = b.train
+            lo, hi = train.steer_range() if train.hinges else (0.0, 0.0)
+            steer = bounds.pop("steer", (lo, hi))
+            throttle = bounds.pop("throttle", (-DEFAULT_THROTTLE, DEFAULT_THROTTLE))
+            names, lows, highs = ["throttle", "steer"], [throttle[0], steer[0]], \
+                [throttle[1], steer[1]]
+            self._clamp = clamp_steer
+        else:
+            for seg in cfg.joints or []:
+                for name in seg.targets:
+                    mode = seg.mode if isinstance(seg.mode, str) else seg.mode[name]
+                    if self.modes.setdefault(name, mode) != mode:
+                        raise ParameterError(f"{self.robot}: joint {name} is commanded in "
+                                             f"both {self.modes[name]} and {mode} mode; an "
+                                             "action space needs one", param="scenario")
+            if not self.modes and cfg.motor is not None:
+                self.modes = {j.name: "position" for j in b.servo}
+            if not self.modes:
+                raise ParameterError(f"{self.robot} has no joint the agent could command",
+                                     param="robot")
+            for name in self.modes:
+                lo, hi = default(name)
+                names.append(name)
+                lows.append(lo)
+                highs.append(hi)
+        if bounds:
+            raise ParameterError(f"action_bounds names {', '.join(sorted(bounds))}, not in "
+                                 f"the action ({', '.join(names)})", param="action_bounds")
+        for name, lo, hi in zip(names, lows, highs, strict=True):
+            if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+                raise ParameterError(f"action bounds of {name} must be finite with low < "
+                                     f"high, got ({lo}, {hi})", param="action_bounds")
+        self.action_names = names
+        self.action_space = spaces.Box(np.array(lows, dtype=np.float32),
+                                       np.array(highs, dtype=np.float32))
+        self._low, self._high = self.action_space.low, self.action_space.high
+        self._by_mode: dict[str, list[int]] = {}
+        for k, name in enumerate(names if self.controller == "joints" else []):
+            self._by_mode.setdefault(self.modes[name], []).append(k)
+
+    def _field_names(self, field: str, value: Any) -> list[str]:
+        if isinstance(value, dict):
+            return [f"{field}.{k}" for k in value]
+        axes = ("x", "y", "z", "w")[:len(value)]
+        return [f"{field}.{a}" for a in axes]
+
+    def _build_observation_space(self, kind: str) -> None:
+        first = self._observe()
+        self.observation_kind = kind
+        names: list[str] = []
+        boxes: dict[str, Any] = {}
+        for f in self.fields:
+            these = self._field_names(f, getattr(first, f))
+            names.extend(these)
+            boxes[f] = spaces.Box(-np.inf, np.inf, shape=(len(these),), dtype=np.float32)
+        self.observation_names = names
+        self.observation_space = spaces.Dict(boxes) if kind == "dict" else \
+            spaces.Box(-np.inf, np.inf, shape=(len(names),), dtype=np.float32)
+
+    def _randomize_plan(self) -> Any:
+        b = self.sim.bodies[self.robot]
+        r = b.config.randomize
+        if r is None:
+            return None
+        p, client = self.sim.session.p, self.sim.session.client
+        # Nominal masses, for mass_scale: the scenario's, before any episode changed them.
+        self._nominal_mass = {link: p.getDynamicsInfo(b.body, b.links[link],
+                                                      physicsClientId=client)[0]
+                              for link in r.mass_scale}
+        return r
+
+    # ---- the Gymnasium API
+
+    def _observe(self) -> Any:
+        """The robot's reported observation now (a copy)."""
+        o = self.sim.observe(self.robot)
+        assert not isinstance(o, dict)
+        return o
+
+    def _obs(self, o: Any) -> Any:
+        if self.observation_kind == "dict":
+            return {f: np.fromiter(_values(getattr(o, f)), dtype=np.float32)
+                    for f in self.fields}
+        out: list[float] = []
+        for f in self.fields:
+            out.extend(_values(getattr(o, f)))
+        return np.array(out, dtype=np.float32)
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
+              ) -> tuple[Any, dict[str, Any]]:
+        """Restore the scenario's start in place (``Simulation.reset``), then randomise.
+
+        The noise is reseeded from ``np_random``, so ``reset(seed=s)`` and the same actions
+        give the same observations. ``options={"overrides": {...}}`` passes per-robot
+        starts to :meth:`Simulation.reset`.
+        """
+        super().reset(seed=seed)
+        rng = self.np_random
+        overrides: dict[str, dict[str, Any]] = {
+            k: dict(v) for k, v in ((options or {}).get("overrides") or {}).items()}
+        r = self._randomize
+        if r is not None:
+            mine = overrides.setdefault(self.robot, {})
+            cfg = self.sim.bodies[self.robot].config
+            if r.initial_joints:
+                joints = dict(mine.get("initial_joints") or {})
+                for name, (lo, hi) in r.initial_joints.items():
+                    joints[name] = float(rng.uniform(lo, hi))
+                mine["initial_joints"] = joints
+            if r.position:
+                start = mine.get("position", cfg.position)
+                mine["position"] = [float(s + rng.uniform(lo, hi))
+                                    for s, (lo, hi) in zip(start, r.position, strict=True)]
+            if r.yaw is not None:
+                roll, pitch, yaw = mine.get("orientation_rpy", cfg.orientation_rpy or (0, 0, 0))
+                mine["orientation_rpy"] = [roll, pitch, yaw + float(rng.uniform(*r.yaw))]
+        noise_seed = int(rng.integers(2**31 - 1))
+        self.sim.reset(seed=noise_seed, overrides=overrides or None)
+        if r is not None:
+            for link, (lo, hi) in r.lateral_friction.items():
+                self.sim.set_friction(self.robot, link, float(rng.uniform(lo, hi)))
+            for link, (lo, hi) in r.mass_scale.items():
+                self.sim.set_mass(self.robot, link,
+                                  self._nominal_mass[link] * float(rng.uniform(lo, hi)))
+        self._steps = 0
+        self._apply(np.zeros(2) if self.controller == "drive" else None)
+        obs = self._observe()
+        return self._obs(obs), {}
+
+    def _apply(self, action: Any) -> None:
+        if action is None:
+            return
+        if self.controller == "drive":
+            b = self.sim.bodies[self.robot]
+            throttle, steer = float(action[0]), float(action[1])
+            steer = self._clamp(b.train, steer)[0]
+            self.sim.set_drive(self.robot, throttle=throttle, steer=steer)
+            return
+        for mode, ks in self._by_mode.items():
+            self.sim.set_joint_targets(self.robot, {self.action_names[k]: float(action[k])
+                                                    for k in ks}, mode=mode)
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """Command the action (clipped to the space) for ``frame_skip`` physics steps.
+
+        Raises:
+            ValueError: an action of the wrong size, or not finite.
+        """
+        a = np.asarray(action, dtype=np.float64).reshape(-1)
+        if a.shape != self._low.shape:
+            raise ValueError(f"expected an action of {len(self.action_names)} values "
+                             f"({', '.join(self.action_names)}), got shape "
+                             f"{np.shape(action)}")
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"the action must be finite, got {a.tolist()}")
+        a = np.clip(a, self._low, self._high)
+        self._apply(a)
+        self.sim.step(self.frame_skip)
+        self._steps += 1
+        o = self._observe()
+        reward = float(self.reward_fn(o)) if self.reward_fn is not None else 0.0
+        done = bool(self.terminated_fn(o)) if self.terminated_fn is not None else False
+        truncated = not done and self._steps >= self.max_episode_steps
+        if self.render_mode == "human":
+            time.sleep(max(0.0, self.frame_skip * self.sim.time_step))
+        return self._obs(o), reward, done, truncated, {"t": o.t}
+
+    def render(self) -> np.ndarray | None:
+        """An ``rgb_array`` frame looking at the robot (height x width x 3, uint8)."""
+        if self.render_mode != "rgb_array":
+            return None
+        p, client = self.sim.session.p, self.sim.session.client
+        b = self.sim.bodies[self.robot]
+        target = p.getBasePositionAndOrientation(b.body, physicsClientId=client)[0]
+        view = p.computeViewMatrixFromYawPitchRoll(target, 2.0, 45.0, -30.0, 0.0, 2,
+                                                   physicsClientId=client)
+        proj = p.computeProjectionMatrixFOV(60.0, self.width / self.height, 0.01, 100.0,
+                                            physicsClientId=client)
+        image = p.getCameraImage(self.width, self.height, view, proj,
+                                 renderer=p.ER_TINY_RENDERER, physicsClientId=client)[2]
+        return np.asarray(image, dtype=np.uint8).reshape(self.height, self.width, 4)[
+            :, :, :3].copy()
+
+    def close(self) -> None:
+        """Close the simulation (safe to call twice)."""
+        self.sim.close()
+
+
+def _values(value: Any) -> list[float]:
+    return list(value.values()) if isinstance(value, dict) else list(value)
+
+
+if SIMPLE_DRIVING_ID not in gym.registry:
+    gym.register(id=SIMPLE_DRIVING_ID, entry_point="urdfkit.gym:SimpleDrivingEnv",
+                 max_episode_steps=250)
