@@ -33,7 +33,7 @@ class TutorialDrivingEnv(gym.Env):
 
     metadata = {"render_modes": []}
 
-    def __init__(self, flags: int = 0):
+    def __init__(self, flags: int = 0, deterministic: bool = False):
         import pybullet as p
 
         from urdfkit.catalog import build_template
@@ -41,6 +41,7 @@ class TutorialDrivingEnv(gym.Env):
 
         self.p = p
         self.flags = flags
+        self.deterministic = deterministic  # tests: the same pair order as urdfkit's env
         self._tmp = tempfile.TemporaryDirectory(prefix="tutorial-driving-")
         folder = Path(self._tmp.name)
         self.car_file = str(build_template("simplecar").write(folder / "simplecar.urdf"))
@@ -65,6 +66,8 @@ class TutorialDrivingEnv(gym.Env):
         p, c = self.p, self.client
         p.resetSimulation(physicsClientId=c)
         p.setGravity(0, 0, -10, physicsClientId=c)
+        if self.deterministic:
+            p.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=c)
         p.loadURDF(self.plane_file, basePosition=[0, 0, 0], physicsClientId=c)
         self.car = p.loadURDF(self.car_file, basePosition=[0, 0, 0.1], flags=self.flags,
                               physicsClientId=c)

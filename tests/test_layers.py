@@ -23,7 +23,7 @@ for floor, names in enumerate([
     # the engine session
     "session",
     # run and draw
-    "inspect body tree report graph vehicle drive sac scenario sim render plot check build",
+    "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build",
     # presentation and the command line
     "present cli __main__",
 ]):

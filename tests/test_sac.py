@@ -77,6 +77,9 @@ class Reference:
         c = self.c
         self.dt = self.sim["time_step"]
         p.setPhysicsEngineParameter(numSolverIterations=30, physicsClientId=c)
+        # urdfkit sorts overlapping pairs (a reproducible reset in place); SimInterface does
+        # not, which changes only the float-level order contacts are solved in.
+        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=c)
         p.setTimeStep(self.dt, physicsClientId=c)
         p.setGravity(0, 0, -9.81, physicsClientId=c)
         p.setPhysicsEngineParameter(enableConeFriction=0, physicsClientId=c)

@@ -135,6 +135,9 @@ class SimpleDrivingEnv(gym.Env):
         p, c = s.p, s.client
         self._p, self._client = p, c
         p.setTimeStep(self.TIME_STEP, physicsClientId=c)
+        # Sorted overlapping pairs: the solver meets contacts in the same order after every
+        # reset (PyBullet's default does not, and single-step episodes then differ).
+        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=c)
         p.setGravity(0, 0, self.GRAVITY, physicsClientId=c)
         plane, car = builtin_file("simpleplane"), builtin_file("simplecar")
         if plane is None or car is None:  # no writable cache: build into a temp folder

@@ -385,6 +385,9 @@ class Simulation:
         ph = self.config.physics
         p.setTimeStep(ph.time_step, physicsClientId=client)
         p.setGravity(*ph.gravity, physicsClientId=client)
+        # Sorted overlapping pairs: without them the order the solver meets contacts in
+        # depends on the engine's history, and a reset in place is not reproducible.
+        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=client)
         p.setPhysicsEngineParameter(numSolverIterations=ph.solver_iterations,
                                     enableConeFriction=int(ph.cone_friction),
                                     physicsClientId=client)
