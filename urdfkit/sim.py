@@ -1379,14 +1379,18 @@ class Simulation:
         """Restitution (bounciness) of a link, or of the floor with robot ``"ground"``."""
         self._change(robot, link, restitution=float(restitution))
 
+    @staticmethod
+    def _joint_named(b: _Body, joint: str) -> JointSpec:
+        try:
+            return b.joint(joint)
+        except KeyError:
+            raise ParameterError(f"`joint`: {b.name} has no joint named {joint!r}",
+                                 param="joint") from None
+
     def set_joint_damping(self, robot: str, joint: str, damping: float) -> None:
         """PyBullet's joint damping of one joint (N m s/rad)."""
         b = self._body(robot)
-        try:
-            spec = b.joint(joint)
-        except KeyError:
-            raise ParameterError(f"`joint`: {robot} has no joint named {joint!r}",
-                                 param="joint") from None
+        spec = self._joint_named(b, joint)
         p, client = self.session.p, self.session.client
         p.changeDynamics(b.body, spec.index, jointDamping=float(damping),
                          physicsClientId=client)
@@ -1401,11 +1405,7 @@ class Simulation:
         friction comes back when it ends. It stays across ``reset()``.
         """
         b = self._body(robot)
-        try:
-            spec = b.joint(joint)
-        except KeyError:
-            raise ParameterError(f"`joint`: {robot} has no joint named {joint!r}",
-                                 param="joint") from None
+        spec = self._joint_named(b, joint)
         if spec not in b.active:
             raise ParameterError(f"`joint`: {joint} of {robot} is fixed", param="joint")
         if not (isinstance(friction, (int, float)) and math.isfinite(friction)
