@@ -12,6 +12,7 @@ import urdfkit.gym  # noqa: F401  (registers urdfkit/SimpleDriving-v0)
 env = gym.make("urdfkit/SimpleDriving-v0")
 returns, successes = [], 0
 obs, info = env.reset(seed=0)
+env.action_space.seed(0)
 episode_return = 0.0
 while len(returns) < 20:
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
