@@ -34,8 +34,7 @@ def _rollout(env, seed: int, steps: int, action_seed: int = 9) -> np.ndarray:
     obs, _ = env.reset(seed=seed)
     out = [obs]
     for _ in range(steps):
-        obs, _, terminated, truncated, _ = env.step(env.action_space.sample()
-                                                    if False else _act(env, rng))
+        obs, _, terminated, truncated, _ = env.step(_act(env, rng))
         out.append(obs)
         if terminated or truncated:
             break
