@@ -23,9 +23,10 @@ for floor, names in enumerate([
     # the engine session
     "session",
     # run and draw
-    "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build",
+    "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
+    " diff collisions",
     # presentation and the command line
-    "present cli __main__",
+    "present ci cli __main__",
 ]):
     LAYERS.update(dict.fromkeys(names.split(), floor))
 

@@ -779,6 +779,15 @@ class Robot(_Element):
         """Parse a URDF file into the model."""
         return _parse_robot(load_xml(path).getroot(), str(path))
 
+    @classmethod
+    def from_element(cls, root: etree._Element, file: str) -> Robot:
+        """Parse an already parsed ``<robot>`` element, such as a resolved (expanded) tree.
+
+        Taking the element keeps its source lines for messages, which re-serialising it for
+        :meth:`from_string` would lose.
+        """
+        return _parse_robot(root, file)
+
 
 # --------------------------------------------------------------------------- parse / write
 # One _parse_X / _write_X pair per tag; keep them side by side so none is forgotten.

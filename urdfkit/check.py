@@ -162,11 +162,13 @@ def _read(path: Path, display: str, no_exec: bool = False,
 
 def check_file(display: str, path: str | Path,
                packages: Mapping[str, Path] | None = None, no_exec: bool = False,
-               xacro_args: Mapping[str, str] | None = None) -> FileResult:
+               xacro_args: Mapping[str, str] | None = None,
+               physics: bool = False) -> FileResult:
     """Run every rule on one file; any failure to read it becomes a ``U000`` finding.
 
     With ``no_exec`` (or URDFKIT_NO_EXEC set) a xacro file is not expanded: it gets one
-    ``U006`` warning saying so, and is otherwise unchecked.
+    ``U006`` warning saying so, and is otherwise unchecked. With ``physics`` a file with no
+    error is also loaded in PyBullet and tested for self-collision at its zero pose (U950).
     """
     from lxml import etree
 
@@ -211,8 +213,44 @@ def check_file(display: str, path: str | Path,
         # one (each message names its element).
         found = [dataclasses.replace(f, line=None) for f in found]
     result.findings.extend(found)
+    if physics and not any(f.level == "error" for f in result.findings):
+        lines = {} if path.suffix == ".xacro" else \
+            {el.get("name"): el.sourceline for el in tree.getroot().iterchildren("link")}
+        result.findings.extend(physics_findings(display, path, lines, packages, xacro_args))
     result.findings.sort(key=lambda f: f.line or 0)
     return result
+
+
+def physics_findings(display: str, path: Path, lines: Mapping[str | None, int | None],
+                     packages: Mapping[str, Path] | None = None,
+                     xacro_args: Mapping[str, str] | None = None) -> list[Finding]:
+    """``check --physics``: load the file in PyBullet and test its zero pose (U950, U951).
+
+    Only files with no error finding get here: the rules have ruled out every crash class.
+    """
+    from .collisions import self_collisions
+    from .errors import UrdfkitError
+    from .resolve import resolve
+
+    try:
+        with resolve(path, packages=packages, xacro_args=xacro_args) as resolved:
+            resolved.name = display
+            found = self_collisions(resolved, packages=packages)
+    except UrdfkitError as e:
+        return [Finding("U951", "error", f"PyBullet cannot load it: {e.message}", display,
+                        e.line)]
+    out = []
+    for x in found.pairs:
+        hull = (f"; {' and '.join(x.hull)} collide{'s' if len(x.hull) == 1 else ''} as a "
+                "convex hull, so the contact may be in a dip of the mesh") if x.hull else ""
+        out.append(Finding(
+            "U950", "warning", f"links {x.link_a!r} and {x.link_b!r} "
+            f"{'interpenetrate by' if x.distance < 0 else 'touch at'} "
+            f"{abs(x.distance) * 1000:.3g} mm at the zero pose: once self-collision is on "
+            "(URDF_USE_SELF_COLLISION) PyBullet pushes them apart every step and the robot "
+            f"jitters; fix the shapes, or disable the pair (urdfkit collisions {display} "
+            f"--python or --srdf){hull}", display, lines.get(x.link_a)))
+    return out
 
 
 def _macro_library(root: object) -> bool:
@@ -223,13 +261,13 @@ def _macro_library(root: object) -> bool:
     return root.tag == "robot" and root.find("link") is None and not root.get("name")
 
 
-def _check_one(job: tuple[str, str, str | None, dict[str, str], bool, dict[str, str]]
+def _check_one(job: tuple[str, str, str | None, dict[str, str], bool, dict[str, str], bool]
                ) -> FileResult:
-    display, path, problem, packages, no_exec, xacro_args = job
+    display, path, problem, packages, no_exec, xacro_args, physics = job
     if problem is not None:
         return FileResult(display, [Finding("U000", "error", problem, display)])
     return check_file(display, path, {k: Path(v) for k, v in packages.items()}, no_exec,
-                      xacro_args)
+                      xacro_args, physics)
 
 
 def _worker_init() -> None:
@@ -270,8 +308,11 @@ def _keep(code: str, select: tuple[str, ...], ignore: tuple[str, ...]) -> bool:
 def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | None = None,
                 select: Sequence[str] = (), ignore: Sequence[str] = (),
                 jobs: int | None = None, no_exec: bool = False,
-                xacro_args: Mapping[str, str] | None = None) -> CheckResult:
+                xacro_args: Mapping[str, str] | None = None,
+                physics: bool = False) -> CheckResult:
     """Check every file under ``paths``, over ``jobs`` processes (default: every core).
+
+    ``physics`` loads each file without errors in PyBullet for the U95x rules.
 
     Workers are killed with the parent (Ctrl-C, SIGTERM, even SIGKILL on Linux) and never
     hold its stdout.
@@ -284,7 +325,7 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
     files = discover(paths)
     pkgs = {k: str(v) for k, v in (packages or {}).items()}
     args = dict(xacro_args or {})
-    work = [(display, str(path), problem, pkgs, no_exec, args)
+    work = [(display, str(path), problem, pkgs, no_exec, args, physics)
             for display, path, problem in files]
     workers = min(jobs or default_jobs(), max(1, len(work) // _PARALLEL_MIN))
     if workers <= 1:

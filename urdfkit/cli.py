@@ -475,11 +475,15 @@ def info(
 
 @app.command(epilog=_examples(
     "urdfkit check robot.urdf", "urdfkit check description/ --fail-on warning",
-    "urdfkit check . --json --ignore U9"))
+    "urdfkit check . --json --ignore U9", "urdfkit check . --format sarif > urdfkit.sarif"))
 def check(
     paths: Annotated[list[str], typer.Argument(
         metavar="FILE_OR_DIR...", help="URDF/xacro files, or folders searched recursively.")],
     as_json: JsonOpt = False,
+    output_format: Annotated[str | None, typer.Option(
+        "--format", metavar="text|json|sarif|junit|github",
+        help="Output: text, JSON (= --json), SARIF 2.1.0 (GitHub code scanning), JUnit XML, "
+        "or GitHub Actions annotations.", show_default="text")] = None,
     fail_on: Annotated[str, typer.Option(
         "--fail-on", metavar="error|warning|info",
         help="Exit 1 when a finding is at or above this level.")] = "error",
@@ -501,6 +505,9 @@ def check(
         "--no-exec", help="Treat xacro as untrusted: do not expand it (xacro runs Python); "
         "each xacro file gets a U006 warning instead. URDFKIT_NO_EXEC=1 does the same.")]
     = False,
+    physics: Annotated[bool, typer.Option(
+        "--physics", help="Also load each file without errors in PyBullet and test its zero "
+        "pose for links in contact (U950; slower).")] = False,
 ) -> None:
     """Check URDF files for errors PyBullet crashes on, physics mistakes and typos.
 
@@ -516,15 +523,28 @@ def check(
 
         raise ParameterError(f"`fail_on` expects error, warning or info, got {fail_on!r}"
                              f"{hint(fail_on, ('error', 'warning', 'info'))}", param="fail_on")
+    fmt = _check_format(output_format, as_json)
     result = check_paths(paths, packages=parse_packages(package, package_path),
                          select=parse_codes(select, "`select`"),
                          ignore=parse_codes(ignore, "`ignore`"), jobs=jobs, no_exec=no_exec,
-                         xacro_args=_xacro_args(arg))
-    if as_json:
-        show.print_json(result.to_dict())
-    else:
-        show.check_report(result)
+                         xacro_args=_xacro_args(arg), physics=physics)
+    show.check_output(result, fmt, fail_on)
     raise typer.Exit(result.exit_code(fail_on))
+
+
+def _check_format(output_format: str | None, as_json: bool) -> str:
+    from .ci import FORMATS
+    from .errors import ParameterError
+
+    if output_format is not None and output_format not in FORMATS:
+        from .suggest import hint
+
+        raise ParameterError(f"`format` expects {', '.join(FORMATS)}, got {output_format!r}"
+                             f"{hint(output_format, FORMATS)}", param="format")
+    if as_json and output_format not in (None, "json"):
+        raise ParameterError(f"`json` means `format` json; it cannot be combined with "
+                             f"`format` {output_format}", param="format")
+    return "json" if as_json else output_format or "text"
 
 
 def _xacro_args(items: list[str] | None) -> dict[str, str]:
@@ -533,6 +553,48 @@ def _xacro_args(items: list[str] | None) -> dict[str, str]:
     from .catalog import parse_assignments  # imports the builder: only when needed
 
     return parse_assignments(items, "xacro_args")
+
+
+# ---- diff: two robots compared in meaning (urdfkit/diff.py)
+
+
+@app.command(epilog=_examples(
+    "urdfkit diff arm.urdf arm_v2.urdf",
+    "urdfkit diff old/robot.urdf.xacro robot.urdf.xacro --arg prefix:=left_",
+    "urdfkit diff a.urdf b.urdf --json | jq '.index_shifts[]'"))
+def diff(
+    old: Annotated[str, typer.Argument(
+        metavar="OLD", help="The first (old) robot: a .urdf or .xacro file.")],
+    new: Annotated[str, typer.Argument(metavar="NEW", help="The second (new) robot.")],
+    as_json: JsonOpt = False,
+    tolerance: Annotated[float, typer.Option(
+        "--tolerance", metavar="TOL",
+        help="Floats this close are equal, absolutely or relatively.")] = 1e-9,
+    package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
+    arg: ArgOpt = None,
+    no_guard: NoGuardOpt = False,
+) -> None:
+    """Compare two robots in meaning: what was added, removed, renamed or changed.
+
+    Links and joints (matched by name, then by structure), each changed field with its old
+    and new value, PyBullet joint indices that shift, total mass and DOF. Whitespace,
+    attribute order, comments and float spelling are not differences. Read from the files
+    alone; PyBullet is not loaded. Exit 0 when the robots are the same, 1 when they differ.
+    --package, --package-path and --arg apply to both files; see docs/diff.md.
+    """
+    from .diff import diff_files
+
+    result = diff_files(old, new, tolerance=tolerance, packages=package, xacro_args=arg,
+                        guard=not no_guard, package_paths=package_path)
+    for w in result.warnings:
+        show.warn(w)
+    if as_json:
+        show.print_json(result.to_dict())
+    else:
+        show.diff_report(result)
+    if not result.same:
+        raise typer.Exit(1)
 
 
 # ---- drive: a headless throttle/steer run (urdfkit/drive.py, vehicle.py, plot.py)
@@ -787,6 +849,64 @@ def render(
         return
     show.wrote(path, f"{picture.width}x{picture.height}, {', '.join(chosen)}"
                f"{', collision shapes' if collision else ''}")
+
+
+@app.command(epilog=_examples(
+    "urdfkit collisions panda.urdf", "urdfkit collisions arm.urdf --samples 100 --json",
+    "urdfkit collisions arm.urdf --samples 200 --srdf >> arm.srdf",
+    "urdfkit collisions hand.urdf --joints finger_joint=0.04 --python"))
+def collisions(
+    file: FileArg,
+    joints: Annotated[list[str] | None, typer.Option(
+        "--joints", "-j", metavar="NAME=VALUE",
+        help="The start pose, in rad or m, held in every sampled pose too (repeatable, or "
+        "a=1,b=2).")] = None,
+    samples: Annotated[int, typer.Option(
+        "--samples", "-n", min=0, help="Random poses within the joint limits to test besides "
+        "the start pose.")] = 0,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the random poses.")] = 0,
+    margin: Annotated[float, typer.Option(
+        "--margin", metavar="M", help="Count links closer than this (m) as touching.")] = 0.0,
+    as_json: JsonOpt = False,
+    srdf: Annotated[bool, typer.Option(
+        "--srdf", help="Print MoveIt <disable_collisions> entries for the pairs in contact "
+        "in every pose.")] = False,
+    python: Annotated[bool, typer.Option(
+        "--python", help="Print p.setCollisionFilterPair calls for the pairs in contact in "
+        "every pose.")] = False,
+    show_all: AllOpt = False,
+    package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
+    arg: ArgOpt = None,
+    no_guard: NoGuardOpt = False,
+) -> None:
+    """Link pairs whose collision shapes touch: robots that jitter under self-collision.
+
+    Exit 0: no pair touches; 1: pairs touch (the table and --json); --srdf and --python exit
+    0, they print filters. Parent-child pairs are skipped: PyBullet never tests them. See
+    docs/collisions.md.
+    """
+    from .collisions import self_collisions
+    from .errors import ParameterError
+    from .render import parse_joint_positions
+    from .resolve import parse_packages
+
+    if sum((as_json, srdf, python)) > 1:
+        raise ParameterError("--json, --srdf and --python are exclusive: pick one")
+    with _open(file, package, arg, no_guard, package_path) as resolved:
+        result = self_collisions(resolved, joints=parse_joint_positions(joints),
+                                 samples=samples, seed=seed, margin=margin,
+                                 packages=parse_packages(package, package_path))
+    if srdf or python:
+        for w in result.warnings:
+            show.warn(w)
+        sys.stdout.write(result.srdf() if srdf else result.python())
+        return
+    if as_json:
+        show.print_json(result.to_dict())
+    else:
+        show.collisions_report(result, show_all)
+    raise typer.Exit(1 if result.pairs else 0)
 
 
 def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,

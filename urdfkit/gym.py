@@ -247,7 +247,7 @@ class SimpleDrivingEnv(gym.Env):
         return np.array((pos[0], pos[1], cos, sin, lin[0], lin[1], *self.goal),
                         dtype=np.float32)
 
-    def render(self) -> np.ndarray | None:
+    def render(self) -> Any:  # an ndarray or None; gymnasium types it as a RenderFrame TypeVar
         """An ``rgb_array`` frame (height x width x 3, uint8); None in ``human`` mode."""
         if self.render_mode != "rgb_array":
             return None
@@ -623,7 +623,7 @@ class ScenarioEnv(gym.Env):
             time.sleep(max(0.0, self.frame_skip * self.sim.time_step))
         return self._obs(o), reward, done, truncated, {"t": o.t}
 
-    def render(self) -> np.ndarray | None:
+    def render(self) -> Any:  # an ndarray or None; gymnasium types it as a RenderFrame TypeVar
         """An ``rgb_array`` frame looking at the robot (height x width x 3, uint8)."""
         if self.render_mode != "rgb_array":
             return None

@@ -21,7 +21,7 @@ shape this module:
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -178,3 +178,42 @@ def filter_joints(joints: Sequence[JointInfo], *, movable: bool = False,
             continue
         out.append(j)
     return out
+
+
+def pose_joints(p: Any, client: int, body: int, joints: Sequence[JointInfo],
+                values: Mapping[str, float], warnings: list[str], file: str
+                ) -> dict[str, float]:
+    """Set joint positions by name with ``resetJointState``; return them by joint name.
+
+    Only one-degree-of-freedom joints can be posed this way. A value beyond the joint's limits
+    is set anyway (the user asked for it) and noted in ``warnings``.
+
+    Raises:
+        ParameterError: an unknown name, a fixed joint, or a multi-DOF joint.
+    """
+    from .errors import ParameterError
+
+    by_name = {j.joint_name: j for j in joints}
+    movable = [j.joint_name for j in joints if j.movable]
+    positions: dict[str, float] = {}
+    for name, value in values.items():
+        info = by_name.get(name)
+        if info is None:
+            from .suggest import hint
+
+            known = ", ".join(movable) or "none"
+            raise ParameterError(f"`joints`: no joint named {name!r}{hint(name, movable)} "
+                                 f"(movable joints: {known})", file=file, param="joints")
+        if info.joint_type == "FIXED":
+            raise ParameterError(f"`joints` {name}: a fixed joint cannot move", file=file,
+                                 param="joints")
+        if info.joint_type not in ("REVOLUTE", "PRISMATIC"):
+            raise ParameterError(f"`joints` {name}: {info.joint_type.lower()} joints take more "
+                                 "than one position; only revolute, continuous and prismatic "
+                                 "joints can be posed", file=file, param="joints")
+        if info.limited and not info.joint_lower_limit <= value <= info.joint_upper_limit:
+            warnings.append(f"joint {name}: {value:g} is beyond its limits "
+                            f"[{info.joint_lower_limit:g}, {info.joint_upper_limit:g}]")
+        p.resetJointState(body, info.joint_index, value, physicsClientId=client)
+        positions[name] = value
+    return positions

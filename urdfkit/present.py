@@ -389,6 +389,30 @@ def check_report(result: Any) -> None:
     screen.print(Text(summary, style=colour), soft_wrap=True)
 
 
+def check_output(result: Any, fmt: str = "text", fail_on: str = "error") -> None:
+    """``urdfkit check --format``: text, JSON, or a CI format (:mod:`urdfkit.ci`) on stdout.
+
+    The CI formats are written whole and unstyled, terminal or not: they are for files and
+    logs. ``fail_on`` decides which files JUnit counts as failed.
+    """
+    if fmt == "text":
+        check_report(result)
+        return
+    if fmt == "json":
+        print_json(result.to_dict())
+        return
+    from . import ci
+
+    if fmt == "sarif":
+        print_json(ci.sarif_log(result))
+    elif fmt == "junit":
+        _write(sys.stdout, ci.junit_xml(result, fail_on))
+    elif fmt == "github":
+        _write(sys.stdout, "".join(f"{command}\n" for command in ci.github_commands(result)))
+    else:
+        raise ValueError(f"no check format {fmt!r}; expected one of {', '.join(ci.FORMATS)}")
+
+
 #: Text output shows this many findings of one code per file, then one line for the rest.
 GROUP_AFTER = 3
 
@@ -413,6 +437,63 @@ def _grouped(findings: Sequence[Any]) -> list[tuple[Any, str]]:
             rest = count[f.code] - GROUP_AFTER
             out.append((f, f"... and {rest} more {f.code} in this file (--json lists every one)"))
     return out
+
+
+# --------------------------------------------------------------------------- diff
+
+
+def diff_value(value: Any) -> str:
+    """A value of ``urdfkit diff`` as text: exact enough to tell 23.7 from 23.70001.
+
+    Floats get 15 significant digits (not :func:`num`'s 4, which would print two values the
+    tolerance tells apart as one), absent values a ``-``, a whole visual its fields.
+    """
+    if value is None:
+        return "-"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        text = f"{value:.15g}"
+        return "0" if text == "-0" else text
+    if isinstance(value, tuple | list):
+        return " ".join(diff_value(v) for v in value)
+    if isinstance(value, dict):
+        return "; ".join(f"{k} {diff_value(v)}" for k, v in value.items() if v is not None)
+    return str(value)
+
+
+def diff_report(result: Any) -> None:
+    """``urdfkit diff``'s text: one line when the robots are the same, else a table.
+
+    Rows go removed, added, renamed, changed, index shifts, totals: what a reader fixing a
+    script needs first is what disappeared.
+    """
+    a, b = result.a, result.b
+    if result.same:
+        line((b.robot, "bold"), f": {a.file} and {b.file} are the same robot "
+             f"({b.links} links, {b.joints} joints; tolerance {result.tolerance:g})")
+        return
+    v = diff_value
+
+    def joint_note(e: Any) -> str:
+        return f"index {e.index}, {e.type}" if e.kind == "joint" else ""
+
+    rows = [["removed", f"{e.kind} {e.name}", "", joint_note(e) or "-", "-"]
+            for e in result.removed]
+    rows += [["added", f"{e.kind} {e.name}", "", "-", joint_note(e) or "-"]
+             for e in result.added]
+    rows += [["renamed", f"{r.kind} {r.new}", "name", r.old, r.new] for r in result.renamed]
+    rows += [["changed", f"{c.kind} {c.name}", c.field, v(c.old), v(c.new)]
+             for c in result.changes]
+    rows += [["index", f"joint {s.joint}", "jointIndex", str(s.old), str(s.new)]
+             for s in result.index_shifts]
+    for what, total, unit in (("mass", result.mass, " kg"), ("dof", result.dof, "")):
+        if total.changed:
+            rows.append(["total", f"robot {b.robot}", what, v(total.old) + unit,
+                         v(total.new) + unit])
+    columns = [("change", 0, "left"), ("element", 0, "left"), ("field", 0, "left"),
+               ("old", 0, "left"), ("new", 0, "left")]
+    table(f"{b.robot}: {result.count} difference(s) from {a.file} to {b.file}", columns, rows)
 
 
 # --------------------------------------------------------------------------- progress
@@ -452,3 +533,41 @@ def progress(label: str, unit: str, enabled: bool = True
             state["bar"].stop()
 
     return update, stop
+
+
+# --------------------------------------------------------------------------- collisions
+
+
+def collisions_report(result: Any, show_all: bool = False) -> None:
+    """``urdfkit collisions``' table: pairs in contact, most often and deepest first."""
+    for w in result.warnings:
+        warn(w)
+    rows = []
+    for x in result.pairs:
+        depth = f"{-x.distance * 1000:.3g} mm deep" if x.distance < 0 else \
+            f"{x.distance * 1000:.3g} mm apart"
+        note_text = f"convex hull of {', '.join(x.hull)}" if x.hull else ""
+        rows.append([x.link_a, x.link_b, depth, f"{x.poses_in_contact}/{result.poses}",
+                     f"{x.index_a} {x.index_b}", note_text])
+    columns: list[Column] = [("link a", 0, "left"), ("link b", 0, "left"),
+                             ("worst", 0, "right"), ("poses", 0, "right"),
+                             ("indices", 2, "right"), ("note", 1, "left")]
+    samples = f" (start + {result.samples} random, seed {result.seed})" if result.samples else \
+        " (the start pose)"
+    title = (f"{result.robot}: {len(result.pairs)} link pair(s) in contact over "
+             f"{result.poses} pose(s){samples}")
+    if rows:
+        table(title, columns, rows, show_all)
+    else:
+        line((title, "green"))
+    always = len(result.always())
+    tail = [f"{result.tested} pairs tested; {len(result.skipped_adjacent)} parent-child pairs "
+            "skipped (PyBullet never tests a link against its parent)"]
+    if result.without_shapes:
+        tail.append(f"{len(result.without_shapes)} link(s) without collision shapes")
+    if always:
+        tail.append(f"{always} pair(s) in contact in every pose: --srdf or --python prints "
+                    "the filters")
+    if any(x.hull for x in result.pairs):
+        tail.append("concave meshes collide as their convex hull in PyBullet")
+    note("; ".join(tail), stderr=False)

@@ -34,7 +34,8 @@ from typing import Any
 
 from . import style
 from .errors import EngineError, InputError, MissingDependencyError, ParameterError
-from .spec import UP_AXES, attr_vec, pybullet_joint_type, rpy_to_matrix, vector
+from .inspect import JointInfo, pose_joints
+from .spec import UP_AXES, attr_vec, rpy_to_matrix, vector
 
 #: The views, as (direction from target to camera, camera up vector). URDF: x forward, z up.
 #: ``front`` looks at the robot's face (+x), ``side`` at its right flank (-y), so the robot
@@ -391,7 +392,8 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
         n = p.getNumJoints(body, physicsClientId=c)
         infos = [p.getJointInfo(body, j, physicsClientId=c) for j in range(n)]
         by_name = {i[1].decode("utf-8"): i for i in infos}
-        positions = _pose(p, c, body, by_name, o.joints, warnings, resolved.name)
+        positions = pose_joints(p, c, body, [JointInfo.from_pybullet(i) for i in infos],
+                                o.joints, warnings, resolved.name)
         if o.collision:
             for link in range(-1, n):
                 session.call("changeVisualShape", body, link, rgbaColor=[*COLLISION_COLOR, 1.0])
@@ -480,37 +482,6 @@ def _half_extent(geometry: Any, rot: Any) -> Any:
         r = vector(sphere.get("radius"), 1)
         return np.full(3, abs(r[0])) if r else None
     return None
-
-
-def _pose(p: Any, c: int, body: int, by_name: Mapping[str, Any], joints: Mapping[str, float],
-          warnings: list[str], file: str) -> dict[str, float]:
-    """Set the joint positions asked for; return them by joint name."""
-    movable = [n for n, i in by_name.items() if i[2] != _JOINT_FIXED]
-    positions: dict[str, float] = {}
-    for name, value in joints.items():
-        info = by_name.get(name)
-        if info is None:
-            from .suggest import hint
-
-            known = ", ".join(movable) or "none"
-            raise ParameterError(f"`joints`: no joint named {name!r}{hint(name, movable)} "
-                                 f"(movable joints: {known})", file=file, param="joints")
-        if info[2] != _JOINT_FIXED and info[2] not in (0, 1):
-            kind = pybullet_joint_type(info[2]).lower()
-            raise ParameterError(f"`joints` {name}: {kind} joints take more than one position; "
-                                 "only revolute, continuous and prismatic joints can be posed",
-                                 file=file, param="joints")
-        if info[2] == _JOINT_FIXED:
-            raise ParameterError(f"`joints` {name}: a fixed joint cannot move", file=file,
-                                 param="joints")
-        lower, upper = info[8], info[9]
-        # Continuous joints come back as revolute with lower=0 > upper=-1: no limits.
-        if lower <= upper and not lower <= value <= upper:
-            warnings.append(f"joint {name}: {value:g} is beyond its limits "
-                            f"[{lower:g}, {upper:g}]")
-        p.resetJointState(body, info[0], value, physicsClientId=c)
-        positions[name] = value
-    return positions
 
 
 def link_frames(root: Any, joint_names: Sequence[str],

@@ -36,6 +36,12 @@ PYBULLET_JOINT_CODES = {0: "REVOLUTE", 1: "PRISMATIC", 2: "SPHERICAL", 3: "PLANA
 #: Velocity degrees of freedom of each PyBullet joint type (a planar joint is x, y and yaw).
 JOINT_DOF = {"REVOLUTE": 1, "PRISMATIC": 1, "SPHERICAL": 3, "PLANAR": 3, "FIXED": 0,
              "POINT2POINT": 0, "GEAR": 0}
+#: Degrees of freedom of each URDF joint type, as the URDF means it (``diff`` counts these).
+#: A planar joint is x, y and yaw, as in PyBullet and MoveIt; a floating joint is 6, though
+#: PyBullet loads it as a fixed joint (and JOINT_DOF then counts 0).
+URDF_JOINT_DOF = {"revolute": 1, "continuous": 1, "prismatic": 1, "fixed": 0, "floating": 6,
+                  "planar": 3, "spherical": 3}
+assert set(URDF_JOINT_DOF) == set(JOINT_TYPES)
 #: What ``joints --type`` accepts: the URDF types and PyBullet's, lower case.
 #: (PyBullet's own type names, lower-cased, are all among them.)
 JOINT_TYPE_FILTERS = JOINT_TYPES

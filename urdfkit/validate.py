@@ -1039,6 +1039,8 @@ CODES: dict[str, str] = {
     "U801": "unknown tag",
     "U802": "unknown attribute",
     "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
+    "U950": "links in contact at the zero pose (check --physics: self-collision jitters)",
+    "U951": "PyBullet cannot load the file (check --physics)",
 }
 
 

@@ -1,0 +1,276 @@
+"""``urdfkit collisions`` and ``check --physics``: self-collision pairs, checked against geometry
+and against raw PyBullet."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from pathlib import Path
+
+import pytest
+from lxml import etree
+from typer.testing import CliRunner
+
+from urdfkit.check import check_paths
+from urdfkit.cli import app
+from urdfkit.collisions import self_collisions
+from urdfkit.errors import ParameterError
+from urdfkit.resolve import resolve
+
+MESHES = Path(__file__).parent / "fixtures" / "meshes"
+INERTIAL = ('<inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" '
+            'iyz="0" izz="1e-4"/></inertial>')
+
+
+def _box_link(name: str, size: str, xyz: str = "0 0 0") -> str:
+    return (f'<link name="{name}">{INERTIAL}<collision><origin xyz="{xyz}"/><geometry>'
+            f'<box size="{size}"/></geometry></collision></link>')
+
+
+def _joint(name: str, kind: str, parent: str, child: str, xyz: str = "0 0 0",
+           extra: str = "") -> str:
+    return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{xyz}"/>{extra}</joint>')
+
+
+def _write(tmp_path: Path, name: str, body: str) -> Path:
+    path = tmp_path / name
+    path.write_text(f'<?xml version="1.0"?>\n<robot name="{path.stem}">\n{body}\n</robot>\n')
+    return path
+
+
+@pytest.fixture
+def gripper(tmp_path: Path) -> Path:
+    """A palm with two fingers 20 mm wide whose centres are 10 mm apart: 10 mm of overlap.
+
+    The right finger mimics the left one mirrored, as real parallel grippers do.
+    """
+    slide = '<axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="10" velocity="1"/>'
+    return _write(tmp_path, "gripper.urdf", "\n".join([
+        _box_link("palm", "0.1 0.1 0.02"),
+        _box_link("left_finger", "0.02 0.02 0.06", "0 0 0.04"),
+        _box_link("right_finger", "0.02 0.02 0.06", "0 0 0.04"),
+        _joint("left_joint", "prismatic", "palm", "left_finger", "0 0.005 0.01", slide),
+        _joint("right_joint", "prismatic", "palm", "right_finger", "0 -0.005 0.01",
+               slide.replace('0 1 0', '0 -1 0') + '<mimic joint="left_joint"/>'),
+    ]))
+
+
+@pytest.fixture
+def sweeper(tmp_path: Path) -> Path:
+    """A thin arm 0.6 m long swinging about z over a block 0.3..0.5 m out, |y| <= 0.05.
+
+    The arm (half-width 5 mm) meets the block while |angle| < atan(0.055 / 0.3) = 0.1813 rad,
+    about; it never meets its own parent, the base, which overlaps it at the pivot.
+    """
+    return _write(tmp_path, "sweeper.urdf", "\n".join([
+        _box_link("base", "0.1 0.1 0.1"),
+        _box_link("block", "0.2 0.1 0.1", "0.4 0 0"),
+        _box_link("arm", "0.6 0.01 0.02", "0.3 0 0"),
+        _joint("block_mount", "fixed", "base", "block"),
+        _joint("swing", "continuous", "base", "arm", extra='<axis xyz="0 0 1"/>'),
+    ]))
+
+
+def test_overlapping_fingers_depth_matches_the_geometry(gripper: Path) -> None:
+    with resolve(gripper) as r:
+        found = self_collisions(r)
+    assert [(x.link_a, x.link_b) for x in found.pairs] == [("left_finger", "right_finger")]
+    assert found.pairs[0].distance == pytest.approx(-0.010, abs=2e-4)
+    assert found.pairs[0].poses_in_contact == 1 == found.poses
+    # The palm overlaps both fingers (their bases sit 10 mm deep in it) but is their parent.
+    assert sorted(found.skipped_adjacent) == [("palm", "left_finger"), ("palm", "right_finger")]
+    assert found.tested == 1
+
+
+def test_opening_the_gripper_separates_the_fingers(gripper: Path) -> None:
+    with resolve(gripper) as r:
+        # 6 mm apart each way: the overlap is gone when the fingers are 2 x 6 mm further out.
+        assert not self_collisions(r, joints={"left_joint": 0.006, "right_joint": 0.006}).pairs
+        touching = self_collisions(r, joints={"left_joint": 0.004, "right_joint": 0.004})
+        assert touching.pairs[0].distance == pytest.approx(-0.002, abs=2e-4)
+        assert self_collisions(r, joints={"left_joint": 0.006, "right_joint": 0.006},
+                               margin=0.003).pairs  # 2 mm apart, within a 3 mm margin
+
+
+def test_mimic_joints_follow_their_leader_in_samples(gripper: Path) -> None:
+    # The right finger mirrors the left: opened by the same amount, they overlap only while
+    # each has moved less than 2.5 mm of its 40 mm travel: about 6% of the samples.
+    with resolve(gripper) as r:
+        found = self_collisions(r, samples=400, seed=3)
+    n = found.pairs[0].poses_in_contact - 1  # less the start pose
+    assert 400 * 0.0625 - 4 * math.sqrt(400 * 0.0625) < n < 400 * 0.0625 + 4 * math.sqrt(25)
+
+
+@pytest.mark.parametrize(("angle", "touches"), [(0.0, True), (0.17, True), (-0.17, True),
+                                                (0.20, False), (-0.20, False), (3.0, False)])
+def test_swinging_arm_meets_the_block_where_geometry_says(sweeper: Path, angle: float,
+                                                          touches: bool) -> None:
+    with resolve(sweeper) as r:
+        found = self_collisions(r, joints={"swing": angle})
+    assert [(x.link_a, x.link_b) for x in found.pairs] == ([("block", "arm")] if touches else [])
+    assert ("base", "arm") in found.skipped_adjacent
+
+
+def test_sampled_contact_rate_matches_the_angle_range(sweeper: Path) -> None:
+    with resolve(sweeper) as r:
+        found = self_collisions(r, samples=2000, seed=11)
+        again = self_collisions(r, samples=2000, seed=11)
+        other = self_collisions(r, samples=2000, seed=12)
+    expected = 2 * math.atan(0.055 / 0.3) / (2 * math.pi) * 2000  # continuous: -pi..pi
+    n = found.pairs[0].poses_in_contact - 1
+    assert abs(n - expected) < 4 * math.sqrt(expected)
+    assert found.to_dict() == again.to_dict()  # the seed fixes the poses
+    assert other.pairs[0].poses_in_contact != found.pairs[0].poses_in_contact or \
+        other.pairs[0].distance != found.pairs[0].distance
+
+
+def test_pairs_agree_with_raw_pybullet_self_collision(pb: tuple[object, int]) -> None:
+    import pybullet_data
+
+    p, c = pb
+    path = Path(pybullet_data.getDataPath()) / "r2d2.urdf"
+    pose = {"head_swivel": 0.0, "gripper_extension": -0.38, "left_gripper_joint": 0.5}
+    with resolve(path) as r:
+        ours = {(x.index_a, x.index_b) for x in self_collisions(r, joints=pose).pairs
+                if x.distance < -1e-3}
+    body = p.loadURDF(str(path), useFixedBase=True, physicsClientId=c,  # type: ignore[attr-defined]
+                      flags=p.URDF_USE_SELF_COLLISION | p.URDF_USE_IMPLICIT_CYLINDER)  # type: ignore[attr-defined]
+    names = {p.getJointInfo(body, i, physicsClientId=c)[1].decode(): i  # type: ignore[attr-defined]
+             for i in range(p.getNumJoints(body, physicsClientId=c))}  # type: ignore[attr-defined]
+    for name, value in pose.items():
+        p.resetJointState(body, names[name], value, physicsClientId=c)  # type: ignore[attr-defined]
+    p.performCollisionDetection(physicsClientId=c)  # type: ignore[attr-defined]
+    raw = {(min(x[3], x[4]), max(x[3], x[4]))
+           for x in p.getContactPoints(body, body, physicsClientId=c)  # type: ignore[attr-defined]
+           if x[8] < -1e-3}
+    assert ours and ours == raw
+
+
+def test_concave_mesh_pairs_name_the_hull(tmp_path: Path) -> None:
+    # A peg in the notch of an L bracket: 0.2 m clear of the bracket's faces, but inside the
+    # convex hull PyBullet collides with.
+    shutil.copy(MESHES / "l_bracket.obj", tmp_path / "l_bracket.obj")
+    path = _write(tmp_path, "notch.urdf", "\n".join([
+        _box_link("base", "0.1 0.1 0.1", "-1 -1 0"),
+        f'<link name="bracket">{INERTIAL}<collision><geometry><mesh filename="l_bracket.obj"/>'
+        '</geometry></collision></link>',
+        _box_link("peg", "0.2 0.2 0.2", "1.3 1.3 0.25"),
+        _joint("turn", "revolute", "base", "bracket",
+               extra='<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'),
+        _joint("peg_mount", "fixed", "base", "peg"),
+    ]))
+    with resolve(path) as r:
+        found = self_collisions(r)
+    assert [(x.link_a, x.link_b, x.hull) for x in found.pairs] == [("bracket", "peg",
+                                                                     ["bracket"])]
+    code, out, _ = _cli("collisions", str(path))
+    assert code == 1 and "convex hull of bracket" in out
+
+
+def _cli(*args: str) -> tuple[int, str, str]:
+    result = CliRunner().invoke(app, list(args))
+    return result.exit_code, result.stdout, result.stderr
+
+
+def test_cli_json_contract(gripper: Path) -> None:
+    code, out, _ = _cli("collisions", str(gripper), "--samples", "20", "--json")
+    data = json.loads(out)
+    assert code == 1
+    assert {"file", "robot", "poses", "pairs"} <= set(data)
+    assert data["poses"] == 21 and data["robot"] == "gripper"
+    pair = data["pairs"][0]
+    assert {"link_a", "link_b", "distance", "poses_in_contact"} <= set(pair)
+    assert pair["link_a"] == "left_finger" and pair["distance"] < 0
+
+
+def test_cli_table_and_exit_codes(sweeper: Path) -> None:
+    code, out, _ = _cli("collisions", str(sweeper))
+    assert code == 1 and "block" in out and "1 parent-child pairs skipped" not in out
+    assert "2 parent-child pairs skipped" in out  # base-block (fixed) and base-arm
+    code, out, _ = _cli("collisions", str(sweeper), "--joints", "swing=1.5")
+    assert code == 0 and "0 link pair(s) in contact" in out
+
+
+def test_srdf_lists_pairs_in_contact_in_every_pose(gripper: Path) -> None:
+    code, out, _ = _cli("collisions", str(gripper), "--srdf")
+    assert code == 0
+    entries = etree.fromstring(f"<robot>{out}</robot>").findall("disable_collisions")
+    assert [(e.get("link1"), e.get("link2"), e.get("reason")) for e in entries] == \
+        [("left_finger", "right_finger", "Default")]
+    # Sampled, the fingers come apart in most poses: nothing is always in contact.
+    assert _cli("collisions", str(gripper), "--srdf", "--samples", "50")[1] == ""
+
+
+def test_python_output_disables_the_pairs_in_pybullet(gripper: Path,
+                                                      pb: tuple[object, int]) -> None:
+    code, out, _ = _cli("collisions", str(gripper), "--python")
+    assert code == 0 and "setCollisionFilterPair" in out
+    p, c = pb
+
+    def contacts(body: int) -> int:
+        p.performCollisionDetection(physicsClientId=c)  # type: ignore[attr-defined]
+        return len(p.getContactPoints(body, body, physicsClientId=c))  # type: ignore[attr-defined]
+
+    flags = p.URDF_USE_SELF_COLLISION  # type: ignore[attr-defined]
+    robot = p.loadURDF(str(gripper), useFixedBase=True, flags=flags,  # type: ignore[attr-defined]
+                       physicsClientId=c)
+    assert contacts(robot) > 0
+    exec(out, {"p": _Bound(p, c), "robot": robot})  # our own output, run as printed
+    assert contacts(robot) == 0
+
+
+class _Bound:
+    """``p`` with this test's client id filled in, so the printed calls run as printed."""
+
+    def __init__(self, p: object, client: int):
+        self.p, self.client = p, client
+
+    def __getattr__(self, name: str) -> object:
+        fn = getattr(self.p, name)
+        return lambda *a, **k: fn(*a, physicsClientId=self.client, **k)
+
+
+def test_bad_input_is_one_line_and_exit_2(gripper: Path, tmp_path: Path) -> None:
+    for args, words in [(("--joints", "nope=1"), "no joint named 'nope'"),
+                        (("--joints", "left_joint=x"), "not a number"),
+                        (("--margin", "-1"), "margin"),
+                        (("--json", "--srdf"), "exclusive")]:
+        code, out, err = _cli("collisions", str(gripper), *args)
+        assert code == 2 and words in err and "Traceback" not in err, (args, err)
+    code, _, err = _cli("collisions", str(tmp_path / "missing.urdf"))
+    assert code == 2 and "missing.urdf" in err
+    with resolve(gripper) as r, pytest.raises(ParameterError, match="samples"):
+        self_collisions(r, samples=-1)
+
+
+def test_check_physics_reports_the_zero_pose_pair_on_the_link_line(gripper: Path) -> None:
+    plain = check_paths([gripper], jobs=1)
+    assert not [f for f in plain.findings if f.code.startswith("U95")]
+    found = [f for f in check_paths([gripper], jobs=1, physics=True).findings
+             if f.code == "U950"]
+    assert len(found) == 1 and "'left_finger' and 'right_finger'" in found[0].message
+    assert "10 mm" in found[0].message
+    line = next(i for i, text in enumerate(gripper.read_text().splitlines(), 1)
+                if '<link name="left_finger">' in text)
+    assert found[0].line == line
+    code, out, _ = _cli("check", str(gripper), "--physics", "--select", "U95")
+    assert code == 0 and "U950" in out  # a warning: exit 1 only with --fail-on warning
+    assert _cli("check", str(gripper), "--physics", "--fail-on", "warning")[0] == 1
+
+
+def test_check_physics_turns_a_pybullet_refusal_into_u951(gripper: Path,
+                                                           monkeypatch: pytest.MonkeyPatch) -> None:
+    from urdfkit.errors import EngineError
+    from urdfkit.session import Session
+
+    def refuse(self: Session, path: object, *args: object, **kwargs: object) -> int:
+        raise EngineError("PyBullet could not load it: Could not parse visual element",
+                          file=str(path))
+
+    monkeypatch.setattr(Session, "load_urdf", refuse)
+    found = [f for f in check_paths([gripper], jobs=1, physics=True).findings
+             if f.code.startswith("U95")]
+    assert [(f.code, f.level) for f in found] == [("U951", "error")]
+    assert "Could not parse visual element" in found[0].message

@@ -1,0 +1,287 @@
+"""``urdfkit collisions``: which links of a robot touch each other, at rest and across poses.
+
+A robot whose links interpenetrate at its start pose jitters or explodes the moment self-
+collision is turned on (``URDF_USE_SELF_COLLISION``): the solver pushes the pair apart every
+step. This module finds those pairs the way PyBullet sees them:
+
+- The robot is loaded with a fixed base and nothing is simulated. Each pose is set with
+  ``resetJointState`` (which updates the link colliders at once), and every pair of links
+  that both have collision shapes is measured with ``getClosestPoints(body, body, margin,
+  linkA, linkB)``: the signed distance of the two links' collision shapes, negative when they
+  interpenetrate. That query ignores collision filters, so it reports a pair whether or not a
+  user later disables it.
+- A link and its parent are never tested: PyBullet's multibody collider skips parent-child
+  pairs (``btMultiBodyLinkCollider::checkCollideWithOverride``) unless a user loads with
+  ``URDF_USE_SELF_COLLISION_INCLUDE_PARENT``. They are counted and said to be skipped.
+- A concave mesh collides as its convex hull (one hull per OBJ object): a pair involving one
+  may be "in contact" only across a hull's dips. Such pairs name the concave link.
+
+Random poses are drawn from a seeded ``numpy`` generator within each joint's limits
+(continuous and unlimited revolute joints over -pi..pi; unlimited prismatic joints stay at 0).
+A ``<mimic>`` joint follows its leader (``multiplier * leader + offset``), as the real
+mechanism does, so a gripper's mirrored fingers are never posed into each other by chance.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from lxml import etree
+
+from .errors import ParameterError
+from .inspect import JointInfo, base_link_name, joint_table, pose_joints
+from .resolve import Resolved
+from .session import LoadOptions, Session
+from .xmlio import children
+
+#: Most random poses one run may draw (each costs one distance query per link pair).
+MAX_SAMPLES = 100_000
+
+
+@dataclass
+class Pair:
+    """Two links whose collision shapes touch or interpenetrate in at least one pose.
+
+    Attributes:
+        link_a: The link with the lower PyBullet index (the base link is -1).
+        link_b: The other link.
+        index_a: PyBullet link index of ``link_a`` (-1 for the base).
+        index_b: PyBullet link index of ``link_b``.
+        distance: The smallest signed distance over all poses, m: negative is a penetration
+            depth.
+        poses_in_contact: In how many of the poses the pair touched (distance <= margin).
+        hull: The links of the pair with a concave collision mesh: PyBullet collides with its
+            convex hull, so the contact may be in the hull's dips, not on the surface.
+    """
+
+    link_a: str
+    link_b: str
+    index_a: int
+    index_b: int
+    distance: float
+    poses_in_contact: int
+    hull: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form."""
+        return {"link_a": self.link_a, "link_b": self.link_b, "link_index_a": self.index_a,
+                "link_index_b": self.index_b, "distance": self.distance,
+                "poses_in_contact": self.poses_in_contact, "convex_hull_of": self.hull}
+
+
+@dataclass
+class Collisions:
+    """The self-collision pairs of one robot.
+
+    Attributes:
+        file: The file as the user named it.
+        robot: The ``<robot name>``.
+        poses: How many poses were tested: the start pose plus the samples.
+        samples: How many of them were random.
+        seed: The seed of the random poses.
+        margin: The distance, m, at or below which a pair counts as in contact.
+        joints: The joint positions pinned by the caller, in every pose.
+        pairs: Pairs in contact in at least one pose, most often first, then deepest first.
+        tested: How many link pairs were measured in each pose.
+        skipped_adjacent: Parent-child pairs, not tested (PyBullet never tests them).
+        without_shapes: Links with no collision shape (nothing to collide).
+        warnings: What the caller should know (values beyond limits, unsampled joints).
+    """
+
+    file: str
+    robot: str
+    poses: int
+    samples: int
+    seed: int
+    margin: float
+    joints: dict[str, float]
+    pairs: list[Pair]
+    tested: int
+    skipped_adjacent: list[tuple[str, str]]
+    without_shapes: list[str]
+    warnings: list[str] = field(default_factory=list)
+
+    def always(self) -> list[Pair]:
+        """Pairs in contact in every pose tested: the ones to filter out."""
+        return [x for x in self.pairs if x.poses_in_contact == self.poses]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``--json`` form (docs/collisions.md)."""
+        return {"file": self.file, "robot": self.robot, "poses": self.poses,
+                "samples": self.samples, "seed": self.seed, "margin": self.margin,
+                "joints": self.joints, "pairs": [x.to_dict() for x in self.pairs],
+                "pairs_tested": self.tested,
+                "skipped_adjacent": [list(x) for x in self.skipped_adjacent],
+                "links_without_collision": self.without_shapes, "warnings": self.warnings}
+
+    def srdf(self) -> str:
+        """``<disable_collisions>`` entries (MoveIt SRDF) for the pairs always in contact.
+
+        The reason is MoveIt Setup Assistant's: ``Default`` for a pair in contact at the one
+        pose tested, ``Always`` for one in contact at every sampled pose too.
+        """
+        reason = "Always" if self.samples else "Default"
+        return "".join(f'<disable_collisions link1="{_attr(x.link_a)}" '
+                       f'link2="{_attr(x.link_b)}" reason="{reason}"/>\n'
+                       for x in self.always())
+
+    def python(self) -> str:
+        """``setCollisionFilterPair`` calls that disable the pairs always in contact."""
+        lines = [f"# urdfkit collisions {self.file}: {len(self.always())} pairs in contact in "
+                 f"all {self.poses} poses tested",
+                 "# robot = p.loadURDF(..., flags=p.URDF_USE_SELF_COLLISION)"]
+        lines += [f"p.setCollisionFilterPair(robot, robot, {x.index_a}, {x.index_b}, "
+                  f"enableCollision=0)  # {x.link_a} / {x.link_b}" for x in self.always()]
+        return "\n".join(lines) + "\n"
+
+
+def _attr(text: str) -> str:
+    return text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+
+
+def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = None,
+                    samples: int = 0, seed: int = 0, margin: float = 0.0,
+                    packages: Mapping[str, Path] | None = None) -> Collisions:
+    """Find the link pairs of a robot that touch, at its start pose and at random poses.
+
+    Args:
+        resolved: The file, resolved and guarded (:func:`urdfkit.resolve.resolve`).
+        joints: Joint positions (rad or m) by name: the start pose, and pinned in every
+            sampled pose too (to test a gripper held closed, say).
+        samples: Random poses to test besides the start pose.
+        seed: Seed of the random poses; the same seed gives the same poses.
+        margin: Count pairs closer than this (m) as in contact; 0 means touching or
+            interpenetrating.
+        packages: ``package://`` mappings, to find concave meshes.
+
+    Raises:
+        ParameterError: a bad ``samples``, ``margin`` or joint name.
+        EngineError: PyBullet refused the file.
+    """
+    if isinstance(samples, bool) or not 0 <= samples <= MAX_SAMPLES:
+        raise ParameterError(f"`samples` must be 0..{MAX_SAMPLES}, got {samples!r}",
+                             param="samples")
+    if not (math.isfinite(margin) and margin >= 0):
+        raise ParameterError(f"`margin` must be a distance of 0 or more, got {margin!r}",
+                             param="margin")
+    import numpy as np
+
+    pinned = dict(joints or {})
+    with Session() as s:
+        p, c = s.p, s.client
+        # Without URDF_USE_SELF_COLLISION, getClosestPoints(body, body, 0, a, b) finds nothing
+        # even for links 10 mm deep in each other (PyBullet 3.2.7).
+        body = s.load_urdf(resolved.load_path, LoadOptions(fixed_base=True, self_collision=True),
+                           display=resolved.name)
+        s.require_state_queries(body, resolved.name)
+        table = joint_table(s, body, resolved.root)
+        names = [base_link_name(s, body)] + [j.link_name for j in table]
+        warnings: list[str] = []
+        pose_joints(p, c, body, table, pinned, warnings, resolved.name)
+        shaped = [i for i in range(-1, len(table))
+                  if s.call("getCollisionShapeData", body, i)]
+        without = [names[i + 1] for i in range(-1, len(table)) if i not in set(shaped)]
+        tested: list[tuple[int, int]] = []
+        adjacent: list[tuple[str, str]] = []
+        for k, a in enumerate(shaped):
+            for b in shaped[k + 1:]:
+                if table[b].parent_index == a:
+                    adjacent.append((names[a + 1], names[b + 1]))
+                else:
+                    tested.append((a, b))
+        sampler = _Sampler(table, resolved.root, pinned, warnings)
+        rng = np.random.default_rng(seed)
+        closest: dict[tuple[int, int], float] = {}
+        hits: dict[tuple[int, int], int] = {}
+        for pose in range(samples + 1):
+            if pose:
+                sampler.pose(p, c, body, rng)
+            for a, b in tested:
+                points = p.getClosestPoints(body, body, margin, a, b, physicsClientId=c)
+                if not points:
+                    continue
+                d = min(x[8] for x in points)
+                if d <= margin:
+                    hits[(a, b)] = hits.get((a, b), 0) + 1
+                    closest[(a, b)] = min(d, closest.get((a, b), math.inf))
+    concave = _concave_links(resolved, packages)
+    pairs = [Pair(names[a + 1], names[b + 1], a, b, closest[(a, b)], n,
+                  [x for x in (names[a + 1], names[b + 1]) if x in concave])
+             for (a, b), n in hits.items()]
+    pairs.sort(key=lambda x: (-x.poses_in_contact, x.distance, x.index_a, x.index_b))
+    return Collisions(resolved.name, resolved.robot_name, samples + 1, samples, seed, margin,
+                      pinned, pairs, len(tested), adjacent, without, warnings)
+
+
+class _Sampler:
+    """Draws joint positions within limits; pinned joints stay, mimic joints follow."""
+
+    def __init__(self, table: Sequence[JointInfo], root: etree._Element,
+                 pinned: Mapping[str, float], warnings: list[str]):
+        self.free: list[tuple[int, float, float]] = []  # (index, low, high) of 1-DOF joints
+        self.spherical: list[int] = []
+        self.mimic: list[tuple[int, int, float, float]] = []  # (index, leader, mult, offset)
+        index = {j.joint_name: j.joint_index for j in table}
+        leaders = {}
+        for el in children(root, "joint"):
+            m = el.find("mimic")
+            if m is not None and m.get("joint") in index and el.get("name") in index:
+                try:
+                    leaders[el.get("name")] = (index[m.get("joint", "")],
+                                               float(m.get("multiplier") or 1.0),
+                                               float(m.get("offset") or 0.0))
+                except ValueError:
+                    continue
+        for j in table:
+            if j.joint_name in pinned or not j.movable:
+                continue
+            if j.joint_name in leaders:
+                self.mimic.append((j.joint_index, *leaders[j.joint_name]))
+            elif j.joint_type == "SPHERICAL":
+                self.spherical.append(j.joint_index)
+            elif j.limited:
+                self.free.append((j.joint_index, j.joint_lower_limit, j.joint_upper_limit))
+            elif j.joint_type == "REVOLUTE":
+                self.free.append((j.joint_index, -math.pi, math.pi))
+            else:
+                warnings.append(f"joint {j.joint_name}: a {j.urdf_type or j.joint_type.lower()} "
+                                "joint without limits has no range to sample; held at 0")
+
+    def pose(self, p: Any, c: int, body: int, rng: Any) -> None:
+        values: dict[int, float] = {}
+        for i, low, high in self.free:
+            values[i] = float(rng.uniform(low, high))
+            p.resetJointState(body, i, values[i], physicsClientId=c)
+        for i in self.spherical:
+            q = rng.normal(size=4)
+            q = q / (float((q * q).sum()) ** 0.5 or 1.0)  # uniform over rotations
+            p.resetJointStateMultiDof(body, i, [float(x) for x in q], physicsClientId=c)
+        for i, leader, mult, offset in self.mimic:
+            if leader in values:
+                p.resetJointState(body, i, mult * values[leader] + offset, physicsClientId=c)
+
+
+def _concave_links(resolved: Resolved, packages: Mapping[str, Path] | None) -> set[str]:
+    """Links with a collision mesh PyBullet replaces by its convex hull, concave or not."""
+    from .meshes import CONCAVE_FRACTION, properties
+    from .spec import attr_vec
+    from .validate import reference
+
+    base = resolved.source.resolve().parent
+    out = set()
+    for link in children(resolved.root, "link"):
+        for mesh in link.iterfind("collision/geometry/mesh"):
+            fn = (mesh.get("filename") or "").strip()
+            target = reference("mesh", fn, base, packages).load_path if fn else None
+            if target is None:
+                continue
+            scale = attr_vec(mesh, "scale", 3, (1.0, 1.0, 1.0)) or (1.0, 1.0, 1.0)
+            props = properties(Path(target), (scale[0], scale[1], scale[2]))
+            if props is not None and props.closed and \
+                    props.concavity > CONCAVE_FRACTION * max(props.extent):
+                out.add(link.get("name", ""))
+    return out
