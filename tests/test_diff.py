@@ -416,8 +416,6 @@ def test_mass_and_dof_totals() -> None:
     assert (result.mass.old, result.mass.new, result.mass.changed) == (6.5, 8.0, True)
     assert result.to_dict()["totals"] == {"mass": {"old": 6.5, "new": 8.0, "changed": True},
                                           "dof": {"old": 3, "new": 6, "changed": True}}
-    code = CliRunner().invoke(app, ["diff", "--help"]).exit_code
-    assert code == 0
 
 
 @pytest.mark.parametrize(("kind", "dof"), [("revolute", 1), ("continuous", 1),
@@ -578,3 +576,34 @@ def test_json_of_the_same_robot(tmp_path: Path) -> None:
     doc = json.loads(out)
     assert code == 0 and doc["same"] is True and doc["changes"] == []
     assert doc["joints"] == {"added": [], "removed": [], "renamed": []}
+
+
+def test_a_mimic_follows_its_joint_through_a_rename() -> None:
+    elbow_limit = '<limit lower="-1" upper="1" effort="23.7" velocity="2"/></joint>'
+    text = arm()
+    last = text.rindex(elbow_limit)  # the elbow joint is declared last
+    text = (text[:last] + elbow_limit.replace(
+        "</joint>", '<mimic joint="shoulder_lift_joint" multiplier="2"/></joint>')
+        + text[last + len(elbow_limit):])
+    a = Robot.from_string(text)
+    assert a.joint("elbow_joint").mimic is not None
+    renamed = diff_robots(a, Robot.from_string(text.replace('"shoulder_lift_joint"', '"lift"')))
+    assert [(r.old, r.new) for r in renamed.renamed] == [("shoulder_lift_joint", "lift")]
+    assert not renamed.changes
+    retargeted = diff_robots(a, Robot.from_string(text.replace(
+        '<mimic joint="shoulder_lift_joint"', '<mimic joint="shoulder_pan_joint"')))
+    assert changes(retargeted) == {("elbow_joint", "mimic.joint"): ("shoulder_lift_joint",
+                                                                   "shoulder_pan_joint")}
+
+
+def test_the_robot_name_is_a_change() -> None:
+    result = diff_robots(Robot.from_string(arm()), Robot.from_string(arm(robot="arm2")))
+    assert [(c.kind, c.name, c.field, c.old, c.new) for c in result.changes] == [
+        ("robot", "arm2", "name", "arm", "arm2")]
+
+
+def test_help_names_the_input_options() -> None:
+    result = CliRunner().invoke(app, ["diff", "--help"], env={"COLUMNS": "200"})
+    assert result.exit_code == 0
+    for flag in ("--json", "--tolerance", "--package", "--package-path", "--arg", "--no-guard"):
+        assert flag in result.stdout
