@@ -607,3 +607,17 @@ def test_help_names_the_input_options() -> None:
     assert result.exit_code == 0
     for flag in ("--json", "--tolerance", "--package", "--package-path", "--arg", "--no-guard"):
         assert flag in result.stdout
+
+
+def test_a_new_world_link_above_a_renamed_base_is_not_taken_for_the_root(
+        tmp_path: Path) -> None:
+    a = Robot.from_string(arm())
+    b = Robot.from_string(arm(names={"base": "base_link"}).replace(
+        "</robot>", '<link name="world"/>' + joint("world_joint", "world", "base_link", "fixed")
+        + "</robot>"))
+    result = diff_robots(a, b)
+    assert [(r.kind, r.old, r.new) for r in result.renamed] == [("link", "base", "base_link")]
+    assert [(e.kind, e.name) for e in result.added] == [("link", "world"),
+                                                        ("joint", "world_joint")]
+    assert {s.joint: (s.old, s.new) for s in result.index_shifts} == {
+        "shoulder_pan_joint": (0, 1), "shoulder_lift_joint": (1, 2), "elbow_joint": (2, 3)}

@@ -390,8 +390,6 @@ def _match(a: Robot, b: Robot, close: Close
     def pair_ends(ja: Joint, jb: Joint) -> bool:
         return any([pair_links(ja.parent, jb.parent), pair_links(ja.child, jb.child)])
 
-    # The roots are the same link if neither is matched by name: everything hangs from them.
-    pair_links(a.root, b.root)
     joint_b_by_end: dict[tuple[str, str], list[Joint]] = {}
     for jb in b.joints:
         joint_b_by_end.setdefault(("parent", jb.parent), []).append(jb)
@@ -404,6 +402,8 @@ def _match(a: Robot, b: Robot, close: Close
         for ja in a.joints:  # a joint kept by name carries its renamed links with it
             if ja.name in joints:
                 progress |= pair_ends(ja, b_joints[joints[ja.name]])
+        # The roots are the same link if nothing else claimed them: all hangs from them.
+        progress |= pair_links(a.root, b.root)
         for ja in order_a:
             if ja.name in joints:
                 continue
@@ -448,8 +448,8 @@ def _candidates(ja: Joint, links: dict[str, str], matched: set[str], taken: set[
 def _most_alike(ja: Joint, candidates: list[Joint], close: Close) -> Joint:
     """The candidate sharing most fields with ``ja`` (the first of the best).
 
-    One equal in every field ends the search: a hub of a thousand identical joints, all
-    renamed, is then matched in linear time rather than comparing every pair.
+    One equal in every field ends the search, so a hub of many identical joints, all
+    renamed, does not compare every field of every pair.
     """
     names = (*_LINK_FIELDS, *_JOINT_NAME_FIELDS)  # the ends are settled; names differ
 

@@ -37,13 +37,16 @@ from .spec import (
     SHAPE_SIZES,
     SHAPES,
     SOLIDS,
+    Matrix3,
     extension_note,
+    matmul,
     numbers,
     rotate,
     rpy_to_matrix,
     solid_inertia,
     solid_volume,
     sym_eigenvalues,
+    transpose,
 )
 from .spec import attr_float as _num
 from .spec import attr_vec as _vec
@@ -660,20 +663,43 @@ def _moments(values: Sequence[float], scale: float) -> str:
     return ", ".join("0" if abs(v) <= 1e-9 * scale else f"{v:.4g}" for v in values)
 
 
-def _shape_trace(link: etree._Element, mass: float | None,
-                 r: Report | None = None) -> tuple[float, float] | None:
-    """Trace of the inertia of the link's collision solids, and their largest size.
+@dataclass(frozen=True)
+class Solid:
+    """A link's collision shapes as one solid of uniform density.
 
-    Primitive shapes use spec's closed forms; STL and OBJ meshes (with ``scale``) are read
-    by :mod:`urdfkit.meshes` when ``r`` knows the file's folder. The trace does not change
-    under rotation, so only each part's offset matters: the parallel-axis theorem adds
-    2 m |d|^2 per part for its offset d from the common centre of mass. None if unknown (no
-    mass, a capsule or plane, a mesh that cannot be read or is not closed, a bad size).
+    Attributes:
+        volume: m^3.
+        com: Centre of mass in the link frame.
+        tensor: Inertia about ``com``, in link axes, per unit density (multiply by
+            mass / volume for a mass).
+        size: The largest size of any part, m (stub shapes are tiny).
     """
-    if mass is None or mass <= 0:
-        return None
-    # (volume, trace per unit density about the part's own centre, centre in the link, size)
-    parts: list[tuple[float, float, tuple[float, ...], float]] = []
+
+    volume: float
+    com: tuple[float, float, float]
+    tensor: tuple[tuple[float, float, float], ...]
+    size: float
+
+    def inertia(self, mass: float) -> tuple[tuple[float, float, float], ...]:
+        """The inertia tensor about ``com`` for a total ``mass``."""
+        k = mass / self.volume
+        return tuple((row[0] * k, row[1] * k, row[2] * k) for row in self.tensor)
+
+    def trace(self, mass: float) -> float:
+        """Trace of :meth:`inertia`."""
+        return sum(self.tensor[i][i] for i in range(3)) * mass / self.volume
+
+
+def link_solid(link: etree._Element, r: Report | None = None) -> Solid | None:
+    """The solid the link's collision shapes make: what ``U605`` and ``urdfkit fix`` use.
+
+    Primitive shapes use spec's closed forms; STL, OBJ and COLLADA meshes (with ``scale``)
+    are integrated by :mod:`urdfkit.meshes` when ``r`` knows the file's folder. Each part's
+    tensor is rotated into the link frame and moved to the common centre of mass (parallel
+    axes). None if unknown: no collision, a capsule, plane or SDF, a mesh that cannot be read
+    or is not closed, a bad size.
+    """
+    parts: list[tuple[float, tuple[float, ...], Matrix3, float]] = []
     for col in link.findall("collision"):
         shape = next((c for c in col.iterfind("geometry/*") if c.tag in SHAPES), None)
         origin = col.find("origin")
@@ -681,8 +707,9 @@ def _shape_trace(link: etree._Element, mass: float | None,
         rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
         if shape is None or xyz is None or rpy is None:
             return None
+        rot = rpy_to_matrix(rpy)
         if shape.tag == "mesh":
-            part = _mesh_part(shape, xyz, rpy, r)
+            part = _mesh_part(shape, xyz, rot, r)
             if part is None:
                 return None
             parts.append(part)
@@ -697,23 +724,41 @@ def _shape_trace(link: etree._Element, mass: float | None,
             return None  # U401/U501 say why
         volume = solid_volume(shape.tag, dims)
         size = max(dims) if shape.tag == "box" else max([2 * dims[0], *dims[1:]])
-        parts.append((volume, sum(solid_inertia(shape.tag, dims, volume)), xyz, size))
+        d = solid_inertia(shape.tag, dims, volume)
+        diag = ((d[0], 0.0, 0.0), (0.0, d[1], 0.0), (0.0, 0.0, d[2]))
+        parts.append((volume, tuple(xyz), matmul(matmul(rot, diag), transpose(rot)), size))
     total = sum(p[0] for p in parts)
     if not parts or not 0 < total < math.inf:
         return None
-    com = [sum(v * c[i] for v, _, c, _ in parts) / total for i in range(3)]
-    trace = 0.0
-    for volume, own, centre, _ in parts:
-        m = mass * volume / total
-        d2 = sum((centre[i] - com[i]) * (centre[i] - com[i]) for i in range(3))
-        trace += own * m / volume + 2 * m * d2
-    largest = max(p[3] for p in parts)
-    return (trace, largest) if math.isfinite(trace) else None
+    com = tuple(sum(v * c[i] for v, c, _, _ in parts) / total for i in range(3))
+    acc = [[0.0] * 3 for _ in range(3)]
+    for volume, centre, tensor, _ in parts:
+        dv = [centre[i] - com[i] for i in range(3)]
+        d2 = sum(x * x for x in dv)
+        for i in range(3):
+            for j in range(3):
+                acc[i][j] += tensor[i][j] + volume * ((d2 if i == j else 0.0) - dv[i] * dv[j])
+    out = tuple((row[0], row[1], row[2]) for row in acc)
+    if not all(math.isfinite(x) for row in out for x in row):
+        return None
+    return Solid(total, (com[0], com[1], com[2]), out, max(p[3] for p in parts))
 
 
-def _mesh_part(shape: etree._Element, xyz: Sequence[float], rpy: Sequence[float],
-               r: Report | None) -> tuple[float, float, tuple[float, ...], float] | None:
-    """A collision mesh as (volume, trace per unit density, centre in the link, size)."""
+def _shape_trace(link: etree._Element, mass: float | None,
+                 r: Report | None = None) -> tuple[float, float] | None:
+    """Trace of the inertia of the link's collision solids for ``mass``, and their size."""
+    if mass is None or mass <= 0:
+        return None
+    solid = link_solid(link, r)
+    if solid is None:
+        return None
+    trace = solid.trace(mass)
+    return (trace, solid.size) if math.isfinite(trace) else None
+
+
+def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3,
+               r: Report | None) -> tuple[float, tuple[float, ...], Matrix3, float] | None:
+    """A collision mesh as (volume, centre in the link, tensor per unit density, size)."""
     fn = (shape.get("filename") or "").strip()
     if r is None or r.base is None or not fn:
         return None
@@ -734,10 +779,11 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rpy: Sequence[float]
         return None
     if props.volume <= 0:
         return None
-    centre = rotate(rpy_to_matrix(rpy), props.com)
+    centre = rotate(rot, props.com)
     t = props.inertia
-    return (props.volume, t[0][0] + t[1][1] + t[2][2],
-            tuple(xyz[i] + centre[i] for i in range(3)), max(props.extent))
+    own = ((t[0][0], t[0][1], t[0][2]), (t[1][0], t[1][1], t[1][2]), (t[2][0], t[2][1], t[2][2]))
+    return (props.volume, tuple(xyz[i] + centre[i] for i in range(3)),
+            matmul(matmul(rot, own), transpose(rot)), max(props.extent))
 
 
 @dataclass(frozen=True)
