@@ -597,6 +597,84 @@ def diff(
         raise typer.Exit(1)
 
 
+@app.command(epilog=_examples(
+    "urdfkit fix robot.urdf -o robot_fixed.urdf", "urdfkit fix robot.urdf --diff",
+    "urdfkit fix robot.urdf --in-place --balance", "urdfkit fix robot.urdf -o - > out.urdf"))
+def fix(
+    file: Annotated[str, typer.Argument(metavar="FILE", help="The URDF to repair.")],
+    output: Annotated[str | None, typer.Option(
+        "--output", "-o", help="Where to write the repaired URDF ('-' for stdout).")] = None,
+    in_place: Annotated[bool, typer.Option(
+        "--in-place", "-i", help="Rewrite FILE itself, keeping the original as FILE.orig.")]
+    = False,
+    show_diff: Annotated[bool, typer.Option(
+        "--diff", help="Print a unified diff of the repairs; write nothing.")] = False,
+    balance: Annotated[bool, typer.Option(
+        "--balance", help="Keep the file's inertia where possible: balance triangle-inequality "
+        "violations (MuJoCo's balanceinertia) instead of deriving from the shapes.")] = False,
+    density: Annotated[float, typer.Option(
+        "--density", metavar="KG/M3",
+        help="Density for the mass of links that have no <inertial>.")] = 1000.0,
+    select: Annotated[list[str] | None, typer.Option(
+        "--select", metavar="CODES", help="Only these codes or prefixes (e.g. U6,U708).")]
+    = None,
+    as_json: JsonOpt = False,
+    force: ForceOpt = False,
+    package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
+) -> None:
+    """Repair inertia, massless links, undefined materials and package:/// paths.
+
+    Only what it fixes changes: comments, order and formatting elsewhere stay byte for byte,
+    and joints are never touched. Each fix is listed with its rule code (docs/fix.md). Exit 0:
+    nothing left to fix; 1: findings were left (listed), or --diff shows changes; 2: bad
+    input or usage.
+    """
+    from .check import parse_codes
+    from .errors import ParameterError
+    from .fix import FIXABLE, fix_file
+    from .output import atomic_write, check_output
+    from .resolve import parse_packages
+
+    if sum((output is not None, in_place, show_diff)) != 1:
+        raise ParameterError("say where the repaired file goes: -o OUT, --in-place, or --diff "
+                             "to preview (one of them)")
+    codes = parse_codes(select, "`select`")
+    if any(not any(f.startswith(c) for f in FIXABLE) for c in codes):
+        raise ParameterError(f"`select`: fix repairs {', '.join(FIXABLE)} only")
+    backup = f"{file}.orig"
+    if output not in (None, "-"):
+        check_output(output, force=force)
+    result = fix_file(file, balance=balance, density=density,
+                      packages=parse_packages(package, package_path), select=codes)
+    if in_place and result.changed:
+        check_output(backup, force=force, what="the backup")
+    to_stdout = output == "-" or show_diff
+    if as_json and not to_stdout:
+        show.print_json(result.to_dict())
+    else:
+        show.fix_report(result, stderr=to_stdout)
+    if show_diff:
+        sys.stdout.write(result.diff())
+        raise typer.Exit(1 if result.changed else 0)
+    if output == "-":
+        sys.stdout.buffer.write(result.fixed)
+        sys.stdout.flush()
+    elif in_place:
+        if result.changed:
+            atomic_write(backup, result.original, force=force)
+            atomic_write(file, result.fixed, force=True)
+            if not as_json:
+                show.wrote(Path(file), f"original kept as {backup}")
+    else:
+        assert output is not None
+        path = atomic_write(output, result.fixed, force=force)
+        if not as_json:
+            show.wrote(path, f"{len(result.repairs)} fix(es)")
+    if result.left or result.other_errors:
+        raise typer.Exit(1)
+
+
 # ---- drive: a headless throttle/steer run (urdfkit/drive.py, vehicle.py, plot.py)
 
 

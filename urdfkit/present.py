@@ -571,3 +571,23 @@ def collisions_report(result: Any, show_all: bool = False) -> None:
     if any(x.hull for x in result.pairs):
         tail.append("concave meshes collide as their convex hull in PyBullet")
     note("; ".join(tail), stderr=False)
+
+
+# --------------------------------------------------------------------------- fix
+
+
+def fix_report(result: Any, stderr: bool = False) -> None:
+    """``urdfkit fix``: each fix with its code and line, then what was left and why."""
+    name = _one_line(result.file)
+    for x in result.repairs:
+        line((f"{name}:{x.line or '-'}: ", "dim"), ("fixed ", "green"), (x.code, "bold"),
+             f" {_one_line(x.message)}", stderr=stderr)
+    for x in result.left:
+        line((f"{name}:{x.line or '-'}: ", "dim"), ("left ", "yellow"), (x.code, "bold"),
+             f" {_one_line(x.message)}", stderr=stderr)
+    if result.other_errors:
+        codes = ", ".join(sorted({x.code for x in result.other_errors}))
+        line((f"{name}: {len(result.other_errors)} other error(s) fix does not repair ({codes}): "
+              "urdfkit check explains them", "yellow"), stderr=stderr)
+    if not result.repairs and not result.left:
+        note(f"{name}: nothing to fix", stderr=stderr)

@@ -106,6 +106,9 @@ class Report:
         self.packages = dict(packages or {})
         self.origins = origins
         self.findings: list[Finding] = []
+        #: The element each finding is about, in step with :attr:`findings` (``urdfkit fix``
+        #: repairs elements, and lines cannot tell apart two elements on one line).
+        self.elements: list[etree._Element | None] = []
         self._references: dict[tuple[str, str], Reference] = {}
 
     def reference(self, tag: str, fn: str) -> Reference:
@@ -124,6 +127,7 @@ class Report:
             line = el.sourceline
         origin = self.origins.get(el) if self.origins is not None and el is not None else None
         self.findings.append(Finding(code, level, message, self.file, line, origin))
+        self.elements.append(el)
 
     @property
     def errors(self) -> list[Finding]:

@@ -1,0 +1,232 @@
+"""``urdfkit fix``: repairs checked against physics, PyBullet, ``check`` and ``diff``, and the
+promise that nothing else in the file changes."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from urdfkit.check import check_file
+from urdfkit.cli import app
+from urdfkit.diff import diff_files
+from urdfkit.errors import InputError, ParameterError
+from urdfkit.fix import FIXABLE, balanced, fix_file
+from urdfkit.spec import rpy_to_matrix
+
+MESHES = Path(__file__).parent / "fixtures" / "meshes"
+
+#: A small arm with every repair ``fix`` makes, written the way people write URDF by hand:
+#: single quotes, comments, four-space indents, several elements on one line.
+BROKEN = (Path(__file__).parent / "fixtures" / "robots" / "broken_arm.urdf").read_text()
+
+
+@pytest.fixture
+def broken(tmp_path: Path) -> Path:
+    """The arm in a ROS package layout (package.xml above it, the mesh in meshes/)."""
+    pkg = tmp_path / "arm_description"
+    (pkg / "meshes").mkdir(parents=True)
+    (pkg / "urdf").mkdir()
+    (pkg / "package.xml").write_text("<package><name>arm_description</name></package>")
+    shutil.copy(MESHES / "unit_cube.stl", pkg / "meshes" / "unit_cube.stl")
+    path = pkg / "urdf" / "arm.urdf"
+    path.write_text(BROKEN)
+    return path
+
+
+def _cli(*args: str) -> tuple[int, str, str]:
+    result = CliRunner().invoke(app, list(args))
+    return result.exit_code, result.stdout, result.stderr
+
+
+def test_every_fixable_finding_is_fixed_and_listed(broken: Path) -> None:
+    result = fix_file(broken)
+    assert sorted({r.code for r in result.repairs}) == ["U602", "U603", "U604", "U606", "U706",
+                                                        "U708"]
+    assert not result.left and not result.other_errors
+    out = broken.with_name("fixed.urdf")
+    out.write_bytes(result.fixed)
+    after = [f for f in check_file(str(out), out).findings if f.code in FIXABLE]
+    assert after == []  # no error, no warning, not even U605's "far from the shapes"
+
+
+def test_only_what_is_fixed_changes(broken: Path) -> None:
+    result = fix_file(broken)
+    before = result.original.decode().splitlines()
+    after = result.fixed.decode().splitlines()
+    # Every original line that is not an edited element survives byte for byte, in order.
+    edited = ("<inertia ", "package:///", "<link name=\"tool0\"/>", "<mass value=\"0\"/>")
+    kept = [x for x in before if not any(e in x for e in edited)]
+    it = iter(after)
+    assert all(any(line == a for a in it) for line in kept)
+    assert "        <!-- keep this comment -->" in after and after[2] == "<robot name='broken_arm'>"
+    # Joints are untouched in meaning: only links (and the new material) differ.
+    fixed = broken.with_name("fixed.urdf")
+    fixed.write_bytes(result.fixed)
+    d = diff_files(broken, fixed)
+    assert {c.kind for c in d.changes} == {"link"}
+    assert not d.added and not d.removed and not d.renamed and not d.index_shifts
+    assert [line for line in after if "<joint" in line] == \
+        [line for line in before if "<joint" in line]
+
+
+def test_derived_inertia_matches_the_closed_forms(broken: Path) -> None:
+    from lxml import etree
+
+    root = etree.fromstring(fix_file(broken).fixed)
+
+    def tensor(link: str) -> list[float]:  # row by row
+        i = root.find(f"link[@name='{link}']/inertial/inertia")
+        assert i is not None
+        g = {k: float(i.get(k, "nan")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+        return [g["ixx"], g["ixy"], g["ixz"], g["ixy"], g["iyy"], g["iyz"], g["ixz"], g["iyz"],
+                g["izz"]]
+
+    # base: a 0.4 x 0.2 x 0.2 box of 2 kg (the mass and the <origin> are the file's).
+    assert tensor("base") == pytest.approx([2 / 12 * 0.08, 0, 0, 0, 2 / 12 * 0.2, 0,
+                                            0, 0, 2 / 12 * 0.2], rel=1e-6)
+    # upper: a cylinder r=0.05 l=0.5 of 1.5 kg, axis z in the link; the file's inertial frame
+    # is pitched 90 degrees, so in that frame the axis is x.
+    axial, radial = 1.5 * 0.05**2 / 2, 1.5 * (3 * 0.05**2 + 0.5**2) / 12
+    flat = tensor("upper")
+    t = [flat[0:3], flat[3:6], flat[6:9]]
+    rot = rpy_to_matrix((0, 1.5707963, 0))
+    back = [sum(rot[i][k] * t[k][m] * rot[j][m] for k in range(3) for m in range(3))
+            for i in range(3) for j in range(3)]  # into link axes
+    assert back == pytest.approx([radial, 0, 0, 0, radial, 0, 0, 0, axial], abs=1e-7)
+    # cube: a 0.1 m cube of water (no <inertial> before): 1 kg, m a^2 / 6 about each axis.
+    mass = root.find("link[@name='cube']/inertial/mass")
+    assert mass is not None and float(mass.get("value", "nan")) == pytest.approx(1.0)
+    assert tensor("cube") == pytest.approx([1 / 600, 0, 0, 0, 1 / 600, 0, 0, 0, 1 / 600],
+                                           rel=1e-6)
+    assert root.find("link[@name='finger']/inertial/mass").get("value") == "0.001"  # type: ignore[union-attr]
+    assert root.find("link[@name='tool0']/inertial/mass").get("value") == "0"  # type: ignore[union-attr]
+
+
+def test_pybullet_loads_the_fix_with_the_inertia_it_derives_itself(broken: Path,
+                                                                   pb: tuple[object, int]) -> None:
+    # Without URDF_USE_INERTIA_FROM_FILE PyBullet computes inertia from the collision box
+    # itself; with the flag it reads ours. For the box base they must agree.
+    p, c = pb
+    fixed = broken.with_name("fixed.urdf")
+    fixed.write_bytes(fix_file(broken).fixed)
+    ours = p.loadURDF(str(fixed), flags=p.URDF_USE_INERTIA_FROM_FILE,  # type: ignore[attr-defined]
+                      physicsClientId=c)
+    theirs = p.loadURDF(str(fixed), physicsClientId=c)  # type: ignore[attr-defined]
+    a = p.getDynamicsInfo(ours, -1, physicsClientId=c)  # type: ignore[attr-defined]
+    b = p.getDynamicsInfo(theirs, -1, physicsClientId=c)  # type: ignore[attr-defined]
+    assert a[0] == b[0] == 2.0
+    assert a[2] == pytest.approx(b[2], rel=1e-4)
+    masses = [p.getDynamicsInfo(ours, j, physicsClientId=c)[0]  # type: ignore[attr-defined]
+              for j in range(p.getNumJoints(ours, physicsClientId=c))]  # type: ignore[attr-defined]
+    assert masses == pytest.approx([1.5, 1.0, 0.001, 0.0])  # tool0: no longer PyBullet's 1 kg
+
+
+def test_balance_keeps_the_file_values_the_mujoco_way(broken: Path) -> None:
+    result = fix_file(broken, balance=True)
+    from lxml import etree
+
+    root = etree.fromstring(result.fixed)
+    i = root.find("link[@name='base']/inertial/inertia")
+    assert i is not None
+    mean = (0.01 + 0.01 + 0.5) / 3  # the trace is kept, spread evenly
+    assert [float(i.get(k, "nan")) for k in ("ixx", "iyy", "izz", "ixy")] == \
+        pytest.approx([mean, mean, mean, 0], rel=1e-8)
+    assert balanced([[0.01, 0, 0], [0, 0.01, 0], [0, 0, 0.5]]) == pytest.approx(mean)
+    assert balanced([[1, 0, 0], [0, 1, 0], [0, 0, 1.5]]) is None  # valid: left alone
+    # Not positive definite cannot be balanced: still derived from the shapes.
+    assert any(r.code == "U603" and "derived" in r.message for r in result.repairs)
+
+
+def test_far_from_shapes_is_derived_unless_balance(tmp_path: Path) -> None:
+    path = tmp_path / "far.urdf"
+    path.write_text(BROKEN.replace('izz="0.5"', 'izz="0.015"').replace(
+        'ixx="0.01" ixy="0" ixz="0" iyy="0.01"', 'ixx="10" ixy="0" ixz="0" iyy="10"')
+        .replace('izz="0.015"', 'izz="10"'))
+    assert [f.code for f in check_file(str(path), path).findings
+            if f.line == 10 and f.code != "U607"] == ["U605"]
+    assert any(r.code == "U605" for r in fix_file(path).repairs)
+    kept = fix_file(path, balance=True)
+    assert [r.code for r in kept.left if r.line == 10] == ["U605"]
+
+
+def test_one_line_files_and_self_closing_links(tmp_path: Path) -> None:
+    path = tmp_path / "flat.urdf"
+    path.write_text('<robot name="flat"><link name="a"><collision><geometry><box size="1 1 1"/>'
+                    '</geometry></collision></link><link name="b"><collision><geometry><sphere '
+                    'radius="0.5"/></geometry></collision></link><link name="c"/><joint name="j" '
+                    'type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+                    '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint><joint name="f" '
+                    'type="fixed"><parent link="b"/><child link="c"/></joint></robot>')
+    result = fix_file(path)
+    assert [r.code for r in result.repairs] == ["U606", "U606", "U606"]
+    out = tmp_path / "out.urdf"
+    out.write_bytes(result.fixed)
+    assert not [f for f in check_file(str(out), out).findings if f.code in FIXABLE]
+    from lxml import etree
+
+    root = etree.fromstring(result.fixed)
+    sphere = root.find("link[@name='b']/inertial")
+    assert sphere is not None
+    m = float(sphere.find("mass").get("value", "nan"))  # type: ignore[union-attr]
+    assert m == pytest.approx(1000 * 4 / 3 * math.pi * 0.125, rel=1e-5)
+    assert float(sphere.find("inertia").get("izz", "nan")) == \
+        pytest.approx(0.4 * m * 0.25, rel=1e-5)  # type: ignore[union-attr]
+
+
+def test_cli_writes_only_where_told(broken: Path, tmp_path: Path) -> None:
+    out = tmp_path / "out.urdf"
+    code, stdout, _ = _cli("fix", str(broken), "-o", str(out))
+    assert code == 0 and out.exists() and "fixed U604" in stdout
+    original = broken.read_bytes()
+    code, _, err = _cli("fix", str(broken), "-o", str(out))
+    assert code == 2 and "exists" in err  # never overwrite without --force
+    assert _cli("fix", str(broken), "-o", str(out), "--force")[0] == 0
+    code, stdout, err = _cli("fix", str(broken), "--diff")
+    assert code == 1 and stdout.startswith("--- a/") and "fixed U604" in err
+    assert broken.read_bytes() == original  # --diff writes nothing
+    code, stdout, _ = _cli("fix", str(broken), "-o", "-")
+    assert code == 0 and stdout.encode() == out.read_bytes()
+    code, stdout, _ = _cli("fix", str(broken), "--in-place", "--json")
+    data = json.loads(stdout)
+    assert code == 0 and data["changed"] and {"code", "line", "message"} <= set(data["fixes"][0])
+    assert Path(f"{broken}.orig").read_bytes() == original
+    assert broken.read_bytes() == out.read_bytes()
+    assert _cli("fix", str(broken), "--diff")[0] == 0  # nothing left to fix
+
+
+def test_bad_input_and_usage(broken: Path, tmp_path: Path) -> None:
+    for args, words in [((), "say where"), (("-o", "x.urdf", "--diff"), "say where"),
+                        (("--diff", "--select", "U3"), "repairs U601"),
+                        (("--diff", "--density", "-5"), "density")]:
+        code, _, err = _cli("fix", str(broken), *args)
+        assert code == 2 and words in err and "Traceback" not in err, (args, err)
+    bad = tmp_path / "bad.urdf"
+    bad.write_text("<robot name='x'><link name='a'>")
+    code, _, err = _cli("fix", str(bad), "--diff")
+    assert code == 2 and "bad.urdf" in err
+    xacro = tmp_path / "arm.urdf.xacro"
+    xacro.write_text("<robot name='x'/>")
+    with pytest.raises(InputError, match="xacro"):
+        fix_file(xacro)
+    with pytest.raises(ParameterError):
+        fix_file(broken, density=0)
+
+
+def test_left_findings_say_why_and_exit_1(tmp_path: Path) -> None:
+    path = tmp_path / "capsule.urdf"
+    path.write_text('<robot name="c"><link name="a"/><link name="b"><collision><geometry>'
+                    '<capsule radius="0.1" length="0.5"/></geometry></collision></link>'
+                    '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+                    '<axis xyz="0 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+                    '</joint></robot>')
+    result = fix_file(path)
+    assert [r.code for r in result.left] == ["U606", "U606"]
+    assert "no collision solid" in result.left[-1].message
+    assert [r.code for r in result.other_errors] == ["U305"]  # a zero axis: check's business
+    code, stdout, _ = _cli("fix", str(path), "-o", str(tmp_path / "o.urdf"))
+    assert code == 1 and "left U606" in stdout and "U305" in stdout

@@ -1,0 +1,560 @@
+"""``urdfkit fix``: repair what ``check`` finds and a machine can repair, and touch nothing else.
+
+The rules of :mod:`urdfkit.validate` decide what is wrong (one road: ``fix`` keeps no rules of
+its own); this module decides the repair, element by element:
+
+- **Inertia.** Where it is missing (U606, U609, U610), impossible (U603 not positive definite,
+  U604 triangle inequality), singular (U608) or far from the shapes (U605), the tensor is
+  derived from the link's collision solid (:func:`urdfkit.validate.link_solid`: primitives in
+  closed form, meshes integrated) at the link's mass, and written in the ``<inertial>``'s own
+  frame, which is kept. A link with no ``<inertial>`` gets the mass of its solid at
+  ``density`` (water, 1000 kg/m^3, unless told). ``balance=True`` keeps the file's values
+  where it can: a triangle-inequality violation is balanced as MuJoCo's ``balanceinertia``
+  does (every principal moment set to their mean, the trace kept), and U605/U608 are left.
+- **Massless moving links** (U602) get 1 g and 1e-6 kg m^2 about each axis (or their solid's
+  inertia at 1 g): enough for the solver, too little to change the robot's dynamics.
+- **Materials** used but never defined (U706) are defined at the top, white: the colour
+  PyBullet draws for them today, so nothing changes on screen until the user picks one.
+- **``package:///path``** (U708, which ROS tools refuse) becomes ``package://NAME/path`` when
+  the file lies in a folder with a ``package.xml``, else a path relative to the URDF.
+
+Edits are spliced into the original text: comments, element order, indentation, quotes and
+number formatting elsewhere stay byte for byte. The result is parsed again and compared,
+element by element, with the same edits made on the parsed tree; a mismatch is a bug in
+urdfkit, raised rather than written. Joints are never edited.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import os
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from lxml import etree
+
+from .errors import InputError, ParameterError
+from .spec import attr_float as _num
+from .spec import attr_vec as _vec
+from .spec import rpy_to_matrix, sym_eigenvalues, transpose
+from .validate import ALL_RULES, STUB_SIZE, Report, Solid, link_solid, refuse_oversized
+from .xmlio import fmt_float, fmt_vec, parse_xml, read_bytes
+
+#: Density (kg/m^3) that gives a link with no ``<inertial>`` its mass: water.
+DEFAULT_DENSITY = 1000.0
+#: Mass (kg) and principal moment (kg m^2) for a massless link that moves.
+SMALL_MASS = 1e-3
+SMALL_INERTIA = 1e-6
+#: What PyBullet draws a visual with an undefined material in.
+UNDEFINED_RGBA = "1 1 1 1"
+#: The codes ``fix`` repairs.
+FIXABLE = ("U601", "U602", "U603", "U604", "U605", "U606", "U608", "U609", "U610", "U706", "U708")
+#: The inertia codes, most serious first: a link gets one inertial repair, for its worst.
+_INERTIA_ORDER = ("U606", "U602", "U601", "U609", "U610", "U603", "U604", "U605", "U608")
+
+
+@dataclass
+class Repair:
+    """One fix made, or one finding left as it was (with why).
+
+    Attributes:
+        code: The rule code of the finding.
+        line: Its line in the original file.
+        message: What was done, or why nothing was.
+    """
+
+    code: str
+    line: int | None
+    message: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form."""
+        return {"code": self.code, "line": self.line, "message": self.message}
+
+
+@dataclass
+class FixResult:
+    """The repaired text of one file, and what was repaired.
+
+    Attributes:
+        file: The file as the user named it.
+        original: Its bytes.
+        fixed: The repaired bytes (equal to ``original`` when nothing was fixed).
+        repairs: The fixes made, in file order.
+        left: Findings of fixable codes that were left, each with the reason.
+        other_errors: Error findings ``fix`` does not repair (a zero axis, a missing limit):
+            ``check`` explains them.
+    """
+
+    file: str
+    original: bytes
+    fixed: bytes
+    repairs: list[Repair] = field(default_factory=list)
+    left: list[Repair] = field(default_factory=list)
+    other_errors: list[Repair] = field(default_factory=list)
+
+    @property
+    def changed(self) -> bool:
+        """Whether anything was fixed."""
+        return self.fixed != self.original
+
+    def diff(self, new_name: str | None = None) -> str:
+        """A unified diff from the original to the fixed text."""
+        a = self.original.decode("utf-8", "replace").splitlines(keepends=True)
+        b = self.fixed.decode("utf-8", "replace").splitlines(keepends=True)
+        return "".join(difflib.unified_diff(a, b, f"a/{self.file}",
+                                            f"b/{new_name or self.file}"))
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``--json`` form (docs/fix.md)."""
+        return {"file": self.file, "changed": self.changed,
+                "fixes": [x.to_dict() for x in self.repairs],
+                "left": [x.to_dict() for x in self.left],
+                "other_errors": [x.to_dict() for x in self.other_errors]}
+
+
+def fix_file(path: str | Path, *, balance: bool = False, density: float = DEFAULT_DENSITY,
+             packages: Mapping[str, Path] | None = None,
+             select: Sequence[str] = ()) -> FixResult:
+    """Repair a URDF file's fixable findings; return the new text (nothing is written).
+
+    Args:
+        path: The URDF (xacro is refused: its inertia comes from macros; fix the macro or
+            the expanded file).
+        balance: Keep the file's inertia values where possible: balance triangle-inequality
+            violations (MuJoCo's ``balanceinertia``) instead of deriving from the shapes, and
+            leave U605 and U608.
+        density: kg/m^3, for the mass of a link that has no ``<inertial>``.
+        packages: ``package://`` mappings, to find meshes.
+        select: Only these codes (or prefixes); empty for all of :data:`FIXABLE`.
+
+    Raises:
+        InputError: the file cannot be read or parsed, or is xacro.
+        ParameterError: a bad ``density``.
+    """
+    display = str(path)
+    source = Path(path)
+    if not (math.isfinite(density) and density > 0):
+        raise ParameterError(f"`density` must be a positive number of kg/m^3, got {density!r}",
+                             param="density")
+    if source.suffix == ".xacro":
+        raise InputError("fix edits URDF files, and a xacro file's values come from its macros "
+                         "and arguments: fix the macro, or expand the file first (urdfkit build "
+                         "or xacro) and fix that", file=display)
+    data = read_bytes(source)
+    refuse_oversized(data, display)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise InputError(f"not UTF-8 text (byte {e.start}); fix rewrites only UTF-8 files",
+                         file=display) from None
+    root = parse_xml(data, display).getroot()
+    report = Report(display, source.absolute().parent, packages)
+    for rule in ALL_RULES:
+        rule(root, report)
+    wanted = tuple(c.upper() for c in select)
+    plan = _Plan(text, root, display, balance, density, report)
+    found: dict[etree._Element, list[tuple[str, int | None]]] = {}
+    for f, el in zip(report.findings, report.elements, strict=True):
+        if f.code not in FIXABLE or el is None:
+            continue
+        if wanted and not any(f.code.startswith(w) for w in wanted):
+            continue
+        target = el if f.code in ("U706", "U708") else _link_of(el)
+        if target is not None:
+            found.setdefault(target, []).append((f.code, f.line))
+    for el, codes in found.items():
+        if el.tag == "link":
+            plan.fix_link(el, codes)
+        elif codes[0][0] == "U706":
+            plan.define_material(el, codes[0][1])
+        else:
+            plan.normalise_uri(el, codes[0][1], packages)
+    fixed = plan.finish()
+    others = [Repair(f.code, f.line, f.message) for f in report.findings
+              if f.level == "error" and f.code not in FIXABLE]
+    return FixResult(display, data, fixed, sorted(plan.repairs, key=_by_line),
+                     sorted(plan.left, key=_by_line), others)
+
+
+def _by_line(x: Repair) -> tuple[int, str]:
+    return (x.line or 0, x.code)
+
+
+def _link_of(el: etree._Element) -> etree._Element | None:
+    if el.tag == "link":
+        return el
+    return next((a for a in el.iterancestors("link")), None)
+
+
+def balanced(tensor: Sequence[Sequence[float]]) -> float | None:
+    """MuJoCo's ``balanceinertia``: one principal moment (their mean) for all three.
+
+    None when the triangle inequality holds, or the tensor is not positive definite.
+    """
+    a, b, c = sym_eigenvalues(tensor)
+    if a <= 0 or a + b >= c:
+        return None
+    return (a + b + c) / 3
+
+
+class _Plan:
+    """The edits to one file: spliced into its text and made on its tree, side by side."""
+
+    def __init__(self, text: str, root: etree._Element, file: str, balance: bool,
+                 density: float, report: Report):
+        self.text = text
+        self.root = root
+        self.file = file
+        self.balance = balance
+        self.density = density
+        self.report = report
+        self.edits: list[tuple[int, int, str]] = []
+        self.repairs: list[Repair] = []
+        self.left: list[Repair] = []
+        self.defined: set[str] = set()
+        starts = [0]
+        starts += [m.end() for m in re.finditer("\n", text)]
+        self.line_starts = starts
+
+    # ---- repairs
+
+    def fix_link(self, link: etree._Element, codes: list[tuple[str, int | None]]) -> None:
+        by_code = dict(codes)
+        code = next(c for c in _INERTIA_ORDER if c in by_code)
+        line = by_code[code]
+        name = link.get("name", "")
+        inertial = link.find("inertial")
+        mass_el = inertial.find("mass") if inertial is not None else None
+        mass = _num(mass_el, "value")
+        solid = link_solid(link, self.report)
+        origin = inertial.find("origin") if inertial is not None else None
+        frame = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0)) or (0.0, 0.0, 0.0)
+
+        def skip(why: str) -> None:
+            self.left.append(Repair(code, line, f"link {name!r}: {why}"))
+
+        if code == "U606" and solid is None and self._fixed_leaf(link):
+            self._insert_first_child(link, [
+                '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" '
+                'izz="0"/></inertial>'])
+            link.insert(0, etree.fromstring(
+                '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" '
+                'izz="0"/></inertial>'))
+            self.repairs.append(Repair(code, line, f"link {name!r} is a frame (no shapes, "
+                                       "fixed to its parent, nothing below it): gave it mass 0, "
+                                       "where PyBullet would add 1 kg"))
+            return
+        if code == "U602":
+            tensor = solid.inertia(SMALL_MASS) if solid else _iso(SMALL_INERTIA)
+            self._write_inertial(link, SMALL_MASS, solid.com if solid and inertial is None
+                                 else None, tensor, frame, keep_mass=False)
+            self.repairs.append(Repair(code, line, f"link {name!r} moves but had no mass: "
+                                       f"gave it {fmt_float(SMALL_MASS)} kg and "
+                                       f"{'its shapes inertia' if solid else 'inertia 1e-06'}"))
+            return
+        if solid is None:
+            skip("no collision solid to derive inertia from (no <collision>, a capsule, plane "
+                 "or SDF, or a mesh that is unreadable or not closed); write <inertial> by hand")
+            return
+        if code in ("U606", "U601"):
+            new_mass = self.density * solid.volume
+            self._write_inertial(link, new_mass, solid.com if inertial is None or origin is None
+                                 else None, solid.inertia(new_mass), frame,
+                                 keep_mass=False)
+            what = "had no <inertial>" if code == "U606" else "had no valid mass"
+            self.repairs.append(Repair(code, line, f"link {name!r} {what}: "
+                                       f"{fmt_float(new_mass, 4)} kg ({fmt_float(solid.volume, 4)}"
+                                       f" m^3 at {fmt_float(self.density)} kg/m^3) and the "
+                                       "inertia of its collision shapes"))
+            return
+        if mass is None or mass <= 0:
+            skip("mass 0: no inertia to derive (a frame); give it a mass if it moves")
+            return
+        inertia = inertial.find("inertia") if inertial is not None else None
+        if self.balance and code in ("U605", "U608"):
+            skip(f"{code} left as it is: --balance keeps the file's values")
+            return
+        if self.balance and code == "U604" and inertia is not None:
+            from .validate import _inertia_tensor
+
+            file_tensor = _inertia_tensor(inertia)
+            mean = balanced(file_tensor) if file_tensor is not None else None
+            if mean is not None:
+                self._replace_inertia(inertia, _iso(mean))
+                self.repairs.append(Repair(code, line, f"link {name!r}: balanced its inertia "
+                                           "as MuJoCo's balanceinertia does (every principal "
+                                           f"moment set to their mean, {fmt_float(mean, 4)})"))
+                return
+        if code == "U605" and solid.size < STUB_SIZE:
+            skip("its collision shapes are stubs (under 1 cm), nothing to derive inertia from")
+            return
+        self._write_inertial(link, mass, None, solid.inertia(mass), frame, keep_mass=True)
+        why = {"U609": "had no <inertia>", "U610": "had an incomplete <inertia>",
+               "U603": "had an inertia that is not positive definite",
+               "U604": "had an inertia that violates the triangle inequality",
+               "U605": "had an inertia far from its shapes'",
+               "U608": "had a singular inertia"}[code]
+        self.repairs.append(Repair(code, line, f"link {name!r} {why}: derived it from its "
+                                   f"collision shapes at its mass {fmt_float(mass, 6)} kg"))
+
+    def _fixed_leaf(self, link: etree._Element) -> bool:
+        """Whether ``link`` hangs from a fixed joint and carries nothing: a frame (tool0)."""
+        name = link.get("name")
+        parent_fixed = False
+        for j in self.root.iterchildren("joint"):
+            parent, child = j.find("parent"), j.find("child")
+            if parent is not None and parent.get("link") == name:
+                return False
+            if child is not None and child.get("link") == name:
+                parent_fixed = j.get("type") == "fixed"
+        return parent_fixed
+
+    def define_material(self, el: etree._Element, line: int | None) -> None:
+        name = el.get("name", "")
+        if name in self.defined:
+            return
+        self.defined.add(name)
+        xml = f'<material name="{_attr(name)}"><color rgba="{UNDEFINED_RGBA}"/></material>'
+        self._insert_first_child(self.root, [xml])
+        new = etree.Element("material", name=name)
+        etree.SubElement(new, "color", rgba=UNDEFINED_RGBA)
+        self.root.insert(0, new)
+        self.repairs.append(Repair("U706", line, f"material {name!r} was used but never "
+                                   f"defined: defined it white ({UNDEFINED_RGBA}), the colour "
+                                   "PyBullet draws it in; set the colour you meant"))
+
+    def normalise_uri(self, el: etree._Element, line: int | None,
+                      packages: Mapping[str, Path] | None) -> None:
+        from .uris import package_xml_name, resolve_uri
+
+        old = el.get("filename", "")
+        base = self.report.base
+        assert base is not None
+        target = resolve_uri(old, base, packages).path
+        if target is None or not target.is_file():
+            self.left.append(Repair("U708", line, f"{old!r}: no file found to point to"))
+            return
+        new = None
+        for folder in [target.parent, *target.parent.parents]:
+            name = package_xml_name(str(folder))
+            if name:
+                new = f"package://{name}/{target.relative_to(folder).as_posix()}"
+                break
+        if new is None:
+            new = Path(os.path.relpath(target, base)).as_posix()
+        self._set_attribute(el, "filename", new)
+        self.repairs.append(Repair("U708", line, f"{old!r} -> {new!r} (package:/// has no "
+                                   "package name; ROS tools refuse it)"))
+
+    # ---- edits, on the text and the tree alike
+
+    def _write_inertial(self, link: etree._Element, mass: float,
+                        com: Sequence[float] | None, tensor: Sequence[Sequence[float]],
+                        frame: Sequence[float], keep_mass: bool) -> None:
+        """Write ``<inertial>``: a new one, or the old one with mass and inertia replaced.
+
+        ``tensor`` is in link axes; it is written in the frame of the inertial's ``<origin
+        rpy>``. An existing ``<origin>`` is kept; ``com`` gives a new one.
+        """
+        rot = rpy_to_matrix(frame)
+        local = _rotate_tensor(transpose(rot), tensor)
+        inertia_xml = _inertia_xml(local)
+        inertial = link.find("inertial")
+        if inertial is None:
+            lines = ["<inertial>"]
+            if com is not None and any(abs(x) > 0 for x in com):
+                lines.append(f'\t<origin xyz="{fmt_vec(tuple(com))}" rpy="0 0 0"/>')
+            lines += [f'\t<mass value="{fmt_float(mass, 6)}"/>', f"\t{inertia_xml}",
+                      "</inertial>"]
+            self._insert_first_child(link, lines)
+            new = etree.fromstring("".join(x.strip() for x in lines))
+            link.insert(0, new)
+            return
+        mass_el = inertial.find("mass")
+        if not keep_mass:
+            if mass_el is not None:
+                self._set_attribute(mass_el, "value", fmt_float(mass, 6))
+            else:
+                self._insert_first_child(inertial, [f'<mass value="{fmt_float(mass, 6)}"/>'])
+                inertial.insert(0, etree.Element("mass", value=fmt_float(mass, 6)))
+        if com is not None and inertial.find("origin") is None and any(com):
+            self._insert_first_child(inertial, [f'<origin xyz="{fmt_vec(tuple(com))}" '
+                                                'rpy="0 0 0"/>'])
+            inertial.insert(0, etree.Element("origin", xyz=fmt_vec(tuple(com)), rpy="0 0 0"))
+        old = inertial.find("inertia")
+        if old is not None:
+            self._replace_inertia(old, local)
+        else:
+            self._insert_last_child(inertial, inertia_xml)
+            inertial.append(etree.fromstring(inertia_xml))
+
+    def _replace_inertia(self, el: etree._Element, tensor: Sequence[Sequence[float]]) -> None:
+        start, end = self._span(el)
+        xml = _inertia_xml(tensor)
+        self.edits.append((start, end, xml))
+        new = etree.fromstring(xml)
+        new.tail = el.tail
+        parent = el.getparent()
+        assert parent is not None
+        parent.replace(el, new)
+
+    def _set_attribute(self, el: etree._Element, name: str, value: str) -> None:
+        start, tag_end, _ = self._start_tag(el)
+        tag = self.text[start:tag_end]
+        m = re.search(rf"(\s{re.escape(name)}\s*=\s*)([\"'])(.*?)\2", tag, re.S)
+        if m is None:  # pragma: no cover - the rules found the attribute in this element
+            raise AssertionError(f"attribute {name} not found in {tag!r}")
+        quote = m.group(2)
+        escaped = _attr(value) if quote == '"' else _attr(value).replace("'", "&apos;")
+        self.edits.append((start + m.start(3), start + m.end(3), escaped))
+        el.set(name, value)
+
+    def _insert_first_child(self, parent: etree._Element, lines: list[str]) -> None:
+        """Insert lines as the first child; a leading tab in a line is one more indent."""
+        start, tag_end, closed = self._start_tag(parent)
+        indent = self._indent(start)
+        first = next(iter(parent), None)
+        if first is not None and not closed:
+            inner = self._indent(self._start_tag(first)[0]) if isinstance(first.tag, str) \
+                else None
+            child = inner if inner is not None and inner.startswith(indent) and inner != indent \
+                else indent + self._unit()
+        else:
+            child = indent + self._unit()
+        unit = self._unit()
+        body = "\n".join(child + unit * (len(x) - len(x.lstrip("\t"))) + x.lstrip("\t")
+                         for x in lines)
+        if closed:  # <link name="x"/> becomes <link name="x"> ... </link>
+            head = self.text[start:tag_end].rstrip(">").rstrip().rstrip("/").rstrip()
+            self.edits.append((start, tag_end, f"{head}>\n{body}\n{indent}</{parent.tag}>"))
+        else:
+            self.edits.append((tag_end, tag_end, "\n" + body))
+
+    def _insert_last_child(self, parent: etree._Element, xml: str) -> None:
+        start, end = self._span(parent)
+        if self.text[end - 2:end] == "/>":  # <inertial/>: open it
+            self._insert_first_child(parent, [xml])
+            return
+        close = self.text.rindex("</", start, end)
+        own_line = self.text[self.text.rfind("\n", 0, close) + 1:close]
+        if own_line.strip() == "":  # the end tag on a line of its own: a child line above it
+            self.edits.append((close, close, f"{self._unit()}{xml}\n{own_line}"))
+        else:  # all on one line: stay on it
+            self.edits.append((close, close, xml))
+
+    # ---- finding elements in the text
+
+    def _start_tag(self, el: etree._Element) -> tuple[int, int, bool]:
+        """(start, end, self-closing) of the element's start tag in the text."""
+        line = el.sourceline or 1
+        same = [x for x in self.root.iter(el.tag) if x.sourceline == line]
+        nth = same.index(el) if el in same else 0
+        pattern = re.compile(rf"<{re.escape(str(el.tag))}(?=[\s/>])")
+        pos = self.line_starts[line - 1]
+        found: re.Match[str] | None = None
+        for _ in range(nth + 1):
+            found = pattern.search(self.text, pos)
+            if found is None:  # pragma: no cover - lxml said it starts on this line
+                raise AssertionError(f"<{el.tag}> not found from line {line}")
+            pos = found.end()
+        assert found is not None
+        m = found
+        start = m.start()
+        i, quote = m.end(), ""
+        while True:
+            ch = self.text[i]
+            if quote:
+                quote = "" if ch == quote else quote
+            elif ch in "\"'":
+                quote = ch
+            elif ch == ">":
+                return start, i + 1, self.text[i - 1] == "/"
+            i += 1
+
+    def _span(self, el: etree._Element) -> tuple[int, int]:
+        start, tag_end, closed = self._start_tag(el)
+        if closed:
+            return start, tag_end
+        tag = re.escape(str(el.tag))
+        token = re.compile(rf"<{tag}(?=[\s/>])|</{tag}\s*>")
+        depth, pos = 1, tag_end
+        while True:
+            m = token.search(self.text, pos)
+            if m is None:  # pragma: no cover - the document is well formed
+                raise AssertionError(f"no end of <{el.tag}>")
+            if m.group().startswith("</"):
+                depth -= 1
+                if depth == 0:
+                    return start, m.end()
+                pos = m.end()
+            else:
+                close = self.text.index(">", m.end())
+                depth += self.text[close - 1] != "/"
+                pos = close + 1
+
+    def _indent(self, pos: int) -> str:
+        line_start = self.text.rfind("\n", 0, pos) + 1
+        lead = self.text[line_start:pos]
+        return lead if lead.strip() == "" else ""
+
+    def _unit(self) -> str:
+        first = next((x for x in self.root if isinstance(x.tag, str)), None)
+        if first is not None:
+            unit = self._indent(self._start_tag(first)[0])
+            if unit:
+                return unit
+        return "  "
+
+    # ---- the result
+
+    def finish(self) -> bytes:
+        if not self.edits:
+            return self.text.encode("utf-8")
+        out = self.text
+        for start, end, new in sorted(self.edits, key=lambda e: (e[0], e[1]), reverse=True):
+            out = out[:start] + new + out[end:]
+        data = out.encode("utf-8")
+        got = _shape(parse_xml(data, self.file).getroot())
+        if got != _shape(self.root):  # pragma: no cover - a bug in the splicing above
+            raise AssertionError(f"{self.file}: the edited text does not parse to the edited "
+                                 "tree; nothing written")
+        return data
+
+
+def _iso(moment: float) -> tuple[tuple[float, float, float], ...]:
+    return ((moment, 0.0, 0.0), (0.0, moment, 0.0), (0.0, 0.0, moment))
+
+
+def _rotate_tensor(rot: Sequence[Sequence[float]], t: Sequence[Sequence[float]]
+                   ) -> tuple[tuple[float, float, float], ...]:
+    """``rot @ t @ rot.T``."""
+    rt = [[sum(rot[i][k] * t[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+    out = [[sum(rt[i][k] * rot[j][k] for k in range(3)) for j in range(3)] for i in range(3)]
+    return tuple((r[0], r[1], r[2]) for r in out)
+
+
+def _inertia_xml(t: Sequence[Sequence[float]]) -> str:
+    def f(x: float) -> str:
+        return fmt_float(x, 9) if abs(x) > 1e-12 * max(abs(t[0][0]), abs(t[1][1]),
+                                                        abs(t[2][2]), 1e-300) else "0"
+
+    return (f'<inertia ixx="{f(t[0][0])}" ixy="{f(t[0][1])}" ixz="{f(t[0][2])}" '
+            f'iyy="{f(t[1][1])}" iyz="{f(t[1][2])}" izz="{f(t[2][2])}"/>')
+
+
+def _attr(text: str) -> str:
+    return text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+
+
+def _shape(el: etree._Element) -> Any:
+    """An element as nested tuples: tag, attributes, stripped text, children (comments too)."""
+    return (str(el.tag), tuple(sorted(el.attrib.items())), (el.text or "").strip(),
+            tuple(_shape(c) for c in el))
+
+
+__all__ = ["DEFAULT_DENSITY", "FIXABLE", "FixResult", "Repair", "Solid", "balanced", "fix_file"]
