@@ -158,9 +158,9 @@ def test_a_worker_dies_with_its_parent_even_when_idle(tmp_path: Path) -> None:
     pidfile = tmp_path / "worker.pid"
     code = f"""
 import os, time
-from urdfkit.check import _worker_init
+from urdfkit.check import worker_init
 if os.fork() == 0:
-    _worker_init()
+    worker_init()
     with open({str(pidfile)!r}, "w") as f:
         f.write(str(os.getpid()))
     time.sleep(60)

@@ -24,7 +24,7 @@ for floor, names in enumerate([
     "session",
     # run and draw
     "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
-    " diff collisions fix",
+    " diff collisions fix sweep",
     # presentation and the command line
     "present ci cli __main__",
 ]):

@@ -270,7 +270,7 @@ def _check_one(job: tuple[str, str, str | None, dict[str, str], bool, dict[str, 
                       xacro_args, physics)
 
 
-def _worker_init() -> None:
+def worker_init() -> None:
     """Pool workers die with their parent and never hold the caller's stdout open."""
     import signal
 
@@ -338,7 +338,7 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
         context = multiprocessing.get_context("fork" if sys.platform.startswith("linux")
                                               else "spawn")
         # The with block terminates the workers on the way out, normal or not (Ctrl-C).
-        with context.Pool(workers, initializer=_worker_init) as pool:
+        with context.Pool(workers, initializer=worker_init) as pool:
             results = pool.map(_check_one, work, chunksize=chunk)
     sel, ign = tuple(select), tuple(ignore)
     noted = False

@@ -684,41 +684,51 @@ def _split_joints(items: list[str] | None) -> list[str] | None:
     return [j.strip() for item in items for j in item.split(",") if j.strip()]
 
 
+# Options of `drive` that `sweep drive` takes too.
+ThrottleOpt = Annotated[float, typer.Option(
+    help="Wheel speed, rad/s: of a wheel on the car's centre line (each wheel turns as "
+    "its path needs); with --drivetrain locked, of every wheel. Negative reverses.")]
+SteerOpt = Annotated[float, typer.Option(
+    help="Steering angle, rad, of the kinematic bicycle model (hinges get Ackermann "
+    "angles); positive turns left. Without hinges (skid steer): the yaw rate, rad/s.")]
+DrivetrainOpt = Annotated[str, typer.Option(
+    "--drivetrain", metavar="differential|rear|locked",
+    help="differential: every wheel at the speed its path needs; rear: rear wheels so, "
+    "fronts roll free; locked: every wheel at --throttle, as the tutorial.")]
+SecondsOpt = Annotated[float | None, typer.Option(
+    help="Simulated duration in seconds.", show_default="10")]
+StepsOpt = Annotated[int | None, typer.Option(help="Number of physics steps instead.")]
+TimeStepOpt = Annotated[float, typer.Option(help="Physics time step, s.", show_default="1/240")]
+MaxForceOpt = Annotated[float | None, typer.Option(
+    help="Wheel motor torque limit, N m.", show_default="10")]
+UrdfOpt = Annotated[str | None, typer.Option(
+    help="Car to drive (.urdf/.xacro; pybullet_data names work).",
+    show_default="the built-in simplecar")]
+PlaneOpt = Annotated[str | None, typer.Option(
+    help="Ground to drive on.", show_default="the built-in simpleplane")]
+UpOpt = Annotated[str, typer.Option(
+    "--up", metavar="z|y|x", help="The car's up axis: y stands up a Y-up model.")]
+
+
 @app.command(epilog=_examples(
     "urdfkit drive --throttle 10 --steer 0.2",
     "urdfkit drive --urdf racecar/racecar.urdf --seconds 5 --json",
     "urdfkit drive --urdf husky/husky.urdf --steer 0.5   # skid steer: 0.5 rad/s of yaw",
     "urdfkit drive --steer 0.3 --trajectory run.csv --plot run.png"))
 def drive(
-    throttle: Annotated[float, typer.Option(
-        help="Wheel speed, rad/s: of a wheel on the car's centre line (each wheel turns as "
-        "its path needs); with --drivetrain locked, of every wheel. Negative reverses.")]
-    = 10.0,
-    steer: Annotated[float, typer.Option(
-        help="Steering angle, rad, of the kinematic bicycle model (hinges get Ackermann "
-        "angles); positive turns left. Without hinges (skid steer): the yaw rate, rad/s.")]
-    = 0.0,
-    drivetrain: Annotated[str, typer.Option(
-        "--drivetrain", metavar="differential|rear|locked",
-        help="differential: every wheel at the speed its path needs; rear: rear wheels so, "
-        "fronts roll free; locked: every wheel at --throttle, as the tutorial.")]
-    = "differential",
+    throttle: ThrottleOpt = 10.0,
+    steer: SteerOpt = 0.0,
+    drivetrain: DrivetrainOpt = "differential",
     tutorial: Annotated[bool, typer.Option(
         "--tutorial", help="Reproduce the PyBullet tutorial's loop exactly: locked wheels, "
         "PyBullet's default motor force, no load flags, car at 0 0 0.1 before the plane.")]
     = False,
-    seconds: Annotated[float | None, typer.Option(
-        help="Simulated duration in seconds.", show_default="10")] = None,
-    steps: Annotated[int | None, typer.Option(help="Number of physics steps instead.")] = None,
-    time_step: Annotated[float, typer.Option(help="Physics time step, s.", show_default="1/240")]
-    = 1.0 / 240.0,
-    max_force: Annotated[float | None, typer.Option(
-        help="Wheel motor torque limit, N m.", show_default="10")] = None,
-    urdf: Annotated[str | None, typer.Option(
-        help="Car to drive (.urdf/.xacro; pybullet_data names work).",
-        show_default="the built-in simplecar")] = None,
-    plane: Annotated[str | None, typer.Option(
-        help="Ground to drive on.", show_default="the built-in simpleplane")] = None,
+    seconds: SecondsOpt = None,
+    steps: StepsOpt = None,
+    time_step: TimeStepOpt = 1.0 / 240.0,
+    max_force: MaxForceOpt = None,
+    urdf: UrdfOpt = None,
+    plane: PlaneOpt = None,
     set_: SetOpt = None,
     arg: ArgOpt = None,
     package: PackageOpt = None,
@@ -740,8 +750,7 @@ def drive(
         "--gui", help="Open the PyBullet GUI with Steering and Throttle sliders.")] = False,
     as_json: JsonOpt = False,
     no_guard: NoGuardOpt = False,
-    up: Annotated[str, typer.Option(
-        "--up", metavar="z|y|x", help="The car's up axis: y stands up a Y-up model.")] = "z",
+    up: UpOpt = "z",
 ) -> None:
     """Drive a car headless at a fixed throttle and steer, and report where it went.
 
@@ -823,6 +832,176 @@ def drive(
         show.interrupted("interrupted; the results cover the steps simulated")
         raise typer.Exit(130)
     if result.problems:  # the run is physically suspect: a finding, for CI
+        raise typer.Exit(1)
+
+
+# ---- sweep: many drives or scenario runs (urdfkit/sweep.py)
+
+
+@app.command(epilog=_examples(
+    "urdfkit sweep drive --vary steer=0.1,0.2,0.3 --seconds 5",
+    "urdfkit sweep drive --vary wheel_radius=0.08:0.14:4 --vary steer=0.1,0.3 --out r.csv "
+    "--plot turning_radius",
+    "urdfkit sweep sim arm.toml --vary 'robots[0].motor.kp=50:400:8' --jobs 2 --out r.jsonl",
+    "urdfkit sweep drive --vary steer=0:0.4:41 --backend ray --address auto --out r.parquet"))
+def sweep(
+    kind: Annotated[str, typer.Argument(
+        metavar="drive|sim", help="What each point runs: a drive, or a scenario.")],
+    scenario: Annotated[str | None, typer.Argument(
+        metavar="[SCENARIO]", help="With sim: the scenario file (.json or .toml).",
+        show_default=False)] = None,
+    vary: Annotated[list[str] | None, typer.Option(
+        "--vary", "-v", metavar="NAME=VALUES",
+        help="A drive option, simplecar parameter or scenario key path, and its values: "
+        "a,b,c or start:stop:count (repeatable: a grid).")] = None,
+    zip_: Annotated[bool, typer.Option(
+        "--zip", help="Pair the --vary lists point by point instead of a grid.")] = False,
+    jobs: Annotated[int | None, typer.Option(
+        "--jobs", "-j", min=1, help="Worker processes (1: in this process).",
+        show_default="every core")] = None,
+    backend: Annotated[str, typer.Option(
+        "--backend", metavar="local|ray", help="local: a process pool; ray: Ray tasks "
+        "(pip install 'urdfkit[ray]').")] = "local",
+    address: Annotated[str | None, typer.Option(
+        "--address", metavar="auto|ray://HOST:PORT",
+        help="With --backend ray: the cluster to run on.", show_default="a local Ray")]
+    = None,
+    out: Annotated[str | None, typer.Option(
+        "--out", "-o", metavar="FILE", help="Write the rows to FILE.csv, .jsonl or .parquet, "
+        "as points finish (FILE.partial until the sweep ends).")] = None,
+    resume: Annotated[bool, typer.Option(
+        "--resume", help="Skip the points already in --out (or its .partial) without an "
+        "error.")] = False,
+    plot: Annotated[str | None, typer.Option(
+        "--plot", metavar="METRIC", help="Draw METRIC against the varied value(s) (needs "
+        "urdfkit\\[plot]).")] = None,
+    plot_file: Annotated[str | None, typer.Option(
+        "--plot-file", metavar="FILE.png", help="Where --plot draws.",
+        show_default="sweep-METRIC.png")] = None,
+    as_json: JsonOpt = False,
+    show_all: AllOpt = False,
+    force: ForceOpt = False,
+    throttle: ThrottleOpt = 10.0,
+    steer: SteerOpt = 0.0,
+    drivetrain: DrivetrainOpt = "differential",
+    seconds: SecondsOpt = None,
+    steps: StepsOpt = None,
+    time_step: TimeStepOpt = 1.0 / 240.0,
+    max_force: MaxForceOpt = None,
+    urdf: UrdfOpt = None,
+    plane: PlaneOpt = None,
+    set_: SetOpt = None,
+    arg: ArgOpt = None,
+    package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
+    up: UpOpt = "z",
+) -> None:
+    """Run many drives or scenario runs, one row of results per point.
+
+    Several --vary form a grid; --zip pairs them. The drive options (--throttle, --seconds,
+    ...) hold for every point of a drive sweep. Every point is checked before any runs; rows
+    are written as points finish. Exit 0: every point ran; 1: some failed (their rows say
+    why); 2: bad input; 130: interrupted (the rows so far are kept). See docs/sweep.md.
+    """
+    from . import sweep as sweeping
+    from .errors import ParameterError
+
+    if kind == "sim":
+        if scenario is None:
+            raise ParameterError("sweep sim needs the scenario file: urdfkit sweep sim "
+                                 "scenario.toml --vary PATH=VALUES", param="kind")
+        changed = [name for name, value, default in (
+            ("--throttle", throttle, 10.0), ("--steer", steer, 0.0),
+            ("--drivetrain", drivetrain, "differential"), ("--seconds", seconds, None),
+            ("--steps", steps, None), ("--time-step", time_step, 1.0 / 240.0),
+            ("--max-force", max_force, None), ("--urdf", urdf, None), ("--plane", plane, None),
+            ("--set", set_, None), ("--arg", arg, None), ("--package", package, None),
+            ("--package-path", package_path, None), ("--up", up, "z")) if value != default]
+        if changed:
+            raise ParameterError(f"{', '.join(changed)}: drive options; a sim sweep varies the "
+                                 "scenario's keys (--vary 'physics.time_step=...')")
+        base: Any = scenario
+    elif kind == "drive":
+        if scenario is not None:
+            raise ParameterError(f"sweep drive takes no scenario file (got {scenario!r}); "
+                                 "drive options are flags", param="kind")
+        if seconds is not None and steps is not None:
+            raise ParameterError("give `seconds` or `steps`, not both", param="seconds")
+        params = None
+        if set_:
+            from .catalog import parse_assignments
+
+            params = parse_assignments(set_, "template_params")
+        base = {"throttle": throttle, "steer": steer, "drivetrain": drivetrain,
+                "seconds": 10.0 if seconds is None else seconds, "steps": steps,
+                "time_step": time_step, "max_force": 10.0 if max_force is None else max_force,
+                "urdf": urdf, "plane": plane, "template_params": params, "xacro_args": arg,
+                "packages": package, "package_paths": package_path, "up": up}
+    else:
+        raise ParameterError(f"`kind` must be drive or sim, got {kind!r}", param="kind")
+    if not vary:
+        raise ParameterError("give at least one --vary NAME=VALUES", param="vary")
+    if resume and out is None:
+        raise ParameterError("--resume carries on the rows of --out: give --out",
+                             param="resume")
+    plan = sweeping.plan(kind, base, vary, zip_=zip_)  # every point checked before any runs
+    picture = None
+    if plot is not None:
+        from .plot import check_plot_path
+
+        picture = plot_file or f"sweep-{plot}.png"
+        check_plot_path(picture, force=force)
+    journal = None
+    if out is not None:
+        journal = sweeping.Journal(Path(out), plan.names, resume=resume, force=force)
+        journal.open()
+    keep = out is None or plot is not None or as_json
+    rows: list[dict[str, Any]] = list(journal.done) if journal is not None and keep else []
+    skip = journal.finished if journal is not None and resume else None
+    total = len(plan.assignments)
+    before = total - sum(1 for a in plan.assignments if skip is not None and skip(a))
+    progress, stop = show.progress("sweeping", "points", enabled=not as_json, rate=True)
+    failed = done = 0
+    interrupted = False
+    try:
+        for row in sweeping.execute(plan, jobs=jobs, backend=backend, address=address,
+                                    skip=skip):
+            done += 1
+            failed += bool(row.get("error"))
+            if journal is not None:
+                journal.add(row)
+            if keep:
+                rows.append(row)
+            if progress is not None:
+                progress(done, before)
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        stop()
+        written = journal.finish() if journal is not None else None
+    if picture is not None and rows:
+        from .plot import write_sweep_plot
+
+        sweeping.check_metric(rows, plan.names, plot)  # type: ignore[arg-type]
+        written_plot: Path | None = write_sweep_plot(rows, plan.names, plot,  # type: ignore[arg-type]
+                                                     picture, force=force)
+    else:
+        written_plot = None
+    skipped = total - before
+    if as_json:
+        show.print_json({"kind": kind, "points": total, "ran": done, "skipped": skipped,
+                         "failed": failed, "out": None if written is None else str(written),
+                         "plot": None if written_plot is None else str(written_plot),
+                         "interrupted": interrupted, "rows": rows})
+    else:
+        show.sweep_report(plan, rows if out is None else [], done, failed, skipped, show_all)
+        for path in (written, written_plot):
+            if path is not None:
+                show.wrote(path)
+    if interrupted:
+        show.interrupted("interrupted; the rows so far are kept")
+        raise typer.Exit(130)
+    if failed:
         raise typer.Exit(1)
 
 

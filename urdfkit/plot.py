@@ -18,6 +18,8 @@ from .errors import MissingDependencyError, ParameterError
 from .output import atomic_write, check_output
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping, Sequence
+
     from .drive import DriveResult
 
 
@@ -105,3 +107,56 @@ def write_plot(result: DriveResult, path: str | Path, *, force: bool = False) ->
     """Draw the drive to a PNG file, atomically."""
     check_plot_path(path, force=force)
     return atomic_write(path, plot_bytes(result), force=force)
+
+
+#: Line colours of a sweep plot, one per value of the second varied name.
+SERIES = (style.PRIMARY, style.SECONDARY, style.START, style.END, style.AXIS_Z, style.AXIS_X)
+
+
+def sweep_plot_bytes(rows: Sequence[Mapping[str, Any]], names: Sequence[str],
+                     metric: str) -> bytes:
+    """A sweep's ``metric`` against its first varied value, one line per value of the others.
+
+    Points that failed, or lack the metric (a drive that did not turn has no radius), are
+    left out of the lines.
+    """
+    plt = _pyplot()
+    x_name, others = names[0], list(names[1:])
+    series: dict[tuple[Any, ...], list[tuple[float, float]]] = {}
+    for r in rows:
+        x, y = r.get(x_name), r.get(metric)
+        if r.get("error") or not isinstance(x, (int, float)) or not isinstance(y, (int, float)):
+            continue
+        series.setdefault(tuple(r.get(n) for n in others), []).append((float(x), float(y)))
+    hexc = style.hex_color
+    with plt.rc_context({"font.family": style.FONT_FAMILY, "font.size": style.FONT_SIZE,
+                         "text.color": hexc(style.TEXT), "axes.labelcolor": hexc(style.TEXT),
+                         "xtick.color": hexc(style.TEXT), "ytick.color": hexc(style.TEXT),
+                         "axes.edgecolor": hexc(style.GRID), "grid.color": hexc(style.GRID)}):
+        fig, ax = plt.subplots(figsize=(7, 4.5), dpi=100)
+        fig.patch.set_facecolor(hexc(style.BACKGROUND))
+        ax.set_facecolor(hexc(style.GROUND))
+        ordered = sorted(series.items(), key=lambda kv: [str(v) for v in kv[0]])
+        for k, (label, pts) in enumerate(ordered):
+            pts.sort()
+            text = ", ".join(f"{n} = {v}" for n, v in zip(others, label, strict=True))
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", linewidth=2,
+                    color=hexc(SERIES[k % len(SERIES)]), label=text or None)
+        ax.set_xlabel(x_name)
+        ax.set_ylabel(metric)
+        ax.set_title(f"{metric} against {x_name}")
+        ax.grid(True, linewidth=0.5)
+        if others and ordered:
+            ax.legend(loc="best", fontsize=style.FONT_SIZE - 1)
+        fig.tight_layout()
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", metadata={"Software": None})
+        plt.close(fig)
+    return buf.getvalue()
+
+
+def write_sweep_plot(rows: Sequence[Mapping[str, Any]], names: Sequence[str], metric: str,
+                     path: str | Path, *, force: bool = False) -> Path:
+    """Draw a sweep's metric to a PNG file, atomically."""
+    check_plot_path(path, force=force)
+    return atomic_write(path, sweep_plot_bytes(rows, names, metric), force=force)

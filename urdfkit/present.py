@@ -499,12 +499,13 @@ def diff_report(result: Any) -> None:
 # --------------------------------------------------------------------------- progress
 
 
-def progress(label: str, unit: str, enabled: bool = True
+def progress(label: str, unit: str, enabled: bool = True, rate: bool = False
              ) -> tuple[Callable[[int, int], None] | None, Callable[[], None]]:
     """A progress callback that shows a bar on stderr once a run looks longer than ~1 s.
 
     Returns ``(update(done, total), stop())``; ``update`` is None when not ``enabled`` or
-    when stdout or stderr is not a terminal (a bar in a log file is noise).
+    when stdout or stderr is not a terminal (a bar in a log file is noise). ``rate`` adds
+    units per second.
     """
     if not (enabled and sys.stdout.isatty() and sys.stderr.isatty()):
         return None, lambda: None
@@ -520,13 +521,18 @@ def progress(label: str, unit: str, enabled: bool = True
                 return
             from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-            bar = Progress(TextColumn(label), BarColumn(),
-                           TextColumn("{task.completed:,}/{task.total:,} " + unit),
-                           TimeRemainingColumn(), console=console(stderr=True), transient=True)
-            state["task"] = bar.add_task(label, total=total)
+            columns = [TextColumn(label), BarColumn(),
+                       TextColumn("{task.completed:,}/{task.total:,} " + unit)]
+            if rate:
+                columns.append(TextColumn("{task.fields[rate]}"))
+            bar = Progress(*columns, TimeRemainingColumn(), console=console(stderr=True),
+                           transient=True)
+            state["task"] = bar.add_task(label, total=total, rate="")
             bar.start()
             state["bar"] = bar
-        bar.update(state["task"], completed=done)
+        elapsed = time.perf_counter() - state["start"]
+        bar.update(state["task"], completed=done,
+                   rate=f"{done / elapsed:.2f} {unit}/s" if rate and elapsed > 0 else "")
 
     def stop() -> None:
         if state["bar"] is not None:
@@ -591,3 +597,39 @@ def fix_report(result: Any, stderr: bool = False) -> None:
               "urdfkit check explains them", "yellow"), stderr=stderr)
     if not result.repairs and not result.left:
         note(f"{name}: nothing to fix", stderr=stderr)
+
+
+# --------------------------------------------------------------------------- sweep
+
+
+def sweep_report(plan: Any, rows: Sequence[Any], done: int, failed: int, skipped: int,
+                 show_all: bool = False) -> None:
+    """``urdfkit sweep``: the rows (when they are not going to a file) and a summary line."""
+    if rows:
+        names = list(plan.names)
+        wanted = {"drive": ["turning_radius", "expected_radius", "distance", "mean_speed",
+                            "final_x", "final_y", "heading_change", "problems"],
+                  "sim": []}[plan.kind]
+        metrics = [k for k in wanted if any(k in r for r in rows)] if wanted else \
+            [k for k in rows[0] if k not in names and k not in ("point", "error")]
+        columns: list[Column] = [("point", 0, "right")]
+        columns += [(n, 0, "right") for n in names]
+        columns += [(m, 1 if k < 4 else 3, "left" if m == "problems" else "right")
+                    for k, m in enumerate(metrics)]
+        columns.append(("error", 0, "left"))
+
+        def cell(v: Any) -> str:
+            if v is None:
+                return "-"
+            if isinstance(v, float):
+                return fixed(v)
+            return str(v)
+
+        table(f"sweep {plan.label}: {len(rows)} point(s)", columns,
+              [[str(r.get("point")), *(cell(r.get(n)) for n in names),
+                *(cell(r.get(m)) for m in metrics), _one_line(r.get("error") or "")]
+               for r in sorted(rows, key=lambda r: r.get("point", 0))], show_all)
+    tail = f"{done} point(s) ran, {failed} failed"
+    if skipped:
+        tail += f", {skipped} skipped (done before: --resume)"
+    line((tail, "red" if failed else "green"))

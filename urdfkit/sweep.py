@@ -1,0 +1,684 @@
+"""``urdfkit sweep``: many drives or scenario runs, one row each, on a process pool or on Ray.
+
+A sweep is a base run plus ``vary`` lists: ``steer=0.1,0.2,0.3`` (values),
+``wheel_radius=0.08:0.14:4`` (start:stop:count, ends included), or for scenarios a key path
+``robots[0].motor.kp=50:400:8``. Several lists form a grid (every combination, the first
+varying slowest), or with ``zip=True`` are paired point by point.
+
+Design, for what the issue asks of it:
+
+- **Every point is built and validated before any runs** (:func:`plan`): a bad name, path or
+  value is one error naming the point, not a failure an hour in.
+- **Each point is the single run it stands for.** A drive point is :func:`urdfkit.drive.drive`
+  on a fresh PyBullet client with exactly the options ``urdfkit drive`` would pass; a sim point
+  is a fresh :class:`urdfkit.sim.Simulation` of the edited document. Rows hold what their
+  ``--json`` prints (the same rounding), less what is not deterministic (wall time).
+- **Start-up is paid once per worker.** Workers are forked after pybullet is imported, and
+  the built-in templates come from urdfkit's cache (built once per parameter set).
+- **Rows are yielded as points finish** (completion order; ``point`` says which). A point
+  that fails yields a row with its ``error`` and the sweep goes on.
+- **Ray** (``backend="ray"``) runs each point as a Ray task, through the same function the
+  pool runs, so the rows are the same; scheduling, retries and clusters are Ray's.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+import os
+import re
+import sys
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+from .errors import InputError, MissingDependencyError, ParameterError, UrdfkitError
+
+KINDS = ("drive", "sim")
+BACKENDS = ("local", "ray")
+#: Drive options a sweep may vary (DriveConfig fields; the rest are files and switches).
+DRIVE_OPTIONS = ("throttle", "steer", "seconds", "steps", "time_step", "max_force",
+                 "drivetrain", "gravity", "urdf", "plane", "up")
+#: The most points one sweep may have: a typo such as 0:1:1e9 must not plan forever.
+MAX_POINTS = 1_000_000
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One varied name and its values."""
+
+    name: str
+    values: tuple[Any, ...]
+
+
+def parse_value(text: str) -> Any:
+    """A value as typed: a number where it reads as one, true/false, else the text."""
+    t = text.strip()
+    if t.lower() in ("true", "false"):
+        return t.lower() == "true"
+    try:
+        number = float(t)
+    except ValueError:
+        return t
+    if not math.isfinite(number):
+        return t  # "nan", "inf": refused where the value is checked, as text
+    if re.fullmatch(r"[+-]?\d+", t):
+        return int(t)
+    return number
+
+
+def parse_vary(text: str) -> Vary:
+    """Parse ``NAME=V1,V2,...`` or ``NAME=START:STOP:COUNT``.
+
+    Raises:
+        ParameterError: no ``=``, no values, or a bad range.
+    """
+    name, sep, spec = text.partition("=")
+    name, spec = name.strip(), spec.strip()
+    if not sep or not name or not spec:
+        raise ParameterError(f"`vary` expects NAME=VALUES (a,b,c or start:stop:count), got "
+                             f"{text!r}", param="vary")
+    if ":" in spec and "," not in spec:
+        parts = spec.split(":")
+        try:
+            if len(parts) != 3:
+                raise ValueError
+            start, stop, count = float(parts[0]), float(parts[1]), float(parts[2])
+        except ValueError:
+            raise ParameterError(f"`vary` {name}: a range is start:stop:count, got {spec!r}",
+                                 param="vary") from None
+        if not (math.isfinite(start) and math.isfinite(stop)) or count != int(count) or \
+                not 1 <= count <= MAX_POINTS:
+            raise ParameterError(f"`vary` {name}: a range needs finite ends and a whole "
+                                 f"count of 1 to {MAX_POINTS:,}, got {spec!r}", param="vary")
+        n = int(count)
+        values = tuple(start if n == 1 else _clean(start + (stop - start) * i / (n - 1))
+                       for i in range(n))
+        return Vary(name, values)
+    values = tuple(parse_value(v) for v in spec.split(","))
+    if any(v == "" for v in values):
+        raise ParameterError(f"`vary` {name}: an empty value in {spec!r}", param="vary")
+    return Vary(name, values)
+
+
+def _clean(x: float) -> float:
+    """0.1 + 0.02 * 3 as 0.16, not 0.16000000000000003: 12 significant digits."""
+    return float(f"{x:.12g}")
+
+
+def points(vary: Sequence[Vary], zip_: bool = False) -> list[dict[str, Any]]:
+    """The assignments of every point: a grid (first name slowest), or zipped.
+
+    Raises:
+        ParameterError: a name varied twice, zipped lists of different lengths, too many points.
+    """
+    names = [v.name for v in vary]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ParameterError(f"`vary` {twice[0]} is given twice", param="vary")
+    if not vary:
+        return [{}]
+    if zip_:
+        lengths = {len(v.values) for v in vary}
+        if len(lengths) > 1:
+            raise ParameterError("`zip` pairs values point by point, so every --vary needs as "
+                                 "many: got " + ", ".join(f"{v.name} {len(v.values)}"
+                                                          for v in vary), param="zip")
+        combos: Iterable[tuple[Any, ...]] = zip(*(v.values for v in vary), strict=True)
+    else:
+        total = math.prod(len(v.values) for v in vary)
+        if total > MAX_POINTS:
+            raise ParameterError(f"{total:,} points: more than {MAX_POINTS:,}; sweep fewer "
+                                 "values", param="vary")
+        combos = itertools.product(*(v.values for v in vary))
+    return [dict(zip(names, combo, strict=True)) for combo in combos]
+
+
+# --------------------------------------------------------------------------- planning
+
+
+@dataclass
+class Plan:
+    """A validated sweep, ready to run.
+
+    Attributes:
+        kind: ``drive`` or ``sim``.
+        names: The varied names, in ``vary`` order (the rows' leading columns).
+        assignments: Each point's values by name.
+        jobs: The payload of each point, as the workers take it (picklable).
+        label: What is swept, for messages.
+    """
+
+    kind: str
+    names: list[str]
+    assignments: list[dict[str, Any]]
+    jobs: list[tuple[str, Any]]
+    label: str
+
+
+def plan(kind: str, base: Any, vary: Sequence[Vary | str], *, zip_: bool = False) -> Plan:
+    """Build and validate every point of a sweep, before any runs.
+
+    Args:
+        kind: ``drive`` (base: a dict of :class:`urdfkit.drive.DriveConfig` fields, with
+            ``template_params`` for the built-in simplecar) or ``sim`` (base: a scenario
+            file, or ``(document, base_dir)``).
+        base: What every point starts from.
+        vary: :class:`Vary` or ``NAME=VALUES`` strings.
+        zip_: Pair the lists instead of forming a grid.
+
+    Raises:
+        ParameterError, InputError: a bad kind, name, path or value, naming the point.
+    """
+    if kind not in KINDS:
+        from .suggest import hint
+
+        raise ParameterError(f"`kind` must be drive or sim, got {kind!r}{hint(kind, KINDS)}",
+                             param="kind")
+    parsed = [v if isinstance(v, Vary) else parse_vary(v) for v in vary]
+    assignments = points(parsed, zip_)
+    names = [v.name for v in parsed]
+    if kind == "drive":
+        base_options = _drive_base(base)
+        jobs = []
+        for i, values in enumerate(assignments):
+            jobs.append(("drive", _drive_point(base_options, values, i)))
+        return Plan(kind, names, assignments, jobs, "drive")
+    document, base_dir, source = _sim_base(base)
+    jobs = []
+    for i, values in enumerate(assignments):
+        jobs.append(("sim", _sim_point(document, base_dir, source, values, i)))
+    return Plan(kind, names, assignments, jobs, source)
+
+
+def _point_label(i: int, values: Mapping[str, Any]) -> str:
+    return f"point {i} (" + ", ".join(f"{k}={v}" for k, v in values.items()) + ")"
+
+
+def _drive_base(base: Any) -> dict[str, Any]:
+    from .drive import DriveConfig
+
+    if isinstance(base, DriveConfig):
+        options = {f.name: getattr(base, f.name) for f in fields(DriveConfig)}
+    else:
+        options = dict(base or {})
+        known = {f.name for f in fields(DriveConfig)}
+        unknown = sorted(set(options) - known)
+        if unknown:
+            raise ParameterError(f"`base` {unknown[0]!r} is not a drive option", param="base")
+    options["keep_trajectory"] = False  # rows need the statistics only: memory stays flat
+    options["gui"] = False
+    return options
+
+
+def _drive_point(base: Mapping[str, Any], values: Mapping[str, Any], i: int) -> dict[str, Any]:
+    """The DriveConfig fields of one point, checked (a template's parameters included)."""
+    from .catalog import get_template
+    from .drive import DriveConfig
+
+    options = dict(base)
+    params = dict(options.get("template_params") or {})
+    simplecar = get_template("simplecar")
+    template_names = [p.name for p in simplecar.params]
+    for name, value in values.items():
+        if name in DRIVE_OPTIONS:
+            options[name] = value
+        elif name in template_names:
+            if options.get("urdf") is not None:
+                raise ParameterError(f"`vary` {name} is a parameter of the built-in simplecar, "
+                                     "and this sweep drives a --urdf file", param="vary")
+            params[name] = str(value)
+        else:
+            from .suggest import hint
+
+            raise ParameterError(
+                f"`vary` {name!r}: not a drive option or simplecar parameter"
+                f"{hint(name, [*DRIVE_OPTIONS, *template_names])} (drive options: "
+                f"{', '.join(DRIVE_OPTIONS)}; simplecar: {', '.join(template_names)})",
+                param="vary")
+    if params:
+        options["template_params"] = params
+    where = _point_label(i, values)
+    try:
+        config = DriveConfig(**options)
+        config.check()
+        if options.get("urdf") is None:
+            simplecar.resolve(params)  # bad parameter values now, not in a worker
+    except (UrdfkitError, TypeError) as e:
+        message = e.message if isinstance(e, UrdfkitError) else str(e)
+        raise ParameterError(f"{where}: {message}", param="vary") from None
+    return {f.name: getattr(config, f.name) for f in fields(DriveConfig)}
+
+
+def _sim_base(base: Any) -> tuple[dict[str, Any], str, str]:
+    if isinstance(base, (str, Path)):
+        from . import sac
+        from .scenario import read_document
+
+        document = read_document(base)
+        if sac.is_config(document):
+            document = sac.convert(document, source=base).scenario
+        return document, str(Path(base).resolve().parent), str(base)
+    document, base_dir = base
+    return dict(document), str(base_dir), "<scenario>"
+
+
+_PATH_TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_-]*)|\[(-?\d+)\]")
+
+
+def parse_path(path: str) -> list[str | int]:
+    """``robots[0].motor.kp`` as ``["robots", 0, "motor", "kp"]``.
+
+    Raises:
+        ParameterError: not a key path.
+    """
+    out: list[str | int] = []
+    pos = 0
+    while pos < len(path):
+        if out and path[pos] == "." and not path.startswith("[", pos):
+            pos += 1
+        m = _PATH_TOKEN.match(path, pos)
+        if m is None or (out == [] and m.group(2) is not None):
+            raise ParameterError(f"`vary` {path!r} is not a key path such as "
+                                 "robots[0].motor.kp or physics.time_step", param="vary")
+        out.append(m.group(1) if m.group(1) is not None else int(m.group(2)))
+        pos = m.end()
+    if not out:
+        raise ParameterError("`vary` needs a key path", param="vary")
+    return out
+
+
+def set_path(document: dict[str, Any], path: str, value: Any) -> None:
+    """Set ``value`` at ``path`` in a scenario document; missing tables are created.
+
+    Raises:
+        ParameterError: an index out of range, or a path through a value that is not a
+            table or list.
+    """
+    keys = parse_path(path)
+    node: Any = document
+    for depth, key in enumerate(keys):
+        last = depth == len(keys) - 1
+        where = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in keys[:depth + 1])
+        where = where.lstrip(".")
+        if isinstance(key, int):
+            if not isinstance(node, list):
+                raise ParameterError(f"`vary` {path}: {where.rsplit('[', 1)[0]} is not a list",
+                                     param="vary")
+            if not -len(node) <= key < len(node):
+                raise ParameterError(f"`vary` {path}: {where} is out of range (the list has "
+                                     f"{len(node)})", param="vary")
+        elif not isinstance(node, dict):
+            raise ParameterError(f"`vary` {path}: {where.rsplit('.', 1)[0]} holds a value, "
+                                 "not a table", param="vary")
+        if last:
+            node[key] = value
+            return
+        if isinstance(key, str) and key not in node:
+            node[key] = {}
+        node = node[key]
+
+
+def _sim_point(document: Mapping[str, Any], base_dir: str, source: str,
+               values: Mapping[str, Any], i: int) -> dict[str, Any]:
+    from .scenario import parse_scenario
+
+    edited = copy.deepcopy(dict(document))
+    for name, value in values.items():
+        set_path(edited, name, value)
+    try:
+        parse_scenario(edited, source=source, base_dir=base_dir)
+    except InputError as e:
+        raise InputError(f"{_point_label(i, values)}: {e.message}", file=e.file) from None
+    return {"document": edited, "base_dir": base_dir}
+
+
+# --------------------------------------------------------------------------- running a point
+
+
+def run_point(job: tuple[int, str, Any]) -> dict[str, Any]:
+    """Run one point and return its metrics; a failure becomes ``{"error": ...}``.
+
+    The one function every backend calls, in a worker process, a Ray task or in-process.
+    """
+    index, kind, payload = job
+    try:
+        metrics = _drive_metrics(payload) if kind == "drive" else _sim_metrics(payload)
+        metrics["error"] = None
+    except UrdfkitError as e:
+        metrics = {"error": str(e)}
+    except KeyboardInterrupt:
+        raise
+    except Exception as e:  # noqa: BLE001 - one broken point must not end the sweep
+        metrics = {"error": f"{type(e).__name__}: {e}"}
+    return {"point": index, **metrics}
+
+
+#: Drive --json keys that are not metrics of the run (or not deterministic).
+_DRIVE_SKIP = ("model", "drivetrain", "simulated", "wall_time", "real_time_factor",
+               "interrupted", "throttle", "steer", "time_step")
+
+
+def _drive_metrics(options: Mapping[str, Any]) -> dict[str, Any]:
+    from .drive import DriveConfig, drive
+
+    result = drive(DriveConfig(**options))
+    data = result.to_dict()
+    out: dict[str, Any] = {}
+    for key, value in data.items():
+        if key in _DRIVE_SKIP:
+            continue
+        if key in ("final_position", "turn_center"):
+            for axis, v in zip("xyz", value or (None, None, None), strict=False):
+                out[f"{key}_{axis}" if key == "turn_center" else f"final_{axis}"] = v
+        elif key in ("warnings", "problems"):
+            out[key] = "; ".join(value)
+        else:
+            out[key] = value
+    out["steer_applied"] = data["steer"]
+    return out
+
+
+def _sim_metrics(payload: Mapping[str, Any]) -> dict[str, Any]:
+    from .sim import Simulation
+
+    with Simulation(payload["document"], base_dir=payload["base_dir"]) as s:
+        result = s.run(keep=False)
+    out: dict[str, Any] = {"steps": result.steps, "rows": result.row_count}
+    for x in result.summaries:
+        prefix = x.robot
+        for axis, v in zip("xyz", x.end, strict=False):
+            out[f"{prefix}.end_{axis}"] = round(v, 6)
+        out[f"{prefix}.distance"] = round(x.distance, 6)
+        out[f"{prefix}.top_speed"] = round(x.top_speed, 6)
+        out[f"{prefix}.heading_deg"] = round(x.heading_deg, 6)
+        for joint, value in x.final_joints.items():
+            out[f"{prefix}.joint.{joint}"] = round(value, 6)
+    return out
+
+
+# --------------------------------------------------------------------------- running a sweep
+
+
+def run(kind: str, base: Any, vary: Sequence[Vary | str], *, zip_: bool = False,
+        jobs: int | None = None, backend: str = "local", address: str | None = None,
+        skip: Callable[[Mapping[str, Any]], bool] | None = None) -> Iterator[dict[str, Any]]:
+    """Run a sweep and yield one row per point, as points finish.
+
+    A row is ``{"point": i, <varied name>: value, ..., <metrics>, "error": None | text}``.
+
+    Args:
+        kind: ``drive`` or ``sim``, as :func:`plan`.
+        base: What every point starts from, as :func:`plan`.
+        vary: The varied names and values, as :func:`plan`.
+        zip_: Pair the lists instead of forming a grid.
+        jobs: Worker processes (default: every core; 1 runs in this process), or for Ray
+            the CPUs of a local cluster it starts.
+        backend: ``local`` (a process pool) or ``ray``.
+        address: Ray's cluster address (``auto``, ``ray://host:10001``); default: a local
+            Ray started here.
+        skip: Points (their assignments) not to run (``--resume``: those already done).
+
+    Raises:
+        ParameterError, InputError: as :func:`plan`, before anything runs.
+        MissingDependencyError: ``ray`` without Ray installed.
+    """
+    sweep = plan(kind, base, vary, zip_=zip_)
+    yield from execute(sweep, jobs=jobs, backend=backend, address=address, skip=skip)
+
+
+def execute(sweep: Plan, *, jobs: int | None = None, backend: str = "local",
+            address: str | None = None,
+            skip: Callable[[Mapping[str, Any]], bool] | None = None
+            ) -> Iterator[dict[str, Any]]:
+    """Run a planned sweep; see :func:`run`."""
+    if backend not in BACKENDS:
+        raise ParameterError(f"`backend` must be local or ray, got {backend!r}",
+                             param="backend")
+    if jobs is not None and (isinstance(jobs, bool) or jobs < 1):
+        raise ParameterError(f"`jobs` must be 1 or more, got {jobs!r}", param="jobs")
+    if address is not None and backend != "ray":
+        raise ParameterError("`address` is a Ray cluster's: add backend='ray'",
+                             param="address")
+    todo = [(i, kind_payload[0], kind_payload[1])
+            for i, (kind_payload, values) in enumerate(zip(sweep.jobs, sweep.assignments,
+                                                           strict=True))
+            if skip is None or not skip(values)]
+    rows: Iterator[dict[str, Any]]
+    if backend == "ray":
+        rows = _ray_rows(todo, jobs, address)
+    else:
+        rows = _local_rows(todo, jobs)
+    for metrics in rows:
+        values = sweep.assignments[metrics["point"]]
+        yield {"point": metrics["point"], **values,
+               **{k: v for k, v in metrics.items() if k != "point"}}
+
+
+def default_jobs() -> int:
+    """Worker processes: the cores this process may run on."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(1, len(os.sched_getaffinity(0)))
+    return os.cpu_count() or 1
+
+
+def _local_rows(todo: list[tuple[int, str, Any]], jobs: int | None
+                ) -> Iterator[dict[str, Any]]:
+    workers = min(jobs or default_jobs(), len(todo))
+    if workers <= 1:
+        for job in todo:
+            yield run_point(job)
+        return
+    import multiprocessing
+
+    from .check import worker_init
+    from .session import import_pybullet
+
+    import_pybullet()  # once, here: the forked workers inherit it, warm
+    context = multiprocessing.get_context("fork" if sys.platform.startswith("linux")
+                                          else "spawn")
+    # The with block terminates the workers on the way out (Ctrl-C included).
+    with context.Pool(workers, initializer=worker_init) as pool:
+        yield from pool.imap_unordered(run_point, todo, chunksize=1)
+
+
+def _ray() -> Any:
+    try:
+        import ray
+    except ImportError as e:
+        raise MissingDependencyError("`backend` ray needs Ray: pip install 'urdfkit[ray]'",
+                                     param="backend") from e
+    return ray
+
+
+def _ray_rows(todo: list[tuple[int, str, Any]], jobs: int | None, address: str | None
+              ) -> Iterator[dict[str, Any]]:
+    ray = _ray()
+    started = False
+    if not ray.is_initialized():
+        options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False,
+                                   "configure_logging": False}
+        if address is not None:
+            options["address"] = address
+        elif jobs is not None:
+            options["num_cpus"] = jobs
+        try:
+            ray.init(**options)
+        except (ConnectionError, ValueError, RuntimeError) as e:
+            raise ParameterError(f"cannot reach the Ray cluster {address or '(local)'}: {e}",
+                                 param="address") from None
+        started = True
+    task = ray.remote(num_cpus=1, max_retries=1)(run_point)
+    pending = {task.remote(job): job[0] for job in todo}
+    try:
+        while pending:
+            done, _ = ray.wait(list(pending), num_returns=1)
+            for ref in done:
+                index = pending.pop(ref)
+                try:
+                    yield ray.get(ref)
+                except ray.exceptions.RayError as e:  # a worker died: the point's error
+                    yield {"point": index, "error": f"Ray: {type(e).__name__}: {e}"}
+    finally:
+        for ref in pending:
+            ray.cancel(ref, force=True)
+        if started:
+            ray.shutdown()
+
+
+# --------------------------------------------------------------------------- the rows file
+
+
+@dataclass
+class Journal:
+    """Rows written as points finish, to ``OUT.partial`` (JSON lines), then to ``OUT``.
+
+    A crash leaves ``OUT.partial`` with every finished row; ``resume`` reads it (and ``OUT``,
+    if a finished sweep left one) to skip the points done. :meth:`finish` writes ``OUT``
+    atomically in its format (``.csv``, ``.jsonl`` or ``.parquet``) and removes the partial
+    file; it is also called on Ctrl-C, so the rows so far land in ``OUT``.
+    """
+
+    path: Path
+    names: list[str]
+    resume: bool = False
+    force: bool = False
+    done: list[dict[str, Any]] = field(default_factory=list)
+    _handle: Any = None
+
+    @property
+    def partial(self) -> Path:
+        """The journal file beside the output."""
+        return self.path.with_name(self.path.name + ".partial")
+
+    def open(self) -> None:
+        """Check the output, read what a previous run did (``resume``), open the journal."""
+        from .sim import check_output
+
+        exists = self.path.exists()
+        check_output(self.path, force=self.force or self.resume or not exists)
+        if not self.resume:
+            if self.partial.exists() and not self.force:
+                raise InputError("a sweep that did not finish left its rows here: add "
+                                 "--resume to carry on, or --force to start again",
+                                 file=self.partial)
+        else:
+            if exists:
+                self.done.extend(read_rows(self.path))
+            if self.partial.exists():
+                self.done.extend(read_rows(self.partial, ".jsonl"))
+        # Keep what a previous run finished: the journal restarts with those rows.
+        self._handle = open(self.partial, "w", encoding="utf-8")  # noqa: SIM115
+        for row in self.done:
+            self._write(row)
+
+    def _write(self, row: Mapping[str, Any]) -> None:
+        import json
+
+        self._handle.write(json.dumps(row, allow_nan=False, default=str) + "\n")
+        self._handle.flush()
+
+    def add(self, row: Mapping[str, Any]) -> None:
+        """Record a finished point."""
+        self._write(row)
+
+    def finished(self, values: Mapping[str, Any]) -> bool:
+        """Whether a point with these values has a row without an error (for ``skip``)."""
+        if not hasattr(self, "_keys"):
+            self._keys = {_key(r, self.names) for r in self.done if not r.get("error")}
+        return _key(values, self.names) in self._keys
+
+    def finish(self) -> Path:
+        """Write ``OUT`` from the journal (atomically) and remove the journal."""
+        if self._handle is not None:
+            os.fsync(self._handle.fileno())
+            self._handle.close()
+            self._handle = None
+        rows = read_rows(self.partial, ".jsonl")
+        from .sim import write_rows
+
+        path = write_rows(self.path, rows, force=True)
+        self.partial.unlink()
+        return path
+
+
+def _key(row: Mapping[str, Any], names: Sequence[str]) -> tuple[str, ...]:
+    """The varied values of a row, comparable across formats (CSV gives text back)."""
+    out = []
+    for n in names:
+        v = row.get(n)
+        if isinstance(v, str):
+            v = parse_value(v)
+        out.append(repr(float(v)) if isinstance(v, (int, float)) and not isinstance(v, bool)
+                   else str(v))
+    return tuple(out)
+
+
+def read_rows(path: Path, fmt: str | None = None) -> list[dict[str, Any]]:
+    """The rows of a sweep's output (``.csv``, ``.jsonl``, ``.parquet``).
+
+    A journal's last line may be cut by a crash: it is dropped.
+
+    Raises:
+        InputError: unreadable, or not a rows file.
+    """
+    import json
+
+    fmt = fmt or path.suffix.lower()
+    try:
+        if fmt == ".jsonl":
+            rows = []
+            with open(path, encoding="utf-8") as f:
+                for line in f:
+                    try:
+                        rows.append(json.loads(line))
+                    except json.JSONDecodeError:
+                        continue  # a line cut short by a crash
+            return rows
+        if fmt == ".csv":
+            import csv
+
+            with open(path, encoding="utf-8", newline="") as f:
+                return [{k: _csv_value(v) for k, v in r.items()} for r in csv.DictReader(f)]
+        if fmt == ".parquet":
+            from .sim import _pyarrow
+
+            _pyarrow()
+            import pyarrow.parquet as pq
+
+            return [dict(r) for r in pq.read_table(path).to_pylist()]
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise InputError(f"cannot read the rows to resume from: {e}", file=path) from None
+    raise InputError("rows are .csv, .jsonl or .parquet", file=path)
+
+
+def _csv_value(text: str | None) -> Any:
+    if text is None or text == "":
+        return None
+    return parse_value(text)
+
+
+def metric_names(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> list[str]:
+    """The numeric metric columns of rows (for ``--plot`` and the table)."""
+    seen: dict[str, None] = {}
+    for r in rows:
+        for k, v in r.items():
+            if k not in names and k not in ("point", "error") and \
+                    isinstance(v, (int, float)) and not isinstance(v, bool):
+                seen[k] = None
+    return list(seen)
+
+
+def check_metric(rows: Sequence[Mapping[str, Any]], names: Sequence[str], metric: str) -> None:
+    """Refuse a ``--plot`` metric the rows do not have, or a sweep with nothing varied."""
+    known = metric_names(rows, names)
+    if metric not in known:
+        from .suggest import hint
+
+        raise ParameterError(f"`plot` {metric!r} is not a numeric column of these rows"
+                             f"{hint(metric, known)} (columns: {', '.join(known) or 'none'})",
+                             param="plot")
+    if not names:
+        raise ParameterError("`plot` needs a varied value to plot against", param="plot")
