@@ -19,6 +19,10 @@ indices gives you those indices. :meth:`Robot.pybullet_joint_order` predicts the
 
 Every tag has a ``_parse_*`` and a ``_write_*`` function side by side, and
 ``parse(write(robot)) == robot`` holds for everything the model holds.
+
+Reading has a lenient mode for comparing what files say (``strict=False``, used by
+``urdfkit diff``): a value the checks refuse is kept as written instead of failing the file
+(:func:`as_written`). Building and writing stay strict.
 """
 
 from __future__ import annotations
@@ -181,6 +185,40 @@ class _Element:
 
 
 # --------------------------------------------------------------------------- elements
+
+
+def as_written(value: Any) -> Any:
+    """A value the checks refuse, kept for comparison: numbers where it has them, else text.
+
+    A number stays a float (a sphere's radius 0, a lower limit above the upper); a vector of
+    numbers, of whatever length, a tuple of floats (``scale="1 1 1 1"``); anything else, a
+    non-finite number included, its text with whitespace normalised (``"0.07, 0, -0.69"``,
+    ``"inf"``), so that two spellings of one broken value still compare equal.
+    """
+    if value is None or isinstance(value, bool):
+        return value
+    if isinstance(value, int | float):
+        x = float(value)
+        return x if math.isfinite(x) else str(x)
+    if isinstance(value, tuple | list):
+        items = [as_written(v) for v in value]
+        return tuple(items) if all(isinstance(v, float) for v in items) else \
+            " ".join(str(v) for v in items)
+    if not isinstance(value, str):
+        return value
+    tokens = value.split()
+    if not tokens:
+        return ""
+    numbers = []
+    for token in tokens:
+        try:
+            numbers.append(float(token))
+        except ValueError:
+            return " ".join(tokens)
+    if not all(math.isfinite(x) for x in numbers):
+        return " ".join(str(x) if not math.isfinite(x) else token
+                        for x, token in zip(numbers, tokens, strict=True))
+    return numbers[0] if len(numbers) == 1 else tuple(numbers)
 
 
 @dataclass(eq=False)
@@ -794,10 +832,17 @@ class Robot(_Element):
 
 
 class _Ctx:
-    """Where we are in the file, for error messages."""
+    """Where we are in the file, for error messages, and whether values are checked.
 
-    def __init__(self, file: str):
+    With ``strict`` False a value the model refuses is kept :func:`as_written` (a missing
+    number as None), for comparing files rather than building from them. Names, joint types,
+    the shape tag and the tree itself are checked either way: without them there is no robot
+    to compare.
+    """
+
+    def __init__(self, file: str, strict: bool = True):
         self.file = file
+        self.strict = strict
 
     def error(self, el: etree._Element, msg: str) -> ModelError:
         return ModelError(msg, file=self.file, line=el.sourceline)
@@ -812,16 +857,61 @@ class _Ctx:
         try:
             return factory(**kw)
         except ModelError as e:
+            if self.strict or not isinstance(factory, type):
+                raise self.error(el, e.message) from None
+        try:
+            return _unchecked(factory, kw)
+        except ModelError as e:
             raise self.error(el, e.message) from None
 
-    def num(self, el: etree._Element, name: str, required: bool = True) -> float | None:
-        raw = self.attr(el, name, required)
+    def num(self, el: etree._Element, name: str, required: bool = True) -> Any:
+        raw = self.attr(el, name, required and self.strict)
         if raw is None:
             return None
         try:
             return _finite(raw)
         except ModelError as e:
+            if not self.strict:
+                return as_written(raw)
             raise self.error(el, f"<{el.tag} {name}>: {e.message}") from None
+
+
+#: Checks of what identifies an element or holds the model together: never relaxed.
+_STRUCTURAL_CHECKS: tuple[Callable[[Any], Any], ...] = ()
+
+
+def _unchecked(cls: type[_Element], kw: dict[str, Any]) -> Any:
+    """An element whose refused values are kept :func:`as_written`: the lenient read.
+
+    Fields are set one by one, each through its check, and a value the check refuses is kept
+    as written; the cross-field checks of ``__post_init__`` (lower above upper, a limit a
+    joint type needs) are skipped. A refused name, joint type or shape still raises.
+    """
+    obj = cls.__new__(cls)
+    for f in dataclasses.fields(cls):  # type: ignore[arg-type]
+        if f.name in kw:
+            value = kw[f.name]
+        elif f.default is not dataclasses.MISSING:
+            value = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            value = f.default_factory()
+        else:
+            value = None
+        check = f.metadata.get("check")
+        if check is not None:
+            try:
+                value = check(value)
+            except ModelError as e:
+                if check in _STRUCTURAL_CHECKS:
+                    raise ModelError(f"during assignment to attribute '{f.name}' of element "
+                                     f"<{cls._tag}>: {e.message}") from None
+                value = as_written(value)
+        object.__setattr__(obj, f.name, value)
+    return obj
+
+
+_STRUCTURAL_CHECKS = (_name, _optional_name, _joint_type, _geometry, _origin, _material,
+                      _inertial, _contact)
 
 
 def _set(el: etree._Element, name: str, value: float | None) -> None:

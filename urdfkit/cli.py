@@ -951,6 +951,8 @@ def sweep(
 
         picture = plot_file or f"sweep-{plot}.png"
         check_plot_path(picture, force=force)
+        if kind == "drive":  # known columns: refuse a typo before the run
+            sweeping.check_metric(kind, [], plan.names, plot)
     journal = None
     if out is not None:
         journal = sweeping.Journal(Path(out), plan.names, resume=resume, force=force)
@@ -982,9 +984,10 @@ def sweep(
     if picture is not None and rows:
         from .plot import write_sweep_plot
 
-        sweeping.check_metric(rows, plan.names, plot)  # type: ignore[arg-type]
-        written_plot: Path | None = write_sweep_plot(rows, plan.names, plot,  # type: ignore[arg-type]
-                                                     picture, force=force)
+        assert plot is not None
+        sweeping.check_metric(kind, rows, plan.names, plot)
+        written_plot: Path | None = write_sweep_plot(rows, plan.names, plot, picture,
+                                                     force=force)
     else:
         written_plot = None
     skipped = total - before

@@ -626,7 +626,7 @@ def sweep_report(plan: Any, rows: Sequence[Any], done: int, failed: int, skipped
             return str(v)
 
         table(f"sweep {plan.label}: {len(rows)} point(s)", columns,
-              [[str(r.get("point")), *(cell(r.get(n)) for n in names),
+              [[str(r.get("point")), *(diff_value(r.get(n)) for n in names),
                 *(cell(r.get(m)) for m in metrics), _one_line(r.get("error") or "")]
                for r in sorted(rows, key=lambda r: r.get("point", 0))], show_all)
     tail = f"{done} point(s) ran, {failed} failed"

@@ -257,6 +257,8 @@ class RobotSummary:
     top_speed: float
     heading_deg: float
     final_joints: dict[str, float]
+    joint_min: dict[str, float] = field(default_factory=dict)
+    joint_max: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form."""
@@ -1569,6 +1571,8 @@ class _Summary:
         self.last: dict[str, Observation] = {}
         self.count: dict[str, int] = {}
         self.top: dict[str, float] = {}
+        self.low: dict[str, dict[str, float]] = {}
+        self.high: dict[str, dict[str, float]] = {}
         self.rows = 0
 
     def add(self, truth: list[Observation]) -> None:
@@ -1577,6 +1581,13 @@ class _Summary:
             self.last[r.robot] = r
             self.count[r.robot] = self.count.get(r.robot, 0) + 1
             self.top[r.robot] = max(self.top.get(r.robot, 0.0), math.hypot(*r.base_lin_vel))
+            low = self.low.setdefault(r.robot, {})
+            high = self.high.setdefault(r.robot, {})
+            for joint, angle in r.motor_angles.items():  # the range a joint swept: overshoot
+                if angle < low.get(joint, math.inf):
+                    low[joint] = angle
+                if angle > high.get(joint, -math.inf):
+                    high[joint] = angle
         self.rows += len(truth)
 
     def robots(self) -> list[RobotSummary]:
@@ -1590,7 +1601,8 @@ class _Summary:
                 end=list(last.base_position),
                 distance=math.dist(first.base_position, last.base_position),
                 top_speed=self.top[name], heading_deg=heading,
-                final_joints=dict(last.motor_angles)))
+                final_joints=dict(last.motor_angles), joint_min=dict(self.low.get(name, {})),
+                joint_max=dict(self.high.get(name, {}))))
         return out
 
 

@@ -396,6 +396,8 @@ def _sim_metrics(payload: Mapping[str, Any]) -> dict[str, Any]:
         out[f"{prefix}.heading_deg"] = round(x.heading_deg, 6)
         for joint, value in x.final_joints.items():
             out[f"{prefix}.joint.{joint}"] = round(value, 6)
+            out[f"{prefix}.joint_min.{joint}"] = round(x.joint_min[joint], 6)
+            out[f"{prefix}.joint_max.{joint}"] = round(x.joint_max[joint], 6)
     return out
 
 
@@ -671,9 +673,20 @@ def metric_names(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> lis
     return list(seen)
 
 
-def check_metric(rows: Sequence[Mapping[str, Any]], names: Sequence[str], metric: str) -> None:
-    """Refuse a ``--plot`` metric the rows do not have, or a sweep with nothing varied."""
-    known = metric_names(rows, names)
+#: The numeric columns of a drive row (the others: radius_note, problems, warnings, error).
+DRIVE_METRICS = ("final_x", "final_y", "final_z", "final_yaw", "heading_change", "yaw_rate",
+                 "distance", "mean_speed", "turning_radius", "turn_center_x", "turn_center_y",
+                 "expected_radius", "sim_time", "steps", "samples", "steer_applied")
+
+
+def check_metric(kind: str, rows: Sequence[Mapping[str, Any]], names: Sequence[str],
+                 metric: str) -> None:
+    """Refuse a ``--plot`` metric a sweep does not have, or a sweep with nothing varied.
+
+    Drive rows have known columns, checked before the run (``rows`` empty); a scenario's
+    depend on its robots, and are checked on the rows.
+    """
+    known = list(DRIVE_METRICS) if kind == "drive" else metric_names(rows, names)
     if metric not in known:
         from .suggest import hint
 
