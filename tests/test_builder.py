@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import pytest
 
@@ -26,6 +27,7 @@ from urdfkit.builder import (
     SafetyController,
     Sphere,
     Visual,
+    as_written,
 )
 from urdfkit.errors import ModelError
 
@@ -168,6 +170,54 @@ def test_parser_rejects_two_roots_and_cycles() -> None:
              '<joint name="j3" type="fixed"><parent link="c"/><child link="b"/></joint></robot>')
     with pytest.raises(ModelError, match="two parent joints"):
         Robot.from_string(cycle)
+
+
+# --------------------------------------------------------------------------- lenient read
+
+
+LENIENT = ('<robot name="r"><link name="a"><collision><geometry><sphere radius="0"/>'
+           '<material name="grey"/></geometry></collision></link><link name="b"/>'
+           '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+           '<origin xyz="0.07, 0, -0.69" rpy="0 0 0 0"/><axis xyz="0 0 0"/>'
+           '<limit lower="1" upper="-1.57." effort="inf"/></joint></robot>')
+
+
+def test_strict_read_refuses_what_the_lenient_read_keeps_as_written() -> None:
+    with pytest.raises(ModelError):
+        Robot.from_string(LENIENT)
+    robot = Robot.from_string(LENIENT, strict=False)
+    joint = robot.joint("j")
+    assert joint.origin.xyz == "0.07, 0, -0.69"  # no numbers: its text
+    assert joint.origin.rpy == (0, 0, 0, 0)  # numbers, of the wrong count
+    assert joint.axis == (0, 0, 0)
+    lim = joint.limit
+    assert lim is not None
+    assert (lim.lower, lim.upper, lim.effort, lim.velocity) == (1.0, "-1.57.", "inf", None)
+    sphere = robot.link("a").collisions[0].geometry
+    assert isinstance(sphere, Sphere) and sphere.radius == 0.0
+    # Building from those values stays refused: assignment is checked as before.
+    with pytest.raises(ModelError, match="axis must not be zero"):
+        joint.axis = (0, 0, 0)
+
+
+def test_lenient_read_still_refuses_what_has_no_tree() -> None:
+    for bad, message in [
+            (LENIENT.replace('type="revolute"', 'type="hinge"'), "unknown joint type"),
+            (LENIENT.replace('<link name="b"/>', ""), "does not exist"),
+            (LENIENT.replace('<sphere radius="0"/>', '<ball/>'), "unknown shape <ball>"),
+            (LENIENT.replace('<link name="a">', '<link>'), "missing attribute 'name'")]:
+        with pytest.raises(ModelError, match=message):
+            Robot.from_string(bad, strict=False)
+
+
+@pytest.mark.parametrize(("value", "kept"), [
+    ("0", 0.0), (" 1e-1 ", 0.1), ("1 2 3 4", (1.0, 2.0, 3.0, 4.0)), (0, 0.0),
+    ("0.07, 0,\n -0.69", "0.07, 0, -0.69"), ("-1.57.", "-1.57."), ("+Infinity", "inf"),
+    ("1 nan 0", "1 nan 0"), ("", ""), (None, None), ((1, 2), (1.0, 2.0)),
+    ((1, "x"), "1.0 x")])
+def test_as_written_keeps_numbers_where_there_are_numbers(value: Any, kept: Any) -> None:
+    assert as_written(value) == kept
+    assert as_written(as_written(value)) == kept  # idempotent: one broken value, one spelling
 
 
 # --------------------------------------------------------------------------- inertia

@@ -521,21 +521,32 @@ def test_malformed_xml_is_one_line_naming_the_file(tmp_path: Path) -> None:
 
 def test_a_file_the_model_refuses_is_bad_input_naming_it(tmp_path: Path) -> None:
     good = write(tmp_path, "good.urdf", arm())
-    # The guard lets it through (PyBullet loads it), but a zero axis has no direction: the
-    # model refuses it, naming the file and the line.
-    bad = write(tmp_path, "zero_axis.urdf", arm().replace(
-        '<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>', 1))
+    # The guard lets it through, but an <inertial> without <mass> is no value to keep as
+    # written: an element is missing (PyBullet refuses it too). The model refuses it, naming
+    # the file and the line.
+    bad = write(tmp_path, "no_mass.urdf", arm().replace('<mass value="4"/>', "", 1))
     with pytest.raises(ModelError) as caught:
         diff_files(good, bad)
     assert caught.value.file == str(bad) and caught.value.line is not None
     code, out, err = run(good, bad)
     assert code == 2 and out == ""
-    assert len(err.strip().splitlines()) == 1 and f"{bad}:" in err and "axis" in err
+    assert len(err.strip().splitlines()) == 1 and f"{bad}:" in err and "<mass>" in err
+
+
+def test_a_guard_refusal_is_still_bad_input(tmp_path: Path) -> None:
+    good = write(tmp_path, "good.urdf", arm())
+    # What crashes PyBullet or is not URDF stays refused: lenience is the model's, not the
+    # guard's.
+    bad = write(tmp_path, "loop.urdf", arm().replace('<parent link="l2"/><child link="l3"/>',
+                                                     '<parent link="l3"/><child link="l3"/>'))
+    with pytest.raises(InputError, match="to itself"):
+        diff_files(good, bad)
+    code, out, err = run(bad, good)
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1 and str(bad) in err
 
 
 def test_a_model_refusal_in_xacro_has_no_false_line(tmp_path: Path) -> None:
-    bad = write(tmp_path, "bad.urdf.xacro", XACRO.replace('<axis xyz="0 0 1"/>',
-                                                          '<axis xyz="0 0 0"/>', 1))
+    bad = write(tmp_path, "bad.urdf.xacro", XACRO.replace('<mass value="${mass}"/>', "", 1))
     with pytest.raises(ModelError) as caught:
         diff_files(bad, bad)
     assert caught.value.file == str(bad) and caught.value.line is None
@@ -621,3 +632,121 @@ def test_a_new_world_link_above_a_renamed_base_is_not_taken_for_the_root(
                                                         ("joint", "world_joint")]
     assert {s.joint: (s.old, s.new) for s in result.index_shifts} == {
         "shoulder_pan_joint": (0, 1), "shoulder_lift_joint": (1, 2), "elbow_joint": (2, 3)}
+
+
+# --------------------------------------------------------------------------- refused values
+
+
+def edit(text: str, after: str, old: str, new: str) -> str:
+    """``text`` with the first ``old`` after ``after`` replaced by ``new``."""
+    start = text.index(after)
+    at = text.index(old, start)
+    return text[:at] + new + text[at + len(old):]
+
+
+ELBOW = '<joint name="elbow_joint"'
+L1, L3 = '<link name="l1">', '<link name="l3">'
+GEOMETRY_END = "</geometry></visual>"
+LIMIT = 'lower="-1" upper="1" effort="23.7" velocity="2"'
+SPHERE = '<collision><geometry><sphere radius="{r}"/>'
+BOX = '<collision><geometry><box size="0.1 0.1 0.1"/>'
+
+#: Values the model refuses to build from, modelled on pybullet_data robots PyBullet loads:
+#: (case, the file with the refused value, a second version, the one change between them).
+REFUSED = [
+    # franka_panda/panda.urdf: an axis of zeros
+    ("zero_axis", edit(arm(), ELBOW, '<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>'), arm(),
+     ("elbow_joint", "axis", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))),
+    # bicycle/bike.urdf (commas), husky/husky.urdf ($(optenv ...)): not numbers, so text
+    ("malformed_vector", edit(arm(), ELBOW, 'xyz="0.3 0 0"', 'xyz="0.3, 0, 0"'), arm(),
+     ("elbow_joint", "origin.xyz", "0.3, 0, 0", (0.3, 0.0, 0.0))),
+    # quadruped/microtaur/microtaur.urdf: four numbers where three belong
+    ("four_numbers", edit(arm(), ELBOW, 'xyz="0.3 0 0"', 'xyz="0.3 0 0" rpy="0 0 0 0"'),
+     arm(), ("elbow_joint", "origin.rpy", (0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0))),
+    # racecar/racecar.urdf: a <material> inside <geometry>, which PyBullet ignores; the shape
+    # before it is still compared
+    ("material_inside_geometry",
+     edit(arm(), L1, GEOMETRY_END, '<material name="grey"/>' + GEOMETRY_END),
+     edit(edit(arm(), L1, GEOMETRY_END, '<material name="grey"/>' + GEOMETRY_END), L1,
+          'size="0.1 0.1 0.1"', 'size="0.2 0.1 0.1"'),
+     ("l1", "visual[0].geometry.size", (0.1, 0.1, 0.1), (0.2, 0.1, 0.1))),
+    # biped/biped2d_pybullet.urdf: lower above upper, in both versions
+    ("lower_above_upper", edit(arm(), ELBOW, LIMIT, LIMIT.replace('lower="-1" upper="1"',
+                                                                 'lower="1" upper="-1"')),
+     edit(arm(), ELBOW, LIMIT, LIMIT.replace('lower="-1" upper="1"', 'lower="1" upper="-0.5"')),
+     ("elbow_joint", "limit.upper", -1.0, -0.5)),
+    # biped/biped2d_pybullet.urdf: lower="-1.57." is no number: compared as its text
+    ("not_a_number", edit(arm(), ELBOW, 'lower="-1"', 'lower="-1.57."'),
+     edit(arm(), ELBOW, 'lower="-1"', 'lower="-1.57"'),
+     ("elbow_joint", "limit.lower", "-1.57.", -1.57)),
+    # laikago/laikago_toes.urdf: a sphere of radius 0
+    ("zero_radius", edit(arm(), L3, BOX, SPHERE.format(r="0.0")),
+     edit(arm(), L3, BOX, SPHERE.format(r="0.01")),
+     ("l3", "collision[0].geometry.radius", 0.0, 0.01)),
+    # spherical_joint_limit.urdf: a <limit> without velocity
+    ("missing_velocity", edit(arm(), ELBOW, ' velocity="2"', ""), arm(),
+     ("elbow_joint", "limit.velocity", None, 2.0)),
+]
+
+
+@pytest.mark.parametrize(("broken", "other", "expected"), [c[1:] for c in REFUSED],
+                         ids=[c[0] for c in REFUSED])
+def test_a_value_the_model_refuses_is_compared_as_written(
+        tmp_path: Path, broken: str, other: str, expected: tuple[Any, ...]) -> None:
+    with pytest.raises(ModelError):  # building from it is still refused
+        Robot.from_string(broken)
+    a = write(tmp_path, "a.urdf", broken)
+    b = write(tmp_path, "b.urdf", other)
+    assert diff_files(a, a).same
+    result = diff_files(a, b)
+    assert [(c.name, c.field, c.old, c.new) for c in result.changes] == [expected]
+    assert result.count == 1
+
+    code, out, err = run(a, b, "--json")
+    assert code == 1, err
+    [change] = json.loads(out)["changes"]
+    name, path, old, new = expected
+    assert (change["name"], change["field"]) == (name, path)
+    assert change["old"] == (list(old) if isinstance(old, tuple) else old)
+    assert run(a, write(tmp_path, "copy.urdf", broken))[0] == 0
+
+
+def test_a_material_inside_geometry_is_ignored_as_pybullet_ignores_it() -> None:
+    inside = edit(arm(), L1, GEOMETRY_END, '<material name="grey"><color rgba="1 0 0 1"/>'
+                  "</material>" + GEOMETRY_END)
+    assert diff_robots(Robot.from_string(inside, strict=False), Robot.from_string(arm())).same
+
+
+def test_refused_values_spelled_differently_are_the_same() -> None:
+    def same(x: str, y: str) -> bool:
+        return diff_robots(Robot.from_string(x, strict=False),
+                           Robot.from_string(y, strict=False)).same
+
+    # Numbers compare as numbers, text with its whitespace normalised.
+    assert same(edit(arm(), ELBOW, '<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>'),
+                edit(arm(), ELBOW, '<axis xyz="0 0 1"/>', '<axis xyz="0.0  -0 0e0"/>'))
+    assert same(edit(arm(), ELBOW, 'xyz="0.3 0 0"', 'xyz="0.3, 0, 0"'),
+                edit(arm(), ELBOW, 'xyz="0.3 0 0"', 'xyz=" 0.3,  0,\n   0"'))
+    assert same(edit(arm(), ELBOW, 'effort="23.7"', 'effort="inf"'),
+                edit(arm(), ELBOW, 'effort="23.7"', 'effort="+Infinity"'))
+    assert not same(edit(arm(), ELBOW, 'xyz="0.3 0 0"', 'xyz="0.3, 0, 0"'),
+                    edit(arm(), ELBOW, 'xyz="0.3 0 0"', 'xyz="0.3,0,0"'))
+
+
+def test_refused_values_in_the_text_report(tmp_path: Path) -> None:
+    a = write(tmp_path, "a.urdf", edit(arm(), ELBOW, 'xyz="0.3 0 0"', 'xyz="0.3, 0, 0"'))
+    b = write(tmp_path, "b.urdf", arm())
+    code, out, err = run(a, b)
+    assert code == 1 and err == ""
+    row = next(line for line in out.splitlines() if "origin.xyz" in line)
+    assert row.split() == ["changed", "joint", "elbow_joint", "origin.xyz", "0.3,", "0,", "0",
+                           "0.3", "0", "0"]
+
+
+def test_a_mass_that_is_no_number_counts_nothing_in_the_total() -> None:
+    a = Robot.from_string(arm())
+    b = Robot.from_string(arm().replace('<mass value="4"/>', '<mass value="4 kg"/>'),
+                          strict=False)
+    result = diff_robots(a, b)
+    assert changes(result) == {("base", "inertial.mass"): (4.0, "4 kg")}
+    assert (result.mass.old, result.mass.new) == (6.5, 2.5)

@@ -27,9 +27,11 @@ def contracts() -> dict[str, dict[str, set[str]]]:
             command = heading.group(1)
             out[command] = {}
             continue
-        item = re.match(r"- `(\.[^`]*)`(?: \([^)]*\))?: (.*)", line)
+        # `- `.a`, `.b` (a note): `key`, `key``: one or more places with the same keys.
+        item = re.match(r"- ((?:`\.[^`]*`(?:, )?)+)(?: \([^)]*\))?: (.*)", line)
         if item and command:
-            out[command][item.group(1)] = set(re.findall(r"`(\w+)`", item.group(2)))
+            for path in re.findall(r"`(\.[^`]*)`", item.group(1)):
+                out[command][path] = set(re.findall(r"`(\w+)`", item.group(2)))
     return out
 
 
@@ -42,6 +44,38 @@ def at(doc: Any, path: str) -> Any:
         if part.endswith("[]"):
             node = node[0]
     return node
+
+
+def diff_pair(tmp: Path) -> tuple[Path, Path]:
+    """Two versions of a robot with one of every kind of difference, so no list is empty.
+
+    NEW drops ``old_link`` and adds ``new_link`` (a fixed joint each, at different origins),
+    renames ``j2`` and its link, raises ``j1``'s effort and declares it first (its index
+    shifts), and adds mass.
+    """
+    inertial = ('<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" '
+                'iyz="0" izz="0.01"/></inertial>')
+
+    def robot(links: list[str], joints: list[tuple[str, str, str, str, str]]) -> str:
+        body = "".join(f'<link name="{x}">{inertial}</link>' for x in ["base", *links])
+        for name, kind, child, xyz, effort in joints:
+            limit = f'<limit lower="-1" upper="1" effort="{effort}" velocity="1"/>' \
+                if kind == "revolute" else ""
+            body += (f'<joint name="{name}" type="{kind}"><parent link="base"/>'
+                     f'<child link="{child}"/><origin xyz="{xyz}"/><axis xyz="0 0 1"/>'
+                     f"{limit}</joint>")
+        return f'<robot name="r">{body}</robot>'
+
+    old = robot(["l1", "l2", "old_link"], [("j_old", "fixed", "old_link", "0 0 1", ""),
+                                           ("j1", "revolute", "l1", "1 0 0", "1"),
+                                           ("j2", "fixed", "l2", "0 1 0", "")])
+    new = robot(["l1", "l2_renamed", "new_link", "extra"], [
+        ("j1", "revolute", "l1", "1 0 0", "2"), ("j_new", "fixed", "new_link", "5 5 5", ""),
+        ("j2_renamed", "fixed", "l2_renamed", "0 1 0", ""),
+        ("j_extra", "fixed", "extra", "0 0 3", "")])
+    (tmp / "old.urdf").write_text(old)
+    (tmp / "new.urdf").write_text(new)
+    return tmp / "old.urdf", tmp / "new.urdf"
 
 
 @pytest.fixture(scope="module")
@@ -62,6 +96,10 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
     r2d2 = Path(pybullet_data.getDataPath()) / "r2d2.urdf"
     runs["check"] = ["check", str(r2d2), "--json"]
+    old, new = diff_pair(tmp)
+    runs["diff"] = ["diff", str(old), str(new), "--json"]
+    # The Franka's links touch at the zero pose, so `pairs` has entries to check.
+    runs["collisions"] = ["collisions", "franka_panda/panda.urdf", "--json"]
     out = {}
     for name, args in runs.items():
         result = CliRunner().invoke(app, args)
@@ -72,7 +110,7 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
 def test_every_json_command_is_documented() -> None:
     assert set(contracts()) == {"joints", "links", "info", "tree", "templates", "check",
-                                "drive", "render", "sim"}
+                                "drive", "render", "sim", "diff", "collisions"}
 
 
 @pytest.mark.parametrize("command", sorted(contracts()))

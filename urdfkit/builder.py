@@ -807,24 +807,33 @@ class Robot(_Element):
         return atomic_write(path, self.to_bytes(), force=force)
 
     @classmethod
-    def from_string(cls, text: str | bytes, file: str = "<string>") -> Robot:
-        """Parse URDF text into the model."""
+    def from_string(cls, text: str | bytes, file: str = "<string>", *,
+                    strict: bool = True) -> Robot:
+        """Parse URDF text into the model (``strict``: see :meth:`from_element`)."""
         data = text.encode("utf-8") if isinstance(text, str) else text
-        return _parse_robot(parse_xml(data, file).getroot(), file)
+        return _parse_robot(parse_xml(data, file).getroot(), file, strict)
 
     @classmethod
-    def from_file(cls, path: str | Path) -> Robot:
-        """Parse a URDF file into the model."""
-        return _parse_robot(load_xml(path).getroot(), str(path))
+    def from_file(cls, path: str | Path, *, strict: bool = True) -> Robot:
+        """Parse a URDF file into the model (``strict``: see :meth:`from_element`)."""
+        return _parse_robot(load_xml(path).getroot(), str(path), strict)
 
     @classmethod
-    def from_element(cls, root: etree._Element, file: str) -> Robot:
+    def from_element(cls, root: etree._Element, file: str, *, strict: bool = True) -> Robot:
         """Parse an already parsed ``<robot>`` element, such as a resolved (expanded) tree.
 
         Taking the element keeps its source lines for messages, which re-serialising it for
         :meth:`from_string` would lose.
+
+        With ``strict`` False the robot is read to be compared, not built: a value the checks
+        refuse (a zero axis, ``xyz="0.07, 0, -0.69"``, a sphere of radius 0, a lower limit
+        above the upper, a missing ``velocity``) is kept :func:`as_written` instead of raising,
+        and a ``<geometry>`` takes its first element as the shape, ignoring what follows, as
+        PyBullet does. Names, joint types, shape tags, required elements and the tree (one
+        root, known links, no cycle) are still checked. Such a model may hold values no URDF
+        should; do not write or simulate it.
         """
-        return _parse_robot(root, file)
+        return _parse_robot(root, file, strict)
 
 
 # --------------------------------------------------------------------------- parse / write
@@ -877,7 +886,8 @@ class _Ctx:
 
 
 #: Checks of what identifies an element or holds the model together: never relaxed.
-_STRUCTURAL_CHECKS: tuple[Callable[[Any], Any], ...] = ()
+_STRUCTURAL_CHECKS: tuple[Callable[[Any], Any], ...] = (
+    _name, _optional_name, _joint_type, _geometry, _origin, _material, _inertial, _contact)
 
 
 def _unchecked(cls: type[_Element], kw: dict[str, Any]) -> Any:
@@ -910,10 +920,6 @@ def _unchecked(cls: type[_Element], kw: dict[str, Any]) -> Any:
     return obj
 
 
-_STRUCTURAL_CHECKS = (_name, _optional_name, _joint_type, _geometry, _origin, _material,
-                      _inertial, _contact)
-
-
 def _set(el: etree._Element, name: str, value: float | None) -> None:
     if value is not None:
         el.set(name, fmt_float(value))
@@ -939,17 +945,20 @@ def _parse_geometry(ctx: _Ctx, el: etree._Element | None, owner: etree._Element)
         raise ctx.error(owner, f"<{owner.tag}> has no <geometry>")
     elements = [c for c in el if isinstance(c.tag, str)]
     # PyBullet reads the first element as the shape and ignores what follows it (an <origin>
-    # misplaced there, say); anything else is not one shape.
+    # misplaced there, say); anything else is not one shape. Read leniently, the first
+    # element is the shape and what follows it is ignored, as PyBullet does (racecar.urdf has
+    # a <material> there).
     shapes = [c for c in elements if c.tag != "origin"]
-    if len(shapes) != 1 or elements[0] is not shapes[0]:
+    if not elements or (ctx.strict and (len(shapes) != 1 or elements[0] is not shapes[0])):
         raise ctx.error(el, f"<geometry> must hold exactly one shape, first, found "
                         f"{', '.join(f'<{c.tag}>' for c in elements) or 'nothing'}")
-    s = shapes[0]
+    s = elements[0]
     cls = SHAPE_CLASSES.get(s.tag)
     if cls is None:
         raise ctx.error(s, f"unknown shape <{s.tag}>; expected one of {', '.join(SHAPES)}")
     if s.tag in SHAPE_SIZES:
-        sizes = {a: ctx.attr(s, a) if a == "size" else ctx.num(s, a) for a in SHAPE_SIZES[s.tag]}
+        sizes = {a: ctx.attr(s, a, ctx.strict) if a == "size" else ctx.num(s, a)
+                 for a in SHAPE_SIZES[s.tag]}
         return ctx.build(s, cls, **sizes)
     if s.tag == "plane":
         return ctx.build(s, Plane, normal=s.get("normal", "0 0 1"))
@@ -1196,8 +1205,8 @@ def _write_joint(parent: etree._Element, j: Joint) -> None:
 _KNOWN_TOP = ("link", "joint", "material")
 
 
-def _parse_robot(el: etree._Element, file: str) -> Robot:
-    ctx = _Ctx(file)
+def _parse_robot(el: etree._Element, file: str, strict: bool = True) -> Robot:
+    ctx = _Ctx(file, strict)
     if el.tag != "robot":
         raise ctx.error(el, f"root element is <{el.tag}>, expected <robot>")
     robot = ctx.build(el, Robot, name=ctx.attr(el, "name"))

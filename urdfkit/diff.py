@@ -22,7 +22,11 @@ upper not at all: each is what the robot *means*. Mesh and texture files are com
 content when their paths differ, so a copied robot with its meshes beside it is the same.
 
 Nothing here loads PyBullet: the files are resolved (xacro, ``package://``, the guard) and
-parsed into the builder's model.
+parsed into the builder's model, leniently (``strict=False``): a diff compares what the files
+say, so a value the model refuses to build from (a zero axis, a malformed vector, a sphere of
+radius 0, a lower limit above the upper) is compared as written, as a number where it is one
+and as its whitespace-normalised text where it is not (:func:`urdfkit.builder.as_written`).
+What the guard refuses, and a file without a tree (a missing link, a cycle), is still bad input.
 """
 
 from __future__ import annotations
@@ -240,7 +244,8 @@ def diff_files(a: str | Path, b: str | Path, *, tolerance: float = DEFAULT_TOLER
 
     Each file goes the road every loader takes (:func:`urdfkit.resolve.open_input`: locate,
     expand xacro, guard, resolve ``package://``), then into the builder's model; a file the
-    model refuses is bad input naming the file. ``packages``, ``xacro_args`` and
+    lenient model still refuses (see :func:`load_robot`) is bad input naming the file.
+    ``packages``, ``xacro_args`` and
     ``package_paths`` are the raw ``NAME=PATH``, ``name:=value`` and folder lists, applied to
     both files.
     """
@@ -259,13 +264,20 @@ def diff_files(a: str | Path, b: str | Path, *, tolerance: float = DEFAULT_TOLER
 def load_robot(name: str | Path, *, packages: list[str] | None = None,
                xacro_args: list[str] | None = None, guard: bool = True,
                package_paths: list[str] | None = None) -> tuple[Robot, list[str]]:
-    """A robot file resolved and parsed into the model, with the guard's lifted refusals."""
+    """A robot file resolved and read into the model, with the guard's lifted refusals.
+
+    The model is read leniently (:meth:`urdfkit.builder.Robot.from_element` with ``strict``
+    False): values it would refuse to build from are kept as written, so two versions of a
+    robot that ``check`` has findings on can still be compared. A missing file, malformed
+    XML, a guard refusal, or a file with no tree to compare (a joint naming a missing link, a
+    cycle, an unknown joint type) still raises.
+    """
     from .resolve import open_input
 
     with open_input(name, packages, xacro_args, guard=guard,
                     package_paths=package_paths) as resolved:
         try:
-            robot = Robot.from_element(resolved.root, resolved.name)
+            robot = Robot.from_element(resolved.root, resolved.name, strict=False)
         except ModelError as e:
             # The lines of expanded xacro are not the lines of the file the user wrote.
             line = None if resolved.source.suffix == ".xacro" else e.line
@@ -340,7 +352,9 @@ def _dof(robot: Robot) -> int:
 
 
 def _total_mass(robot: Robot) -> float:
-    return math.fsum(x.inertial.mass for x in robot.links if x.inertial is not None)
+    """The files' masses summed; one that is not a number (kept as written) counts 0."""
+    return math.fsum(x.inertial.mass for x in robot.links if x.inertial is not None
+                     and isinstance(x.inertial.mass, float | int))
 
 
 # --------------------------------------------------------------------------- matching

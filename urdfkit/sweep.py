@@ -513,9 +513,17 @@ def _ray_rows(todo: list[tuple[int, str, Any]], jobs: int | None, address: str |
                                  param="address") from None
         started = True
     task = ray.remote(num_cpus=1, max_retries=1)(run_point)
-    pending = {task.remote(job): job[0] for job in todo}
+    # A window of tasks in flight, not all of them: ray.wait scans the list it is given, so
+    # a million pending refs would make every wait slow, and hold every payload at once.
+    window = max(16, 4 * int(ray.cluster_resources().get("CPU", 1)))
+    queue = iter(todo)
+    pending: dict[Any, int] = {}
     try:
-        while pending:
+        while True:
+            for job in itertools.islice(queue, window - len(pending)):
+                pending[task.remote(job)] = job[0]
+            if not pending:
+                break
             done, _ = ray.wait(list(pending), num_returns=1)
             for ref in done:
                 index = pending.pop(ref)
