@@ -21,16 +21,23 @@ def contracts() -> dict[str, dict[str, set[str]]]:
     """{command: {path: keys}} from the lists under each ``## `urdfkit CMD ... --json` ``."""
     out: dict[str, dict[str, set[str]]] = {}
     command = ""
+    paths: list[str] = []  # the places of the list item being read
     for line in DOC.read_text().splitlines():
         heading = re.match(r"## `urdfkit (\w+)", line)
         if heading:
-            command = heading.group(1)
+            command, paths = heading.group(1), []
             out[command] = {}
             continue
+        if paths and re.match(r"\s+\S", line):  # an item continued on an indented line
+            for path in paths:
+                out[command][path] |= set(re.findall(r"`(\w+)`", line))
+            continue
+        paths = []
         # `- `.a`, `.b` (a note): `key`, `key``: one or more places with the same keys.
         item = re.match(r"- ((?:`\.[^`]*`(?:, )?)+)(?: \([^)]*\))?: (.*)", line)
         if item and command:
-            for path in re.findall(r"`(\.[^`]*)`", item.group(1)):
+            paths = re.findall(r"`(\.[^`]*)`", item.group(1))
+            for path in paths:
                 out[command][path] = set(re.findall(r"`(\w+)`", item.group(2)))
     return out
 

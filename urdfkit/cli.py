@@ -861,7 +861,7 @@ def sweep(
         show_default="every core")] = None,
     backend: Annotated[str, typer.Option(
         "--backend", metavar="local|ray", help="local: a process pool; ray: Ray tasks "
-        "(pip install 'urdfkit[ray]').")] = "local",
+        "(pip install 'urdfkit\\[ray]').")] = "local",
     address: Annotated[str | None, typer.Option(
         "--address", metavar="auto|ray://HOST:PORT",
         help="With --backend ray: the cluster to run on.", show_default="a local Ray")]

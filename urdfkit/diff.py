@@ -74,8 +74,10 @@ class Change:
         name: The element's name in the second robot.
         field: The field's path, as in the URDF: ``limit.effort``, ``origin.xyz``,
             ``visual[0].geometry.size``, ``inertial.inertia.ixx``.
-        old: The first robot's value (None where it has none). Vectors are lists; a whole
-            visual or collision that only one side has is a dict of its fields.
+        old: The first robot's value (None where it has none). Vectors are tuples (lists in
+            JSON); a whole visual or collision that only one side has is a dict of its
+            fields; a value the model refuses is as written (a number, numbers of any count,
+            or text: :func:`urdfkit.builder.as_written`).
         new: The second robot's value.
     """
 
