@@ -107,6 +107,14 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     runs["diff"] = ["diff", str(old), str(new), "--json"]
     # The Franka's links touch at the zero pose, so `pairs` has entries to check.
     runs["collisions"] = ["collisions", "franka_panda/panda.urdf", "--json"]
+    # The broken arm, with a capsule (no solid to derive inertia from: a finding left) and a
+    # zero joint axis (an error fix does not repair), so no list is empty.
+    broken = (ROOT / "tests" / "fixtures" / "robots" / "broken_arm.urdf").read_text()
+    broken = broken.replace("<cylinder ", "<capsule ").replace(
+        '<origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>', '<origin xyz="0 0 0.5"/><axis xyz="0 0 0"/>')
+    (tmp / "broken.urdf").write_text(broken)
+    runs["fix"] = ["fix", str(tmp / "broken.urdf"), "-o", str(tmp / "fixed.urdf"), "--json"]
+    runs["sweep"] = ["sweep", "drive", "--steps", "5", "--vary", "steer=0.1,0.2", "--json"]
     out = {}
     for name, args in runs.items():
         result = CliRunner().invoke(app, args)
@@ -117,7 +125,7 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
 def test_every_json_command_is_documented() -> None:
     assert set(contracts()) == {"joints", "links", "info", "tree", "templates", "check",
-                                "drive", "render", "sim", "diff", "collisions"}
+                                "drive", "render", "sim", "diff", "collisions", "fix", "sweep"}
 
 
 @pytest.mark.parametrize("command", sorted(contracts()))
