@@ -557,6 +557,7 @@ class Journal:
     force: bool = False
     done: list[dict[str, Any]] = field(default_factory=list)
     _handle: Any = None
+    _keys: set[tuple[str, ...]] | None = None
 
     @property
     def partial(self) -> Path:
@@ -596,7 +597,7 @@ class Journal:
 
     def finished(self, values: Mapping[str, Any]) -> bool:
         """Whether a point with these values has a row without an error (for ``skip``)."""
-        if not hasattr(self, "_keys"):
+        if self._keys is None:
             self._keys = {_key(r, self.names) for r in self.done if not r.get("error")}
         return _key(values, self.names) in self._keys
 
