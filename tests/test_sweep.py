@@ -181,6 +181,8 @@ def test_a_failing_point_records_its_error_and_the_sweep_goes_on(tmp_path: Path)
 
 @pytest.mark.parametrize("suffix", [".csv", ".jsonl", ".parquet"])
 def test_rows_file_in_each_format(tmp_path: Path, suffix: str) -> None:
+    if suffix == ".parquet":
+        pytest.importorskip("pyarrow.parquet")  # the parquet extra
     out = tmp_path / f"rows{suffix}"
     code, _, err = _cli("sweep", "drive", "--seconds", "1", "--vary", "steer=0.1,0.2",
                         "--out", str(out), "-j", "1")
