@@ -432,3 +432,34 @@ def test_millimetre_meshes_are_flagged_until_scaled(tmp_path: Path) -> None:
     assert "U613" in _codes(tmp_path, with_scale("0.000001 0.000001 0.000001"))  # scaled twice
     # Without two offset joints there is no scale to judge by.
     assert "U613" not in _codes(tmp_path, doc(A, link("b", body=mesh("1 1 1")), J))
+
+
+@pytest.mark.parametrize("text", [
+    # ROS 1's include files: a <root> element (pr2_description's sensors).
+    '<root xmlns:xacro="http://wiki.ros.org/xacro"><xacro:macro name="cam" params="p">'
+    '<link name="${p}_cam"/></xacro:macro></root>',
+    # A named library of macros and properties (franka_description's franka_arm.xacro).
+    '<robot name="arm" xmlns:xacro="http://wiki.ros.org/xacro"><xacro:property name="r" '
+    'value="0.1"/><xacro:macro name="arm" params="p"><link name="${p}_l"/></xacro:macro>'
+    '</robot>'])
+def test_xacro_libraries_are_noted_not_errors(text: str, tmp_path: Path) -> None:
+    path = tmp_path / "lib.xacro"
+    path.write_text(text)
+    assert [(f.code, f.level) for f in check_file(str(path), path).findings] == [
+        ("U007", "info")]
+
+
+def test_a_used_but_undeclared_xacro_arg_can_be_given(tmp_path: Path) -> None:
+    # unitree_ros uses $(arg DEBUG) without <xacro:arg>; xacro takes DEBUG:=false anyway.
+    path = tmp_path / "robot.xacro"
+    path.write_text('<robot name="r" xmlns:xacro="http://wiki.ros.org/xacro"><link name="a"/>'
+                    '<xacro:if value="$(arg DEBUG)"><link name="debug"/><joint name="j" type="fixed">'
+                    '<parent link="a"/><child link="debug"/></joint></xacro:if></robot>')
+    missing = check_file(str(path), path).findings
+    assert [f.code for f in missing] == ["U000"] and "DEBUG:=VALUE" in missing[0].message
+    given = check_file(str(path), path, xacro_args={"DEBUG": "false"}).findings
+    assert not [f for f in given if f.level == "error"]
+    from urdfkit.resolve import resolve
+
+    with resolve(path, xacro_args={"DEBUG": "true"}) as r:  # strict: the name is known
+        assert [x.get("name") for x in r.root.iter("link")] == ["a", "debug"]

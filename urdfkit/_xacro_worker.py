@@ -237,7 +237,7 @@ def main(argv: list[str]) -> int:
 
         declared = sorted(_declared_args([source, *xacro.all_includes]))
         print(f"`xacro_args`: {unknown[0]!r} is not an argument of this file or its includes"
-              f"{hint(unknown[0], declared)} (its <xacro:arg>s: {', '.join(declared) or 'none'})",
+              f"{hint(unknown[0], declared)} (its arguments: {', '.join(declared) or 'none'})",
               file=sys.stderr)
         return 3  # urdfkit.expand.BAD_ARGS
     import json
@@ -272,9 +272,9 @@ def _message(e: BaseException) -> str:
     undefined = re.match(r"Undefined substitution argument (\S+)", text)
     if undefined:
         name = undefined.group(1)
-        return (f"$(arg {name}) has no value where it is used (the root element's attributes "
-                f"are read before its <xacro:arg> defaults); give it with `xacro_args` "
-                f"({name}:=VALUE)")
+        return (f"$(arg {name}) has no value where it is used: give it with `xacro_args` "
+                f"({name}:=VALUE) (a <xacro:arg> default counts only after its declaration, "
+                "and never in the root element's attributes)")
     unknown = re.search(r"Unknown substitution command \[([^\]]*)\]", text)
     if unknown:
         return (f"$({unknown.group(1)}) is a ROS substitution urdfkit cannot run; without ROS "
@@ -283,15 +283,21 @@ def _message(e: BaseException) -> str:
 
 
 def _declared_args(files: list[str]) -> set[str]:
-    """The names of every ``<xacro:arg>`` in the files xacro read (the file and includes)."""
+    """The arguments the files xacro read take: every ``<xacro:arg>``, and every ``$(arg X)``.
+
+    xacro itself accepts any ``name:=value`` and a file may use ``$(arg DEBUG)`` without
+    declaring it (unitree_ros does): such a name is an argument too, only one with no default.
+    """
     import re
 
-    pattern = re.compile(rb"<xacro:arg\s[^>]*?name\s*=\s*[\"']([^\"']+)[\"']")
+    pattern = re.compile(rb"<xacro:arg\s[^>]*?name\s*=\s*[\"']([^\"']+)[\"']"
+                         rb"|\$\(arg\s+([^)\s]+)\s*\)")
     names: set[str] = set()
     for path in set(files):
         try:
             with open(path, "rb") as f:
-                names.update(m.decode("utf-8", "replace") for m in pattern.findall(f.read()))
+                for declared, used in pattern.findall(f.read()):
+                    names.add((declared or used).decode("utf-8", "replace"))
         except OSError:
             continue
     return names

@@ -254,11 +254,16 @@ def physics_findings(display: str, path: Path, lines: Mapping[str | None, int | 
 
 
 def _macro_library(root: object) -> bool:
-    """A xacro file that only defines macros: after expansion, no <link> and no name."""
+    """A xacro file that only defines macros or properties: after expansion, no <link>.
+
+    Real libraries carry a ``name`` (franka_description's franka_arm.xacro) or use ROS 1's
+    ``<root>`` element (pr2_description's sensors); what marks them is that expanding them
+    alone makes nothing.
+    """
     from lxml import etree
 
     assert isinstance(root, etree._Element)
-    return root.tag == "robot" and root.find("link") is None and not root.get("name")
+    return root.tag in ("robot", "root") and root.find("link") is None
 
 
 def _check_one(job: tuple[str, str, str | None, dict[str, str], bool, dict[str, str], bool]

@@ -49,6 +49,17 @@ def flag_message(message: str) -> str:
                   message)
 
 
+#: Parameters every loading command takes from the same flags: their names are translated in
+#: any message (a xacro or package error deep in a load, a check finding), not only in errors
+#: about a parameter. None of them is ever a scenario key.
+INPUT_PARAMS = ("xacro_args", "packages", "package_paths")
+
+
+def input_flags(message: str) -> str:
+    """A message with the input parameters (``xacro_args``) shown as their flags (``--arg``)."""
+    return re.sub(r"`(" + "|".join(INPUT_PARAMS) + r")`", lambda m: FLAGS[m.group(1)], message)
+
+
 def _click_error(e: BaseException) -> bool:
     # click's own errors (bad option values, unknown options, missing arguments). Told apart
     # by shape, not class: typer 0.28 carries a private copy of click, older typer uses click.
@@ -103,7 +114,7 @@ def run(command: Any, argv: list[str], prog_name: str, extra: dict[str, Any]) ->
         return e.exit_code
     except UrdfkitError as e:
         # Only errors about a parameter speak of flags; a scenario file's `wheels` stays a key.
-        show.error(flag_message(str(e)) if e.param is not None else str(e))
+        show.error(flag_message(str(e)) if e.param is not None else input_flags(str(e)))
         return e.exit_code
     except (KeyboardInterrupt, typer.Abort):
         show.interrupted()
@@ -528,6 +539,11 @@ def check(
                          select=parse_codes(select, "`select`"),
                          ignore=parse_codes(ignore, "`ignore`"), jobs=jobs, no_exec=no_exec,
                          xacro_args=_xacro_args(arg), physics=physics)
+    import dataclasses
+
+    for fr in result.files:  # a xacro or package problem speaks of flags, not parameters
+        fr.findings = [dataclasses.replace(f, message=input_flags(f.message))
+                       for f in fr.findings]
     show.check_output(result, fmt, fail_on)
     raise typer.Exit(result.exit_code(fail_on))
 
