@@ -94,6 +94,15 @@ def test_opening_the_gripper_separates_the_fingers(gripper: Path) -> None:
                                margin=0.003).pairs  # 2 mm apart, within a 3 mm margin
 
 
+def test_pinning_the_leader_moves_its_mimic_joint(gripper: Path) -> None:
+    # The documented use: hold a gripper open by its leading joint alone.
+    with resolve(gripper) as r:
+        assert not self_collisions(r, joints={"left_joint": 0.006}).pairs
+        assert not self_collisions(r, joints={"left_joint": 0.006}, samples=20).pairs
+        with pytest.raises(ParameterError, match="finite"):
+            self_collisions(r, joints={"left_joint": float("nan")})
+
+
 def test_mimic_joints_follow_their_leader_in_samples(gripper: Path) -> None:
     # The right finger mirrors the left: opened by the same amount, they overlap only while
     # each has moved less than 2.5 mm of its 40 mm travel: about 6% of the samples.

@@ -750,3 +750,18 @@ def test_a_mass_that_is_no_number_counts_nothing_in_the_total() -> None:
     result = diff_robots(a, b)
     assert changes(result) == {("base", "inertial.mass"): (4.0, "4 kg")}
     assert (result.mass.old, result.mass.new) == (6.5, 2.5)
+
+
+def test_nameless_inline_materials_of_cad_exports_are_compared_by_colour(tmp_path: Path) -> None:
+    # The SolidWorks exporter writes <material name=""> with the colour inline.
+    def robot(rgba: str) -> Path:
+        path = tmp_path / f"cad_{rgba.replace(' ', '_')}.urdf"
+        path.write_text(f'<robot name="cad"><link name="base"><visual><geometry><box size="1 1 1"/>'
+                        f'</geometry><material name=""><color rgba="{rgba}"/></material>'
+                        '</visual></link></robot>')
+        return path
+
+    grey, red = robot("0.7 0.7 0.7 1"), robot("1 0 0 1")
+    assert diff_files(grey, grey).same
+    changes = diff_files(grey, red).changes
+    assert len(changes) == 1 and changes[0].new == (1.0, 0.0, 0.0, 1.0)

@@ -986,11 +986,18 @@ def _write_geometry(parent: etree._Element, g: Geometry) -> None:
 def _parse_material(ctx: _Ctx, el: etree._Element) -> Material:
     color = el.find("color")
     texture = el.find("texture")
-    return ctx.build(
-        el, Material, name=ctx.attr(el, "name"),
+    name = el.get("name")
+    # The SolidWorks exporter writes <material name=""> with the colour inline; PyBullet takes
+    # it. Read leniently it is kept, nameless: a material is compared by what it holds.
+    unnamed = not ctx.strict and not (name or "").strip()
+    material = ctx.build(
+        el, Material, name="unnamed" if unnamed else ctx.attr(el, "name"),
         color=None if color is None else ctx.attr(color, "rgba"),
         texture=None if texture is None else ctx.attr(texture, "filename"),
     )
+    if unnamed:
+        object.__setattr__(material, "name", name or "")
+    return material
 
 
 def _write_material(parent: etree._Element, m: Material) -> None:

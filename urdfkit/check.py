@@ -233,12 +233,14 @@ def physics_findings(display: str, path: Path, lines: Mapping[str | None, int | 
     from .resolve import resolve
 
     try:
-        with resolve(path, packages=packages, xacro_args=xacro_args) as resolved:
+        with resolve(path, packages=packages, xacro_args=xacro_args,
+                     strict_args=False) as resolved:
             resolved.name = display
             found = self_collisions(resolved, packages=packages)
     except UrdfkitError as e:
         return [Finding("U951", "error", f"PyBullet cannot load it: {e.message}", display,
                         e.line)]
+    args = " with the same --arg values" if xacro_args and path.suffix == ".xacro" else ""
     out = []
     for x in found.pairs:
         hull = (f"; {' and '.join(x.hull)} collide{'s' if len(x.hull) == 1 else ''} as a "
@@ -248,8 +250,8 @@ def physics_findings(display: str, path: Path, lines: Mapping[str | None, int | 
             f"{'interpenetrate by' if x.distance < 0 else 'touch at'} "
             f"{abs(x.distance) * 1000:.3g} mm at the zero pose: once self-collision is on "
             "(URDF_USE_SELF_COLLISION) PyBullet pushes them apart every step and the robot "
-            f"jitters; fix the shapes, or disable the pair (urdfkit collisions {display} "
-            f"--python or --srdf){hull}", display, lines.get(x.link_a)))
+            f"jitters; fix the shapes, or disable the pair (urdfkit collisions {display} --python "
+            f"or --srdf{args}){hull}", display, lines.get(x.link_a)))
     return out
 
 

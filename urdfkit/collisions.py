@@ -182,6 +182,8 @@ def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = 
         names = [base_link_name(s, body)] + [j.link_name for j in table]
         warnings: list[str] = []
         pose_joints(p, c, body, table, pinned, warnings, resolved.name)
+        sampler = _Sampler(table, resolved.root, pinned, warnings)
+        sampler.follow(p, c, body, sampler.start())  # mimic joints follow at the start too
         shaped = [i for i in range(-1, len(table))
                   if s.call("getCollisionShapeData", body, i)]
         without = [names[i + 1] for i in range(-1, len(table)) if i not in set(shaped)]
@@ -193,7 +195,6 @@ def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = 
                     adjacent.append((names[a + 1], names[b + 1]))
                 else:
                     tested.append((a, b))
-        sampler = _Sampler(table, resolved.root, pinned, warnings)
         rng = np.random.default_rng(seed)
         closest: dict[tuple[int, int], float] = {}
         hits: dict[tuple[int, int], int] = {}
@@ -226,6 +227,7 @@ class _Sampler:
         self.spherical: list[int] = []
         self.mimic: list[tuple[int, int, float, float]] = []  # (index, leader, mult, offset)
         index = {j.joint_name: j.joint_index for j in table}
+        self.pinned = {index[name]: value for name, value in pinned.items() if name in index}
         leaders = {}
         for el in children(root, "joint"):
             m = el.find("mimic")
@@ -251,8 +253,18 @@ class _Sampler:
                 warnings.append(f"joint {j.joint_name}: a {j.urdf_type or j.joint_type.lower()} "
                                 "joint without limits has no range to sample; held at 0")
 
+    def start(self) -> dict[int, float]:
+        """Every leader's position at the start pose: pinned, else 0."""
+        return {leader: self.pinned.get(leader, 0.0) for _, leader, _, _ in self.mimic}
+
+    def follow(self, p: Any, c: int, body: int, values: dict[int, float]) -> None:
+        """Set each mimic joint from its leader's position in ``values``."""
+        for i, leader, mult, offset in self.mimic:
+            if leader in values:
+                p.resetJointState(body, i, mult * values[leader] + offset, physicsClientId=c)
+
     def pose(self, p: Any, c: int, body: int, rng: Any) -> None:
-        values: dict[int, float] = {}
+        values: dict[int, float] = dict(self.pinned)
         for i, low, high in self.free:
             values[i] = float(rng.uniform(low, high))
             p.resetJointState(body, i, values[i], physicsClientId=c)
@@ -260,9 +272,7 @@ class _Sampler:
             q = rng.normal(size=4)
             q = q / (float((q * q).sum()) ** 0.5 or 1.0)  # uniform over rotations
             p.resetJointStateMultiDof(body, i, [float(x) for x in q], physicsClientId=c)
-        for i, leader, mult, offset in self.mimic:
-            if leader in values:
-                p.resetJointState(body, i, mult * values[leader] + offset, physicsClientId=c)
+        self.follow(p, c, body, values)
 
 
 def _concave_links(resolved: Resolved, packages: Mapping[str, Path] | None) -> set[str]:

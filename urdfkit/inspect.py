@@ -196,7 +196,12 @@ def pose_joints(p: Any, client: int, body: int, joints: Sequence[JointInfo],
     by_name = {j.joint_name: j for j in joints}
     movable = [j.joint_name for j in joints if j.movable]
     positions: dict[str, float] = {}
+    import math
+
     for name, value in values.items():
+        if not math.isfinite(value):
+            raise ParameterError(f"`joints` {name}: {value!r} is not a finite number",
+                                 file=file, param="joints")
         info = by_name.get(name)
         if info is None:
             from .suggest import hint

@@ -155,17 +155,20 @@ def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
 
 
 def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
-            xacro_args: Mapping[str, str] | None = None, guard: bool = True) -> Resolved:
+            xacro_args: Mapping[str, str] | None = None, guard: bool = True,
+            strict_args: bool = True) -> Resolved:
     """Locate, expand, parse, guard and package-resolve a URDF for loading.
 
     With ``guard=False`` the guard's refusals that are stricter than PyBullet (see
     :data:`urdfkit.validate.LIFTABLE_CODES`) become :attr:`Resolved.warnings`; whatever
-    crashes PyBullet is refused either way.
+    crashes PyBullet is refused either way. ``strict_args=False`` lets a xacro file ignore
+    ``xacro_args`` it does not take (``check`` passes one set to every file).
     """
     display = str(name)
     source = locate(name)
     if source.suffix == ".xacro":
-        expanded = expand_xacro(source, xacro_args, display=display, packages=packages)
+        expanded = expand_xacro(source, xacro_args, display=display, packages=packages,
+                                strict_args=strict_args)
         try:
             return _resolve_tree(source, display, parse_xml(expanded, display), packages,
                                  guard, copy=True, origins=expanded.origins)
