@@ -453,8 +453,9 @@ def test_a_used_but_undeclared_xacro_arg_can_be_given(tmp_path: Path) -> None:
     # unitree_ros uses $(arg DEBUG) without <xacro:arg>; xacro takes DEBUG:=false anyway.
     path = tmp_path / "robot.xacro"
     path.write_text('<robot name="r" xmlns:xacro="http://wiki.ros.org/xacro"><link name="a"/>'
-                    '<xacro:if value="$(arg DEBUG)"><link name="debug"/><joint name="j" type="fixed">'
-                    '<parent link="a"/><child link="debug"/></joint></xacro:if></robot>')
+                    '<xacro:if value="$(arg DEBUG)"><link name="debug"/>'
+                    '<joint name="j" type="fixed"><parent link="a"/><child link="debug"/>'
+                    '</joint></xacro:if></robot>')
     missing = check_file(str(path), path).findings
     assert [f.code for f in missing] == ["U000"] and "DEBUG:=VALUE" in missing[0].message
     given = check_file(str(path), path, xacro_args={"DEBUG": "false"}).findings

@@ -765,3 +765,20 @@ def test_nameless_inline_materials_of_cad_exports_are_compared_by_colour(tmp_pat
     assert diff_files(grey, grey).same
     changes = diff_files(grey, red).changes
     assert len(changes) == 1 and changes[0].new == (1.0, 0.0, 0.0, 1.0)
+
+
+def test_two_spellings_of_one_rotation_or_axis_are_not_differences(tmp_path: Path) -> None:
+    def robot(rpy: str, axis: str) -> Path:
+        path = tmp_path / f"r_{len(list(tmp_path.iterdir()))}.urdf"
+        path.write_text(f'<robot name="r"><link name="a"/><link name="b"/><joint name="j" '
+                        f'type="revolute"><parent link="a"/><child link="b"/><origin '
+                        f'rpy="{rpy}"/><axis xyz="{axis}"/><limit lower="-1" upper="1" '
+                        'effort="1" velocity="1"/></joint></robot>')
+        return path
+
+    base = robot("0 0 3.141592653589793", "0 0 1")
+    assert diff_files(base, robot("0 0 -3.141592653589793", "0 0 2")).same
+    flipped = diff_files(base, robot("0 0 3.141592653589793", "0 0 -1"))  # the other way
+    assert [c.field for c in flipped.changes] == ["axis"]
+    turned = diff_files(base, robot("0 0 1.5707963267948966", "0 0 1"))
+    assert [c.field for c in turned.changes] == ["origin.rpy"]

@@ -672,7 +672,7 @@ def fix(
         show.fix_report(result, stderr=to_stdout)
     if show_diff:
         sys.stdout.write(result.diff())
-        raise typer.Exit(1 if result.changed else 0)
+        raise typer.Exit(1 if result.changed or result.left or result.other_errors else 0)
     if output == "-":
         sys.stdout.buffer.write(result.fixed)
         sys.stdout.flush()

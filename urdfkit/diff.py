@@ -597,7 +597,7 @@ def _compare(kind: str, name: str, old: dict[str, Any], new: dict[str, Any], clo
             mapped = names[path].get(was, was)  # a renamed link or joint is the same one
         x = _default(path) if mapped is None else mapped
         y = _default(path) if now is None else now
-        if not equal(x, y):
+        if not _same_meaning(path, x, y, equal):
             changes.append(Change(kind, name, path, was, now))
     # A field only the old side has goes beside its group (visual[0], limit), not last.
     groups: dict[str, int] = {}
@@ -605,6 +605,34 @@ def _compare(kind: str, name: str, old: dict[str, Any], new: dict[str, Any], clo
         groups.setdefault(path.split(".", 1)[0], len(groups))
     changes.sort(key=lambda c: groups.get(c.field.split(".", 1)[0], 0))
     return changes
+
+
+def _vector3(v: Any) -> bool:
+    return isinstance(v, tuple | list) and len(v) == 3 and \
+        all(isinstance(c, int | float) and not isinstance(c, bool) for c in v)
+
+
+def _same_meaning(path: str, x: Any, y: Any, equal: Close) -> bool:
+    """Equal values, or two spellings of one thing.
+
+    An rpy is compared as the rotation it makes (yaw +pi is yaw -pi), an axis as its
+    direction (PyBullet normalises ``0 0 2`` to ``0 0 1``; ``0 0 -1`` stays different).
+    """
+    if equal(x, y):
+        return True
+    if not (_vector3(x) and _vector3(y)):
+        return False
+    if path.endswith("rpy"):
+        from .spec import rpy_to_matrix
+
+        return all(equal(p, q) for row_x, row_y in zip(rpy_to_matrix(x), rpy_to_matrix(y),
+                                                       strict=True)
+                   for p, q in zip(row_x, row_y, strict=True))
+    if path == "axis":
+        nx, ny = math.sqrt(sum(c * c for c in x)), math.sqrt(sum(c * c for c in y))
+        return nx > 0 and ny > 0 and all(equal(p / nx, q / ny) for p, q in zip(x, y,
+                                                                                strict=True))
+    return False
 
 
 def _item(path: str) -> str | None:
