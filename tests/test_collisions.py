@@ -176,6 +176,8 @@ def test_concave_mesh_pairs_name_the_hull(tmp_path: Path) -> None:
                                                                      ["bracket"])]
     code, out, _ = _cli("collisions", str(path))
     assert code == 1 and "convex hull of bracket" in out
+    srdf = _cli("collisions", str(path), "--srdf")[1]
+    assert "<!-- bracket: a concave mesh" in srdf and 'link1="bracket"' in srdf
 
 
 def _cli(*args: str) -> tuple[int, str, str]:

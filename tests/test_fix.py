@@ -230,3 +230,24 @@ def test_left_findings_say_why_and_exit_1(tmp_path: Path) -> None:
     assert [r.code for r in result.other_errors] == ["U305"]  # a zero axis: check's business
     code, stdout, _ = _cli("fix", str(path), "-o", str(tmp_path / "o.urdf"))
     assert code == 1 and "left U606" in stdout and "U305" in stdout
+
+
+def test_stub_shapes_and_relative_paths(tmp_path: Path) -> None:
+    shutil.copy(MESHES / "unit_cube.stl", tmp_path / "cube.stl")
+    path = tmp_path / "r.urdf"
+    path.write_text('<robot name="r"><link name="footprint"><collision><geometry><box '
+                    'size="0.001 0.001 0.001"/></geometry></collision></link><link name="b">'
+                    '<collision><geometry><mesh filename="cube.stl" scale="0.1 0.1 0.1"/>'
+                    '</geometry></collision></link><joint name="j" type="revolute"><parent '
+                    'link="footprint"/><child link="b"/><axis xyz="0 0 1"/><limit lower="-1" '
+                    'upper="1" effort="1" velocity="1"/></joint></robot>')
+    result = fix_file(path)
+    # A 1 mm placeholder box is no body to weigh (PR2's base_footprint): left, with why.
+    assert [(r.code, "stubs" in r.message) for r in result.left] == [("U606", True)]
+    assert result.relative_paths == ["cube.stl"]
+    elsewhere = tmp_path / "out"
+    elsewhere.mkdir()
+    code, _, err = _cli("fix", str(path), "-o", str(elsewhere / "r.urdf"))
+    assert "do not resolve" in err and "'cube.stl'" in err
+    code, _, err = _cli("fix", str(path), "-o", str(tmp_path / "r_fixed.urdf"))
+    assert "do not resolve" not in err

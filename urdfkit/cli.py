@@ -684,6 +684,12 @@ def fix(
                 show.wrote(Path(file), f"original kept as {backup}")
     else:
         assert output is not None
+        if result.relative_paths and \
+                Path(output).absolute().parent.resolve() != Path(file).absolute().parent.resolve():
+            show.warn(f"{output}: {len(result.relative_paths)} mesh or texture path(s) in it are "
+                      f"relative to {file}'s folder ({result.relative_paths[0]!r}, ...) and "
+                      "do not resolve from where it is written: write it beside the original "
+                      "(or --in-place), or copy what it names")
         path = atomic_write(output, result.fixed, force=force)
         if not as_json:
             show.wrote(path, f"{len(result.repairs)} fix(es)")

@@ -125,9 +125,15 @@ class Collisions:
         pose tested, ``Always`` for one in contact at every sampled pose too.
         """
         reason = "Always" if self.samples else "Default"
-        return "".join(f'<disable_collisions link1="{_attr(x.link_a)}" '
-                       f'link2="{_attr(x.link_b)}" reason="{reason}"/>\n'
-                       for x in self.always())
+        out = []
+        for x in self.always():
+            if x.hull:  # MoveIt (FCL) collides the mesh itself: the pair may be clear there
+                out.append(f"<!-- {_attr(', '.join(x.hull))}: a concave mesh PyBullet collides "
+                           "as its convex hull; MoveIt checks the mesh itself, so check this "
+                           "pair there before disabling it -->\n")
+            out.append(f'<disable_collisions link1="{_attr(x.link_a)}" '
+                       f'link2="{_attr(x.link_b)}" reason="{reason}"/>\n')
+        return "".join(out)
 
     def python(self) -> str:
         """``setCollisionFilterPair`` calls that disable the pairs always in contact."""
@@ -135,7 +141,9 @@ class Collisions:
                  f"all {self.poses} poses tested",
                  "# robot = p.loadURDF(..., flags=p.URDF_USE_SELF_COLLISION)"]
         lines += [f"p.setCollisionFilterPair(robot, robot, {x.index_a}, {x.index_b}, "
-                  f"enableCollision=0)  # {x.link_a} / {x.link_b}" for x in self.always()]
+                  f"enableCollision=0)  # {x.link_a} / {x.link_b}"
+                  + (f" (convex hull of {', '.join(x.hull)})" if x.hull else "")
+                  for x in self.always()]
         return "\n".join(lines) + "\n"
 
 

@@ -88,6 +88,8 @@ class FixResult:
         left: Findings of fixable codes that were left, each with the reason.
         other_errors: Error findings ``fix`` does not repair (a zero axis, a missing limit):
             ``check`` explains them.
+        relative_paths: Mesh and texture paths relative to the file's folder: a copy
+            written elsewhere no longer finds them.
     """
 
     file: str
@@ -96,6 +98,7 @@ class FixResult:
     repairs: list[Repair] = field(default_factory=list)
     left: list[Repair] = field(default_factory=list)
     other_errors: list[Repair] = field(default_factory=list)
+    relative_paths: list[str] = field(default_factory=list)
 
     @property
     def changed(self) -> bool:
@@ -177,8 +180,12 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float = DEFAUL
     fixed = plan.finish()
     others = [Repair(f.code, f.line, f.message) for f in report.findings
               if f.level == "error" and f.code not in FIXABLE]
+    from .spec import FILE_TAGS
+
+    relative = sorted({fn for el in root.iter(*FILE_TAGS) if (fn := (el.get("filename") or "")
+                       .strip()) and "://" not in fn and not Path(fn).is_absolute()})
     return FixResult(display, data, fixed, sorted(plan.repairs, key=_by_line),
-                     sorted(plan.left, key=_by_line), others)
+                     sorted(plan.left, key=_by_line), others, relative)
 
 
 def _by_line(x: Repair) -> tuple[int, str]:
@@ -253,13 +260,17 @@ class _Plan:
             tensor = solid.inertia(SMALL_MASS) if solid else _iso(SMALL_INERTIA)
             self._write_inertial(link, SMALL_MASS, solid.com if solid and inertial is None
                                  else None, tensor, frame, keep_mass=False)
+            given = "the inertia of its shapes at that mass" if solid else "inertia 1e-06"
             self.repairs.append(Repair(code, line, f"link {name!r} moves but had no mass: "
-                                       f"gave it {fmt_float(SMALL_MASS)} kg and "
-                                       f"{'its shapes inertia' if solid else 'inertia 1e-06'}"))
+                                       f"gave it {fmt_float(SMALL_MASS)} kg and {given}"))
             return
         if solid is None:
             skip("no collision solid to derive inertia from (no <collision>, a capsule, plane "
                  "or SDF, or a mesh that is unreadable or not closed); write <inertial> by hand")
+            return
+        if code in ("U606", "U601") and solid.size < STUB_SIZE:
+            skip("its collision shapes are stubs (under 1 cm): no mass to derive from them; "
+                 "write <inertial> by hand (mass 0 for a frame)")
             return
         if code in ("U606", "U601"):
             new_mass = self.density * solid.volume
@@ -297,7 +308,7 @@ class _Plan:
         why = {"U609": "had no <inertia>", "U610": "had an incomplete <inertia>",
                "U603": "had an inertia that is not positive definite",
                "U604": "had an inertia that violates the triangle inequality",
-               "U605": "had an inertia far from its shapes'",
+               "U605": "had an inertia far from what its shapes imply",
                "U608": "had a singular inertia"}[code]
         self.repairs.append(Repair(code, line, f"link {name!r} {why}: derived it from its "
                                    f"collision shapes at its mass {fmt_float(mass, 6)} kg"))

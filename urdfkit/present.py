@@ -572,8 +572,10 @@ def collisions_report(result: Any, show_all: bool = False) -> None:
     if result.without_shapes:
         tail.append(f"{len(result.without_shapes)} link(s) without collision shapes")
     if always:
-        tail.append(f"{always} pair(s) in contact in every pose: --srdf or --python prints "
-                    "the filters")
+        where = "in every pose" if result.samples else "at the one pose tested (--samples N " \
+            "tests more before you filter)"
+        tail.append(f"{always} pair(s) in contact {where}: --srdf or --python prints the "
+                    "filters")
     if any(x.hull for x in result.pairs):
         tail.append("concave meshes collide as their convex hull in PyBullet")
     note("; ".join(tail), stderr=False)
