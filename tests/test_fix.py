@@ -251,3 +251,20 @@ def test_stub_shapes_and_relative_paths(tmp_path: Path) -> None:
     assert "do not resolve" in err and "'cube.stl'" in err
     code, _, err = _cli("fix", str(path), "-o", str(tmp_path / "r_fixed.urdf"))
     assert "do not resolve" not in err
+
+
+def test_a_frame_with_frames_below_gets_mass_0(tmp_path: Path) -> None:
+    # A lidar mount with its optical frame under it (unitree a2's front_lidar_link).
+    path = tmp_path / "lidar.urdf"
+    path.write_text('<robot name="r"><link name="base"><inertial><mass value="5"/><inertia '
+                    'ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>'
+                    '<link name="lidar"/><link name="lidar_optical"/>'
+                    '<joint name="m" type="fixed"><parent link="base"/><child link="lidar"/>'
+                    '</joint><joint name="o" type="fixed"><parent link="lidar"/><child '
+                    'link="lidar_optical"/></joint></robot>')
+    result = fix_file(path)
+    assert [(r.code, "frame" in r.message) for r in result.repairs] == [("U606", True)] * 2
+    from lxml import etree
+
+    root = etree.fromstring(result.fixed)
+    assert [m.get("value") for m in root.iter("mass")] == ["5", "0", "0"]

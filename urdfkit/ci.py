@@ -171,8 +171,9 @@ def junit_xml(result: CheckResult, fail_on: str = "error") -> str:
     suite = ET.SubElement(suites, "testsuite", name=name)
     failed = 0
     for fr in result.files:
+        shown = relative_path(fr.file) or fr.file  # `check .`: robots/a.urdf, as SARIF
         case = ET.SubElement(suite, "testcase", classname="urdfkit.check",
-                             name=xml_safe(fr.file), file=xml_safe(fr.file))
+                             name=xml_safe(shown), file=xml_safe(shown))
         failing = [f for f in fr.findings if LEVELS.index(f.level) >= threshold]
         others = [f for f in fr.findings if LEVELS.index(f.level) < threshold]
         if failing:

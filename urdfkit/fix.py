@@ -253,8 +253,8 @@ class _Plan:
                 '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" '
                 'izz="0"/></inertial>'))
             self.repairs.append(Repair(code, line, f"link {name!r} is a frame (no shapes, "
-                                       "fixed to its parent, nothing below it): gave it mass 0, "
-                                       "where PyBullet would add 1 kg"))
+                                       "fixed to its parent, only frames below it): gave it "
+                                       "mass 0, where PyBullet would add 1 kg"))
             return
         if code == "U602":
             tensor = solid.inertia(SMALL_MASS) if solid else _iso(SMALL_INERTIA)
@@ -314,16 +314,31 @@ class _Plan:
                                    f"collision shapes at its mass {fmt_float(mass, 6)} kg"))
 
     def _fixed_leaf(self, link: etree._Element) -> bool:
-        """Whether ``link`` hangs from a fixed joint and carries nothing: a frame (tool0)."""
-        name = link.get("name")
-        parent_fixed = False
+        """Whether ``link`` is a frame (a ``tool0``, a lidar mount with its optical frame).
+
+        A frame hangs from a fixed joint, has no shapes, and has only frames fixed below it.
+        """
+        by_name = {x.get("name"): x for x in self.root.iterchildren("link")}
+        below: dict[str | None, list[tuple[str | None, bool]]] = {}
+        parent_fixed: dict[str | None, bool] = {}
         for j in self.root.iterchildren("joint"):
             parent, child = j.find("parent"), j.find("child")
-            if parent is not None and parent.get("link") == name:
+            if parent is None or child is None:
+                continue
+            fixed = j.get("type") == "fixed"
+            below.setdefault(parent.get("link"), []).append((child.get("link"), fixed))
+            parent_fixed[child.get("link")] = fixed
+
+        def frame(name: str | None, seen: frozenset[str | None]) -> bool:
+            el = by_name.get(name)
+            if el is None or name in seen or el.find("collision") is not None \
+                    or el.find("visual") is not None:
                 return False
-            if child is not None and child.get("link") == name:
-                parent_fixed = j.get("type") == "fixed"
-        return parent_fixed
+            return all(fixed and frame(child, seen | {name})
+                       for child, fixed in below.get(name, []))
+
+        name = link.get("name")
+        return parent_fixed.get(name, False) and frame(name, frozenset())
 
     def define_material(self, el: etree._Element, line: int | None) -> None:
         name = el.get("name", "")
