@@ -281,3 +281,25 @@ def test_ray_missing_is_an_install_hint(monkeypatch: pytest.MonkeyPatch) -> None
     monkeypatch.setattr(builtins, "__import__", no_ray)
     with pytest.raises(Exception, match=r"urdfkit\[ray\]"):
         list(sweep.run("drive", BASE, ["steer=0.1"], backend="ray"))
+
+
+def test_ctrl_c_inside_a_drive_stops_the_sweep(tmp_path: Path,
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    # drive() catches Ctrl-C itself and returns an interrupted result: the sweep must stop
+    # there, not record half a drive and go on to the next point.
+    import urdfkit.drive as driving
+
+    real, calls = driving.drive, []
+
+    def drive_once_then_ctrl_c(config: DriveConfig, progress: Any = None) -> Any:
+        result = real(config, progress)
+        calls.append(config.steer)
+        result.interrupted = len(calls) == 2
+        return result
+
+    monkeypatch.setattr(driving, "drive", drive_once_then_ctrl_c)
+    out = tmp_path / "rows.jsonl"
+    code, _, _ = _cli("sweep", "drive", "--steps", "10", "--vary", "steer=0.1,0.2,0.3",
+                      "--out", str(out), "-j", "1")
+    assert code == 130 and calls == [0.1, 0.2]
+    assert [r["steer"] for r in sweep.read_rows(out)] == [0.1]

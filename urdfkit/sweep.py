@@ -365,6 +365,8 @@ def _drive_metrics(options: Mapping[str, Any]) -> dict[str, Any]:
     from .drive import DriveConfig, drive
 
     result = drive(DriveConfig(**options))
+    if result.interrupted:  # drive() stops early on Ctrl-C and says so: so does the sweep
+        raise KeyboardInterrupt
     data = result.to_dict()
     out: dict[str, Any] = {}
     for key, value in data.items():
@@ -386,6 +388,8 @@ def _sim_metrics(payload: Mapping[str, Any]) -> dict[str, Any]:
 
     with Simulation(payload["document"], base_dir=payload["base_dir"]) as s:
         result = s.run(keep=False)
+    if result.interrupted:
+        raise KeyboardInterrupt
     out: dict[str, Any] = {"steps": result.steps, "rows": result.row_count}
     for x in result.summaries:
         prefix = x.robot
