@@ -357,3 +357,23 @@ def test_scenario_env_refusals():
             env.step([math.inf])
     finally:
         env.close()
+
+
+def test_registered_env_passes_the_checker_headless(monkeypatch):
+    # check_env makes the registered env in every listed render mode, human included: without
+    # a display, human runs without a window (with a warning) instead of failing.
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    env = gym.make("urdfkit/SimpleDriving-v0")
+    try:
+        _quiet_check(env.unwrapped)
+    finally:
+        env.close()
+    with pytest.warns(UserWarning, match="needs a display"):
+        human = SimpleDrivingEnv(render_mode="human")
+    try:
+        human.reset(seed=0)
+        assert human.step(np.array([1.0, 0.0], dtype=np.float32))[0].shape == (8,)
+        assert human.render() is None
+    finally:
+        human.close()

@@ -55,6 +55,25 @@ def _finite_pair(action: Any) -> tuple[float, float]:
     return first, second
 
 
+
+def _gui(render_mode: str | None) -> bool:
+    """Whether ``render_mode`` opens PyBullet's window: ``human`` where there is a display.
+
+    Headless (CI, a cluster node), ``human`` runs without a window and says so once, rather
+    than failing: ``gymnasium.utils.env_checker.check_env`` makes an env in every listed mode.
+    """
+    if render_mode != "human":
+        return False
+    from .session import has_display
+
+    if has_display():
+        return True
+    import warnings
+
+    warnings.warn("render_mode='human' needs a display (DISPLAY is not set): running without "
+                  "a window", stacklevel=3)
+    return False
+
 class SimpleDrivingEnv(gym.Env):
     """Drive the tutorial car to a goal: the tutorial's ``SimpleDriving-v0``, in Gymnasium 1.x.
 
@@ -116,7 +135,7 @@ class SimpleDrivingEnv(gym.Env):
         self.observation_space = spaces.Box(
             np.array([-edge, -edge, -1, -1, -5, -5, -9, -9], dtype=np.float32),
             np.array([edge, edge, 1, 1, 5, 5, 9, 9], dtype=np.float32))
-        self._session = Session(gui=render_mode == "human")
+        self._session = Session(gui=_gui(render_mode))
         try:
             self._setup(implicit_cylinder)
         except BaseException:
@@ -231,7 +250,7 @@ class SimpleDrivingEnv(gym.Env):
             reward = self.GOAL_BONUS
         else:
             terminated = False
-        if self.render_mode == "human":
+        if self.render_mode == "human" and self._session.gui:
             self._follow_in_gui(x, y)
         return obs, reward, terminated, False, {"distance": distance, "is_success": reached}
 
@@ -355,7 +374,7 @@ class ScenarioEnv(gym.Env):
             if fn is not None and not callable(fn):
                 raise ParameterError(f"{name} must be a callable taking the observation",
                                      param=name)
-        gui = render_mode == "human"
+        gui = _gui(render_mode)
         if isinstance(scenario, Simulation):
             if gui and not scenario.session.gui:
                 raise ParameterError("render_mode='human' needs a Simulation made with "
