@@ -209,8 +209,8 @@ def test_resume_runs_only_the_missing_and_failed_points(tmp_path: Path) -> None:
                            str(out), "--resume")
     assert code == 0 and "2 point(s) ran" in stdout and "1 skipped" in stdout
     rows = sweep.read_rows(out)
-    good = {r["steer"]: r for r in rows if not r["error"]}
-    assert sorted(good) == [0.1, 0.2, 0.3]
+    assert sorted((r["point"], r["steer"]) for r in rows) == [(0, 0.1), (1, 0.2), (2, 0.3)]
+    assert not any(r["error"] for r in rows)  # the failed row was replaced, not kept beside
     code, stdout, _ = _cli("sweep", "drive", "--vary", vary[0], "--vary", vary[1], "--out",
                            str(out), "--resume")
     assert code == 0 and "0 point(s) ran" in stdout and "3 skipped" in stdout
@@ -303,3 +303,16 @@ def test_ctrl_c_inside_a_drive_stops_the_sweep(tmp_path: Path,
                       "--out", str(out), "-j", "1")
     assert code == 130 and calls == [0.1, 0.2]
     assert [r["steer"] for r in sweep.read_rows(out)] == [0.1]
+
+
+def test_resume_refuses_the_rows_of_another_sweep(tmp_path: Path) -> None:
+    out = tmp_path / "rows.csv"
+    assert _cli("sweep", "drive", "--steps", "5", "--vary", "steer=0.1,0.2", "--out",
+                str(out))[0] == 0
+    before = out.read_bytes()
+    for other in (["--vary", "steer=0.1,0.3"], ["--vary", "throttle=1,2"],
+                  ["--vary", "steer=0.1,0.2", "--vary", "throttle=1,2"]):
+        code, _, err = _cli("sweep", "drive", "--steps", "5", *other, "--out", str(out),
+                            "--resume")
+        assert code == 2 and "another sweep" in err, (other, err)
+        assert out.read_bytes() == before and not Path(f"{out}.partial").exists()

@@ -977,7 +977,8 @@ def sweep(
             sweeping.check_metric(kind, [], plan.names, plot)
     journal = None
     if out is not None:
-        journal = sweeping.Journal(Path(out), plan.names, resume=resume, force=force)
+        journal = sweeping.Journal(Path(out), plan.names, resume=resume, force=force,
+                                   assignments=plan.assignments)
         journal.open()
     keep = out is None or plot is not None or as_json
     rows: list[dict[str, Any]] = list(journal.done) if journal is not None and keep else []

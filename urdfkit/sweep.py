@@ -560,6 +560,7 @@ class Journal:
     resume: bool = False
     force: bool = False
     done: list[dict[str, Any]] = field(default_factory=list)
+    assignments: list[dict[str, Any]] = field(default_factory=list)
     _handle: Any = None
     _keys: set[tuple[str, ...]] | None = None
 
@@ -580,14 +581,38 @@ class Journal:
                                  "--resume to carry on, or --force to start again",
                                  file=self.partial)
         else:
-            if exists:
-                self.done.extend(read_rows(self.path))
+            found = read_rows(self.path) if exists else []
             if self.partial.exists():
-                self.done.extend(read_rows(self.partial, ".jsonl"))
+                found += read_rows(self.partial, ".jsonl")
+            self.done = self._same_sweep(found)
         # Keep what a previous run finished: the journal restarts with those rows.
         self._handle = open(self.partial, "w", encoding="utf-8")  # noqa: SIM115
         for row in self.done:
             self._write(row)
+
+    def _same_sweep(self, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+        """The rows to keep: each must be a point of this sweep; failed ones run again.
+
+        Raises:
+            InputError: a row that is not the same point of this sweep (another grid, other
+                names): resuming would mix two sweeps in one file.
+        """
+        kept: dict[int, dict[str, Any]] = {}
+        for row in rows:
+            point = row.get("point")
+            if isinstance(point, float) and point.is_integer():
+                point = int(point)
+            if not isinstance(point, int) or not 0 <= point < len(self.assignments) or \
+                    _key(row, self.names) != _key(self.assignments[point], self.names) or \
+                    any(n not in row for n in self.names):
+                shown = ", ".join(f"{n}={row.get(n)}" for n in self.names)
+                raise InputError(f"holds rows of another sweep (point {point}: {shown} is not "
+                                 "that point of this one): --resume carries on the same "
+                                 "command; give another --out, or --force to start again",
+                                 file=self.path)
+            if not row.get("error"):
+                kept[point] = row  # a point that failed runs again, and its new row replaces
+        return [kept[p] for p in sorted(kept)]
 
     def _write(self, row: Mapping[str, Any]) -> None:
         import json
