@@ -365,7 +365,7 @@ def test_repeated_findings_are_grouped_in_text_and_kept_in_json(tmp_path: Path) 
     (tmp_path / "b.urdf").write_text(doc(A))
     text = CliRunner().invoke(app, ["check", str(tmp_path)]).stdout
     assert text.count("U606  <link name=") == 3
-    assert "... and 4 more U606 in this file (--json lists every one)" in text
+    assert "... and 4 more U606 in this file (--all or --json lists every one)" in text
     doc_json = json.loads(CliRunner().invoke(app, ["check", str(tmp_path), "--json"]).stdout)
     codes = [f["code"] for f in doc_json["findings"]]
     assert codes.count("U606") == 7
@@ -464,3 +464,18 @@ def test_a_used_but_undeclared_xacro_arg_can_be_given(tmp_path: Path) -> None:
 
     with resolve(path, xacro_args={"DEBUG": "true"}) as r:  # strict: the name is known
         assert [x.get("name") for x in r.root.iter("link")] == ["a", "debug"]
+
+
+def test_text_groups_repeated_codes_and_all_lists_them(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from urdfkit.cli import app
+
+    path = tmp_path / "many.urdf"
+    path.write_text(doc(*(link(f"l{i}", inertial="") for i in range(7)),  # 7 x U606
+                        *(joint(f"j{i}", f"l{i}", f"l{i + 1}") for i in range(6))))
+    grouped = CliRunner().invoke(app, ["check", str(path)]).stdout
+    every = CliRunner().invoke(app, ["check", str(path), "--all"]).stdout
+    assert grouped.count("warning  U606  <link") == 3 and "4 more U606" in grouped
+    assert "--all or --json lists every one" in grouped
+    assert every.count("warning  U606  <link") == 7 and "more" not in every

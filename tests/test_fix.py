@@ -202,7 +202,8 @@ def test_cli_writes_only_where_told(broken: Path, tmp_path: Path) -> None:
 def test_bad_input_and_usage(broken: Path, tmp_path: Path) -> None:
     for args, words in [((), "say where"), (("-o", "x.urdf", "--diff"), "say where"),
                         (("--diff", "--select", "U3"), "repairs U601"),
-                        (("--diff", "--density", "-5"), "density")]:
+                        (("--diff", "--density", "-5"), "density"),
+                        (("--diff", "--json"), "--json describes")]:
         code, _, err = _cli("fix", str(broken), *args)
         assert code == 2 and words in err and "Traceback" not in err, (args, err)
     bad = tmp_path / "bad.urdf"

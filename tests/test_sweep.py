@@ -316,3 +316,28 @@ def test_resume_refuses_the_rows_of_another_sweep(tmp_path: Path) -> None:
                             "--resume")
         assert code == 2 and "another sweep" in err, (other, err)
         assert out.read_bytes() == before and not Path(f"{out}.partial").exists()
+
+
+def test_a_value_given_twice_and_a_lone_plot_file_are_refused(tmp_path: Path) -> None:
+    for args, words in [(("--steer", "0.3", "--vary", "steer=0.1"), "--steer and by --vary"),
+                        (("--set", "wheel_radius=0.2", "--vary", "wheel_radius=0.1"),
+                         "--set and by --vary"),
+                        (("--vary", "steer=0.1", "--plot-file", "x.png"), "--plot METRIC")]:
+        code, _, err = _cli("sweep", "drive", *args)
+        assert code == 2 and words in err, (args, err)
+
+
+def test_a_scenario_plot_metric_is_checked_before_the_run(tmp_path: Path) -> None:
+    scenario = str(EXAMPLES / "pendulum_servo.json")
+    out = tmp_path / "rows.csv"
+    code, _, err = _cli("sweep", "sim", scenario, "--vary", "duration=0.2,0.3", "--plot",
+                        "pendulm.distance", "--out", str(out))
+    assert code == 2 and "did you mean 'pendulum.distance'" in err and not out.exists()
+    # A joint's name is the robot file's: a typo there is known only after the run, which
+    # keeps its rows, draws nothing and says why.
+    picture = tmp_path / "p.png"
+    code, _, err = _cli("sweep", "sim", scenario, "--vary", "duration=0.2,0.3", "--plot",
+                        "pendulum.joint_max.hnge", "--plot-file", str(picture), "--out",
+                        str(out))
+    assert code == 1 and "did you mean 'pendulum.joint_max.hinge'" in err
+    assert out.exists() and not picture.exists()

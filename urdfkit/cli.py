@@ -37,6 +37,7 @@ FLAGS = {
     "packages": "--package", "package_paths": "--package-path", "types": "--type",
     "urdf": "--urdf", "force=True": "--force",
     "force": "--force", "joints": "--joints", "views": "--views", "guard=False": "--no-guard",
+    "kind": "KIND",
 }
 
 DEBUG_ENV = "URDFKIT_DEBUG"
@@ -516,6 +517,9 @@ def check(
         "--no-exec", help="Treat xacro as untrusted: do not expand it (xacro runs Python); "
         "each xacro file gets a U006 warning instead. URDFKIT_NO_EXEC=1 does the same.")]
     = False,
+    show_all: Annotated[bool, typer.Option(
+        "--all", help="Text: list every finding (by default a code seen more than 4 times in "
+        "a file shows 3 and a count).")] = False,
     physics: Annotated[bool, typer.Option(
         "--physics", help="Also load each file without errors in PyBullet and test its zero "
         "pose for links in contact (U950; slower).")] = False,
@@ -544,7 +548,7 @@ def check(
     for fr in result.files:  # a xacro or package problem speaks of flags, not parameters
         fr.findings = [dataclasses.replace(f, message=input_flags(f.message))
                        for f in fr.findings]
-    show.check_output(result, fmt, fail_on)
+    show.check_output(result, fmt, fail_on, show_all)
     raise typer.Exit(result.exit_code(fail_on))
 
 
@@ -655,6 +659,9 @@ def fix(
     if sum((output is not None, in_place, show_diff)) != 1:
         raise ParameterError("say where the repaired file goes: -o OUT, --in-place, or --diff "
                              "to preview (one of them)")
+    if as_json and (show_diff or output == "-"):
+        raise ParameterError("--json describes the fixes of -o FILE or --in-place; --diff and "
+                             "-o - print text on stdout")
     codes = parse_codes(select, "`select`")
     if any(not any(f.startswith(c) for f in FIXABLE) for c in codes):
         raise ParameterError(f"`select`: fix repairs {', '.join(FIXABLE)} only")
@@ -963,6 +970,21 @@ def sweep(
         raise ParameterError(f"`kind` must be drive or sim, got {kind!r}", param="kind")
     if not vary:
         raise ParameterError("give at least one --vary NAME=VALUES", param="vary")
+    if plot_file is not None and plot is None:
+        raise ParameterError("--plot-file says where --plot draws: give --plot METRIC too")
+    if kind == "drive":
+        given = {"throttle": throttle != 10.0, "steer": steer != 0.0,
+                 "drivetrain": drivetrain != "differential", "seconds": seconds is not None,
+                 "steps": steps is not None, "time_step": time_step != 1.0 / 240.0,
+                 "max_force": max_force is not None, "urdf": urdf is not None,
+                 "plane": plane is not None, "up": up != "z"}
+        set_names = {item.replace(":=", "=").partition("=")[0].strip() for item in set_ or []}
+        for item in vary:
+            name = item.partition("=")[0].strip()
+            if given.get(name) or name in set_names:
+                how = "--set" if name in set_names else "--" + name.replace("_", "-")
+                raise ParameterError(f"{name} is given both by {how} and by --vary; a varied "
+                                     "value replaces the fixed one in every point: drop one")
     if resume and out is None:
         raise ParameterError("--resume carries on the rows of --out: give --out",
                              param="resume")
@@ -975,6 +997,8 @@ def sweep(
         check_plot_path(picture, force=force)
         if kind == "drive":  # known columns: refuse a typo before the run
             sweeping.check_metric(kind, [], plan.names, plot)
+        else:
+            sweeping.check_sim_metric(plan, plot)
     journal = None
     if out is not None:
         journal = sweeping.Journal(Path(out), plan.names, resume=resume, force=force,
@@ -1004,15 +1028,20 @@ def sweep(
     finally:
         stop()
         written = journal.finish() if journal is not None else None
+    written_plot: Path | None = None
+    failed_plot = False
     if picture is not None and rows:
+        from .errors import UrdfkitError
         from .plot import write_sweep_plot
 
         assert plot is not None
-        sweeping.check_metric(kind, rows, plan.names, plot)
-        written_plot: Path | None = write_sweep_plot(rows, plan.names, plot, picture,
-                                                     force=force)
-    else:
-        written_plot = None
+        try:  # a scenario's joint names are known only now: the rows are kept either way
+            sweeping.check_metric(kind, rows, plan.names, plot)
+        except UrdfkitError as e:
+            show.warn(f"no plot: {input_flags(flag_message(e.message))}")
+            failed_plot = True
+        else:
+            written_plot = write_sweep_plot(rows, plan.names, plot, picture, force=force)
     skipped = total - before
     if as_json:
         show.print_json({"kind": kind, "points": total, "ran": done, "skipped": skipped,
@@ -1027,7 +1056,7 @@ def sweep(
     if interrupted:
         show.interrupted("interrupted; the rows so far are kept")
         raise typer.Exit(130)
-    if failed:
+    if failed or failed_plot:
         raise typer.Exit(1)
 
 

@@ -349,7 +349,7 @@ def tree(root: Any, robot: str) -> None:
 # --------------------------------------------------------------------------- check
 
 
-def check_report(result: Any) -> None:
+def check_report(result: Any, show_all: bool = False) -> None:
     """``urdfkit check``'s text: findings grouped by file, then one summary line.
 
     Piped it is written as plain lines in one go (no rich), so text costs about what
@@ -364,7 +364,7 @@ def check_report(result: Any) -> None:
         for fr in result.files:
             if fr.findings:
                 out.append(_one_line(fr.file))
-                for f, more in _grouped(fr.findings):
+                for f, more in _grouped(fr.findings, show_all):
                     if more:
                         out.append(f"  {'':>5}  {f.level:<7}  {f.code}  {more}")
                     else:
@@ -380,7 +380,7 @@ def check_report(result: Any) -> None:
         if not fr.findings:
             continue
         screen.print(Text(_one_line(fr.file), style="bold"), soft_wrap=True)
-        for f, more in _grouped(fr.findings):
+        for f, more in _grouped(fr.findings, show_all):
             where = f"{f.line:>5}" if f.line is not None and not more else "    -"
             screen.print(Text.assemble(f"  {where}  ", (f"{f.level:<7}", LEVEL_STYLE[f.level]),
                                        "  ", (f.code, "dim"), "  ",
@@ -389,14 +389,15 @@ def check_report(result: Any) -> None:
     screen.print(Text(summary, style=colour), soft_wrap=True)
 
 
-def check_output(result: Any, fmt: str = "text", fail_on: str = "error") -> None:
+def check_output(result: Any, fmt: str = "text", fail_on: str = "error",
+                 show_all: bool = False) -> None:
     """``urdfkit check --format``: text, JSON, or a CI format (:mod:`urdfkit.ci`) on stdout.
 
     The CI formats are written whole and unstyled, terminal or not: they are for files and
     logs. ``fail_on`` decides which files JUnit counts as failed.
     """
     if fmt == "text":
-        check_report(result)
+        check_report(result, show_all)
         return
     if fmt == "json":
         print_json(result.to_dict())
@@ -417,12 +418,14 @@ def check_output(result: Any, fmt: str = "text", fail_on: str = "error") -> None
 GROUP_AFTER = 3
 
 
-def _grouped(findings: Sequence[Any]) -> list[tuple[Any, str]]:
+def _grouped(findings: Sequence[Any], show_all: bool = False) -> list[tuple[Any, str]]:
     """Findings to print: ``(finding, "")`` for each one shown.
 
     A code seen more than GROUP_AFTER times in a file shows its first ones, then
-    ``(next, summary)`` for the rest (--json keeps them all).
+    ``(next, summary)`` for the rest (--json keeps them all); ``show_all`` shows every one.
     """
+    if show_all:
+        return [(f, "") for f in findings]
     count: dict[str, int] = {}
     for f in findings:
         count[f.code] = count.get(f.code, 0) + 1
@@ -435,7 +438,8 @@ def _grouped(findings: Sequence[Any]) -> list[tuple[Any, str]]:
             out.append((f, ""))
         elif n == GROUP_AFTER:
             rest = count[f.code] - GROUP_AFTER
-            out.append((f, f"... and {rest} more {f.code} in this file (--json lists every one)"))
+            out.append((f, f"... and {rest} more {f.code} in this file (--all or --json lists "
+                           "every one)"))
     return out
 
 
@@ -612,8 +616,9 @@ def sweep_report(plan: Any, rows: Sequence[Any], done: int, failed: int, skipped
         wanted = {"drive": ["turning_radius", "expected_radius", "distance", "mean_speed",
                             "final_x", "final_y", "heading_change", "problems"],
                   "sim": []}[plan.kind]
-        metrics = [k for k in wanted if any(k in r for r in rows)] if wanted else \
-            [k for k in rows[0] if k not in names and k not in ("point", "error")]
+        every = list(dict.fromkeys(k for r in rows for k in r
+                                   if k not in names and k not in ("point", "error")))
+        metrics = [k for k in wanted if k in every] if wanted and not show_all else every
         columns: list[Column] = [("point", 0, "right")]
         columns += [(n, 0, "right") for n in names]
         columns += [(m, 1 if k < 4 else 3, "left" if m == "problems" else "right")

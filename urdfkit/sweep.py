@@ -446,7 +446,7 @@ def execute(sweep: Plan, *, jobs: int | None = None, backend: str = "local",
     if jobs is not None and (isinstance(jobs, bool) or jobs < 1):
         raise ParameterError(f"`jobs` must be 1 or more, got {jobs!r}", param="jobs")
     if address is not None and backend != "ray":
-        raise ParameterError("`address` is a Ray cluster's: add backend='ray'",
+        raise ParameterError("`address` is a Ray cluster's: it needs `backend` ray",
                              param="address")
     todo = [(i, kind_payload[0], kind_payload[1])
             for i, (kind_payload, values) in enumerate(zip(sweep.jobs, sweep.assignments,
@@ -537,7 +537,12 @@ def _ray_rows(todo: list[tuple[int, str, Any]], jobs: int | None, address: str |
                     yield {"point": index, "error": f"Ray: {type(e).__name__}: {e}"}
     finally:
         for ref in pending:
-            ray.cancel(ref, force=True)
+            # Not force=True: killing workers mid-task has crashed Ray's task manager
+            # ("Tried to complete task that was not pending") on Ctrl-C.
+            try:
+                ray.cancel(ref)
+            except Exception:  # noqa: BLE001 - cancelling is best effort on the way out
+                pass
         if started:
             ray.shutdown()
 
@@ -715,6 +720,34 @@ def metric_names(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> lis
 DRIVE_METRICS = ("final_x", "final_y", "final_z", "final_yaw", "heading_change", "yaw_rate",
                  "distance", "mean_speed", "turning_radius", "turn_center_x", "turn_center_y",
                  "expected_radius", "sim_time", "steps", "samples", "steer_applied")
+
+
+#: Per-robot columns of a scenario row (the joint ones end in ``.JOINT``).
+SIM_FIELDS = ("end_x", "end_y", "end_z", "distance", "top_speed", "heading_deg")
+SIM_JOINT_FIELDS = ("joint", "joint_min", "joint_max")
+
+
+def check_sim_metric(sweep: Plan, metric: str) -> None:
+    """Refuse, before a scenario sweep runs, a ``--plot`` metric its rows cannot have.
+
+    The robot and the field are checked here; a joint's name only once the rows exist (the
+    joints are the robot file's).
+    """
+    robots = [str(r.get("name")) for r in sweep.jobs[0][1]["document"].get("robots", [])
+              if isinstance(r, Mapping)]
+    if metric in ("steps", "rows"):
+        return
+    robot, _, field_name = metric.partition(".")
+    family = field_name.split(".", 1)[0]
+    if robot in robots and (field_name in SIM_FIELDS or
+                            (family in SIM_JOINT_FIELDS and "." in field_name)):
+        return
+    known = ["steps", "rows", *(f"{r}.{f}" for r in robots for f in SIM_FIELDS),
+             *(f"{r}.{f}.JOINT" for r in robots for f in SIM_JOINT_FIELDS)]
+    from .suggest import hint
+
+    raise ParameterError(f"`plot` {metric!r} is not a column of this sweep"
+                         f"{hint(metric, known)} (columns: {', '.join(known)})", param="plot")
 
 
 def check_metric(kind: str, rows: Sequence[Mapping[str, Any]], names: Sequence[str],
