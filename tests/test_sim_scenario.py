@@ -249,3 +249,13 @@ def test_up_stands_a_y_up_robot_before_its_orientation(tmp_path: Path) -> None:
         row = s.run().rows[0]
     expected = quat_mul(p.getQuaternionFromEuler((0, 0, 0.5)), UP_AXES["y"])
     assert row.base_orientation == pytest.approx(expected, abs=1e-6)
+
+
+def test_errors_name_document_keys_not_pydantic_union_members() -> None:
+    from urdfkit.errors import InputError
+    from urdfkit.scenario import parse_scenario
+
+    doc = {"robots": [{"name": "a", "template": "simplecar", "motor": {"kp": "abc"}}]}
+    with pytest.raises(InputError) as e:
+        parse_scenario(doc)
+    assert e.value.message == "robots[0].motor.kp: expected a number"  # kp is float | dict

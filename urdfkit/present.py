@@ -554,8 +554,12 @@ def collisions_report(result: Any, show_all: bool = False) -> None:
         warn(w)
     rows = []
     for x in result.pairs:
-        depth = f"{-x.distance * 1000:.3g} mm deep" if x.distance < 0 else \
-            f"{x.distance * 1000:.3g} mm apart"
+        if abs(x.distance) < 5e-7:  # 0 or -0 to the display's precision
+            depth = "touching"
+        elif x.distance < 0:
+            depth = f"{-x.distance * 1000:.3g} mm deep"
+        else:
+            depth = f"{x.distance * 1000:.3g} mm apart"
         note_text = f"convex hull of {', '.join(x.hull)}" if x.hull else ""
         rows.append([x.link_a, x.link_b, depth, f"{x.poses_in_contact}/{result.poses}",
                      f"{x.index_a} {x.index_b}", note_text])

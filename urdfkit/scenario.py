@@ -357,10 +357,23 @@ def _known_size(root: Any, loc: Sequence[str | int]) -> int | None:
     return low.pop() if len(low) == 1 and low == high else None
 
 
+#: Parts pydantic adds to an error's location for the member of a union it tried
+#: (``constrained-float``, ``dict[str,constrained-float]``): not keys of the document.
+_TAG_PREFIXES = ("constrained-", "function-", "json-or-python", "is-instance", "lax-or-strict",
+                 "nullable", "tagged-union", "chain")
+_TAG_NAMES = frozenset({"float", "int", "str", "bool", "none"})
+
+
+def key_path(loc: Sequence[str | int]) -> tuple[str | int, ...]:
+    """An error location as the document's keys, without pydantic's union-member tags."""
+    return tuple(p for p in loc if isinstance(p, int) or not (
+        "[" in p or p.startswith(_TAG_PREFIXES) or p in _TAG_NAMES))
+
+
 def _describe(error: Mapping[str, Any], root: Any) -> str:
     """One pydantic error as ``path: what was expected``."""
     kind = error["type"]
-    loc = tuple(error["loc"])
+    loc = key_path(error["loc"])
     ctx = error.get("ctx") or {}
     simple = {
         "float_type": "expected a number", "float_parsing": "expected a number",
@@ -474,8 +487,10 @@ def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
     except ValidationError as e:
         errors = e.errors()
         message = _describe(errors[0], models.Scenario)
-        if len(errors) > 1:
-            message += f" (and {len(errors) - 1} more problem{'s' if len(errors) > 2 else ''})"
+        # Each member of a union a value fails is an error of its own: one place, one problem.
+        more = len({key_path(x["loc"]) for x in errors} - {key_path(errors[0]["loc"])})
+        if more:
+            message += f" (and {more} more problem{'s' if more > 1 else ''})"
         raise InputError(message, file=source) from None
     scenario._source = str(source) if source is not None else None
     if base_dir is not None:
