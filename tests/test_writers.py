@@ -138,3 +138,70 @@ def test_unwritable_folders_are_one_line(tmp_path: Path) -> None:
         ro.chmod(0o555)
         result = runner.invoke(app, ["build", "simplecar", "-o", str(ro / "car.urdf")])
         assert result.exit_code == 2 and "permission denied" in one_line(result.stderr)
+
+
+BROKEN_ARM = Path(__file__).parent / "fixtures" / "robots" / "broken_arm.urdf"
+
+
+def _arm_package(tmp_path: Path) -> Path:
+    """broken_arm.urdf (which fix changes) in a package, its mesh beside it."""
+    pkg = tmp_path / "arm_description"
+    (pkg / "meshes").mkdir(parents=True)
+    (pkg / "urdf").mkdir()
+    (pkg / "package.xml").write_text("<package><name>arm_description</name></package>")
+    shutil.copy(Path(__file__).parent / "fixtures" / "meshes" / "unit_cube.stl",
+                pkg / "meshes" / "unit_cube.stl")
+    path = pkg / "urdf" / "arm.urdf"
+    shutil.copy(BROKEN_ARM, path)
+    return path
+
+
+def test_a_replaced_file_keeps_its_mode_and_its_backup_too(tmp_path: Path) -> None:
+    path = _arm_package(tmp_path)
+    path.chmod(0o600)
+    result = runner.invoke(app, ["fix", str(path), "--in-place"])
+    assert result.exit_code in (0, 1), result.stderr
+    assert path.read_bytes() != BROKEN_ARM.read_bytes()  # it was rewritten
+    assert oct(path.stat().st_mode & 0o7777) == oct(0o600)
+    backup = Path(f"{path}.orig")
+    assert backup.read_bytes() == BROKEN_ARM.read_bytes()
+    assert oct(backup.stat().st_mode & 0o7777) == oct(0o600)
+    out = tmp_path / "out.urdf"
+    out.write_text("old")
+    out.chmod(0o751)
+    result = runner.invoke(app, ["fix", str(path), "-o", str(out), "--force"])
+    assert result.exit_code in (0, 1), result.stderr
+    assert oct(out.stat().st_mode & 0o7777) == oct(0o751)
+    # A new file gets open()'s mode under the umask, not mkstemp's 0600.
+    umask = os.umask(0o022)
+    try:
+        atomic_write(tmp_path / "new.txt", b"x")
+    finally:
+        os.umask(umask)
+    assert oct((tmp_path / "new.txt").stat().st_mode & 0o777) == oct(0o644)
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="changing a file's owner needs root")
+def test_a_replaced_file_keeps_its_owner(tmp_path: Path) -> None:
+    path = _arm_package(tmp_path)
+    os.chown(path, 4321, 4322)
+    path.chmod(0o755)
+    result = runner.invoke(app, ["fix", str(path), "--in-place"])
+    assert result.exit_code in (0, 1), result.stderr
+    st = path.stat()
+    assert (st.st_uid, st.st_gid, st.st_mode & 0o7777) == (4321, 4322, 0o755)
+    st = Path(f"{path}.orig").stat()
+    assert (st.st_uid, st.st_gid, st.st_mode & 0o7777) == (4321, 4322, 0o755)
+
+
+def test_fix_in_place_on_a_symlink_fixes_the_target(tmp_path: Path) -> None:
+    target = _arm_package(tmp_path)
+    link = target.parent / "linked.urdf"
+    link.symlink_to(target.name)
+    result = runner.invoke(app, ["fix", str(link), "--in-place"])
+    assert result.exit_code in (0, 1), result.stderr
+    assert link.is_symlink() and os.readlink(link) == target.name
+    assert target.read_bytes() != BROKEN_ARM.read_bytes()
+    assert Path(f"{link}.orig").read_bytes() == BROKEN_ARM.read_bytes()
+    # No temp file of ours is left beside the link or the target.
+    assert not [p for p in target.parent.iterdir() if p.name.endswith(".tmp")]

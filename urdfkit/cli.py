@@ -685,7 +685,7 @@ def fix(
         sys.stdout.flush()
     elif in_place:
         if result.changed:
-            atomic_write(backup, result.original, force=force)
+            atomic_write(backup, result.original, force=force, like=file)
             atomic_write(file, result.fixed, force=True)
             if not as_json:
                 show.wrote(Path(file), f"original kept as {backup}")

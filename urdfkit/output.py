@@ -8,7 +8,9 @@ Nothing is lost and nothing is clobbered:
   missing folder.
 - :func:`atomic_write` writes a temp file beside the target and renames it into place: a
   crash or SIGKILL leaves the old file or the new one, never a mix. Stale temp files of ours
-  for the same name are removed first.
+  for the same name are removed first. A file it replaces keeps its mode and owner (a 600
+  secret stays 600, a 755 script owned by another user stays theirs), and a symlink to a
+  regular file is written through: the target is replaced, the link stays a link.
 - :class:`StreamingFile` does the same for output produced over a long run (trajectories,
   simulation rows): rows go to disk as they come, and on Ctrl-C/SIGTERM the complete rows so
   far are kept.
@@ -116,24 +118,27 @@ class StreamingFile:
     """
 
     def __init__(self, path: str | Path, *, force: bool = False,
-                 suffixes: Sequence[str] | None = None, keep_on_interrupt: bool = False):
+                 suffixes: Sequence[str] | None = None, keep_on_interrupt: bool = False,
+                 like: str | Path | None = None):
         self.path = check_output(path, force=force, suffixes=suffixes)
         self.force = force
         self.keep_on_interrupt = keep_on_interrupt
+        #: Where the bytes go: the path, or the regular file a symlink at the path points to.
+        self.target = _write_target(self.path)
+        #: Whose mode and owner the new file takes: ``like``, else the file it replaces.
+        self._like = Path(like) if like is not None else self.target
         self._fd: int | None = None
         self._tmp: str | None = None
 
     def __enter__(self) -> StreamingFile:
         import tempfile
 
-        clean_stale(self.path)
-        folder = self.path.parent if str(self.path.parent) else Path(".")
+        clean_stale(self.target)
+        folder = self.target.parent if str(self.target.parent) else Path(".")
         try:
-            self._fd, self._tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp",
+            self._fd, self._tmp = tempfile.mkstemp(prefix=f".{self.target.name}.", suffix=".tmp",
                                                    dir=folder)
-            umask = os.umask(0)
-            os.umask(umask)
-            os.fchmod(self._fd, 0o666 & ~umask)  # mkstemp makes 0600; give open()'s mode
+            _take_mode(self._fd, self._like)
         except OSError as e:
             self._discard()
             raise _oserror(e, self.path) from None
@@ -172,7 +177,7 @@ class StreamingFile:
             if not self.force and os.path.lexists(self.path):
                 raise OutputError("exists; pass `force=True` to overwrite it", file=self.path,
                                   param="force")
-            os.replace(self._tmp, self.path)
+            os.replace(self._tmp, self.target)
             self._tmp = None
         except OSError as e:
             self._discard()
@@ -196,10 +201,56 @@ class StreamingFile:
             self._tmp = None
 
 
+def _write_target(path: Path) -> Path:
+    """The file a write to ``path`` replaces: the path, or the regular file its symlink names.
+
+    Renaming a temp file over a symlink would replace the link with a file, cutting it from
+    what it pointed to (``fix --in-place`` on a linked URDF); writing beside the target and
+    renaming there keeps the link and updates what it names. A dangling link is the path.
+    """
+    if not path.is_symlink():
+        return path
+    try:
+        target = path.resolve(strict=True)
+    except (OSError, RuntimeError):
+        return path
+    return target if target.is_file() else path
+
+
+def _take_mode(fd: int, like: Path) -> None:
+    """Give the new file ``like``'s mode and owner, or open()'s default mode if it is new.
+
+    mkstemp makes 0600. A replaced file keeps its permission bits (setuid/setgid dropped, as
+    every editor does) and, where we may (root, or the same owner), its owner and group.
+    """
+    try:
+        st = os.stat(like)
+    except OSError:
+        st = None
+    if st is None or not stat.S_ISREG(st.st_mode):
+        umask = os.umask(0)
+        os.umask(umask)
+        os.fchmod(fd, 0o666 & ~umask)
+        return
+    if hasattr(os, "fchown"):
+        try:
+            os.fchown(fd, st.st_uid, st.st_gid)
+        except OSError:
+            try:  # not root: keep the group at least, where we belong to it
+                os.fchown(fd, -1, st.st_gid)
+            except OSError:
+                pass
+    os.fchmod(fd, stat.S_IMODE(st.st_mode) & 0o1777)
+
+
 def atomic_write(path: str | Path, data: bytes, *, force: bool = False,
-                 suffixes: Sequence[str] | None = None) -> Path:
-    """Write ``data`` to ``path`` atomically (temp file, fsync, rename); see the module doc."""
-    out = StreamingFile(path, force=force, suffixes=suffixes)
+                 suffixes: Sequence[str] | None = None, like: str | Path | None = None) -> Path:
+    """Write ``data`` to ``path`` atomically (temp file, fsync, rename); see the module doc.
+
+    ``like`` names a file whose mode and owner the new file takes (a backup takes its
+    original's); by default a replaced file keeps its own, and a new one gets open()'s mode.
+    """
+    out = StreamingFile(path, force=force, suffixes=suffixes, like=like)
     with out:
         out.write(data)
     return out.path
