@@ -54,7 +54,7 @@ from .spec import (
     sym_eigenvalues,
     transpose,
 )
-from .xmlio import fmt_float, fmt_vec, load_xml, parse_xml, to_bytes
+from .xmlio import fmt_float, fmt_vec, line_of, load_xml, parse_xml, to_bytes
 
 __all__ = ["JOINT_TYPES", "LIMITED_JOINT_TYPES", "rpy_to_matrix"]  # re-exported from spec
 
@@ -854,7 +854,7 @@ class _Ctx:
         self.strict = strict
 
     def error(self, el: etree._Element, msg: str) -> ModelError:
-        return ModelError(msg, file=self.file, line=el.sourceline)
+        return ModelError(msg, file=self.file, line=line_of(el))
 
     def attr(self, el: etree._Element, name: str, required: bool = True) -> str | None:
         value = el.get(name)

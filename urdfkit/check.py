@@ -173,7 +173,7 @@ def check_file(display: str, path: str | Path,
     from lxml import etree
 
     from .expand import XacroNotExpanded
-    from .xmlio import long_line, parse_xml, tolerate_quirks
+    from .xmlio import line_of, long_line, parse_xml, tolerate_quirks
 
     path = Path(path)
     result = FileResult(display)
@@ -215,7 +215,7 @@ def check_file(display: str, path: str | Path,
     result.findings.extend(found)
     if physics and not any(f.level == "error" for f in result.findings):
         lines = {} if path.suffix == ".xacro" else \
-            {el.get("name"): el.sourceline for el in tree.getroot().iterchildren("link")}
+            {el.get("name"): line_of(el) for el in tree.getroot().iterchildren("link")}
         result.findings.extend(physics_findings(display, path, lines, packages, xacro_args))
     result.findings.sort(key=lambda f: f.line or 0)
     return result

@@ -42,7 +42,7 @@ from .spec import attr_float as _num
 from .spec import attr_vec as _vec
 from .spec import rpy_to_matrix, sym_eigenvalues, transpose
 from .validate import ALL_RULES, STUB_SIZE, Report, Solid, link_solid, refuse_oversized
-from .xmlio import fmt_float, fmt_vec, parse_xml, read_bytes
+from .xmlio import fmt_float, fmt_vec, parse_xml, read_bytes, start_tags
 
 #: Density (kg/m^3) that gives a link with no ``<inertial>`` its mass: water.
 DEFAULT_DENSITY = 1000.0
@@ -209,6 +209,11 @@ def balanced(tensor: Sequence[Sequence[float]]) -> float | None:
     return (a + b + c) / 3
 
 
+#: What may follow an element's start tag up to its end tag: end tags, start tags (``<``
+#: then a name), and comments, CDATA and processing instructions, whose ``<`` start nothing.
+_TOKEN = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|</[^>]*>|<(?=[^!?/])", re.DOTALL)
+
+
 class _Plan:
     """The edits to one file: spliced into its text and made on its tree, side by side."""
 
@@ -227,6 +232,12 @@ class _Plan:
         starts = [0]
         starts += [m.end() for m in re.finditer("\n", text)]
         self.line_starts = starts
+        # Every element's start tag by its path: exact past line 65,535 (where lxml's
+        # sourceline stops), for prefixed tags, and with tags quoted in comments.
+        tree = root.getroottree()
+        elements = (el for el in root.iter() if isinstance(el.tag, str))
+        self.tag_at = {tree.getpath(el): pos
+                       for el, pos in zip(elements, start_tags(text), strict=False)}
 
     # ---- repairs
 
@@ -477,21 +488,13 @@ class _Plan:
 
     def _start_tag(self, el: etree._Element) -> tuple[int, int, bool]:
         """(start, end, self-closing) of the element's start tag in the text."""
-        line = el.sourceline or 1
-        same = [x for x in self.root.iter(el.tag) if x.sourceline == line]
-        nth = same.index(el) if el in same else 0
-        pattern = re.compile(rf"<{re.escape(str(el.tag))}(?=[\s/>])")
-        pos = self.line_starts[line - 1]
-        found: re.Match[str] | None = None
-        for _ in range(nth + 1):
-            found = pattern.search(self.text, pos)
-            if found is None:  # pragma: no cover - lxml said it starts on this line
-                raise AssertionError(f"<{el.tag}> not found from line {line}")
-            pos = found.end()
-        assert found is not None
-        m = found
-        start = m.start()
-        i, quote = m.end(), ""
+        start = self.tag_at[self.root.getroottree().getpath(el)]
+        end, closed = self._tag_end(start)
+        return start, end, closed
+
+    def _tag_end(self, start: int) -> tuple[int, bool]:
+        """The end of the start tag at ``start`` (past its ``>``, quotes minded), self-closing."""
+        i, quote = start + 1, ""
         while True:
             ch = self.text[i]
             if quote:
@@ -499,18 +502,16 @@ class _Plan:
             elif ch in "\"'":
                 quote = ch
             elif ch == ">":
-                return start, i + 1, self.text[i - 1] == "/"
+                return i + 1, self.text[i - 1] == "/"
             i += 1
 
     def _span(self, el: etree._Element) -> tuple[int, int]:
         start, tag_end, closed = self._start_tag(el)
         if closed:
             return start, tag_end
-        tag = re.escape(str(el.tag))
-        token = re.compile(rf"<{tag}(?=[\s/>])|</{tag}\s*>")
         depth, pos = 1, tag_end
         while True:
-            m = token.search(self.text, pos)
+            m = _TOKEN.search(self.text, pos)
             if m is None:  # pragma: no cover - the document is well formed
                 raise AssertionError(f"no end of <{el.tag}>")
             if m.group().startswith("</"):
@@ -518,10 +519,11 @@ class _Plan:
                 if depth == 0:
                     return start, m.end()
                 pos = m.end()
-            else:
-                close = self.text.index(">", m.end())
-                depth += self.text[close - 1] != "/"
-                pos = close + 1
+            elif m.group() == "<":
+                pos, closed = self._tag_end(m.start())
+                depth += not closed
+            else:  # a comment, CDATA or processing instruction: no tags in it
+                pos = m.end()
 
     def _indent(self, pos: int) -> str:
         line_start = self.text.rfind("\n", 0, pos) + 1

@@ -27,7 +27,7 @@ from .spec import FILE_SHAPES, FILE_TAGS, PYBULLET_LINE_BYTES
 from .uris import PackageIndex, not_a_file, pybullet_data_path
 from .validate import STRICTER, Finding, reference, refuse_oversized
 from .validate import guard as run_guard
-from .xmlio import long_line, parse_xml, read_bytes, to_bytes
+from .xmlio import line_of, long_line, parse_xml, read_bytes, to_bytes
 
 
 def locate(name: str | Path) -> Path:
@@ -147,7 +147,7 @@ def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
         ref = reference(el.tag, fn.strip(), base, packages)
         if ref.level == "error" and ref.code is not None and (
                 el.tag in FILE_SHAPES or ref.code in ("U702", "U704")):
-            raise InputError(ref.message, file=name, line=el.sourceline)
+            raise InputError(ref.message, file=name, line=line_of(el))
         if ref.load_path is not None:
             changed |= ref.code == "U703" or fn.startswith(("package://", "file://"))
             el.set("filename", str(ref.load_path.resolve()))
@@ -210,7 +210,7 @@ def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
             if not _utf8(el.get("filename") or ""):
                 tmp.cleanup()
                 raise InputError("PyBullet cannot open a mesh whose path is not valid UTF-8: "
-                                 f"{el.get('filename')!r}", file=display, line=el.sourceline)
+                                 f"{el.get('filename')!r}", file=display, line=line_of(el))
         body = to_bytes(root)
         if long_line(body) is not None:  # a long comment is harmless, but costs nothing to drop
             for comment in list(root.iter(etree.Comment)):

@@ -15,7 +15,7 @@ from typing import Any
 from lxml import etree
 
 from .spec import AXIS_JOINT_TYPES, LIMITED_JOINT_TYPES, attr_float, attr_vec, depth_first
-from .xmlio import children
+from .xmlio import children, line_of
 
 Vec3 = tuple[float, float, float]
 
@@ -134,4 +134,4 @@ def _tree_joint(j: etree._Element, index: int) -> TreeJoint:
     return TreeJoint(j.get("name", ""), jtype, index,
                      attr_vec(origin, "xyz", 3, (0, 0, 0)),  # type: ignore[arg-type]
                      attr_vec(origin, "rpy", 3, (0, 0, 0)),  # type: ignore[arg-type]
-                     axis, limit, j.sourceline)  # type: ignore[arg-type]
+                     axis, limit, line_of(j))  # type: ignore[arg-type]

@@ -51,7 +51,7 @@ from .spec import (
 from .spec import attr_float as _num
 from .spec import attr_vec as _vec
 from .uris import not_a_file, pybullet_data_path, resolve_uri
-from .xmlio import children
+from .xmlio import children, line_of
 
 LEVELS = ("info", "warning", "error")
 
@@ -124,7 +124,7 @@ class Report:
             line: int | None = None) -> None:
         """Record a finding; its line comes from ``el`` unless given."""
         if line is None and el is not None:
-            line = el.sourceline
+            line = line_of(el)
         origin = self.origins.get(el) if self.origins is not None and el is not None else None
         self.findings.append(Finding(code, level, message, self.file, line, origin))
         self.elements.append(el)
@@ -245,7 +245,7 @@ def rule_names(root: etree._Element, r: Report) -> None:
                 continue
             if name in seen:
                 r.add(code, "error", f"duplicate {tag} name {name!r} (first on line "
-                      f"{seen[name].sourceline}); names must be unique", el)
+                      f"{line_of(seen[name])}); names must be unique", el)
             else:
                 seen[name] = el
     seen_mat: dict[str, etree._Element] = {}
@@ -255,7 +255,7 @@ def rule_names(root: etree._Element, r: Report) -> None:
             continue
         if name in seen_mat:
             r.add("U105", "error", f"duplicate material name {name!r} (first on line "
-                  f"{seen_mat[name].sourceline})", el)
+                  f"{line_of(seen_mat[name])})", el)
         seen_mat[name] = el
     for el in root.iter("material"):
         if el.getparent() is not root and el.get("name") and "%" in el.get("name", ""):
@@ -295,7 +295,7 @@ def rule_tree(root: etree._Element, r: Report) -> None:
         if child in parent_of:
             first, first_el = parent_of[child]
             r.add("U204", "error", f"link {child!r} has two parents: joint {first!r} (line "
-                  f"{first_el.sourceline}) and {jname!r}; a link may be the child of one "
+                  f"{line_of(first_el)}) and {jname!r}; a link may be the child of one "
                   "joint only", j)
             continue
         parent_of[child] = (jname, j)

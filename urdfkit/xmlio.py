@@ -22,7 +22,13 @@ from .spec import PYBULLET_LINE_BYTES
 MAX_FILE_BYTES = 32 * 1024 * 1024
 
 
-def _parser() -> etree.XMLParser:
+#: libxml2 keeps an element's line in 16 bits; past this it finds the true line from the
+#: whitespace text after the tag, which ``remove_blank_text`` drops (every later element
+#: then reads 65,535).
+BIG_LINES = 65535
+
+
+def _parser(lines: int = 0) -> etree.XMLParser:
     return etree.XMLParser(
         resolve_entities=False,
         no_network=True,
@@ -30,7 +36,9 @@ def _parser() -> etree.XMLParser:
         load_dtd=False,
         dtd_validation=False,
         remove_comments=False,
-        remove_blank_text=True,
+        # Blank text is dropped for speed, except in a file long enough that findings past
+        # line 65,535 need it to carry their line (nothing reads URDF element text).
+        remove_blank_text=lines < BIG_LINES,
     )
 
 
@@ -158,7 +166,8 @@ def parse_xml(data: bytes, file: str | Path) -> etree._ElementTree:
         raise InputError("file is empty", file=file)
     data, _ = tolerate_quirks(data)
     try:
-        root = etree.fromstring(data, _parser())
+        lines = data.count(b"\n")
+        root = etree.fromstring(data, _parser(lines))
     except etree.XMLSyntaxError as e:
         line = e.lineno if e.lineno else None
         msg = str(e.msg if hasattr(e, "msg") and e.msg else e)
@@ -168,7 +177,61 @@ def parse_xml(data: bytes, file: str | Path) -> etree._ElementTree:
     except ValueError as e:  # e.g. unicode strings with encoding declarations
         raise InputError(f"not well-formed XML: {e}", file=file) from None
     _refuse_entities(root, file)
+    if lines >= BIG_LINES:
+        _remember_lines(root, data)
     return root.getroottree()
+
+
+#: Start tags, and what may hide a ``<`` that starts none (comments, CDATA, PIs, a DOCTYPE
+#: with its internal subset). ``<`` cannot stand in attribute values or text in XML.
+_TAGS = (r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<!DOCTYPE(?:[^>\[]|\[.*?\])*>"
+         r"|<(?=[^/!?])")
+_TAGS_BYTES = re.compile(_TAGS.encode(), re.DOTALL)
+_TAGS_TEXT = re.compile(_TAGS, re.DOTALL)
+
+#: The true lines of the elements of the last few long documents, by document key and
+#: element path: lxml reads 65,535 for every element past that line.
+_BIG: dict[str, dict[str, int]] = {}
+_BIG_KEEP = 8
+
+
+def start_tags(data: bytes | str) -> list[int]:
+    """Offsets of the element start tags in ``data`` (bytes or text), in document order.
+
+    The n-th offset is the n-th element of ``root.iter()`` (elements only): a position for
+    every element that relies neither on lxml's line numbers nor on finding its tag name
+    (a prefixed ``<xacro:arg>``, a ``<link`` inside a comment).
+    """
+    found = _TAGS_TEXT.finditer(data) if isinstance(data, str) else _TAGS_BYTES.finditer(data)
+    return [m.start() for m in found if m.end() - m.start() == 1]
+
+
+def _remember_lines(root: etree._Element, data: bytes) -> None:
+    import bisect
+
+    newlines = [m.start() for m in re.finditer(rb"\n", data)]
+    elements = (el for el in root.iter() if isinstance(el.tag, str))
+    tree = root.getroottree()
+    lines = {tree.getpath(el): bisect.bisect_left(newlines, pos) + 1
+             for el, pos in zip(elements, start_tags(data), strict=False)}
+    key = f"urdfkit-big-lines:{next(_KEYS)}"
+    tree.docinfo.URL = key  # survives with the document, unlike Python attributes on proxies
+    _BIG[key] = lines
+    while len(_BIG) > _BIG_KEEP:
+        del _BIG[next(iter(_BIG))]
+
+
+_KEYS = iter(range(1, 1 << 62))
+
+
+def line_of(el: etree._Element) -> int | None:
+    """The line an element starts on, past 65,535 too (where lxml's ``sourceline`` stops)."""
+    line = el.sourceline
+    if line is None or line < BIG_LINES:
+        return line
+    tree = el.getroottree()
+    found = _BIG.get(tree.docinfo.URL or "")
+    return found.get(tree.getpath(el), line) if found is not None else line
 
 
 def _refuse_entities(root: etree._Element, file: str | Path) -> None:
@@ -180,7 +243,7 @@ def _refuse_entities(root: etree._Element, file: str | Path) -> None:
                          file=file, line=1)
     for node in root.iter(etree.Entity):
         raise InputError("uses an XML entity reference; urdfkit refuses them",
-                         file=file, line=node.sourceline)
+                         file=file, line=line_of(node))
 
 
 def load_xml(path: str | Path) -> etree._ElementTree:
