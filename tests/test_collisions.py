@@ -285,3 +285,84 @@ def test_check_physics_turns_a_pybullet_refusal_into_u951(gripper: Path,
              if f.code.startswith("U95")]
     assert [(f.code, f.level) for f in found] == [("U951", "error")]
     assert "Could not parse visual element" in found[0].message
+
+
+# ---- values that cannot be simulated (issue: overflow and NaN reach the engine)
+
+
+def _arm_and_block(tmp_path: Path, name: str, limit: str, box: str = "0.3 0.02 0.02",
+                   arm_xyz: str = "0.15 0 0") -> Path:
+    """A 0.3 m arm swinging about z over a block 0.2 m out along y: it meets the block
+    within one turn, so a sampled turn finds the contact."""
+    return _write(tmp_path, name, "\n".join([
+        _box_link("base", "0.02 0.02 0.02"),
+        _box_link("arm", box, arm_xyz),
+        _box_link("block", "0.05 0.05 0.05"),
+        _joint("swing", "revolute", "base", "arm", "0 0 0",
+               f'<axis xyz="0 0 1"/><limit {limit} effort="1" velocity="1"/>'),
+        _joint("fix", "fixed", "base", "block", "0 0.2 0"),
+    ]))
+
+
+@pytest.mark.parametrize("limit", ['lower="-1e308" upper="1e308"', 'lower="-inf" upper="inf"'])
+def test_limits_past_any_range_sample_one_turn(tmp_path: Path, limit: str) -> None:
+    wide = self_collisions(resolve(str(_arm_and_block(tmp_path, "wide.urdf", limit))),
+                           samples=200, seed=3)
+    turn = self_collisions(resolve(str(_arm_and_block(
+        tmp_path, "turn.urdf", f'lower="{-math.pi!r}" upper="{math.pi!r}"'))), samples=200, seed=3)
+    assert [(x.link_a, x.link_b, x.poses_in_contact) for x in wide.pairs] == \
+        [(x.link_a, x.link_b, x.poses_in_contact) for x in turn.pairs]
+    assert [x.link_b for x in turn.pairs] == ["block"]  # the arm does meet the block
+    assert any("one turn" in w for w in wide.warnings)
+
+
+@pytest.mark.parametrize(("field", "bad"), [("arm_xyz", "nan 0 0"), ("box", "0.3 nan 0.02"),
+                                            ("arm_xyz", "0.15 inf 0")])
+def test_non_finite_shapes_are_refused_not_reported_clean(tmp_path: Path, field: str,
+                                                          bad: str) -> None:
+    path = _arm_and_block(tmp_path, "bad.urdf", 'lower="1.3" upper="1.7"', **{field: bad})
+    result = CliRunner().invoke(app, ["collisions", str(path)])
+    assert result.exit_code == 2, result.output
+    line = result.stderr.strip()
+    assert "\n" not in line and "Traceback" not in line and "not a finite number" in line
+    written = next(n for n, x in enumerate(path.read_text().splitlines(), 1) if bad in x)
+    assert f"bad.urdf:{written}:" in line
+    # The finite twin at the same pose does collide: a clean report would have been wrong.
+    good = _arm_and_block(tmp_path, "good.urdf", 'lower="1.3" upper="1.7"')
+    assert self_collisions(resolve(str(good)), joints={"swing": 1.5}).pairs
+
+
+def test_a_mimic_chain_follows_through(tmp_path: Path) -> None:
+    """c follows b, which follows a: pinning a moves c into the block beside it."""
+    slide = '<axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="10" velocity="1"/>'
+    path = _write(tmp_path, "chain.urdf", "\n".join([
+        _box_link("palm", "0.02 0.02 0.02"),
+        _box_link("a", "0.01 0.01 0.01"), _box_link("b", "0.01 0.01 0.01"),
+        _box_link("c", "0.01 0.01 0.01"), _box_link("block", "0.02 0.02 0.02"),
+        _joint("ja", "prismatic", "palm", "a", "0.1 0 0", slide),
+        _joint("jb", "prismatic", "palm", "b", "0.2 0 0", slide + '<mimic joint="ja"/>'),
+        _joint("jc", "prismatic", "palm", "c", "0.3 0 0", slide + '<mimic joint="jb"/>'),
+        _joint("fix", "fixed", "palm", "block", "0.3 0.045 0"),
+    ]))
+    # With a at 0.04, c sits at y = 0.04: its face at 0.045 is 10 mm past the block's near
+    # face (0.045 - 0.01 = 0.035).
+    found = self_collisions(resolve(str(path)), joints={"ja": 0.04})
+    assert [(x.link_a, x.link_b) for x in found.pairs] == [("c", "block")]
+    assert found.pairs[0].distance == pytest.approx(-0.010, abs=1e-4)
+    assert not self_collisions(resolve(str(path)), joints={"ja": 0.0}).pairs
+
+
+@pytest.mark.parametrize("ring", [("ja",), ("ja", "jb")])
+def test_a_mimic_ring_is_refused(tmp_path: Path, ring: tuple[str, ...]) -> None:
+    slide = '<axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="10" velocity="1"/>'
+    follows = {name: ring[(k + 1) % len(ring)] for k, name in enumerate(ring)}
+    joints = [_joint(n, "prismatic", "palm", n[1], f"0.{k + 1} 0 0",
+                     slide + (f'<mimic joint="{follows[n]}"/>' if n in follows else ""))
+              for k, n in enumerate(("ja", "jb"))]
+    path = _write(tmp_path, "ring.urdf", "\n".join(
+        [_box_link("palm", "0.02 0.02 0.02"), _box_link("a", "0.01 0.01 0.01"),
+         _box_link("b", "0.01 0.01 0.01"), *joints]))
+    result = CliRunner().invoke(app, ["collisions", str(path), "--samples", "5"])
+    assert result.exit_code == 2, result.output
+    assert "ring (" + " -> ".join([*ring, ring[0]]) + ")" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1

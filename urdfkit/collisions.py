@@ -32,11 +32,11 @@ from typing import Any
 
 from lxml import etree
 
-from .errors import ParameterError
+from .errors import InputError, ParameterError
 from .inspect import JointInfo, base_link_name, joint_table, pose_joints
 from .resolve import Resolved
 from .session import LoadOptions, Session
-from .xmlio import children
+from .xmlio import children, line_of
 
 #: Most random poses one run may draw (each costs one distance query per link pair).
 MAX_SAMPLES = 100_000
@@ -179,6 +179,8 @@ def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = 
     import numpy as np
 
     pinned = dict(joints or {})
+    _refuse_non_finite(resolved)
+    _refuse_mimic_cycles(resolved)
     with Session() as s:
         p, c = s.p, s.client
         # Without URDF_USE_SELF_COLLISION, getClosestPoints(body, body, 0, a, b) finds nothing
@@ -226,6 +228,58 @@ def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = 
                       pinned, pairs, len(tested), adjacent, without, warnings)
 
 
+#: The numbers that place and shape what collides: (element path under <robot>, attributes).
+_PLACING = (("joint/origin", ("xyz", "rpy")), ("joint/axis", ("xyz",)),
+            ("joint/mimic", ("multiplier", "offset")),
+            ("link/collision/origin", ("xyz", "rpy")),
+            ("link/collision/geometry/box", ("size",)),
+            ("link/collision/geometry/sphere", ("radius",)),
+            ("link/collision/geometry/cylinder", ("radius", "length")),
+            ("link/collision/geometry/capsule", ("radius", "length")),
+            ("link/collision/geometry/mesh", ("scale",)))
+
+
+def _refuse_non_finite(resolved: Resolved) -> None:
+    """Refuse NaN or infinite positions, sizes and mimic factors before anything runs.
+
+    PyBullet takes them and answers nonsense: a NaN box collides with nothing, so the report
+    would say "0 pairs in contact" of a robot whose finite twin collides.
+    """
+    for path, attrs in _PLACING:
+        for el in resolved.root.iterfind(path):
+            for attr in attrs:
+                text = el.get(attr)
+                if text is None:
+                    continue
+                try:
+                    values = [float(x) for x in text.split()]
+                except ValueError:
+                    values = [math.nan]  # not numbers at all: as unusable
+                if all(map(math.isfinite, values)):
+                    continue
+                shown = text if len(text) <= 60 else f"{text[:60]}... ({len(text)} characters)"
+                raise InputError(f"<{el.tag} {attr}={shown!r}> is not a finite number; "
+                                 "collisions cannot place or size a shape with it",
+                                 file=resolved.name, line=line_of(el))
+
+
+def _refuse_mimic_cycles(resolved: Resolved) -> None:
+    """A mimic joint that follows itself, or a ring of them, has no position to take."""
+    els = {j.get("name"): j for j in children(resolved.root, "joint")}
+    leader = {name: m.get("joint") for name, j in els.items()
+              if (m := j.find("mimic")) is not None}
+    for start in leader:
+        seen, name = [start], leader[start]
+        while name in leader and name not in seen:
+            seen.append(name)
+            name = leader[name]
+        if name == start:
+            ring = " -> ".join(str(x) for x in [*seen, start])
+            raise InputError(f"mimic joints follow each other in a ring ({ring}): none has a "
+                             "position to follow", file=resolved.name,
+                             line=line_of(els[start]))
+
+
 class _Sampler:
     """Draws joint positions within limits; pinned joints stay, mimic joints follow."""
 
@@ -246,30 +300,50 @@ class _Sampler:
                                                float(m.get("offset") or 0.0))
                 except ValueError:
                     continue
-        for j in table:
+        for j in self._leaders_first(table, leaders):
             if j.joint_name in pinned or not j.movable:
                 continue
             if j.joint_name in leaders:
                 self.mimic.append((j.joint_index, *leaders[j.joint_name]))
             elif j.joint_type == "SPHERICAL":
                 self.spherical.append(j.joint_index)
-            elif j.limited:
+            elif j.limited and math.isfinite(j.joint_upper_limit - j.joint_lower_limit):
                 self.free.append((j.joint_index, j.joint_lower_limit, j.joint_upper_limit))
             elif j.joint_type == "REVOLUTE":
+                if j.limited:  # limits of 1e308 or inf: no range to draw from but a turn
+                    warnings.append(f"joint {j.joint_name}: limits {j.joint_lower_limit:g}.."
+                                    f"{j.joint_upper_limit:g} span more than any number can "
+                                    "hold; sampled over one turn (-pi..pi)")
                 self.free.append((j.joint_index, -math.pi, math.pi))
             else:
                 warnings.append(f"joint {j.joint_name}: a {j.urdf_type or j.joint_type.lower()} "
-                                "joint without limits has no range to sample; held at 0")
+                                "joint without finite limits has no range to sample; held at 0")
+
+    @staticmethod
+    def _leaders_first(table: Sequence[JointInfo],
+                       leaders: Mapping[Any, tuple[int, float, float]]) -> list[JointInfo]:
+        """The joints with every mimic after the joint it follows (chains: A <- B <- C)."""
+        by_index = {j.joint_index: j for j in table}
+        depth: dict[str, int] = {}
+        for j in table:
+            n, name = 0, j.joint_name
+            while name in leaders and n <= len(table):
+                name, n = by_index[leaders[name][0]].joint_name, n + 1
+            depth[j.joint_name] = n
+        return sorted(table, key=lambda j: depth[j.joint_name])
 
     def start(self) -> dict[int, float]:
         """Every leader's position at the start pose: pinned, else 0."""
-        return {leader: self.pinned.get(leader, 0.0) for _, leader, _, _ in self.mimic}
+        followers = {i for i, _, _, _ in self.mimic}
+        return {leader: self.pinned.get(leader, 0.0) for _, leader, _, _ in self.mimic
+                if leader not in followers}
 
     def follow(self, p: Any, c: int, body: int, values: dict[int, float]) -> None:
         """Set each mimic joint from its leader's position in ``values``."""
-        for i, leader, mult, offset in self.mimic:
+        for i, leader, mult, offset in self.mimic:  # leaders first: a chain follows through
             if leader in values:
-                p.resetJointState(body, i, mult * values[leader] + offset, physicsClientId=c)
+                values[i] = mult * values[leader] + offset
+                p.resetJointState(body, i, values[i], physicsClientId=c)
 
     def pose(self, p: Any, c: int, body: int, rng: Any) -> None:
         values: dict[int, float] = dict(self.pinned)
