@@ -782,3 +782,20 @@ def test_two_spellings_of_one_rotation_or_axis_are_not_differences(tmp_path: Pat
     assert [c.field for c in flipped.changes] == ["axis"]
     turned = diff_files(base, robot("0 0 1.5707963267948966", "0 0 1"))
     assert [c.field for c in turned.changes] == ["origin.rpy"]
+
+
+def test_masses_whose_sum_overflows(tmp_path: Path) -> None:
+    """Two links of 1e308 kg: each is a float, their sum is not; the total reads inf."""
+    huge = ('<robot name="r">' + link("base", 1e308) + link("l1", 1e308)
+            + joint("j", "base", "l1") + "</robot>")
+    a = write(tmp_path, "a.urdf", huge)
+    code, out, err = run(a, a)
+    assert (code, err) == (0, "") and "same robot" in out
+    b = write(tmp_path, "b.urdf", huge.replace('value="1e+308"', 'value="2"'))
+    assert 'value="2"' in b.read_text()
+    code, out, err = run(a, b, "--json")
+    assert code == 1 and "Traceback" not in err
+    doc = json.loads(out)
+    assert doc["totals"]["mass"]["old"] is None  # inf has no JSON number: null, and said so
+    assert doc["totals"]["mass"]["new"] == pytest.approx(4.0)
+    assert "non-finite" in err and len(err.strip().splitlines()) == 1

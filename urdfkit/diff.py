@@ -355,8 +355,12 @@ def _dof(robot: Robot) -> int:
 
 def _total_mass(robot: Robot) -> float:
     """The files' masses summed; one that is not a number (kept as written) counts 0."""
-    return math.fsum(x.inertial.mass for x in robot.links if x.inertial is not None
-                     and isinstance(x.inertial.mass, float | int))
+    masses = [x.inertial.mass for x in robot.links if x.inertial is not None
+              and isinstance(x.inertial.mass, float | int)]
+    try:
+        return math.fsum(masses)
+    except OverflowError:  # finite masses whose sum is not (two of 1e308): inf, as plain sum
+        return sum(masses)
 
 
 # --------------------------------------------------------------------------- matching
