@@ -22,12 +22,18 @@ def cache_dir() -> Path | None:
     return Path(base) / "urdfkit"
 
 
+#: No entry of ours is near this; a larger file in the cache folder is not ours.
+MAX_ENTRY_BYTES = 64 * 1024 * 1024
+
+
 def read_entry(path: Path) -> bytes | None:
     """An entry's bytes, or None when it is absent or unreadable."""
-    try:
-        with open(path, "rb") as f:
-            return f.read()
-    except OSError:
+    from .errors import InputError
+    from .xmlio import read_regular
+
+    try:  # a FIFO planted in the cache folder must not hang a run
+        return read_regular(path, limit=MAX_ENTRY_BYTES, kind="cache entry")
+    except InputError:
         return None
 
 

@@ -1004,6 +1004,8 @@ def sweep(
         journal = sweeping.Journal(Path(out), plan.names, resume=resume, force=force,
                                    assignments=plan.assignments)
         journal.open()
+        for note in journal.notes:
+            show.warn(note)
     keep = out is None or plot is not None or as_json
     rows: list[dict[str, Any]] = list(journal.done) if journal is not None and keep else []
     skip = journal.finished if journal is not None and resume else None

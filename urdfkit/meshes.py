@@ -183,13 +183,12 @@ def read_integrals(path: Path, suffix: str | None = None) -> Integrals | None:
     """Read a mesh and integrate it (no cache); None if unreadable, unsupported or empty."""
     import numpy as np
 
+    from .xmlio import read_regular
+
     suffix = (suffix or path.suffix).lower()
-    try:
-        with open(path, "rb") as f:
-            data = f.read(MAX_MESH_BYTES + 1)
-    except OSError:
-        return None
-    if len(data) > MAX_MESH_BYTES:
+    try:  # a FIFO or device named like a mesh must not hang or fill memory
+        data = read_regular(path, limit=MAX_MESH_BYTES, kind="mesh")
+    except InputError:
         return None
     starts: list[int] = []
     try:

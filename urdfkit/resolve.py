@@ -14,6 +14,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +31,11 @@ from .validate import guard as run_guard
 from .xmlio import line_of, long_line, parse_xml, read_bytes, to_bytes
 
 
+def _clip(text: str, most: int = 120) -> str:
+    """``text`` quoted, or its start and its length when longer than ``most``."""
+    return repr(text) if len(text) <= most else f"{text[:most]!r}... ({len(text)} characters)"
+
+
 def locate(name: str | Path) -> Path:
     """Find a file as given, else in pybullet_data; refuse folders."""
     path = Path(name).expanduser()
@@ -38,12 +44,15 @@ def locate(name: str | Path) -> Path:
         return path
     if why != "missing":
         raise InputError(f"is {why}, not a URDF file", file=name)
+    if path.is_symlink():  # the name is there: no "did you mean" the same name
+        raise InputError("no such file: it is a symlink to nothing (its target "
+                         f"{_clip(os.readlink(path))} does not exist)", file=name)
     data = None if path.is_absolute() else pybullet_data_path()
     if data is not None and (data / path).is_file():
         return data / path
     from .suggest import files
 
-    close = files(str(name), data)
+    close = [c for c in files(str(name), data) if c != str(name)]
     more = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
     raise InputError(f"no such file (looked in the current folder and in pybullet_data){more}",
                      file=name)

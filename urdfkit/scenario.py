@@ -440,10 +440,13 @@ def read_document(path: str | Path) -> dict[str, Any]:
     suffix = file.suffix.lower()
     if suffix not in (".json", ".toml"):
         raise InputError("a scenario is a .json or .toml file", file=path)
+    from .xmlio import read_regular
+
+    raw = read_regular(file, kind="scenario file")  # never a FIFO, a device, or too much
     try:
-        text = file.read_text("utf-8")
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(f"cannot read: {e}", file=path) from None
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise InputError(f"not UTF-8 text (byte {e.start})", file=path) from None
     if suffix == ".toml":
         if sys.version_info >= (3, 11):
             import tomllib

@@ -43,11 +43,22 @@ def _parser(lines: int = 0) -> etree.XMLParser:
 
 
 def read_bytes(path: str | Path) -> bytes:
-    """Read a regular file for parsing: never a FIFO, device, socket or folder; never too much.
+    """Read a URDF (or xacro, or mesh) file for parsing; see :func:`read_regular`."""
+    return read_regular(path)
 
-    The file is opened non-blocking (a FIFO would otherwise wait forever for a writer), then
-    ``fstat`` on the open descriptor decides: only a regular file is read. The size cap counts
-    bytes as they are read, never trusting ``st_size`` (0 for /dev/zero behind a symlink).
+
+def read_regular(path: str | Path, *, limit: int = MAX_FILE_BYTES,
+                 kind: str = "URDF file") -> bytes:
+    """Read a regular file: never a FIFO, device, socket or folder; never more than ``limit``.
+
+    Every file urdfkit reads comes through here (URDF, xacro output, scenarios and configs,
+    sweep rows, meshes, cache entries). The file is opened non-blocking (a FIFO would
+    otherwise wait forever for a writer), then ``fstat`` on the open descriptor decides: only
+    a regular file is read. The size cap counts bytes as they are read, never trusting
+    ``st_size`` (0 for /dev/zero behind a symlink). ``kind`` names what was expected.
+
+    Raises:
+        InputError: one line naming the file.
     """
     import errno
     import stat
@@ -57,23 +68,25 @@ def read_bytes(path: str | Path) -> bytes:
     try:
         fd = os.open(path, flags)
     except FileNotFoundError:
-        raise InputError("no such file", file=path) from None
+        dangling = os.path.islink(path)
+        raise InputError("no such file: it is a symlink to nothing" if dangling
+                         else "no such file", file=path) from None
     except IsADirectoryError:
-        raise InputError("is a directory, not a URDF file", file=path) from None
+        raise InputError(f"is a directory, not a {kind}", file=path) from None
     except OSError as e:
-        what = {errno.ENAMETOOLONG: "a path component is longer than the file system allows",
-                errno.EACCES: "permission denied", errno.ELOOP: "a symlink loop"}
-        raise InputError(f"cannot read: {what.get(e.errno or 0, e.strerror)}",
+        why = {errno.ENAMETOOLONG: "a path component is longer than the file system allows",
+               errno.EACCES: "permission denied", errno.ELOOP: "a symlink loop"}
+        raise InputError(f"cannot read: {why.get(e.errno or 0, e.strerror)}",
                          file=path) from None
     except ValueError:  # a NUL byte in the name
         raise InputError("cannot read: the path holds a NUL byte", file=path) from None
     try:
         mode = os.fstat(fd).st_mode
         if not stat.S_ISREG(mode):
-            kind = ("a directory" if stat.S_ISDIR(mode) else "a FIFO (named pipe)"
+            what = ("a directory" if stat.S_ISDIR(mode) else "a FIFO (named pipe)"
                     if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or
                     stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else "special")
-            raise InputError(f"is {kind}, not a regular file; urdfkit reads only regular "
+            raise InputError(f"is {what}, not a regular file; urdfkit reads only regular "
                              "files", file=path)
         chunks, size = [], 0
         while True:
@@ -86,13 +99,18 @@ def read_bytes(path: str | Path) -> bytes:
             if not chunk:
                 break
             size += len(chunk)
-            if size > MAX_FILE_BYTES:
-                raise InputError(f"file is over {MAX_FILE_BYTES // (1024 * 1024)} MiB; urdfkit "
-                                 "refuses larger files", file=path)
+            if size > limit:
+                raise InputError(f"file is over {_size(limit)}; urdfkit refuses larger "
+                                 f"{kind}s", file=path)
             chunks.append(chunk)
         return b"".join(chunks)
     finally:
         os.close(fd)
+
+
+def _size(n: int) -> str:
+    return f"{n / (1 << 30):g} GiB" if n >= 1 << 30 else f"{n / (1 << 20):g} MiB" \
+        if n >= 1 << 20 else f"{n:,} bytes"
 
 
 #: An XML declaration anywhere near the start of a file.
