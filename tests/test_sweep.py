@@ -48,10 +48,11 @@ def test_values_ranges_and_types() -> None:
 
 def test_grid_varies_the_first_name_slowest_and_zip_pairs() -> None:
     a, b = sweep.parse_vary("a=1,2"), sweep.parse_vary("b=x,y,z")
-    assert sweep.points([a, b]) == [{"a": 1, "b": "x"}, {"a": 1, "b": "y"}, {"a": 1, "b": "z"},
-                                    {"a": 2, "b": "x"}, {"a": 2, "b": "y"}, {"a": 2, "b": "z"}]
+    assert list(sweep.points([a, b])) == [
+        {"a": 1, "b": "x"}, {"a": 1, "b": "y"}, {"a": 1, "b": "z"},
+        {"a": 2, "b": "x"}, {"a": 2, "b": "y"}, {"a": 2, "b": "z"}]
     c = sweep.parse_vary("c=3,4")
-    assert sweep.points([a, c], zip_=True) == [{"a": 1, "c": 3}, {"a": 2, "c": 4}]
+    assert list(sweep.points([a, c], zip_=True)) == [{"a": 1, "c": 3}, {"a": 2, "c": 4}]
     with pytest.raises(ParameterError, match="as many"):
         sweep.points([a, b], zip_=True)
     with pytest.raises(ParameterError, match="twice"):

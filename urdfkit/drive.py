@@ -43,7 +43,7 @@ from typing import Any
 from .cache import cache_dir, write_entry
 from .errors import ParameterError
 from .session import LoadOptions, Session, quiet_stdout
-from .spec import UP_AXES, finite, quat_mul
+from .spec import MAX_STEPS, UP_AXES, finite, quat_mul
 from .vehicle import (
     DRIVETRAINS,
     PYBULLET_DEFAULT_FORCE,
@@ -173,6 +173,14 @@ class DriveConfig:
             if self.seconds <= 0:
                 raise ParameterError(f"`seconds` must be positive, got {self.seconds:g}",
                                      param="seconds")
+        steps = self.steps if self.steps is not None else \
+            (self.seconds or 0.0) / self.time_step
+        if not steps <= MAX_STEPS:
+            many = f"{steps:.3g}" if math.isfinite(steps) else "more than 1e308"
+            raise ParameterError(
+                f"the run would take {many} steps; a run takes at most {MAX_STEPS:,} "
+                "(shorten `seconds` or lengthen `time_step`)",
+                param="steps" if self.steps is not None else "seconds")
         self.throttle = _finite("throttle", self.throttle)
         self.steer = _finite("steer", self.steer)
         if self.max_force is not None:

@@ -17,6 +17,7 @@ import gc
 import json
 import math
 import os
+import re
 import sys
 from collections.abc import Callable, Iterable, Sequence
 from typing import Any
@@ -121,10 +122,32 @@ def diagnostics(lines: Iterable[str]) -> None:
         warn(f"pybullet: {text}")
 
 
+LONGEST_WORD = 200
+"""The longest run without a space a message line quotes whole (a value, a name, a path)."""
+LONGEST_LINE = 2000
+"""The longest message line; past it the middle is left out, with a count."""
+
+
+def _clip_word(m: re.Match[str]) -> str:
+    word = m.group(0)
+    core = word.rstrip(":,;")
+    return f"{core[:120]}...{core[-40:]} ({len(core):,} characters){word[len(core):]}"
+
+
 def _one_line(text: str) -> str:
     # A message must stay one line whatever it quotes (a file name with a newline, a
-    # multi-line xacro error): escape what would break it.
-    return text.replace("\r", "\\r").replace("\n", " | ")
+    # multi-line xacro error): escape what would break it. And it stays short whatever it
+    # quotes: a 20 MB string in a config or a 10,000-character mesh name is cut to its
+    # ends and its length, so every error and warning line is bounded.
+    text = text.replace("\r", "\\r").replace("\n", " | ")
+    text = _LONG_WORD.sub(_clip_word, text)
+    if len(text) > LONGEST_LINE:
+        left = len(text) - LONGEST_LINE + 200
+        text = f"{text[:LONGEST_LINE - 400]} ...({left:,} characters left out)... {text[-200:]}"
+    return text
+
+
+_LONG_WORD = re.compile(rf"\S{{{LONGEST_WORD + 1},}}")
 
 
 # --------------------------------------------------------------------------- numbers

@@ -16,6 +16,7 @@ from __future__ import annotations
 import functools
 import json
 import math
+import os
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -23,6 +24,7 @@ from types import SimpleNamespace
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
 from .errors import InputError, MissingDependencyError, ParameterError
+from .spec import MAX_STEPS
 
 #: The observation fields that carry noise; each is a vector or a joint-keyed mapping.
 OBSERVATION_FIELDS = (
@@ -272,7 +274,10 @@ def schema() -> SimpleNamespace:
             "As given" lets :func:`urdfkit.resolve.locate` find ``plane.urdf`` in pybullet_data.
             """
             candidate = self._base_dir / Path(name).expanduser()
-            return str(candidate) if candidate.exists() else name
+            try:
+                return str(candidate) if os.path.lexists(candidate) else name
+            except (OSError, ValueError):  # too long a name, a NUL byte: locate says so
+                return name
 
     return SimpleNamespace(
         Scenario=Scenario, Physics=Physics, Ground=Ground, Record=Record, Robot=Robot,
@@ -456,6 +461,8 @@ def read_document(path: str | Path) -> dict[str, Any]:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as e:
             raise InputError(f"invalid TOML: {e}", file=path) from None
+        except RecursionError:
+            raise InputError(_TOO_DEEP, file=path) from None
     else:
         try:
             data = json.loads(text, object_pairs_hook=_no_duplicates)
@@ -464,6 +471,8 @@ def read_document(path: str | Path) -> dict[str, Any]:
                              line=e.lineno) from None
         except ValueError as e:  # a duplicate key
             raise InputError(f"invalid JSON: {e}", file=path) from None
+        except RecursionError:
+            raise InputError(_TOO_DEEP, file=path) from None
     if not isinstance(data, dict):
         raise InputError("the top level must be an object", file=path)
     return data
@@ -551,9 +560,17 @@ def _check_file(scenario: Any, path: str, name: str) -> None:
 
     try:
         locate(scenario.path_of(name))
-    except InputError:
-        raise _fail(scenario, path, f"no such file: {name} (looked next to the scenario and "
-                                    "in pybullet_data)") from None
+    except InputError as e:
+        if e.message.startswith("no such file"):
+            raise _fail(scenario, path, f"no such file: {name} (looked next to the scenario "
+                                        "and in pybullet_data)") from None
+        raise _fail(scenario, path, f"{name}: {e.message}") from None
+    except (OSError, ValueError) as e:
+        raise _fail(scenario, path, f"{name}: cannot read: {getattr(e, 'strerror', e)}"
+                    ) from None
+
+
+_TOO_DEEP = "nested deeper than Python's parser can follow (a config is a few levels deep)"
 
 
 def check(scenario: Any) -> None:
@@ -572,6 +589,12 @@ def check(scenario: Any) -> None:
             if g.params:
                 raise _fail(scenario, "ground.params", "params are for templates only")
             _check_file(scenario, "ground.urdf", g.urdf)
+    steps = scenario.duration / scenario.physics.time_step
+    if not steps <= MAX_STEPS:
+        many = f"{steps:.3g}" if math.isfinite(steps) else "more than 1e308"
+        raise _fail(scenario, "duration", f"{scenario.duration:g} s at a time step of "
+                    f"{scenario.physics.time_step:g} s is {many} steps; a run takes at most "
+                    f"{MAX_STEPS:,} (shorten it, or lengthen physics.time_step)")
     names: dict[str, int] = {}
     for i, robot in enumerate(scenario.robots):
         path = f"robots[{i}]"

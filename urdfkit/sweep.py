@@ -114,8 +114,11 @@ def _clean(x: float) -> float:
     return float(f"{x:.12g}")
 
 
-def points(vary: Sequence[Vary], zip_: bool = False) -> list[dict[str, Any]]:
+def points(vary: Sequence[Vary], zip_: bool = False) -> Points:
     """The assignments of every point: a grid (first name slowest), or zipped.
+
+    The points are computed on demand (:class:`Points`), so a million-point grid takes no
+    more memory than a ten-point one.
 
     Raises:
         ParameterError: a name varied twice, zipped lists of different lengths, too many points.
@@ -124,22 +127,77 @@ def points(vary: Sequence[Vary], zip_: bool = False) -> list[dict[str, Any]]:
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise ParameterError(f"`vary` {twice[0]} is given twice", param="vary")
-    if not vary:
-        return [{}]
-    if zip_:
+    if zip_ and vary:
         lengths = {len(v.values) for v in vary}
         if len(lengths) > 1:
             raise ParameterError("`zip` pairs values point by point, so every --vary needs as "
                                  "many: got " + ", ".join(f"{v.name} {len(v.values)}"
                                                           for v in vary), param="zip")
-        combos: Iterable[tuple[Any, ...]] = zip(*(v.values for v in vary), strict=True)
-    else:
+    elif vary:
         total = math.prod(len(v.values) for v in vary)
         if total > MAX_POINTS:
             raise ParameterError(f"{total:,} points: more than {MAX_POINTS:,}; sweep fewer "
                                  "values", param="vary")
-        combos = itertools.product(*(v.values for v in vary))
-    return [dict(zip(names, combo, strict=True)) for combo in combos]
+    return Points(tuple(vary), zip_)
+
+
+class Points(Sequence[dict[str, Any]]):
+    """A sweep's points, each computed from its index: a grid (first name slowest) or zipped.
+
+    Point ``i`` of a grid is ``i`` written in mixed radix, one digit per varied name (the
+    last name's digit changes fastest), as :func:`itertools.product` orders them.
+    """
+
+    def __init__(self, vary: tuple[Vary, ...], zip_: bool) -> None:
+        self.vary = vary
+        self.zip = zip_
+        self.names = [v.name for v in vary]
+        if not vary:
+            self._len = 1
+        elif zip_:
+            self._len = len(vary[0].values)
+        else:
+            self._len = math.prod(len(v.values) for v in vary)
+
+    def __len__(self) -> int:
+        return self._len
+
+    def digits(self, i: int) -> list[int]:
+        """Each varied name's value index at point ``i``."""
+        if self.zip:
+            return [i] * len(self.vary)
+        out = []
+        for v in reversed(self.vary):
+            i, d = divmod(i, len(v.values))
+            out.append(d)
+        return out[::-1]
+
+    def at(self, digits: Sequence[int]) -> dict[str, Any]:
+        """The assignment with these value indices."""
+        return {v.name: v.values[d] for v, d in zip(self.vary, digits, strict=True)}
+
+    def __getitem__(self, i: Any) -> Any:
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(self._len))]
+        if not -self._len <= i < self._len:
+            raise IndexError(i)
+        return self.at(self.digits(i % self._len))
+
+    def probes(self) -> list[int]:
+        """Points that together try every value of every name once, checked before a run.
+
+        A zipped sweep has as many points as values: all of them. A grid gets, for each
+        name, its every value with the other names at their first value, plus the last point:
+        as many as the values given, never the product.
+        """
+        if self.zip or len(self.vary) <= 1:
+            return list(range(self._len))
+        seen = {0, self._len - 1}
+        radix = [math.prod(len(w.values) for w in self.vary[k + 1:])
+                 for k in range(len(self.vary))]
+        for k, v in enumerate(self.vary):
+            seen.update(d * radix[k] for d in range(len(v.values)))
+        return sorted(seen)
 
 
 # --------------------------------------------------------------------------- planning
@@ -152,20 +210,44 @@ class Plan:
     Attributes:
         kind: ``drive`` or ``sim``.
         names: The varied names, in ``vary`` order (the rows' leading columns).
-        assignments: Each point's values by name.
-        jobs: The payload of each point, as the workers take it (picklable).
+        assignments: Each point's values by name (computed on demand).
+        jobs: The payload of each point, as the workers take it (picklable; computed on
+            demand, and checked as it is: a point that fails its check becomes a failed row).
         label: What is swept, for messages.
     """
 
     kind: str
     names: list[str]
-    assignments: list[dict[str, Any]]
-    jobs: list[tuple[str, Any]]
+    assignments: Points
+    jobs: Jobs
     label: str
 
 
+class Jobs(Sequence[tuple[str, Any]]):
+    """Each point's ``(kind, payload)``, built from the base and the point's values."""
+
+    def __init__(self, kind: str, assignments: Points,
+                 build: Callable[[Mapping[str, Any], int], Any]) -> None:
+        self.kind = kind
+        self.assignments = assignments
+        self.build = build
+
+    def __len__(self) -> int:
+        return len(self.assignments)
+
+    def __getitem__(self, i: Any) -> Any:
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(len(self)))]
+        return (self.kind, self.build(self.assignments[i], i % len(self)))
+
+
 def plan(kind: str, base: Any, vary: Sequence[Vary | str], *, zip_: bool = False) -> Plan:
-    """Build and validate every point of a sweep, before any runs.
+    """Plan a sweep and check its values before any point runs.
+
+    Every value of every name is tried before anything runs (:meth:`Points.probes`: each
+    value once, the others at their first, so a million-point grid checks ~as many points
+    as values were given, and keeps no point in memory). A combination that only fails
+    together (``seconds`` and ``time_step`` too many steps apart) fails that point's row.
 
     Args:
         kind: ``drive`` (base: a dict of :class:`urdfkit.drive.DriveConfig` fields, with
@@ -186,17 +268,25 @@ def plan(kind: str, base: Any, vary: Sequence[Vary | str], *, zip_: bool = False
     parsed = [v if isinstance(v, Vary) else parse_vary(v) for v in vary]
     assignments = points(parsed, zip_)
     names = [v.name for v in parsed]
+    build: Callable[[Mapping[str, Any], int], Any]
     if kind == "drive":
         base_options = _drive_base(base)
-        jobs = []
-        for i, values in enumerate(assignments):
-            jobs.append(("drive", _drive_point(base_options, values, i)))
-        return Plan(kind, names, assignments, jobs, "drive")
-    document, base_dir, source = _sim_base(base)
-    jobs = []
-    for i, values in enumerate(assignments):
-        jobs.append(("sim", _sim_point(document, base_dir, source, values, i)))
-    return Plan(kind, names, assignments, jobs, source)
+
+        def build(values: Mapping[str, Any], i: int) -> Any:
+            return _drive_point(base_options, values, i)
+
+        label = "drive"
+    else:
+        document, base_dir, source = _sim_base(base)
+
+        def build(values: Mapping[str, Any], i: int) -> Any:
+            return _sim_point(document, base_dir, source, values, i)
+
+        label = source
+    jobs = Jobs(kind, assignments, build)
+    for i in assignments.probes():
+        jobs[i]  # raises, naming the point
+    return Plan(kind, names, assignments, jobs, label)
 
 
 def _point_label(i: int, values: Mapping[str, Any]) -> str:
@@ -350,6 +440,8 @@ def run_point(job: tuple[int, str, Any]) -> dict[str, Any]:
     The one function every backend calls, in a worker process, a Ray task or in-process.
     """
     index, kind, payload = job
+    if kind == "error":  # the point failed its check while the sweep was planned
+        return {"point": index, "error": payload}
     try:
         metrics = _drive_metrics(payload) if kind == "drive" else _sim_metrics(payload)
         metrics["error"] = None
@@ -454,19 +546,36 @@ def execute(sweep: Plan, *, jobs: int | None = None, backend: str = "local",
     if address is not None and backend != "ray":
         raise ParameterError("`address` is a Ray cluster's: it needs `backend` ray",
                              param="address")
-    todo = [(i, kind_payload[0], kind_payload[1])
-            for i, (kind_payload, values) in enumerate(zip(sweep.jobs, sweep.assignments,
-                                                           strict=True))
-            if skip is None or not skip(values)]
+    count = len(sweep.assignments) if skip is None else \
+        sum(1 for values in sweep.assignments if not skip(values))
+    todo = _todo(sweep, skip)
     rows: Iterator[dict[str, Any]]
     if backend == "ray":
         rows = _ray_rows(todo, jobs, address)
     else:
-        rows = _local_rows(todo, jobs)
+        rows = _local_rows(todo, count, jobs)
     for metrics in rows:
         values = sweep.assignments[metrics["point"]]
         yield {"point": metrics["point"], **values,
                **{k: v for k, v in metrics.items() if k != "point"}}
+
+
+def _todo(sweep: Plan, skip: Callable[[Mapping[str, Any]], bool] | None
+          ) -> Iterator[tuple[int, str, Any]]:
+    """The points to run, built one at a time (a million-point grid stays flat in memory).
+
+    A point whose own check fails (a combination no single value showed) is run as a
+    failing job, so it becomes a row with its error like any failed point.
+    """
+    for i, values in enumerate(sweep.assignments):
+        if skip is not None and skip(values):
+            continue
+        try:
+            kind, payload = sweep.jobs[i]
+        except UrdfkitError as e:
+            yield (i, "error", e.message)
+            continue
+        yield (i, kind, payload)
 
 
 def default_jobs() -> int:
@@ -476,9 +585,9 @@ def default_jobs() -> int:
     return os.cpu_count() or 1
 
 
-def _local_rows(todo: list[tuple[int, str, Any]], jobs: int | None
+def _local_rows(todo: Iterable[tuple[int, str, Any]], count: int, jobs: int | None
                 ) -> Iterator[dict[str, Any]]:
-    workers = min(jobs or default_jobs(), len(todo))
+    workers = min(jobs or default_jobs(), count)
     if workers <= 1:
         for job in todo:
             yield run_point(job)
@@ -505,7 +614,7 @@ def _ray() -> Any:
     return ray
 
 
-def _ray_rows(todo: list[tuple[int, str, Any]], jobs: int | None, address: str | None
+def _ray_rows(todo: Iterable[tuple[int, str, Any]], jobs: int | None, address: str | None
               ) -> Iterator[dict[str, Any]]:
     ray = _ray()
     started = False
@@ -576,7 +685,7 @@ class Journal:
     resume: bool = False
     force: bool = False
     done: list[dict[str, Any]] = field(default_factory=list)
-    assignments: list[dict[str, Any]] = field(default_factory=list)
+    assignments: Sequence[dict[str, Any]] = field(default_factory=list)
     #: What the caller should tell the user (rows dropped, and why).
     notes: list[str] = field(default_factory=list)
     _fd: int | None = None
