@@ -43,13 +43,45 @@ _HINGES = (0, 2)
 _WHEELS = (1, 3, 4, 5)
 
 
+def _real(action: Any) -> None:
+    """Refuse an action of complex numbers, text or objects before numpy casts it silently."""
+    kind = np.asarray(action).dtype.kind if not isinstance(action, np.ndarray) else \
+        action.dtype.kind
+    if kind not in "biuf":
+        raise ValueError(f"the action must be real numbers, got {np.asarray(action).dtype} "
+                         f"values: {_short(action)}")
+
+
+def _short(action: Any) -> str:
+    text = repr(action)
+    return text if len(text) <= 200 else text[:200] + f"... ({len(text):,} characters)"
+
+
+def _open(env: Any) -> None:
+    """Refuse a call on a closed env with a clear error, not PyBullet's "Not connected"."""
+    if getattr(env, "_closed", False):
+        raise RuntimeError(f"this {type(env).__name__} is closed; make a new one")
+
+
+def _after_end(env: Any) -> None:
+    """Warn once per episode when ``step`` is called after it ended, as Gymnasium asks."""
+    if getattr(env, "_ended", False) and not getattr(env, "_warned_end", False):
+        import warnings
+
+        env._warned_end = True
+        warnings.warn(f"{type(env).__name__}.step() called after the episode ended "
+                      "(terminated or truncated); call reset() to start a new one",
+                      stacklevel=3)
+
+
 def _finite_pair(action: Any) -> tuple[float, float]:
     try:
+        _real(action)
         a, b = action
         first, second = float(a), float(b)
     except (TypeError, ValueError):
         raise ValueError(f"expected an action of two numbers (throttle, steer), got "
-                         f"{action!r}") from None
+                         f"{_short(action)}") from None
     if not (math.isfinite(first) and math.isfinite(second)):
         raise ValueError(f"the action must be finite, got ({first}, {second})")
     return first, second
@@ -189,7 +221,9 @@ class SimpleDrivingEnv(gym.Env):
         The goal is drawn as the tutorial draws it, from ``np_random``: x and y each from
         ``[5, 9]`` or ``[-9, -5]``, with equal chance. ``options={"goal": (x, y)}`` sets it.
         """
+        _open(self)
         super().reset(seed=seed)
+        self._ended = self._warned_end = False
         p, c = self._p, self._client
         restore_clean(p, c, self._start, [self.car])
         goal = (options or {}).get("goal")
@@ -218,7 +252,9 @@ class SimpleDrivingEnv(gym.Env):
         Raises:
             ValueError: an action that is not two finite numbers.
         """
+        _open(self)
         throttle, steer = _finite_pair(action)
+        _after_end(self)
         throttle = min(max(throttle, 0.0), 1.0)
         steer = max(min(steer, 0.6), -0.6)
         p, c, car = self._p, self._client, self.car
@@ -252,6 +288,7 @@ class SimpleDrivingEnv(gym.Env):
             terminated = False
         if self.render_mode == "human" and self._session.gui:
             self._follow_in_gui(x, y)
+        self._ended = terminated
         return obs, reward, terminated, False, {"distance": distance, "is_success": reached}
 
     def _observe(self) -> np.ndarray:
@@ -301,7 +338,8 @@ class SimpleDrivingEnv(gym.Env):
         self._last_frame = time.perf_counter()
 
     def close(self) -> None:
-        """Disconnect the client (safe to call twice)."""
+        """Disconnect the client (safe to call twice); reset or step after it is an error."""
+        self._closed = True
         self._session.close()
         tmp = self.__dict__.pop("_tmp", None)
         if tmp is not None:
@@ -367,6 +405,11 @@ class ScenarioEnv(gym.Env):
         if observation not in ("flat", "dict"):
             raise ParameterError(f"observation must be flat or dict, got {observation!r}",
                                  param="observation")
+        if max_episode_steps is not None and (isinstance(max_episode_steps, bool) or
+                                              not isinstance(max_episode_steps, int) or
+                                              max_episode_steps < 1):
+            raise ParameterError(f"max_episode_steps must be an integer >= 1, got "
+                                 f"{max_episode_steps!r}", param="max_episode_steps")
         if not isinstance(frame_skip, int) or frame_skip < 1:
             raise ParameterError(f"frame_skip must be an integer >= 1, got {frame_skip!r}",
                                  param="frame_skip")
@@ -571,7 +614,9 @@ class ScenarioEnv(gym.Env):
         give the same observations. ``options={"overrides": {...}}`` passes per-robot
         starts to :meth:`Simulation.reset`.
         """
+        _open(self)
         super().reset(seed=seed)
+        self._ended = self._warned_end = False
         rng = self.np_random
         overrides: dict[str, dict[str, Any]] = {
             k: dict(v) for k, v in ((options or {}).get("overrides") or {}).items()}
@@ -623,6 +668,8 @@ class ScenarioEnv(gym.Env):
         Raises:
             ValueError: an action of the wrong size, or not finite.
         """
+        _open(self)
+        _real(action)
         a = np.asarray(action, dtype=np.float64).reshape(-1)
         if a.shape != self._low.shape:
             raise ValueError(f"expected an action of {len(self.action_names)} values "
@@ -630,6 +677,7 @@ class ScenarioEnv(gym.Env):
                              f"{np.shape(action)}")
         if not np.all(np.isfinite(a)):
             raise ValueError(f"the action must be finite, got {a.tolist()}")
+        _after_end(self)
         a = np.clip(a, self._low, self._high)
         self._apply(a)
         self.sim.step(self.frame_skip)
@@ -640,6 +688,7 @@ class ScenarioEnv(gym.Env):
         truncated = not done and self._steps >= self.max_episode_steps
         if self.render_mode == "human":
             time.sleep(max(0.0, self.frame_skip * self.sim.time_step))
+        self._ended = done or truncated
         return self._obs(o), reward, done, truncated, {"t": o.t}
 
     def render(self) -> Any:  # an ndarray or None; gymnasium types it as a RenderFrame TypeVar
@@ -659,7 +708,8 @@ class ScenarioEnv(gym.Env):
             :, :, :3].copy()
 
     def close(self) -> None:
-        """Close the simulation (safe to call twice)."""
+        """Close the simulation (safe to call twice); reset or step after it is an error."""
+        self._closed = True
         self.sim.close()
 
 
