@@ -5,14 +5,14 @@ refusals, or unparsable JSON. The full run is bench/fuzz.py."""
 from __future__ import annotations
 
 import pytest
-from fuzz.runner import FAILURES, campaign, classify
+from fuzz.runner import FAILURES, campaign, classify, commands
 
 pytestmark = pytest.mark.fuzz
 
 
 def test_seeded_sample_has_no_failures() -> None:
     report = campaign(60, seed=20261122, jobs=2)
-    assert report.runs == 60 * 10
+    assert report.runs == 60 * len(commands("r.urdf"))
     failures = [f"{f['class']}: {' '.join(map(str, f['command']))} <- {f['seed']} "
                 f"{f['mutations']}: {str(f['stderr']).strip()[-300:]}" for f in report.failures]
     assert failures == []
@@ -34,6 +34,9 @@ def test_seeded_sample_has_no_failures() -> None:
       "stdout": "", "stderr": "urdfkit: error: something\n"}, "unnamed refusal"),
     ({"command": ["joints", "r.urdf"], "code": 2, "signal": None, "hang": False,
       "stdout": "", "stderr": "urdfkit: error: r.urdf: a\nmore\n"}, "multi-line error"),
+    ({"command": ["joints", "r.urdf"], "code": 2, "signal": None, "hang": False,
+      "stdout": "", "stderr": "urdfkit: error: r.urdf: " + "x" * 3000 + "\n"},
+     "unbounded error"),
     ({"command": ["joints", "r.urdf", "--json"], "code": 0, "signal": None, "hang": False,
       "stdout": "{not json", "stderr": ""}, "dirty json"),
     ({"command": ["joints", "r.urdf", "--json"], "code": 0, "signal": None, "hang": False,

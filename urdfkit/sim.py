@@ -1689,7 +1689,9 @@ class RowText:
         if header:
             writer.writeheader()
         writer.writerows(flat)
-        return text.getvalue().encode("utf-8")
+        # A name that is not UTF-8 (a Latin-1 file name, read as surrogates) is written
+        # escaped (\udce9), so the file stays UTF-8 text, as the JSON rows are.
+        return text.getvalue().encode("utf-8", "backslashreplace")
 
 
 def rows_to_bytes(rows: Sequence[Mapping[str, Any]], fmt: str) -> bytes:

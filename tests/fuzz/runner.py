@@ -23,7 +23,9 @@ from .mutate import Mutant, mutate, seeds
 
 DRIVER = Path(__file__).with_name("driver.py")
 FAILURES = ("signal", "hang", "traceback", "bug", "bad exit", "multi-line error",
-            "unnamed refusal", "dirty json")
+            "unbounded error", "unnamed refusal", "dirty json")
+#: The longest stderr line a run may print (present.py cuts every message to 2,000).
+LONGEST_LINE = 2_500
 LATIN1_NAME = os.fsdecode(b"caf\xe9.urdf")
 
 
@@ -34,6 +36,12 @@ def commands(file: str) -> list[list[str]]:
         ["links", file, "--json"], ["tree", file], ["tree", file, "--json"],
         ["info", file, "--json"], ["render", file, "-o", "out.png", "--size", "64x48", "--force"],
         ["drive", "--urdf", file, "--steps", "24", "--json"], ["sim", "scenario.json", "--json"],
+        ["fix", file, "-o", "fixed.urdf", "--force", "--json"], ["fix", file, "--diff"],
+        ["diff", file, "fixed.urdf", "--json"], ["collisions", file, "--samples", "4", "--json"],
+        ["sweep", "drive", "--urdf", file, "--steps", "12", "--vary", "throttle=1,2",
+         "--jobs", "1", "--json"],
+        ["sweep", "sim", "scenario.json", "--vary", "duration=0.02,0.04", "--jobs", "1",
+         "-o", "rows.csv", "--force"],
     ]
 
 
@@ -51,6 +59,8 @@ def classify(run: dict[str, object], file: str) -> str:
     code = run["code"]
     if code == 3:
         return "bug"
+    if any(len(ln) > LONGEST_LINE for ln in err.splitlines()):
+        return "unbounded error"
     if code not in (0, 1, 2):
         return "bad exit"
     if code == 2:
@@ -58,7 +68,8 @@ def classify(run: dict[str, object], file: str) -> str:
                   and not ln.startswith("urdfkit: warning:")]
         if len(errors) != 1:
             return "multi-line error"
-        shown = (file, file.encode("utf-8", "backslashreplace").decode("utf-8"), "scenario.json")
+        shown = (file, file.encode("utf-8", "backslashreplace").decode("utf-8"), "scenario.json",
+                 "fixed.urdf")
         if not any(name in errors[0] for name in shown):
             return "unnamed refusal"
         return "refusal"
