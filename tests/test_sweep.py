@@ -168,10 +168,14 @@ def test_sim_rows_equal_single_scenario_runs() -> None:
 def test_a_failing_point_records_its_error_and_the_sweep_goes_on(tmp_path: Path) -> None:
     car = tmp_path / "car.urdf"
     code, _, _ = _cli("build", "simplecar", "-o", str(car))
-    missing = tmp_path / "gone.urdf"
+    missing = tmp_path / "broken.urdf"  # there, but not a robot: fails when its point loads
+    missing.write_text("<robot name='r'><link name='a'/><link name='b'/></robot>")
     rows = _by_point(list(sweep.run("drive", BASE, [f"urdf={car},{missing}"], jobs=1)))
     assert rows[0]["error"] is None and rows[0]["distance"] > 0
-    assert "gone.urdf" in rows[1]["error"] and "distance" not in rows[1]
+    assert "broken.urdf" in rows[1]["error"] and "distance" not in rows[1]
+    # A file that is not there at all is bad input: refused before any point runs.
+    with pytest.raises(InputError, match="gone.urdf: no such file"):
+        sweep.plan("drive", BASE, [f"urdf={car},{tmp_path / 'gone.urdf'}"])
     out = tmp_path / "rows.jsonl"
     code, stdout, _ = _cli("sweep", "drive", "--seconds", "1", "--vary",
                            f"urdf={car},{missing}", "--out", str(out))

@@ -34,6 +34,40 @@ ORIGIN_ATTR = "urdfkit-origin:at"
 FILES: list[str] = []
 
 
+#: An included file larger than this is refused (xmlio.MAX_FILE_BYTES, the cap of every read).
+MAX_INCLUDE_BYTES = 32 * 1024 * 1024
+
+
+def _refuse_special(xacro: object, filename: str, path: str) -> None:
+    """Refuse to include a FIFO, a device or a huge file: xacro would wait or read forever.
+
+    The file is opened non-blocking (a FIFO would wait for a writer) and judged by ``fstat``
+    on the open descriptor, as :func:`urdfkit.xmlio.read_regular` does for every other read.
+    """
+    import stat
+
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError:
+        return  # missing or unreadable: xacro says so, its own way
+    try:
+        st = os.fstat(fd)
+    finally:
+        os.close(fd)
+    what = None
+    if stat.S_ISFIFO(st.st_mode):
+        what = "is a FIFO (named pipe), not a regular file"
+    elif stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode):
+        what = "is a device, not a regular file"
+    elif stat.S_ISSOCK(st.st_mode):
+        what = "is a socket, not a regular file"
+    elif stat.S_ISREG(st.st_mode) and st.st_size > MAX_INCLUDE_BYTES:
+        what = f"is {st.st_size:,} bytes, more than the {MAX_INCLUDE_BYTES:,} urdfkit reads"
+    if what is not None:
+        raise xacro.XacroException(  # type: ignore[attr-defined]
+            f"included file {filename}: {what}; urdfkit reads only regular files")
+
+
 def _tag_origins(xacro: object) -> None:
     """Make xacro's file reader tag every element it reads with ``index:line``."""
     from lxml import etree
@@ -45,6 +79,7 @@ def _tag_origins(xacro: object) -> None:
         if inp is not None or not filename:
             return original(inp, filename)
         path = os.path.join(xacro.root_dir, filename)  # type: ignore[attr-defined]
+        _refuse_special(xacro, filename, path)
         try:
             with open(path, "rb") as f:
                 text = f.read()

@@ -337,6 +337,10 @@ def _drive_point(base: Mapping[str, Any], values: Mapping[str, Any], i: int) -> 
     if params:
         options["template_params"] = params
     where = _point_label(i, values)
+    if options.get("urdf") is not None:
+        from .resolve import locate
+
+        locate(options["urdf"])  # a missing file, a FIFO or a folder: refused before any runs
     try:
         config = DriveConfig(**options)
         config.check()
