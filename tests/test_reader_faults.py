@@ -157,3 +157,27 @@ def test_the_readers_still_read_regular_files(tmp_path: Path, simplecar_urdf: Pa
     code, err = _run(["sim", "{F}", "-o", "{D}/rows.csv"], tmp_path / "s.json", tmp_path,
                      simplecar_urdf)
     assert code == 0, err
+
+
+SAC = Path(__file__).parent / "fixtures" / "sac"
+
+
+@pytest.mark.parametrize("kind", ("fifo", "zero", "folder", "long"))
+def test_a_simulation_and_control_urdf_path_that_is_not_a_file(kind: str, tmp_path: Path,
+                                                                alarm: None) -> None:
+    import json
+
+    shutil.copytree(SAC / "models", tmp_path / "models")
+    (tmp_path / "configs").mkdir()
+    conf = json.loads((SAC / "configs" / "pendulum.json").read_text())
+    name = "a/" * 2500 + "x.urdf" if kind == "long" else "bad.urdf"
+    if kind != "long":
+        _make(kind, tmp_path / "models" / name)
+    conf["robot_pybullet"]["urdf_path"] = [name]
+    config = tmp_path / "configs" / "pendulum.json"
+    config.write_text(json.dumps(conf))
+    code, err = _run(["sim", "{F}", "-o", "{D}/rows.csv"], config, tmp_path, config)
+    assert code == 2
+    line = _one_line_naming(err, "urdf_path[0]")
+    assert "no such file" not in line  # it is there, or too long a name: said as such
+    assert len(line) < 1000

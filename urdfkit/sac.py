@@ -179,11 +179,23 @@ def _resolve_urdf(reader: _Reader, where: str, name: Any, base: Path) -> Path:
     """
     if not isinstance(name, str) or not name:
         raise reader.fail(where, f"expected a file name, got {name!r}")
+    import stat
+
     given = Path(name).expanduser()
     for candidate in (base.parent / "models" / given, base / "models" / given, base / given,
                       given):
-        if candidate.is_file():
+        try:
+            mode = os.stat(candidate).st_mode
+        except FileNotFoundError:
+            continue
+        except (OSError, ValueError) as e:  # too long a name, a NUL byte, a loop
+            raise reader.fail(where, f"cannot read {name}: "
+                                     f"{getattr(e, 'strerror', None) or e}") from None
+        if stat.S_ISREG(mode):
             return Path(os.path.abspath(candidate))
+        what = ("a directory" if stat.S_ISDIR(mode) else "a FIFO (named pipe)"
+                if stat.S_ISFIFO(mode) else "a device or socket")
+        raise reader.fail(where, f"{candidate} is {what}, not a URDF file")
     raise reader.fail(where, f"no such file: {name} (looked in {base.parent / 'models'}, "
                              f"{base / 'models'} and {base})")
 
