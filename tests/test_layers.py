@@ -17,9 +17,9 @@ PACKAGE = Path(urdfkit.__file__).parent
 LAYERS: dict[str, int] = {}
 for floor, names in enumerate([
     # spec and model
-    "errors spec style templatedir suggest output cache xmlio tomlio builder catalog",
+    "errors deps spec style templatedir suggest output cache xmlio tomlio builder catalog",
     # sources: files, packages, xacro, and the guard every loader calls
-    "uris meshes _xacro_worker expand validate resolve",
+    "uris meshes resultcache _xacro_worker expand validate resolve",
     # the engine session
     "session",
     # run and draw

@@ -226,6 +226,37 @@ def _install_find(packages_json: str, source: str) -> None:
     sys.modules.setdefault("ament_index_python.packages", module)
 
 
+def _record_reads(deps: str) -> None:
+    """Note every file xacro opens for reading (includes, YAML, ...).
+
+    The list goes to ``deps`` (JSON) when the worker exits, failed or not: check's result
+    cache reuses a result only while none of them changed (:mod:`urdfkit.deps`).
+    """
+    import atexit
+    import builtins
+    import json
+
+    read: set[str] = set()
+    real_open = builtins.open
+
+    def recording_open(file: object, mode: str = "r", *args: object, **kwargs: object) -> object:
+        if isinstance(file, (str, bytes, os.PathLike)) and not any(c in mode for c in "wax+"):
+            path = os.path.abspath(os.fsdecode(file))
+            if not path.startswith(("/proc/", "/sys/", "/dev/")):
+                read.add(path)
+        return real_open(file, mode, *args, **kwargs)  # type: ignore[call-overload]
+
+    def write() -> None:
+        try:
+            with real_open(deps, "w", encoding="utf-8", errors="surrogateescape") as f:
+                json.dump(sorted(read), f)
+        except OSError:
+            pass
+
+    builtins.open = recording_open  # type: ignore[assignment]
+    atexit.register(write)
+
+
 def main(argv: list[str]) -> int:
     """Expand FILE with ``name:=value`` mappings into OUT; errors go to ERR (last line)."""
     if len(argv) < 6:
@@ -245,6 +276,7 @@ def main(argv: list[str]) -> int:
             print(f"bad argument {item!r}: expected name:=value", file=sys.stderr)
             return 2
         mappings[key] = value
+    _record_reads(out + ".deps")
     try:
         import xacro
 

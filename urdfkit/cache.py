@@ -32,7 +32,7 @@ def read_entry(path: Path) -> bytes | None:
     from .xmlio import read_regular
 
     try:  # a FIFO planted in the cache folder must not hang a run
-        return read_regular(path, limit=MAX_ENTRY_BYTES, kind="cache entry")
+        return read_regular(path, limit=MAX_ENTRY_BYTES, kind="cache entry", track=False)
     except InputError:
         return None
 

@@ -34,6 +34,8 @@ class FileResult:
 
     file: str
     findings: list[Finding] = field(default_factory=list)
+    #: Whether the findings came from the result cache (not in the JSON).
+    cached: bool = field(default=False, compare=False)
 
     def count(self, level: str) -> int:
         """How many findings of ``level``."""
@@ -268,13 +270,44 @@ def _macro_library(root: object) -> bool:
     return root.tag in ("robot", "root") and root.find("link") is None
 
 
-def _check_one(job: tuple[str, str, str | None, dict[str, str], bool, dict[str, str], bool]
-               ) -> FileResult:
-    display, path, problem, packages, no_exec, xacro_args, physics = job
+_Job = tuple[str, str, str | None, dict[str, str], bool, dict[str, str], bool, bool]
+_caches: dict[str, object] = {}
+
+
+def _check_one(job: _Job) -> FileResult:
+    display, path, problem, packages, no_exec, xacro_args, physics, use_cache = job
     if problem is not None:
         return FileResult(display, [Finding("U000", "error", problem, display)])
-    return check_file(display, path, {k: Path(v) for k, v in packages.items()}, no_exec,
-                      xacro_args, physics)
+    pkgs = {k: Path(v) for k, v in packages.items()}
+    if not use_cache:
+        return check_file(display, path, pkgs, no_exec, xacro_args, physics)
+    from . import deps
+    from .resultcache import ResultCache
+
+    options: dict[str, object] = {"packages": packages, "no_exec": no_exec,
+                                  "xacro_args": xacro_args, "physics": physics}
+    if physics:  # U950/U951 come from PyBullet itself
+        from importlib.metadata import version
+
+        options["pybullet"] = version("pybullet")
+    from .cache import cache_dir
+
+    memo = repr((sorted(options.items()), cache_dir()))
+    if memo not in _caches:  # one per option set and process (the key prefix is made once)
+        _caches[memo] = ResultCache.open(options)
+    cache = _caches[memo]
+    assert cache is None or isinstance(cache, ResultCache)
+    key = cache.key(display, path) if cache is not None else None
+    if cache is None or key is None:
+        return check_file(display, path, pkgs, no_exec, xacro_args, physics)
+    hit = cache.get(key)
+    if hit is not None:
+        return FileResult(display, [Finding(**f) for f in hit], cached=True)
+    with deps.record() as recorded:
+        recorded[os.path.abspath(path)] = deps.signature(os.path.abspath(path))
+        result = check_file(display, path, pkgs, no_exec, xacro_args, physics)
+    cache.put(key, recorded, [f.to_dict() for f in result.findings])
+    return result
 
 
 def worker_init() -> None:
@@ -316,10 +349,12 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
                 select: Sequence[str] = (), ignore: Sequence[str] = (),
                 jobs: int | None = None, no_exec: bool = False,
                 xacro_args: Mapping[str, str] | None = None,
-                physics: bool = False) -> CheckResult:
+                physics: bool = False, cache: bool = True) -> CheckResult:
     """Check every file under ``paths``, over ``jobs`` processes (default: every core).
 
-    ``physics`` loads each file without errors in PyBullet for the U95x rules.
+    ``physics`` loads each file without errors in PyBullet for the U95x rules. ``cache``
+    reuses a file's findings while neither it nor anything it read changed
+    (:mod:`urdfkit.resultcache`; also off when ``URDFKIT_CACHE_DIR`` is empty).
 
     Workers are killed with the parent (Ctrl-C, SIGTERM, even SIGKILL on Linux) and never
     hold its stdout.
@@ -332,7 +367,7 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
     files = discover(paths)
     pkgs = {k: str(v) for k, v in (packages or {}).items()}
     args = dict(xacro_args or {})
-    work = [(display, str(path), problem, pkgs, no_exec, args, physics)
+    work = [(display, str(path), problem, pkgs, no_exec, args, physics, cache)
             for display, path, problem in files]
     workers = min(jobs or default_jobs(), max(1, len(work) // _PARALLEL_MIN))
     if workers <= 1:
@@ -347,6 +382,12 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
         # The with block terminates the workers on the way out, normal or not (Ctrl-C).
         with context.Pool(workers, initializer=worker_init) as pool:
             results = pool.map(_check_one, work, chunksize=chunk)
+    if cache and not all(fr.cached for fr in results):
+        from .resultcache import ResultCache
+
+        store = ResultCache.open({})
+        if store is not None:
+            store.trim()  # new entries were written: keep the folder under its cap
     sel, ign = tuple(select), tuple(ignore)
     noted = False
     for fr in results:

@@ -523,6 +523,10 @@ def check(
     physics: Annotated[bool, typer.Option(
         "--physics", help="Also load each file without errors in PyBullet and test its zero "
         "pose for links in contact (U950; slower).")] = False,
+    no_cache: Annotated[bool, typer.Option(
+        "--no-cache", help="Check every file afresh: do not read or write the result cache "
+        "(a file's findings, reused while neither it nor anything it read changed). "
+        "URDFKIT_CACHE_DIR= also turns it off.")] = False,
 ) -> None:
     """Check URDF files for errors PyBullet crashes on, physics mistakes and typos.
 
@@ -542,7 +546,7 @@ def check(
     result = check_paths(paths, packages=parse_packages(package, package_path),
                          select=parse_codes(select, "`select`"),
                          ignore=parse_codes(ignore, "`ignore`"), jobs=jobs, no_exec=no_exec,
-                         xacro_args=_xacro_args(arg), physics=physics)
+                         xacro_args=_xacro_args(arg), physics=physics, cache=not no_cache)
     import dataclasses
 
     for fr in result.files:  # a xacro or package problem speaks of flags, not parameters

@@ -130,6 +130,7 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
                 raise
             finally:
                 _kill_group(proc.pid)  # background children left in its group
+                _note_reads(Path(str(out) + ".deps"))
         if code == BAD_ARGS:
             from .errors import ParameterError
 
@@ -151,6 +152,23 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
             raise InputError(f"xacro failed: {redact(msg, secrets)}", file=name,
                              param=named.group(1) if named else None)
         return Expanded(out.read_bytes(), _origins(Path(str(out) + ".origins")))
+
+
+def _note_reads(path: Path) -> None:
+    """Tell :mod:`urdfkit.deps` every file the worker read (when a result is being recorded)."""
+    from . import deps
+
+    if not deps._active:
+        return
+    import json
+
+    try:
+        read = json.loads(path.read_text("utf-8", "surrogateescape"))
+    except (OSError, ValueError):
+        return
+    for name in read if isinstance(read, list) else []:
+        if isinstance(name, str):
+            deps.note(name)
 
 
 class Expanded(bytes):

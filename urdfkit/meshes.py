@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from . import deps
 from .cache import cache_dir, read_entry, write_entry
 from .errors import InputError
 from .spec import axis_angle_matrix
@@ -146,6 +147,7 @@ def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
     suffix = path.suffix.lower()
     if suffix not in (".stl", ".obj", ".dae"):
         return None
+    deps.note(path)
     try:
         st = os.stat(path)
     except (OSError, ValueError):

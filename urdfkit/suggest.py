@@ -11,6 +11,8 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
+from . import deps
+
 ROBOT_SUFFIXES = (".urdf", ".xacro", ".urdf.xacro")
 
 
@@ -51,6 +53,7 @@ def hint(word: str, choices: Iterable[str], n: int = 3) -> str:
 def _robot_files(folder: Path, limit: int = 2000) -> list[str]:
     """The robot-file names in ``folder`` (not recursive; bounded for huge folders)."""
     out: list[str] = []
+    deps.note_listing(folder)
     try:
         with os.scandir(folder) as it:
             for entry in it:

@@ -19,6 +19,8 @@ from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from . import deps
+
 #: How many folders above the file PyBullet searches for a ``package://`` path.
 PYBULLET_SEARCH_DEPTH = 5
 
@@ -127,6 +129,8 @@ def find_package(name: str, start: Path) -> Path | None:
         if folder.name == name:
             return folder
         try:
+            deps.note(folder / name)
+            deps.note(folder / "package.xml")
             if (folder / name).is_dir():
                 return folder / name
             pkg = folder / "package.xml"
@@ -186,6 +190,7 @@ def not_a_file(path: Path) -> str | None:
     import errno
     import stat
 
+    deps.note(path)  # check's result cache: a mesh that appears or changes counts
     try:
         mode = os.stat(path).st_mode
     except FileNotFoundError:
@@ -208,6 +213,7 @@ def not_a_file(path: Path) -> str | None:
 
 
 def _is_file(path: Path) -> bool:
+    deps.note(path)
     try:
         return os.path.isfile(path)
     except (OSError, ValueError):

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from lxml import etree
 
+from . import deps as _deps
 from .errors import InputError
 from .spec import PYBULLET_LINE_BYTES
 
@@ -48,7 +49,7 @@ def read_bytes(path: str | Path) -> bytes:
 
 
 def read_regular(path: str | Path, *, limit: int = MAX_FILE_BYTES,
-                 kind: str = "URDF file") -> bytes:
+                 kind: str = "URDF file", track: bool = True) -> bytes:
     """Read a regular file: never a FIFO, device, socket or folder; never more than ``limit``.
 
     Every file urdfkit reads comes through here (URDF, xacro output, scenarios and configs,
@@ -64,6 +65,8 @@ def read_regular(path: str | Path, *, limit: int = MAX_FILE_BYTES,
     import stat
 
     path = Path(path)
+    if track:  # check's result cache: this result depends on the file (cache entries do not)
+        _deps.note(path)
     flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
     try:
         fd = os.open(path, flags)

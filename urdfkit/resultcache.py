@@ -1,0 +1,202 @@
+"""``check``'s result cache: a file's findings, reused while nothing they came from changed.
+
+As ruff and mypy keep theirs. An entry is found by a key made of everything that decides the
+findings and is known before checking: the file's content (BLAKE2b), its absolute path and the
+name it is shown by, urdfkit's own code (the size and mtime of each of its modules, so an edit
+or an upgrade misses), the options that change findings (``--arg``, ``--package``,
+``--no-exec``, ``--physics``) and the environment that finds packages (ROS_PACKAGE_PATH,
+AMENT_PREFIX_PATH, URDFKIT_NO_EXEC). ``--select`` and ``--ignore`` are not in it: the entry
+keeps every finding and the filter runs after.
+
+What is only known after checking is in the entry: every path the check read or looked for
+(:mod:`urdfkit.deps`: xacro includes and YAML, meshes, ``package.xml`` files, the places a
+missing mesh was sought) with its ``stat`` signature. A hit is used only if each is unchanged,
+so a change to any dependency invalidates exactly the files that used it.
+
+An entry is written atomically and read as untrusted: anything that does not parse, or has
+the wrong shape, is a miss (and is rewritten). Results that depend on the machine's load (a
+xacro expansion stopped by its time or memory limit) are never stored. The folder is capped
+(:data:`MAX_BYTES`): past it, the oldest entries are removed. ``--no-cache`` or
+``URDFKIT_CACHE_DIR=`` turns the cache off.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import stat
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from . import deps
+from .cache import MAX_ENTRY_BYTES, cache_dir, write_entry
+from .xmlio import MAX_FILE_BYTES
+
+#: The subfolder of the cache folder.
+FOLDER = "check-v1"
+#: The most the result cache may hold; past it the oldest entries go, down to 3/4 of it.
+MAX_BYTES = 64 * 1024 * 1024
+#: Environment variables that change how packages are found or whether xacro runs.
+ENV_KEYS = ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH", "URDFKIT_NO_EXEC")
+#: Messages of results that say more about the machine than the file: never stored.
+TRANSIENT = ("took longer than", "ran out of memory", "was killed", "ran out of CPU time",
+             "died of signal")
+_FIELDS = ("code", "level", "message", "file", "line", "origin")
+
+_code_key: str | None = None
+
+
+def code_key() -> str:
+    """A digest of urdfkit's own modules (name, size, mtime): a new version or an edit misses."""
+    global _code_key
+    if _code_key is None:
+        from . import __version__
+
+        h = hashlib.blake2b(__version__.encode(), digest_size=16)
+        package = Path(__file__).parent
+        with os.scandir(package) as it:
+            for entry in sorted(it, key=lambda e: e.name):
+                if entry.name.endswith(".py"):
+                    st = entry.stat()
+                    h.update(f"{entry.name}\0{st.st_size}\0{st.st_mtime_ns}\0".encode())
+        _code_key = h.hexdigest()
+    return _code_key
+
+
+def _read_regular(path: str, limit: int) -> bytes | None:
+    """A regular file's bytes, or None (absent, special, unreadable or over ``limit``).
+
+    :func:`urdfkit.xmlio.read_regular`'s rules without its messages or pathlib: this runs
+    twice per file on a warm re-run, where it is most of the cost.
+    """
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except (OSError, ValueError):
+        return None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or st.st_size > limit:
+            return None
+        chunks = []
+        size = 0
+        while True:
+            chunk = os.read(fd, max(st.st_size + 1 - size, 65536))
+            if not chunk:
+                break
+            size += len(chunk)
+            if size > limit:
+                return None
+            chunks.append(chunk)
+        return b"".join(chunks)
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+
+
+class ResultCache:
+    """Entries under ``<cache>/check-v1``; see the module docstring."""
+
+    def __init__(self, folder: Path, options: Mapping[str, Any]) -> None:
+        self.folder = folder
+        self._root = os.fspath(folder)
+        settings = {"options": dict(options), "env": {k: os.environ.get(k) for k in ENV_KEYS},
+                    "code": code_key()}
+        self._prefix = json.dumps(settings, sort_keys=True, default=str).encode(
+            "utf-8", "surrogateescape")
+        self.wrote = 0
+
+    @classmethod
+    def open(cls, options: Mapping[str, Any], enabled: bool = True) -> ResultCache | None:
+        """The cache for a run with these options; None when it is turned off."""
+        folder = cache_dir() if enabled else None
+        return cls(folder / FOLDER, options) if folder is not None else None
+
+    def key(self, display: str, path: str | Path) -> str | None:
+        """The entry key of a file; None if it is not a readable regular file.
+
+        Such a file is checked uncached, and the check says why it cannot be read.
+        """
+        data = _read_regular(os.fspath(path), MAX_FILE_BYTES)
+        if data is None:
+            return None
+        h = hashlib.blake2b(self._prefix, digest_size=20)
+        where = f"\0{display}\0{os.path.abspath(path)}\0".encode("utf-8", "surrogateescape")
+        h.update(where)
+        h.update(data)
+        return h.hexdigest()
+
+    def _entry(self, key: str) -> str:
+        return os.path.join(self._root, key[:2], f"{key}.json")
+
+    def get(self, key: str) -> list[dict[str, Any]] | None:
+        """The findings stored under ``key`` (as dicts), if every dependency is unchanged."""
+        raw = _read_regular(self._entry(key), MAX_ENTRY_BYTES)
+        if raw is None:
+            return None
+        try:
+            entry = json.loads(raw)
+            recorded, findings = entry["deps"], entry["findings"]
+            if not (isinstance(recorded, dict) and isinstance(findings, list)):
+                return None
+            for f in findings:
+                if not (isinstance(f, dict) and set(f) == set(_FIELDS)
+                        and isinstance(f["code"], str) and isinstance(f["level"], str)
+                        and isinstance(f["message"], str) and isinstance(f["file"], str)
+                        and (f["line"] is None or type(f["line"]) is int)
+                        and (f["origin"] is None or isinstance(f["origin"], str))):
+                    return None
+        except (ValueError, KeyError, TypeError):  # damaged: a miss, never trusted
+            return None
+        if not deps.unchanged(recorded):
+            return None
+        return findings
+
+    def put(self, key: str, recorded: Mapping[str, deps.Signature],
+            findings: list[dict[str, Any]]) -> None:
+        """Store a result (unless it depends on the machine's load)."""
+        if any(any(t in str(f.get("message")) for t in TRANSIENT) for f in findings):
+            return
+        try:
+            data = json.dumps({"deps": recorded, "findings": findings}, allow_nan=False,
+                              ensure_ascii=True).encode("ascii")
+        except (ValueError, TypeError):
+            return
+        if write_entry(Path(self._entry(key)), data):
+            self.wrote += 1
+
+    def trim(self, limit: int = MAX_BYTES) -> int:
+        """Remove the oldest entries while the folder holds more than ``limit`` bytes.
+
+        Returns:
+            How many entries were removed.
+        """
+        entries: list[tuple[int, int, str]] = []
+        total = 0
+        try:
+            with os.scandir(self.folder) as shards:
+                for shard in shards:
+                    if not shard.is_dir(follow_symlinks=False):
+                        continue
+                    with os.scandir(shard.path) as it:
+                        for e in it:
+                            if e.is_file(follow_symlinks=False):
+                                st = e.stat(follow_symlinks=False)
+                                entries.append((st.st_mtime_ns, st.st_size, e.path))
+                                total += st.st_size
+        except OSError:
+            return 0
+        removed = 0
+        if total > limit:
+            for _, size, path in sorted(entries):
+                if total <= limit * 3 // 4:
+                    break
+                try:
+                    os.unlink(path)
+                except OSError:
+                    continue
+                total -= size
+                removed += 1
+        return removed
