@@ -262,3 +262,23 @@ def test_the_cache_is_capped_and_the_oldest_entries_go(cache: Path, tmp_path: Pa
     assert removed > 0 and len(left) == 40 - removed
     assert left == [f"{i:02d}" for i in range(removed, 40)]  # the newest stay
     assert sum(p.stat().st_size for p in (cache / FOLDER).rglob("*.json")) <= sizes // 2 * 3 // 4
+
+
+def test_a_fresh_checkout_hits_and_a_same_size_edit_misses(cache: Path, tmp_path: Path) -> None:
+    # CI restores the cache onto a fresh checkout: every file has a new mtime (and inode),
+    # the same bytes. The stat differs, so the dependency is read and compared by digest.
+    _stl(tmp_path / "a.stl", 0.1)
+    robot = tmp_path / "r.urdf"
+    robot.write_text(ARM.format(mesh="a.stl"))
+    check_paths([robot], jobs=1)
+    for path in (robot, tmp_path / "a.stl"):
+        data = path.read_bytes()
+        path.unlink()
+        path.write_bytes(data)  # a new inode
+        os.utime(path, ns=(10**18, 10**18))  # and a new mtime
+    assert _cached(check_paths([robot], jobs=1)) == {"r.urdf": True}
+    # the same size, different bytes: a miss (a 0.1 m cube becomes a 0.2 m one)
+    _stl(tmp_path / "b.stl", 0.2)
+    os.replace(tmp_path / "b.stl", tmp_path / "a.stl")
+    os.utime(tmp_path / "a.stl", ns=(10**18, 10**18))
+    assert _cached(check_paths([robot], jobs=1)) == {"r.urdf": False}

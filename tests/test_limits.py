@@ -172,3 +172,45 @@ def test_a_20_mb_string_in_a_config_comes_back_short(tmp_path: Path) -> None:
     code, _, err = invoke("sim", str(path))
     line = one_line(err)
     assert code == 2 and len(line) < 1000 and "(20,000,005 characters)" in line
+
+
+# --------------------------------------------------------------------------- fuzz finds
+
+
+NAN_ARM = """<?xml version="1.0"?>
+<robot name="r">
+  <link name="base"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="tip"><inertial><mass value="1"/>
+    <inertia ixx="0.01" iyy="nan" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><cylinder radius="0.05" length="{length}"/></geometry></collision>
+  </link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".jsonl"])
+def test_a_sweep_whose_simulation_blows_up_writes_null_not_exit_3(tmp_path: Path,
+                                                                  suffix: str) -> None:
+    (tmp_path / "r.urdf").write_text(NAN_ARM.format(length="0.1"))
+    scenario = tmp_path / "s.json"
+    scenario.write_text(json.dumps({"duration": 0.05, "robots": [
+        {"name": "r", "urdf": "r.urdf", "base": "fixed"}]}))
+    out = tmp_path / f"rows{suffix}"
+    code, _, err = invoke("sweep", "sim", str(scenario), "--vary", "duration=0.02,0.04",
+                          "--jobs", "1", "-o", str(out))
+    assert code == 0, err
+    assert "not finite" in err and "written as null" in err
+    rows = sweep.read_rows(out)
+    assert len(rows) == 2 and any(v is None or v == "" for v in rows[0].values())
+
+
+def test_a_subnormal_cylinder_is_checked_and_fixed_without_a_bug(tmp_path: Path) -> None:
+    robot = tmp_path / "r.urdf"
+    robot.write_text(NAN_ARM.format(length="1e-320").replace('iyy="nan"', 'iyy="0.01"'))
+    for args in (["check", str(robot)], ["fix", str(robot), "--diff"]):
+        code, _, err = invoke(*args)
+        assert code in (0, 1), err
+        assert "internal error" not in err

@@ -303,9 +303,9 @@ def _check_one(job: _Job) -> FileResult:
     hit = cache.get(key)
     if hit is not None:
         return FileResult(display, [Finding(**f) for f in hit], cached=True)
-    with deps.record() as recorded:
-        recorded[os.path.abspath(path)] = deps.signature(os.path.abspath(path))
+    with deps.record() as recorded:  # the file itself is in the key, by its content
         result = check_file(display, path, pkgs, no_exec, xacro_args, physics)
+    recorded.pop(os.path.abspath(path), None)
     cache.put(key, recorded, [f.to_dict() for f in result.findings])
     return result
 

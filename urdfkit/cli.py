@@ -1010,6 +1010,7 @@ def sweep(
         journal.open()
         for note in journal.notes:
             show.warn(note)
+    noted = len(journal.notes) if journal is not None else 0
     keep = out is None or plot is not None or as_json
     rows: list[dict[str, Any]] = list(journal.done) if journal is not None and keep else []
     skip = journal.finished if journal is not None and resume else None
@@ -1034,6 +1035,8 @@ def sweep(
     finally:
         stop()
         written = journal.finish() if journal is not None else None
+    for note in journal.notes[noted:] if journal is not None else []:
+        show.warn(note)
     written_plot: Path | None = None
     failed_plot = False
     if picture is not None and rows:

@@ -6,9 +6,12 @@ its xacro includes and YAML, its meshes, the ``package.xml`` files and folders a
 appears later changes the findings as surely as one that changes). Readers and probes call
 :func:`note`; it costs nothing unless :func:`record` is active.
 
-A path's signature is what ``stat`` says: for a file its size, modification time (ns), inode
-and mode; for a folder only that it is one; ``None`` for nothing there. A result is reused only
-while every signature is unchanged.
+A path's signature is what ``stat`` says, and for a file also a digest of its bytes: its
+size, modification time (ns), inode, mode and BLAKE2b. A result is reused only while every
+path is unchanged, judged as git judges its index: the same ``stat`` is unchanged at no cost;
+a different ``stat`` with the same size is read and compared by digest (a fresh checkout in CI
+gives every file a new modification time, not new bytes). A folder signs as only being one;
+nothing there as ``None``.
 """
 
 from __future__ import annotations
@@ -18,21 +21,46 @@ import stat
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 
-#: A path's signature: (size, mtime_ns, inode, mode) for a file, ("dir",) for a folder, None
-#: when nothing is there, or ("other", mode) for a FIFO, device or socket.
-Signature = tuple[int, int, int, int] | tuple[str] | tuple[str, int] | None
+#: A path's signature: (size, mtime_ns, inode, mode, digest) for a file, ("dir",) for a
+#: folder, None when nothing is there, or ("other", mode) for a FIFO, device or socket.
+Signature = tuple[int, int, int, int, str] | tuple[str] | tuple[str, int] | None
+#: A file larger than this is judged by its stat alone (never read just to sign it).
+MAX_DIGEST_BYTES = 256 * 1024 * 1024
 
 _active: list[dict[str, Signature]] = []
 
 
+def digest(path: str, size: int) -> str:
+    """BLAKE2b of a regular file's bytes ("" if it cannot be read or is too large to sign)."""
+    import hashlib
+
+    if size > MAX_DIGEST_BYTES:
+        return ""
+    h = hashlib.blake2b(digest_size=16)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except (OSError, ValueError):
+        return ""
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return ""
+        while chunk := os.read(fd, 1 << 20):
+            h.update(chunk)
+    except OSError:
+        return ""
+    finally:
+        os.close(fd)
+    return h.hexdigest()
+
+
 def signature(path: str) -> Signature:
-    """What ``stat`` says of ``path`` now (following symlinks), as compared for reuse."""
+    """What ``stat`` says of ``path`` now (following symlinks), and a file's digest."""
     try:
         st = os.stat(path)
     except (OSError, ValueError):
         return None
     if stat.S_ISREG(st.st_mode):
-        return (st.st_size, st.st_mtime_ns, st.st_ino, st.st_mode)
+        return (st.st_size, st.st_mtime_ns, st.st_ino, st.st_mode, digest(path, st.st_size))
     if stat.S_ISDIR(st.st_mode):
         return ("dir",)
     return ("other", st.st_mode)
@@ -76,15 +104,31 @@ def record() -> Iterator[dict[str, Signature]]:
 
 
 def unchanged(recorded: Mapping[str, object]) -> bool:
-    """Whether every recorded path still has the signature it had (lists compare as tuples)."""
+    """Whether every recorded path is as it was (see the module docstring)."""
     for path, was in recorded.items():
+        was = tuple(was) if isinstance(was, list) else was
         if path.endswith(os.sep):  # a folder listing: its mtime
             try:
                 now: object = ("listing", os.stat(path).st_mtime_ns)
             except (OSError, ValueError):
                 now = None
-        else:
-            now = signature(path)
-        if (tuple(was) if isinstance(was, list) else was) != now:
+            if was != now:
+                return False
+            continue
+        try:
+            st = os.stat(path)
+        except (OSError, ValueError):
+            if was is not None:
+                return False
+            continue
+        if not stat.S_ISREG(st.st_mode):
+            if was != (("dir",) if stat.S_ISDIR(st.st_mode) else ("other", st.st_mode)):
+                return False
+            continue
+        if not (isinstance(was, tuple) and len(was) == 5):
+            return False
+        if was[:4] == (st.st_size, st.st_mtime_ns, st.st_ino, st.st_mode):
+            continue  # the same stat: the same file, as git's index judges it
+        if was[0] != st.st_size or not was[4] or digest(path, st.st_size) != was[4]:
             return False
     return True

@@ -694,6 +694,7 @@ class Journal:
     notes: list[str] = field(default_factory=list)
     _fd: int | None = None
     _keys: set[tuple[str, ...]] | None = None
+    _nonfinite: bool = False
 
     @property
     def partial(self) -> Path:
@@ -801,7 +802,19 @@ class Journal:
             raise _write_error(e, self.partial) from None
 
     def add(self, row: Mapping[str, Any]) -> None:
-        """Record a finished point."""
+        """Record a finished point.
+
+        A metric that is not finite (a robot whose file holds NaN blew up) is recorded as
+        null, as ``--json`` writes it, with one note for the run: JSON has no NaN.
+        """
+        bad = [k for k, v in row.items() if isinstance(v, float) and not math.isfinite(v)]
+        if bad:
+            row = {k: None if k in bad else v for k, v in row.items()}
+            if not self._nonfinite:
+                self._nonfinite = True
+                self.notes.append(f"point {row.get('point')}: {', '.join(bad[:3])}"
+                                  f"{' ...' if len(bad) > 3 else ''} not finite (the "
+                                  "simulation blew up): written as null")
         self._write(row)
 
     def finished(self, values: Mapping[str, Any]) -> bool:

@@ -647,7 +647,7 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
                   f"no rigid body has it: lower the largest to at most {a + b:.4g}{fix}",
                   inertia)
             continue
-        if shapes and trace > 0 and not 0.1 <= trace / shapes[0] <= 10:
+        if shapes and shapes[0] > 0 and trace > 0 and not 0.1 <= trace / shapes[0] <= 10:
             ratio = f"inertia of {_label(link)} is {trace / shapes[0]:.3g} times what its " \
                     f"collision shapes and mass {mass:g} kg imply"
             if shapes[1] < STUB_SIZE:
