@@ -282,3 +282,9 @@ def test_a_fresh_checkout_hits_and_a_same_size_edit_misses(cache: Path, tmp_path
     os.replace(tmp_path / "b.stl", tmp_path / "a.stl")
     os.utime(tmp_path / "a.stl", ns=(10**18, 10**18))
     assert _cached(check_paths([robot], jobs=1)) == {"r.urdf": False}
+
+
+def test_the_keyed_size_limit_is_the_readers() -> None:
+    from urdfkit import resultcache, xmlio
+
+    assert resultcache.MAX_FILE_BYTES == xmlio.MAX_FILE_BYTES

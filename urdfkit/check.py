@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import InputError, ParameterError
+from .finding import LEVELS, Finding
 from .spec import PYBULLET_LINE_BYTES
-from .validate import ALL_RULES, CODES, LEVELS, Finding, refuse_oversized, run_rules
 
 #: File suffixes a folder search picks up.
 SUFFIXES = (".urdf", ".xacro")
@@ -81,8 +81,12 @@ def parse_codes(items: Sequence[str] | None, option: str) -> tuple[str, ...]:
     Raises:
         ParameterError: a value matches no known code.
     """
+    if not items:
+        return ()
+    from .validate import CODES
+
     out: list[str] = []
-    for item in items or []:
+    for item in items:
         for code in (c.strip().upper() for c in item.split(",")):
             if not code:
                 continue
@@ -93,7 +97,7 @@ def parse_codes(items: Sequence[str] | None, option: str) -> tuple[str, ...]:
     return tuple(out)
 
 
-def discover(paths: Iterable[str | Path]) -> list[tuple[str, Path, str | None]]:
+def discover(paths: Iterable[str | Path]) -> list[tuple[str, str, str | None]]:
     """Expand the command-line paths into ``(display name, path, problem)`` triples.
 
     A folder is walked with ``os.scandir`` (not following symlinked folders, so a link loop
@@ -105,10 +109,10 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, Path, str | None]]:
     Raises:
         ParameterError: a path given on the command line does not exist (exit code 2).
     """
-    out: list[tuple[str, Path, str | None]] = []
+    out: list[tuple[str, str, str | None]] = []
     seen: set[str] = set()
 
-    def add(display: str, path: Path, problem: str | None = None) -> None:
+    def add(display: str, path: str, problem: str | None = None) -> None:
         key = os.path.abspath(path)
         if key not in seen:
             seen.add(key)
@@ -126,7 +130,7 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, Path, str | None]]:
                     with os.scandir(folder) as it:
                         entries = sorted(it, key=lambda e: e.name)
                 except OSError as e:
-                    add(folder, Path(folder), f"cannot list this folder: {e.strerror}")
+                    add(folder, folder, f"cannot list this folder: {e.strerror}")
                     continue
                 subdirs = []
                 for entry in entries:
@@ -135,12 +139,12 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, Path, str | None]]:
                     except OSError:
                         is_dir = False
                     if entry.name.endswith(SUFFIXES):
-                        add(entry.path, Path(entry.path))
+                        add(entry.path, entry.path)
                     elif is_dir:
                         subdirs.append(entry.path)
                 stack.extend(reversed(subdirs))
         else:
-            add(str(item), path)
+            add(str(item), str(path))
     return out
 
 
@@ -175,6 +179,7 @@ def check_file(display: str, path: str | Path,
     from lxml import etree
 
     from .expand import XacroNotExpanded
+    from .validate import ALL_RULES, refuse_oversized, run_rules
     from .xmlio import line_of, long_line, parse_xml, tolerate_quirks
 
     path = Path(path)
@@ -271,29 +276,28 @@ def _macro_library(root: object) -> bool:
 
 
 _Job = tuple[str, str, str | None, dict[str, str], bool, dict[str, str], bool, bool]
-_caches: dict[str, object] = {}
+_caches: dict[tuple[object, ...], object] = {}
 
 
 def _check_one(job: _Job) -> FileResult:
     display, path, problem, packages, no_exec, xacro_args, physics, use_cache = job
     if problem is not None:
         return FileResult(display, [Finding("U000", "error", problem, display)])
-    pkgs = {k: Path(v) for k, v in packages.items()}
+    pkgs = {k: Path(v) for k, v in packages.items()} if packages else {}
     if not use_cache:
         return check_file(display, path, pkgs, no_exec, xacro_args, physics)
     from . import deps
     from .resultcache import ResultCache
 
-    options: dict[str, object] = {"packages": packages, "no_exec": no_exec,
-                                  "xacro_args": xacro_args, "physics": physics}
-    if physics:  # U950/U951 come from PyBullet itself
-        from importlib.metadata import version
-
-        options["pybullet"] = version("pybullet")
-    from .cache import cache_dir
-
-    memo = repr((sorted(options.items()), cache_dir()))
+    memo = (tuple(sorted(packages.items())), no_exec, tuple(sorted(xacro_args.items())),
+            physics, os.environ.get("URDFKIT_CACHE_DIR"))
     if memo not in _caches:  # one per option set and process (the key prefix is made once)
+        options: dict[str, object] = {"packages": packages, "no_exec": no_exec,
+                                      "xacro_args": xacro_args, "physics": physics}
+        if physics:  # U950/U951 come from PyBullet itself
+            from importlib.metadata import version
+
+            options["pybullet"] = version("pybullet")
         _caches[memo] = ResultCache.open(options)
     cache = _caches[memo]
     assert cache is None or isinstance(cache, ResultCache)
@@ -367,7 +371,7 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
     files = discover(paths)
     pkgs = {k: str(v) for k, v in (packages or {}).items()}
     args = dict(xacro_args or {})
-    work = [(display, str(path), problem, pkgs, no_exec, args, physics, cache)
+    work = [(display, path, problem, pkgs, no_exec, args, physics, cache)
             for display, path, problem in files]
     workers = min(jobs or default_jobs(), max(1, len(work) // _PARALLEL_MIN))
     if workers <= 1:

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 from urllib.parse import quote
 
 from . import __version__
-from .validate import CODES, LEVELS
+from .finding import LEVELS
 
 if TYPE_CHECKING:
     from .check import CheckResult
@@ -42,6 +42,13 @@ GITHUB_COMMAND = {"error": "error", "warning": "warning", "info": "notice"}
 
 # --------------------------------------------------------------------------- paths
 
+
+
+def _codes() -> dict[str, str]:
+    """Every rule code and its title (the rules module, loaded only for SARIF's rule list)."""
+    from .validate import CODES
+
+    return CODES
 
 def relative_path(file: str) -> str | None:
     """``file`` relative to the current folder, with ``/`` separators; None outside it.
@@ -118,7 +125,7 @@ def sarif_log(result: CheckResult) -> dict[str, Any]:
     codes = sorted(worst)
     index = {code: i for i, code in enumerate(codes)}
     rules = [{"id": code,
-              "shortDescription": {"text": CODES.get(code, code)},
+              "shortDescription": {"text": _codes().get(code, code)},
               "help": {"text": "See docs/check.md, section Rules, in the urdfkit "
                                "repository."},
               "defaultConfiguration": {"level": SARIF_LEVEL[worst[code]]}}

@@ -222,7 +222,7 @@ def build(
     Python code, so only expand files you trust (see docs/security.md).
     """
     from . import build as building
-    from .resolve import parse_packages
+    from .uris import parse_packages
 
     result = building.build(target, params=set_, xacro_args=arg,
                             packages=parse_packages(package, package_path))
@@ -535,7 +535,7 @@ def check(
     """
     from .check import check_paths, parse_codes
     from .errors import ParameterError
-    from .resolve import parse_packages
+    from .uris import parse_packages
 
     if fail_on not in ("error", "warning", "info"):
         from .suggest import hint
@@ -658,7 +658,7 @@ def fix(
     from .errors import ParameterError
     from .fix import FIXABLE, fix_file
     from .output import atomic_write, check_output
-    from .resolve import parse_packages
+    from .uris import parse_packages
 
     if sum((output is not None, in_place, show_diff)) != 1:
         raise ParameterError("say where the repaired file goes: -o OUT, --in-place, or --diff "
@@ -1210,7 +1210,7 @@ def collisions(
     from .collisions import self_collisions
     from .errors import ParameterError
     from .render import parse_joint_positions
-    from .resolve import parse_packages
+    from .uris import parse_packages
 
     if sum((as_json, srdf, python)) > 1:
         raise ParameterError("--json, --srdf and --python are exclusive: pick one")

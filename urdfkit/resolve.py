@@ -22,10 +22,11 @@ from typing import Any
 
 from lxml import etree
 
-from .errors import InputError, ParameterError
+from .errors import InputError
 from .expand import expand_xacro
 from .spec import FILE_SHAPES, FILE_TAGS, PYBULLET_LINE_BYTES
-from .uris import PackageIndex, not_a_file, pybullet_data_path
+from .uris import not_a_file, pybullet_data_path
+from .uris import parse_packages as parse_packages  # re-exported: callers import it here
 from .validate import STRICTER, Finding, reference, refuse_oversized
 from .validate import guard as run_guard
 from .xmlio import line_of, long_line, parse_xml, read_bytes, to_bytes
@@ -69,29 +70,6 @@ def _utf8(text: str) -> bool:
     except UnicodeEncodeError:
         return False
     return True
-
-
-def parse_packages(items: list[str] | None,
-                   package_paths: list[str] | None = None) -> PackageIndex:
-    """Where packages are, as a :class:`urdfkit.uris.PackageIndex`.
-
-    ``NAME=PATH`` items (``--package``) first, then ``package_paths`` (``--package-path``),
-    then ROS_PACKAGE_PATH and AMENT_PREFIX_PATH.
-    """
-    out: dict[str, Path] = {}
-    for item in items or []:
-        name, sep, path = item.partition("=")
-        if not sep or not name or not path:
-            raise ParameterError(f"`packages` expects NAME=PATH, got {item!r}", param="packages")
-        if not Path(path).is_dir():
-            raise ParameterError(f"`packages` {name}: folder {path!r} does not exist",
-                                 param="packages")
-        out[name] = Path(path).resolve()
-    for folder in package_paths or []:
-        if not Path(folder).is_dir():
-            raise ParameterError(f"`package_paths`: folder {folder!r} does not exist",
-                                 param="package_paths")
-    return PackageIndex(out, [str(Path(p).resolve()) for p in package_paths or []])
 
 
 @dataclass

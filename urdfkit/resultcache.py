@@ -32,8 +32,10 @@ from typing import Any
 
 from . import deps
 from .cache import MAX_ENTRY_BYTES, cache_dir, write_entry
-from .xmlio import MAX_FILE_BYTES
 
+#: The largest file keyed (:data:`urdfkit.xmlio.MAX_FILE_BYTES`, not imported: lxml is slow
+#: to load, and a cached run never needs it). A larger file is checked uncached.
+MAX_FILE_BYTES = 32 * 1024 * 1024
 #: The subfolder of the cache folder.
 FOLDER = "check-v1"
 #: The most the result cache may hold; past it the oldest entries go, down to 3/4 of it.

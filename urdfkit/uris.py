@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import deps
+from .errors import ParameterError
 
 #: How many folders above the file PyBullet searches for a ``package://`` path.
 PYBULLET_SEARCH_DEPTH = 5
@@ -218,3 +219,26 @@ def _is_file(path: Path) -> bool:
         return os.path.isfile(path)
     except (OSError, ValueError):
         return False
+
+
+def parse_packages(items: list[str] | None,
+                   package_paths: list[str] | None = None) -> PackageIndex:
+    """Where packages are, as a :class:`urdfkit.uris.PackageIndex`.
+
+    ``NAME=PATH`` items (``--package``) first, then ``package_paths`` (``--package-path``),
+    then ROS_PACKAGE_PATH and AMENT_PREFIX_PATH.
+    """
+    out: dict[str, Path] = {}
+    for item in items or []:
+        name, sep, path = item.partition("=")
+        if not sep or not name or not path:
+            raise ParameterError(f"`packages` expects NAME=PATH, got {item!r}", param="packages")
+        if not Path(path).is_dir():
+            raise ParameterError(f"`packages` {name}: folder {path!r} does not exist",
+                                 param="packages")
+        out[name] = Path(path).resolve()
+    for folder in package_paths or []:
+        if not Path(folder).is_dir():
+            raise ParameterError(f"`package_paths`: folder {folder!r} does not exist",
+                                 param="package_paths")
+    return PackageIndex(out, [str(Path(p).resolve()) for p in package_paths or []])

@@ -14,12 +14,13 @@ import math
 import re
 import sys
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 
 from lxml import etree
 
 from .errors import InputError
+from .finding import LEVELS, Finding  # noqa: F401 - re-exported: rules and callers use both
 from .spec import (
     CRASH_NAME_BYTES,
     CRASH_PERCENT_TAGS,
@@ -52,41 +53,6 @@ from .spec import attr_float as _num
 from .spec import attr_vec as _vec
 from .uris import not_a_file, pybullet_data_path, resolve_uri
 from .xmlio import children, line_of
-
-LEVELS = ("info", "warning", "error")
-
-
-@dataclass(frozen=True)
-class Finding:
-    """One problem found in a file.
-
-    Attributes:
-        code: A stable identifier such as ``U201``, for ``--select`` and ``--ignore``.
-        level: ``error``, ``warning`` or ``info``.
-        message: What is wrong with which element, and how to fix it.
-        file: The file, as the user named it.
-        line: The 1-based line, where known.
-    """
-
-    code: str
-    level: str
-    message: str
-    file: str
-    line: int | None = None
-    origin: str | None = None
-
-    def to_dict(self) -> dict[str, object]:
-        """The JSON form."""
-        return asdict(self)
-
-    def __str__(self) -> str:
-        where = self.file if self.line is None else f"{self.file}:{self.line}"
-        return f"{where}: {self.level} {self.code}: {self.text}"
-
-    @property
-    def text(self) -> str:
-        """The message, with where the element was written when that is another file."""
-        return f"{self.message} (written at {self.origin})" if self.origin else self.message
 
 
 class Report:
