@@ -666,6 +666,8 @@ def fix(
     if as_json and (show_diff or output == "-"):
         raise ParameterError("--json describes the fixes of -o FILE or --in-place; --diff and "
                              "-o - print text on stdout")
+    if output is not None and not output.strip():
+        raise ParameterError("-o needs a file name (or - for stdout)")
     codes = parse_codes(select, "`select`")
     if any(not any(f.startswith(c) for f in FIXABLE) for c in codes):
         raise ParameterError(f"`select`: fix repairs {', '.join(FIXABLE)} only")
@@ -677,22 +679,28 @@ def fix(
     if in_place and result.changed:
         check_output(backup, force=force, what="the backup")
     to_stdout = output == "-" or show_diff
-    if as_json and not to_stdout:
-        show.print_json(result.to_dict())
-    else:
-        show.fix_report(result, stderr=to_stdout)
+
+    def report() -> None:  # after the write: nothing is said "fixed" that was not written
+        if as_json and not to_stdout:
+            show.print_json(result.to_dict())
+        else:
+            show.fix_report(result, stderr=to_stdout)
+
     if show_diff:
+        report()
         sys.stdout.write(result.diff())
         raise typer.Exit(1 if result.changed or result.left or result.other_errors else 0)
     if output == "-":
+        report()
         sys.stdout.buffer.write(result.fixed)
         sys.stdout.flush()
     elif in_place:
         if result.changed:
             atomic_write(backup, result.original, force=force, like=file)
             atomic_write(file, result.fixed, force=True)
-            if not as_json:
-                show.wrote(Path(file), f"original kept as {backup}")
+        report()
+        if result.changed and not as_json:
+            show.wrote(Path(file), f"original kept as {backup}")
     else:
         assert output is not None
         if result.relative_paths and \
@@ -702,6 +710,7 @@ def fix(
                       "do not resolve from where it is written: write it beside the original "
                       "(or --in-place), or copy what it names")
         path = atomic_write(output, result.fixed, force=force)
+        report()
         if not as_json:
             show.wrote(path, f"{len(result.repairs)} fix(es)")
     if result.left or result.other_errors:

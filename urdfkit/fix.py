@@ -70,6 +70,8 @@ class Repair:
     code: str
     line: int | None
     message: str
+    #: The link a repair is to (for the re-check), not in the JSON.
+    subject: str | None = field(default=None, compare=False)
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form."""
@@ -160,24 +162,40 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float = DEFAUL
     for rule in ALL_RULES:
         rule(root, report)
     wanted = tuple(c.upper() for c in select)
-    plan = _Plan(text, root, display, balance, density, report)
-    found: dict[etree._Element, list[tuple[str, int | None]]] = {}
-    for f, el in zip(report.findings, report.elements, strict=True):
-        if f.code not in FIXABLE or el is None:
-            continue
-        if wanted and not any(f.code.startswith(w) for w in wanted):
-            continue
-        target = el if f.code in ("U706", "U708") else _link_of(el)
-        if target is not None:
-            found.setdefault(target, []).append((f.code, f.line))
-    for el, codes in found.items():
-        if el.tag == "link":
-            plan.fix_link(el, codes)
-        elif codes[0][0] == "U706":
-            plan.define_material(el, codes[0][1])
-        else:
-            plan.normalise_uri(el, codes[0][1], packages)
-    fixed = plan.finish()
+
+    def run(skip: Mapping[str, str]) -> tuple[_Plan, bytes]:
+        # A fresh tree each time (the plan edits the tree it is given); the findings' elements
+        # are the pristine ``root``'s, mapped to it by position.
+        tree = parse_xml(data, display).getroot()
+        plan = _Plan(text, tree, display, balance, density, report)
+        elements = _same_elements(root, tree)
+        found: dict[etree._Element, list[tuple[str, int | None]]] = {}
+        for f, el in zip(report.findings, report.elements, strict=True):
+            if f.code not in FIXABLE or el is None:
+                continue
+            if wanted and not any(f.code.startswith(w) for w in wanted):
+                continue
+            target = el if f.code in ("U706", "U708") else _link_of(el)
+            if target is not None:
+                found.setdefault(elements[target], []).append((f.code, f.line))
+        for el, codes in found.items():
+            if el.tag == "link" and el.get("name", "") in skip:
+                plan.left.append(Repair(codes[0][0], codes[0][1],
+                                        f"link {el.get('name', '')!r}: {skip[el.get('name', '')]}"))
+            elif el.tag == "link":
+                plan.fix_link(el, codes)
+            elif codes[0][0] == "U706":
+                plan.define_material(el, codes[0][1])
+            else:
+                plan.normalise_uri(el, codes[0][1], packages)
+        return plan, plan.finish()
+
+    plan, fixed = run({})
+    # A fix counts only if check then passes its rule: re-check the repaired links, and redo
+    # without those still flagged (a mass of 1e308 has no inertia a float can hold).
+    still = _unfixed(fixed, display, source, packages, plan.repairs)
+    if still:
+        plan, fixed = run(still)
     others = [Repair(f.code, f.line, f.message) for f in report.findings
               if f.level == "error" and f.code not in FIXABLE]
     from .spec import FILE_TAGS
@@ -186,6 +204,31 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float = DEFAUL
                        .strip()) and "://" not in fn and not Path(fn).is_absolute()})
     return FixResult(display, data, fixed, sorted(plan.repairs, key=_by_line),
                      sorted(plan.left, key=_by_line), others, relative)
+
+
+def _same_elements(a: etree._Element, b: etree._Element) -> dict[etree._Element, etree._Element]:
+    """Each element of tree ``a`` mapped to the one at the same place in ``b`` (a re-parse)."""
+    return dict(zip(a.iter(), b.iter(), strict=True))
+
+
+def _unfixed(fixed: bytes, display: str, source: Path, packages: Mapping[str, Path] | None,
+             repairs: Sequence[Repair]) -> dict[str, str]:
+    """Links whose inertia repair ``check`` would still flag, each with the finding."""
+    subjects = {r.subject for r in repairs if r.subject is not None and r.code in _INERTIA_ORDER}
+    if not subjects:
+        return {}
+    report = Report(display, source.absolute().parent, packages)
+    tree = parse_xml(fixed, display).getroot()
+    for rule in ALL_RULES:
+        rule(tree, report)
+    out: dict[str, str] = {}
+    for f, el in zip(report.findings, report.elements, strict=True):
+        link = _link_of(el) if el is not None else None
+        name = link.get("name", "") if link is not None else None
+        if name in subjects and f.code in _INERTIA_ORDER and name not in out:
+            out[name] = (f"not fixed: the derived inertial still fails {f.code} "
+                         f"({f.message}); set a mass a float can carry, then run fix again")
+    return out
 
 
 def _by_line(x: Repair) -> tuple[int, str]:
@@ -242,6 +285,14 @@ class _Plan:
     # ---- repairs
 
     def fix_link(self, link: etree._Element, codes: list[tuple[str, int | None]]) -> None:
+        before = len(self.repairs)
+        try:
+            self._fix_link(link, codes)
+        finally:
+            for r in self.repairs[before:]:
+                r.subject = link.get("name", "")
+
+    def _fix_link(self, link: etree._Element, codes: list[tuple[str, int | None]]) -> None:
         by_code = dict(codes)
         code = next(c for c in _INERTIA_ORDER if c in by_code)
         line = by_code[code]

@@ -1,0 +1,85 @@
+"""fix says "fixed" only for what it wrote and what check then passes (issue 26, class 4 and 8)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from urdfkit.check import check_paths
+from urdfkit.cli import app
+from urdfkit.errors import OutputError
+
+runner = CliRunner()
+
+ROBOT = """<?xml version="1.0"?>
+<robot name="r">
+  <link name="a"><inertial><mass value="{mass}"/>
+    <inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <link name="b"><inertial><mass value="2"/>
+    <inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.1 0.2 0.3"/></geometry></collision></link>
+  <joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>
+</robot>
+"""
+INERTIA = ("U601", "U602", "U603", "U604", "U605", "U606", "U608", "U609", "U610")
+
+
+def _inertia_codes(path: Path) -> dict[str, set[str]]:
+    out: dict[str, set[str]] = {}
+    for f in check_paths([path], jobs=1, cache=False).findings:
+        if f.code in INERTIA:
+            name = f.message.split("'")[1] if "'" in f.message else ""
+            out.setdefault(name, set()).add(f.code)
+    return out
+
+
+def test_a_mass_no_float_inertia_can_carry_is_left_and_said(tmp_path: Path) -> None:
+    src, out = tmp_path / "r.urdf", tmp_path / "fixed.urdf"
+    src.write_text(ROBOT.format(mass="1e308"))
+    result = runner.invoke(app, ["fix", str(src), "-o", str(out)])
+    assert result.exit_code == 1, result.output
+    assert "left U605 link 'a': not fixed" in result.stdout
+    assert "fixed U605 link 'a'" not in result.stdout
+    assert "fixed U605 link 'b'" in result.stdout  # the other link is repaired
+    # what was written passes check for every repaired link: only 'a' is still flagged
+    codes = _inertia_codes(out)
+    assert "b" not in codes and codes.get("a")
+
+
+@pytest.mark.parametrize("mass", ["nan", "inf", "-inf"])
+def test_a_non_finite_mass_is_never_reported_fixed(tmp_path: Path, mass: str) -> None:
+    src = tmp_path / "r.urdf"
+    src.write_text(ROBOT.format(mass=mass))
+    result = runner.invoke(app, ["fix", str(src), "-o", str(tmp_path / "f.urdf")])
+    assert result.exit_code == 1
+    assert "fixed U60" not in result.stdout.replace("fixed U605 link 'b'", "")
+    assert "U401" in result.stdout  # said as an error fix does not repair
+
+
+def test_an_empty_output_name_is_a_usage_error(tmp_path: Path) -> None:
+    src = tmp_path / "r.urdf"
+    src.write_text(ROBOT.format(mass="1"))
+    result = runner.invoke(app, ["fix", str(src), "-o", ""])
+    assert result.exit_code == 2
+    assert result.stderr.strip() == "urdfkit: error: -o needs a file name (or - for stdout)"
+
+
+def test_nothing_is_said_fixed_when_the_write_fails(tmp_path: Path,
+                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    import urdfkit.output
+
+    def full(path: object, *_a: object, **_k: object) -> None:
+        raise OutputError("cannot write: no space left on device", file=str(path))
+
+    monkeypatch.setattr(urdfkit.output, "atomic_write", full)
+    src = tmp_path / "r.urdf"
+    src.write_text(ROBOT.format(mass="1"))
+    for args in (["-o", str(tmp_path / "f.urdf")], ["--in-place"]):
+        result = runner.invoke(app, ["fix", str(src), *args])
+        assert result.exit_code == 2
+        lines = [ln for ln in result.stderr.splitlines() if ln.strip()]
+        assert lines == [f"urdfkit: error: {lines[0].split('error: ', 1)[1]}"]
+        assert "no space left" in lines[0] and ": fixed " not in result.output
