@@ -214,3 +214,35 @@ def test_a_subnormal_cylinder_is_checked_and_fixed_without_a_bug(tmp_path: Path)
         code, _, err = invoke(*args)
         assert code in (0, 1), err
         assert "internal error" not in err
+
+
+RING = """<?xml version="1.0"?>
+<robot name="r">
+  <link name="a"/><link name="b"/><link name="c"/><link name="d"/>
+  <joint name="j1" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="j2"/></joint>
+  <joint name="j2" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="{lead}"/></joint>
+  <joint name="j3" type="revolute"><parent link="c"/><child link="d"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+def test_check_flags_a_ring_of_mimic_joints_once_and_a_chain_not_at_all(tmp_path: Path) -> None:
+    from urdfkit.check import check_paths
+
+    ring, chain = tmp_path / "ring.urdf", tmp_path / "chain.urdf"
+    ring.write_text(RING.format(lead="j1"))
+    chain.write_text(RING.format(lead="j3"))  # j1 -> j2 -> j3: a chain with a leader
+    found = check_paths([ring, chain], jobs=1, cache=False)
+    by_file = {Path(fr.file).name: [f for f in fr.findings if f.code == "U309"]
+               for fr in found.files}
+    assert len(by_file["ring.urdf"]) == 1 and by_file["chain.urdf"] == []
+    f = by_file["ring.urdf"][0]
+    assert f.level == "error" and "'j1' -> 'j2' -> 'j1'" in f.message and f.line == 5
+    # collisions refuses the same file, and agrees with check on the chain
+    code, _, err = invoke("collisions", str(ring))
+    assert code == 2 and "ring" in err
+    code, _, err = invoke("collisions", str(chain), "--samples", "2")
+    assert code in (0, 1), err

@@ -361,8 +361,9 @@ for (_tag, _attr), _n in NUMERIC.items():
 
 
 def rule_joints(root: etree._Element, r: Report) -> None:
-    """U301-U307: joint type known, limits present and ordered, axis non-zero, mimic exists."""
+    """U301-U307, U309: joint type, limits, axis; a mimic's leader exists and leads somewhere."""
     joints = {j.get("name") for j in _elements(root, "joint")}
+    leaders: dict[str | None, tuple[str | None, etree._Element]] = {}
     for j in _elements(root, "joint"):
         jtype = j.get("type")
         if jtype not in JOINT_TYPES:
@@ -401,6 +402,20 @@ def rule_joints(root: etree._Element, r: Report) -> None:
             if target not in joints or target == j.get("name"):
                 r.add("U307", "error", f"<mimic> of {_label(j)} follows joint {target!r}, which "
                       "does not exist (or is itself); name another joint", mimic)
+            else:
+                leaders[j.get("name")] = (target, mimic)
+    reported: set[str | None] = set()
+    for start in leaders:
+        ring, name = [start], leaders[start][0]
+        while name in leaders and name not in ring:
+            ring.append(name)
+            name = leaders[name][0]
+        if name == start and start not in reported:
+            reported.update(ring)
+            r.add("U309", "error", "mimic joints follow each other in a ring ("
+                  + " -> ".join(repr(n) for n in [*ring, start]) + "): none has a leader to "
+                  "take its position from; make one of them an ordinary joint",
+                  leaders[start][1])
 
 
 def rule_geometry(root: etree._Element, r: Report) -> None:
@@ -1020,6 +1035,7 @@ CODES: dict[str, str] = {
     "U305": "zero joint axis",
     "U306": "joint axis not unit length",
     "U307": "mimic refers to a missing joint",
+    "U309": "mimic joints follow each other in a ring",
     "U308": "revolute/prismatic <limit> without lower or upper (PyBullet: unlimited)",
     "U401": "number does not parse or is not finite",
     "U402": "vector of the wrong length",
