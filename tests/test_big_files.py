@@ -72,7 +72,8 @@ def test_check_names_lines_past_the_cap(big: Path, fmt: str) -> None:
 
 def test_fix_splices_at_the_right_place_past_the_cap(big: Path, tmp_path: Path) -> None:
     out = tmp_path / "fixed.urdf"
-    result = CliRunner().invoke(app, ["fix", str(big), "-o", str(out), "--select", "U601"])
+    result = CliRunner().invoke(app, ["fix", str(big), "-o", str(out), "--select", "U601",
+                                       "--density", "1000", "--allow-mass-change"])
     assert result.exit_code == 0, result.stderr
     before, after = big.read_text().splitlines(), out.read_text().splitlines()
     assert len(before) == len(after)

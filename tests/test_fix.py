@@ -44,7 +44,7 @@ def _cli(*args: str) -> tuple[int, str, str]:
 
 
 def test_every_fixable_finding_is_fixed_and_listed(broken: Path) -> None:
-    result = fix_file(broken)
+    result = fix_file(broken, density=1000.0)
     assert sorted({r.code for r in result.repairs}) == ["U602", "U603", "U604", "U606", "U706",
                                                         "U708"]
     assert not result.left and not result.other_errors
@@ -77,7 +77,7 @@ def test_only_what_is_fixed_changes(broken: Path) -> None:
 def test_derived_inertia_matches_the_closed_forms(broken: Path) -> None:
     from lxml import etree
 
-    root = etree.fromstring(fix_file(broken).fixed)
+    root = etree.fromstring(fix_file(broken, density=1000.0).fixed)
 
     def tensor(link: str) -> list[float]:  # row by row
         i = root.find(f"link[@name='{link}']/inertial/inertia")
@@ -162,7 +162,12 @@ def test_one_line_files_and_self_closing_links(tmp_path: Path) -> None:
                     'type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
                     '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint><joint name="f" '
                     'type="fixed"><parent link="b"/><child link="c"/></joint></robot>')
-    result = fix_file(path)
+    # By default fix invents no mass: only the frame 'c' gets its mass 0; a and b are left.
+    plain = fix_file(path)
+    assert [(r.code, r.subject) for r in plain.repairs] == [("U606", "c")]
+    assert [r.code for r in plain.left] == ["U606", "U606"]
+    assert "root link" in plain.left[0].message and "mass 0 if" not in plain.left[0].message
+    result = fix_file(path, density=1000.0)
     assert [r.code for r in result.repairs] == ["U606", "U606", "U606"]
     out = tmp_path / "out.urdf"
     out.write_bytes(result.fixed)
@@ -178,25 +183,28 @@ def test_one_line_files_and_self_closing_links(tmp_path: Path) -> None:
         pytest.approx(0.4 * m * 0.25, rel=1e-5)  # type: ignore[union-attr]
 
 
+MASS = ("--density", "1000", "--allow-mass-change")  # the fixture's massless links get one
+
+
 def test_cli_writes_only_where_told(broken: Path, tmp_path: Path) -> None:
     out = tmp_path / "out.urdf"
-    code, stdout, _ = _cli("fix", str(broken), "-o", str(out))
+    code, stdout, _ = _cli("fix", str(broken), *MASS, "-o", str(out))
     assert code == 0 and out.exists() and "fixed U604" in stdout
     original = broken.read_bytes()
-    code, _, err = _cli("fix", str(broken), "-o", str(out))
+    code, _, err = _cli("fix", str(broken), *MASS, "-o", str(out))
     assert code == 2 and "exists" in err  # never overwrite without --force
-    assert _cli("fix", str(broken), "-o", str(out), "--force")[0] == 0
-    code, stdout, err = _cli("fix", str(broken), "--diff")
+    assert _cli("fix", str(broken), *MASS, "-o", str(out), "--force")[0] == 0
+    code, stdout, err = _cli("fix", str(broken), *MASS, "--diff")
     assert code == 1 and stdout.startswith("--- a/") and "fixed U604" in err
     assert broken.read_bytes() == original  # --diff writes nothing
-    code, stdout, _ = _cli("fix", str(broken), "-o", "-")
+    code, stdout, _ = _cli("fix", str(broken), *MASS, "-o", "-")
     assert code == 0 and stdout.encode() == out.read_bytes()
-    code, stdout, _ = _cli("fix", str(broken), "--in-place", "--json")
+    code, stdout, _ = _cli("fix", str(broken), *MASS, "--in-place", "--json")
     data = json.loads(stdout)
     assert code == 0 and data["changed"] and {"code", "line", "message"} <= set(data["fixes"][0])
     assert Path(f"{broken}.orig").read_bytes() == original
     assert broken.read_bytes() == out.read_bytes()
-    assert _cli("fix", str(broken), "--diff")[0] == 0  # nothing left to fix
+    assert _cli("fix", str(broken), *MASS, "--diff")[0] == 0  # nothing left to fix
 
 
 def test_bad_input_and_usage(broken: Path, tmp_path: Path) -> None:
@@ -204,7 +212,7 @@ def test_bad_input_and_usage(broken: Path, tmp_path: Path) -> None:
                         (("--diff", "--select", "U3"), "repairs U601"),
                         (("--diff", "--density", "-5"), "density"),
                         (("--diff", "--json"), "--json describes")]:
-        code, _, err = _cli("fix", str(broken), *args)
+        code, _, err = _cli("fix", str(broken), *MASS, *args)
         assert code == 2 and words in err and "Traceback" not in err, (args, err)
     bad = tmp_path / "bad.urdf"
     bad.write_text("<robot name='x'><link name='a'>")
@@ -242,15 +250,15 @@ def test_stub_shapes_and_relative_paths(tmp_path: Path) -> None:
                     '</geometry></collision></link><joint name="j" type="revolute"><parent '
                     'link="footprint"/><child link="b"/><axis xyz="0 0 1"/><limit lower="-1" '
                     'upper="1" effort="1" velocity="1"/></joint></robot>')
-    result = fix_file(path)
+    result = fix_file(path, density=1000.0)
     # A 1 mm placeholder box is no body to weigh (PR2's base_footprint): left, with why.
     assert [(r.code, "stubs" in r.message) for r in result.left] == [("U606", True)]
     assert result.relative_paths == ["cube.stl"]
     elsewhere = tmp_path / "out"
     elsewhere.mkdir()
-    code, _, err = _cli("fix", str(path), "-o", str(elsewhere / "r.urdf"))
+    code, _, err = _cli("fix", str(path), *MASS, "-o", str(elsewhere / "r.urdf"))
     assert "do not resolve" in err and "'cube.stl'" in err
-    code, _, err = _cli("fix", str(path), "-o", str(tmp_path / "r_fixed.urdf"))
+    code, _, err = _cli("fix", str(path), *MASS, "-o", str(tmp_path / "r_fixed.urdf"))
     assert "do not resolve" not in err
 
 

@@ -636,9 +636,14 @@ def fix(
     balance: Annotated[bool, typer.Option(
         "--balance", help="Keep the file's inertia where possible: balance triangle-inequality "
         "violations (MuJoCo's balanceinertia) instead of deriving from the shapes.")] = False,
-    density: Annotated[float, typer.Option(
+    density: Annotated[float | None, typer.Option(
         "--density", metavar="KG/M3",
-        help="Density for the mass of links that have no <inertial>.")] = 1000.0,
+        help="Give links with no mass (no <inertial>, or mass <= 0) the mass of their "
+        "collision shapes at this density (1000: water). Without it fix invents no mass.")]
+    = None,
+    allow_mass_change: Annotated[bool, typer.Option(
+        "--allow-mass-change", help="Write the file even if the robot's total mass changes by "
+        "more than 1% (--density gives massless links a mass).")] = False,
     select: Annotated[list[str] | None, typer.Option(
         "--select", metavar="CODES", help="Only these codes or prefixes (e.g. U6,U708).")]
     = None,
@@ -676,6 +681,16 @@ def fix(
         check_output(output, force=force)
     result = fix_file(file, balance=balance, density=density,
                       packages=parse_packages(package, package_path), select=codes)
+    before, after = result.mass_before, result.mass_after
+    if after != before:
+        change = (f"{(after - before) / before:+.1%}" if before > 0 else "from none")
+        line = f"{file}: total mass {before:.6g} kg -> {after:.6g} kg ({change})"
+        moved = before <= 0 or abs(after - before) > 0.01 * before
+        if moved and not allow_mass_change and not show_diff:
+            raise ParameterError(f"{line}: more than 1%, so nothing was written; pass "
+                                 "--allow-mass-change to write it")
+        if not as_json:
+            show.note(line)
     if in_place and result.changed:
         check_output(backup, force=force, what="the backup")
     to_stdout = output == "-" or show_diff

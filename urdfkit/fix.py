@@ -97,6 +97,9 @@ class FixResult:
     file: str
     original: bytes
     fixed: bytes
+    #: The file's total mass (the sum of its finite ``<mass>`` values), before and after.
+    mass_before: float = 0.0
+    mass_after: float = 0.0
     repairs: list[Repair] = field(default_factory=list)
     left: list[Repair] = field(default_factory=list)
     other_errors: list[Repair] = field(default_factory=list)
@@ -117,12 +120,13 @@ class FixResult:
     def to_dict(self) -> dict[str, Any]:
         """The ``--json`` form (docs/fix.md)."""
         return {"file": self.file, "changed": self.changed,
+                "mass": {"before": self.mass_before, "after": self.mass_after},
                 "fixes": [x.to_dict() for x in self.repairs],
                 "left": [x.to_dict() for x in self.left],
                 "other_errors": [x.to_dict() for x in self.other_errors]}
 
 
-def fix_file(path: str | Path, *, balance: bool = False, density: float = DEFAULT_DENSITY,
+def fix_file(path: str | Path, *, balance: bool = False, density: float | None = None,
              packages: Mapping[str, Path] | None = None,
              select: Sequence[str] = ()) -> FixResult:
     """Repair a URDF file's fixable findings; return the new text (nothing is written).
@@ -133,7 +137,10 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float = DEFAUL
         balance: Keep the file's inertia values where possible: balance triangle-inequality
             violations (MuJoCo's ``balanceinertia``) instead of deriving from the shapes, and
             leave U605 and U608.
-        density: kg/m^3, for the mass of a link that has no ``<inertial>``.
+        density: kg/m^3, to give a link that has no mass (no ``<inertial>``, or mass <= 0)
+            the mass of its collision shapes. None (the default): fix invents no mass; such
+            links are left and said (a ROS ``base_link`` whose robot's mass sits in a fixed
+            ``inertial_link`` must stay massless).
         packages: ``package://`` mappings, to find meshes.
         select: Only these codes (or prefixes); empty for all of :data:`FIXABLE`.
 
@@ -143,7 +150,7 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float = DEFAUL
     """
     display = str(path)
     source = Path(path)
-    if not (math.isfinite(density) and density > 0):
+    if density is not None and not (math.isfinite(density) and density > 0):
         raise ParameterError(f"`density` must be a positive number of kg/m^3, got {density!r}",
                              param="density")
     if source.suffix == ".xacro":
@@ -202,8 +209,23 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float = DEFAUL
 
     relative = sorted({fn for el in root.iter(*FILE_TAGS) if (fn := (el.get("filename") or "")
                        .strip()) and "://" not in fn and not Path(fn).is_absolute()})
-    return FixResult(display, data, fixed, sorted(plan.repairs, key=_by_line),
+    before = _total_mass(root)
+    after = _total_mass(parse_xml(fixed, display).getroot()) if fixed != data else before
+    return FixResult(display, data, fixed, before, after, sorted(plan.repairs, key=_by_line),
                      sorted(plan.left, key=_by_line), others, relative)
+
+
+def _total_mass(root: etree._Element) -> float:
+    """The sum of a robot's finite link masses, as written.
+
+    PyBullet gives a link with no ``<inertial>`` 1 kg; that is not counted.
+    """
+    total = 0.0
+    for link in root.iterchildren("link"):
+        mass = _num(link.find("inertial/mass"), "value")
+        if mass is not None and math.isfinite(mass):
+            total += mass
+    return total if math.isfinite(total) else math.inf
 
 
 def _same_elements(a: etree._Element, b: etree._Element) -> dict[etree._Element, etree._Element]:
@@ -261,7 +283,7 @@ class _Plan:
     """The edits to one file: spliced into its text and made on its tree, side by side."""
 
     def __init__(self, text: str, root: etree._Element, file: str, balance: bool,
-                 density: float, report: Report):
+                 density: float | None, report: Report):
         self.text = text
         self.root = root
         self.file = file
@@ -331,10 +353,21 @@ class _Plan:
                  "or SDF, or a mesh that is unreadable or not closed); write <inertial> by hand")
             return
         if code in ("U606", "U601") and solid.size < STUB_SIZE:
+            root = link.get("name") not in {c.get("link") for c in self.root.iter("child")}
             skip("its collision shapes are stubs (under 1 cm): no mass to derive from them; "
-                 "write <inertial> by hand (mass 0 for a frame)")
+                 "write <inertial> by hand" + ("" if root else " (mass 0 for a frame)"))
+            return
+        if code in ("U606", "U601") and self.density is None:
+            root = link.get("name") not in {c.get("link") for c in self.root.iter("child")}
+            advice = ("it is the root link: mass 0 would make PyBullet fix the robot in place, "
+                      "so give it its real <inertial>" if root else
+                      "give it its real <inertial> (mass 0 if it is a frame)")
+            skip(f"{'no <inertial>' if code == 'U606' else 'no valid mass'} and fix invents no "
+                 f"mass: {advice}, or pass --density to give it the mass of its collision "
+                 "shapes at that density")
             return
         if code in ("U606", "U601"):
+            assert self.density is not None
             new_mass = self.density * solid.volume
             self._write_inertial(link, new_mass, solid.com if inertial is None or origin is None
                                  else None, solid.inertia(new_mass), frame,
