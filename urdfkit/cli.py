@@ -956,8 +956,8 @@ def sweep(
     """Run many drives or scenario runs, one row of results per point.
 
     Several --vary form a grid; --zip pairs them. The drive options (--throttle, --seconds,
-    ...) hold for every point of a drive sweep. Every point is checked before any runs; rows
-    are written as points finish. Exit 0: every point ran; 1: some failed (their rows say
+    ...) hold for every point of a drive sweep. Every value is checked before any point runs;
+    rows are written as points finish. Exit 0: every point ran; 1: some failed (their rows say
     why); 2: bad input; 130: interrupted (the rows so far are kept). See docs/sweep.md.
     """
     from . import sweep as sweeping
