@@ -51,6 +51,19 @@ ENV_KEYS = ("env_script_name",)
 PIN_KEYS = ("urdf_path", "robot_description_model", "base_type",
             "joint_state_conversion_active", "control_groups")
 FOOT_LABELS = ("FL", "FR", "RL", "RR")
+#: robot_pybullet keys SimInterface's constructor indexes directly (a missing one stops it
+#: with a KeyError), each with what urdfkit runs with instead: the value that means "off".
+#: (urdf_path, init_motor_angles and the servo gains have no such value: urdfkit needs them.)
+SIM_INDEXES: dict[str, str] = {
+    "robot_description_model": "none", "floating_base_name": "none",
+    "base_type": "floating", "collision_enable": "off", "init_link_base_orientation": "as loaded",
+    "init_link_base_vel": "at rest", "init_link_base_ang_vel": "at rest",
+    "init_motor_vel": "at rest", "motor_offset": "0", "motor_direction": "1",
+    "motor_damping": "off", "motor_damping_coeff": "0", "motor_elastic_torque": "off",
+    "motor_elastic_coeff": "0", "motor_inertia": "off", "motor_inertia_coeff": "0",
+    "foot_friction": "1", "foot_restitution": "0", "enable_feet_joint_force_sensors": "none",
+    "noise_flag": "off", "robot_noise": "none", "delay_measure_flag": "off",
+}
 
 #: robot_noise key -> the native noise fields it sets.
 NOISE_KEYS: dict[str, tuple[str, ...]] = {
@@ -101,6 +114,7 @@ class _Reader:
     def __init__(self, data: Mapping[str, Any], source: str | None):
         self.data = data
         self.source = source
+        self.notes: list[str] = []
 
     def fail(self, where: str, message: str) -> InputError:
         return InputError(f"{where}: {message} (a simulation_and_control config)",
@@ -111,9 +125,9 @@ class _Reader:
         if not isinstance(value, Mapping):
             raise self.fail(name, "expected an object")
         for key in value:
-            if key not in known:
-                raise self.fail(f"{name}.{key}", "not a key simulation_and_control reads; "
-                                                 f"known keys: {', '.join(known)}")
+            if key not in known:  # SimInterface never looks at it: say so, and go on
+                self.notes.append(f"{name}.{key}: not a key SimInterface reads, so it has no "
+                                  "effect there, nor here")
         return value
 
     def per_robot(self, section: Mapping[str, Any], where: str, key: str, count: int,
@@ -237,15 +251,19 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
     src = None if source is None else str(source)
     reader = _Reader(data, src)
     for key in data:
-        if key not in SECTIONS:
-            raise reader.fail(key, "not a section of a simulation_and_control config; "
-                                   f"sections: {', '.join(SECTIONS)}")
+        if key not in SECTIONS:  # SimInterface never looks at it
+            reader.notes.append(f"{key}: not a section SimInterface reads (it reads "
+                                f"{', '.join(SECTIONS)}), so it has no effect there, nor here")
     base = Path(source).resolve().parent if source is not None else Path.cwd()
     sim = reader.section("sim", SIM_KEYS)
     rp = reader.section("robot_pybullet", ROBOT_KEYS)
     env = reader.section("env_pybullet", ENV_KEYS)
     pin = reader.section("robot_pin", PIN_KEYS)
-    notes: list[str] = []
+    notes = reader.notes
+    for key, off in SIM_INDEXES.items():
+        if key not in rp:
+            notes.append(f"robot_pybullet.{key}: missing; SimInterface stops with a KeyError "
+                         f"without it, urdfkit runs with {off}")
 
     script = env.get("env_script_name", "")
     if script:
@@ -416,19 +434,22 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
                                       "names none of enable_feet_joint_force_sensors' joints "
                                       "(SimInterface raises ValueError here too)")
             for joint in sensors:
-                if joint not in robot.joints:
-                    raise reader.fail(w.format("enable_feet_joint_force_sensors"),
-                                      f"{robot.path.name} has no joint named {joint!r}")
+                if joint not in robot.joints:  # SimInterface finds none and reads nothing
+                    notes.append(f"{w.format('enable_feet_joint_force_sensors')}: "
+                                 f"{robot.path.name} has no joint named {joint!r}; "
+                                 "SimInterface puts no sensor there, and neither does urdfkit")
+                    continue
                 if joint not in joint_forces:
                     joint_forces.append(joint)
 
         base_joint = get("floating_base_name", "")[i]
         if base_joint:
             link = next((lk for lk, j in robot.links.items() if j == base_joint), None)
-            if link is None:
-                raise reader.fail(w.format("floating_base_name"),
-                                  f"{robot.path.name} has no joint named {base_joint!r}")
-            if link not in link_poses:
+            if link is None:  # SimInterface matches no joint and records no base link
+                notes.append(f"{w.format('floating_base_name')}: {robot.path.name} has no "
+                             f"joint named {base_joint!r}; SimInterface then records no "
+                             "floating-base link, and neither does urdfkit")
+            elif link not in link_poses:
                 link_poses.append(link)
 
         if _flag(reader, w.format("noise_flag"), get("noise_flag", False)[i]):
