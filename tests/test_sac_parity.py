@@ -87,3 +87,159 @@ def test_an_unknown_key_is_a_warning_never_a_refusal(tmp_path: Path, where: str)
     notes = sac.convert(conf, source=config).notes
     name = "made_up_key" if where == "top" else f"{where}.made_up_key"
     assert any(n.startswith(f"{name}: not a") and "no effect" in n for n in notes)
+
+
+# --------------------------------------------------------------------------- the reference
+
+
+import collections  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pybullet as p  # noqa: E402
+import pybullet_data  # noqa: E402
+
+OFFSETS, DIRECTIONS = [0.2, -0.1], [-1, 1]
+
+
+def _arm_config(tmp_path: Path, *, delay: int, damping: float, spring: float) -> Path:
+    shutil.copytree(FIXTURES / "models", tmp_path / "models", dirs_exist_ok=True)
+    (tmp_path / "configs").mkdir(exist_ok=True)
+    conf = json.loads((FIXTURES / "configs" / "pendulum.json").read_text())
+    rp = conf["robot_pybullet"]
+    rp.update({
+        "urdf_path": ["arm2.urdf"], "init_link_base_position": [[0.0, 0.0, 0.0]],
+        "init_motor_angles": [[0.4, -0.7]], "init_motor_vel": [[0.0, 0.0]],
+        "motor_offset": [OFFSETS], "motor_direction": [DIRECTIONS],
+        "servo_pos_gains": [60.0], "servo_vel_gains": [4.0],
+        "motor_damping": [int(damping > 0)], "motor_damping_coeff": [damping],
+        "motor_elastic_torque": [int(spring > 0)], "motor_elastic_coeff": [spring],
+        "delay_measure_flag": [int(delay > 0)], "delay_measure_steps": [delay]})
+    conf["robot_pin"]["urdf_path"] = ["arm2.urdf"]
+    path = tmp_path / "configs" / f"arm_{delay}_{damping}_{spring}.json"
+    path.write_text(json.dumps(conf))
+    return path
+
+
+class SimInterfaceArm:
+    """SimInterface's semantics for one fixed-base robot, in raw PyBullet (from its code):
+
+    motor angles ``(q - offset) * direction`` and velocities ``qd * direction`` (offsets not
+    applied to velocities), delayed by ``delay`` steps; the servo reads the delayed state, its
+    friction and spring terms multiplied by ``calculateMassMatrix`` at the *current* adjusted
+    angles passed as joint angles; the torque applied is the servo's times ``direction``, and
+    GetMotorTorques reports that applied torque, undelayed.
+    """
+
+    def __init__(self, config: Path):
+        conf = json.loads(config.read_text())
+        rp = self.rp = conf["robot_pybullet"]
+        c = self.c = p.connect(p.DIRECT)
+        p.setPhysicsEngineParameter(numSolverIterations=30, physicsClientId=c)
+        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=c)
+        p.setTimeStep(conf["sim"]["time_step"], physicsClientId=c)
+        p.setGravity(0, 0, -9.81, physicsClientId=c)
+        p.setPhysicsEngineParameter(enableConeFriction=0, physicsClientId=c)
+        p.loadURDF(str(Path(pybullet_data.getDataPath()) / "plane.urdf"), physicsClientId=c)
+        urdf = config.parent.parent / "models" / rp["urdf_path"][0]
+        self.body = p.loadURDF(str(urdf), [0, 0, 0], [0, 0, 0, 1], useFixedBase=True,
+                               flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=c)
+        n = p.getNumJoints(self.body, physicsClientId=c)
+        for j in range(n):  # SimInterface's quirk: body id = joint index
+            p.changeDynamics(j, -1, linearDamping=0.0, angularDamping=0.0, physicsClientId=c)
+        self.active = [j for j in range(n)
+                       if p.getJointInfo(self.body, j, physicsClientId=c)[2] != p.JOINT_FIXED]
+        self.off, self.dir = np.array(rp["motor_offset"][0]), np.array(rp["motor_direction"][0])
+        for k, j in enumerate(self.active):
+            p.setJointMotorControl2(self.body, j, p.VELOCITY_CONTROL, targetVelocity=0,
+                                    force=0, physicsClientId=c)
+            p.resetJointState(self.body, j, rp["init_motor_angles"][0][k], 0.0,
+                              physicsClientId=c)
+        delay = rp["delay_measure_steps"][0] if rp["delay_measure_flag"][0] else 0
+        self.buffer: collections.deque[tuple[np.ndarray, np.ndarray]] = \
+            collections.deque(maxlen=delay + 1)
+        self.buffer.append(self.state())
+        self.applied = np.zeros(len(self.active))
+
+    def state(self) -> tuple[np.ndarray, np.ndarray]:
+        st = p.getJointStates(self.body, self.active, physicsClientId=self.c)
+        q = np.array([s[0] for s in st])
+        qd = np.array([s[1] for s in st])
+        return (q - self.off) * self.dir, qd * self.dir
+
+    def step(self, command: list[float] | None) -> None:
+        rp, n = self.rp, len(self.active)
+        q, qd = self.buffer[0]  # delayed
+        now_q, _ = self.buffer[-1]  # current, adjusted: what ComputeMassMatrix is given
+        m = np.array(p.calculateMassMatrix(self.body, now_q.tolist(), physicsClientId=self.c))
+        extra = np.zeros(n)
+        if rp["motor_damping"][0]:
+            extra -= rp["motor_damping_coeff"][0] * qd
+        if rp["motor_elastic_torque"][0]:
+            extra -= rp["motor_elastic_coeff"][0] * q
+        tau = m @ extra
+        if command is not None:
+            tau += -rp["servo_pos_gains"][0] * (q - np.asarray(command)) \
+                - rp["servo_vel_gains"][0] * qd
+        self.applied = tau * self.dir
+        p.setJointMotorControlArray(self.body, self.active, p.TORQUE_CONTROL,
+                                    forces=self.applied.tolist(), physicsClientId=self.c)
+        p.stepSimulation(physicsClientId=self.c)
+        self.buffer.append(self.state())
+
+    def close(self) -> None:
+        p.disconnect(self.c)
+
+
+@pytest.mark.parametrize(("delay", "damping", "spring", "command"), [
+    (0, 0.0, 0.0, None),          # free: gravity only
+    (3, 0.0, 0.0, [0.3, 0.5]),    # the servo, on a 3-step-delayed reading
+    (3, 0.8, 2.0, [0.3, 0.5]),    # and friction and spring through the mass matrix
+])
+def test_an_arm_with_offsets_directions_delay_and_servo_reports_what_siminterface_does(
+        tmp_path: Path, delay: int, damping: float, spring: float,
+        command: list[float] | None) -> None:
+    config = _arm_config(tmp_path, delay=delay, damping=damping, spring=spring)
+    ref = SimInterfaceArm(config)
+    try:
+        with Simulation.from_file(config) as s:
+            robot = s.robot_names()[0]
+            names = list(s.joint_positions(robot))
+            if command is not None:
+                s.set_joint_targets(robot, dict(zip(names, command, strict=True)))
+            moved = 0.0
+            for step in range(400):
+                s.step()
+                ref.step(command)
+                seen = s.observe(robot)
+                q, qd = ref.buffer[0]  # what SimInterface's getters report (delayed)
+                assert [seen.motor_angles[k] for k in names] == pytest.approx(q, abs=1e-9)
+                assert [seen.motor_velocities[k] for k in names] == pytest.approx(qd, abs=1e-9)
+                torques = s.motor_torques(robot)
+                # the applied torque, in the joint's own frame, never delayed
+                assert [torques[k] for k in names] == pytest.approx(ref.applied.tolist(),
+                                                                    abs=1e-9), step
+                moved = max(moved, float(np.max(np.abs(ref.buffer[-1][0] - ref.buffer[0][0]))))
+            if delay:
+                assert moved > 1e-4  # the delay is visible: the test can tell it apart
+    finally:
+        ref.close()
+
+
+def test_a_direction_of_minus_one_is_not_a_sign_flip_of_the_torque(tmp_path: Path) -> None:
+    # The torque reported is the one PyBullet applied at the joint: after one step from rest
+    # its sign is the sign of the joint's acceleration (gravity held off by the servo aside).
+    config = _arm_config(tmp_path, delay=0, damping=0.0, spring=0.0)
+    with Simulation.from_file(config) as s:
+        robot = s.robot_names()[0]
+        s.set_joint_targets(robot, {"shoulder": 1.5, "elbow": 0.0})
+        s.step()
+        applied = s.motor_torques(robot)["shoulder"]
+        ps, c = s.session.p, s.session.client
+        body = s.bodies[robot].body
+        m = np.array(ps.calculateMassMatrix(body, [0.4, -0.7], physicsClientId=c))
+        g = np.array(ps.calculateInverseDynamics(body, [0.4, -0.7], [0.0, 0.0], [0.0, 0.0],
+                                                 physicsClientId=c))
+        qdd = np.linalg.solve(m, np.array([applied, s.motor_torques(robot)["elbow"]]) - g)
+        joint_qd = ps.getJointState(body, 0, physicsClientId=c)[1]
+        dt = s.time_step
+        assert joint_qd == pytest.approx(qdd[0] * dt, rel=0.02)

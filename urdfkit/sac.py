@@ -385,13 +385,20 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
                              names, one_ok=False, non_negative=True),
             "kd": _per_joint(reader, w.format("servo_vel_gains"), get("servo_vel_gains")[i],
                              names, one_ok=False, non_negative=True),
-            "scale_by_mass_matrix": True, "max_torque": "unlimited", "measured_state": True}
+            "scale_by_mass_matrix": True, "mass_matrix_angles": "measured",
+            "max_torque": "unlimited", "measured_state": True}
         for flag_key, coeff_key, native in (
                 ("motor_damping", "motor_damping_coeff", "viscous_friction"),
                 ("motor_elastic_torque", "motor_elastic_coeff", "stiffness")):
             if _flag(reader, w.format(flag_key), get(flag_key, False)[i]):
                 motor[native] = _per_joint(reader, w.format(coeff_key), get(coeff_key, 0.0)[i],
                                            names, one_ok=True, non_negative=True)
+        if ("viscous_friction" in motor or "stiffness" in motor) and \
+                (any(offset) or any(d < 0 for d in direction)):
+            notes.append(f"{w.format('motor_damping')}: SimInterface multiplies the friction "
+                         "and spring torques by a mass matrix it computes at the offset and "
+                         "direction-adjusted angles, as if they were joint angles; urdfkit "
+                         "follows it for parity (the physical one is at the joint angles)")
         if _flag(reader, w.format("motor_inertia"), get("motor_inertia", False)[i]):
             coeff = _per_joint(reader, w.format("motor_inertia_coeff"),
                                get("motor_inertia_coeff", 0.0)[i], names, one_ok=True)

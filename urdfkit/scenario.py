@@ -136,6 +136,10 @@ def schema() -> SimpleNamespace:
         # The friction and spring torques multiplied by the joint-space mass matrix M(q)
         # (simulation_and_control's servo): the coefficients are then accelerations' gains.
         scale_by_mass_matrix: bool = False
+        # Where that M is taken: "joint" (the robot's joint angles, in the joint frame, D M D:
+        # the physics), or "measured" (simulation_and_control's: calculateMassMatrix given the
+        # offset/direction-adjusted angles as if they were joint angles, and no D).
+        mass_matrix_angles: Literal["joint", "measured"] = "joint"
         inertia: non_negative = 0.0  # rotor inertia reflected to the joint, kg m^2
         # None: the joint's effort limit; "unlimited": no clip.
         max_torque: positive | Literal["unlimited"] | None = None

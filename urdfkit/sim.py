@@ -73,7 +73,7 @@ class Observation:
         contacts: For ``record.contact_links``: ``{link: {"normal_force", "count"}}``.
         joint_forces: For ``record.joint_forces``: reaction ``[fx, fy, fz, mx, my, mz]``.
         motor_torques: With ``record.motor_torques``: the torque each joint's motor applied in
-            the last step (measured frame).
+            the last step, in the joint's own frame (not the measured one), never delayed.
         link_poses: For ``record.link_poses``: each link's URDF frame, ``{"position",
             "orientation"}`` (world; quaternion x, y, z, w).
         feet: For ``record.feet``: per foot (its label, else its link name), the contact
@@ -812,15 +812,26 @@ class Simulation:
         b.torques.update(zip((spec.name for spec in b.servo), torques, strict=True))
 
     def _times_mass_matrix(self, b: _Body, vector: list[float]) -> list[float]:
-        """``D M D v`` for the servo joints: M(q) at the true state, in the measured frame."""
+        """``D M D v`` for the servo joints: M(q) at the true state, in the measured frame.
+
+        With ``mass_matrix_angles = "measured"`` (simulation_and_control's servo): ``M v``
+        with M from calculateMassMatrix given the measured angles ``(q - offset) * direction``
+        as if they were joint angles, and no ``D``; the same as ``D M D v`` when every offset
+        is 0 and every direction 1.
+        """
         dyn = self._dynamics_joints(b)
         q, _ = self._physical_state(b)
+        measured = b.config.motor is not None and \
+            b.config.motor.mass_matrix_angles == "measured"
+        if measured:
+            q = [(x - b.offsets.get(j.name, 0.0)) * b.directions.get(j.name, 1.0)
+                 for x, j in zip(q, dyn, strict=True)]
         p, client, body = self._model(b)
         matrix = p.calculateMassMatrix(body, q, physicsClientId=client)
         skip = len(matrix) - len(dyn)  # a floating base's 6 coordinates come first
         where = {j.name: skip + k for k, j in enumerate(dyn)}
         rows = [where[spec.name] for spec in b.servo]
-        signs = [b.directions.get(spec.name, 1.0) for spec in b.servo]
+        signs = [1.0 if measured else b.directions.get(spec.name, 1.0) for spec in b.servo]
         return [signs[i] * math.fsum(matrix[r][c] * signs[k] * vector[k]
                                      for k, c in enumerate(rows))
                 for i, r in enumerate(rows)]
@@ -885,9 +896,8 @@ class Simulation:
         if b.active:
             indices, names, signs, offsets = b.frame
             states = p.getJointStates(b.body, indices, physicsClientId=client)
-            if self.config.record.motor_torques:
-                torques = {n: b.torques.get(n, st[3]) * s
-                           for n, st, s in zip(names, states, signs, strict=True)}
+            if self.config.record.motor_torques:  # the joint's own frame, as applied
+                torques = {n: b.torques.get(n, st[3]) for n, st in zip(names, states, strict=True)}
             qd = [st[1] for st in states]
             angles = {n: (st[0] - o) * s
                       for n, st, s, o in zip(names, states, signs, offsets, strict=True)}
@@ -996,6 +1006,8 @@ class Simulation:
             self._fresh(b)
             # history ends with the current observation; the delayed one is `delay` before.
             source = b.history[max(0, len(b.history) - 1 - b.config.delay)]
+            if b.config.delay:  # angles and velocities are delayed; torques are not
+                source = source._replace(motor_torques=b.history[-1].motor_torques)
             if b.config.delay or b.config.noise is not None:
                 source = self._add_noise(b, source._replace(t=self.t, step=self.step_count))
             b.reported = (self.step_count, source)
@@ -1151,16 +1163,18 @@ class Simulation:
         return dict(self._fresh(self._body(robot)).motor_velocities)
 
     def motor_torques(self, robot: str) -> dict[str, float]:
-        """The torque each joint's motor applied in the last step (measured frame).
+        """The torque each joint's motor applied in the last step, in the joint's own frame.
 
-        PyBullet's applied motor torque for position and velocity motors; for the servo model
-        and torque commands, the torque it was given.
+        As simulation_and_control's ``GetMotorTorques``: the torque applied at the joint (the
+        motor's torque times its ``motor_direction``), not in the measured frame the angles
+        are reported in, and never delayed. PyBullet's applied motor torque for position and
+        velocity motors; for the servo model and torque commands, the torque it applied.
         """
         b = self._body(robot)
         p, client = self.session.p, self.session.client
         states = p.getJointStates(b.body, [j.index for j in b.active], physicsClientId=client)
         # PyBullet reports 0 for a torque-controlled joint: the torque given is the answer.
-        return {j.name: b.torques.get(j.name, st[3]) * b.directions.get(j.name, 1.0)
+        return {j.name: b.torques.get(j.name, st[3])
                 for j, st in zip(b.active, states, strict=True)}
 
     def link_pose(self, robot: str, link: str) -> tuple[list[float], list[float]]:
