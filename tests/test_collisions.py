@@ -366,3 +366,23 @@ def test_a_mimic_ring_is_refused(tmp_path: Path, ring: tuple[str, ...]) -> None:
     assert result.exit_code == 2, result.output
     assert "ring (" + " -> ".join([*ring, ring[0]]) + ")" in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("multiplier", ["two", "1,5", "nan"])
+def test_a_mimic_multiplier_that_is_not_a_number_is_refused_not_sampled_freely(
+        tmp_path: Path, multiplier: str) -> None:
+    # It once became a free joint, sampled over its limits as if it had no leader.
+    slide = '<axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="10" velocity="1"/>'
+    path = _write(tmp_path, "m.urdf", "\n".join([
+        _box_link("palm", "0.02 0.02 0.02"),
+        _box_link("a", "0.01 0.01 0.01"), _box_link("b", "0.01 0.01 0.01"),
+        _joint("ja", "prismatic", "palm", "a", "0.1 0 0", slide),
+        _joint("jb", "prismatic", "palm", "b", "0.2 0 0",
+               slide + f'<mimic joint="ja" multiplier="{multiplier}"/>'),
+    ]))
+    result = CliRunner().invoke(app, ["collisions", str(path)])
+    assert result.exit_code == 2, result.output
+    line = result.stderr.strip()
+    written = next(n for n, x in enumerate(path.read_text().splitlines(), 1)
+                   if "multiplier" in x)
+    assert f"m.urdf:{written}:" in line and "multiplier" in line and "\n" not in line

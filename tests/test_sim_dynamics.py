@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from urdfkit.errors import ParameterError
+from urdfkit.errors import InputError, ParameterError
 from urdfkit.sim import Simulation
 
 M, L, INERTIA = 2.0, 0.5, 0.01  # bob mass (kg), rod length (m), inertia about its centre
@@ -302,7 +302,7 @@ def test_servo_gains_per_joint_and_desired_velocity(tmp_path: Path) -> None:
     held = servo_run(tmp_path, {"kp": {"hinge": 400.0}, "kd": {"hinge": 20.0}}, 2.0,
                      segment=hold)
     assert held[-1]["motor_angles"]["hinge"] == pytest.approx(0.3, abs=0.03)
-    with pytest.raises(Exception, match=r"motor\.kp\.elbow"):
+    with pytest.raises(InputError, match=r"motor\.kp\.elbow"):
         servo_run(tmp_path, {"kp": {"elbow": 1.0}}, 0.1)
     # kp 0, kd 5: pure velocity tracking of the segment's desired velocity (no gravity).
     track = {"mode": "position", "targets": {"hinge": 0.0}, "velocities": {"hinge": 1.0}}

@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 from urdfkit import sweep
 from urdfkit.cli import app
 from urdfkit.drive import DriveConfig, drive
-from urdfkit.errors import InputError, ParameterError
+from urdfkit.errors import InputError, MissingDependencyError, ParameterError
 from urdfkit.sim import Simulation
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -284,7 +284,7 @@ def test_ray_missing_is_an_install_hint(monkeypatch: pytest.MonkeyPatch) -> None
         return real(name, *args, **kwargs)
 
     monkeypatch.setattr(builtins, "__import__", no_ray)
-    with pytest.raises(Exception, match=r"urdfkit\[ray\]"):
+    with pytest.raises(MissingDependencyError, match=r"pip install 'urdfkit\[ray\]'"):
         list(sweep.run("drive", BASE, ["steer=0.1"], backend="ray"))
 
 
