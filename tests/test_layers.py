@@ -24,7 +24,7 @@ for floor, names in enumerate([
     "session",
     # run and draw
     "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
-    " diff collisions fix sweep",
+    " diff collisions fix sweep view",
     # presentation and the command line
     "present ci cli __main__",
 ]):

@@ -1197,6 +1197,50 @@ def render(
 
 
 @app.command(epilog=_examples(
+    "urdfkit view r2d2.urdf", "urdfkit view arm.urdf.xacro --arg prefix:=left_ --open",
+    "urdfkit view robot.urdf --host 0.0.0.0 --port 8080"))
+def view(
+    file: FileArg,
+    port: Annotated[int | None, typer.Option(
+        "--port", min=1, max=65535, help="The port to serve on.", show_default="a free one")]
+    = None,
+    host: Annotated[str, typer.Option(
+        "--host", help="The address to serve on; 0.0.0.0 serves beyond this machine.")]
+    = "127.0.0.1",
+    open_browser: Annotated[bool, typer.Option("--open", help="Open the page in a browser.")]
+    = False,
+    inertia_from_file: Annotated[bool, typer.Option(
+        "--inertia-from-file", help="Load the file's <inertia> (URDF_USE_INERTIA_FROM_FILE) "
+        "instead of PyBullet's recomputed one.")] = False,
+    package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
+    arg: ArgOpt = None,
+) -> None:
+    """Show the robot in a browser as PyBullet loads it, with check's findings on its links.
+
+    Joint sliders, visual and collision shapes, frames, centres of mass and inertia boxes;
+    the page reloads when the file or its includes and meshes change.
+    Serves until Ctrl-C (exit 130). See docs/view.md.
+    """
+    from .view import Viewer
+
+    viewer = Viewer(file, packages=package, package_paths=package_path, xacro_args=arg,
+                    inertia_from_file=inertia_from_file, host=host, port=port)
+    try:
+        show.line(f"urdfkit view: {viewer.url} (Ctrl-C to stop)")
+        if open_browser:
+            import webbrowser
+
+            webbrowser.open(viewer.url)
+        import time
+
+        while True:
+            time.sleep(3600)
+    finally:
+        viewer.close()
+
+
+@app.command(epilog=_examples(
     "urdfkit collisions panda.urdf", "urdfkit collisions arm.urdf --samples 100 --json",
     "urdfkit collisions arm.urdf --samples 200 --srdf >> arm.srdf",
     "urdfkit collisions hand.urdf --joints finger_joint=0.04 --python"))
