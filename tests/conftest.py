@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -49,3 +50,36 @@ def pb() -> Iterator[tuple[object, int]]:
     finally:
         with quiet_stdout():
             p.disconnect(physicsClientId=client)
+
+
+# --------------------------------------------------------------------------- skips in CI
+
+#: Test ids (prefixes) CI may skip. With URDFKIT_CI=1 (.ci/run sets it) any other skip fails
+#: the run: CI installs Ray, pyarrow, Graphviz and Chromium, so a skip there means a test it is
+#: meant to run did not run.
+ALLOWED_CI_SKIPS: tuple[str, ...] = ()
+_skipped: list[tuple[str, str]] = []
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    if report.skipped and not hasattr(report, "wasxfail"):
+        reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else str(report.longrepr)
+        _skipped.append((report.nodeid, reason))
+
+
+def _unexpected() -> list[tuple[str, str]]:
+    return [(n, r) for n, r in _skipped
+            if not (ALLOWED_CI_SKIPS and n.startswith(ALLOWED_CI_SKIPS))]
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    if os.environ.get("URDFKIT_CI") and exitstatus == 0 and _unexpected():
+        session.exitstatus = 1
+
+
+def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
+    if os.environ.get("URDFKIT_CI") and _unexpected():
+        terminalreporter.write_line(
+            f"URDFKIT_CI: {len(_unexpected())} test(s) skipped that CI must run:", red=True)
+        for nodeid, reason in _unexpected():
+            terminalreporter.write_line(f"  {nodeid}: {reason}", red=True)
