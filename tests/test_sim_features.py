@@ -33,13 +33,29 @@ def test_one_segment_drives_each_joint_in_its_own_mode():
                      "FR_calf_joint": "torque"},
             "targets": {"FR_hip_joint": 0.3, "FR_thigh_joint": 1.5, "FR_calf_joint": 0.2}}]}]}
     with Simulation(doc) as s:
-        s.step(240)
+        # The torque's effect, not its echo: over the first step the joints' accelerations,
+        # put through PyBullet's inverse dynamics, need exactly the 0.2 N m the calf was given
+        # (and the hip's position motor at its 30 N m limit).
+        p, c, body = s.session.p, s.session.client, s.bodies["q"].body
+        movable = [j for j in range(p.getNumJoints(body, physicsClientId=c))
+                   if p.getJointInfo(body, j, physicsClientId=c)[2] != p.JOINT_FIXED]
+        names = [p.getJointInfo(body, j, physicsClientId=c)[1].decode() for j in movable]
+        before = p.getJointStates(body, movable, physicsClientId=c)
+        s.step()
+        after = p.getJointStates(body, movable, physicsClientId=c)
+        qdd = [(b[1] - a[1]) * 240 for a, b in zip(before, after, strict=True)]
+        needed = dict(zip(names, p.calculateInverseDynamics(
+            body, [a[0] for a in before], [a[1] for a in before], qdd, physicsClientId=c),
+            strict=True))
+        first = s.motor_torques("q")
+        s.step(239)
         q = s.joint_positions("q")
         qd = s.joint_velocities("q")
-        torques = s.motor_torques("q")
+    assert needed["FR_calf_joint"] == pytest.approx(0.2, abs=1e-6)
+    assert first["FR_calf_joint"] == pytest.approx(needed["FR_calf_joint"], abs=1e-6)
+    assert first["FR_hip_joint"] == pytest.approx(needed["FR_hip_joint"], abs=1e-6) == 30.0
     assert q["FR_hip_joint"] == pytest.approx(0.3, abs=1e-3)  # held at its target
     assert qd["FR_thigh_joint"] == pytest.approx(1.5, rel=1e-3)  # turning at its speed
-    assert torques["FR_calf_joint"] == pytest.approx(0.2)  # the torque, every step
 
 
 def test_a_mode_per_joint_needs_every_target():
@@ -101,13 +117,19 @@ def test_set_motor_gains_changes_the_servo_torque():
                     joints=[{"until": 1.0, "targets": {"hinge": 0.0}}])
     doc["physics"] = doc["robots"][0].pop("physics")
     with Simulation(doc) as s:
+        # The servo's torque by its effect: from rest, with no gravity, one step of dt gives
+        # the hinge qd = dt * tau / M(q), M from PyBullet's own mass matrix.
+        p, c, body = s.session.p, s.session.client, s.bodies["pendulum"].body
+        m = p.calculateMassMatrix(body, [0.5], physicsClientId=c)[0][0]
         s.step()
-        first = s.motor_torques("pendulum")["hinge"]
+        first = s.joint_velocities("pendulum")["hinge"] * m / 0.001
+        assert s.motor_torques("pendulum")["hinge"] == pytest.approx(first, rel=1e-9)
         s.reset()
         s.set_motor_gains("pendulum", kp={"hinge": 40.0})
         s.step()
-        assert first == pytest.approx(-10.0 * 0.5)
-        assert s.motor_torques("pendulum")["hinge"] == pytest.approx(-40.0 * 0.5)
+        assert first == pytest.approx(-10.0 * 0.5, rel=1e-9)  # -kp (q - target)
+        assert s.joint_velocities("pendulum")["hinge"] * m / 0.001 == \
+            pytest.approx(-40.0 * 0.5, rel=1e-9)
         with pytest.raises(ParameterError, match="drives no joint named 'x'"):
             s.set_motor_gains("pendulum", kd={"x": 1.0})
 
