@@ -227,8 +227,9 @@ def test_ground_options(simplecar_urdf: Path, car_views: dict) -> None:
 def test_xacro_input_with_args(tmp_path: Path) -> None:
     xacro = Path(__file__).parents[1] / "templates" / "simplecar.urdf.xacro"
     r = render_file(xacro, RenderOptions(**SMALL), xacro_args=["wheel_radius:=0.2"])
-    # Bigger wheels: a taller bounding box than the default 0.1 m wheels give.
-    assert r.aabb[1][2] - r.aabb[0][2] == pytest.approx(0.402, abs=0.01)
+    # Bigger wheels: the wheels (radius 0.2, axles at the body's height) now set the height,
+    # 2 r, plus PyBullet's 1 mm collision margin above and below: 0.402 m, exactly.
+    assert r.aabb[1][2] - r.aabb[0][2] == pytest.approx(2 * 0.2 + 2 * 0.001, abs=1e-9)
 
 
 def test_frame_view_fits_every_corner() -> None:
