@@ -604,10 +604,7 @@ class Viewer:
         import numpy as np
 
         scene, gui, m = self.server.scene, self.server.gui, self.model
-        for handles in self._nodes.values():
-            for h in handles:
-                h.remove()
-        for h in self._frames + self._gui:
+        for h in self._frames + self._gui:  # a link's frame takes its shapes with it
             h.remove()
         self._nodes = {"visual": [], "collision": [], "frames": [], "inertia": []}
         self._frames, self._gui, self.sliders = [], [], {}
@@ -643,6 +640,8 @@ class Viewer:
                 self._nodes["inertia"].append(scene.add_box(
                     f"{root}/com/box", dimensions=box, color=(0, 114, 178), opacity=0.35))
         self.apply_toggles()
+        listed, flags = m.joint_vector()
+        self.vector_text.value, self.joints_text.value = listed, flags
         with self.joints_folder:
             for j in m.joints:
                 step = (j.upper - j.lower) / 1000 if j.upper > j.lower else 0.001
@@ -697,7 +696,7 @@ class Viewer:
         size = max(max(b - a for a, b in zip(lo, hi, strict=True)), 0.1)
         cam = self.server.initial_camera
         cam.look_at = tuple(mid)
-        cam.position = (mid[0] + 1.6 * size, mid[1] - 1.6 * size, mid[2] + 1.1 * size)
+        cam.position = (mid[0] + 1.3 * size, mid[1] - 1.3 * size, mid[2] + 0.9 * size)
 
     def apply_toggles(self) -> None:
         """Show or hide each layer as the Show checkboxes say."""

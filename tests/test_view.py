@@ -1,0 +1,372 @@
+"""``urdfkit view``: the model against raw PyBullet, and the page in a real headless Chromium.
+
+The server-side tests compare what the viewer shows with PyBullet DIRECT driven by hand and
+with the physics of a uniform box. The browser tests drive Debian's Chromium through Playwright
+(software WebGL via SwiftShader), as a person would: they look for robot pixels, move a slider
+with the keyboard, click the collision toggle, and assert on PyBullet's state and the scene
+afterwards, never on pixel-exact images.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
+
+from urdfkit.view import TINTS, Viewer  # noqa: E402
+
+DOCS = Path(__file__).parent.parent / "docs"
+CHROMIUM = os.environ.get("URDFKIT_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
+#: Software WebGL: what a CI machine without a GPU has.
+CHROMIUM_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+
+#: Green visuals, so robot pixels are told from the white page and grey grid.
+ARM = """<?xml version="1.0"?>
+<robot name="arm">
+  <material name="green"><color rgba="0 0.9 0 1"/></material>
+  <link name="base">
+    <inertial><mass value="2"/>
+      <inertia ixx="0.02" iyy="0.02" izz="0.02" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><box size="0.3 0.3 0.1"/></geometry><material name="green"/></visual>
+    <collision><geometry><box size="0.3 0.3 0.1"/></geometry></collision>
+  </link>
+  <link name="upper">
+    <inertial><origin xyz="0 0 0.25"/><mass value="1.5"/>
+      <inertia ixx="0.02" iyy="0.03" izz="0.04" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><origin xyz="0 0 0.25"/><geometry><box size="0.08 0.08 0.5"/></geometry>
+      <material name="green"/></visual>
+    <collision><origin xyz="0 0 0.25"/><geometry><box size="0.08 0.08 0.5"/></geometry></collision>
+  </link>
+  <link name="finger">
+    <inertial><mass value="0.1"/>
+      <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><box size="0.02 0.02 0.1"/></geometry><material name="green"/></visual>
+  </link>
+  <link name="wheel">
+    <inertial><mass value="0.1"/>
+      <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><cylinder radius="0.05" length="0.02"/></geometry>
+      <material name="green"/></visual>
+  </link>
+  <joint name="shoulder" type="revolute">
+    <parent link="base"/><child link="upper"/><origin xyz="0 0 0.05"/><axis xyz="0 1 0"/>
+    <limit lower="-1.5" upper="1.5" effort="10" velocity="1"/>
+  </joint>
+  <joint name="slide" type="prismatic">
+    <parent link="upper"/><child link="finger"/><origin xyz="0 0 0.5"/><axis xyz="1 0 0"/>
+    <limit lower="-0.1" upper="0.1" effort="10" velocity="1"/>
+    <mimic joint="shoulder" multiplier="0.05" offset="0.01"/>
+  </joint>
+  <joint name="spin" type="continuous">
+    <parent link="base"/><child link="wheel"/><origin xyz="0.2 0 0"/><axis xyz="0 0 1"/>
+  </joint>
+</robot>
+"""
+
+
+@pytest.fixture
+def arm(tmp_path: Path) -> Path:
+    """The test arm, in a folder of its own (edits in one test never reach another)."""
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM)
+    return path
+
+
+@pytest.fixture
+def viewer_of() -> Iterator[Callable[..., Viewer]]:
+    """Start viewers on free ports; every one is closed after the test."""
+    started: list[Viewer] = []
+
+    def start(path: Path, **kwargs: Any) -> Viewer:
+        v = Viewer(str(path), **kwargs)
+        started.append(v)
+        return v
+
+    yield start
+    for v in started:
+        v.close()
+
+
+def _raw_link_state(path: Path, joints: dict[str, float], link: str,
+                    **load: Any) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """A link frame's world pose from PyBullet DIRECT, set up by hand."""
+    import pybullet as p
+
+    c = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(str(path), physicsClientId=c,
+                          flags=p.URDF_USE_IMPLICIT_CYLINDER, **load)
+        index = {}
+        for j in range(p.getNumJoints(body, physicsClientId=c)):
+            info = p.getJointInfo(body, j, physicsClientId=c)
+            index[info[1].decode()] = j
+            index["link:" + info[12].decode()] = j
+        for name, value in joints.items():
+            p.resetJointState(body, index[name], value, physicsClientId=c)
+        state = p.getLinkState(body, index["link:" + link], computeForwardKinematics=1,
+                               physicsClientId=c)
+        return tuple(state[4]), tuple(state[5])
+    finally:
+        p.disconnect(physicsClientId=c)
+
+
+def _same_rotation(wxyz: tuple[float, ...], xyzw: tuple[float, ...]) -> bool:
+    q = (xyzw[3], xyzw[0], xyzw[1], xyzw[2])
+    return abs(abs(sum(a * b for a, b in zip(wxyz, q, strict=True))) - 1) < 1e-5
+
+
+def _wait(cond: Callable[[], bool], seconds: float = 10.0) -> bool:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.05)
+    return cond()
+
+
+# --------------------------------------------------------------------------- the server
+
+
+def test_sliders_in_pybullet_order_within_limits(arm: Path, viewer_of: Any) -> None:
+    import pybullet as p
+
+    v = viewer_of(arm)
+    c = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(str(arm), physicsClientId=c)
+        movable = [p.getJointInfo(body, j, physicsClientId=c)[1].decode()
+                   for j in range(p.getNumJoints(body, physicsClientId=c))
+                   if p.getJointInfo(body, j, physicsClientId=c)[2] in (p.JOINT_REVOLUTE,
+                                                                         p.JOINT_PRISMATIC)]
+    finally:
+        p.disconnect(physicsClientId=c)
+    assert list(v.sliders) == movable
+    assert (v.sliders["shoulder"].min, v.sliders["shoulder"].max) == (-1.5, 1.5)
+    assert (v.sliders["spin"].min, v.sliders["spin"].max) == (-math.pi, math.pi)  # continuous
+    assert v.sliders["slide"].disabled  # a mimic joint follows, it has no slider of its own
+
+
+def test_moving_a_joint_moves_pybullet_and_the_scene(arm: Path, viewer_of: Any) -> None:
+    v = viewer_of(arm)
+    before = v.link_pose("upper")
+    now = v.set_joints({"shoulder": 0.7})
+    assert now["shoulder"] == pytest.approx(0.7)
+    assert now["slide"] == pytest.approx(0.7 * 0.05 + 0.01)  # the mimic follows its leader
+    for link in ("upper", "finger"):
+        pos, quat = _raw_link_state(arm, {"shoulder": 0.7, "slide": 0.045}, link)
+        scene_pos, scene_wxyz = v.link_pose(link)
+        assert scene_pos == pytest.approx(pos, abs=1e-6)
+        assert _same_rotation(scene_wxyz, quat)
+    assert v.link_pose("upper") != before
+    assert v.vector_text.value == "[0.7, 0.045, 0.0]"
+    assert v.joints_text.value == "--joints shoulder=0.7,slide=0.045,spin=0"
+    v.reset()
+    assert v.model.positions() == {"shoulder": 0.0, "slide": pytest.approx(0.01), "spin": 0.0}
+
+
+def test_inertia_box_matches_the_principal_moments(arm: Path, viewer_of: Any) -> None:
+    v = viewer_of(arm, inertia_from_file=True)
+    # A uniform box of sides a, b, c and mass m: Ixx = m (b^2 + c^2) / 12, and so on.
+    m, (ixx, iyy, izz) = 1.5, (0.02, 0.03, 0.04)
+    want = [math.sqrt(6 * (iyy + izz - ixx) / m), math.sqrt(6 * (ixx + izz - iyy) / m),
+            math.sqrt(6 * (ixx + iyy - izz) / m)]
+    upper = next(lk for lk in v.model.links if lk.name == "upper")
+    assert upper.inertia_box == pytest.approx(want)
+    box = [h for h in v.nodes("inertia", "upper") if h.name.endswith("/box")]
+    assert len(box) == 1 and tuple(box[0].dimensions) == pytest.approx(want)
+    a, b, c = box[0].dimensions
+    assert m * (b * b + c * c) / 12 == pytest.approx(ixx)
+
+
+def test_inertia_box_without_the_file_is_pybullets(arm: Path, viewer_of: Any) -> None:
+    # Without URDF_USE_INERTIA_FROM_FILE PyBullet computes inertia from the collision box's
+    # bounds, so the equivalent box is the collision box itself.
+    v = viewer_of(arm)
+    upper = next(lk for lk in v.model.links if lk.name == "upper")
+    assert upper.inertia_box == pytest.approx((0.08, 0.08, 0.5), abs=1e-6)
+
+
+def test_collision_layer_hidden_until_asked(arm: Path, viewer_of: Any) -> None:
+    v = viewer_of(arm)
+    assert v.visible("visual") and not v.visible("collision")
+    v.show_collision.value = True
+    v.apply_toggles()
+    assert v.visible("collision")
+    (shape,) = v.nodes("collision", "upper")
+    assert shape.position == pytest.approx((0, 0, 0.25))  # in the link frame
+
+
+U604 = ARM.replace('<inertia ixx="0.02" iyy="0.03" izz="0.04"',
+                   '<inertia ixx="0.01" iyy="0.01" izz="0.5"')
+
+
+def test_u604_error_tints_its_link_and_names_its_line(tmp_path: Path, viewer_of: Any) -> None:
+    path = tmp_path / "bad.urdf"
+    path.write_text(U604)
+    line = next(i for i, text in enumerate(U604.splitlines(), 1) if 'izz="0.5"' in text)
+    v = viewer_of(path, inertia_from_file=True)
+    levels = {lk.name: lk.level for lk in v.model.links}
+    assert levels["upper"] == "error" and levels["base"] is None
+    assert [h.color for h in v.nodes("visual", "upper")] == [TINTS["error"]]
+    # The file's colour, as PyBullet keeps it (float32 0.9 of 255 = 229.49...).
+    assert v.nodes("visual", "base")[0].color == (0, 229, 0)
+    u604 = [f for f in v.model.findings if f.code == "U604"]
+    assert [f.line for f in u604] == [line]
+    assert f"{path}:{line}" in v._findings_text()
+
+
+def test_edit_reloads_and_a_broken_file_keeps_the_last_robot(arm: Path, viewer_of: Any) -> None:
+    v = viewer_of(arm)
+    v.set_joints({"shoulder": 0.3})
+    arm.write_text(ARM.replace('<origin xyz="0 0 0.05"/><axis xyz="0 1 0"/>',
+                               '<origin xyz="0 0 0.15"/><axis xyz="0 1 0"/>'))
+    assert _wait(lambda: v.reloads == 1, 5), "the edit was not picked up"
+    assert v.model.positions()["shoulder"] == pytest.approx(0.3)  # kept by name
+    pos, _ = _raw_link_state(arm, {"shoulder": 0.3}, "upper")
+    assert v.link_pose("upper")[0] == pytest.approx(pos, abs=1e-6)
+    assert pos[2] == pytest.approx(0.15)
+    good = v.model
+    arm.write_text(ARM.replace("</robot>", ""))
+    assert _wait(lambda: v.error is not None, 5), "the broken file was not noticed"
+    assert "arm.urdf" in v.error and v.model is good and v.reloads == 1
+    assert "Reload failed" in v.status.content
+    with urllib.request.urlopen(v.url, timeout=5) as r:  # the server is still up
+        assert r.status == 200
+    arm.write_text(ARM)
+    assert _wait(lambda: v.reloads == 2 and v.error is None, 5)
+
+
+def test_a_bad_file_refused_before_serving(tmp_path: Path) -> None:
+    path = tmp_path / "bad.urdf"
+    path.write_text("<robot name='x'><link name='a'>")
+    with pytest.raises(Exception, match="bad.urdf") as e:
+        Viewer(str(path))
+    assert type(e.value).__name__ == "InputError"
+
+
+def test_cli_prints_the_url_serves_and_exits_130(arm: Path) -> None:
+    proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "view", str(arm)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None
+        line = proc.stdout.readline()
+        assert line.startswith("urdfkit view: http://localhost:"), line
+        url = line.split()[2]
+        with urllib.request.urlopen(url, timeout=10) as r:
+            assert r.status == 200 and b"<html" in r.read().lower()
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130
+    assert err.strip() == "urdfkit: interrupted" and out == ""
+
+
+def test_cli_bad_file_is_one_line_exit_2(tmp_path: Path) -> None:
+    r = subprocess.run([sys.executable, "-m", "urdfkit", "view", str(tmp_path / "none.urdf")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2
+    assert r.stderr.count("\n") == 1 and "none.urdf" in r.stderr and r.stdout == ""
+
+
+# --------------------------------------------------------------------------- the page
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    """Debian's Chromium under Playwright; the page tests skip, saying why, without it."""
+    if not os.path.exists(CHROMIUM):
+        pytest.skip(f"no Chromium at {CHROMIUM}: apt-get install -y chromium (CI does)")
+    sync_api = pytest.importorskip("playwright.sync_api",
+                                   reason="pip install playwright (in urdfkit[test])")
+    with sync_api.sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+def _open_page(browser: Any, v: Viewer) -> Any:
+    page = browser.new_page(viewport={"width": 1000, "height": 700})
+    page.goto(v.url)
+    page.get_by_text("Connected").wait_for(timeout=30000)
+    return page
+
+
+def _pixels(page: Any, colour: str = "green", path: Path | None = None) -> int:
+    """How many pixels of the scene are clearly green (visuals) or orange (collision)."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    png = page.screenshot(path=str(path) if path else None)
+    # Where the camera looks: below the notice, above the axes gizmo (its y axis is green),
+    # left of the control panel (whose "Connected" cloud is green too).
+    rgb = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)[160:620, :640]
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    if colour == "green":
+        return int(((g > r + 60) & (g > b + 60)).sum())
+    return int(((r > g + 40) & (g > b + 40)).sum())
+
+
+def test_page_connects_and_draws_the_robot(browser: Any, arm: Path, viewer_of: Any,
+                                           tmp_path: Path) -> None:
+    v = viewer_of(arm)
+    page = _open_page(browser, v)
+    assert _wait(lambda: _pixels(page) > 2000, 30), "no robot pixels on the page"
+    _pixels(page, path=DOCS / "view.png" if os.environ.get("URDFKIT_SHOTS") else None)
+    assert page.get_by_text("arm", exact=False).first.is_visible()
+
+
+def test_slider_in_the_page_moves_pybullet_and_the_scene(browser: Any, arm: Path,
+                                                         viewer_of: Any) -> None:
+    v = viewer_of(arm)
+    page = _open_page(browser, v)
+    thumb = page.locator("[role=slider][aria-valuemin='-1.5']")
+    thumb.focus()
+    page.keyboard.press("End")  # to the upper limit, as a keyboard user does
+    assert _wait(lambda: v.model.positions()["shoulder"] == pytest.approx(1.5), 10)
+    pos, quat = _raw_link_state(arm, {"shoulder": 1.5, "slide": 1.5 * 0.05 + 0.01}, "finger")
+    scene_pos, scene_wxyz = v.link_pose("finger")
+    assert scene_pos == pytest.approx(pos, abs=1e-6) and _same_rotation(scene_wxyz, quat)
+    page.get_by_role("button", name="Reset to zero").click()
+    assert _wait(lambda: v.model.positions()["shoulder"] == 0.0, 10)
+    assert _wait(lambda: thumb.get_attribute("aria-valuenow") == "0", 10)
+
+
+def test_collision_toggle_in_the_page(browser: Any, arm: Path, viewer_of: Any) -> None:
+    v = viewer_of(arm)
+    page = _open_page(browser, v)
+    page.get_by_label("Collision").check()
+    assert _wait(lambda: v.visible("collision"), 10)
+    page.get_by_label("Visual").uncheck()
+    assert _wait(lambda: not v.visible("visual"), 10)
+    # Collision shapes only: the green visuals are gone from the picture, orange ones drawn.
+    assert _wait(lambda: _pixels(page) < 20 and _pixels(page, "orange") > 2000, 10)
+
+
+def test_finding_and_reload_error_shown_in_the_page(browser: Any, tmp_path: Path,
+                                                   viewer_of: Any) -> None:
+    path = tmp_path / "bad.urdf"
+    path.write_text(U604)
+    line = next(i for i, text in enumerate(U604.splitlines(), 1) if 'izz="0.5"' in text)
+    v = viewer_of(path, inertia_from_file=True)
+    page = _open_page(browser, v)
+    page.get_by_text(f"{path}:{line}").wait_for(timeout=10000)
+    path.write_text("<robot")
+    page.get_by_text("Reload failed").wait_for(timeout=10000)
+    assert page.get_by_text("Connected").is_visible()
