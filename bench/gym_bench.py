@@ -3,7 +3,11 @@
 bench/tutorial_driving.py is the tutorial's part-2 env (resetSimulation and three loadURDF
 per reset; steering and wheels set every step). Goals: a step at most 1.05x the tutorial's,
 a reset at most 0.3x. Both envs run the same random actions; repetitions alternate; CPU time
-(process_time), medians. Not a unit test: figures go in bench/README.md.
+(process_time), medians. Steps and resets are timed apart: when an episode ends inside the
+step loop, its reset runs off the clock (the tutorial's resets reload three URDFs, and once
+cost its steps 15%). Each env's sanity is printed: how many steps ran, how many episodes
+ended, and that a reset leaves one car and one goal in the world. Not a unit test: figures go
+in bench/README.md, from a regular install (pip install .).
 
 Usage: python bench/gym_bench.py [--steps 3000] [--resets 200] [--repeat 9]
 """
@@ -21,15 +25,28 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
-def steps_cost(env, n: int) -> float:
+def steps_cost(env, n: int) -> tuple[float, int]:
+    """CPU seconds per step, and how many episodes ended (their resets are not timed)."""
     rng = np.random.default_rng(0)
     actions = rng.uniform([0, -0.6], [1, 0.6], size=(n, 2)).astype(np.float32)
     env.reset(seed=0)
-    start = time.process_time()
+    spent = 0.0
+    ended = 0
     for a in actions:
-        if env.step(a)[2]:
-            env.reset()  # episodes end: resets counted here are a few in thousands
-    return (time.process_time() - start) / n
+        start = time.process_time()
+        done = env.step(a)[2]
+        spent += time.process_time() - start
+        if done:
+            ended += 1
+            env.reset()  # off the clock
+    return spent / n, ended
+
+
+def bodies(env) -> int:
+    """How many bodies the env's world holds (a car, a goal and a plane after a reset)."""
+    p = env._p if hasattr(env, "_p") else env.p
+    client = env._client if hasattr(env, "_client") else env.client
+    return p.getNumBodies(physicsClientId=client)
 
 
 def resets_cost(env, n: int) -> float:
@@ -51,11 +68,20 @@ def main() -> int:
     a = ap.parse_args()
     ours, theirs = SimpleDrivingEnv(), TutorialDrivingEnv()
     step_ours, step_theirs, reset_ours, reset_theirs = [], [], [], []
+    ended = {"urdfkit": 0, "tutorial": 0}
     for _ in range(a.repeat):
-        step_ours.append(steps_cost(ours, a.steps))
-        step_theirs.append(steps_cost(theirs, a.steps))
+        cost, n = steps_cost(ours, a.steps)
+        step_ours.append(cost)
+        ended["urdfkit"] += n
+        cost, n = steps_cost(theirs, a.steps)
+        step_theirs.append(cost)
+        ended["tutorial"] += n
         reset_ours.append(resets_cost(ours, a.resets))
         reset_theirs.append(resets_cost(theirs, a.resets))
+    # Sanity: both did the same work (steps, episodes that ended) and a reset leaves the same
+    # world (a broken baseline that loads nothing would make any ratio look good).
+    print(f"sanity: {a.repeat} x {a.steps} steps each; episodes ended: {ended}; bodies after a "
+          f"reset: urdfkit {bodies(ours)}, tutorial {bodies(theirs)}")
     so, st = statistics.median(step_ours), statistics.median(step_theirs)
     ro, rt = statistics.median(reset_ours), statistics.median(reset_theirs)
     print(f"step: urdfkit {so * 1e6:.1f} us, tutorial {st * 1e6:.1f} us: {so / st:.3f} "
