@@ -83,3 +83,23 @@ def test_nothing_is_said_fixed_when_the_write_fails(tmp_path: Path,
         lines = [ln for ln in result.stderr.splitlines() if ln.strip()]
         assert lines == [f"urdfkit: error: {lines[0].split('error: ', 1)[1]}"]
         assert "no space left" in lines[0] and ": fixed " not in result.output
+
+
+def test_two_undefined_materials_in_a_one_line_file_are_both_defined(tmp_path: Path) -> None:
+    # The second definition went first into a robot whose first child the first one had
+    # just inserted, and fix exited 3 (found by the fuzzer).
+    src = tmp_path / "r.urdf"
+    src.write_text('<robot name="r"><material name="blue"/><link name="a"><visual><geometry>'
+                   '<box size="1 1 1"/></geometry><material name="blue"/></visual><visual>'
+                   '<geometry><box size="1 1 1"/></geometry><material name="red"/></visual>'
+                   '</link></robot>')
+    out = tmp_path / "f.urdf"
+    result = runner.invoke(app, ["fix", str(src), "-o", str(out), "--select", "U706"])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.count("fixed U706") == 2
+    from lxml import etree
+
+    root = etree.parse(str(out)).getroot()
+    defined = {m.get("name") for m in root.findall("material") if m.find("color") is not None}
+    assert defined == {"blue", "red"}
+    assert not [f for f in check_paths([out], jobs=1, cache=False).findings if f.code == "U706"]

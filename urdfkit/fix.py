@@ -299,10 +299,11 @@ class _Plan:
         self.line_starts = starts
         # Every element's start tag by its path: exact past line 65,535 (where lxml's
         # sourceline stops), for prefixed tags, and with tags quoted in comments.
-        tree = root.getroottree()
+        # Keyed by the element itself (the map keeps each proxy alive, so lxml hands back the
+        # same one): an element a repair inserted has no start tag in the text, and is skipped.
         elements = (el for el in root.iter() if isinstance(el.tag, str))
-        self.tag_at = {tree.getpath(el): pos
-                       for el, pos in zip(elements, start_tags(text), strict=False)}
+        self.tag_at: dict[etree._Element, int] = dict(
+            zip(elements, start_tags(text), strict=False))
 
     # ---- repairs
 
@@ -539,7 +540,9 @@ class _Plan:
         """Insert lines as the first child; a leading tab in a line is one more indent."""
         start, tag_end, closed = self._start_tag(parent)
         indent = self._indent(start)
-        first = next(iter(parent), None)
+        # The first child written in the text (not one an earlier repair inserted).
+        first = next((c for c in parent if not isinstance(c.tag, str) or c in self.tag_at),
+                     None)
         if first is not None and not closed:
             inner = self._indent(self._start_tag(first)[0]) if isinstance(first.tag, str) \
                 else None
@@ -572,7 +575,7 @@ class _Plan:
 
     def _start_tag(self, el: etree._Element) -> tuple[int, int, bool]:
         """(start, end, self-closing) of the element's start tag in the text."""
-        start = self.tag_at[self.root.getroottree().getpath(el)]
+        start = self.tag_at[el]
         end, closed = self._tag_end(start)
         return start, end, closed
 
@@ -615,7 +618,8 @@ class _Plan:
         return lead if lead.strip() == "" else ""
 
     def _unit(self) -> str:
-        first = next((x for x in self.root if isinstance(x.tag, str)), None)
+        first = next((x for x in self.root if isinstance(x.tag, str) and x in self.tag_at),
+                     None)
         if first is not None:
             unit = self._indent(self._start_tag(first)[0])
             if unit:
