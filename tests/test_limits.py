@@ -246,3 +246,18 @@ def test_check_flags_a_ring_of_mimic_joints_once_and_a_chain_not_at_all(tmp_path
     assert code == 2 and "ring" in err
     code, _, err = invoke("collisions", str(chain), "--samples", "2")
     assert code in (0, 1), err
+
+
+def test_drive_survives_an_infinite_wheel(tmp_path: Path, simplecar_urdf: Path) -> None:
+    # A cylinder of radius 1e309 (infinite) once made wheel detection take int(NaN): exit 3.
+    import re
+
+    text = simplecar_urdf.read_text()
+    car = tmp_path / "car.urdf"
+    car.write_text(re.sub(r'(<cylinder[^>]*radius=")[^"]+', r"\g<1>1e309", text, count=1))
+    assert car.read_text() != text
+    code, out, err = invoke("drive", "--urdf", str(car), "--steps", "24", "--json")
+    assert code in (0, 1, 2), err
+    assert "internal error" not in err
+    if code == 0:
+        json.loads(out)

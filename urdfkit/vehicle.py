@@ -339,8 +339,13 @@ def _unit(a: Sequence[float]) -> Vec:
 
 
 def _roundness(points: list[Vec], origin: Vec, axis: Vec) -> tuple[float, float, Vec] | None:
-    """``(radius, worst sector fraction, centre on the axis)`` of points about an axis."""
-    if not points:
+    """``(radius, worst sector fraction, centre on the axis)`` of points about an axis.
+
+    None for no points, or for points that are not all finite (a shape sized 1e309 is
+    infinite): nothing round can be measured from them.
+    """
+    if not points or not all(math.isfinite(c) for pt in points for c in pt) or \
+            not all(math.isfinite(c) for c in (*origin, *axis)):
         return None
     # Two directions perpendicular to the axis.
     helper = (1.0, 0.0, 0.0) if abs(axis[0]) < 0.9 else (0.0, 1.0, 0.0)
