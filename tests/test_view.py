@@ -156,6 +156,9 @@ def test_sliders_in_pybullet_order_within_limits(arm: Path, viewer_of: Any) -> N
     assert (v.sliders["shoulder"].min, v.sliders["shoulder"].max) == (-1.5, 1.5)
     assert (v.sliders["spin"].min, v.sliders["spin"].max) == (-math.pi, math.pi)  # continuous
     assert v.sliders["slide"].disabled  # a mimic joint follows, it has no slider of its own
+    # From the start: shoulder 0 puts the mimic at its offset, in PyBullet and on its slider.
+    assert v.model.positions()["slide"] == pytest.approx(0.01)
+    assert v.sliders["slide"].value == pytest.approx(0.01)
 
 
 def test_moving_a_joint_moves_pybullet_and_the_scene(arm: Path, viewer_of: Any) -> None:
@@ -307,7 +310,7 @@ def _open_page(browser: Any, v: Viewer) -> Any:
 
 
 def _pixels(page: Any, colour: str = "green", path: Path | None = None) -> int:
-    """How many pixels of the scene are clearly green (visuals) or orange (collision)."""
+    """Pixels of the scene that are clearly green (visuals), red (error tint) or orange."""
     import io
 
     import numpy as np
@@ -320,6 +323,8 @@ def _pixels(page: Any, colour: str = "green", path: Path | None = None) -> int:
     r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
     if colour == "green":
         return int(((g > r + 60) & (g > b + 60)).sum())
+    if colour == "red":
+        return int(((r > g + 90) & (r > b + 90) & (abs(g - b) < 40)).sum())
     return int(((r > g + 40) & (g > b + 40)).sum())
 
 
@@ -328,7 +333,6 @@ def test_page_connects_and_draws_the_robot(browser: Any, arm: Path, viewer_of: A
     v = viewer_of(arm)
     page = _open_page(browser, v)
     assert _wait(lambda: _pixels(page) > 2000, 30), "no robot pixels on the page"
-    _pixels(page, path=DOCS / "view.png" if os.environ.get("URDFKIT_SHOTS") else None)
     assert page.get_by_text("arm", exact=False).first.is_visible()
 
 
@@ -367,6 +371,14 @@ def test_finding_and_reload_error_shown_in_the_page(browser: Any, tmp_path: Path
     v = viewer_of(path, inertia_from_file=True)
     page = _open_page(browser, v)
     page.get_by_text(f"{path}:{line}").wait_for(timeout=10000)
+    # Red where the error is: the tinted link's pixels are in the picture.
+    assert _wait(lambda: _pixels(page, "red") > 500, 20)
+    if os.environ.get("URDFKIT_SHOTS"):  # docs/view.png: URDFKIT_SHOTS=1 pytest -k finding
+        page.locator("button.mantine-Notification-closeButton").click()
+        page.get_by_label("COM and inertia boxes").check()
+        page.get_by_label("Frames and axes").check()
+        time.sleep(2)
+        page.screenshot(path=str(DOCS / "view.png"))
     path.write_text("<robot")
     page.get_by_text("Reload failed").wait_for(timeout=10000)
     assert page.get_by_text("Connected").is_visible()

@@ -572,6 +572,7 @@ class Viewer:
                                    section_size=1.0)
         self._static_gui()
         self._show_model()
+        self.reset()  # mimic joints to their leaders' zero pose (offsets included)
         self._aim_camera()
         self._stop = threading.Event()
         self._watcher = threading.Thread(target=self._watch, name="urdfkit-view-watch",
@@ -642,6 +643,7 @@ class Viewer:
         self.apply_toggles()
         listed, flags = m.joint_vector()
         self.vector_text.value, self.joints_text.value = listed, flags
+        now = m.positions()
         with self.joints_folder:
             for j in m.joints:
                 step = (j.upper - j.lower) / 1000 if j.upper > j.lower else 0.001
@@ -649,7 +651,7 @@ class Viewer:
                 if j.mimic is not None:
                     hint += f"; mimics {j.mimic[0]} x {j.mimic[1]:g} + {j.mimic[2]:g}"
                 s = gui.add_slider(j.name, min=j.lower, max=max(j.upper, j.lower + step),
-                                   step=step, initial_value=min(max(0.0, j.lower), j.upper),
+                                   step=step, initial_value=min(max(now[j.name], j.lower), j.upper),
                                    disabled=j.mimic is not None, hint=hint)
                 s.on_update(lambda _event, name=j.name: self._slider_moved(name))
                 self.sliders[j.name] = s
