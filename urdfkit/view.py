@@ -622,6 +622,8 @@ class Viewer:
                     self._nodes[kind].append(scene.add_mesh_simple(
                         f"{root}/{kind}{k}", sh.vertices, sh.faces, color=tint or sh.rgb,
                         opacity=None if sh.opacity >= 1 else sh.opacity,
+                        # No shadow pass: it doubles the first draw in software WebGL.
+                        cast_shadow=False, receive_shadow=False,
                         position=sh.pos, wxyz=_wxyz(sh.quat)))
             self._nodes["frames"].append(scene.add_frame(
                 f"{root}/axes", axes_length=size * 0.08, axes_radius=size * 0.004))
@@ -790,8 +792,10 @@ class Viewer:
         kept = self.model.positions()
         try:
             model = Model(self.file, **self._load_args)
-        except UrdfkitError as e:
-            self.error = str(e)
+        except Exception as e:  # noqa: BLE001 - any failure keeps the last good robot
+            self.error = str(e) if isinstance(e, UrdfkitError) else \
+                f"internal error (a bug in urdfkit): {type(e).__name__}: {e}"
+            # Not retried until a file changes again: a bad file is not loaded 4 times a second.
             with deps.record() as recorded:  # what the failed attempt depends on
                 deps.note(self.file)
                 for path in self.model.depends:
