@@ -25,7 +25,7 @@ import pytest
 
 pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
 
-from urdfkit.view import TINTS, Viewer  # noqa: E402
+from urdfkit.view import TINTS, TOUCHING_RGB, Viewer  # noqa: E402
 
 DOCS = Path(__file__).parent.parent / "docs"
 CHROMIUM = os.environ.get("URDFKIT_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
@@ -57,8 +57,9 @@ ARM = """<?xml version="1.0"?>
   <link name="wheel">
     <inertial><mass value="0.1"/>
       <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
-    <visual><geometry><cylinder radius="0.05" length="0.02"/></geometry>
+    <visual><geometry><cylinder radius="0.05" length="0.06"/></geometry>
       <material name="green"/></visual>
+    <collision><geometry><cylinder radius="0.05" length="0.06"/></geometry></collision>
   </link>
   <joint name="shoulder" type="revolute">
     <parent link="base"/><child link="upper"/><origin xyz="0 0 0.05"/><axis xyz="0 1 0"/>
@@ -199,6 +200,48 @@ def test_inertia_box_without_the_file_is_pybullets(arm: Path, viewer_of: Any) ->
     v = viewer_of(arm)
     upper = next(lk for lk in v.model.links if lk.name == "upper")
     assert upper.inertia_box == pytest.approx((0.08, 0.08, 0.5), abs=1e-6)
+
+
+def _raw_touching(path: Path, joints: dict[str, float]) -> dict[tuple[str, str], float]:
+    """Non-adjacent link pairs within 0 m, from PyBullet DIRECT with self-collision on."""
+    import pybullet as p
+
+    c = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(str(path), useFixedBase=True, physicsClientId=c,
+                          flags=p.URDF_USE_SELF_COLLISION | p.URDF_USE_IMPLICIT_CYLINDER)
+        n = p.getNumJoints(body, physicsClientId=c)
+        infos = [p.getJointInfo(body, j, physicsClientId=c) for j in range(n)]
+        for info in infos:
+            if info[1].decode() in joints:
+                p.resetJointState(body, info[0], joints[info[1].decode()], physicsClientId=c)
+        names = {-1: p.getBodyInfo(body, physicsClientId=c)[0].decode()}
+        names.update({i[0]: i[12].decode() for i in infos})
+        out = {}
+        for a in range(-1, n):
+            for b in range(a + 1, n):
+                if infos[b][16] == a:
+                    continue
+                points = p.getClosestPoints(body, body, 0.0, a, b, physicsClientId=c)
+                if points:
+                    out[(names[a], names[b])] = min(pt[8] for pt in points)
+        return out
+    finally:
+        p.disconnect(physicsClientId=c)
+
+
+def test_touching_pairs_follow_the_sliders(arm: Path, viewer_of: Any) -> None:
+    v = viewer_of(arm)
+    assert v.touching == [] and _raw_touching(arm, {}) == {}
+    v.set_joints({"shoulder": 1.5})  # the arm swings down onto the wheel
+    raw = _raw_touching(arm, {"shoulder": 1.5, "slide": 0.085})
+    assert list(raw) == [("upper", "wheel")]
+    assert [(a, b) for a, b, _ in v.touching] == [("upper", "wheel")]
+    assert v.touching[0][2] == pytest.approx(raw[("upper", "wheel")], abs=1e-6)
+    assert [h.color for h in v.nodes("visual", "wheel")] == [TOUCHING_RGB]
+    assert "touching: upper and wheel" in v.touching_text.content
+    v.reset()
+    assert v.touching == [] and v.nodes("visual", "wheel")[0].color == (0, 229, 0)
 
 
 def test_collision_layer_hidden_until_asked(arm: Path, viewer_of: Any) -> None:
@@ -355,7 +398,7 @@ def test_slider_in_the_page_moves_pybullet_and_the_scene(browser: Any, arm: Path
 def test_collision_toggle_in_the_page(browser: Any, arm: Path, viewer_of: Any) -> None:
     v = viewer_of(arm)
     page = _open_page(browser, v)
-    page.get_by_label("Collision").check()
+    page.get_by_label("Collision", exact=True).check()
     assert _wait(lambda: v.visible("collision"), 10)
     page.get_by_label("Visual").uncheck()
     assert _wait(lambda: not v.visible("visual"), 10)

@@ -36,6 +36,8 @@ TINTS = {"error": (220, 38, 38), "warning": (245, 158, 11)}
 #: Colour of collision shapes; of those PyBullet replaces by a hull of a concave mesh.
 COLLISION_RGB = (213, 94, 0)
 CONCAVE_RGB = (204, 121, 167)
+#: Links touching another at the current pose (self-collision pairs).
+TOUCHING_RGB = (200, 0, 200)
 #: How often the watcher looks at the files the robot was read from (s).
 POLL_SECONDS = 0.25
 #: Meshes with more triangles than this are thinned for display (only: PyBullet keeps all).
@@ -229,6 +231,7 @@ class Model:
         self.notes: list[str] = []
         self.lock = threading.RLock()
         self.session: Any = None
+        self._probe: tuple[Any, int, list[tuple[int, int]]] | None = None
         with deps.record() as recorded:
             deps.note(file)
             try:
@@ -480,6 +483,47 @@ class Model:
                 return (-0.5, -0.5, -0.5), (0.5, 0.5, 0.5)
             return tuple(lo), tuple(hi)  # type: ignore[return-value]
 
+    def touching(self) -> list[tuple[str, str, float]]:
+        """Link pairs touching or interpenetrating at the current pose, as ``collisions`` sees them.
+
+        Measured in a second body loaded with URDF_USE_SELF_COLLISION (without it PyBullet's
+        getClosestPoints finds nothing between a body's own links) and pinned, posed like the
+        shown one; links joined by a joint are not tested, as in ``urdfkit collisions``.
+        Returns (link a, link b, signed distance in m), deepest first.
+        """
+        with self.lock:
+            if self._probe is None:
+                self._probe = self._open_probe()
+            session, body, pairs = self._probe
+            p, c = session.p, session.client
+            for j in self.joints:
+                p.resetJointState(body, j.index, p.getJointState(
+                    self.body, j.index, physicsClientId=self.session.client)[0],
+                    physicsClientId=c)
+            out = []
+            for a, b in pairs:
+                points = p.getClosestPoints(body, body, 0.0, a, b, physicsClientId=c)
+                if points:
+                    out.append((self.links[a + 1].name, self.links[b + 1].name,
+                                float(min(pt[8] for pt in points))))
+            return sorted(out, key=lambda x: x[2])
+
+    def _open_probe(self) -> tuple[Any, int, list[tuple[int, int]]]:
+        from .session import LoadOptions, Session
+
+        session = Session()
+        try:
+            body = session.load_urdf(self.resolved.load_path, LoadOptions(
+                fixed_base=True, self_collision=True), display=self.resolved.name)
+        except BaseException:
+            session.close()
+            raise
+        shaped = [lk.index for lk in self.links if lk.collisions]
+        parent = {j.joint_index: j.parent_index for j in self.table}
+        pairs = [(a, b) for k, a in enumerate(shaped) for b in shaped[k + 1:]
+                 if parent.get(b) != a and parent.get(a) != b]
+        return session, body, pairs
+
     def joint_vector(self) -> tuple[str, str]:
         """The current joints as a Python list (index order) and as ``--joints`` text."""
         now = self.positions()
@@ -492,6 +536,10 @@ class Model:
         if self.session is not None:
             self.session.close()
             self.session = None
+        probe = getattr(self, "_probe", None)
+        if probe is not None:
+            probe[0].close()
+            self._probe = None
         resolved = getattr(self, "resolved", None)
         if resolved is not None:
             resolved.close()
@@ -572,7 +620,9 @@ class Viewer:
                                    section_size=1.0)
         self._static_gui()
         self._show_model()
-        self.reset()  # mimic joints to their leaders' zero pose (offsets included)
+        # Mimic joints to their leaders' zero pose (offsets included). Self-collisions are
+        # first measured by the watcher, so their second load does not delay the first draw.
+        self.set_joints(self.zero(), touching=False)
         self._aim_camera()
         self._stop = threading.Event()
         self._watcher = threading.Thread(target=self._watch, name="urdfkit-view-watch",
@@ -589,8 +639,14 @@ class Viewer:
             self.show_collision = gui.add_checkbox("Collision", False)
             self.show_frames = gui.add_checkbox("Frames and axes", False)
             self.show_inertia = gui.add_checkbox("COM and inertia boxes", False)
+            self.show_touching = gui.add_checkbox(
+                "Self-collisions", True, hint="Links touching at this pose, as urdfkit "
+                "collisions measures them, in magenta")
+            self.touching_text = gui.add_markdown("")
         for box in (self.show_visual, self.show_collision, self.show_frames, self.show_inertia):
             box.on_update(lambda _event: self.apply_toggles())
+        self.show_touching.on_update(lambda _event: self.update_touching())
+        self.touching: list[tuple[str, str, float]] = []
         self.joints_folder = gui.add_folder("Joints", order=2)
         with self.joints_folder:
             self.reset_button = gui.add_button("Reset to zero")
@@ -723,8 +779,12 @@ class Viewer:
             return
         self.set_joints({name: float(self.sliders[name].value)})
 
-    def set_joints(self, values: Mapping[str, float]) -> dict[str, float]:
-        """Move joints (by name) in PyBullet and update the scene; return the new positions."""
+    def set_joints(self, values: Mapping[str, float], touching: bool = True
+                   ) -> dict[str, float]:
+        """Move joints (by name) in PyBullet and update the scene; return the new positions.
+
+        ``touching=False`` leaves the self-collision highlight as it was.
+        """
         with self._lock:
             now = self.model.set_positions(values)
             self._setting = True
@@ -736,6 +796,8 @@ class Viewer:
             finally:
                 self._setting = False
             self.update_poses()
+            if touching:
+                self.update_touching()
             listed, flags = self.model.joint_vector()
             self.vector_text.value = listed
             self.joints_text.value = flags
@@ -748,9 +810,32 @@ class Viewer:
                 frame.position = pos
                 frame.wxyz = _wxyz(quat)
 
+    def update_touching(self) -> None:
+        """Measure the touching pairs (when shown) and colour their links magenta."""
+        with self._lock:
+            self.touching = self.model.touching() if self.show_touching.value else []
+            hit = {name for a, b, _ in self.touching for name in (a, b)}
+            for link, k in zip(self.model.links, range(len(self.model.links)), strict=True):
+                base = TINTS.get(link.level or "")
+                for kind, shapes in (("visual", link.visuals), ("collision", link.collisions)):
+                    handles = [h for h in self._nodes.get(kind, [])
+                               if h.name.startswith(f"/robot/link{k}/")]
+                    for h, sh in zip(handles, shapes, strict=True):
+                        want = TOUCHING_RGB if link.name in hit else (base or sh.rgb)
+                        if tuple(h.color) != tuple(want):
+                            h.color = want
+            self.touching_text.content = "\n".join(
+                f"- touching: {_md(a)} and {_md(b)} "
+                f"({'by' if d < 0 else 'at'} {abs(d) * 1000:.3g} mm)"
+                for a, b, d in self.touching)
+
+    def zero(self) -> dict[str, float]:
+        """Every joint at zero, or at its nearest limit when zero is outside them."""
+        return {j.name: min(max(0.0, j.lower), j.upper) for j in self.model.joints}
+
     def reset(self) -> None:
-        """Every joint to zero (or to its nearest limit when zero is outside them)."""
-        self.set_joints({j.name: min(max(0.0, j.lower), j.upper) for j in self.model.joints})
+        """Every joint to :meth:`zero`."""
+        self.set_joints(self.zero())
 
     def link_pose(self, name: str) -> tuple[Vec3, tuple[float, float, float, float]]:
         """A link node's pose in the scene: (position, wxyz)."""
@@ -771,6 +856,11 @@ class Viewer:
     def _watch(self) -> None:
         from . import deps
 
+        try:
+            self.update_touching()
+        except Exception as e:  # noqa: BLE001 - the server outlives a probe that fails
+            self.error = f"self-collisions not measured: {e}"
+            self._refresh_status()
         while not self._stop.wait(POLL_SECONDS):
             recorded = self._failed if self._failed is not None else self.model.depends
             try:
