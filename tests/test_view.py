@@ -329,6 +329,37 @@ def test_cli_bad_file_is_one_line_exit_2(tmp_path: Path) -> None:
     assert r.stderr.count("\n") == 1 and "none.urdf" in r.stderr and r.stdout == ""
 
 
+@pytest.mark.parametrize("kind", ["fifo", "folder", "dangling"])
+def test_cli_refuses_what_is_not_a_file_at_once(kind: str, tmp_path: Path) -> None:
+    path = tmp_path / "robot.urdf"
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "folder":
+        path.mkdir()
+    else:
+        path.symlink_to(tmp_path / "gone.urdf")
+    t0 = time.monotonic()
+    r = subprocess.run([sys.executable, "-m", "urdfkit", "view", str(path)],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and time.monotonic() - t0 < 30
+    assert r.stderr.count("\n") == 1 and "robot.urdf" in r.stderr and r.stdout == ""
+
+
+def test_xacro_with_args(tmp_path: Path, viewer_of: Any) -> None:
+    path = tmp_path / "two.urdf.xacro"
+    path.write_text(
+        '<robot name="two" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:arg name="reach" default="0.2"/>'
+        '<link name="a"><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>'
+        '<link name="b"><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>'
+        '<joint name="j" type="prismatic"><parent link="a"/><child link="b"/>'
+        '<limit lower="0" upper="$(arg reach)" effort="1" velocity="1"/></joint></robot>')
+    v = viewer_of(path, xacro_args=["reach:=0.7"])
+    assert (v.sliders["j"].min, v.sliders["j"].max) == (0.0, 0.7)
+    v.set_joints({"j": 0.5})
+    assert v.link_pose("b")[0] == pytest.approx((0.5, 0.0, 0.0), abs=1e-6)  # axis default x
+
+
 # --------------------------------------------------------------------------- the page
 
 
