@@ -50,6 +50,10 @@ CASES = [
     ("U104", doc(A, link("b%n") + "<!--HERE-->", joint(child="b%n"))),
     ("U105", doc('<material name="m"><color rgba="1 0 0 1"/></material>',
                  '<material name="m"><!--HERE--><color rgba="1 0 0 1"/></material>', A)),
+    ("U109", doc('<material><!--HERE-->\n<color rgba="1 0 0 1"/></material>', A)),
+    ("U110", doc(link("a", body='<visual><geometry><box size="1 1 1"/></geometry>\n'
+                                '<material><color rgba="1 0 0 1"/></material><!--HERE-->\n'
+                                '</visual>'))),
     ("U106", doc(A, link("b", "", "") + "\n" + joint("é" * 632) + "<!--HERE-->")),
     ("U107", doc(A, B, joint("j%s%n") + "<!--HERE-->")),
     ("U108", doc(A, link("ロ" * 334) + "<!--HERE-->", joint(child="ロ" * 334))),
@@ -141,6 +145,11 @@ CASES = [
     ("U614", doc(A, link("b", body=f'<collision><geometry>\n<mesh filename='
                                    f'"{MESHES / "l_bracket.obj"}" scale="0.1 0.1 0.1"/>'
                                    '<!--HERE-->\n</geometry></collision>'), J)),
+    ("U710", doc(link("a", body='<visual><geometry><box size="1 1 1"/></geometry>'
+                                '<material name="m"><color rgba="1 0 0 1"/></material></visual>'
+                                '<visual><geometry><box size="1 1 1"/></geometry>'
+                                '<material name="m">\n<color rgba="0 1 0 1"/><!--HERE-->\n'
+                                '</material></visual>'))),
     ("U706", doc(link("a", body='<visual><geometry><box size="1 1 1"/></geometry>\n'
                                 '<material name="steel"/><!--HERE-->\n</visual>'))),
     ("U707", doc('<material name="m">\n<texture/><!--HERE-->\n</material>', A)),

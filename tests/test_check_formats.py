@@ -275,8 +275,8 @@ def test_github_format_on_a_tricky_file_name(repo: Path) -> None:
         "::error file=robots/we%2Cird%3A50%25.urdf,line=3,title=U102::duplicate link name 'a' "
         "(first on line 2); names must be unique",
         "::warning file=robots/we%2Cird%3A50%25.urdf,line=3,title=U606::<link name='a'> has no "
-        "<inertial>; PyBullet silently gives it 1 kg and unit inertia: add <inertial> (mass 0 "
-        "for a frame)",
+        "<inertial>; PyBullet silently gives it 1 kg and unit inertia: add <inertial> with its "
+        "real mass (mass 0 would fix the robot in place)",
         "::notice file=robots/good.urdf,line=3,title=U607::PyBullet ignores <inertia> from the "
         "file and recomputes it from the collision shapes unless loaded with "
         "URDF_USE_INERTIA_FROM_FILE (urdfkit: --inertia-from-file)",

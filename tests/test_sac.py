@@ -354,7 +354,6 @@ def test_keys_simulation_and_control_never_reads_are_warnings_not_refusals():
 
 
 def test_a_top_level_section_of_theirs_is_recognised():
-    conf = json.loads(PENDULUM.read_text())
     assert sac.is_config({"sim": {}}) and not sac.is_config({"robots": []})
     with pytest.raises(InputError, match="robot_pybullet: required section"):
         sac.convert({"sim": {"time_step": 0.01}}, source=PENDULUM)

@@ -216,6 +216,12 @@ def rule_names(root: etree._Element, r: Report) -> None:
                 seen[name] = el
     seen_mat: dict[str, etree._Element] = {}
     for el in _elements(root, "material"):
+        if el.get("name") is None or not el.get("name", "").strip():
+            # PyBullet warns ("Material must contain a name attribute") and loads the file;
+            # nothing can refer to a nameless material, so its colour is never drawn.
+            r.add("U109", "warning", "<material> at the top level has no name: PyBullet "
+                  "skips it with a warning, and no <visual> can use it; give it a name", el)
+            continue
         name = _check_name(el, r)
         if name is None:
             continue
@@ -224,7 +230,16 @@ def rule_names(root: etree._Element, r: Report) -> None:
                   f"{line_of(seen_mat[name])})", el)
         seen_mat[name] = el
     for el in root.iter("material"):
-        if el.getparent() is not root and el.get("name") and "%" in el.get("name", ""):
+        if el.getparent() is root:
+            continue
+        if el.get("name") is None and el.getparent() is not None and \
+                el.getparent().tag == "visual":
+            # Measured: PyBullet refuses the whole file ("Could not parse visual element");
+            # name="" loads.
+            r.add("U110", "error", "<material> of a <visual> has no name attribute: PyBullet "
+                  "refuses the file (\"Could not parse visual element\"); give it one "
+                  "(name=\"\" is enough)", el)
+        elif el.get("name") and "%" in el.get("name", ""):
             _check_name(el, r)
 
 
@@ -476,11 +491,16 @@ def rule_mass(root: etree._Element, r: Report) -> None:
             fixed_children.setdefault(parent.get("link", ""), []).append(child.get("link", ""))
         else:
             moving.append((child.get("link", ""), j))
+    child_names = {c.get("link") for j in _elements(root, "joint") for c in j.findall("child")}
     for link in links.values():
         inertial = link.find("inertial")
         if inertial is None:
+            # Never "mass 0" for the root: PyBullet fixes a mass-0 base in place (U611).
+            advice = ("add <inertial> with its real mass (mass 0 would fix the robot in place)"
+                      if link.get("name") not in child_names else
+                      "add <inertial> (mass 0 for a frame)")
             r.add("U606", "warning", f"{_label(link)} has no <inertial>; PyBullet silently gives "
-                  "it 1 kg and unit inertia: add <inertial> (mass 0 for a frame)", link)
+                  f"it 1 kg and unit inertia: {advice}", link)
             continue
         mass_el = inertial.find("mass")
         mass = _num(mass_el, "value")
@@ -506,15 +526,24 @@ def rule_mass(root: etree._Element, r: Report) -> None:
         if name in links and rigid_mass(name) == 0:
             r.add("U602", "error", f"{_label(links[name])} moves (joint {j.get('name')!r} is "
                   f"{j.get('type')}) but has mass 0; give it a mass > 0", links[name])
-    children = {c.get("link") for j in _elements(root, "joint") for c in j.findall("child")}
-    roots = [link for name, link in links.items() if name not in children]
-    if len(roots) == 1 and rigid_mass(roots[0].get("name", "")) == 0:
+    roots = [link for name, link in links.items() if name not in child_names]
+    # PyBullet judges the root link's own mass: 0 fixes the base in place, whatever its fixed
+    # children weigh (a mass-0 base_footprint over a 28 kg base_link hangs in the air). A
+    # root with no <inertial> gets 1 kg, so it moves (U606 says so).
+    own = _mass_of(roots[0]) if len(roots) == 1 and roots[0].find("inertial") is not None \
+        else None
+    if own is not None and own == 0:
         base, static = roots[0], not moving
-        r.add("U611", "info" if static else "warning",
+        carried = rigid_mass(base.get("name", ""))
+        held = (f"; its fixed links weigh {carried:g} kg, and PyBullet ignores that: it looks "
+                "at the root's own mass" if carried > 0 else "")
+        r.add("U611", "info" if static and not carried else "warning",
               f"root {_label(base)} has mass 0: PyBullet makes the base static, fixed where it "
-              "is loaded" + (" (right for a static object such as ground)" if static
-                             else "; right for an arm bolted to the world, wrong for a robot "
-                             "that should fall or drive: give the base a mass"), base)
+              "is loaded" + (" (right for a static object such as ground)"
+                             if static and not carried else
+                             "; right for an arm bolted to the world, wrong for a robot "
+                             "that should fall or drive: give the root link a mass, or make "
+                             "the massive link the root") + held, base)
 
 
 def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | None:
@@ -523,6 +552,29 @@ def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | 
         return None
     ixx, ixy, ixz, iyy, iyz, izz = vals
     return ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))  # type: ignore[return-value]
+
+
+def rule_material_colours(root: etree._Element, r: Report) -> None:
+    """U710: one material name given several colours; PyBullet draws them all in one.
+
+    Measured on PyBullet 3.2.7: every visual whose material has that name (``""`` included,
+    at the top level or inline) is drawn in the colour written last in the file.
+    """
+    colours: dict[str, list[tuple[str, etree._Element]]] = {}
+    for m in root.iter("material"):
+        name, color = m.get("name"), m.find("color")
+        if name is None or color is None or color.get("rgba") is None:
+            continue
+        colours.setdefault(name, []).append((" ".join(color.get("rgba", "").split()), color))
+    for name, found in colours.items():
+        distinct = list(dict.fromkeys(c for c, _ in found))
+        if len(distinct) < 2:
+            continue
+        shown = ", ".join(distinct[:4]) + (f" and {len(distinct) - 4} more"
+                                           if len(distinct) > 4 else "")
+        r.add("U710", "warning", f"material name {name!r} is given {len(distinct)} colours "
+              f"({shown}): PyBullet draws every visual named so in the last one written, "
+              f"rgba {found[-1][0]}; give each colour its own name", found[1][1])
 
 
 def rule_references(root: etree._Element, r: Report) -> None:
@@ -991,14 +1043,14 @@ GUARD_RULES: tuple[Rule, ...] = (rule_document, rule_names, rule_tree, rule_link
 #: values (limits, sizes, masses, inertia) are ``check`` findings: PyBullet loads such files,
 #: and pybullet_data ships some, so the loading commands still load them.
 GUARD_CODES = frozenset({"U001", "U002", "U003", "U005", "U101", "U102", "U103", "U104", "U105",
-                         "U106", "U107", "U108", "U201", "U202", "U203", "U204", "U205",
+                         "U106", "U107", "U108", "U110", "U201", "U202", "U203", "U204", "U205",
                          "U206", "U207", "U209", "U301", "U302", "U502", "U505", "U506",
                          "U609", "U610"})
 
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
                                rule_inertia, rule_meshes, rule_mesh_shapes, rule_references,
-                               rule_portability)
+                               rule_material_colours, rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -1019,6 +1071,8 @@ CODES: dict[str, str] = {
     "U106": "name near PyBullet's crash length (joint 1200, link 2200, robot 1024 bytes)",
     "U107": "'%' in a joint, material or robot name (refused; --no-guard lifts it)",
     "U108": "name over 1000 bytes (refused; --no-guard lifts it)",
+    "U109": "top-level <material> without a name (PyBullet skips it; warning)",
+    "U110": "<material> of a <visual> without a name attribute (PyBullet refuses the file)",
     "U201": "joint without <parent> or <child>",
     "U202": "joint refers to a missing link",
     "U203": "joint joins a link to itself",
@@ -1068,6 +1122,7 @@ CODES: dict[str, str] = {
     "U707": "<texture> without a filename",
     "U708": "package:/// without a package name",
     "U709": "transmission names a missing joint",
+    "U710": "one material name given several colours (PyBullet draws them all in the last)",
     "U801": "unknown tag",
     "U802": "unknown attribute",
     "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
