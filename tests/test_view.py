@@ -303,10 +303,16 @@ def test_a_bad_file_refused_before_serving(tmp_path: Path) -> None:
 
 
 def test_cli_prints_the_url_serves_and_exits_130(arm: Path) -> None:
+    import select
+
     proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "view", str(arm)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert proc.stdout is not None
+        # The URL within two minutes (seconds on a quiet machine; a loaded 2-core one has
+        # taken 30): a server that never says where it is fails here, never hangs the suite.
+        ready, _, _ = select.select([proc.stdout], [], [], 120)
+        assert ready, "urdfkit view printed no URL within 120 s"
         line = proc.stdout.readline()
         assert line.startswith("urdfkit view: http://localhost:"), line
         url = line.split()[2]
@@ -318,6 +324,9 @@ def test_cli_prints_the_url_serves_and_exits_130(arm: Path) -> None:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+        for pipe in (proc.stdout, proc.stderr):
+            if pipe is not None:
+                pipe.close()
     assert proc.returncode == 130
     assert err.strip() == "urdfkit: interrupted" and out == ""
 
