@@ -188,8 +188,8 @@ def test_help_keeps_brackets_and_shows_readable_defaults() -> None:
 
 
 def test_shell_completion() -> None:
-    code, out, _ = invoke("--show-completion", "bash")
-    assert code == 0 and "_urdfkit_completion" in out and "complete" in out
+    code, out, err = invoke("--show-completion", "bash")
+    assert code == 0 and "_urdfkit_completion" in out and "complete" in out, (code, out, err)
     done = subprocess.run([sys.executable, "-m", "urdfkit"], capture_output=True, text=True,
                           env={**os.environ, "_URDFKIT_COMPLETE": "complete_bash",
                                "COMP_WORDS": "urdfkit joints --mov", "COMP_CWORD": "2"},
