@@ -271,12 +271,13 @@ FileArg = Annotated[str, typer.Argument(
 
 
 def _open(file: str, package: list[str] | None, arg: list[str] | None, no_guard: bool,
-          package_path: list[str] | None = None) -> Any:
+          package_path: list[str] | None = None, meshes: bool = True) -> Any:
     from .resolve import open_input
 
-    resolved = open_input(file, package, arg, guard=not no_guard, package_paths=package_path)
+    resolved = open_input(file, package, arg, guard=not no_guard, package_paths=package_path,
+                          meshes=meshes)
     for w in resolved.warnings:
-        show.warn(w)
+        show.warn(input_flags(w))
     return resolved
 
 
@@ -435,7 +436,7 @@ def tree(
     if dot or output is not None:
         _tree_dot(file, package, arg, output, force, as_json, no_guard, package_path)
         return
-    with _open(file, package, arg, no_guard, package_path) as resolved:
+    with _open(file, package, arg, no_guard, package_path, meshes=False) as resolved:
         root = kinematic_tree(resolved.root)
         robot = resolved.robot_name
     if as_json:

@@ -143,13 +143,15 @@ def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
 
 def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
             xacro_args: Mapping[str, str] | None = None, guard: bool = True,
-            strict_args: bool = True) -> Resolved:
+            strict_args: bool = True, meshes: bool = True) -> Resolved:
     """Locate, expand, parse, guard and package-resolve a URDF for loading.
 
     With ``guard=False`` the guard's refusals that are stricter than PyBullet (see
     :data:`urdfkit.validate.LIFTABLE_CODES`) become :attr:`Resolved.warnings`; whatever
     crashes PyBullet is refused either way. ``strict_args=False`` lets a xacro file ignore
-    ``xacro_args`` it does not take (``check`` passes one set to every file).
+    ``xacro_args`` it does not take (``check`` passes one set to every file). With
+    ``meshes=False`` (``tree``, which reads the file only) a mesh that cannot be found or
+    loaded is a warning, not a refusal.
     """
     display = str(name)
     source = locate(name)
@@ -158,7 +160,7 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
                                 strict_args=strict_args)
         try:
             return _resolve_tree(source, display, parse_xml(expanded, display), packages,
-                                 guard, copy=True, origins=expanded.origins)
+                                 guard, copy=True, origins=expanded.origins, meshes=meshes)
         except InputError as e:
             # Lines of xacro's output are not lines of the file the user wrote: say none
             # rather than a false one (the message names the element and, where recovered,
@@ -170,12 +172,13 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
         # PyBullet breaks lines over 8191 bytes (and may then refuse or misread the file): it
         # gets a reformatted copy, one element per line.
         return _resolve_tree(source, display, parse_xml(data, display), packages, guard,
-                             copy=long_line(data) is not None)
+                             copy=long_line(data) is not None, meshes=meshes)
 
 
 def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
                   packages: Mapping[str, Path] | None, guard: bool,
-                  copy: bool = False, origins: list[str | None] | None = None) -> Resolved:
+                  copy: bool = False, origins: list[str | None] | None = None,
+                  meshes: bool = True) -> Resolved:
     lifted = [f"{where(f)}: let through without the guard ({f.code}): "
               f"{f.message.removesuffix(STRICTER)}"
               for f in run_guard(tree, display, strict=guard, origins=origins)]
@@ -183,8 +186,15 @@ def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
     # PyBullet takes paths as UTF-8 text: a file name that is not (bytes from another locale,
     # kept by Python as surrogates) is loaded from a copy with a clean name.
     needs_copy = copy or not _utf8(str(source))
-    needs_copy = _check_files(root, source.resolve().parent, packages or {}, display) \
-        or needs_copy
+    try:
+        needs_copy = _check_files(root, source.resolve().parent, packages or {}, display) \
+            or needs_copy
+    except InputError as e:
+        if meshes:
+            raise
+        # Only the file is read (tree): a mesh it names is not needed, so its problem is a
+        # note; the tree is built from the file as written.
+        lifted.append(f"{e}: not needed to read the tree" if e.file else str(e))
     if needs_copy:
         import tempfile  # here, not at the top: most loads need no copy
 
@@ -218,7 +228,7 @@ def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
 
 def open_input(name: str | Path, packages: list[str] | None = None,
                xacro_args: list[str] | None = None, guard: bool = True,
-               package_paths: list[str] | None = None) -> Resolved:
+               package_paths: list[str] | None = None, meshes: bool = True) -> Resolved:
     """:func:`resolve` with the raw ``--package NAME=PATH`` and ``--arg k:=v`` option lists."""
     args: dict[str, str] = {}
     if xacro_args:
@@ -227,4 +237,4 @@ def open_input(name: str | Path, packages: list[str] | None = None,
 
         args = dict(parse_assignments(xacro_args, "xacro_args"))
     return resolve(name, packages=parse_packages(packages, package_paths), xacro_args=args,
-                   guard=guard)
+                   guard=guard, meshes=meshes)
