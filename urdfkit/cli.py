@@ -195,6 +195,12 @@ PackagePathOpt = Annotated[list[str] | None, typer.Option(
     "(repeatable); ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are searched too.")]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
 FixedBaseOpt = Annotated[bool, typer.Option("--fixed-base", help="Pin the root link to the world.")]
+FlagsOpt = Annotated[str | None, typer.Option(
+    "--flags", metavar="NAMES",
+    help="Exactly these PyBullet loadURDF flags, comma-separated (URDF_USE_INERTIA_FROM_FILE,"
+    "URDF_USE_IMPLICIT_CYLINDER, ...; the URDF_ may be left out), or none: to match your own "
+    "p.loadURDF call. Default: URDF_USE_IMPLICIT_CYLINDER (true cylinders).",
+    show_default=False)]
 NoGuardOpt = Annotated[bool, typer.Option(
     "--no-guard", help="Lift the guard's refusals that are stricter than PyBullet ('%' in a "
     "joint name, names over 1000 bytes); each is printed as a warning. What crashes PyBullet "
@@ -284,13 +290,28 @@ def _open(file: str, package: list[str] | None, arg: list[str] | None, no_guard:
 def _inspect(file: str, package: list[str] | None, arg: list[str] | None, *,
              fixed_base: bool = False, inertia_from_file: bool = False,
              links: bool = False, info: bool = False, no_guard: bool = False,
-             package_path: list[str] | None = None) -> Any:
+             package_path: list[str] | None = None, flags: str | None = None) -> Any:
     from .report import inspect_file
-    from .session import LoadOptions
+    from .session import LoadOptions, parse_flags
 
-    options = LoadOptions(fixed_base=fixed_base, inertia_from_file=inertia_from_file)
+    if flags is not None:
+        if inertia_from_file:
+            from .errors import ParameterError
+
+            raise ParameterError("give --inertia-from-file or --flags (with "
+                                 "URDF_USE_INERTIA_FROM_FILE in it), not both", param="flags")
+        options = LoadOptions(fixed_base=fixed_base, **parse_flags(flags))
+    else:
+        options = LoadOptions(fixed_base=fixed_base, inertia_from_file=inertia_from_file)
     with _open(file, package, arg, no_guard, package_path) as resolved:
-        return inspect_file(resolved, options, links=links, info=info)
+        report = inspect_file(resolved, options, links=links, info=info)
+    report.load_flags = options.flag_names()
+    return report
+
+
+def _loaded_with(report: Any) -> None:
+    """The flags the robot was loaded with, under the table (text mode)."""
+    show.note("loaded with " + (" | ".join(report.load_flags) or "no flags"), stderr=False)
 
 
 @app.command(epilog=_examples(
@@ -303,6 +324,7 @@ def joints(
     movable: MovableOpt = False,
     joint_type: TypeOpt = None,
     fixed_base: FixedBaseOpt = False,
+    flags: FlagsOpt = None,
     package: PackageOpt = None,
     package_path: PackagePathOpt = None,
     arg: ArgOpt = None,
@@ -316,7 +338,7 @@ def joints(
     from .inspect import filter_joints
 
     report = _inspect(file, package, arg, fixed_base=fixed_base, no_guard=no_guard,
-                      package_path=package_path)
+                      package_path=package_path, flags=flags)
     rows = filter_joints(report.joints, movable=movable, types=joint_type or ())
     if as_json:
         show.print_json({**report.header(), "joints": [j.to_dict() for j in rows],
@@ -326,10 +348,11 @@ def joints(
     num, nums = show.num, show.nums
     columns = [("#", 0, "right"), ("joint", 0, "left"), ("type", 0, "left"),
                ("child link", 1, "left"), ("parent", 3, "left"), ("limits", 1, "right"),
-               ("axis", 2, "left"), ("max force", 3, "right"), ("max vel", 3, "right"),
-               ("xyz", 4, "left"), ("rpy", 4, "left"), ("q", 5, "right"), ("u", 5, "right"),
-               ("damping", 6, "right"), ("friction", 6, "right"), ("quat", 9, "left"),
-               ("flags", 9, "right")]
+               ("axis", 2, "left"), ("origin xyz", 3, "left"), ("origin rpy", 3, "left"),
+               ("max force", 3, "right"), ("max vel", 3, "right"),
+               ("parentFramePos", 4, "left"), ("parentFrameRpy", 4, "left"), ("q", 5, "right"),
+               ("u", 5, "right"), ("damping", 6, "right"), ("friction", 6, "right"),
+               ("quat", 9, "left"), ("flags", 9, "right")]
     cells = []
     for j in rows:
         if j.limited:
@@ -339,7 +362,10 @@ def joints(
         cells.append([
             str(j.joint_index), j.joint_name, j.type_label, j.link_name,
             f"{j.parent_index} {j.parent_link_name}", limits,
-            nums(j.joint_axis) if j.movable else "", num(j.joint_max_force),
+            nums(j.joint_axis) if j.movable else "",
+            nums(j.origin_xyz) if j.origin_xyz is not None else "",
+            nums(j.origin_rpy) if j.origin_rpy is not None else "",
+            num(j.joint_max_force),
             num(j.joint_max_velocity), nums(j.parent_frame_pos), nums(j.parent_frame_rpy),
             str(j.q_index), str(j.u_index), num(j.joint_damping), num(j.joint_friction),
             nums(j.parent_frame_orn), str(j.flags)])
@@ -347,6 +373,7 @@ def joints(
         else str(len(rows))
     show.table(f"{report.robot}: {shown} joints, base link {report.base_link}", columns, cells,
                show_all)
+    _loaded_with(report)
 
 
 @app.command(epilog=_examples(
@@ -361,6 +388,7 @@ def links(
         help="Load with URDF_USE_INERTIA_FROM_FILE. Without it PyBullet ignores <inertia> "
              "and recomputes it from the collision shapes.")] = False,
     fixed_base: FixedBaseOpt = False,
+    flags: FlagsOpt = None,
     package: PackageOpt = None,
     package_path: PackagePathOpt = None,
     arg: ArgOpt = None,
@@ -373,7 +401,8 @@ def links(
     """
     report = _inspect(file, package, arg, fixed_base=fixed_base,
                       inertia_from_file=inertia_from_file, links=True, no_guard=no_guard,
-                      package_path=package_path)
+                      package_path=package_path, flags=flags)
+    inertia_from_file = "URDF_USE_INERTIA_FROM_FILE" in report.load_flags
     if as_json:
         show.print_json({**report.header(), "inertia_from_file": inertia_from_file,
                          "links": [link.to_dict() for link in report.links],
@@ -404,6 +433,7 @@ def links(
     inertia = "from the file" if inertia_from_file else "recomputed by PyBullet"
     show.table(f"{report.robot}: {len(report.links)} links, inertia {inertia}", columns, cells,
                show_all)
+    _loaded_with(report)
     if differs and not inertia_from_file:
         show.note("! = PyBullet's value differs from the file's; --inertia-from-file keeps the "
                   "file's <inertia>", stderr=False)
@@ -452,6 +482,7 @@ def info(
     file: FileArg,
     as_json: JsonOpt = False,
     fixed_base: FixedBaseOpt = False,
+    flags: FlagsOpt = None,
     package: PackageOpt = None,
     package_path: PackagePathOpt = None,
     arg: ArgOpt = None,
@@ -459,7 +490,7 @@ def info(
 ) -> None:
     """The robot at a glance: links, joints by type, DOF, total mass, bounding box."""
     report = _inspect(file, package, arg, fixed_base=fixed_base, info=True, no_guard=no_guard,
-                      package_path=package_path)
+                      package_path=package_path, flags=flags)
     s = report.summary
     if as_json:
         show.print_json({**report.header(), **s.to_dict(), "diagnostics": report.diagnostics})
@@ -480,6 +511,7 @@ def info(
         ("total mass", mass),
         ("bounding box", f"{nums(s.aabb_min)} .. {nums(s.aabb_max)}"),
         ("size", f"{nums(s.size)} m"),
+        ("loaded with", " | ".join(report.load_flags) or "no flags (--flags)"),
     ])
 
 

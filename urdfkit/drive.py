@@ -660,7 +660,7 @@ class Scenario:
         start = c.base_position or (TUTORIAL_START if c.tutorial else (0.0, 0.0, 0.0))
         # The tutorial's load: no flags. Otherwise implicit cylinders (smooth wheels) and the
         # file's own inertia; see the module docstring.
-        flags = {"implicit_cylinder": False} if c.tutorial else {
+        flags: dict[str, Any] = {"implicit_cylinder": False} if c.tutorial else {
             "inertia_from_file": True, "implicit_cylinder": True}
         self.flags = [] if c.tutorial else ["URDF_USE_IMPLICIT_CYLINDER",
                                             "URDF_USE_INERTIA_FROM_FILE"]

@@ -28,7 +28,7 @@ from typing import Any
 from lxml import etree
 
 from .session import Session
-from .spec import JOINT_TYPE_FILTERS, pybullet_joint_type, quat_to_rpy
+from .spec import JOINT_TYPE_FILTERS, attr_vec, pybullet_joint_type, quat_to_rpy
 from .xmlio import children
 
 #: The 17 ``getJointInfo`` fields, in tuple order, as the Quickstart Guide names them.
@@ -61,6 +61,10 @@ class JointInfo:
             none, but a merged body could).
         parent_link_name: The parent link's name (the base link for parent_index -1).
         parent_frame_rpy: ``parent_frame_orn`` as roll, pitch, yaw, for humans.
+        origin_xyz, origin_rpy: The joint's ``<origin>`` as the file writes it (in the parent
+            link's frame). PyBullet's ``parent_frame_pos``/``orn`` differ: they are relative to
+            the parent's centre of mass (its inertial frame), not its link frame. None if no
+            ``<joint>`` of that name is in the file.
     """
 
     joint_index: int
@@ -83,6 +87,8 @@ class JointInfo:
     urdf_type: str | None = None
     parent_link_name: str = ""
     parent_frame_rpy: Vec3 = (0.0, 0.0, 0.0)
+    origin_xyz: Vec3 | None = None
+    origin_rpy: Vec3 | None = None
 
     @classmethod
     def from_pybullet(cls, info: Sequence[Any]) -> JointInfo:
@@ -125,7 +131,9 @@ class JointInfo:
         out = dict(zip(JOINT_INFO_FIELDS, values, strict=False))
         out.update(urdfType=self.urdf_type, parentLinkName=self.parent_link_name,
                    parentFrameRpy=list(self.parent_frame_rpy), movable=self.movable,
-                   limited=self.limited)
+                   limited=self.limited,
+                   originXyz=None if self.origin_xyz is None else list(self.origin_xyz),
+                   originRpy=None if self.origin_rpy is None else list(self.origin_rpy))
         return out
 
 
@@ -143,13 +151,21 @@ def joint_table(s: Session, body: int, root: etree._Element | None = None) -> li
         root: The ``<robot>`` element the body was loaded from; gives ``urdfType``.
     """
     urdf_types: dict[str, str] = {}
+    origins: dict[str, tuple[Vec3, Vec3]] = {}
     if root is not None:
-        urdf_types = {j.get("name", ""): j.get("type", "") for j in children(root, "joint")}
+        for el in children(root, "joint"):
+            urdf_types[el.get("name", "")] = el.get("type", "")
+            origin = el.find("origin")
+            xyz = attr_vec(origin, "xyz", 3, (0.0, 0.0, 0.0)) or (0.0, 0.0, 0.0)
+            rpy = attr_vec(origin, "rpy", 3, (0.0, 0.0, 0.0)) or (0.0, 0.0, 0.0)
+            origins[el.get("name", "")] = (tuple(xyz), tuple(rpy))  # type: ignore[assignment]
     joints = [JointInfo.from_pybullet(s.call("getJointInfo", body, i))
               for i in range(s.call("getNumJoints", body))]
     base = base_link_name(s, body)
     for j in joints:
         j.urdf_type = urdf_types.get(j.joint_name)
+        if j.joint_name in origins:
+            j.origin_xyz, j.origin_rpy = origins[j.joint_name]
         j.parent_link_name = base if j.parent_index < 0 else joints[j.parent_index].link_name
     return joints
 

@@ -34,6 +34,7 @@ class Report:
         links: The link table (``urdfkit links`` only).
         summary: The summary (``urdfkit info`` only).
         diagnostics: PyBullet's own output (warnings), captured off stdout.
+        load_flags: The ``loadURDF`` flags the robot was loaded with, by name.
     """
 
     file: str
@@ -44,11 +45,12 @@ class Report:
     links: list[LinkDynamics] = field(default_factory=list)
     summary: Summary | None = None
     diagnostics: list[str] = field(default_factory=list)
+    load_flags: list[str] = field(default_factory=list)
 
     def header(self) -> dict[str, Any]:
         """The keys every ``--json`` output starts with."""
         return {"file": self.file, "path": self.path, "robot": self.robot,
-                "base_link": self.base_link}
+                "base_link": self.base_link, "load_flags": list(self.load_flags)}
 
 
 @contextmanager

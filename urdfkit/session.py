@@ -136,6 +136,46 @@ def has_display() -> bool:
                 or sys.platform in ("darwin", "win32"))
 
 
+#: The flags LoadOptions has a field for; any other p.URDF_* name goes to ``extra_flags``.
+FLAG_FIELDS = {"URDF_USE_INERTIA_FROM_FILE": "inertia_from_file",
+               "URDF_USE_IMPLICIT_CYLINDER": "implicit_cylinder",
+               "URDF_USE_SELF_COLLISION": "self_collision",
+               "URDF_MERGE_FIXED_LINKS": "merge_fixed_links"}
+
+
+def parse_flags(text: str) -> dict[str, Any]:
+    """``--flags A,B`` (or ``none``) as LoadOptions fields: exactly these flags, nothing else.
+
+    Raises:
+        ParameterError: a name that is not one of PyBullet's ``URDF_*`` flags.
+    """
+    from .errors import ParameterError
+
+    names = [n.strip().upper() for n in text.split(",") if n.strip()]
+    if names in (["NONE"], ["0"]):
+        names = []
+    p = import_pybullet()
+    known = sorted(n for n in dir(p) if n.startswith("URDF_"))
+    out: dict[str, Any] = dict.fromkeys(FLAG_FIELDS.values(), False)
+    extra, extra_names = 0, []
+    for name in names:
+        full = next((c for c in (name, f"URDF_{name}", f"URDF_USE_{name}") if c in known),
+                    name if name.startswith("URDF_") else f"URDF_{name}")
+        if full not in known:
+            from .suggest import hint
+
+            raise ParameterError(f"`flags`: {name!r} is not a PyBullet loadURDF flag"
+                                 f"{hint(full, known)} (or give none)", param="flags")
+        if full in FLAG_FIELDS:
+            out[FLAG_FIELDS[full]] = True
+        else:
+            extra |= int(getattr(p, full))
+            extra_names.append(full)
+    out["extra_flags"] = extra
+    out["extra_names"] = tuple(extra_names)
+    return out
+
+
 @dataclass
 class LoadOptions:
     """How to load a URDF.
@@ -163,6 +203,17 @@ class LoadOptions:
     base_orientation: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
     global_scaling: float = 1.0
     extra_flags: int = 0
+    #: The names of ``extra_flags`` (for messages and JSON), as the user gave them.
+    extra_names: tuple[str, ...] = ()
+
+    def flag_names(self) -> list[str]:
+        """The ``loadURDF`` flags these options mean, by name (``p.URDF_*``)."""
+        names = [name for on, name in (
+            (self.inertia_from_file, "URDF_USE_INERTIA_FROM_FILE"),
+            (self.implicit_cylinder, "URDF_USE_IMPLICIT_CYLINDER"),
+            (self.self_collision, "URDF_USE_SELF_COLLISION"),
+            (self.merge_fixed_links, "URDF_MERGE_FIXED_LINKS")) if on]
+        return names + [n for n in self.extra_names if n not in names]
 
     def flags(self, p: Any) -> int:
         """The ``loadURDF`` flags these options mean."""
