@@ -51,9 +51,12 @@ from .vehicle import (
     Drivetrain,
     DrivetrainError,
     apply_drive,
+    base_link_pose,
     clamp_steer,
     detect_upright,
     disable_default_motors,
+    lowest_point,
+    set_base_link_pose,
 )
 
 #: Default simulated samples per second in the trajectory (and for the statistics): enough
@@ -674,8 +677,8 @@ class Scenario:
                                                      c.hinges, c.drivetrain)
         except DrivetrainError as e:
             raise DrivetrainError(e.message, file=car, param=e.param) from None
-        if spawn != upright:
-            p.resetBasePositionAndOrientation(self.body, start, spawn, physicsClientId=client)
+        if spawn != upright:  # the link frame, as loadURDF placed it
+            set_base_link_pose(p, self.body, client, start, spawn)
         # The tutorial loads its plane as it is (a mass-0 box: static either way).
         self.plane = self._load(s, c.plane, "simpleplane", LoadOptions(
             fixed_base=not c.tutorial, implicit_cylinder=not c.tutorial), self._ground_params())
@@ -716,13 +719,11 @@ class Scenario:
         """Lower or raise the car until its lowest point is 1 mm above the ground's top."""
         assert self.session is not None
         p, client = self.session.p, self.session.client
-        n = p.getNumJoints(self.body, physicsClientId=client)
-        lowest = min(p.getAABB(self.body, link, physicsClientId=client)[0][2]
-                     for link in range(-1, n))
+        lowest = lowest_point(p, self.body, client)  # the shapes' own, not the AABB's
         top = self.ground_top if self.ground_top is not None else 0.0
-        pos, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=client)
-        p.resetBasePositionAndOrientation(self.body, (pos[0], pos[1], pos[2] + top + 0.001
-                                                      - lowest), orn, physicsClientId=client)
+        pos, orn = base_link_pose(p, self.body, client)
+        set_base_link_pose(p, self.body, client,
+                           (pos[0], pos[1], pos[2] + top + 0.001 - lowest), orn)
 
     def _check_start(self) -> None:
         """A static base, or a start inside the ground, make the run meaningless: say so."""
@@ -765,10 +766,25 @@ class Scenario:
         joints = self.drivetrain.wheels + self.drivetrain.hinges
         pose, velocity = p.getBasePositionAndOrientation, p.getBaseVelocity
         euler, states = p.getEulerFromQuaternion, p.getJointStates
+        # The base link frame's pose and velocity, not the inertial frame's PyBullet reports:
+        # with inertia products or an <inertial><origin> they differ (a yaw of -0.16 rad at
+        # rest). The local inertial pose is fixed for the run: inverted once.
+        local = p.getDynamicsInfo(body, -1, physicsClientId=client)
+        inv_pos, inv_orn = p.invertTransform(local[3], local[4])
+        compose = p.multiplyTransforms
+        offset = any(abs(x) > 0 for x in inv_pos) or any(abs(x) > 0 for x in inv_orn[:3])
 
         def sample(t: float) -> tuple[float, ...]:
-            pos, orn = pose(body, physicsClientId=client)
-            lin, _ = velocity(body, physicsClientId=client)
+            com, com_orn = pose(body, physicsClientId=client)
+            lin, ang = velocity(body, physicsClientId=client)
+            if offset:
+                pos, orn = compose(com, com_orn, inv_pos, inv_orn)
+                r = (pos[0] - com[0], pos[1] - com[1], pos[2] - com[2])
+                lin = (lin[0] + ang[1] * r[2] - ang[2] * r[1],
+                       lin[1] + ang[2] * r[0] - ang[0] * r[2],
+                       lin[2] + ang[0] * r[1] - ang[1] * r[0])
+            else:
+                pos, orn = com, com_orn
             row = [t, *pos, *euler(orn), *lin]
             if joints:
                 for st in states(body, joints, physicsClientId=client):

@@ -282,8 +282,12 @@ def _shape_points(p: Any, body: int, link: int, client: int) -> list[Vec]:
     Meshes (and cylinders PyBullet turned into meshes) give their vertices; implicit
     cylinders, capsules, spheres and boxes are outlined from their dimensions.
     """
-    st = p.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=client)
-    com_pos, com_rot = st[0], quat_to_matrix(st[1])
+    if link < 0:  # the base: getBasePositionAndOrientation is its inertial (COM) frame
+        pos_, orn_ = p.getBasePositionAndOrientation(body, physicsClientId=client)
+        com_pos, com_rot = tuple(pos_), quat_to_matrix(orn_)
+    else:
+        st = p.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=client)
+        com_pos, com_rot = st[0], quat_to_matrix(st[1])
     out: list[Vec] = []
     for k, shape in enumerate(p.getCollisionShapeData(body, link, physicsClientId=client)):
         kind, dims, pos, orn = shape[2], shape[3], shape[5], shape[6]
@@ -314,6 +318,46 @@ def _shape_points(p: Any, body: int, link: int, client: int) -> list[Vec]:
             in_com = _add(pos, rotate(shape_rot, v))
             out.append(_add(com_pos, rotate(com_rot, in_com)))
     return out
+
+
+def base_link_pose(p: Any, body: int, client: int) -> tuple[Any, Any]:
+    """The base link frame's world pose (PyBullet reports the base's inertial frame).
+
+    With ``URDF_USE_INERTIA_FROM_FILE`` an ``<inertia>`` with products (ixy, ixz, iyz), or an
+    ``<inertial><origin>``, puts the inertial frame elsewhere than the link frame: its pose is
+    not the robot's.
+    """
+    pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
+    local = p.getDynamicsInfo(body, -1, physicsClientId=client)
+    inv_pos, inv_orn = p.invertTransform(local[3], local[4])
+    return p.multiplyTransforms(pos, orn, inv_pos, inv_orn)
+
+
+def set_base_link_pose(p: Any, body: int, client: int, pos: Sequence[float],
+                       orn: Sequence[float]) -> None:
+    """Place the base link frame.
+
+    ``resetBasePositionAndOrientation`` places the inertial frame; ``loadURDF`` the link frame.
+    """
+    local = p.getDynamicsInfo(body, -1, physicsClientId=client)
+    com_pos, com_orn = p.multiplyTransforms(pos, orn, local[3], local[4])
+    p.resetBasePositionAndOrientation(body, com_pos, com_orn, physicsClientId=client)
+
+
+def lowest_point(p: Any, body: int, client: int) -> float:
+    """The lowest z of the body's collision shapes, from the shapes themselves.
+
+    Not from ``getAABB``: a link whose ``<inertia>`` has products gets a rotated inertial
+    frame, and its AABB grows with it (1.8 cm below a small car's real corners), which would
+    lift the start and disqualify the wheels as "above the robot's lowest point". A link
+    without collision shapes does not count; a body with none falls back to the AABB.
+    """
+    n = p.getNumJoints(body, physicsClientId=client)
+    zs = [pt[2] for link in range(-1, n) for pt in _shape_points(p, body, link, client)]
+    finite = [z for z in zs if math.isfinite(z)]
+    if finite:
+        return min(finite)
+    return min(p.getAABB(body, link, physicsClientId=client)[0][2] for link in range(-1, n))
 
 
 _SPHERE_DIRECTIONS = [(math.cos(a) * math.cos(b), math.sin(a) * math.cos(b), math.sin(b))
@@ -406,8 +450,7 @@ def detect_drivetrain(p: Any, body: int, client: int,
     base_link, base_link_orn = p.multiplyTransforms(base_pos, base_orn, inv_pos, inv_orn)
     base_rot = quat_to_matrix(base_link_orn)
     base_x, base_y = rotate(base_rot, (1.0, 0.0, 0.0)), rotate(base_rot, (0.0, 1.0, 0.0))
-    lowest = min(p.getAABB(body, link, physicsClientId=client)[0][2]
-                 for link in range(-1, n))
+    lowest = lowest_point(p, body, client)
 
     shapes: dict[int, tuple[float, float, Vec] | None] = {}
 
@@ -540,20 +583,20 @@ def detect_upright(p: Any, body: int, client: int, upright: Sequence[float],
                    wheels: Sequence[str | int] | None = None,
                    hinges: Sequence[str | int] | None = None,
                    mode: str = "differential") -> Drivetrain:
-    """:func:`detect_drivetrain` with the base turned to ``upright`` (a quaternion) meanwhile.
+    """:func:`detect_drivetrain` with the base link turned to ``upright`` (a quaternion).
 
     A body spawned tilted (or upside down) is stood up where it is for detection, so its
     wheels are judged in its own frame, then put back exactly as it was.
     """
-    pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
+    pos, orn = base_link_pose(p, body, client)  # the link frame is the one to stand up
     turned = any(abs(a - b) > 1e-12 for a, b in zip(orn, upright, strict=True))
     if turned:
-        p.resetBasePositionAndOrientation(body, pos, list(upright), physicsClientId=client)
+        set_base_link_pose(p, body, client, pos, list(upright))
     try:
         return detect_drivetrain(p, body, client, wheels, hinges, mode)
     finally:
         if turned:
-            p.resetBasePositionAndOrientation(body, pos, orn, physicsClientId=client)
+            set_base_link_pose(p, body, client, pos, orn)
 
 
 def disable_default_motors(p: Any, body: int, client: int, joints: Sequence[int]) -> None:
