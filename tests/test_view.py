@@ -304,22 +304,32 @@ def test_a_bad_file_refused_before_serving(tmp_path: Path) -> None:
 
 def test_cli_prints_the_url_serves_and_exits_130(arm: Path) -> None:
     import select
+    import threading
 
     proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "view", str(arm)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    err_lines: list[str] = []
+    # stderr is read as it comes, so the server can never block on a full pipe, and whatever
+    # it said is in the message if no URL comes.
+    reader = threading.Thread(target=lambda: err_lines.extend(iter(proc.stderr.readline, "")),
+                              daemon=True)  # type: ignore[union-attr]
+    reader.start()
     try:
         assert proc.stdout is not None
         # The URL within two minutes (seconds on a quiet machine; a loaded 2-core one has
         # taken 30): a server that never says where it is fails here, never hangs the suite.
         ready, _, _ = select.select([proc.stdout], [], [], 120)
-        assert ready, "urdfkit view printed no URL within 120 s"
+        assert ready, (f"urdfkit view printed no URL within 120 s (exit {proc.poll()}); "
+                       f"stderr: {''.join(err_lines)[-2000:]!r}")
         line = proc.stdout.readline()
-        assert line.startswith("urdfkit view: http://localhost:"), line
+        assert line.startswith("urdfkit view: http://localhost:"), (line, "".join(err_lines))
         url = line.split()[2]
         with urllib.request.urlopen(url, timeout=10) as r:
             assert r.status == 200 and b"<html" in r.read().lower()
         proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=20)
+        proc.wait(timeout=20)
+        out = proc.stdout.read()
+        reader.join(10)
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -328,7 +338,7 @@ def test_cli_prints_the_url_serves_and_exits_130(arm: Path) -> None:
             if pipe is not None:
                 pipe.close()
     assert proc.returncode == 130
-    assert err.strip() == "urdfkit: interrupted" and out == ""
+    assert "".join(err_lines).strip() == "urdfkit: interrupted" and out == ""
 
 
 def test_cli_bad_file_is_one_line_exit_2(tmp_path: Path) -> None:

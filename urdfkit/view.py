@@ -562,6 +562,37 @@ def _wxyz(q: Sequence[float]) -> tuple[float, float, float, float]:
     return (float(q[3]), float(q[0]), float(q[1]), float(q[2]))
 
 
+#: Seconds the web server may take to start. viser waits on its server thread without a time
+#: limit, and that thread dies silently on anything but a port in use: a hang, never a
+#: message. Bounded here.
+SERVER_START_TIMEOUT = 60.0
+
+
+def _start_server(viser: Any, host: str, port: int) -> Any:
+    """``viser.ViserServer``, started in a thread of its own.
+
+    Waited for at most :data:`SERVER_START_TIMEOUT` seconds (TimeoutError past it); its
+    errors are re-raised here.
+    """
+    box: dict[str, Any] = {}
+
+    def start() -> None:
+        try:
+            with _quiet():  # viser prints a banner with rich whatever `verbose` says
+                box["server"] = viser.ViserServer(host=host, port=port, verbose=False)
+        except BaseException as e:  # handed to the caller's thread
+            box["error"] = e
+
+    thread = threading.Thread(target=start, name="urdfkit-view-start", daemon=True)
+    thread.start()
+    thread.join(SERVER_START_TIMEOUT)
+    if thread.is_alive():
+        raise TimeoutError
+    if "error" in box:
+        raise box["error"]
+    return box["server"]
+
+
 def free_port(host: str) -> int:
     """A TCP port nothing listens on now."""
     import socket
@@ -607,12 +638,15 @@ class Viewer:
         self.host = host
         self.port = free_port(host) if not port else port
         try:
-            with _quiet():  # viser prints a banner with rich whatever `verbose` says
-                self.server = viser.ViserServer(host=host, port=self.port, verbose=False)
+            self.server = _start_server(viser, host, self.port)
         except OSError as e:
             self.model.close()
             raise EngineError(f"cannot serve on {host}:{self.port}: {e.strerror or e}",
                               param="port") from None
+        except TimeoutError:
+            self.model.close()
+            raise EngineError(f"the server on {host}:{self.port} did not start within "
+                              f"{SERVER_START_TIMEOUT:g} s", param="port") from None
         self.port = int(self.server.get_port())
         self.url = f"http://{'localhost' if host in ('127.0.0.1', '::1') else host}:{self.port}"
         self.server.scene.set_up_direction("+z")
