@@ -841,6 +841,9 @@ def drive(
     as_json: JsonOpt = False,
     no_guard: NoGuardOpt = False,
     up: UpOpt = "z",
+    limp: Annotated[bool, typer.Option(
+        "--limp", help="Let joints that are neither wheels, hinges nor casters go limp "
+        "instead of holding their start angle (with the URDF's effort).")] = False,
 ) -> None:
     """Drive a car headless at a fixed throttle and steer, and report where it went.
 
@@ -883,17 +886,21 @@ def drive(
         max_force=10.0 if max_force is None else max_force, drivetrain=drivetrain,
         tutorial=tutorial, keep_trajectory=plot is not None,
         wheels=_split_joints(wheels), hinges=_split_joints(hinges), sample_every=sample_every,
-        gui=gui, guard=not no_guard, package_paths=package_path, up=up)
+        gui=gui, guard=not no_guard, package_paths=package_path, up=up, limp=limp)
     with Scenario(config) as sc:
         t = sc.drivetrain
 
         def names(joints: list[int]) -> str:
             return ", ".join(t.joint_names[j] for j in joints) or "none"
 
+        casters = [t.joint_names[j] for j in t.casters] + \
+            [t.link_names.get(k, str(k)) for k in t.caster_links]
         show.note(f"{sc.model}: wheels {names(t.wheels)}; hinges {names(t.hinges)}; "
-                  f"passive {names(t.passive)}; drivetrain {t.mode} ({t.steering} steering)")
+                  f"casters {', '.join(casters) or 'none'}; held {names(list(sc.held))}; "
+                  f"limp {names(sc.limp)}; drivetrain {t.mode} ({t.steering} steering)")
         for w in sc.warnings:
             show.warn(w)
+        said = list(sc.warnings)
         progress, stop = show.progress("driving", "steps", enabled=not as_json)
         written = []
         try:
@@ -915,7 +922,7 @@ def drive(
         data["files"] = [str(w) for w in written]
         show.print_json(data)
     else:
-        _drive_summary(result)
+        _drive_summary(result, said)
         for path in written:
             show.wrote(path)
     if result.interrupted:
@@ -1126,10 +1133,12 @@ def sweep(
         raise typer.Exit(1)
 
 
-def _drive_summary(r: Any) -> None:
+def _drive_summary(r: Any, said: list[str]) -> None:
     x, y, z = r.final_position
+    model = {"ackermann": "kinematic bicycle model", "differential": "v / omega"}.get(
+        r.drivetrain.steering, "model")
     bicycle = ("" if r.expected_radius is None
-               else f" (kinematic bicycle model: {r.expected_radius:.3f} m)")
+               else f" ({model}: {r.expected_radius:.3f} m)")
     turn = (f"none: {r.radius_note}{bicycle}" if r.turning_radius is None else
             f"{r.turning_radius:.3f} m around ({r.turn_center[0]:.2f}, {r.turn_center[1]:.2f})"
             f"{bicycle}")
@@ -1137,7 +1146,7 @@ def _drive_summary(r: Any) -> None:
     force = (f"PyBullet's default ({sim['wheel_force']:g} N m)" if sim["wheel_force_default"]
              else f"{sim['wheel_force']:g} N m")
     flags = ", ".join(sim["load_flags"]) or "none"
-    unit = "rad/s of yaw" if r.drivetrain.steering == "skid" else "rad"
+    unit = "rad/s of yaw" if r.drivetrain.yaw_steered else "rad"
     show.fields([("drive", "bold"), f" {r.model}: throttle {r.throttle:g} rad/s, "
                  f"steer {r.steer:g} {unit}"], [
         ("final position", f"x {x:.3f}  y {y:.3f}  z {z:.3f} m"),
@@ -1153,8 +1162,11 @@ def _drive_summary(r: Any) -> None:
                       f"damping {sim['link_damping']['linear']:g} (PyBullet's default)"),
         ("wall time", f"{r.wall_time:.3f} s (real-time factor {r.real_time_factor:.1f}x)"),
     ])
-    for problem in r.problems:
-        show.warn(problem)
+    # Every warning shows in text too, not only in JSON: those found by the run itself (a
+    # base turning at a fraction of its command, the problems) after the summary.
+    for w in r.warnings:
+        if w not in said:
+            show.warn(w)
 
 
 # ---- render: headless PNG pictures (urdfkit/render.py) and tree --dot (urdfkit/graph.py)

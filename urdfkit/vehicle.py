@@ -10,10 +10,12 @@ are addressed by), in the **base frame**: the caller stands the body upright for
   collision shapes, cylinder, sphere or mesh, reach the same radius all the way round) and
   **touches the ground** (its lowest point is the robot's lowest point). An arm's wrist and a
   quadruped's knee are none of these.
-- A **steering hinge** is a revolute joint about an axis vertical in the base frame that
-  carries a wheel.
-- Every other movable joint is **passive**: its default velocity motor is switched off, or
-  PyBullet would hold it still like a brake.
+- A **steering hinge** is a revolute joint with limits about an axis vertical in the base
+  frame that carries a wheel. A vertical joint without limits (a full turn) that carries a
+  wheel is a **caster's swivel**; it and its wheel roll free and are listed as a caster, as
+  are the links that rest on the ground beside the wheels (a fixed ball or skid).
+- Every other movable joint is **passive**. The drive holds passive joints at their start
+  angle (an arm on a mobile base) unless asked to let them go limp; casters always roll free.
 
 Driving (:class:`Drivetrain`) follows the kinematic bicycle model: with steer angle ``d`` the
 car turns about the point on the rear axle's line at ``R = L / tan d`` (``L`` the wheelbase,
@@ -22,6 +24,10 @@ when the hinges share a pivot, as simplecar's do), and in the ``differential`` d
 wheel turns at the speed its own path needs (an ideal electronic differential). Without
 hinges, wheels are driven as a skid-steered base: ``steer`` is then the yaw rate (rad/s), and
 each side's speed differs by it times the track.
+
+A base without hinges whose two driven wheels sit one each side is a **two-wheel differential**
+robot (steering ``differential``); with more it is **skid steered** (``skid``). Both take
+``steer`` as the yaw rate; the differential one's model radius is ``v / omega``.
 
 Signs are part of detection. Positive throttle means "forward along the base's x axis" and
 positive steer means "left, counter-clockwise seen from above", whatever way each joint's axis
@@ -93,6 +99,12 @@ class Drivetrain:
         pivot: Each hinge's pivot (x, y) in the base frame.
         forward: The direction "forward" (x, y components in the base frame): the way the
             wheels roll that is closest to the base's +x (+y when they roll along y).
+        casters: Caster joints (swivels without limits that carry a wheel, and those
+            wheels): passive, and always free.
+        caster_links: Links other than the wheels that rest on the ground at the start (a
+            fixed ball or skid under the base), by index.
+        link_names: Name of every link index (-1 the base).
+        efforts: Each joint's effort limit from the URDF (N m or N; 0 when not given).
     """
 
     wheels: list[int]
@@ -108,13 +120,32 @@ class Drivetrain:
     carried_by: dict[int, int | None] = field(default_factory=dict)
     pivot: dict[int, tuple[float, float]] = field(default_factory=dict)
     forward: tuple[float, float] = (1.0, 0.0)
+    casters: list[int] = field(default_factory=list)
+    caster_links: list[int] = field(default_factory=list)
+    link_names: dict[int, str] = field(default_factory=dict)
+    efforts: dict[int, float] = field(default_factory=dict)
 
     # ---- geometry
 
     @property
     def steering(self) -> str:
-        """``ackermann`` (steered by hinges) or ``skid`` (by left/right speed difference)."""
-        return "ackermann" if self.hinges else "skid"
+        """How the base is steered.
+
+        ``ackermann``: by hinges. Without hinges, by the speed difference of left and right
+        (``steer`` is then a yaw rate): ``differential`` for two driven wheels, one each side
+        (casters aside); ``skid`` for more, whose wheels must slip sideways to turn.
+        """
+        if self.hinges:
+            return "ackermann"
+        ys = [self.contact[w][1] for w in self.driven if w in self.contact]
+        if len(ys) == 2 and ys[0] * ys[1] < 0:
+            return "differential"
+        return "skid"
+
+    @property
+    def yaw_steered(self) -> bool:
+        """True when ``steer`` is a yaw rate (no hinges: differential or skid steering)."""
+        return not self.hinges
 
     @property
     def rear_x(self) -> float:
@@ -159,9 +190,29 @@ class Drivetrain:
 
     def turn_center(self, steer: float) -> tuple[float, float] | None:
         """The instantaneous centre of rotation (x, y) in the base frame, None if straight."""
-        if self.steering == "skid" or steer == 0 or not self.wheelbase:
+        if self.yaw_steered or steer == 0 or not self.wheelbase:
             return None
         return (self.rear_x, self.wheelbase / math.tan(steer))
+
+    def expected_radius(self, throttle: float, steer: float) -> float | None:
+        """The model's turning radius of the base link's origin (m), None without a model.
+
+        Ackermann steering: the kinematic bicycle model, ``R = L / tan(steer)`` about the
+        rear axle. Two-wheel differential: rolling without slip, the wheels' midpoint moves
+        at ``v = throttle * radius`` and turns at ``omega = steer``, about the point ``v /
+        omega`` to its left on the axle's line. Skid steering has no such model: its wheels
+        must slip sideways to turn at all.
+        """
+        if self.mode == "locked":
+            return None
+        if self.steering == "ackermann":
+            return self.bicycle_radius(steer)
+        if self.steering != "differential" or steer == 0:
+            return None
+        v = throttle * self.reference_radius
+        xs = [self.contact[w][0] for w in self.driven if w in self.contact]
+        axle_x = sum(xs) / len(xs) if xs else 0.0
+        return math.hypot(axle_x, v / steer)
 
     def bicycle_radius(self, steer: float) -> float | None:
         """The kinematic bicycle model's turning radius of the base link's origin (m)."""
@@ -192,7 +243,7 @@ class Drivetrain:
             return {w: throttle for w in self.wheels}
         speed = throttle * self.reference_radius  # m/s of the rear axle's centre
         out: dict[int, float] = {}
-        if self.steering == "skid":
+        if self.yaw_steered:
             for w in self.driven:
                 y = self.contact.get(w, (0.0, 0.0))[1]
                 out[w] = (speed - steer * y) / self.radius.get(w, self.reference_radius)
@@ -237,6 +288,8 @@ class Drivetrain:
                         if w in self.contact else None, "driven": w in self.driven}
                        for w in self.wheels],
             "hinges": named(self.hinges), "passive": named(self.passive),
+            "casters": named(self.casters),
+            "caster_links": [self.link_names.get(k, str(k)) for k in self.caster_links],
             "forward": [r(v) for v in self.forward],
             "wheelbase": None if self.wheelbase is None else r(self.wheelbase),
             "track": r(self.track),
@@ -309,6 +362,9 @@ def _shape_points(p: Any, body: int, link: int, client: int) -> list[Vec]:
             local = [(r * math.cos(a), r * math.sin(a), z)
                      for a in (2 * math.pi * i / 24 for i in range(24))
                      for z in (-length / 2, length / 2)]
+            if kind == _CAPSULE:  # and its two half-spheres, beyond the cylinder's ends
+                local += [(r * x, r * y, r * z + math.copysign(length / 2, z))
+                          for x, y, z in _SPHERE_DIRECTIONS]
         elif kind == _BOX:
             hx, hy, hz = (d / 2 for d in dims)
             local = [(sx * hx, sy * hy, sz * hz) for sx in (-1, 1) for sy in (-1, 1)
@@ -344,25 +400,41 @@ def set_base_link_pose(p: Any, body: int, client: int, pos: Sequence[float],
     p.resetBasePositionAndOrientation(body, com_pos, com_orn, physicsClientId=client)
 
 
-def lowest_point(p: Any, body: int, client: int) -> float:
+def lowest_point(p: Any, body: int, client: int,
+                 points: dict[int, list[Vec]] | None = None) -> float:
     """The lowest z of the body's collision shapes, from the shapes themselves.
 
     Not from ``getAABB``: a link whose ``<inertia>`` has products gets a rotated inertial
     frame, and its AABB grows with it (1.8 cm below a small car's real corners), which would
     lift the start and disqualify the wheels as "above the robot's lowest point". A link
     without collision shapes does not count; a body with none falls back to the AABB.
+    ``points`` (link index to :func:`_shape_points`) saves measuring them again.
     """
     n = p.getNumJoints(body, physicsClientId=client)
-    zs = [pt[2] for link in range(-1, n) for pt in _shape_points(p, body, link, client)]
+    if points is None:
+        points = {link: _shape_points(p, body, link, client) for link in range(-1, n)}
+    zs = [pt[2] for pts in points.values() for pt in pts]
     finite = [z for z in zs if math.isfinite(z)]
     if finite:
         return min(finite)
     return min(p.getAABB(body, link, physicsClientId=client)[0][2] for link in range(-1, n))
 
 
-_SPHERE_DIRECTIONS = [(math.cos(a) * math.cos(b), math.sin(a) * math.cos(b), math.sin(b))
-                      for a in (2 * math.pi * i / 12 for i in range(12))
-                      for b in (-math.pi / 3, 0.0, math.pi / 3)] + [(0, 0, 1), (0, 0, -1)]
+def _fibonacci_sphere(n: int) -> list[Vec]:
+    """``n`` unit vectors spread evenly over the sphere."""
+    golden = math.pi * (3.0 - math.sqrt(5.0))
+    out: list[Vec] = []
+    for i in range(n):
+        z = 1.0 - 2.0 * (i + 0.5) / n
+        r = math.sqrt(1.0 - z * z)
+        out.append((r * math.cos(golden * i), r * math.sin(golden * i), z))
+    return out
+
+
+#: Directions outlining a sphere. 100 spread evenly keep every one of the 12 sectors about
+#: ANY axis through the centre at >= 0.97 of the radius (measured over random axes), so a
+#: sphere wheel is round whichever way its joint turns; a few dozen on meridians are not.
+_SPHERE_DIRECTIONS = _fibonacci_sphere(100)
 
 
 def _add(a: Sequence[float], b: Sequence[float]) -> Vec:
@@ -450,13 +522,14 @@ def detect_drivetrain(p: Any, body: int, client: int,
     base_link, base_link_orn = p.multiplyTransforms(base_pos, base_orn, inv_pos, inv_orn)
     base_rot = quat_to_matrix(base_link_orn)
     base_x, base_y = rotate(base_rot, (1.0, 0.0, 0.0)), rotate(base_rot, (0.0, 1.0, 0.0))
-    lowest = lowest_point(p, body, client)
+    link_points = {link: _shape_points(p, body, link, client) for link in range(-1, n)}
+    lowest = lowest_point(p, body, client, link_points)
 
     shapes: dict[int, tuple[float, float, Vec] | None] = {}
 
     def round_about(j: int) -> tuple[float, float, Vec] | None:
         if j not in shapes:
-            shapes[j] = _roundness(_shape_points(p, body, j, client), origin[j], axes[j])
+            shapes[j] = _roundness(link_points[j], origin[j], axes[j])
         return shapes[j]
 
     rejected: list[str] = []
@@ -502,12 +575,29 @@ def detect_drivetrain(p: Any, body: int, client: int,
             k = infos[k][16]
         return None
 
+    casters: list[int] = []
     if hinges is not None:
         hinge_list = _pick(hinges, names, movable, "hinges")
     else:
         verticals = [j for j in movable if j not in wheel_set and infos[j][2] == _REVOLUTE
                      and abs(axes[j][2]) > VERTICAL_TOLERANCE]
-        hinge_list = [j for j in verticals if any(hinge_of(w, [j]) == j for w in wheel_list)]
+        carrying = [j for j in verticals if any(hinge_of(w, [j]) == j for w in wheel_list)]
+        # A vertical joint that turns all the way round is a caster's swivel, not steering:
+        # it and the wheels it carries roll free (unless the user named those wheels).
+        swivels = [j for j in carrying if _is_continuous(infos[j])]
+        hinge_list = [j for j in carrying if j not in swivels]
+        if swivels:
+            trailing = [w for w in wheel_list if hinge_of(w, swivels) is not None]
+            casters = swivels + ([] if wheels is not None else trailing)
+            if wheels is None:
+                wheel_list = [w for w in wheel_list if w not in trailing]
+                wheel_set = set(wheel_list)
+                if not wheel_list:
+                    raise DrivetrainError(
+                        "no wheels found: every wheel hangs from a swivel that turns all the "
+                        f"way round (casters: {', '.join(names[j] for j in casters)}); name "
+                        "the wheels to drive with `wheels` and the joints that steer them with "
+                        "`hinges`", param="wheels")
     overlap = wheel_set & set(hinge_list)
     if overlap:
         raise DrivetrainError(f"joint {names[min(overlap)]!r} cannot be both a wheel and a hinge",
@@ -552,8 +642,21 @@ def detect_drivetrain(p: Any, body: int, client: int,
     driven = wheel_set | set(hinge_list)
     passive = [j for j in movable if j not in driven]
     in_base = (_dot(forward, base_x), _dot(forward, base_y))
+    # Links resting on the ground beside the wheels: a fixed caster ball or skid. The links
+    # the wheels and casters turn with are not among them, nor is the base itself.
+    rolling = {j for j in wheel_list + casters}
+    for j in range(n):
+        if hinge_of(j, sorted(rolling)) is not None:
+            rolling.add(j)
+    caster_links = [k for k in range(n) if k not in rolling and link_points[k]
+                    and min(pt[2] for pt in link_points[k]) - lowest <= 0.005]
+    link_names = {k: infos[k][12].decode("utf-8", "replace") for k in range(n)}
+    link_names[-1] = p.getBodyInfo(body, physicsClientId=client)[0].decode("utf-8", "replace")
+    efforts = {j: float(infos[j][10]) for j in movable}
     return Drivetrain(wheel_list, hinge_list, passive, names, hinge_limits, wheel_signs,
-                      hinge_signs, mode, radius, contact, carried_by, pivot, in_base)
+                      hinge_signs, mode, radius, contact, carried_by, pivot, in_base,
+                      [j for j in movable if j in set(casters)], caster_links, link_names,
+                      efforts)
 
 
 def _forward(wheel_axes: list[Vec], base_x: Vec, base_y: Vec) -> Vec:
@@ -650,7 +753,7 @@ def apply_drive(p: Any, body: int, client: int, train: Drivetrain, throttle: flo
 
 def clamp_steer(train: Drivetrain, steer: float) -> tuple[float, str | None]:
     """The steer that keeps every hinge within its limits, and a warning if it changed."""
-    if train.steering == "skid" or not train.hinges:
+    if train.yaw_steered:
         return steer, None
     lo, hi = train.steer_range()
     clamped = min(max(steer, lo), hi)
