@@ -176,8 +176,11 @@ def test_skid_steer_turns_by_speed_difference_and_says_when_it_cannot() -> None:
     strong = drive(DriveConfig(urdf="husky/husky.urdf", steer=0.3, seconds=6, max_force=500,
                                keep_trajectory=False))
     assert strong.heading_change > 0.5 and strong.problems == []
-    # Skid-steered wheels slip sideways: the achieved rate is measured and said.
-    assert strong.yaw_rate is not None and 0.03 < strong.yaw_rate < 0.3
+    # Skid-steered wheels slip sideways: the achieved rate is measured and said. Bounds from
+    # the model: without slip the wheel speeds give exactly the 0.3 commanded, and sideways
+    # slip can only lose yaw (above); the run reported no problem, so it turned at over the
+    # 10% of the command that is the "cannot turn" line (below).
+    assert strong.yaw_rate is not None and 0.1 * 0.3 < strong.yaw_rate < 0.3
     assert any(w.startswith("skid steering turns at") for w in strong.warnings)
     speeds = strong.drivetrain.wheel_speeds(10, 0.3)
     left = [w for w in strong.drivetrain.wheels if strong.drivetrain.contact[w][1] > 0]
@@ -247,14 +250,27 @@ def test_memory_stays_flat_from_20k_to_200k_rows(tmp_path: Path) -> None:
     assert big - small < 8 * 1024, (small, big)  # KiB: 180k more rows, under 8 MB more
 
 
+#: simplecar is symmetric about its x-z plane, so a right turn is the left one mirrored,
+#: exactly but for Bullet's sequential-impulse solver, which visits the left and right wheels'
+#: contacts in a fixed order and converges to its tolerance, not to zero. Measured at steer
+#: 0.2 over 10 s: headings 5.0322 and -5.0330 rad (0.016%), radii 1.9884 and 1.9878 m
+#: (0.03%). Allowed: 0.5% on each, 15x the measured asymmetry.
+MIRROR = 0.005
+
+
 def test_left_and_right_turns_are_mirror_images(left: DriveResult, right: DriveResult) -> None:
-    assert right.heading_change < 0
-    assert right.turning_radius == pytest.approx(left.turning_radius, rel=0.05)
+    psi, radius = left.heading_change, left.turning_radius
+    assert radius is not None and right.turning_radius is not None
+    assert -right.heading_change == pytest.approx(psi, rel=MIRROR)
+    assert right.turning_radius == pytest.approx(radius, rel=MIRROR)
+    # The end points, from those two: on a circle of radius R, a heading off by d_psi moves
+    # the end by R d_psi along it, and a radius off by d_R by at most 2 d_R across it.
+    reach = radius * MIRROR * abs(psi) + 2 * radius * MIRROR
     lx, ly, _ = left.final_position
     rx, ry, _ = right.final_position
-    assert rx == pytest.approx(lx, abs=0.3)
-    assert ry == pytest.approx(-ly, abs=0.3)
-    assert right.turn_center[1] == pytest.approx(-left.turn_center[1], abs=0.2)
+    assert math.hypot(rx - lx, ry + ly) <= reach
+    assert right.turn_center is not None and left.turn_center is not None
+    assert right.turn_center[1] == pytest.approx(-left.turn_center[1], abs=2 * radius * MIRROR)
 
 
 def test_negative_throttle_reverses() -> None:

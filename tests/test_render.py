@@ -72,12 +72,13 @@ def test_image_has_requested_size_and_real_content(robot: str, car_views: dict,
         assert img.shape == (240, 320, 3), name
         assert img.dtype == np.uint8
         # Not blank: many distinct colours (shaded faces, smoothed edges, the grid), a real
-        # contrast, and the robot covers a share of the frame without filling it.
+        # contrast, and some ink. How much of the frame the robot covers is bounded by
+        # geometry, not here: by PyBullet's own segmentation mask and the robot's projected
+        # bounding box (test_render_projection.py).
         colours = len(np.unique(img.reshape(-1, 3), axis=0))
         assert colours > 10, (name, colours)
         assert img.std() > 20, (name, img.std())
-        share = _ink(img).mean()
-        assert 0.04 < share < 0.8, (name, share)
+        assert _ink(img).any(), name
 
 
 def test_views_differ(car_views: dict, r2d2_views: dict) -> None:

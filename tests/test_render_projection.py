@@ -70,3 +70,79 @@ def test_a_known_box_covers_exactly_its_projected_corners(tmp_path: Path, view: 
     assert inside.sum() > 2000  # the box fills a real part of the frame
     assert (inside & ~red).sum() <= perimeter, view
     assert (red & ~inside).sum() <= perimeter, view
+
+
+def _ink_share(img: np.ndarray) -> np.ndarray:
+    """Pixels that are neither the background nor the grid (test_render.py's measure)."""
+    from urdfkit import style
+
+    far_bg = np.abs(img.astype(int) - np.array(style.rgb255(style.BACKGROUND))).sum(axis=2) > 30
+    far_grid = np.abs(img.astype(int) - np.array(style.rgb255(style.GRID))).sum(axis=2) > 30
+    return far_bg & far_grid
+
+
+@pytest.mark.parametrize("robot", ["simplecar", "r2d2.urdf"])
+@pytest.mark.parametrize("view", ["iso", "top", "front", "side"])
+def test_the_robots_share_of_the_frame_is_what_pybullet_sees(tmp_path: Path, robot: str,
+                                                             view: str) -> None:
+    """The ink share, bounded by geometry rather than by a guessed 0.04..0.8 (issue 27.10).
+
+    Below: raw PyBullet's own segmentation mask, shot with the same camera (view matrix from
+    the eye, target and up render reports), counts the robot's pixels; render's picture may
+    differ from it only on the anti-aliased silhouette edge, at most one pixel per pixel of
+    the mask's outline (both ways for a coloured robot; for r2d2's white body only "no ink
+    outside the robot"). Above: the robot lies in its bounding box, so its silhouette lies in
+    the hull of the box's eight projected corners.
+    """
+    if robot == "simplecar":
+        from urdfkit.catalog import build_template
+
+        path = tmp_path / "simplecar.urdf"
+        build_template("simplecar").write(path)
+        load = str(path)
+    else:
+        import pybullet_data
+
+        load = str(Path(pybullet_data.getDataPath()) / robot)
+    r = render_file(load, RenderOptions(width=320, height=240, views=(view,), ground="none"))
+    cam = r.cameras[0]
+    w, h = r.width, r.height
+    ink = _ink_share(r.image)
+    c = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(load, useFixedBase=True, physicsClientId=c)
+        look = p.computeViewMatrix(cam.eye, cam.target, cam.up, physicsClientId=c)
+        lens = p.computeProjectionMatrixFOV(cam.fov_deg, w / h, 0.01, 100.0, physicsClientId=c)
+        seg = np.reshape(np.asarray(p.getCameraImage(
+            w, h, look, lens, renderer=p.ER_TINY_RENDERER, physicsClientId=c)[4]), (h, w))
+        lo, hi = p.getAABB(body, -1, physicsClientId=c)
+        for j in range(p.getNumJoints(body, physicsClientId=c)):
+            a, b = p.getAABB(body, j, physicsClientId=c)
+            lo, hi = np.minimum(lo, a), np.maximum(hi, b)
+    finally:
+        p.disconnect(physicsClientId=c)
+    mask = seg == body
+    # The mask's outline: pixels of the mask with a 4-neighbour outside it.
+    edge = mask & ~(np.roll(mask, 1, 0) & np.roll(mask, -1, 0) & np.roll(mask, 1, 1)
+                    & np.roll(mask, -1, 1))
+    margin = int(edge.sum())
+    assert mask.sum() > 1000, "the robot fills a real part of the frame"
+    # Nothing is drawn where the robot is not...
+    assert (ink & ~mask).sum() <= margin, view
+    # ...and, for a robot of colours unlike the white background, all of it is drawn
+    # (r2d2's body is white: its inside counts as background; only its outline is ink).
+    if robot == "simplecar":
+        assert (mask & ~ink).sum() <= margin, view
+    look_m = np.array(look).reshape(4, 4).T
+    lens_m = np.array(lens).reshape(4, 4).T
+    corners = []
+    for corner in itertools.product(*zip(lo, hi, strict=True)):
+        clip = lens_m @ look_m @ np.array([*corner, 1.0])
+        ndc = clip[:3] / clip[3]
+        corners.append(((ndc[0] + 1) / 2 * w, (1 - ndc[1]) / 2 * h))
+    hull = _hull(np.array(corners))
+    yy, xx = np.mgrid[0:h, 0:w]
+    inside = Polygon(hull).contains_points(np.c_[xx.ravel() + 0.5, yy.ravel() + 0.5]).reshape(h, w)
+    perimeter = sum(float(np.hypot(*np.subtract(a, b)))
+                    for a, b in zip(hull, hull[1:] + hull[:1], strict=True))
+    assert (ink & ~inside).sum() <= perimeter, view
