@@ -91,8 +91,10 @@ CASES = [
                  '<origin xyz="0 0"/><!--HERE-->', "</joint>")),
     ("U501", doc(link("a", body='<collision><geometry>\n<sphere radius="0"/><!--HERE-->\n'
                                 '</geometry></collision>'))),
-    ("U502", doc(link("a", body='<collision>\n<geometry><!--HERE--><box size="1 1 1"/>'
-                                '<sphere radius="1"/></geometry>\n</collision>'))),
+    ("U502", doc(link("a", body='<collision>\n<geometry><!--HERE--></geometry>\n'
+                                '</collision>'))),
+    ("U507", doc(link("a", body='<collision>\n<geometry><box size="1 1 1"/>\n'
+                                '<sphere radius="1"/><!--HERE--></geometry>\n</collision>'))),
     ("U503", doc(link("a", body='<visual><geometry>\n<mesh/><!--HERE-->\n</geometry></visual>'))),
     ("U601", doc(link("a", '<inertial>\n<mass value="-1"/><!--HERE-->\n</inertial>'))),
     ("U602", doc(A, link("b", '<inertial><mass value="0"/></inertial>') + "<!--HERE-->",

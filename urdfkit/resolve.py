@@ -27,7 +27,7 @@ from .expand import expand_xacro
 from .spec import FILE_SHAPES, FILE_TAGS, PYBULLET_LINE_BYTES
 from .uris import not_a_file, pybullet_data_path
 from .uris import parse_packages as parse_packages  # re-exported: callers import it here
-from .validate import STRICTER, Finding, reference, refuse_oversized
+from .validate import GUARD_WARNINGS, STRICTER, Finding, reference, refuse_oversized
 from .validate import guard as run_guard
 from .xmlio import line_of, long_line, parse_xml, read_bytes, to_bytes
 
@@ -179,7 +179,8 @@ def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
                   packages: Mapping[str, Path] | None, guard: bool,
                   copy: bool = False, origins: list[str | None] | None = None,
                   meshes: bool = True) -> Resolved:
-    lifted = [f"{where(f)}: let through without the guard ({f.code}): "
+    lifted = [f"{where(f)}: {f.message} ({f.code})" if f.code in GUARD_WARNINGS else
+              f"{where(f)}: let through without the guard ({f.code}): "
               f"{f.message.removesuffix(STRICTER)}"
               for f in run_guard(tree, display, strict=guard, origins=origins)]
     root = tree.getroot()

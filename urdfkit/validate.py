@@ -451,12 +451,18 @@ def rule_geometry(root: etree._Element, r: Report) -> None:
                 r.add("U504", "warning", "<origin> inside <geometry> is ignored by PyBullet; put "
                       "it in the enclosing <visual> or <collision>", c)
         shapes = [c for c in geom if isinstance(c.tag, str) and c.tag in SHAPES]
-        if len(shapes) != 1:
-            owner = geom.getparent()
-            what = f"<{owner.tag}> of {_label(owner.getparent())}" if owner is not None \
-                and owner.getparent() is not None else "<geometry>"
-            r.add("U502", "error", f"<geometry> in {what} holds {len(shapes)} shapes; it needs "
-                  f"exactly one of {', '.join(SHAPES[:4])}", geom)
+        owner = geom.getparent()
+        what = f"<{owner.tag}> of {_label(owner.getparent())}" if owner is not None \
+            and owner.getparent() is not None else "<geometry>"
+        if not shapes:
+            r.add("U502", "error", f"<geometry> in {what} holds no shape, which PyBullet "
+                  f"refuses; it needs one of {', '.join(SHAPES[:4])}", geom)
+        elif len(shapes) > 1:
+            # Measured (PyBullet 3.2.7): the file loads, visual and collision alike built from
+            # the first shape; the others are ignored.
+            r.add("U507", "warning", f"<geometry> in {what} holds {len(shapes)} shapes "
+                  f"({', '.join(f'<{c.tag}>' for c in shapes)}); PyBullet uses the first, "
+                  f"<{shapes[0].tag}>, and ignores the rest: keep one", shapes[1])
         for shape in shapes:
             for attr in SHAPE_SIZES.get(shape.tag, ()):
                 vals = numbers(shape.get(attr))
@@ -1038,7 +1044,7 @@ GUARD_RULES: tuple[Rule, ...] = (rule_document, rule_names, rule_tree, rule_link
                                  rule_joints, rule_geometry, rule_inertial)
 
 #: The error codes every command refuses: what crashes PyBullet, and what is not URDF at all
-#: (an unknown joint type or shape, a <geometry> without exactly one shape, a revolute or
+#: (an unknown joint type or shape, a <geometry> without a shape, a revolute or
 #: prismatic joint without <limit>), which PyBullet refuses or silently misreads. Errors in
 #: values (limits, sizes, masses, inertia) are ``check`` findings: PyBullet loads such files,
 #: and pybullet_data ships some, so the loading commands still load them.
@@ -1094,11 +1100,12 @@ CODES: dict[str, str] = {
     "U401": "number does not parse or is not finite",
     "U402": "vector of the wrong length",
     "U501": "missing or non-positive shape size",
-    "U502": "<geometry> without exactly one shape",
+    "U502": "<geometry> without a shape",
     "U503": "mesh without filename",
     "U504": "<origin> inside <geometry> (ignored by PyBullet)",
     "U505": "<geometry> whose first element is not the shape",
     "U506": "<visual> or <collision> without <geometry>",
+    "U507": "<geometry> with more than one shape (PyBullet uses the first)",
     "U601": "negative or missing mass",
     "U602": "moving link with mass 0",
     "U603": "inertia not positive definite",
@@ -1159,11 +1166,19 @@ def origin_map(root: etree._Element, origins: Sequence[str | None] | None
     return {el: at for el, at in zip(elements, origins, strict=True) if at}
 
 
+#: Warnings every loading command shows (the file loads, but not as written): PyBullet builds
+#: a <geometry> with two shapes from the first alone.
+GUARD_WARNINGS = frozenset({"U507"})
+
+
 def guard_findings(root: etree._Element, file: str,
                    origins: Sequence[str | None] | None = None) -> list[Finding]:
-    """The findings that make every command refuse a document (codes in GUARD_CODES)."""
+    """The findings every command refuses a document for, or warns of.
+
+    Codes in GUARD_CODES (refused) and GUARD_WARNINGS (shown as warnings).
+    """
     return [f for f in run_rules(root, file, GUARD_RULES, origins=origins)
-            if f.code in GUARD_CODES]
+            if f.code in GUARD_CODES or f.code in GUARD_WARNINGS]
 
 
 def guard(tree: etree._ElementTree | etree._Element, file: str, *,
@@ -1172,13 +1187,14 @@ def guard(tree: etree._ElementTree | etree._Element, file: str, *,
 
     With ``strict=False`` (``--no-guard``), the refusals in :data:`LIFTABLE_CODES`, where the
     guard is stricter than PyBullet, are returned instead, for the caller to show as warnings;
-    everything that crashes PyBullet is still refused. Nothing is skipped silently.
+    everything that crashes PyBullet is still refused. Nothing is skipped silently. The
+    :data:`GUARD_WARNINGS` are returned either way.
     ``origins`` (xacro's) name where a refused element was written.
     """
     root = tree.getroot() if isinstance(tree, etree._ElementTree) else tree
     lifted = []
     for f in guard_findings(root, file, origins):
-        if not strict and f.code in LIFTABLE_CODES:
+        if f.code in GUARD_WARNINGS or (not strict and f.code in LIFTABLE_CODES):
             lifted.append(f)
             continue
         raise InputError(f.text, file=f.file, line=f.line,

@@ -1,0 +1,94 @@
+"""Files PyBullet loads that urdfkit used to refuse (issue 24, items 17-19), each measured
+against raw PyBullet on a small robot written here."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from urdfkit.session import quiet_stdout
+
+INERTIAL = ('<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" '
+            'ixz="0" iyz="0"/></inertial>')
+
+
+def _cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "urdfkit", *args], capture_output=True,
+                          text=True, timeout=120)
+
+
+def _raw_shapes(path: Path) -> tuple[list, list]:
+    """(collision, visual) shape data of the base as raw PyBullet loads the file."""
+    import pybullet as p
+
+    with quiet_stdout():
+        c = p.connect(p.DIRECT)
+    try:
+        with quiet_stdout():
+            body = p.loadURDF(str(path), physicsClientId=c)
+        return (list(p.getCollisionShapeData(body, -1, physicsClientId=c)),
+                list(p.getVisualShapeData(body, physicsClientId=c)))
+    finally:
+        p.disconnect(physicsClientId=c)
+
+
+@pytest.mark.parametrize(("first", "second", "geom"), [
+    ('<box size="0.1 0.2 0.3"/>', '<sphere radius="0.5"/>', 3),
+    ('<sphere radius="0.5"/>', '<box size="0.1 0.2 0.3"/>', 2),
+])
+def test_two_shapes_in_one_geometry_load_as_pybullet_loads_them(
+        tmp_path: Path, first: str, second: str, geom: int) -> None:
+    path = tmp_path / "two.urdf"
+    path.write_text(f'<robot name="t"><link name="a">{INERTIAL}<visual><geometry>{first}'
+                    f'{second}</geometry></visual><collision><geometry>{first}{second}'
+                    '</geometry></collision></link></robot>')
+    collision, visual = _raw_shapes(path)
+    # Measured: PyBullet builds both from the first shape and ignores the second.
+    assert [s[2] for s in collision] == [geom] and [s[2] for s in visual] == [geom]
+    check = _cli("check", str(path), "--json")
+    assert check.returncode == 0, check.stdout
+    found = [f for f in json.loads(check.stdout)["findings"] if f["code"] in ("U502", "U507")]
+    assert [(f["code"], f["level"], f["line"]) for f in found] == [
+        ("U507", "warning", 1), ("U507", "warning", 1)]
+    assert f"uses the first, {first.split()[0]}>" in found[0]["message"]
+    links = _cli("links", str(path), "--json")
+    assert links.returncode == 0, links.stderr
+    assert links.stderr.count("U507") == 2  # said by every loader, once per <geometry>
+    # The same body as raw PyBullet's: the collision shape's kind and size.
+    data = json.loads(links.stdout)["links"][0]
+    raw_inertia = _raw_inertia(path)
+    assert data["local_inertia_diagonal"] == pytest.approx(raw_inertia)
+
+
+def _raw_inertia(path: Path) -> list[float]:
+    import pybullet as p
+
+    with quiet_stdout():
+        c = p.connect(p.DIRECT)
+    try:
+        with quiet_stdout():
+            body = p.loadURDF(str(path), flags=p.URDF_USE_IMPLICIT_CYLINDER, physicsClientId=c)
+        return list(p.getDynamicsInfo(body, -1, physicsClientId=c)[2])
+    finally:
+        p.disconnect(physicsClientId=c)
+
+
+def test_a_geometry_without_a_shape_is_still_refused(tmp_path: Path) -> None:
+    path = tmp_path / "empty.urdf"
+    path.write_text(f'<robot name="t"><link name="a">{INERTIAL}<collision><geometry/>'
+                    '</collision></link></robot>')
+    import pybullet as p
+
+    with quiet_stdout():
+        c = p.connect(p.DIRECT)
+    try:
+        with quiet_stdout(), pytest.raises(p.error, match="Cannot load URDF"):
+            p.loadURDF(str(path), physicsClientId=c)
+    finally:
+        p.disconnect(physicsClientId=c)
+    r = _cli("joints", str(path))
+    assert r.returncode == 2 and "holds no shape" in r.stderr and r.stderr.count("\n") == 1
