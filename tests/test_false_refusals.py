@@ -92,3 +92,55 @@ def test_a_geometry_without_a_shape_is_still_refused(tmp_path: Path) -> None:
         p.disconnect(physicsClientId=c)
     r = _cli("joints", str(path))
     assert r.returncode == 2 and "holds no shape" in r.stderr and r.stderr.count("\n") == 1
+
+
+NS = """<robot name="t">
+  <link name="a">{inertial}</link>
+  <gazebo reference="a">
+    <sensor:camera name="cam"><sensor:fov>1.0</sensor:fov></sensor:camera>
+    <plugin:ros name="p"/>
+  </gazebo>
+  <link name="b"><inertial><mass value="2"/><inertia ixx="0.01" iyy="0.01" izz="-0.01" ixy="0"
+    ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.1 0.1 0.1"/></geometry>
+    </collision></link>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+def test_undeclared_namespace_prefixes_are_read_as_pybullet_reads_them(tmp_path: Path) -> None:
+    from lxml import etree
+
+    path = tmp_path / "gazebo.urdf"
+    path.write_text(NS.format(inertial=INERTIAL))
+    with pytest.raises(etree.XMLSyntaxError, match="Namespace prefix sensor"):
+        etree.fromstring(path.read_bytes())  # libxml2 refuses it...
+    import pybullet as p
+
+    with quiet_stdout():
+        c = p.connect(p.DIRECT)
+    try:
+        with quiet_stdout():
+            body = p.loadURDF(str(path), physicsClientId=c)  # ...PyBullet loads it
+        raw = [p.getJointInfo(body, j, physicsClientId=c)[1].decode()
+               for j in range(p.getNumJoints(body, physicsClientId=c))]
+    finally:
+        p.disconnect(physicsClientId=c)
+    joints = _cli("joints", str(path), "--json")
+    assert joints.returncode == 0, joints.stderr
+    assert [j["jointName"] for j in json.loads(joints.stdout)["joints"]] == raw == ["j"]
+    warned = [ln for ln in joints.stderr.splitlines() if "never declared" in ln]
+    assert [ln.split(": namespace prefix ")[1].split()[0] for ln in warned] == ["'sensor'",
+                                                                                 "'plugin'"]
+    assert all(f"{path}:4:" in ln or f"{path}:5:" in ln for ln in warned)
+    check = json.loads(_cli("check", str(path), "--json").stdout)
+    assert [(f["code"], f["line"]) for f in check["findings"] if f["code"] == "U004"] == [
+        ("U004", 4), ("U004", 5)]
+    # fix repairs the inertia and leaves every other byte as it was: no declaration added.
+    out = tmp_path / "fixed.urdf"
+    fixed = _cli("fix", str(path), "-o", str(out))
+    assert fixed.returncode in (0, 1), fixed.stderr
+    before, after = path.read_text(), out.read_text()
+    assert "xmlns" not in after and "<sensor:camera" in after and before != after
+    assert before.splitlines()[:6] == after.splitlines()[:6]

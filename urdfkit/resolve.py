@@ -29,7 +29,7 @@ from .uris import not_a_file, pybullet_data_path
 from .uris import parse_packages as parse_packages  # re-exported: callers import it here
 from .validate import GUARD_WARNINGS, STRICTER, Finding, reference, refuse_oversized
 from .validate import guard as run_guard
-from .xmlio import line_of, long_line, parse_xml, read_bytes, to_bytes
+from .xmlio import line_of, long_line, parse_xml, read_bytes, to_bytes, undeclared_prefixes
 
 
 def _clip(text: str, most: int = 120) -> str:
@@ -171,8 +171,12 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
         refuse_oversized(data, display)  # before a tree of 280,000 links is built
         # PyBullet breaks lines over 8191 bytes (and may then refuse or misread the file): it
         # gets a reformatted copy, one element per line.
-        return _resolve_tree(source, display, parse_xml(data, display), packages, guard,
-                             copy=long_line(data) is not None, meshes=meshes)
+        resolved = _resolve_tree(source, display, parse_xml(data, display), packages, guard,
+                                 copy=long_line(data) is not None, meshes=meshes)
+        # Read though libxml2 refuses it, as PyBullet reads it: said, as check says it (U004).
+        resolved.warnings[:0] = [f"{display}:{line}: {note}"
+                                 for line, note in undeclared_prefixes(data)]
+        return resolved
 
 
 def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,

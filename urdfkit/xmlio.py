@@ -140,11 +140,62 @@ def tolerate_quirks(data: bytes) -> tuple[bytes, list[tuple[int, str]]]:
 
     pybullet_data itself ships such files (``plane.urdf`` declares ``version="0.0"``,
     ``humanoid.urdf`` ends in a NUL byte, ``biped2d_pybullet.urdf`` has blank lines before the
-    declaration). Refusing them would refuse files PyBullet loads. Line numbers are kept.
+    declaration), and Gazebo extensions in real packages use namespace prefixes they never
+    declare (``<sensor:camera>``). Refusing them would refuse files PyBullet loads. Line
+    numbers are kept.
 
     Returns:
         The repaired bytes and ``(line, note)`` pairs saying what was repaired.
     """
+    data, notes = _declaration_quirks(data)
+    return _declare_prefixes(data, notes)
+
+
+#: A prefixed start tag (``<sensor:camera``), and a namespace declaration.
+_PREFIXED = re.compile(rb"<([A-Za-z_][\w.-]*):[A-Za-z_]")
+_DECLARED = re.compile(rb"xmlns:([A-Za-z_][\w.-]*)\s*=")
+_START = re.compile(rb"<(?![?!/])[^\s/>]+")
+
+
+def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
+                      ) -> tuple[bytes, list[tuple[int, str]]]:
+    """Declare the namespace prefixes a document uses but never declares.
+
+    tinyxml2 knows nothing of namespaces: to PyBullet ``<sensor:camera>`` is just an element it
+    does not read. libxml2 refuses the document. Each such prefix is declared on the root
+    element (on its own line, so no line number moves), and noted.
+    """
+    if _PREFIXED.search(data) is None:
+        return data, notes
+    first: dict[bytes, int] = {}
+    for m in _PREFIXED.finditer(data):
+        first.setdefault(m.group(1), m.start())
+    declared = set(_DECLARED.findall(data)) | {b"xml", b"xmlns"}
+    missing = [prefix for prefix in first if prefix not in declared]
+    root = _START.search(data)
+    if not missing or root is None:
+        return data, notes
+    for prefix in missing:
+        at = first[prefix]
+        tag = data[at + 1:data.find(b" ", at, at + 200) if data.find(b" ", at, at + 200) > 0
+                   else at + 40].split(b">")[0].decode("utf-8", "replace")
+        name = prefix.decode("utf-8", "replace")
+        notes.append((data.count(b"\n", 0, at) + 1,
+                      f"namespace prefix {name!r} is used (<{tag}>) but never declared: "
+                      "PyBullet ignores the element, other XML parsers refuse the file; "
+                      f"declare xmlns:{name} on <robot>"))
+    extra = b"".join(b' xmlns:' + prefix + b'="urn:urdfkit:undeclared:' + prefix + b'"'
+                     for prefix in missing)
+    return data[:root.end()] + extra + data[root.end():], notes
+
+
+def undeclared_prefixes(data: bytes) -> list[tuple[int, str]]:
+    """``(line, note)`` for each namespace prefix ``data`` uses but never declares."""
+    return _declare_prefixes(data, [])[1]
+
+
+def _declaration_quirks(data: bytes) -> tuple[bytes, list[tuple[int, str]]]:
+    """The quirks of NUL bytes and the XML declaration (see :func:`tolerate_quirks`)."""
     notes: list[tuple[int, str]] = []
     trimmed = data.rstrip(b"\0 \t\r\n")
     if b"\0" in data[len(trimmed):]:
