@@ -8,7 +8,11 @@ Standalone: ``python bench/view_bench.py [-n ROUNDS] [--moves 200]``. Measures
   the clock, as a user's browser is already open;
 - slider to scene on the server: :meth:`urdfkit.view.Viewer.set_joints` (resetJointState, mimic
   followers, getLinkState of every link, every link node moved, the joint vector texts),
-  median over ``--moves`` moves (goal: at most 20 ms).
+  median over ``--moves`` moves (goal: at most 20 ms);
+- ``drive --view`` against ``drive``, both at ``--speed max`` (no pacing), simplecar for
+  ``--drive-seconds`` simulated seconds: the run loop alone (the same opened scenario run
+  with and without the stream as its sink; goal: at most 1.3x), and the whole command up to
+  its summary (viser, the page's own load and check included), rounds interleaved.
 
 The robot: four arms of eight links on a base, every link a KUKA iiwa STL from pybullet_data
 (visual and collision), green so its pixels are found. Exit status 1 if a goal is missed.
@@ -29,6 +33,7 @@ from pathlib import Path
 #: The issue's goals.
 FIRST_DRAW_RATIO = 1.5
 MOVE_MS = 20.0
+DRIVE_VIEW_RATIO = 1.3
 CHROMIUM = os.environ.get("URDFKIT_CHROMIUM", "/usr/bin/chromium")
 
 
@@ -122,12 +127,59 @@ def slider_moves(path: Path, moves: int) -> list[float]:
         v.close()
 
 
+def drive_loops(seconds: float) -> tuple[float, float]:
+    """Wall seconds of one simplecar run loop without, then with, the page's stream."""
+    from urdfkit.drive import DriveConfig, Scenario
+    from urdfkit.view import RunStream, Viewer
+
+    config = DriveConfig(throttle=10, steer=0.2, seconds=seconds, keep_trajectory=False)
+    with Scenario(config) as sc:
+        t0 = time.perf_counter()
+        sc.run()
+        plain = time.perf_counter() - t0
+    with Scenario(config) as sc:
+        viewer = Viewer(sc.car_file, inertia_from_file=True, watch=False, ground=40.0)
+        try:
+            stream = RunStream(viewer, sc.link_poses, None, seconds)
+            t0 = time.perf_counter()
+            sc.run(sink=stream)
+            streamed = time.perf_counter() - t0
+        finally:
+            viewer.close()
+    return plain, streamed
+
+
+def drive_commands(seconds: float) -> tuple[float, float]:
+    """Wall seconds of ``urdfkit drive`` and of ``drive --view --speed max`` to its summary."""
+    args = [sys.executable, "-m", "urdfkit", "drive", "--steer", "0.2", "--seconds",
+            str(seconds), "--json"]
+    t0 = time.perf_counter()
+    subprocess.run(args, check=True, capture_output=True)
+    plain = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([*args, "--view", "--speed", "max"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    assert proc.stderr is not None
+    while "until Ctrl-C" not in proc.stderr.readline():
+        if proc.poll() is not None:
+            raise RuntimeError("drive --view ended before its summary")
+    viewed = time.perf_counter() - t0
+    proc.send_signal(2)
+    proc.communicate(timeout=30)
+    return plain, viewed
+
+
 def main() -> int:
     """Run the bench and print its figures; 1 if a goal is missed."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("-n", "--rounds", type=int, default=3)
     parser.add_argument("--moves", type=int, default=200)
+    parser.add_argument("--drive-seconds", type=float, default=30.0)
     args = parser.parse_args()
+    loops = [drive_loops(args.drive_seconds) for _ in range(args.rounds)]
+    commands = [drive_commands(args.drive_seconds) for _ in range(args.rounds)]
+    loop_ratio = statistics.median(b / a for a, b in loops)
+    command_ratio = statistics.median(b / a for a, b in commands)
     from playwright.sync_api import sync_playwright
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -149,7 +201,13 @@ def main() -> int:
     print(f"ratio view/render: {draw / rend:.2f} (goal <= {FIRST_DRAW_RATIO})")
     print(f"slider -> scene: median {move:.2f} ms, p95 {p95:.2f} ms over {len(moves)} moves "
           f"(goal <= {MOVE_MS} ms)")
-    return int(draw / rend > FIRST_DRAW_RATIO or move > MOVE_MS)
+    print(f"drive --view run loop: median {loop_ratio:.2f}x the plain loop over "
+          f"{args.rounds} ({', '.join(f'{a:.2f}/{b:.2f} s' for a, b in loops)}; goal <= "
+          f"{DRIVE_VIEW_RATIO}x)")
+    print(f"drive --view command to its summary: median {command_ratio:.2f}x drive "
+          f"({', '.join(f'{a:.2f}/{b:.2f} s' for a, b in commands)})")
+    return int(draw / rend > FIRST_DRAW_RATIO or move > MOVE_MS
+               or loop_ratio > DRIVE_VIEW_RATIO)
 
 
 if __name__ == "__main__":

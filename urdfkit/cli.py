@@ -844,6 +844,15 @@ def drive(
     limp: Annotated[bool, typer.Option(
         "--limp", help="Let joints that are neither wheels, hinges nor casters go limp "
         "instead of holding their start angle (with the URDF's effort).")] = False,
+    view: Annotated[bool, typer.Option(
+        "--view", help="Stream the run to a browser page (urdfkit view) while it simulates "
+        "headless; the page stays up after the run until Ctrl-C.")] = False,
+    speed: Annotated[str, typer.Option(
+        "--speed", metavar="FACTOR|max", help="With --view: simulated seconds per wall "
+        "second (max: no pacing).")] = "1",
+    port: Annotated[int | None, typer.Option(
+        "--port", min=1, max=65535, help="With --view: the port to serve on.",
+        show_default="a free one")] = None,
 ) -> None:
     """Drive a car headless at a fixed throttle and steer, and report where it went.
 
@@ -861,9 +870,12 @@ def drive(
                              param="tutorial")
     from .session import has_display
 
+    if view and gui:
+        raise ParameterError("`view` replaces `gui`: give one of them", param="view")
+    pace = _speed(speed) if view else None
     if gui and not has_display():
         raise ParameterError("`gui` needs a display (DISPLAY is not set); drop it to drive "
-                             "headless", param="gui")
+                             "headless, or use --view", param="gui")
     # Check the outputs before a long run, not after it.
     if trajectory is not None:
         from .output import check_output
@@ -901,16 +913,24 @@ def drive(
         for w in sc.warnings:
             show.warn(w)
         said = list(sc.warnings)
-        progress, stop = show.progress("driving", "steps", enabled=not as_json)
+        stream = _run_view(sc, config, pace, port) if view else None
+        progress, stop = show.progress("driving", "steps", enabled=not as_json and not view)
         written = []
         try:
             if trajectory is None:
-                result = sc.run(progress)
+                result = sc.run(progress, sink=stream)
             else:
                 from .drive import drive_to_file
 
-                result, path = drive_to_file(sc, trajectory, force=force, progress=progress)
+                result, path = drive_to_file(sc, trajectory, force=force, progress=progress,
+                                             sink=stream)
                 written.append(path)
+            if stream is not None:
+                stream.finish(_run_view_summary(result))
+        except BaseException:
+            if stream is not None:
+                stream.viewer.close()
+            raise
         finally:
             stop()
     if plot is not None:
@@ -926,10 +946,81 @@ def drive(
         for path in written:
             show.wrote(path)
     if result.interrupted:
+        if stream is not None:
+            stream.viewer.close()
         show.interrupted("interrupted; the results cover the steps simulated")
         raise typer.Exit(130)
+    if stream is not None:
+        _serve_until_interrupted(stream.viewer, "the run is over; its page")
     if result.problems:  # the run is physically suspect: a finding, for CI
         raise typer.Exit(1)
+
+
+def _speed(text: str) -> float | None:
+    """``--speed``: a positive factor, or None for ``max``."""
+    import math
+
+    from .errors import ParameterError
+
+    if text.strip().lower() == "max":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ParameterError(f"`speed` takes a positive factor or max, got {text!r}",
+                             param="speed")
+    return value
+
+
+def _run_view(sc: Any, config: Any, pace: float | None, port: int | None) -> Any:
+    """Start the page a run streams to (drive --view), and say where it is."""
+    import math
+
+    from .view import RunStream, Viewer
+
+    total = config.total_steps * config.time_step
+    reach = abs(config.throttle) * sc.drivetrain.reference_radius * total
+    viewer = Viewer(sc.car_file, packages=config.packages, package_paths=config.package_paths,
+                    xacro_args=config.xacro_args, inertia_from_file=not config.tutorial,
+                    port=port, watch=False, ground=float(max(4, math.ceil(2 * reach + 2))))
+    try:
+        stream = RunStream(viewer, sc.link_poses, pace, total)
+        stream.push()
+    except BaseException:
+        viewer.close()
+        raise
+    pacing = "as fast as it goes" if pace is None else \
+        ("in real time" if pace == 1 else f"at {pace:g}x real time")
+    show.line(f"urdfkit drive: {viewer.url} (the run streams there {pacing})", stderr=True)
+    return stream
+
+
+def _run_view_summary(r: Any) -> str:
+    """The run's summary, as the page shows it at the end."""
+    x, y, _ = r.final_position
+    radius = "none" if r.turning_radius is None else f"{r.turning_radius:.3f} m"
+    text = (f"**Done**: {r.sim_time:.2f} s simulated; {r.distance:.3f} m along the path to "
+            f"x {x:.3f}, y {y:.3f}; heading change {r.heading_change:.3f} rad; turning radius "
+            f"{radius}")
+    if r.problems:
+        text += "\n\n**Problems**: " + "; ".join(r.problems)
+    return text
+
+
+def _serve_until_interrupted(viewer: Any, what: str) -> None:
+    """Keep a page up until Ctrl-C, then close it (the command's exit code is its own)."""
+    import time
+
+    show.line(f"urdfkit drive: {what} stays at {viewer.url} until Ctrl-C", stderr=True)
+    try:
+        while True:
+            time.sleep(3600)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        viewer.close()
 
 
 # ---- sweep: many drives or scenario runs (urdfkit/sweep.py)

@@ -289,10 +289,13 @@ def trajectory_format(path: str | Path) -> str:
 
 
 def drive_to_file(scenario: Scenario, path: str | Path, *, force: bool = False,
-                  progress: ProgressFn | None = None) -> tuple[DriveResult, Path]:
+                  progress: ProgressFn | None = None,
+                  sink: Callable[[tuple[float, ...]], None] | None = None
+                  ) -> tuple[DriveResult, Path]:
     """Run ``scenario`` (opened), streaming its trajectory to ``path`` as it is sampled.
 
     On Ctrl-C (SIGTERM, SIGHUP in the CLI) the file holds every sample taken so far.
+    ``sink`` also gets every sample (after it is written).
     """
     from .output import StreamingFile
 
@@ -300,7 +303,12 @@ def drive_to_file(scenario: Scenario, path: str | Path, *, force: bool = False,
     with StreamingFile(path, force=force, keep_on_interrupt=True) as out:
         out.write(Trajectory(scenario.columns).header_bytes(fmt))
         traj = Trajectory(scenario.columns)
-        result = scenario.run(progress, sink=lambda row: out.write(traj.rows_bytes([row], fmt)))
+        def write(row: tuple[float, ...]) -> None:
+            out.write(traj.rows_bytes([row], fmt))
+            if sink is not None:
+                sink(row)
+
+        result = scenario.run(progress, sink=write)
     return result, out.path
 
 
@@ -631,6 +639,7 @@ class Scenario:
         self.problems: list[str] = []
         self.static_base = False
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
+        self._last_file = ""
         self.session: Session | None = None
         try:
             self._open()
@@ -653,9 +662,12 @@ class Scenario:
     def _load(self, s: Session, name: str | None, builtin: str, options: LoadOptions,
               params: Mapping[str, str] | None = None) -> int:
         if name is None:
-            return s.load_urdf(self._builtin(builtin, params), options, display=builtin)
+            path = self._builtin(builtin, params)
+            self._last_file = str(path)
+            return s.load_urdf(path, options, display=builtin)
         from .resolve import open_input
 
+        self._last_file = name
         with open_input(name, self.config.packages, self.config.xacro_args,
                         guard=self.config.guard, package_paths=self.config.package_paths) as res:
             self.warnings.extend(res.warnings)
@@ -681,6 +693,8 @@ class Scenario:
         # turned to its spawn tilt only after its wheels are found in its own frame.
         self.body = self._load(s, c.urdf, "simplecar", LoadOptions(
             base_position=start, base_orientation=upright, **flags), c.template_params)
+        #: The car's file, for a viewer to load the same robot (the built-in one's build).
+        self.car_file = self._last_file
         s.require_state_queries(self.body, car)
         try:
             self.drivetrain = train = detect_upright(p, self.body, client, upright, c.wheels,
@@ -796,6 +810,16 @@ class Scenario:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+    def link_poses(self) -> list[tuple[Any, Any]]:
+        """Every URDF link frame's world pose now, base first (``(xyz, xyzw)``)."""
+        assert self.session is not None
+        p, body, client = self.session.p, self.body, self.session.client
+        out = [base_link_pose(p, body, client)]
+        for j in range(p.getNumJoints(body, physicsClientId=client)):
+            st = p.getLinkState(body, j, computeForwardKinematics=True, physicsClientId=client)
+            out.append((st[4], st[5]))
+        return out
 
     def _sampler(self) -> Callable[[float], tuple[float, ...]]:
         assert self.session is not None

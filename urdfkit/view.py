@@ -619,7 +619,8 @@ class Viewer:
     def __init__(self, file: str, *, packages: Sequence[str] | None = None,
                  package_paths: Sequence[str] | None = None,
                  xacro_args: Sequence[str] | None = None, inertia_from_file: bool = False,
-                 host: str = "127.0.0.1", port: int | None = None) -> None:
+                 host: str = "127.0.0.1", port: int | None = None, watch: bool = True,
+                 ground: float = 4.0) -> None:
         self._load_args: dict[str, Any] = {
             "packages": packages, "package_paths": package_paths, "xacro_args": xacro_args,
             "inertia_from_file": inertia_from_file}
@@ -650,8 +651,8 @@ class Viewer:
         self.port = int(self.server.get_port())
         self.url = f"http://{'localhost' if host in ('127.0.0.1', '::1') else host}:{self.port}"
         self.server.scene.set_up_direction("+z")
-        self.server.scene.add_grid("/ground", width=4.0, height=4.0, cell_size=0.1,
-                                   section_size=1.0)
+        self.server.scene.add_grid("/ground", width=ground, height=ground,
+                                   cell_size=0.1 if ground <= 4.0 else 0.5, section_size=1.0)
         self._static_gui()
         self._show_model()
         # Mimic joints to their leaders' zero pose (offsets included). Self-collisions are
@@ -659,8 +660,9 @@ class Viewer:
         self.set_joints(self.zero(), touching=False)
         self._aim_camera()
         self._stop = threading.Event()
-        self._watcher = threading.Thread(target=self._watch, name="urdfkit-view-watch",
-                                         daemon=True)
+        # A run on show (drive --view) is not reloaded under it: no watcher then.
+        self._watcher = threading.Thread(target=self._watch if watch else lambda: None,
+                                         name="urdfkit-view-watch", daemon=True)
         self._watcher.start()
 
     # ------------------------------------------------------------------ the page
@@ -879,6 +881,19 @@ class Viewer:
                         tuple(float(x) for x in frame.wxyz))
         raise KeyError(name)
 
+    def show_poses(self, poses: Sequence[tuple[Sequence[float], Sequence[float]]]) -> None:
+        """Put every link node at a world pose (``(xyz, xyzw)``, base first), as given.
+
+        For a run simulated elsewhere (``drive --view``): the poses come from that session,
+        not from this viewer's model.
+        """
+        if len(poses) != len(self._frames):
+            raise EngineError(f"the run has {len(poses)} links, the view {len(self._frames)}")
+        with self._lock, self.server.atomic():
+            for frame, (pos, quat) in zip(self._frames, poses, strict=True):
+                frame.position = tuple(float(x) for x in pos)
+                frame.wxyz = _wxyz(quat)
+
     def nodes(self, kind: str, link: str) -> list[Any]:
         """The scene handles of one layer of one link (for tests and tools)."""
         index = next(i for i, lk in enumerate(self.model.links) if lk.name == link)
@@ -945,6 +960,83 @@ class Viewer:
         with _quiet():
             self.server.stop()
         self.model.close()
+
+
+#: Frames pushed to the page per second of wall time, at most, while a run streams.
+STREAM_FPS = 30.0
+#: Points of a run's path kept on the page (halved by dropping every other one past this).
+PATH_POINTS = 2000
+
+
+class RunStream:
+    """Stream a simulated run to a :class:`Viewer`: link poses, the path, then the summary.
+
+    Use it as the run's ``sink`` (called with each trajectory sample): it paces the run to
+    ``speed`` times real time (``None``: as fast as it goes), pushes the robot's link poses,
+    read from the run's own PyBullet session, at most :data:`STREAM_FPS` times a second of
+    wall time, and draws the base's path on the ground.
+
+    Args:
+        viewer: The page (loaded from the same file as the run).
+        poses: Returns every link's world pose in the run's session, base first.
+        speed: Simulated seconds per wall second; None for no pacing.
+        total: The run's simulated duration (for the status line).
+    """
+
+    def __init__(self, viewer: Viewer, poses: Any, speed: float | None,
+                 total: float) -> None:
+        import time
+
+        self.viewer, self.poses, self.speed, self.total = viewer, poses, speed, total
+        self.path: list[tuple[float, float, float]] = []
+        self.frames = 0
+        self._clock = time.perf_counter
+        self._sleep = time.sleep
+        self._start = self._clock()
+        self._last = -1.0
+        self._stride = 1
+        self._seen = 0
+        viewer.status.content = f"**Running**: 0.0 of {total:g} s simulated"
+        # The page shows the run, not the model's own joints: its controls would fight it.
+        for control in (*viewer.sliders.values(), viewer.reset_button):
+            control.disabled = True
+
+    def __call__(self, row: Sequence[float]) -> None:
+        """Take one trajectory sample ``(t, x, y, z, ...)``: pace, record, maybe push."""
+        t = float(row[0])
+        self._seen += 1
+        if self._seen % self._stride == 0:
+            self.path.append((float(row[1]), float(row[2]), float(row[3])))
+            if len(self.path) > PATH_POINTS:
+                self.path = self.path[::2]
+                self._stride *= 2
+        if self.speed is not None:
+            ahead = self._start + t / self.speed - self._clock()
+            if ahead > 0:
+                self._sleep(ahead)
+        now = self._clock()
+        if now - self._last >= 1.0 / STREAM_FPS:
+            self._last = now
+            self.push(f"**Running**: {t:.1f} of {self.total:g} s simulated")
+
+    def push(self, status: str | None = None) -> None:
+        """Show the run's current pose and path now."""
+        import numpy as np
+
+        self.viewer.show_poses(self.poses())
+        self.frames += 1
+        if len(self.path) >= 2:
+            pts = np.asarray(self.path, dtype=np.float32)
+            pts[:, 2] = 0.002  # on the ground, not at the base's height
+            segments = np.stack([pts[:-1], pts[1:]], axis=1)
+            self.viewer.server.scene.add_line_segments(
+                "/run/path", segments, (230, 97, 0), thickness=3.0, thickness_units="screen")
+        if status is not None:
+            self.viewer.status.content = status
+
+    def finish(self, summary: str) -> None:
+        """The final pose and path, and the run's summary in the page."""
+        self.push(summary)
 
 
 def _quiet() -> Any:

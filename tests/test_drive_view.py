@@ -1,0 +1,98 @@
+"""``drive --view`` (issue 29): the run streams to the page while it simulates headless, and
+what the page ends on is the run ``drive --json`` reports."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+import urllib.request
+
+import pytest
+
+pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
+
+from urdfkit.drive import DriveConfig, Scenario, drive  # noqa: E402
+from urdfkit.view import RunStream, Viewer  # noqa: E402
+
+
+def _streamed(config: DriveConfig, speed: float | None) -> tuple[object, RunStream, float]:
+    with Scenario(config) as sc:
+        viewer = Viewer(sc.car_file, inertia_from_file=True, watch=False, ground=20.0)
+        try:
+            stream = RunStream(viewer, sc.link_poses, speed, config.seconds or 0.0)
+            start = time.perf_counter()
+            result = sc.run(sink=stream)
+            wall = time.perf_counter() - start
+            stream.finish("done")
+            base = viewer.link_pose(viewer.model.links[0].name)
+            wheel = viewer.link_pose("left_back_wheel")
+            raw_wheel = sc.link_poses()[[lk.name for lk in viewer.model.links]
+                                        .index("left_back_wheel")]
+        finally:
+            viewer.close()
+    stream.final = (base, wheel, raw_wheel)  # type: ignore[attr-defined]
+    return result, stream, wall
+
+
+def test_the_page_ends_where_drive_json_ends() -> None:
+    config = DriveConfig(throttle=10, steer=0.2, seconds=3)
+    result, stream, _ = _streamed(config, None)
+    (base_pos, _), (wheel_pos, _), raw_wheel = stream.final  # type: ignore[attr-defined]
+    plain = drive(DriveConfig(throttle=10, steer=0.2, seconds=3))
+    # The same run (PyBullet is deterministic): streaming changes nothing it simulates...
+    assert result.final_position == pytest.approx(plain.final_position, abs=1e-9)  # type: ignore[attr-defined]
+    # ...and the page's base and wheel frames are where the run's session has them.
+    assert base_pos == pytest.approx(plain.final_position, abs=1e-6)
+    assert wheel_pos == pytest.approx(raw_wheel[0], abs=1e-6)
+    assert stream.frames >= 2
+    # The path on the ground: every sample, ending at the final position.
+    assert len(stream.path) == result.samples  # type: ignore[attr-defined]
+    assert stream.path[-1][:2] == pytest.approx(plain.final_position[:2], abs=1e-9)
+
+
+def test_the_run_is_paced_to_its_speed() -> None:
+    # 2 simulated seconds at 4x real time take at least 0.5 s of wall time (a lower bound
+    # the pacing guarantees; an unpaced run of simplecar takes ~0.1 s).
+    _, _, wall = _streamed(DriveConfig(throttle=10, seconds=2), 4.0)
+    assert wall >= 0.5
+
+
+def test_cli_streams_prints_json_and_serves_until_ctrl_c() -> None:
+    proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "drive", "--steer", "0.2",
+                             "--seconds", "3", "--view", "--speed", "max", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    err = ""
+    try:
+        deadline = time.monotonic() + 120
+        while "until Ctrl-C" not in err and time.monotonic() < deadline and \
+                proc.poll() is None:
+            err += proc.stderr.readline()  # type: ignore[union-attr]
+        assert "until Ctrl-C" in err, err
+        url = err.split("stays at ")[1].split()[0]
+        with urllib.request.urlopen(url, timeout=10) as r:
+            assert r.status == 200
+        proc.send_signal(signal.SIGINT)
+        out, rest = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, rest  # the run finished clean: Ctrl-C only closed the page
+    plain = subprocess.run([sys.executable, "-m", "urdfkit", "drive", "--steer", "0.2",
+                            "--seconds", "3", "--json"], capture_output=True, text=True,
+                           timeout=120)
+    assert json.loads(out)["final_position"] == json.loads(plain.stdout)["final_position"]
+
+
+@pytest.mark.parametrize(("args", "says"), [
+    (["--view", "--gui"], "--view replaces --gui"),
+    (["--view", "--speed", "0"], "--speed takes a positive factor or max"),
+    (["--view", "--speed", "fast"], "--speed takes a positive factor or max"),
+])
+def test_cli_refuses_bad_view_options(args: list[str], says: str) -> None:
+    r = subprocess.run([sys.executable, "-m", "urdfkit", "drive", *args], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and says in r.stderr and r.stderr.count("\n") == 1, r.stderr
