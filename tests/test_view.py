@@ -475,3 +475,58 @@ def test_finding_and_reload_error_shown_in_the_page(browser: Any, tmp_path: Path
     path.write_text("<robot")
     page.get_by_text("Reload failed").wait_for(timeout=10000)
     assert page.get_by_text("Connected").is_visible()
+
+
+# --------------------------------------------------------------------------- selection
+
+
+def test_selecting_a_link_highlights_it_and_shows_its_joint_row(tmp_path: Path,
+                                                                viewer_of: Any) -> None:
+    from urdfkit.view import NO_LINK, SELECTED_RGB
+
+    path = tmp_path / "bad.urdf"
+    path.write_text(U604)
+    v = viewer_of(path, inertia_from_file=True)
+    v.select("upper")
+    assert v.select_link.value == "upper"
+    assert [h.color for h in v.nodes("visual", "upper")] == [SELECTED_RGB]
+    assert v.nodes("visual", "base")[0].color == (0, 229, 0)  # the others keep theirs
+    # Its joint's row, decoded as `urdfkit joints` decodes it, and the finding on it.
+    row = next(j for j in v.model.table if j.link_name == "upper")
+    assert f"joint {row.joint_index} **shoulder**" in v.selected_text.content
+    assert "U604" in v.selected_text.content
+    v.select(None)
+    assert v.select_link.value == NO_LINK
+    assert [h.color for h in v.nodes("visual", "upper")] == [TINTS["error"]]  # tint again
+    with pytest.raises(KeyError):
+        v.select("no_such_link")
+
+
+def test_clicking_a_finding_and_choosing_a_link_in_the_page_select_it(
+        browser: Any, tmp_path: Path, viewer_of: Any) -> None:
+    path = tmp_path / "bad.urdf"
+    path.write_text(U604)
+    line = next(i for i, text in enumerate(U604.splitlines(), 1) if 'izz="0.5"' in text)
+    v = viewer_of(path, inertia_from_file=True)
+    page = _open_page(browser, v)
+    # The finding's button in the page selects the link it is about, on the server.
+    page.get_by_role("button", name=f"U604 line {line}: upper").click()
+    assert _wait(lambda: v.selected == "upper", 10)
+    page.get_by_text("child of joint").wait_for(timeout=10000)
+    # Choosing another link in the Selection dropdown moves the selection to it.
+    page.get_by_label("Link", exact=True).click()
+    page.get_by_role("option", name="finger", exact=True).click()
+    assert _wait(lambda: v.selected == "finger", 10)
+    # Clicking the red (U604) link in the scene selects it: the middle of its red pixels.
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    assert _wait(lambda: _pixels(page, "red") > 500, 20)
+    rgb = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
+    r, g, b = rgb[160:620, :640, 0], rgb[160:620, :640, 1], rgb[160:620, :640, 2]
+    ys, xs = np.nonzero((r > g + 90) & (r > b + 90) & (abs(g - b) < 40))
+    k = len(ys) // 2  # a red pixel in the middle of the list, not on the silhouette's edge
+    page.mouse.click(int(xs[k]), int(ys[k]) + 160)
+    assert _wait(lambda: v.selected == "upper", 10), v.selected

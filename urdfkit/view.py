@@ -38,6 +38,10 @@ COLLISION_RGB = (213, 94, 0)
 CONCAVE_RGB = (204, 121, 167)
 #: Links touching another at the current pose (self-collision pairs).
 TOUCHING_RGB = (200, 0, 200)
+#: The selected link.
+SELECTED_RGB = (86, 180, 233)
+#: The selection dropdown's entry for no link.
+NO_LINK = "(none)"
 #: How often the watcher looks at the files the robot was read from (s).
 POLL_SECONDS = 0.25
 #: Meshes with more triangles than this are thinned for display (only: PyBullet keeps all).
@@ -683,6 +687,13 @@ class Viewer:
             box.on_update(lambda _event: self.apply_toggles())
         self.show_touching.on_update(lambda _event: self.update_touching())
         self.touching: list[tuple[str, str, float]] = []
+        self.selected: str | None = None
+        with gui.add_folder("Selection", order=1.5):
+            self.select_link = gui.add_dropdown(
+                "Link", [NO_LINK], initial_value=NO_LINK,
+                hint="Or click a link in the scene, or a finding")
+            self.selected_text = gui.add_markdown("")
+        self.select_link.on_update(lambda _event: self._dropdown_moved())
         self.joints_folder = gui.add_folder("Joints", order=2)
         with self.joints_folder:
             self.reset_button = gui.add_button("Reset to zero")
@@ -711,12 +722,15 @@ class Viewer:
             tint = TINTS.get(link.level or "")
             for kind, shapes in (("visual", link.visuals), ("collision", link.collisions)):
                 for k, sh in enumerate(shapes):
-                    self._nodes[kind].append(scene.add_mesh_simple(
+                    mesh = scene.add_mesh_simple(
                         f"{root}/{kind}{k}", sh.vertices, sh.faces, color=tint or sh.rgb,
                         opacity=None if sh.opacity >= 1 else sh.opacity,
                         # No shadow pass: it doubles the first draw in software WebGL.
                         cast_shadow=False, receive_shadow=False,
-                        position=sh.pos, wxyz=_wxyz(sh.quat)))
+                        position=sh.pos, wxyz=_wxyz(sh.quat))
+                    # Clicking a link in the scene selects it (and its joint's row).
+                    mesh.on_click(lambda _event, name=link.name: self.select(name))
+                    self._nodes[kind].append(mesh)
             self._nodes["frames"].append(scene.add_frame(
                 f"{root}/axes", axes_length=size * 0.08, axes_radius=size * 0.004))
             joint = by_index.get(link.index)
@@ -752,6 +766,21 @@ class Viewer:
                 self._gui.append(s)
         with self.findings_folder:
             self._gui.append(gui.add_markdown(self._findings_text()))
+            # One button per finding on a link: clicking it selects that link.
+            for f in (f for f in m.findings if f.level in TINTS):
+                links = m.finding_links(f)
+                if not links:
+                    continue
+                where = f"line {f.line}" if f.line is not None else f.file
+                button = gui.add_button(f"{f.code} {where}: {links[0]}",
+                                        hint=f.text[:300])
+                button.on_click(lambda _event, name=links[0]: self.select(name))
+                self._gui.append(button)
+        names = [lk.name for lk in m.links]
+        self.select_link.options = [NO_LINK, *names]
+        if self.selected not in names:
+            self.selected = None
+        self.select(self.selected)
         with self.table_folder:
             self._gui.append(gui.add_markdown(self._table_text()))
         self._refresh_status()
@@ -846,10 +875,9 @@ class Viewer:
                 frame.position = pos
                 frame.wxyz = _wxyz(quat)
 
-    def update_touching(self) -> None:
-        """Measure the touching pairs (when shown) and colour their links magenta."""
+    def _recolour(self) -> None:
+        """Each link's colour: selected, else touching, else its findings' tint, else its own."""
         with self._lock:
-            self.touching = self.model.touching() if self.show_touching.value else []
             hit = {name for a, b, _ in self.touching for name in (a, b)}
             for link, k in zip(self.model.links, range(len(self.model.links)), strict=True):
                 base = TINTS.get(link.level or "")
@@ -857,9 +885,60 @@ class Viewer:
                     handles = [h for h in self._nodes.get(kind, [])
                                if h.name.startswith(f"/robot/link{k}/")]
                     for h, sh in zip(handles, shapes, strict=True):
-                        want = TOUCHING_RGB if link.name in hit else (base or sh.rgb)
+                        want = SELECTED_RGB if link.name == self.selected else \
+                            TOUCHING_RGB if link.name in hit else (base or sh.rgb)
                         if tuple(h.color) != tuple(want):
                             h.color = want
+
+    def _dropdown_moved(self) -> None:
+        if self._setting:
+            return
+        value = str(self.select_link.value)
+        self.select(None if value == NO_LINK else value)
+
+    def select(self, link: str | None) -> None:
+        """Select a link (None: none): highlight it, show its joint's row and its findings.
+
+        Clicking the link in the scene, choosing it in the Selection dropdown, or clicking a
+        finding about it all come here.
+        """
+        with self._lock:
+            m = self.model
+            if link is not None and link not in {lk.name for lk in m.links}:
+                raise KeyError(link)
+            self.selected = link
+            self._setting = True
+            try:
+                want = NO_LINK if link is None else link
+                if self.select_link.value != want:
+                    self.select_link.value = want
+            finally:
+                self._setting = False
+            self._recolour()
+            if link is None:
+                self.selected_text.content = ""
+                return
+            row = next((j for j in m.table if j.link_name == link), None)
+            lines = [f"**{_md(link)}**: " + (
+                "the base" if row is None else
+                f"child of joint {row.joint_index} **{_md(row.joint_name)}** "
+                f"({row.type_label}"
+                + (f", {row.joint_lower_limit:g} .. {row.joint_upper_limit:g}"
+                   if row.limited else "") + f"), parent {_md(row.parent_link_name)}")]
+            view = next(lk for lk in m.links if lk.name == link)
+            lines.append(f"mass {view.mass:g} kg")
+            for f in m.findings:
+                if f.level in TINTS and link in m.finding_links(f):
+                    where = f.file if f.line is None else f"{f.file}:{f.line}"
+                    lines.append(f"- **{f.level} {f.code}** `{where}`: {_md(f.text)}")
+            self.selected_text.content = "\n\n".join(lines[:2]) + (
+                "\n\n" + "\n".join(lines[2:]) if lines[2:] else "")
+
+    def update_touching(self) -> None:
+        """Measure the touching pairs (when shown) and colour their links magenta."""
+        with self._lock:
+            self.touching = self.model.touching() if self.show_touching.value else []
+            self._recolour()
             self.touching_text.content = "\n".join(
                 f"- touching: {_md(a)} and {_md(b)} "
                 f"({'by' if d < 0 else 'at'} {abs(d) * 1000:.3g} mm)"
