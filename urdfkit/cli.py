@@ -1009,11 +1009,11 @@ def _run_view_summary(r: Any) -> str:
     return text
 
 
-def _serve_until_interrupted(viewer: Any, what: str) -> None:
+def _serve_until_interrupted(viewer: Any, what: str, command: str = "drive") -> None:
     """Keep a page up until Ctrl-C, then close it (the command's exit code is its own)."""
     import time
 
-    show.line(f"urdfkit drive: {what} stays at {viewer.url} until Ctrl-C", stderr=True)
+    show.line(f"urdfkit {command}: {what} stays at {viewer.url} until Ctrl-C", stderr=True)
     try:
         while True:
             time.sleep(3600)
@@ -1481,6 +1481,15 @@ def sim(
         "--real-time", help="Pace the steps to the wall clock.")] = False,
     as_json: JsonOpt = False,
     force: ForceOpt = False,
+    view: Annotated[bool, typer.Option(
+        "--view", help="Stream the run to a browser page while it simulates headless; the "
+        "page stays up after the run until Ctrl-C.")] = False,
+    speed: Annotated[str, typer.Option(
+        "--speed", metavar="FACTOR|max", help="With --view: simulated seconds per wall "
+        "second (max: no pacing).")] = "1",
+    port: Annotated[int | None, typer.Option(
+        "--port", min=1, max=65535, help="With --view: the port to serve on.",
+        show_default="a free one")] = None,
 ) -> None:
     """Simulate a scenario of one or more robots and record their observations.
 
@@ -1495,9 +1504,9 @@ def sim(
             raise ParameterError("convert needs the simulation_and_control config: "
                                  "urdfkit sim convert conf.json -o scenario.toml",
                                  param="scenario")
-        if gui or real_time or as_json:
-            raise ParameterError("convert writes a file; --gui, --real-time and --json do not "
-                                 "apply", param="scenario")
+        if gui or real_time or as_json or view:
+            raise ParameterError("convert writes a file; --gui, --real-time, --view and --json "
+                                 "do not apply", param="scenario")
         _sim_convert(config, out, force)
         return
     if config is not None:
@@ -1506,20 +1515,40 @@ def sim(
                              param="scenario")
     from .session import has_display
 
+    if view and (gui or real_time):
+        raise ParameterError("`view` paces the run itself (--speed) and replaces `gui`: drop "
+                             "--gui and --real-time", param="view")
+    pace = _speed(speed) if view else None
     if gui and not has_display():
         raise ParameterError("`gui` needs a display (DISPLAY is not set); drop it to run "
-                             "headless", param="gui")
+                             "headless, or use --view", param="gui")
     if out is not None:
         simulation.check_output(out, force=force)  # fail before the run, not after it
     written = None
+    stream: Any = None
     with simulation.Simulation.from_file(scenario, gui=gui) as s:
         for note in s.config.notes:
             show.warn(note)
-        if out is None:
-            result = s.run(real_time=real_time or gui)
-        else:
-            result, written = simulation.run_to_file(s, out, force=force,
-                                                     real_time=real_time or gui)
+        if view:
+            stream = _sim_view(s, pace, port)
+        tick = None if stream is None else (lambda _batch: stream.tick(s.t))
+        try:
+            if out is None:
+                result = s.run(real_time=real_time or gui, sink=tick)
+            else:
+                result, written = simulation.run_to_file(s, out, force=force,
+                                                         real_time=real_time or gui,
+                                                         also=tick)
+            if stream is not None:
+                stream.finish(f"**Done**: {result.steps:,} steps of {result.time_step:.5g} s "
+                              f"simulated, {result.row_count:,} rows")
+        except BaseException:
+            if stream is not None:
+                stream.viewer.close()
+            raise
+    if stream is not None and result.interrupted:
+        stream.viewer.close()
+        stream = None
     rows = result.to_dicts()
     summaries = simulation.summarize(result)
     if as_json:
@@ -1535,6 +1564,8 @@ def sim(
         if result.interrupted:
             show.interrupted("interrupted; the rows cover the steps simulated")
             raise typer.Exit(130)
+        if stream is not None:
+            _serve_until_interrupted(stream.viewer, "the run is over; its page", "sim")
         return
     fixed = show.fixed
     show.table(f"sim {scenario}: {result.steps:,} steps of {result.time_step:.5g} s", [
@@ -1551,6 +1582,35 @@ def sim(
     if result.interrupted:
         show.interrupted("interrupted; the rows cover the steps simulated")
         raise typer.Exit(130)
+    if stream is not None:
+        _serve_until_interrupted(stream.viewer, "the run is over; its page", "sim")
+
+
+def _sim_view(s: Any, pace: float | None, port: int | None) -> Any:
+    """Start the page a scenario streams to (sim --view): every robot, and say where."""
+    from .view import RunStream, Viewer
+
+    bodies = [b for b in s.bodies.values() if b.loaded is not None]
+    if not bodies:
+        from .errors import ParameterError
+
+        raise ParameterError("the scenario has no robot to show", param="view")
+    first, options = bodies[0].loaded
+    viewer = Viewer(first, inertia_from_file=options.inertia_from_file, port=port,
+                    watch=False, ground=20.0)
+    try:
+        for b in bodies[1:]:
+            viewer.add_robot(b.loaded[0], inertia_from_file=b.loaded[1].inertia_from_file)
+        stream = RunStream(viewer, s.link_poses, pace, s.total_steps * s.time_step,
+                           robots=True)
+        stream.push()
+    except BaseException:
+        viewer.close()
+        raise
+    pacing = "as fast as it goes" if pace is None else \
+        ("in real time" if pace == 1 else f"at {pace:g}x real time")
+    show.line(f"urdfkit sim: {viewer.url} (the run streams there {pacing})", stderr=True)
+    return stream
 
 
 def _sim_convert(config: str, out: str | None, force: bool) -> None:

@@ -1510,6 +1510,26 @@ class Simulation:
                                  for v, a in zip(value, axes, strict=True)]
         return obs._replace(**changes)
 
+    def link_poses(self) -> list[list[tuple[Any, Any]]]:
+        """Every robot's URDF link frames' world poses now, base first (``(xyz, xyzw)``).
+
+        Robots in the scenario's order; the base's pose is its link frame, not the inertial
+        frame ``getBasePositionAndOrientation`` reports.
+        """
+        p, client = self.session.p, self.session.client
+        out = []
+        for b in self.bodies.values():
+            pos, orn = p.getBasePositionAndOrientation(b.body, physicsClientId=client)
+            local = p.getDynamicsInfo(b.body, -1, physicsClientId=client)
+            inv = p.invertTransform(local[3], local[4])
+            poses = [p.multiplyTransforms(pos, orn, inv[0], inv[1])]
+            for j in range(p.getNumJoints(b.body, physicsClientId=client)):
+                st = p.getLinkState(b.body, j, computeForwardKinematics=True,
+                                    physicsClientId=client)
+                poses.append((st[4], st[5]))
+            out.append(poses)
+        return out
+
     def run(self, duration: float | None = None,
             sink: Callable[[list[Observation]], None] | None = None, *,
             keep: bool = True, real_time: bool = False) -> SimResult:
@@ -1732,7 +1752,8 @@ def write_rows(path: str | Path, rows: Sequence[Mapping[str, Any]], *, force: bo
 
 
 def run_to_file(simulation: Simulation, path: str | Path, *, force: bool = False,
-                duration: float | None = None, real_time: bool = False
+                duration: float | None = None, real_time: bool = False,
+                also: Callable[[list[Observation]], None] | None = None
                 ) -> tuple[SimResult, Path]:
     """Run ``simulation``, writing its rows to ``path`` as they are recorded.
 
@@ -1740,7 +1761,7 @@ def run_to_file(simulation: Simulation, path: str | Path, *, force: bool = False
     :data:`PARQUET_ROWS`. The result keeps no rows (their count and the summary only), so
     memory does not grow with the run. On Ctrl-C (SIGTERM, SIGHUP in the CLI) the file holds
     every complete row so far (a parquet file gets its footer). Nothing is replaced without
-    ``force``.
+    ``force``. ``also`` gets every batch too, after it is written.
     """
     from .output import StreamingFile
 
@@ -1748,11 +1769,15 @@ def run_to_file(simulation: Simulation, path: str | Path, *, force: bool = False
     fmt = Path(path).suffix.lower()
     if fmt == ".parquet":
         return _run_to_parquet(simulation, path, force=force, duration=duration,
-                               real_time=real_time)
+                               real_time=real_time, also=also)
     text = RowText(fmt)
     with StreamingFile(path, force=force, keep_on_interrupt=True) as out:
-        result = simulation.run(duration, sink=lambda batch: out.write(
-            text.encode([r.to_dict() for r in batch])), keep=False, real_time=real_time)
+        def write(batch: list[Observation]) -> None:
+            out.write(text.encode([r.to_dict() for r in batch]))
+            if also is not None:
+                also(batch)
+
+        result = simulation.run(duration, sink=write, keep=False, real_time=real_time)
     return result, out.path
 
 
@@ -1761,7 +1786,9 @@ PARQUET_ROWS = 4096
 
 
 def _run_to_parquet(simulation: Simulation, path: str | Path, *, force: bool,
-                    duration: float | None, real_time: bool) -> tuple[SimResult, Path]:
+                    duration: float | None, real_time: bool,
+                    also: Callable[[list[Observation]], None] | None = None
+                    ) -> tuple[SimResult, Path]:
     from .output import StreamingFile
 
     pa = _pyarrow()
@@ -1788,6 +1815,8 @@ def _run_to_parquet(simulation: Simulation, path: str | Path, *, force: bool,
             buffer.extend(flat)
             if len(buffer) >= PARQUET_ROWS:
                 flush()
+            if also is not None:
+                also(batch)
 
         result = simulation.run(duration, sink=take, keep=False, real_time=real_time)
         if buffer or writer is None:

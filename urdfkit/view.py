@@ -637,6 +637,8 @@ class Viewer:
         self._setting = False
         self._nodes: dict[str, list[Any]] = {}
         self._frames: list[Any] = []
+        #: More robots on the page (sim --view): each model and its link frames.
+        self.extra: list[tuple[Model, list[Any]]] = []
         self._gui: list[Any] = []
         self.sliders: dict[str, Any] = {}
         viser = _viser()
@@ -960,18 +962,52 @@ class Viewer:
                         tuple(float(x) for x in frame.wxyz))
         raise KeyError(name)
 
-    def show_poses(self, poses: Sequence[tuple[Sequence[float], Sequence[float]]]) -> None:
-        """Put every link node at a world pose (``(xyz, xyzw)``, base first), as given.
+    def add_robot(self, file: str, *, inertia_from_file: bool = False) -> int:
+        """Draw one more robot (its visual and collision shapes, no controls); its number.
 
-        For a run simulated elsewhere (``drive --view``): the poses come from that session,
-        not from this viewer's model.
+        For a scenario of several robots (``sim --view``): robot 0 is :attr:`model`, the
+        others come here, and :meth:`show_poses` places each.
         """
-        if len(poses) != len(self._frames):
-            raise EngineError(f"the run has {len(poses)} links, the view {len(self._frames)}")
+        m = Model(file, inertia_from_file=inertia_from_file)
+        k = len(self.extra) + 1
+        scene, frames = self.server.scene, []
+        with self._lock:
+            for link, (pos, quat) in zip(m.links, m.link_poses(), strict=True):
+                root = f"/robot{k}/link{link.index + 1}"
+                frames.append(scene.add_frame(root, show_axes=False, position=pos,
+                                              wxyz=_wxyz(quat)))
+                for kind, shapes in (("visual", link.visuals), ("collision", link.collisions)):
+                    for n, sh in enumerate(shapes):
+                        self._nodes[kind].append(scene.add_mesh_simple(
+                            f"{root}/{kind}{n}", sh.vertices, sh.faces, color=sh.rgb,
+                            opacity=None if sh.opacity >= 1 else sh.opacity,
+                            cast_shadow=False, receive_shadow=False, position=sh.pos,
+                            wxyz=_wxyz(sh.quat)))
+            self.extra.append((m, frames))
+            self.apply_toggles()
+        return k
+
+    def show_poses(self, poses: Sequence[tuple[Sequence[float], Sequence[float]]],
+                   robot: int = 0) -> None:
+        """Put every link node of a robot at a world pose (``(xyz, xyzw)``, base first).
+
+        For a run simulated elsewhere (``drive --view``, ``sim --view``): the poses come from
+        that session, not from this viewer's models. ``robot`` 0 is :attr:`model`; others
+        were added with :meth:`add_robot`.
+        """
+        frames = self._frames if robot == 0 else self.extra[robot - 1][1]
+        if len(poses) != len(frames):
+            raise EngineError(f"the run has {len(poses)} links, the view {len(frames)}")
         with self._lock, self.server.atomic():
-            for frame, (pos, quat) in zip(self._frames, poses, strict=True):
+            for frame, (pos, quat) in zip(frames, poses, strict=True):
                 frame.position = tuple(float(x) for x in pos)
                 frame.wxyz = _wxyz(quat)
+
+    def robot_pose(self, robot: int, link: int = 0) -> tuple[Vec3, tuple[float, ...]]:
+        """A link node's pose in the scene, by robot number and link position (base 0)."""
+        frame = (self._frames if robot == 0 else self.extra[robot - 1][1])[link]
+        return (tuple(float(x) for x in frame.position),  # type: ignore[return-value]
+                tuple(float(x) for x in frame.wxyz))
 
     def nodes(self, kind: str, link: str) -> list[Any]:
         """The scene handles of one layer of one link (for tests and tools)."""
@@ -1039,6 +1075,8 @@ class Viewer:
         with _quiet():
             self.server.stop()
         self.model.close()
+        for m, _ in self.extra:
+            m.close()
 
 
 #: Frames pushed to the page per second of wall time, at most, while a run streams.
@@ -1056,18 +1094,24 @@ class RunStream:
     wall time, and draws the base's path on the ground.
 
     Args:
-        viewer: The page (loaded from the same file as the run).
-        poses: Returns every link's world pose in the run's session, base first.
+        viewer: The page (loaded from the same file as the run; more robots added with
+            :meth:`Viewer.add_robot`).
+        poses: Returns every link's world pose in the run's session, base first: one list,
+            or (``robots=True``) a list of them, one per robot in the viewer's order.
         speed: Simulated seconds per wall second; None for no pacing.
         total: The run's simulated duration (for the status line).
+        robots: ``poses`` gives one list per robot.
     """
 
     def __init__(self, viewer: Viewer, poses: Any, speed: float | None,
-                 total: float) -> None:
+                 total: float, robots: bool = False) -> None:
         import time
 
-        self.viewer, self.poses, self.speed, self.total = viewer, poses, speed, total
+        self.viewer, self.speed, self.total = viewer, speed, total
+        self.poses = poses if robots else (lambda: [poses()])
         self.path: list[tuple[float, float, float]] = []
+        #: Each robot's base path, sampled as frames are pushed (:meth:`tick`).
+        self.paths: list[list[tuple[float, float, float]]] = []
         self.frames = 0
         self._clock = time.perf_counter
         self._sleep = time.sleep
@@ -1081,7 +1125,7 @@ class RunStream:
             control.disabled = True
 
     def __call__(self, row: Sequence[float]) -> None:
-        """Take one trajectory sample ``(t, x, y, z, ...)``: pace, record, maybe push."""
+        """Take one drive sample ``(t, x, y, z, ...)``: pace, record, maybe push."""
         t = float(row[0])
         self._seen += 1
         if self._seen % self._stride == 0:
@@ -1089,6 +1133,10 @@ class RunStream:
             if len(self.path) > PATH_POINTS:
                 self.path = self.path[::2]
                 self._stride *= 2
+        self.tick(t)
+
+    def tick(self, t: float) -> None:
+        """The run is at simulated time ``t``: wait for the wall clock (paced), maybe push."""
         if self.speed is not None:
             ahead = self._start + t / self.speed - self._clock()
             if ahead > 0:
@@ -1102,14 +1150,28 @@ class RunStream:
         """Show the run's current pose and path now."""
         import numpy as np
 
-        self.viewer.show_poses(self.poses())
+        every = self.poses()
+        for k, poses in enumerate(every):
+            self.viewer.show_poses(poses, robot=k)
         self.frames += 1
-        if len(self.path) >= 2:
-            pts = np.asarray(self.path, dtype=np.float32)
+        paths = [self.path]
+        if not self._seen:  # not fed drive samples: each robot's path from its base poses
+            while len(self.paths) < len(every):
+                self.paths.append([])
+            for path, poses in zip(self.paths, every, strict=False):
+                path.append(tuple(float(x) for x in poses[0][0]))  # type: ignore[arg-type]
+                if len(path) > PATH_POINTS:
+                    path[:] = path[::2]
+            paths = self.paths
+        for k, path in enumerate(paths):
+            if len(path) < 2:
+                continue
+            pts = np.asarray(path, dtype=np.float32)
             pts[:, 2] = 0.002  # on the ground, not at the base's height
             segments = np.stack([pts[:-1], pts[1:]], axis=1)
             self.viewer.server.scene.add_line_segments(
-                "/run/path", segments, (230, 97, 0), thickness=3.0, thickness_units="screen")
+                f"/run/path{k or ''}", segments, (230, 97, 0), thickness=3.0,
+                thickness_units="screen")
         if status is not None:
             self.viewer.status.content = status
 

@@ -1,0 +1,78 @@
+"""``sim --view`` (issue 29): every robot of a scenario streams to one page, which ends where
+the same scenario run without a page ends."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
+
+from urdfkit.sim import Simulation  # noqa: E402
+from urdfkit.view import RunStream, Viewer  # noqa: E402
+
+TWO_CARS = Path(__file__).parent.parent / "examples" / "two_cars.toml"
+
+
+def test_every_robot_ends_on_the_page_where_the_run_ends() -> None:
+    with Simulation.from_file(str(TWO_CARS)) as s:
+        bodies = list(s.bodies.values())
+        viewer = Viewer(bodies[0].loaded[0], inertia_from_file=True, watch=False)
+        try:
+            viewer.add_robot(bodies[1].loaded[0], inertia_from_file=True)
+            stream = RunStream(viewer, s.link_poses, None, 3.0, robots=True)
+            result = s.run(sink=lambda _batch: stream.tick(s.t))
+            stream.finish("done")
+            end = s.link_poses()
+            shown = [[viewer.robot_pose(k, link)[0] for link in range(len(end[k]))]
+                     for k in range(2)]
+        finally:
+            viewer.close()
+    with Simulation.from_file(str(TWO_CARS)) as s:
+        s.run()
+        plain = s.link_poses()
+    assert result.steps == 720 and not result.interrupted
+    for k in range(2):  # every link of both cars, on the page as in the run and in a plain one
+        for page, run, alone in zip(shown[k], end[k], plain[k], strict=True):
+            assert list(page) == pytest.approx(list(run[0]), abs=1e-6)
+            assert list(run[0]) == pytest.approx(list(alone[0]), abs=1e-9)
+    # The driving car moved, the parked one did not: the page shows two different paths.
+    assert abs(end[1][0][0][1] - 2.0) > 0.5 and abs(end[0][0][0][1] + 2.0) < 0.01
+    assert len(stream.paths) == 2 and all(len(path) >= 2 for path in stream.paths)
+
+
+def test_cli_sim_view_prints_json_and_serves_until_ctrl_c(tmp_path: Path) -> None:
+    out = tmp_path / "rows.jsonl"
+    proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "sim", str(TWO_CARS), "--view",
+                             "--speed", "max", "--json", "-o", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    err = ""
+    try:
+        deadline = time.monotonic() + 120
+        while "until Ctrl-C" not in err and time.monotonic() < deadline and \
+                proc.poll() is None:
+            err += proc.stderr.readline()  # type: ignore[union-attr]
+        assert "until Ctrl-C" in err, err
+        proc.send_signal(signal.SIGINT)
+        stdout, rest = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, rest
+    data = json.loads(stdout)
+    assert data["steps"] == 720 and data["rows"] == 122
+    assert len(out.read_text().splitlines()) == 122  # the rows file as without --view
+
+
+def test_cli_sim_view_refuses_gui_and_real_time() -> None:
+    for extra in (["--gui"], ["--real-time"]):
+        r = subprocess.run([sys.executable, "-m", "urdfkit", "sim", str(TWO_CARS), "--view",
+                            *extra], capture_output=True, text=True, timeout=60)
+        assert r.returncode == 2 and "--view paces the run itself" in r.stderr, r.stderr
