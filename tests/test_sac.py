@@ -77,9 +77,8 @@ class Reference:
         c = self.c
         self.dt = self.sim["time_step"]
         p.setPhysicsEngineParameter(numSolverIterations=30, physicsClientId=c)
-        # urdfkit sorts overlapping pairs (a reproducible reset in place); SimInterface does
-        # not, which changes only the float-level order contacts are solved in.
-        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=c)
+        # Overlapping pairs left unsorted, as SimInterface leaves them (so does urdfkit for a
+        # simulation_and_control config; sorted, a quadruped's contacts part after 30 steps).
         p.setTimeStep(self.dt, physicsClientId=c)
         p.setGravity(0, 0, -9.81, physicsClientId=c)
         p.setPhysicsEngineParameter(enableConeFriction=0, physicsClientId=c)
@@ -193,7 +192,9 @@ def test_quadruped_holding_its_stance_matches(tmp_path):
     # Floating base, 12 motors, the servo reading a 3-step-old state; noise off to compare.
     config = _config(tmp_path, QUADRUPED, robot_pybullet__noise_flag=[0])
     worst_q, worst_base = _compare(config, 300, STANCE)
-    assert worst_q < 1e-6 and worst_base < 1e-6
+    # 2.6e-11 measured against this reference (its mass matrix product rounds differently);
+    # against the real SimInterface bench/sac_side_by_side.py finds it bit for bit.
+    assert worst_q < 1e-9 and worst_base < 1e-9
 
 
 # --------------------------------------------------------------------------- physics

@@ -135,7 +135,6 @@ class SimInterfaceArm:
         rp = self.rp = conf["robot_pybullet"]
         c = self.c = p.connect(p.DIRECT)
         p.setPhysicsEngineParameter(numSolverIterations=30, physicsClientId=c)
-        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=c)
         p.setTimeStep(conf["sim"]["time_step"], physicsClientId=c)
         p.setGravity(0, 0, -9.81, physicsClientId=c)
         p.setPhysicsEngineParameter(enableConeFriction=0, physicsClientId=c)

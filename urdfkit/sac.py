@@ -482,8 +482,10 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
                      "mass_matrix, gravity_torques, coriolis_and_gravity and jacobian give "
                      "PyBullet's own")
     scenario: dict[str, Any] = {
+        # SimInterface's engine settings; contacts in the engine's own order, not sorted.
         "physics": {"time_step": time_step, "gravity": [0.0, 0.0, -9.81],
-                    "solver_iterations": 30, "cone_friction": False},
+                    "solver_iterations": 30, "cone_friction": False,
+                    "deterministic_pairs": False},
         "ground": "plane.urdf",
         "record": record,
         "robots": out_robots,

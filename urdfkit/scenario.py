@@ -74,6 +74,9 @@ def schema() -> SimpleNamespace:
         # None: PyBullet's own 0.04 on every link (an undamped pendulum needs 0).
         linear_damping: non_negative | None = None
         angular_damping: non_negative | None = None
+        # PyBullet's deterministicOverlappingPairs: contacts met in a sorted order, so a
+        # reset in place replays the same run. simulation_and_control leaves it off.
+        deterministic_pairs: bool = True
 
     class Ground(Model):
         template: str | None = None

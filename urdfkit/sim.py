@@ -388,8 +388,11 @@ class Simulation:
         p.setTimeStep(ph.time_step, physicsClientId=client)
         p.setGravity(*ph.gravity, physicsClientId=client)
         # Sorted overlapping pairs: without them the order the solver meets contacts in
-        # depends on the engine's history, and a reset in place is not reproducible.
-        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=client)
+        # depends on the engine's history, and a reset in place is not reproducible. A
+        # simulation_and_control config turns them off, as SimInterface leaves them (else
+        # its contacts are solved in another order and the runs part after a few steps).
+        p.setPhysicsEngineParameter(deterministicOverlappingPairs=int(ph.deterministic_pairs),
+                                    physicsClientId=client)
         p.setPhysicsEngineParameter(numSolverIterations=ph.solver_iterations,
                                     enableConeFriction=int(ph.cone_friction),
                                     physicsClientId=client)
@@ -831,6 +834,23 @@ class Simulation:
         skip = len(matrix) - len(dyn)  # a floating base's 6 coordinates come first
         where = {j.name: skip + k for k, j in enumerate(dyn)}
         rows = [where[spec.name] for spec in b.servo]
+        if measured and rows == list(range(skip, skip + len(rows))):
+            # As simulation_and_control computes it, to the last bit: a floating base's
+            # matrix at the base's true pose (flags=1 takes position and quaternion first;
+            # the quaternion's 4th row and column are zero and dropped), and numpy's matrix
+            # product (whose rounding differs from an exact sum by an ulp or two).
+            import numpy as np
+
+            if skip:
+                pos, orn = self.session.p.getBasePositionAndOrientation(
+                    b.body, physicsClientId=self.session.client)
+                full = np.asarray(p.calculateMassMatrix(body, [*pos, *orn, *q], flags=1,
+                                                        physicsClientId=client))
+                full = np.delete(np.delete(full, 6, 0), 6, 1)
+            else:
+                full = np.asarray(matrix)
+            block = full[skip:, skip:][:len(rows), :len(rows)]
+            return [float(x) for x in block @ np.asarray(vector, dtype=float)]
         signs = [1.0 if measured else b.directions.get(spec.name, 1.0) for spec in b.servo]
         return [signs[i] * math.fsum(matrix[r][c] * signs[k] * vector[k]
                                      for k, c in enumerate(rows))
