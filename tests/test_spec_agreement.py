@@ -55,12 +55,17 @@ ACCEPTED = {
     # PyBullet ignores an <origin> after the shape; check warns (U504), nobody refuses.
     "origin after the shape": robot(shape='<box size="0.1 0.1 0.1"/><origin xyz="0 0 1"/>'),
 }
-# Not URDF by the spec: PyBullet refuses these or silently misreads them (it keeps the first of
-# two shapes), so every command refuses them.
+# PyBullet loads these, but not as written: two shapes in one <geometry> load as the first
+# (measured, issue 24.19). check warns and every loading command loads them and says so; the
+# model API (Robot.from_file, strict) refuses, as writing it back would drop the rest.
+WARNED = {
+    "two shapes": (robot(shape='<box size="1 1 1"/><sphere radius="1"/>'), "U507"),
+}
+# Not URDF by the spec: PyBullet refuses these or silently misreads them, so every command
+# refuses them.
 REFUSED = {
     "unknown joint type": robot("hinge"),
     "unknown shape": robot(shape='<cone radius="0.1" length="0.2"/>'),
-    "two shapes": robot(shape='<box size="1 1 1"/><sphere radius="1"/>'),
     "revolute without limit": robot("revolute", joint_inner='<axis xyz="0 0 1"/>'),
     "origin before the shape": robot(shape='<origin xyz="0 0 1"/><box size="0.1 0.1 0.1"/>'),
     "inertia missing a component": robot().replace('izz="0.01"', "", 1),
@@ -110,6 +115,24 @@ def test_every_command_accepts(case: str, tmp_path: Path) -> None:
         result = runner.invoke(app, [command[0], str(path), *command[1:]])
         assert result.exit_code == 0, (command, result.output)
         json.loads(result.stdout)
+
+
+@pytest.mark.parametrize("case", sorted(WARNED))
+def test_every_loading_command_loads_and_warns(case: str, tmp_path: Path) -> None:
+    text, code = WARNED[case]
+    path = _write(tmp_path, case, text)
+    result = runner.invoke(app, ["check", str(path), "--json"])
+    assert result.exit_code == 0, result.output
+    findings = json.loads(result.stdout)["findings"]
+    assert not [f for f in findings if f["level"] == "error"], findings
+    assert [f["level"] for f in findings if f["code"] == code] == ["warning"]
+    for command in LOADING:
+        result = runner.invoke(app, [command[0], str(path), *command[1:]])
+        assert result.exit_code == 0, (command, result.output)
+        json.loads(result.stdout)
+        assert f"({code})" in result.stderr, (command, result.stderr)
+    with pytest.raises(ModelError):
+        Robot.from_file(path)
 
 
 @pytest.mark.parametrize("case", sorted(REFUSED))
