@@ -144,3 +144,85 @@ def test_undeclared_namespace_prefixes_are_read_as_pybullet_reads_them(tmp_path:
     before, after = path.read_text(), out.read_text()
     assert "xmlns" not in after and "<sensor:camera" in after and before != after
     assert before.splitlines()[:6] == after.splitlines()[:6]
+
+
+# --------------------------------------------------------------------------- item 17
+
+TETRA = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n"
+
+
+def _mesh_robot(folder: Path, filename: str, name: str = "r.urdf") -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / name
+    shape = f'<geometry><mesh filename="{filename}"/></geometry>'
+    path.write_text(f'<robot name="r"><link name="l">{INERTIAL}<visual>{shape}</visual>'
+                    f'<collision>{shape}</collision></link></robot>')
+    return path
+
+
+def _raw_mesh_file(path: Path) -> str | None:
+    """The mesh file raw PyBullet loaded for the base's visual, or None if it refused."""
+    import pybullet as p
+
+    with quiet_stdout():
+        c = p.connect(p.DIRECT)
+    try:
+        with quiet_stdout():
+            try:
+                body = p.loadURDF(str(path), physicsClientId=c)
+            except p.error:
+                return None
+        return str(Path(p.getVisualShapeData(body, physicsClientId=c)[0][4].decode()).resolve())
+    finally:
+        p.disconnect(physicsClientId=c)
+
+
+@pytest.mark.parametrize(("written", "placed", "up"), [
+    ("meshes/tetra_rel3.obj", "meshes/tetra_rel3.obj", 3),      # relative, 3 folders up
+    ("meshes/tetra_rel8.obj", "meshes/tetra_rel8.obj", 8),      # and 8: no depth limit
+    ("package:///meshes/tetra_p7.obj", "meshes/tetra_p7.obj", 7),  # three slashes, 7 up
+    # A package urdfkit cannot find by package.xml: PyBullet drops "package://" and
+    # searches for pkg_x/... in every folder above.
+    ("package://pkg_x/meshes/tetra_pkg.obj", "pkg_x/meshes/tetra_pkg.obj", 4),
+])
+def test_mesh_paths_are_found_where_pybullet_finds_them(tmp_path: Path, written: str,
+                                                         placed: str, up: int) -> None:
+    deep = tmp_path.joinpath(*[f"d{k}" for k in range(9)])
+    top = deep.parents[up - 1]
+    (top / placed).parent.mkdir(parents=True, exist_ok=True)
+    (top / placed).write_text(TETRA)
+    path = _mesh_robot(deep, written)
+    raw = _raw_mesh_file(path)
+    assert raw == str((top / placed).resolve())  # PyBullet finds it there
+    check = json.loads(_cli("check", str(path), "--json").stdout)
+    assert not [f for f in check["findings"] if f["code"] in ("U701", "U702")], check
+    links = _cli("links", str(path), "--json")
+    assert links.returncode == 0, links.stderr
+    # urdfkit's own load draws the same mesh file as raw PyBullet's.
+    from urdfkit.resolve import open_input
+    from urdfkit.session import Session
+
+    with open_input(str(path)) as res, Session() as s:
+        body = s.load_urdf(res.load_path)
+        ours = s.p.getVisualShapeData(body, physicsClientId=s.client)[0][4].decode()
+    assert str(Path(ours).resolve()) == raw
+
+
+def test_the_deepest_match_wins_and_a_mesh_nowhere_is_still_refused(tmp_path: Path) -> None:
+    deep = tmp_path / "a" / "b" / "c"
+    for folder, scale in ((tmp_path / "a", "0.1"), (deep, "0.2")):
+        (folder / "m").mkdir(parents=True, exist_ok=True)
+        (folder / "m" / "w.obj").write_text(TETRA.replace("0.1", scale))
+    path = _mesh_robot(deep, "m/w.obj")
+    assert _raw_mesh_file(path) == str((deep / "m" / "w.obj").resolve())
+    from urdfkit.uris import resolve_uri
+
+    assert resolve_uri("m/w.obj", deep).path == deep / "m" / "w.obj"
+    (deep / "m" / "w.obj").unlink()  # now only the one two folders up
+    assert _raw_mesh_file(path) == str((tmp_path / "a" / "m" / "w.obj").resolve())
+    assert resolve_uri("m/w.obj", deep).path == tmp_path / "a" / "m" / "w.obj"
+    missing = _mesh_robot(deep, "m/not_there_anywhere_q7.obj", "missing.urdf")
+    assert _raw_mesh_file(missing) is None
+    r = _cli("joints", str(missing))
+    assert r.returncode == 2 and "not_there_anywhere_q7.obj" in r.stderr
+    assert r.stderr.count("\n") == 1

@@ -22,8 +22,23 @@ from pathlib import Path
 from . import deps
 from .errors import ParameterError
 
-#: How many folders above the file PyBullet searches for a ``package://`` path.
-PYBULLET_SEARCH_DEPTH = 5
+
+def pybullet_search(rest: str, base: Path) -> Path | None:
+    """Where PyBullet 3.2.7 finds a mesh path: the file's folder, then every folder above it.
+
+    Measured: a relative ``filename`` (and a ``package://`` or ``model://`` one, with just
+    that prefix dropped: ``package://pkg/m.stl`` is looked for as ``pkg/m.stl``) is tried in
+    the URDF's folder and then in each folder above it, deepest first, up to the root (a mesh
+    nine folders up is found); the first that exists wins. PyBullet then also tries ``.``,
+    ``..`` and ``../..`` of the working directory, which urdfkit does not: a result that
+    depends on where the command runs would differ between two runs of it.
+    """
+    if not rest:
+        return None
+    for folder in [base, *base.parents]:
+        if _is_file(folder / rest):
+            return folder / rest
+    return None
 
 
 def pybullet_data_path() -> Path | None:
@@ -163,22 +178,39 @@ def resolve_uri(uri: str, base: Path, packages: Mapping[str, Path] | None = None
     """Resolve a ``filename`` attribute written in a URDF whose folder is ``base``."""
     uri = uri.strip()
     if uri.startswith("package://"):
-        pkg, _, rest = uri[len("package://"):].partition("/")
-        if not pkg:  # package:///rest: PyBullet searches the file's folder and five above
-            for folder in [base, *list(base.parents)[:PYBULLET_SEARCH_DEPTH]]:
-                if _is_file(folder / rest):
-                    return Target(folder / rest)
+        stripped = uri[len("package://"):]
+        pkg, _, rest = stripped.partition("/")
+        if not pkg:  # package:///rest: PyBullet searches the file's folder and all above
+            found_at = pybullet_search(rest, base)
+            if found_at is not None:
+                return Target(found_at)
             return Target(None, "", f"{uri!r} has no package name and {rest!r} is not in the "
-                          f"file's folder or the {PYBULLET_SEARCH_DEPTH} above it")
+                          "file's folder or any folder above it")
         found = (packages or {}).get(pkg) or find_package(pkg, base)
         if found is None:
-            return Target(None, pkg, f"package {pkg!r} not found near the file; map it with "
-                          f"`packages` ({pkg}=PATH)")
+            # Not a package urdfkit can find; PyBullet drops "package://" and searches the
+            # file's folder and those above for NAME/rest: follow it when that finds it.
+            found_at = pybullet_search(stripped, base)
+            if found_at is not None:
+                return Target(found_at, pkg)
+            return Target(None, pkg, f"package {pkg!r} not found near the file (nor "
+                          f"{stripped!r} in its folder or any above, where PyBullet looks); "
+                          f"map it with `packages` ({pkg}=PATH)")
         return Target(found / rest, pkg)
+    if uri.startswith("model://"):  # Gazebo's; PyBullet drops the prefix and searches
+        stripped = uri[len("model://"):]
+        return Target(pybullet_search(stripped, base) or base / stripped)
     if uri.startswith("file://"):
         uri = uri[len("file://"):]
     path = Path(uri)
-    return Target(path if path.is_absolute() else base / path)
+    if path.is_absolute():
+        return Target(path)
+    if not _is_file(base / path):
+        # PyBullet looks a relative path up in every folder above the file too.
+        found_at = pybullet_search(uri, base)
+        if found_at is not None:
+            return Target(found_at)
+    return Target(base / path)
 
 
 def not_a_file(path: Path) -> str | None:

@@ -607,7 +607,7 @@ def rule_references(root: etree._Element, r: Report) -> None:
         if (el.get("filename") or "").strip().startswith("package:///"):
             r.add("U708", "info", f"<{el.tag} filename={el.get('filename')!r}>: package:/// "
                   "has no package name; PyBullet and urdfkit look the path up beside the file "
-                  "and in the five folders above, ROS tools refuse it", el)
+                  "and in every folder above, ROS tools refuse it", el)
     joints = {j.get("name") for j in _elements(root, "joint")}
     for t in root.iter("transmission"):
         for j in t.iter("joint"):
