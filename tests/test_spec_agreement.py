@@ -165,8 +165,15 @@ def test_value_errors_are_findings_everywhere_and_loadable(case: str, tmp_path: 
     assert result.exit_code == 1, result.output
     xacro = tmp_path / (path.stem + ".urdf.xacro")
     xacro.write_text(VALUE_ERRORS[case])
+    # build writes what PyBullet loads, the error as a warning naming the line (issue 24.9);
+    # --strict refuses it with exit 1 and writes nothing.
     built = runner.invoke(app, ["build", str(xacro), "-o", str(tmp_path / "out.urdf")])
-    assert built.exit_code == 2 and xacro.name in built.output, built.output
+    assert built.exit_code == 0 and xacro.name in built.stderr, built.output
+    assert "warning" in built.stderr and (tmp_path / "out.urdf").exists()
+    strict = runner.invoke(app, ["build", str(xacro), "-o", str(tmp_path / "strict.urdf"),
+                                 "--strict"])
+    assert strict.exit_code == 1 and xacro.name in strict.stderr, strict.output
+    assert not (tmp_path / "strict.urdf").exists()
     for command in LOADING:
         result = runner.invoke(app, [command[0], str(path), *command[1:]])
         assert result.exit_code == 0, (command, result.output)

@@ -180,7 +180,7 @@ def check_file(display: str, path: str | Path,
 
     from .expand import XacroNotExpanded
     from .validate import ALL_RULES, refuse_oversized, run_rules
-    from .xmlio import line_of, long_line, parse_xml, tolerate_quirks
+    from .xmlio import line_of, long_line, parse_xml, tolerate_quirks, xacro_marker, xacro_note
 
     path = Path(path)
     result = FileResult(display)
@@ -201,6 +201,10 @@ def check_file(display: str, path: str | Path,
         return result
     result.findings.extend(Finding("U004", "warning", note, display, line)
                            for line, note in quirks)
+    xacro = xacro_marker(data) if path.suffix != ".xacro" else None
+    if xacro is not None:
+        result.findings.append(Finding("U009", "warning", xacro_note(xacro[1]), display,
+                                       xacro[0]))
     too_long = long_line(data) if path.suffix != ".xacro" else None
     if too_long is not None:
         result.findings.append(Finding(

@@ -221,25 +221,30 @@ def build(
     force: ForceOpt = False,
     package: PackageOpt = None,
     package_path: PackagePathOpt = None,
+    strict: Annotated[bool, typer.Option(
+        "--strict", help="Refuse (exit 1, nothing written) when check finds errors in the "
+        "expanded file, instead of writing it with warnings.")] = False,
 ) -> None:
     """Build a URDF from a template or a xacro file, check it, and write it atomically.
 
-    A .xacro file is expanded in a subprocess with a timeout: xacro's ${...} expressions run
-    Python code, so only expand files you trust (see docs/security.md).
+    A .xacro file (or a .urdf holding xacro) is expanded in a subprocess with a timeout:
+    xacro's ${...} expressions run Python code, so only expand files you trust (see
+    docs/security.md). What PyBullet loads is written: check's errors on it are warnings
+    (--strict refuses them); what would crash PyBullet is refused.
     """
     from . import build as building
     from .uris import parse_packages
 
     result = building.build(target, params=set_, xacro_args=arg,
-                            packages=parse_packages(package, package_path))
+                            packages=parse_packages(package, package_path), strict=strict)
     out = output if output is not None else result.default_output
+    for w in result.warnings:
+        show.warn(w)
     if out == "-":
         sys.stdout.buffer.write(result.data)
         sys.stdout.flush()
         return
     path = building.write_output(out, result.data, force=force)
-    for w in result.warnings:
-        show.warn(w)
     show.wrote(path, f"{result.links} links, {result.joints} joints")
 
 

@@ -29,7 +29,16 @@ from .uris import not_a_file, pybullet_data_path
 from .uris import parse_packages as parse_packages  # re-exported: callers import it here
 from .validate import GUARD_WARNINGS, STRICTER, Finding, reference, refuse_oversized
 from .validate import guard as run_guard
-from .xmlio import line_of, long_line, parse_xml, read_bytes, to_bytes, undeclared_prefixes
+from .xmlio import (
+    line_of,
+    long_line,
+    parse_xml,
+    read_bytes,
+    to_bytes,
+    undeclared_prefixes,
+    xacro_marker,
+    xacro_note,
+)
 
 
 def _clip(text: str, most: int = 120) -> str:
@@ -176,6 +185,9 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
         # Read though libxml2 refuses it, as PyBullet reads it: said, as check says it (U004).
         resolved.warnings[:0] = [f"{display}:{line}: {note}"
                                  for line, note in undeclared_prefixes(data)]
+        xacro = xacro_marker(data)
+        if xacro is not None:
+            resolved.warnings.insert(0, f"{display}:{xacro[0]}: {xacro_note(xacro[1])} (U009)")
         return resolved
 
 

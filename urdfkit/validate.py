@@ -1066,6 +1066,7 @@ CODES: dict[str, str] = {
     "U006": "xacro not expanded: executing it is disabled (--no-exec, URDFKIT_NO_EXEC)",
     "U007": "xacro macro library (no links of its own): checked through its includers",
     "U008": "line longer than 8191 bytes: PyBullet breaks it and may misread the file",
+    "U009": "a file not named .xacro that holds xacro: read literally ('${prefix}base')",
     "U001": "root element is not <robot>",
     "U002": "<robot> has no name",
     "U003": "no <link>",

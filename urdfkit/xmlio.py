@@ -189,6 +189,32 @@ def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
     return data[:root.end()] + extra + data[root.end():], notes
 
 
+#: What only xacro writes: its namespace, an element of it, a ``${...}`` expression or a
+#: ``$(arg ...)``-style substitution.
+_XACRO = re.compile(rb"xmlns:xacro\s*=|<xacro:|\$\{[^}\n]{0,200}\}"
+                    rb"|\$\((?:arg|find|env|optenv|eval|dirname|cwd)\b")
+
+
+def xacro_marker(data: bytes) -> tuple[int, str] | None:
+    """``(line, what)`` of the first thing in ``data`` only xacro writes, or None.
+
+    A ``.urdf`` holding xacro (ROS 2 packages ship these) is URDF to nobody: read as it is,
+    its links are named ``${prefix}base_link``.
+    """
+    m = _XACRO.search(data)
+    if m is None:
+        return None
+    found = m.group(0).decode("utf-8", "replace")
+    return data.count(b"\n", 0, m.start()) + 1, found if len(found) <= 60 else found[:57] + "..."
+
+
+def xacro_note(what: str) -> str:
+    """What to say of a ``.urdf`` holding xacro (``what``: :func:`xacro_marker`'s)."""
+    return (f"holds xacro ({what}) but is not a .xacro file: it is read as plain URDF, "
+            "expressions and all taken literally (links named '${prefix}base_link'); expand "
+            "it first: urdfkit build FILE")
+
+
 def undeclared_prefixes(data: bytes) -> list[tuple[int, str]]:
     """``(line, note)`` for each namespace prefix ``data`` uses but never declares."""
     return _declare_prefixes(data, [])[1]
