@@ -226,3 +226,35 @@ def test_the_deepest_match_wins_and_a_mesh_nowhere_is_still_refused(tmp_path: Pa
     r = _cli("joints", str(missing))
     assert r.returncode == 2 and "not_there_anywhere_q7.obj" in r.stderr
     assert r.stderr.count("\n") == 1
+
+
+def test_a_package_folder_without_the_mesh_falls_back_to_pybullets_search(
+        tmp_path: Path) -> None:
+    # package.xml at a repository's root, meshes under share/NAME/ (a real layout): the
+    # package found by its package.xml lacks meshes/m.obj, PyBullet finds share/pkg/meshes.
+    repo = tmp_path / "pkg"
+    repo.mkdir()
+    (repo / "package.xml").write_text("<package><name>pkg</name></package>")
+    (repo / "share" / "pkg" / "meshes").mkdir(parents=True)
+    (repo / "share" / "pkg" / "meshes" / "m.obj").write_text(TETRA)
+    path = _mesh_robot(repo / "share" / "pkg" / "robots" / "r", "package://pkg/meshes/m.obj")
+    raw = _raw_mesh_file(path)
+    assert raw == str((repo / "share" / "pkg" / "meshes" / "m.obj").resolve())
+    for extra in ([], ["--package-path", str(repo)], ["--package", f"pkg={repo}"]):
+        r = _cli("joints", str(path), *extra)
+        assert r.returncode == 0, (extra, r.stderr)
+
+
+def test_empty_visual_and_collision_names_are_no_names(tmp_path: Path) -> None:
+    path = tmp_path / "named.urdf"
+    path.write_text(f'<robot name="n"><link name="a">{INERTIAL}<visual name=""><geometry>'
+                    '<box size="0.1 0.1 0.1"/></geometry></visual><collision name="">'
+                    '<geometry><box size="0.1 0.1 0.1"/></geometry></collision></link></robot>')
+    collision, visual = _raw_shapes(path)  # PyBullet loads it
+    assert len(collision) == 1 and len(visual) == 1
+    r = _cli("diff", str(path), str(path))
+    assert r.returncode == 0, r.stderr
+    xacro = tmp_path / "named.urdf.xacro"
+    xacro.write_text(path.read_text())
+    r = _cli("build", str(xacro), "-o", str(tmp_path / "out.urdf"))
+    assert r.returncode == 0, r.stderr

@@ -1037,7 +1037,8 @@ def _parse_visual(ctx: _Ctx, el: etree._Element) -> Visual:
     return ctx.build(el, Visual, geometry=_parse_geometry(ctx, el.find("geometry"), el),
                      origin=_parse_origin(ctx, el.find("origin")),
                      material=None if mat is None else _parse_material(ctx, mat),
-                     name=el.get("name"))
+                     # name="" (exporters write it) names nothing, to PyBullet as here.
+                     name=el.get("name") or None)
 
 
 def _write_visual(parent: etree._Element, v: Visual) -> None:
@@ -1052,7 +1053,7 @@ def _write_visual(parent: etree._Element, v: Visual) -> None:
 
 def _parse_collision(ctx: _Ctx, el: etree._Element) -> Collision:
     return ctx.build(el, Collision, geometry=_parse_geometry(ctx, el.find("geometry"), el),
-                     origin=_parse_origin(ctx, el.find("origin")), name=el.get("name"))
+                     origin=_parse_origin(ctx, el.find("origin")), name=el.get("name") or None)
 
 
 def _write_collision(parent: etree._Element, c: Collision) -> None:
