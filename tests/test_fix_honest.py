@@ -103,3 +103,46 @@ def test_two_undefined_materials_in_a_one_line_file_are_both_defined(tmp_path: P
     defined = {m.get("name") for m in root.findall("material") if m.find("color") is not None}
     assert defined == {"blue", "red"}
     assert not [f for f in check_paths([out], jobs=1, cache=False).findings if f.code == "U706"]
+
+
+def test_the_mass_pybullet_loads_is_guarded_too(tmp_path: Path) -> None:
+    """Frames given mass 0 lose PyBullet's phantom 1 kg each: said, and guarded like any
+    mass change (a corpus robot went from 183 to 33 kg as loaded, unsaid)."""
+    import json
+    import subprocess
+    import sys
+
+    import pybullet as p
+
+    from urdfkit.session import quiet_stdout
+
+    frames = "".join(f'<link name="f{k}"/><joint name="jf{k}" type="fixed"><parent link="box"/>'
+                     f'<child link="f{k}"/></joint>' for k in range(3))
+    path = tmp_path / "frames.urdf"
+    path.write_text('<robot name="r"><link name="box"><inertial><mass value="2"/><inertia '
+                    'ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+                    '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'
+                    f'</link>{frames}</robot>')
+
+    def loaded(f: Path) -> float:
+        with quiet_stdout():
+            c = p.connect(p.DIRECT)
+        try:
+            with quiet_stdout():
+                body = p.loadURDF(str(f), physicsClientId=c)
+            return sum(p.getDynamicsInfo(body, k, physicsClientId=c)[0]
+                       for k in range(-1, p.getNumJoints(body, physicsClientId=c)))
+        finally:
+            p.disconnect(physicsClientId=c)
+
+    out = tmp_path / "fixed.urdf"
+    cmd = [sys.executable, "-m", "urdfkit", "fix", str(path), "-o", str(out)]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and not out.exists()
+    assert "mass as PyBullet loads it 5 kg -> 2 kg (-60.0%)" in r.stderr
+    r = subprocess.run([*cmd, "--allow-mass-change", "--json"], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    mass = json.loads(r.stdout)["mass"]
+    assert (mass["loaded_before"], mass["loaded_after"]) == (loaded(path), loaded(out)) == (5, 2)
+    assert mass["before"] == mass["after"] == 2.0  # the file's own masses did not move

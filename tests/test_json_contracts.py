@@ -113,7 +113,8 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     broken = broken.replace("<cylinder ", "<capsule ").replace(
         '<origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>', '<origin xyz="0 0 0.5"/><axis xyz="0 0 0"/>')
     (tmp / "broken.urdf").write_text(broken)
-    runs["fix"] = ["fix", str(tmp / "broken.urdf"), "-o", str(tmp / "fixed.urdf"), "--json"]
+    runs["fix"] = ["fix", str(tmp / "broken.urdf"), "-o", str(tmp / "fixed.urdf"), "--json",
+                   "--allow-mass-change"]
     runs["sweep"] = ["sweep", "drive", "--steps", "5", "--vary", "steer=0.1,0.2", "--json"]
     out = {}
     for name, args in runs.items():

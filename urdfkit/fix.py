@@ -100,6 +100,10 @@ class FixResult:
     #: The file's total mass (the sum of its finite ``<mass>`` values), before and after.
     mass_before: float = 0.0
     mass_after: float = 0.0
+    #: The total mass PyBullet loads, before and after: the file's plus 1 kg for every link
+    #: without ``<inertial>`` (a frame given mass 0 loses that phantom kilogram).
+    loaded_before: float = 0.0
+    loaded_after: float = 0.0
     repairs: list[Repair] = field(default_factory=list)
     left: list[Repair] = field(default_factory=list)
     other_errors: list[Repair] = field(default_factory=list)
@@ -120,7 +124,9 @@ class FixResult:
     def to_dict(self) -> dict[str, Any]:
         """The ``--json`` form (docs/fix.md)."""
         return {"file": self.file, "changed": self.changed,
-                "mass": {"before": self.mass_before, "after": self.mass_after},
+                "mass": {"before": self.mass_before, "after": self.mass_after,
+                         "loaded_before": self.loaded_before,
+                         "loaded_after": self.loaded_after},
                 "fixes": [x.to_dict() for x in self.repairs],
                 "left": [x.to_dict() for x in self.left],
                 "other_errors": [x.to_dict() for x in self.other_errors]}
@@ -209,19 +215,26 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
 
     relative = sorted({fn for el in root.iter(*FILE_TAGS) if (fn := (el.get("filename") or "")
                        .strip()) and "://" not in fn and not Path(fn).is_absolute()})
-    before = _total_mass(root)
-    after = _total_mass(parse_xml(fixed, display).getroot()) if fixed != data else before
-    return FixResult(display, data, fixed, before, after, sorted(plan.repairs, key=_by_line),
-                     sorted(plan.left, key=_by_line), others, relative)
+    new_root = parse_xml(fixed, display).getroot() if fixed != data else root
+    return FixResult(display, data, fixed, mass_before=_total_mass(root),
+                     mass_after=_total_mass(new_root),
+                     loaded_before=_total_mass(root, loaded=True),
+                     loaded_after=_total_mass(new_root, loaded=True),
+                     repairs=sorted(plan.repairs, key=_by_line),
+                     left=sorted(plan.left, key=_by_line), other_errors=others,
+                     relative_paths=relative)
 
 
-def _total_mass(root: etree._Element) -> float:
+def _total_mass(root: etree._Element, loaded: bool = False) -> float:
     """The sum of a robot's finite link masses, as written.
 
-    PyBullet gives a link with no ``<inertial>`` 1 kg; that is not counted.
+    ``loaded``: as PyBullet loads it, which gives a link with no ``<inertial>`` 1 kg.
     """
     total = 0.0
     for link in root.iterchildren("link"):
+        if loaded and link.find("inertial") is None:
+            total += 1.0
+            continue
         mass = _num(link.find("inertial/mass"), "value")
         if mass is not None and math.isfinite(mass):
             total += mass
