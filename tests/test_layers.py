@@ -17,7 +17,8 @@ PACKAGE = Path(urdfkit.__file__).parent
 LAYERS: dict[str, int] = {}
 for floor, names in enumerate([
     # spec and model
-    "errors deps finding spec style templatedir suggest output cache xmlio tomlio builder catalog",
+    "errors deps finding spec style templatedir suggest output cache xmlio tomlio builder catalog"
+    " displaymesh stdio",
     # sources: files, packages, xacro, and the guard every loader calls
     "uris meshes resultcache _xacro_worker expand validate resolve",
     # the engine session

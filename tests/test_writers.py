@@ -159,7 +159,7 @@ def _arm_package(tmp_path: Path) -> Path:
 def test_a_replaced_file_keeps_its_mode_and_its_backup_too(tmp_path: Path) -> None:
     path = _arm_package(tmp_path)
     path.chmod(0o600)
-    result = runner.invoke(app, ["fix", str(path), "--in-place"])
+    result = runner.invoke(app, ["fix", str(path), "--in-place", "--allow-mass-change"])
     assert result.exit_code in (0, 1), result.stderr
     assert path.read_bytes() != BROKEN_ARM.read_bytes()  # it was rewritten
     assert oct(path.stat().st_mode & 0o7777) == oct(0o600)
@@ -169,7 +169,8 @@ def test_a_replaced_file_keeps_its_mode_and_its_backup_too(tmp_path: Path) -> No
     out = tmp_path / "out.urdf"
     out.write_text("old")
     out.chmod(0o751)
-    result = runner.invoke(app, ["fix", str(path), "-o", str(out), "--force"])
+    result = runner.invoke(app, ["fix", str(path), "-o", str(out), "--force",
+                                 "--allow-mass-change"])
     assert result.exit_code in (0, 1), result.stderr
     assert oct(out.stat().st_mode & 0o7777) == oct(0o751)
     # A new file gets open()'s mode under the umask, not mkstemp's 0600.
@@ -186,7 +187,7 @@ def test_a_replaced_file_keeps_its_owner(tmp_path: Path) -> None:
     path = _arm_package(tmp_path)
     os.chown(path, 4321, 4322)
     path.chmod(0o755)
-    result = runner.invoke(app, ["fix", str(path), "--in-place"])
+    result = runner.invoke(app, ["fix", str(path), "--in-place", "--allow-mass-change"])
     assert result.exit_code in (0, 1), result.stderr
     st = path.stat()
     assert (st.st_uid, st.st_gid, st.st_mode & 0o7777) == (4321, 4322, 0o755)
@@ -198,7 +199,7 @@ def test_fix_in_place_on_a_symlink_fixes_the_target(tmp_path: Path) -> None:
     target = _arm_package(tmp_path)
     link = target.parent / "linked.urdf"
     link.symlink_to(target.name)
-    result = runner.invoke(app, ["fix", str(link), "--in-place"])
+    result = runner.invoke(app, ["fix", str(link), "--in-place", "--allow-mass-change"])
     assert result.exit_code in (0, 1), result.stderr
     assert link.is_symlink() and os.readlink(link) == target.name
     assert target.read_bytes() != BROKEN_ARM.read_bytes()

@@ -58,14 +58,17 @@ def console(stderr: bool = False) -> Any:
 
 
 def _write(stream: Any, text: str) -> None:
-    try:
-        stream.write(text)
-    except UnicodeEncodeError:
-        # A file name that is not UTF-8 (kept by Python as surrogates), or a terminal whose
-        # encoding lacks a character: escape it rather than fail.
-        encoding = getattr(stream, "encoding", None) or "utf-8"
-        stream.write(text.encode(encoding, "backslashreplace").decode(encoding))
-    stream.flush()
+    from .stdio import LOCK
+
+    with LOCK:  # never while another thread has fd 1 captured (urdfkit.stdio)
+        try:
+            stream.write(text)
+        except UnicodeEncodeError:
+            # A file name that is not UTF-8 (kept by Python as surrogates), or a terminal
+            # whose encoding lacks a character: escape it rather than fail.
+            encoding = getattr(stream, "encoding", None) or "utf-8"
+            stream.write(text.encode(encoding, "backslashreplace").decode(encoding))
+        stream.flush()
 
 
 def line(*parts: Part, stderr: bool = False) -> None:
@@ -79,7 +82,10 @@ def line(*parts: Part, stderr: bool = False) -> None:
     if styled(stream):
         from rich.text import Text
 
-        console(stderr).print(Text.assemble(*parts), soft_wrap=True)
+        from .stdio import LOCK
+
+        with LOCK:
+            console(stderr).print(Text.assemble(*parts), soft_wrap=True)
     else:
         _write(stream, "".join(p if isinstance(p, str) else p[0] for p in parts) + "\n")
 

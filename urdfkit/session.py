@@ -73,14 +73,23 @@ def quiet_stdout() -> Iterator[Captured]:
     Re-entrant: an inner block captures nothing of its own; the outermost one collects all.
     """
     global _depth
+    from .stdio import LOCK
+
     captured = Captured()
-    if _depth > 0:
-        _depth += 1
-        try:
-            yield captured
-        finally:
-            _depth -= 1
-        return
+    with LOCK:  # no other thread prints, or redirects, while fd 1 points elsewhere
+        if _depth > 0:
+            _depth += 1
+            try:
+                yield captured
+            finally:
+                _depth -= 1
+            return
+        yield from _capture_fd1(captured)
+
+
+def _capture_fd1(captured: Captured) -> Iterator[Captured]:
+    """The outermost :func:`quiet_stdout` block: fd 1 into a temporary file, then back."""
+    global _depth
     sys.stdout.flush()
     _c_fflush()
     saved = os.dup(1)

@@ -311,23 +311,23 @@ class Model:
             vertices = np.asarray(mesh[0], dtype=float) * np.asarray(dims[:3], dtype=float)
             faces = np.asarray(mesh[1], dtype=np.int64)
             kind_name = "mesh"
-            if collision:
-                import trimesh
+            if collision:  # what PyBullet collides with: the hull (urdfkit.displaymesh)
+                from .displaymesh import HULL_POINTS, convex_hull
 
-                try:  # trimesh's hull needs scipy, which urdfkit does not require
-                    hull = trimesh.Trimesh(vertices, faces, process=False).convex_hull
-                    vertices, faces = np.asarray(hull.vertices), np.asarray(hull.faces)
-                    note = "convex hull of a concave mesh" if concave else "convex hull"
-                except ImportError:
-                    note = "the mesh itself: PyBullet collides with its convex hull (drawing " \
-                        "the hull needs scipy)"
-                    if note not in self.notes:
-                        self.notes.append(note)
+                hull = convex_hull(vertices)
+                if hull is not None:
+                    thinned = len(vertices) > HULL_POINTS
+                    vertices, faces = hull
+                    note = ("convex hull of a concave mesh" if concave else "convex hull") + \
+                        (" (of its points thinned on a grid, for display)" if thinned else "")
             elif len(faces) > MAX_DISPLAY_FACES:
-                step = math.ceil(len(faces) / MAX_DISPLAY_FACES)
-                note = f"{Path(name).name}: {len(faces)} triangles, every {step}th drawn"
+                from .displaymesh import decimate
+
+                before = len(faces)
+                vertices, faces = decimate(vertices, faces, MAX_DISPLAY_FACES)
+                note = (f"{Path(name).name}: {before} triangles, drawn as {len(faces)} "
+                        "(vertex clustering, for display only: PyBullet keeps them all)")
                 self.notes.append(note)
-                faces = faces[::step]
         else:
             made = _primitive(kind, dims)
             if made is None:
