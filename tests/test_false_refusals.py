@@ -258,3 +258,42 @@ def test_empty_visual_and_collision_names_are_no_names(tmp_path: Path) -> None:
     xacro.write_text(path.read_text())
     r = _cli("build", str(xacro), "-o", str(tmp_path / "out.urdf"))
     assert r.returncode == 0, r.stderr
+
+
+@pytest.mark.parametrize("ignored", [
+    '<sphere/>',                               # no radius
+    '<sphere radius="-1"/>',                   # a negative size
+    '<cylinder radius="nan" length="1"/>',     # not a number
+    '<mesh filename="nowhere_at_all_k3.obj"/>',  # a mesh file that does not exist
+    '<mesh/>',                                 # a mesh with no filename
+])
+def test_a_shape_after_the_first_is_never_read(tmp_path: Path, ignored: str) -> None:
+    # Measured on 3.2.7: PyBullet builds <geometry> from its first element and never reads
+    # the rest, so what is wrong with a second shape does not stop it loading.
+    path = tmp_path / "second.urdf"
+    shape = f'<geometry><box size="0.1 0.2 0.3"/>{ignored}</geometry>'
+    path.write_text(f'<robot name="t"><link name="a">{INERTIAL}<visual>{shape}</visual>'
+                    f'<collision>{shape}</collision></link></robot>')
+    collision, visual = _raw_shapes(path)
+    assert [(s[2], s[3]) for s in collision] == [(3, pytest.approx((0.1, 0.2, 0.3)))]
+    assert [(s[2], s[3]) for s in visual] == [(3, pytest.approx((0.1, 0.2, 0.3)))]
+    check = _cli("check", str(path), "--json")
+    assert check.returncode == 0, check.stdout
+    assert not [f for f in json.loads(check.stdout)["findings"] if f["level"] == "error"]
+    for args in (["links", "--json"], ["collisions", "--samples", "2"],
+                 ["render", "-o", str(tmp_path / "r.png"), "--size", "64x48"]):
+        r = _cli(args[0], str(path), *args[1:])
+        assert r.returncode == 0, (args, r.stderr)
+        assert r.stderr.count("(U507)") == 2, (args, r.stderr)
+    data = json.loads(_cli("links", str(path), "--json").stdout)["links"][0]
+    assert data["local_inertia_diagonal"] == pytest.approx(_raw_inertia(path))
+
+
+def test_render_frames_the_shape_pybullet_draws() -> None:
+    import numpy as np
+    from lxml import etree
+
+    from urdfkit.render import _half_extent
+
+    geometry = etree.fromstring('<geometry><sphere radius="0.5"/><box size="4 4 4"/></geometry>')
+    assert _half_extent(geometry, np.eye(3)) == pytest.approx([0.5, 0.5, 0.5])
