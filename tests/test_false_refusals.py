@@ -144,6 +144,39 @@ def test_undeclared_namespace_prefixes_are_read_as_pybullet_reads_them(tmp_path:
     before, after = path.read_text(), out.read_text()
     assert "xmlns" not in after and "<sensor:camera" in after and before != after
     assert before.splitlines()[:6] == after.splitlines()[:6]
+    # Byte for byte outside the one <inertia> fix rewrote.
+    import re
+
+    inertia = re.compile(r"<inertia\b[^>]*/>")
+    assert len(inertia.findall(before)) == 2 and inertia.findall(before)[0] in after
+    assert inertia.sub("", before) == inertia.sub("", after)
+
+
+def test_prefixes_in_comments_and_attributes(tmp_path: Path) -> None:
+    path = tmp_path / "attrs.urdf"
+    path.write_text(f'<robot name="t">\n<!-- <xacro:include filename="x.xacro"/> -->\n'
+                    f'<link name="a" sensor:id="3">{INERTIAL}</link>\n'
+                    '<link name="b"><![CDATA[ <plugin:x/> ]]></link>\n'
+                    '<joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>\n'
+                    '</robot>\n')
+    import pybullet as p
+
+    with quiet_stdout():
+        c = p.connect(p.DIRECT)
+    try:
+        with quiet_stdout():
+            body = p.loadURDF(str(path), physicsClientId=c)  # the attribute is ignored
+        raw = [p.getJointInfo(body, j, physicsClientId=c)[1].decode()
+               for j in range(p.getNumJoints(body, physicsClientId=c))]
+    finally:
+        p.disconnect(physicsClientId=c)
+    joints = _cli("joints", str(path), "--json")
+    assert joints.returncode == 0, joints.stderr
+    assert [j["jointName"] for j in json.loads(joints.stdout)["joints"]] == raw == ["j"]
+    check = json.loads(_cli("check", str(path), "--json").stdout)
+    # Only the attribute's prefix: a commented-out element or CDATA text uses none.
+    assert [(f["line"], f["message"].split(" is used")[0]) for f in check["findings"]
+            if f["code"] == "U004"] == [(3, "namespace prefix 'sensor'")]
 
 
 # --------------------------------------------------------------------------- item 17
