@@ -153,7 +153,7 @@ def tolerate_quirks(data: bytes) -> tuple[bytes, list[tuple[int, str]]]:
 
 #: A prefixed name, cheaply (a tag ``<sensor:camera`` or an attribute ``sensor:x=``); a start
 #: tag with its attributes; a prefixed attribute; a namespace declaration.
-_PREFIXED = re.compile(rb"[<\s][A-Za-z_][\w.-]*:[A-Za-z_]")
+_PREFIXED = re.compile(rb"[<\s]([A-Za-z_][\w.-]*):[A-Za-z_]")
 _TAG = re.compile(rb"<(?![?!/])([^\s/>]+)([^>]*)>")
 _ATTR = re.compile(rb"\s([A-Za-z_][\w.-]*):([A-Za-z_][\w.-]*)\s*=")
 _DECLARED = re.compile(rb"xmlns:([A-Za-z_][\w.-]*)\s*=")
@@ -181,8 +181,9 @@ def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
     document. Comments, CDATA and processing instructions are not looked in. Each such prefix
     is declared in the root's start tag (no newline added, so no line number moves), and noted.
     """
-    if _PREFIXED.search(data) is None:
-        return data, notes
+    used = set(_PREFIXED.findall(data)) - {b"xml", b"xmlns"}
+    if not used or used <= set(_DECLARED.findall(data)):
+        return data, notes  # the common case, without looking at each tag
     markup = _markup_only(data)
     first: dict[bytes, tuple[int, str]] = {}  # prefix: (offset, what uses it)
     for tag in _TAG.finditer(markup):
