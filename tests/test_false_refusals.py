@@ -330,3 +330,39 @@ def test_render_frames_the_shape_pybullet_draws() -> None:
 
     geometry = etree.fromstring('<geometry><sphere radius="0.5"/><box size="4 4 4"/></geometry>')
     assert _half_extent(geometry, np.eye(3)) == pytest.approx([0.5, 0.5, 0.5])
+
+
+def test_a_mesh_found_above_gives_the_shapes_raw_pybullet_gives(tmp_path: Path) -> None:
+    # Twelve folders up (measured: no depth limit), scaled, in visual and collision: the shape
+    # data of urdfkit's load equals raw p.loadURDF's, and every reading command takes it.
+    deep = tmp_path.joinpath(*[f"d{k}" for k in range(12)])
+    (tmp_path / "shapes").mkdir()
+    (tmp_path / "shapes" / "t12.obj").write_text(TETRA)
+    path = deep / "r.urdf"
+    deep.mkdir(parents=True)
+    shape = '<geometry><mesh filename="shapes/t12.obj" scale="2 3 4"/></geometry>'
+    path.write_text(f'<robot name="r"><link name="l">{INERTIAL}<visual>{shape}</visual>'
+                    f'<collision>{shape}</collision></link></robot>')
+    raw_collision, raw_visual = _raw_shapes(path)
+    assert raw_collision and raw_visual  # PyBullet loads it
+    from urdfkit.resolve import open_input
+    from urdfkit.session import LoadOptions, Session
+
+    with open_input(str(path)) as res, Session() as s:
+        body = s.load_urdf(res.load_path, LoadOptions(implicit_cylinder=False))
+        ours_collision = list(s.p.getCollisionShapeData(body, -1, physicsClientId=s.client))
+        ours_visual = list(s.p.getVisualShapeData(body, physicsClientId=s.client))
+
+    def same(rows: list) -> list:  # file names compared as resolved paths
+        return [tuple(str(Path(x.decode()).resolve()) if isinstance(x, bytes) and x else x
+                      for x in row) for row in rows]
+
+    assert same(ours_collision) == same(raw_collision)
+    assert same(ours_visual) == same(raw_visual)
+    for args in (["joints", "--no-guard"], ["info"], ["collisions", "--samples", "2"],
+                 ["render", "-o", str(tmp_path / "r.png"), "--size", "64x48"],
+                 ["diff", str(path)]):
+        r = _cli(args[0], str(path), *args[1:])
+        assert r.returncode == 0 and "U701" not in r.stderr, (args, r.stderr)
+    fixed = _cli("fix", str(path), "--diff")
+    assert fixed.returncode in (0, 1) and "U701" not in fixed.stdout + fixed.stderr, fixed
