@@ -181,8 +181,8 @@ def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
     document. Comments, CDATA and processing instructions are not looked in. Each such prefix
     is declared in the root's start tag (no newline added, so no line number moves), and noted.
     """
-    used = set(_PREFIXED.findall(data)) - {b"xml", b"xmlns"}
-    if not used or used <= set(_DECLARED.findall(data)):
+    prefixes = set(_PREFIXED.findall(data)) - {b"xml", b"xmlns"}
+    if not prefixes or prefixes <= set(_DECLARED.findall(data)):
         return data, notes  # the common case, without looking at each tag
     markup = _markup_only(data)
     first: dict[bytes, tuple[int, str]] = {}  # prefix: (offset, what uses it)
@@ -192,8 +192,8 @@ def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
             first.setdefault(tag.group(1).partition(b":")[0], (tag.start(), f"<{name}>"))
         for attr in _ATTR.finditer(tag.group(2)):
             if attr.group(1) != b"xmlns":  # an attribute (PyBullet ignores it too)
-                used = f"<{name} {attr.group(0).decode().strip()}...>"
-                first.setdefault(attr.group(1), (tag.start(2) + attr.start(1), used))
+                what = f"<{name} {attr.group(0).decode().strip()}...>"
+                first.setdefault(attr.group(1), (tag.start(2) + attr.start(1), what))
     declared = set(_DECLARED.findall(markup)) | {b"xml", b"xmlns"}
     missing = [prefix for prefix in first if prefix not in declared]
     root = _START.search(markup)
