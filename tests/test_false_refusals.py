@@ -144,6 +144,39 @@ def test_undeclared_namespace_prefixes_are_read_as_pybullet_reads_them(tmp_path:
     before, after = path.read_text(), out.read_text()
     assert "xmlns" not in after and "<sensor:camera" in after and before != after
     assert before.splitlines()[:6] == after.splitlines()[:6]
+    # Byte for byte outside the one <inertia> fix rewrote.
+    import re
+
+    inertia = re.compile(r"<inertia\b[^>]*/>")
+    assert len(inertia.findall(before)) == 2 and inertia.findall(before)[0] in after
+    assert inertia.sub("", before) == inertia.sub("", after)
+
+
+def test_prefixes_in_comments_and_attributes(tmp_path: Path) -> None:
+    path = tmp_path / "attrs.urdf"
+    path.write_text(f'<robot name="t">\n<!-- <xacro:include filename="x.xacro"/> -->\n'
+                    f'<link name="a" sensor:id="3">{INERTIAL}</link>\n'
+                    '<link name="b"><![CDATA[ <plugin:x/> ]]></link>\n'
+                    '<joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>\n'
+                    '</robot>\n')
+    import pybullet as p
+
+    with quiet_stdout():
+        c = p.connect(p.DIRECT)
+    try:
+        with quiet_stdout():
+            body = p.loadURDF(str(path), physicsClientId=c)  # the attribute is ignored
+        raw = [p.getJointInfo(body, j, physicsClientId=c)[1].decode()
+               for j in range(p.getNumJoints(body, physicsClientId=c))]
+    finally:
+        p.disconnect(physicsClientId=c)
+    joints = _cli("joints", str(path), "--json")
+    assert joints.returncode == 0, joints.stderr
+    assert [j["jointName"] for j in json.loads(joints.stdout)["joints"]] == raw == ["j"]
+    check = json.loads(_cli("check", str(path), "--json").stdout)
+    # Only the attribute's prefix: a commented-out element or CDATA text uses none.
+    assert [(f["line"], f["message"].split(" is used")[0]) for f in check["findings"]
+            if f["code"] == "U004"] == [(3, "namespace prefix 'sensor'")]
 
 
 # --------------------------------------------------------------------------- item 17
@@ -258,3 +291,78 @@ def test_empty_visual_and_collision_names_are_no_names(tmp_path: Path) -> None:
     xacro.write_text(path.read_text())
     r = _cli("build", str(xacro), "-o", str(tmp_path / "out.urdf"))
     assert r.returncode == 0, r.stderr
+
+
+@pytest.mark.parametrize("ignored", [
+    '<sphere/>',                               # no radius
+    '<sphere radius="-1"/>',                   # a negative size
+    '<cylinder radius="nan" length="1"/>',     # not a number
+    '<mesh filename="nowhere_at_all_k3.obj"/>',  # a mesh file that does not exist
+    '<mesh/>',                                 # a mesh with no filename
+])
+def test_a_shape_after_the_first_is_never_read(tmp_path: Path, ignored: str) -> None:
+    # Measured on 3.2.7: PyBullet builds <geometry> from its first element and never reads
+    # the rest, so what is wrong with a second shape does not stop it loading.
+    path = tmp_path / "second.urdf"
+    shape = f'<geometry><box size="0.1 0.2 0.3"/>{ignored}</geometry>'
+    path.write_text(f'<robot name="t"><link name="a">{INERTIAL}<visual>{shape}</visual>'
+                    f'<collision>{shape}</collision></link></robot>')
+    collision, visual = _raw_shapes(path)
+    assert [(s[2], s[3]) for s in collision] == [(3, pytest.approx((0.1, 0.2, 0.3)))]
+    assert [(s[2], s[3]) for s in visual] == [(3, pytest.approx((0.1, 0.2, 0.3)))]
+    check = _cli("check", str(path), "--json")
+    assert check.returncode == 0, check.stdout
+    assert not [f for f in json.loads(check.stdout)["findings"] if f["level"] == "error"]
+    for args in (["links", "--json"], ["collisions", "--samples", "2"],
+                 ["render", "-o", str(tmp_path / "r.png"), "--size", "64x48"]):
+        r = _cli(args[0], str(path), *args[1:])
+        assert r.returncode == 0, (args, r.stderr)
+        assert r.stderr.count("(U507)") == 2, (args, r.stderr)
+    data = json.loads(_cli("links", str(path), "--json").stdout)["links"][0]
+    assert data["local_inertia_diagonal"] == pytest.approx(_raw_inertia(path))
+
+
+def test_render_frames_the_shape_pybullet_draws() -> None:
+    import numpy as np
+    from lxml import etree
+
+    from urdfkit.render import _half_extent
+
+    geometry = etree.fromstring('<geometry><sphere radius="0.5"/><box size="4 4 4"/></geometry>')
+    assert _half_extent(geometry, np.eye(3)) == pytest.approx([0.5, 0.5, 0.5])
+
+
+def test_a_mesh_found_above_gives_the_shapes_raw_pybullet_gives(tmp_path: Path) -> None:
+    # Twelve folders up (measured: no depth limit), scaled, in visual and collision: the shape
+    # data of urdfkit's load equals raw p.loadURDF's, and every reading command takes it.
+    deep = tmp_path.joinpath(*[f"d{k}" for k in range(12)])
+    (tmp_path / "shapes").mkdir()
+    (tmp_path / "shapes" / "t12.obj").write_text(TETRA)
+    path = deep / "r.urdf"
+    deep.mkdir(parents=True)
+    shape = '<geometry><mesh filename="shapes/t12.obj" scale="2 3 4"/></geometry>'
+    path.write_text(f'<robot name="r"><link name="l">{INERTIAL}<visual>{shape}</visual>'
+                    f'<collision>{shape}</collision></link></robot>')
+    raw_collision, raw_visual = _raw_shapes(path)
+    assert raw_collision and raw_visual  # PyBullet loads it
+    from urdfkit.resolve import open_input
+    from urdfkit.session import LoadOptions, Session
+
+    with open_input(str(path)) as res, Session() as s:
+        body = s.load_urdf(res.load_path, LoadOptions(implicit_cylinder=False))
+        ours_collision = list(s.p.getCollisionShapeData(body, -1, physicsClientId=s.client))
+        ours_visual = list(s.p.getVisualShapeData(body, physicsClientId=s.client))
+
+    def same(rows: list) -> list:  # file names compared as resolved paths
+        return [tuple(str(Path(x.decode()).resolve()) if isinstance(x, bytes) and x else x
+                      for x in row) for row in rows]
+
+    assert same(ours_collision) == same(raw_collision)
+    assert same(ours_visual) == same(raw_visual)
+    for args in (["joints", "--no-guard"], ["info"], ["collisions", "--samples", "2"],
+                 ["render", "-o", str(tmp_path / "r.png"), "--size", "64x48"],
+                 ["diff", str(path)]):
+        r = _cli(args[0], str(path), *args[1:])
+        assert r.returncode == 0 and "U701" not in r.stderr, (args, r.stderr)
+    fixed = _cli("fix", str(path), "--diff")
+    assert fixed.returncode in (0, 1) and "U701" not in fixed.stdout + fixed.stderr, fixed

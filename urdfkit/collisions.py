@@ -36,6 +36,7 @@ from .errors import InputError, ParameterError
 from .inspect import JointInfo, base_link_name, joint_table, pose_joints
 from .resolve import Resolved
 from .session import LoadOptions, Session
+from .spec import ignored_shape
 from .xmlio import children, line_of
 
 #: Most random poses one run may draw (each costs one distance query per link pair).
@@ -247,6 +248,8 @@ def _refuse_non_finite(resolved: Resolved) -> None:
     """
     for path, attrs in _PLACING:
         for el in resolved.root.iterfind(path):
+            if ignored_shape(el):  # PyBullet never reads a shape after the first
+                continue
             for attr in attrs:
                 text = el.get(attr)
                 if text is None:
@@ -367,6 +370,8 @@ def _concave_links(resolved: Resolved, packages: Mapping[str, Path] | None) -> s
     out = set()
     for link in children(resolved.root, "link"):
         for mesh in link.iterfind("collision/geometry/mesh"):
+            if ignored_shape(mesh):
+                continue
             fn = (mesh.get("filename") or "").strip()
             target = reference("mesh", fn, base, packages).load_path if fn else None
             if target is None:

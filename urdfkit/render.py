@@ -466,7 +466,11 @@ def _half_extent(geometry: Any, rot: Any) -> Any:
 
     if geometry is None:
         return None
-    box, cyl, sphere = geometry.find("box"), geometry.find("cylinder"), geometry.find("sphere")
+    from .spec import used_shape
+
+    shape = used_shape(geometry)  # what PyBullet draws: the first element
+    box, cyl, sphere = (shape if shape is not None and shape.tag == tag else None
+                        for tag in ("box", "cylinder", "sphere"))
     if box is not None:
         size = vector(box.get("size"), 3)
         return np.abs(rot) @ (np.abs(size) / 2) if size else None

@@ -24,7 +24,7 @@ from lxml import etree
 
 from .errors import InputError
 from .expand import expand_xacro
-from .spec import FILE_SHAPES, FILE_TAGS, PYBULLET_LINE_BYTES
+from .spec import FILE_SHAPES, FILE_TAGS, PYBULLET_LINE_BYTES, ignored_shape
 from .uris import not_a_file, pybullet_data_path
 from .uris import parse_packages as parse_packages  # re-exported: callers import it here
 from .validate import GUARD_WARNINGS, STRICTER, Finding, reference, refuse_oversized
@@ -138,7 +138,7 @@ def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
     changed = False
     for el in root.iter(*FILE_TAGS):
         fn = el.get("filename")
-        if not fn:
+        if not fn or ignored_shape(el):  # PyBullet never opens a shape after the first
             continue
         ref = reference(el.tag, fn.strip(), base, packages)
         if ref.level == "error" and ref.code is not None and (

@@ -69,6 +69,26 @@ SHAPE_SIZES: dict[str, tuple[str, ...]] = {
 FILE_SHAPES = ("mesh", "cdf")
 #: Elements whose ``filename`` attribute names a file to load.
 FILE_TAGS = ("mesh", "cdf", "texture")
+
+
+def used_shape(geometry: Any) -> Any:
+    """The element PyBullet 3.2.7 builds a ``<geometry>`` from: its first child element.
+
+    Measured: tinyxml2's ``FirstChildElement`` is the shape (comments skipped); a second
+    shape, even one with no size, a negative size or a missing mesh file, is never read, and
+    an unknown first element makes loadURDF fail. None if ``geometry`` has no child element.
+    """
+    if geometry is None:
+        return None
+    return next((c for c in geometry if isinstance(c.tag, str)), None)
+
+
+def ignored_shape(el: Any) -> bool:
+    """Whether ``el`` sits in a ``<geometry>`` after its first element (PyBullet skips it)."""
+    parent = el.getparent()
+    return parent is not None and parent.tag == "geometry" and used_shape(parent) is not el
+
+
 #: Mesh formats PyBullet 3.2.7's URDF importer reads (any case); with any other suffix, or a
 #: missing mesh file, loadURDF fails ("Cannot load URDF file").
 MESH_FORMATS = (".stl", ".obj", ".dae")

@@ -29,9 +29,10 @@ def pybullet_search(rest: str, base: Path) -> Path | None:
     Measured: a relative ``filename`` (and a ``package://`` or ``model://`` one, with just
     that prefix dropped: ``package://pkg/m.stl`` is looked for as ``pkg/m.stl``) is tried in
     the URDF's folder and then in each folder above it, deepest first, up to the root (a mesh
-    nine folders up is found); the first that exists wins. PyBullet then also tries ``.``,
-    ``..`` and ``../..`` of the working directory, which urdfkit does not: a result that
-    depends on where the command runs would differ between two runs of it.
+    twelve folders up is found; measured on every depth from 0 to 12); the first that exists
+    wins. PyBullet then also tries ``.``, ``..`` and ``../..`` of the working directory, which
+    urdfkit does not: a result that depends on where the command runs would differ between
+    two runs of it.
     """
     if not rest:
         return None

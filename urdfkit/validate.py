@@ -40,6 +40,7 @@ from .spec import (
     SOLIDS,
     Matrix3,
     extension_note,
+    ignored_shape,
     matmul,
     numbers,
     rotate,
@@ -48,6 +49,7 @@ from .spec import (
     solid_volume,
     sym_eigenvalues,
     transpose,
+    used_shape,
 )
 from .spec import attr_float as _num
 from .spec import attr_vec as _vec
@@ -365,8 +367,8 @@ def _elements_below(el: etree._Element, tag: str, r: Report) -> None:
         if allowed is not None and ctag not in allowed:
             r.add("U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
                   "ignores it", child)
-        if ctag not in OPAQUE:
-            _elements_below(child, ctag, r)
+        if ctag not in OPAQUE and not (tag == "geometry" and ignored_shape(child)):
+            _elements_below(child, ctag, r)  # a shape after the first is never read (U507)
 
 
 #: NUMERIC by tag: {tag: {attribute: how many numbers}}, for one lookup per element.
@@ -463,7 +465,7 @@ def rule_geometry(root: etree._Element, r: Report) -> None:
             r.add("U507", "warning", f"<geometry> in {what} holds {len(shapes)} shapes "
                   f"({', '.join(f'<{c.tag}>' for c in shapes)}); PyBullet uses the first, "
                   f"<{shapes[0].tag}>, and ignores the rest: keep one", shapes[1])
-        for shape in shapes:
+        for shape in shapes[:1]:  # PyBullet reads none after the first (measured)
             for attr in SHAPE_SIZES.get(shape.tag, ()):
                 vals = numbers(shape.get(attr))
                 if shape.get(attr) is None:
@@ -882,7 +884,7 @@ def rule_meshes(root: etree._Element, r: Report) -> None:
         return
     for el in root.iter(*FILE_TAGS):
         fn = (el.get("filename") or "").strip()
-        if fn:
+        if fn and not ignored_shape(el):  # a mesh after the first shape is never opened
             ref = r.reference(el.tag, fn)
             if ref.code is not None:
                 r.add(ref.code, ref.level, ref.message, el)
@@ -914,8 +916,9 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
         for part in link:
             if part.tag not in ("visual", "collision"):
                 continue
-            mesh = part.find("geometry/mesh")
-            fn = (mesh.get("filename") or "").strip() if mesh is not None else ""
+            mesh = used_shape(part.find("geometry"))
+            fn = (mesh.get("filename") or "").strip() if mesh is not None and \
+                mesh.tag == "mesh" else ""
             if not fn or (ref := r.reference("mesh", fn)).load_path is None:
                 continue
             scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))

@@ -151,10 +151,25 @@ def tolerate_quirks(data: bytes) -> tuple[bytes, list[tuple[int, str]]]:
     return _declare_prefixes(data, notes)
 
 
-#: A prefixed start tag (``<sensor:camera``), and a namespace declaration.
-_PREFIXED = re.compile(rb"<([A-Za-z_][\w.-]*):[A-Za-z_]")
+#: A prefixed name, cheaply (a tag ``<sensor:camera`` or an attribute ``sensor:x=``); a start
+#: tag with its attributes; a prefixed attribute; a namespace declaration.
+_PREFIXED = re.compile(rb"[<\s]([A-Za-z_][\w.-]*):[A-Za-z_]")
+_TAG = re.compile(rb"<(?![?!/])([^\s/>]+)([^>]*)>")
+_ATTR = re.compile(rb"\s([A-Za-z_][\w.-]*):([A-Za-z_][\w.-]*)\s*=")
 _DECLARED = re.compile(rb"xmlns:([A-Za-z_][\w.-]*)\s*=")
 _START = re.compile(rb"<(?![?!/])[^\s/>]+")
+#: What no parser reads as markup: comments, CDATA sections, processing instructions.
+_NOT_MARKUP = re.compile(rb"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>", re.DOTALL)
+
+
+def _markup_only(data: bytes) -> bytes:
+    """``data`` with comments, CDATA and processing instructions blanked, offsets kept.
+
+    A commented-out ``<!-- <xacro:include .../> -->`` declares nothing and uses nothing.
+    """
+    if b"<!" not in data and b"<?" not in data:
+        return data
+    return _NOT_MARKUP.sub(lambda m: b" " * len(m.group(0)), data)
 
 
 def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
@@ -162,27 +177,34 @@ def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
     """Declare the namespace prefixes a document uses but never declares.
 
     tinyxml2 knows nothing of namespaces: to PyBullet ``<sensor:camera>`` is just an element it
-    does not read. libxml2 refuses the document. Each such prefix is declared on the root
-    element (on its own line, so no line number moves), and noted.
+    does not read, ``<link sensor:x="1">`` an attribute it does not read. libxml2 refuses the
+    document. Comments, CDATA and processing instructions are not looked in. Each such prefix
+    is declared in the root's start tag (no newline added, so no line number moves), and noted.
     """
-    if _PREFIXED.search(data) is None:
-        return data, notes
-    first: dict[bytes, int] = {}
-    for m in _PREFIXED.finditer(data):
-        first.setdefault(m.group(1), m.start())
-    declared = set(_DECLARED.findall(data)) | {b"xml", b"xmlns"}
+    prefixes = set(_PREFIXED.findall(data)) - {b"xml", b"xmlns"}
+    if not prefixes or prefixes <= set(_DECLARED.findall(data)):
+        return data, notes  # the common case, without looking at each tag
+    markup = _markup_only(data)
+    first: dict[bytes, tuple[int, str]] = {}  # prefix: (offset, what uses it)
+    for tag in _TAG.finditer(markup):
+        name = tag.group(1).decode("utf-8", "replace")
+        if ":" in name:
+            first.setdefault(tag.group(1).partition(b":")[0], (tag.start(), f"<{name}>"))
+        for attr in _ATTR.finditer(tag.group(2)):
+            if attr.group(1) != b"xmlns":  # an attribute (PyBullet ignores it too)
+                what = f"<{name} {attr.group(0).decode().strip()}...>"
+                first.setdefault(attr.group(1), (tag.start(2) + attr.start(1), what))
+    declared = set(_DECLARED.findall(markup)) | {b"xml", b"xmlns"}
     missing = [prefix for prefix in first if prefix not in declared]
-    root = _START.search(data)
+    root = _START.search(markup)
     if not missing or root is None:
         return data, notes
     for prefix in missing:
-        at = first[prefix]
-        tag = data[at + 1:data.find(b" ", at, at + 200) if data.find(b" ", at, at + 200) > 0
-                   else at + 40].split(b">")[0].decode("utf-8", "replace")
-        name = prefix.decode("utf-8", "replace")
+        at, used = first[prefix]
+        name = prefix.decode()
         notes.append((data.count(b"\n", 0, at) + 1,
-                      f"namespace prefix {name!r} is used (<{tag}>) but never declared: "
-                      "PyBullet ignores the element, other XML parsers refuse the file; "
+                      f"namespace prefix {name!r} is used ({used}) but never declared: "
+                      "PyBullet ignores what it names, other XML parsers refuse the file; "
                       f"declare xmlns:{name} on <robot>"))
     extra = b"".join(b' xmlns:' + prefix + b'="urn:urdfkit:undeclared:' + prefix + b'"'
                      for prefix in missing)
