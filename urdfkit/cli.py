@@ -1025,8 +1025,8 @@ def _serve_until_interrupted(viewer: Any, what: str, command: str = "drive") -> 
     """Keep a page up until Ctrl-C, then close it (the command's exit code is its own)."""
     import time
 
-    show.line(f"urdfkit {command}: {what} stays at {viewer.url} until Ctrl-C", stderr=True)
-    try:
+    try:  # the line inside: a Ctrl-C right after it still closes the page, exit unchanged
+        show.line(f"urdfkit {command}: {what} stays at {viewer.url} until Ctrl-C", stderr=True)
         while True:
             time.sleep(3600)
     except KeyboardInterrupt:

@@ -637,6 +637,9 @@ class Viewer:
         self._setting = False
         self._nodes: dict[str, list[Any]] = {}
         self._frames: list[Any] = []
+        #: The page shows poses given from outside (a run, :meth:`show_poses`): the model's
+        #: own joints no longer move the scene, even from a late slider callback.
+        self.external_poses = False
         #: More robots on the page (sim --view): each model and its link frames.
         self.extra: list[tuple[Model, list[Any]]] = []
         self._gui: list[Any] = []
@@ -871,7 +874,9 @@ class Viewer:
             return now
 
     def update_poses(self) -> None:
-        """Move every link node to the pose PyBullet reports."""
+        """Move every link node to the pose PyBullet reports (not while a run is shown)."""
+        if self.external_poses:
+            return
         with self._lock, self.server.atomic():
             for frame, (pos, quat) in zip(self._frames, self.model.link_poses(), strict=True):
                 frame.position = pos
@@ -995,6 +1000,7 @@ class Viewer:
         that session, not from this viewer's models. ``robot`` 0 is :attr:`model`; others
         were added with :meth:`add_robot`.
         """
+        self.external_poses = True
         frames = self._frames if robot == 0 else self.extra[robot - 1][1]
         if len(poses) != len(frames):
             raise EngineError(f"the run has {len(poses)} links, the view {len(frames)}")

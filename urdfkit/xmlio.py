@@ -224,6 +224,12 @@ def xacro_marker(data: bytes) -> tuple[int, str] | None:
     its links are named ``${prefix}base_link``.
     """
     m = _XACRO.search(data)
+    while m is not None:
+        opened = data.rfind(b"<!--", 0, m.start())
+        if opened < 0 or data.find(b"-->", opened, m.start()) >= 0:
+            break  # not inside a comment
+        closed = data.find(b"-->", m.start())
+        m = _XACRO.search(data, closed + 3) if closed >= 0 else None
     if m is None:
         return None
     found = m.group(0).decode("utf-8", "replace")
