@@ -130,7 +130,7 @@ def test_undeclared_namespace_prefixes_are_read_as_pybullet_reads_them(tmp_path:
     joints = _cli("joints", str(path), "--json")
     assert joints.returncode == 0, joints.stderr
     assert [j["jointName"] for j in json.loads(joints.stdout)["joints"]] == raw == ["j"]
-    warned = [ln for ln in joints.stderr.splitlines() if "never declared" in ln]
+    warned = [ln for ln in joints.stderr.splitlines() if "where it is not declared" in ln]
     assert [ln.split(": namespace prefix ")[1].split()[0] for ln in warned] == ["'sensor'",
                                                                                  "'plugin'"]
     assert all(f"{path}:4:" in ln or f"{path}:5:" in ln for ln in warned)
@@ -150,6 +150,23 @@ def test_undeclared_namespace_prefixes_are_read_as_pybullet_reads_them(tmp_path:
     inertia = re.compile(r"<inertia\b[^>]*/>")
     assert len(inertia.findall(before)) == 2 and inertia.findall(before)[0] in after
     assert inertia.sub("", before) == inertia.sub("", after)
+
+
+def test_a_prefix_declared_on_a_sibling_is_not_declared(tmp_path: Path) -> None:
+    path = tmp_path / "scope.urdf"
+    path.write_text(f'<robot name="t">\n<link name="a">{INERTIAL}</link>\n'
+                    '<gazebo xmlns:sensor="urn:s"><sensor:a/></gazebo>\n'
+                    '<gazebo><sensor:b/></gazebo>\n</robot>\n')
+    from lxml import etree
+
+    with pytest.raises(etree.XMLSyntaxError, match="Namespace prefix sensor on b"):
+        etree.fromstring(path.read_bytes())
+    assert _raw_shapes(path) == ([], [])  # PyBullet loads it (a link with no shapes)
+    check = json.loads(_cli("check", str(path), "--json").stdout)
+    assert [(f["code"], f["line"]) for f in check["findings"] if f["level"] == "error"
+            or f["code"] == "U004"] == [("U004", 4)]
+    r = _cli("tree", str(path))
+    assert r.returncode == 0 and f"{path}:4: namespace prefix 'sensor'" in r.stderr, r.stderr
 
 
 def test_prefixes_in_comments_and_attributes(tmp_path: Path) -> None:

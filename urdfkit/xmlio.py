@@ -154,7 +154,7 @@ def tolerate_quirks(data: bytes) -> tuple[bytes, list[tuple[int, str]]]:
 #: A prefixed name, cheaply (a tag ``<sensor:camera`` or an attribute ``sensor:x=``); a start
 #: tag with its attributes; a prefixed attribute; a namespace declaration.
 _PREFIXED = re.compile(rb"[<\s]([A-Za-z_][\w.-]*):[A-Za-z_]")
-_TAG = re.compile(rb"<(?![?!/])([^\s/>]+)([^>]*)>")
+_TAG = re.compile(rb"<(/?)(?![?!])([^\s/>]+)([^>]*?)(/?)>")
 _ATTR = re.compile(rb"\s([A-Za-z_][\w.-]*):([A-Za-z_][\w.-]*)\s*=")
 _DECLARED = re.compile(rb"xmlns:([A-Za-z_][\w.-]*)\s*=")
 _START = re.compile(rb"<(?![?!/])[^\s/>]+")
@@ -178,32 +178,70 @@ def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
 
     tinyxml2 knows nothing of namespaces: to PyBullet ``<sensor:camera>`` is just an element it
     does not read, ``<link sensor:x="1">`` an attribute it does not read. libxml2 refuses the
-    document. Comments, CDATA and processing instructions are not looked in. Each such prefix
-    is declared in the root's start tag (no newline added, so no line number moves), and noted.
+    document. Comments, CDATA and processing instructions are not looked in; a declaration
+    holds inside its element only, as in libxml2. Each such prefix is declared in the root's
+    start tag (no newline added, so no line number moves; declarations further in still
+    shadow it), and noted.
     """
+    root = _START.search(data)
     prefixes = set(_PREFIXED.findall(data)) - {b"xml", b"xmlns"}
-    if not prefixes or prefixes <= set(_DECLARED.findall(data)):
+    if root is None or not prefixes:
+        return data, notes
+    root_tag = data[root.start():data.find(b">", root.start()) + 1]
+    if prefixes <= set(_DECLARED.findall(root_tag)):
         return data, notes  # the common case, without looking at each tag
     markup = _markup_only(data)
-    first: dict[bytes, tuple[int, str]] = {}  # prefix: (offset, what uses it)
-    for tag in _TAG.finditer(markup):
-        name = tag.group(1).decode("utf-8", "replace")
-        if ":" in name:
-            first.setdefault(tag.group(1).partition(b":")[0], (tag.start(), f"<{name}>"))
-        for attr in _ATTR.finditer(tag.group(2)):
-            if attr.group(1) != b"xmlns":  # an attribute (PyBullet ignores it too)
-                what = f"<{name} {attr.group(0).decode().strip()}...>"
-                first.setdefault(attr.group(1), (tag.start(2) + attr.start(1), what))
-    declared = set(_DECLARED.findall(markup)) | {b"xml", b"xmlns"}
-    missing = [prefix for prefix in first if prefix not in declared]
     root = _START.search(markup)
-    if not missing or root is None:
+    if root is None:
+        return data, notes
+    first: dict[bytes, tuple[int, str]] = {}  # prefix: (offset, what uses it out of scope)
+    if not prefixes & set(_DECLARED.findall(markup)):
+        # Declared nowhere: the first use is the first out of scope, found without a walk.
+        for prefix in sorted(prefixes):
+            p = re.escape(prefix)
+            element = re.search(rb"<" + p + rb":[^\s/>]+", markup)
+            attribute = re.search(rb"(?<=\s)" + p + rb":[A-Za-z_][\w.-]*(?=\s*=)", markup)
+            for m, shown in ((element, "<{}>"), (attribute, "{}=...")):
+                if m is not None and (prefix not in first or m.start() < first[prefix][0]):
+                    text = m.group(0).decode("utf-8", "replace").lstrip("<")
+                    first[prefix] = (m.start(), shown.format(text))
+        return _declare(data, markup, root, first, notes)
+    # Walk the tags with the declarations in scope: a prefix declared on one <gazebo> is not
+    # declared on the next one.
+    scopes: list[set[bytes]] = []
+    in_scope: set[bytes] = {b"xml", b"xmlns"}
+    for tag in _TAG.finditer(markup):
+        if tag.group(1):  # an end tag
+            if scopes:
+                in_scope = scopes.pop()
+            continue
+        raw, attrs = tag.group(2), tag.group(3)
+        here = in_scope | set(_DECLARED.findall(attrs))
+        name = raw.decode("utf-8", "replace")
+        if b":" in raw and raw.partition(b":")[0] not in here:
+            first.setdefault(raw.partition(b":")[0], (tag.start(), f"<{name}>"))
+        for attr in _ATTR.finditer(attrs):
+            if attr.group(1) not in here:  # an attribute (PyBullet ignores it too)
+                what = f"<{name} {attr.group(0).decode().strip()}...>"
+                first.setdefault(attr.group(1), (tag.start(3) + attr.start(1), what))
+        if not tag.group(4):  # not <empty/>: its declarations hold until its end tag
+            scopes.append(in_scope)
+            in_scope = here
+    return _declare(data, markup, root, first, notes)
+
+
+def _declare(data: bytes, markup: bytes, root: re.Match[bytes],
+             first: dict[bytes, tuple[int, str]], notes: list[tuple[int, str]]
+             ) -> tuple[bytes, list[tuple[int, str]]]:
+    """Note each prefix of ``first`` and declare it in the root's start tag."""
+    missing = sorted(first, key=lambda prefix: first[prefix][0])
+    if not missing:
         return data, notes
     for prefix in missing:
         at, used = first[prefix]
         name = prefix.decode()
         notes.append((data.count(b"\n", 0, at) + 1,
-                      f"namespace prefix {name!r} is used ({used}) but never declared: "
+                      f"namespace prefix {name!r} is used ({used}) where it is not declared: "
                       "PyBullet ignores what it names, other XML parsers refuse the file; "
                       f"declare xmlns:{name} on <robot>"))
     extra = b"".join(b' xmlns:' + prefix + b'="urn:urdfkit:undeclared:' + prefix + b'"'
