@@ -72,3 +72,32 @@ def test_a_turned_inertial_frame_does_not_turn_the_reported_yaw(tmp_path: Path) 
     # (to float32: PyBullet's poses are single precision)
     assert rows[0][1] == pytest.approx(0.0, abs=1e-6) and rows[0][2] == pytest.approx(0.0,
                                                                                     abs=1e-6)
+
+
+def test_a_wheel_whose_inertial_frame_is_turned_still_turns_about_its_own_axis(
+        tmp_path: Path) -> None:
+    """getJointInfo's axis is in the child's inertial frame: an <inertial><origin rpy> (or
+    inertia products, with the file's inertia) turns that frame, and the axis must turn with
+    it. A PR2 caster swivel read 32 degrees off vertical before, so its wheels were taken for
+    skid-steered ones."""
+    text = build_template("simplecar").to_bytes().decode()
+    text = text.replace('<inertial>\n      <mass value="0.3"/>',
+                        '<inertial>\n      <origin rpy="0.9 0 0.6"/>\n      <mass value="0.3"/>')
+    assert text.count('rpy="0.9 0 0.6"') == 4  # every wheel
+    path = tmp_path / "turned_wheels.urdf"
+    path.write_text(text)
+    c = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(str(path), flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=c)
+        wheel = next(j for j in range(p.getNumJoints(body, physicsClientId=c))
+                     if p.getJointInfo(body, j, physicsClientId=c)[1] == b"base_to_left_back_wheel")
+        # The reported axis is far from the file's (0 1 0) in the link frame...
+        assert abs(p.getJointInfo(body, wheel, physicsClientId=c)[13][1]) < 0.6
+    finally:
+        p.disconnect(physicsClientId=c)
+    plain, turned = _run(_car(tmp_path, "plain.urdf")), _run(path)
+    for r in (plain, turned):  # ...yet all four wheels and both hinges are found, and drive
+        d = r.to_dict()  # type: ignore[attr-defined]
+        assert len(d["drivetrain"]["wheels"]) == 4 and len(d["drivetrain"]["hinges"]) == 2
+    radii = [r.to_dict()["turning_radius"] for r in (plain, turned)]  # type: ignore[attr-defined]
+    assert radii[1] == pytest.approx(radii[0], rel=0.02)

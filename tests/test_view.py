@@ -530,3 +530,27 @@ def test_clicking_a_finding_and_choosing_a_link_in_the_page_select_it(
     k = len(ys) // 2  # a red pixel in the middle of the list, not on the silhouette's edge
     page.mouse.click(int(xs[k]), int(ys[k]) + 160)
     assert _wait(lambda: v.selected == "upper", 10), v.selected
+
+
+def test_a_joint_axis_is_drawn_in_the_link_frame_whatever_the_inertial_frame(
+        tmp_path: Path, viewer_of: Any) -> None:
+    # PyBullet reports the axis in the child's inertial frame; an <inertial><origin rpy> turns
+    # that frame. The axis drawn in the link's node must still be the file's (0 1 0).
+    import numpy as np
+
+    path = tmp_path / "turned.urdf"
+    text = ARM
+    i = text.index('<link name="upper">')
+    j = text.index("<inertial>", i) + len("<inertial>")
+    path.write_text(text[:j] + '<origin rpy="0.9 0 0.6"/>' + text[j:])
+    v = viewer_of(path)
+    shoulder = next(jc for jc in v.model.joints if jc.name == "shoulder")
+    assert abs(shoulder.axis[1]) < 0.6  # PyBullet's own, turned
+    line = [h for h in v.nodes("frames", "upper") if h.name.endswith("/joint_axis")]
+    assert len(line) == 1
+    a, b = (np.asarray(pt, dtype=float) for pt in line[0].points[0])
+    direction = (b - a) / np.linalg.norm(b - a)
+    file_axis = [float(x) for x in ARM.split('<joint name="shoulder"')[1].split('xyz="')[2]
+                 .split('"')[0].split()]
+    assert direction == pytest.approx(np.asarray(file_axis) / np.linalg.norm(file_axis),
+                                      abs=1e-6)

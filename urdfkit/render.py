@@ -421,7 +421,10 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
             if info[2] == _JOINT_FIXED or info[2] not in (0, 1):
                 continue
             pos, rot = frames[j + 1]
-            axes.append((pos, rot @ np.array(info[13], dtype=float)))
+            # PyBullet's axis is in the child's inertial frame: turn it into the link frame.
+            local = p.getDynamicsInfo(body, j, physicsClientId=c)[4]
+            inertial = np.array(p.getMatrixFromQuaternion(local), dtype=float).reshape(3, 3)
+            axes.append((pos, rot @ inertial @ np.array(info[13], dtype=float)))
     except p.error as e:
         raise EngineError(f"PyBullet cannot report this body's state ({e})",
                           file=resolved.name) from None

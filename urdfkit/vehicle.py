@@ -515,7 +515,10 @@ def detect_drivetrain(p: Any, body: int, client: int,
     states = {j: p.getLinkState(body, j, computeForwardKinematics=True, physicsClientId=client)
               for j in movable}
     origin = {j: tuple(states[j][4]) for j in movable}
-    axes = {j: _unit(rotate(quat_to_matrix(states[j][5]), infos[j][13])) for j in movable}
+    # getJointInfo's axis is in the child's inertial frame (measured: with inertia products
+    # and URDF_USE_INERTIA_FROM_FILE a PR2 caster's vertical axis read 32 degrees off in the
+    # link frame), so it turns with the link's centre-of-mass orientation, not its URDF frame.
+    axes = {j: _unit(rotate(quat_to_matrix(states[j][1]), infos[j][13])) for j in movable}
     base_pos, base_orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
     dyn = p.getDynamicsInfo(body, -1, physicsClientId=client)
     inv_pos, inv_orn = p.invertTransform(dyn[3], dyn[4])
