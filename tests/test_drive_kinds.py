@@ -174,3 +174,36 @@ def test_yaw_shortfall_warnings_show_in_text_and_their_advice_is_measured() -> N
     data = json.loads(_cli("--urdf", "husky/husky.urdf", "--steer", "0.3", "--seconds", "6",
                            "--max-force", "1000", "--json").stdout)
     assert said[0].removeprefix("urdfkit: warning: ") in data["warnings"]
+
+
+def test_a_flipped_robot_gets_no_yaw_advice_and_made_up_mass_is_named(tmp_path: Path) -> None:
+    """Frames without <inertial> weigh 1 kg each in PyBullet: on a 0.6 kg two-wheeler, two
+    frames 30 cm up tip it over. drive names the made-up mass, and once the robot has flipped
+    it gives no advice about its yaw rate (its wheels are in the air)."""
+    wheel = ('<inertial><mass value="0.05"/><inertia ixx="1e-5" iyy="1e-5" izz="2e-5" ixy="0" '
+             'ixz="0" iyz="0"/></inertial><collision><geometry><cylinder radius="0.03" '
+             'length="0.02"/></geometry></collision>')
+    parts = ['<robot name="tippy"><link name="base"><inertial><mass value="0.5"/><inertia '
+             'ixx="0.002" iyy="0.002" izz="0.003" ixy="0" ixz="0" iyz="0"/></inertial><collision>'
+             '<origin xyz="0 0 0.02"/><geometry><box size="0.2 0.16 0.02"/></geometry></collision>'
+             '</link>']
+    for side, y in (("l", 0.1), ("r", -0.1)):
+        parts.append(f'<joint name="w{side}" type="continuous"><parent link="base"/><child '
+                     f'link="w{side}_link"/><origin xyz="0 {y} 0" rpy="-1.5708 0 0"/><axis '
+                     f'xyz="0 0 1"/></joint><link name="w{side}_link">{wheel}</link>')
+    parts.append('<joint name="cj" type="fixed"><parent link="base"/><child link="caster"/>'
+                 '<origin xyz="-0.08 0 -0.015"/></joint><link name="caster"><inertial><mass '
+                 'value="0.01"/><inertia ixx="1e-6" iyy="1e-6" izz="1e-6" ixy="0" ixz="0" '
+                 'iyz="0"/></inertial><collision><geometry><sphere radius="0.015"/></geometry>'
+                 '</collision></link>'
+                 '<joint name="cam" type="fixed"><parent link="base"/><child link="camera_frame"/>'
+                 '<origin xyz="0.1 0 0.3"/></joint><link name="camera_frame"/>'
+                 '<joint name="opt" type="fixed"><parent link="camera_frame"/><child '
+                 'link="camera_optical_frame"/></joint><link name="camera_optical_frame"/></robot>')
+    path = tmp_path / "tippy.urdf"
+    path.write_text("".join(parts))
+    r = drive(DriveConfig(urdf=str(path), throttle=10, steer=0.5, seconds=4))
+    made_up = [w for w in r.warnings if w.startswith("PyBullet gives the 2 link(s) without")]
+    assert len(made_up) == 1 and "camera_frame" in made_up[0]
+    assert any(p.startswith("flipped over") for p in r.problems), r.problems
+    assert not [w for w in r.warnings if "steering turns at" in w]

@@ -383,3 +383,23 @@ def test_a_mesh_found_above_gives_the_shapes_raw_pybullet_gives(tmp_path: Path) 
         assert r.returncode == 0 and "U701" not in r.stderr, (args, r.stderr)
     fixed = _cli("fix", str(path), "--diff")
     assert fixed.returncode in (0, 1) and "U701" not in fixed.stdout + fixed.stderr, fixed
+
+
+def test_a_nameless_material_in_a_gazebo_extension_is_ignored_as_pybullet_ignores_it(
+        tmp_path: Path) -> None:
+    path = tmp_path / "gz.urdf"  # Gazebo's own syntax, as linorobot2 writes it
+    path.write_text(f'<robot name="g"><link name="base">{INERTIAL}<visual><geometry><box '
+                    'size="0.2 0.2 0.2"/></geometry><material name="yellow"><color rgba="1 1 0 '
+                    '1"/></material></visual></link><gazebo reference="base"><visual>'
+                    '<material><ambient>1 1 0 1</ambient></material></visual></gazebo></robot>')
+    collision, visual = _raw_shapes(path)  # PyBullet loads it, the link's yellow box
+    assert [tuple(round(x, 3) for x in v[7]) for v in visual] == [(1.0, 1.0, 0.0, 1.0)]
+    check = json.loads(_cli("check", str(path), "--json").stdout)
+    assert not [f for f in check["findings"] if f["code"] == "U110"]
+    for command in ("joints", "tree", "links"):
+        assert _cli(command, str(path)).returncode == 0, command
+    # A link's own <visual><material> without a name is still refused, as PyBullet refuses it.
+    bad = tmp_path / "bad.urdf"
+    bad.write_text(path.read_text().replace('<material name="yellow">', "<material>"))
+    r = _cli("joints", str(bad))
+    assert r.returncode == 2 and "U110" not in r.stdout and "no name attribute" in r.stderr

@@ -640,6 +640,7 @@ class Scenario:
         self.static_base = False
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
         self._last_file = ""
+        self._phantom: list[str] | None = None
         self.session: Session | None = None
         try:
             self._open()
@@ -671,6 +672,9 @@ class Scenario:
         with open_input(name, self.config.packages, self.config.xacro_args,
                         guard=self.config.guard, package_paths=self.config.package_paths) as res:
             self.warnings.extend(res.warnings)
+            if self._phantom is None:  # the car, loaded first: links PyBullet gives 1 kg
+                self._phantom = [el.get("name", "") for el in res.root.iterchildren("link")
+                                 if el.find("inertial") is None]
             return s.load_urdf(res.load_path, options, display=res.name)
 
     def _open(self) -> None:
@@ -713,11 +717,33 @@ class Scenario:
         self.steer, note = clamp_steer(train, c.steer)
         if note:
             self.warnings.append(note)
+        self._warn_phantom_mass()
         self._plan_holds()
         self.columns = list(BASE_COLUMNS)
         for j in train.wheels + train.hinges:
             name = train.joint_names[j]
             self.columns += [f"{name}_angle", f"{name}_speed"]
+
+    def _warn_phantom_mass(self) -> None:
+        """Say when PyBullet's 1 kg for each link without <inertial> is much of the robot.
+
+        Frames (camera, IMU, sensor links) usually have no <inertial>; PyBullet makes each a
+        1 kg body. On a small robot that is most of its weight, high up: a TurtleBot-sized base
+        with five such frames (5 of 8.55 kg) tips over in raw PyBullet with its motors off.
+        """
+        if not self._phantom:
+            return
+        assert self.session is not None
+        p, client = self.session.p, self.session.client
+        total = sum(p.getDynamicsInfo(self.body, k, physicsClientId=client)[0]
+                    for k in range(-1, p.getNumJoints(self.body, physicsClientId=client)))
+        made_up = float(len(self._phantom))
+        if total > 0 and made_up >= 0.1 * total:
+            names = ", ".join(self._phantom[:5]) + (", ..." if len(self._phantom) > 5 else "")
+            self.warnings.append(
+                f"PyBullet gives the {len(self._phantom)} link(s) without <inertial> 1 kg each "
+                f"({names}): {made_up:g} of the {total:.4g} kg simulated; if they are frames, "
+                "`urdfkit fix` gives them mass 0")
 
     def _plan_holds(self) -> None:
         """Which passive joints hold their start angle, with what force, and which go limp.
@@ -953,8 +979,10 @@ class Scenario:
         rate = stats.yaw_rate()
         train = self.drivetrain
         warnings = list(self.warnings)
+        # A base that flipped, fell or left the ground has no yaw rate worth advice on.
+        upset = bool(monitor.seen & {"flipped", "fell", "left"})
         if train.yaw_steered and self.steer and rate is not None and not self._probe \
-                and not interrupted and c.drivetrain != "locked":
+                and not interrupted and c.drivetrain != "locked" and not upset:
             share = rate / self.steer
             if share < 0.9:
                 (problems if share < 0.1 else warnings).append(

@@ -234,8 +234,11 @@ def rule_names(root: etree._Element, r: Report) -> None:
     for el in root.iter("material"):
         if el.getparent() is root:
             continue
-        if el.get("name") is None and el.getparent() is not None and \
-                el.getparent().tag == "visual":
+        visual = el.getparent()
+        # Only a link's visual: PyBullet ignores <gazebo> and what is in it (a Gazebo
+        # <visual><material><ambient> has no name and loads; found on linorobot2).
+        if el.get("name") is None and visual is not None and visual.tag == "visual" and \
+                visual.getparent() is not None and visual.getparent().tag == "link":
             # Measured: PyBullet refuses the whole file ("Could not parse visual element");
             # name="" loads.
             r.add("U110", "error", "<material> of a <visual> has no name attribute: PyBullet "
