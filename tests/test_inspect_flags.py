@@ -81,3 +81,37 @@ def test_flags_refuse_a_name_pybullet_lacks_and_a_double_inertia_option() -> Non
     assert bad.exit_code == 2 and "not a PyBullet loadURDF flag" in bad.stderr
     both = CliRunner().invoke(app, ["links", R2D2, "--flags", "none", "--inertia-from-file"])
     assert both.exit_code == 2 and "not both" in both.stderr
+
+
+def test_the_axis_column_is_the_files_and_jointaxis_pybullets(tmp_path: Path) -> None:
+    """PyBullet's jointAxis is in the child's inertial frame: an <inertial><origin rpy> turns
+    it. The table's axis (JSON axisXyz) is the file's; jointAxis stays PyBullet's own."""
+    import json
+    import subprocess
+    import sys
+
+    import pybullet as p
+
+    path = tmp_path / "turned.urdf"
+    inertial = ('<inertial><origin rpy="0.9 0 0.6"/><mass value="1"/><inertia ixx="0.01" '
+                'iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>')
+    path.write_text(f'<robot name="t"><link name="a">{inertial}</link><link name="b">'
+                    f'{inertial}</link><joint name="j" type="revolute"><parent link="a"/>'
+                    '<child link="b"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" '
+                    'effort="1" velocity="1"/></joint></robot>')
+    c = p.connect(p.DIRECT)
+    try:
+        raw = p.getJointInfo(p.loadURDF(str(path), physicsClientId=c), 0,
+                             physicsClientId=c)[13]
+    finally:
+        p.disconnect(physicsClientId=c)
+    r = subprocess.run([sys.executable, "-m", "urdfkit", "joints", str(path), "--json"],
+                       capture_output=True, text=True, timeout=60)
+    joint = json.loads(r.stdout)["joints"][0]
+    assert joint["jointAxis"] == list(raw) and abs(raw[1]) < 0.6  # PyBullet's, turned
+    assert joint["axisXyz"] == [0.0, 1.0, 0.0]  # the file's
+    text = subprocess.run([sys.executable, "-m", "urdfkit", "joints", str(path), "--all"],
+                          capture_output=True, text=True, timeout=60, env={
+                              **__import__("os").environ, "COLUMNS": "400"}).stdout
+    header, row = text.splitlines()[1], text.splitlines()[2]
+    assert "jointAxis" in header and " 0 1 0 " in row

@@ -357,7 +357,7 @@ def joints(
                ("max force", 3, "right"), ("max vel", 3, "right"),
                ("parentFramePos", 4, "left"), ("parentFrameRpy", 4, "left"), ("q", 5, "right"),
                ("u", 5, "right"), ("damping", 6, "right"), ("friction", 6, "right"),
-               ("quat", 9, "left"), ("flags", 9, "right")]
+               ("quat", 9, "left"), ("flags", 9, "right"), ("jointAxis", 9, "left")]
     cells = []
     for j in rows:
         if j.limited:
@@ -367,13 +367,15 @@ def joints(
         cells.append([
             str(j.joint_index), j.joint_name, j.type_label, j.link_name,
             f"{j.parent_index} {j.parent_link_name}", limits,
-            nums(j.joint_axis) if j.movable else "",
+            # The file's axis (the joint frame); PyBullet's jointAxis is in the child's
+            # inertial frame, turned by an <inertial><origin rpy> (its own column).
+            nums(j.axis_xyz if j.axis_xyz is not None else j.joint_axis) if j.movable else "",
             nums(j.origin_xyz) if j.origin_xyz is not None else "",
             nums(j.origin_rpy) if j.origin_rpy is not None else "",
             num(j.joint_max_force),
             num(j.joint_max_velocity), nums(j.parent_frame_pos), nums(j.parent_frame_rpy),
             str(j.q_index), str(j.u_index), num(j.joint_damping), num(j.joint_friction),
-            nums(j.parent_frame_orn), str(j.flags)])
+            nums(j.parent_frame_orn), str(j.flags), nums(j.joint_axis) if j.movable else ""])
     shown = f"{len(rows)} of {len(report.joints)}" if len(rows) != len(report.joints) \
         else str(len(rows))
     show.table(f"{report.robot}: {shown} joints, base link {report.base_link}", columns, cells,

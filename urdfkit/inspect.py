@@ -89,6 +89,7 @@ class JointInfo:
     parent_frame_rpy: Vec3 = (0.0, 0.0, 0.0)
     origin_xyz: Vec3 | None = None
     origin_rpy: Vec3 | None = None
+    axis_xyz: Vec3 | None = None
 
     @classmethod
     def from_pybullet(cls, info: Sequence[Any]) -> JointInfo:
@@ -133,7 +134,8 @@ class JointInfo:
                    parentFrameRpy=list(self.parent_frame_rpy), movable=self.movable,
                    limited=self.limited,
                    originXyz=None if self.origin_xyz is None else list(self.origin_xyz),
-                   originRpy=None if self.origin_rpy is None else list(self.origin_rpy))
+                   originRpy=None if self.origin_rpy is None else list(self.origin_rpy),
+                   axisXyz=None if self.axis_xyz is None else list(self.axis_xyz))
         return out
 
 
@@ -152,6 +154,7 @@ def joint_table(s: Session, body: int, root: etree._Element | None = None) -> li
     """
     urdf_types: dict[str, str] = {}
     origins: dict[str, tuple[Vec3, Vec3]] = {}
+    axes: dict[str, Vec3] = {}
     if root is not None:
         for el in children(root, "joint"):
             urdf_types[el.get("name", "")] = el.get("type", "")
@@ -159,6 +162,9 @@ def joint_table(s: Session, body: int, root: etree._Element | None = None) -> li
             xyz = attr_vec(origin, "xyz", 3, (0.0, 0.0, 0.0)) or (0.0, 0.0, 0.0)
             rpy = attr_vec(origin, "rpy", 3, (0.0, 0.0, 0.0)) or (0.0, 0.0, 0.0)
             origins[el.get("name", "")] = (tuple(xyz), tuple(rpy))  # type: ignore[assignment]
+            # The file's axis, in the joint (child link) frame; URDF's default is x.
+            axis = attr_vec(el.find("axis"), "xyz", 3, (1.0, 0.0, 0.0)) or (1.0, 0.0, 0.0)
+            axes[el.get("name", "")] = tuple(axis)  # type: ignore[assignment]
     joints = [JointInfo.from_pybullet(s.call("getJointInfo", body, i))
               for i in range(s.call("getNumJoints", body))]
     base = base_link_name(s, body)
@@ -166,6 +172,7 @@ def joint_table(s: Session, body: int, root: etree._Element | None = None) -> li
         j.urdf_type = urdf_types.get(j.joint_name)
         if j.joint_name in origins:
             j.origin_xyz, j.origin_rpy = origins[j.joint_name]
+            j.axis_xyz = axes[j.joint_name]
         j.parent_link_name = base if j.parent_index < 0 else joints[j.parent_index].link_name
     return joints
 
