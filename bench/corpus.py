@@ -26,7 +26,7 @@ by a raw `p.loadURDF` in PyBullet DIRECT (a subprocess) with the flags urdfkit s
 with urdfkit's joints/links JSON. A xacro input is compared through `build`'s output.
 
 Each non-zero exit is classified: `findings` (1), `refusal` (2; a *false refusal* when raw
-PyBullet loaded the file), `bug` (3), `crash` (killed by a signal or another code) or `timeout`.
+PyBullet loaded the file, except for drive, whose refusals are about wheels and are judged by hand), `bug` (3), `crash` (killed by a signal or another code) or `timeout`.
 
 Output: a markdown table on stdout (robot, each command's result, equal to PyBullet, notes)
 and a JSON summary in DIR/summary.json (also per robot in DIR/results/NAME.json, so --resume
@@ -62,7 +62,8 @@ COMMANDS = (
     "build",
     "drive",
 )
-LOADERS = ("joints", "links", "info", "render", "collisions", "drive", "tree")
+# drive's refusals are about wheels, not loading ("no wheels found"): judged by hand, not here.
+LOADERS = ("joints", "links", "info", "render", "collisions", "tree")
 _SYMBOL = {
     "ok": "ok",
     "findings": "F",
@@ -72,6 +73,8 @@ _SYMBOL = {
     "crash": "X",
     "timeout": "T",
 }
+# Refusals that name something PyBullet loads but cannot then do (not false refusals).
+PYBULLET_LIMITS = ("PyBullet cannot report the state",)
 _BAD = ("false_refusal", "bug", "crash", "timeout")
 
 RAW_SCRIPT = r"""
@@ -329,6 +332,7 @@ def survey(entry: dict[str, Any], out: Path, timeout: float, size: str) -> Resul
             run_.kind == "refusal"
             and command in LOADERS + ("check", "build", "fix", "diff")
             and result.raw_loaded
+            and not any(limit in run_.stderr for limit in PYBULLET_LIMITS)
         ):
             run_.kind = "false_refusal"
     if result.raw_loaded and joints.exit == 0 and links.exit == 0:
