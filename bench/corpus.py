@@ -8,7 +8,7 @@ MANIFEST is a JSON or TOML file with a list of entries (JSON: a list, or {"robot
 TOML: [[robots]] tables). Each entry:
 
     name             short name, unique (required)
-    path             the .urdf or .xacro file (required)
+    path             the .urdf or .xacro file (required; {pybullet_data}, ~ and $VARS expand)
     packages         {"pkg_name": "/path/to/pkg", ...}  -> urdfkit -p pkg_name=/path/to/pkg
     package_path     ["/dir", ...]                        -> urdfkit --package-path /dir
     ros_package_path "/a:/b"                              -> ROS_PACKAGE_PATH in the environment
@@ -25,8 +25,15 @@ by a raw `p.loadURDF` in PyBullet DIRECT (a subprocess) with the flags urdfkit s
 (`load_flags` in joints --json); joint count, names, types, limits and link masses are compared
 with urdfkit's joints/links JSON. A xacro input is compared through `build`'s output.
 
+`fix` and `build` write NAME.corpus-fixed.urdf / NAME.corpus-built.urdf next to each source, so that
+relative and package:// mesh paths resolve from the written file: run it on a scratch copy of the
+packages, or pass --no-beside to write under --out instead (diff is then not run).
+bench/corpus-example.json runs on pybullet_data's robots.
+
 Each non-zero exit is classified: `findings` (1), `refusal` (2; a *false refusal* when raw
-PyBullet loaded the file, except for drive, whose refusals are about wheels and are judged by hand), `bug` (3), `crash` (killed by a signal or another code) or `timeout`.
+PyBullet loaded the file, unless the message names a PyBullet limit (128-link state); drive's
+refusals are about wheels and are judged by hand), `bug` (3), `crash` (killed by a signal or another
+code) or `timeout`.
 
 Output: a markdown table on stdout (robot, each command's result, equal to PyBullet, notes)
 and a JSON summary in DIR/summary.json (also per robot in DIR/results/NAME.json, so --resume
@@ -163,6 +170,15 @@ def load_manifest(path: Path) -> list[dict[str, Any]]:
     return list(entries)
 
 
+def expand(path: str) -> str:
+    """Expand ``{pybullet_data}``, ``~`` and environment variables in a manifest path."""
+    if "{pybullet_data}" in path:
+        import pybullet_data
+
+        path = path.replace("{pybullet_data}", pybullet_data.getDataPath())
+    return os.path.expandvars(os.path.expanduser(path))
+
+
 def _urdfkit() -> list[str]:
     return [sys.executable, "-m", "urdfkit"]
 
@@ -268,9 +284,11 @@ def _json(run_: Run) -> dict[str, Any]:
     return data if isinstance(data, dict) else {}
 
 
-def survey(entry: dict[str, Any], out: Path, timeout: float, size: str) -> Result:
+def survey(
+    entry: dict[str, Any], out: Path, timeout: float, size: str, write_beside: bool = True
+) -> Result:
     """Run every command on one entry and compare with raw PyBullet."""
-    name, path = entry["name"], os.path.abspath(str(entry["path"]))
+    name, path = entry["name"], os.path.abspath(expand(str(entry["path"])))
     result = Result(name, path, entry.get("group", ""))
     if entry.get("notes"):
         result.notes.append(str(entry["notes"]))
@@ -296,9 +314,9 @@ def survey(entry: dict[str, Any], out: Path, timeout: float, size: str) -> Resul
     )
     go("collisions", ["collisions", path, "--json", *opts, *xargs])
     loadable = path
-    # build and fix write beside the source (outside the repository: the corpus folder), so that
+    # With beside, build and fix write next to the source (a scratch copy of the corpus), so that
     # relative and package:// mesh paths resolve from the written file as from the original.
-    beside = Path(path).parent if os.access(Path(path).parent, os.W_OK) else work
+    beside = Path(path).parent if write_beside and os.access(Path(path).parent, os.W_OK) else work
     if is_xacro:
         built = beside / f"{Path(path).name.split('.')[0]}.corpus-built.urdf"
         if (
@@ -312,8 +330,12 @@ def survey(entry: dict[str, Any], out: Path, timeout: float, size: str) -> Resul
         fixed = beside / f"{Path(loadable).name.split('.')[0]}.corpus-fixed.urdf"
         fixed.unlink(missing_ok=True)
         go("fix", ["fix", loadable, "-o", str(fixed), "--force", *opts])
-        if fixed.exists():
+        if fixed.exists() and beside != work:
             go("diff", ["diff", loadable, str(fixed), *opts])
+        elif fixed.exists():
+            result.notes.append(
+                "diff not run: the fixed copy is not beside its meshes (--no-beside)"
+            )
     if entry.get("wheeled"):
         go(
             "drive",
@@ -414,6 +436,11 @@ def main(argv: list[str] | None = None) -> int:
         "--timeout", type=float, default=180.0, help="seconds per command (drive: twice)"
     )
     parser.add_argument("--size", default="160x120", help="render size")
+    parser.add_argument(
+        "--no-beside",
+        action="store_true",
+        help="write fix/build output under --out, not next to each source",
+    )
     parser.add_argument("--resume", action="store_true", help="skip robots with a stored result")
     parser.add_argument(
         "--table-only", action="store_true", help="print the table from stored results"
@@ -433,7 +460,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.table_only:
             continue
         print(f"... {entry['name']}", file=sys.stderr, flush=True)
-        res = asdict(survey(entry, args.out, args.timeout, args.size))
+        res = asdict(survey(entry, args.out, args.timeout, args.size, not args.no_beside))
         stored.write_text(json.dumps(res, indent=1))
         results.append(res)
     summary = summarize(results)
