@@ -1,0 +1,50 @@
+"""bench/corpus.py, the corpus runner: its exit classes and its comparison with raw PyBullet."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+from typer.testing import CliRunner
+
+from urdfkit.cli import app
+
+R2D2 = "r2d2.urdf"
+
+
+def _corpus() -> ModuleType:
+    path = Path(__file__).parent.parent / "bench" / "corpus.py"
+    spec = importlib.util.spec_from_file_location("corpus_bench", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclasses look themselves up there
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize(("code", "kind"), [
+    ("pass", "ok"), ("raise SystemExit(1)", "findings"), ("raise SystemExit(2)", "refusal"),
+    ("raise SystemExit(3)", "bug"), ("import os; os.abort()", "crash"),
+    ("import time; time.sleep(30)", "timeout"),
+])
+def test_each_exit_is_classified(code: str, kind: str) -> None:
+    run = _corpus().run([sys.executable, "-c", code], {}, timeout=3.0)
+    assert run.kind == kind
+
+
+def test_urdfkit_equals_raw_pybullet_and_a_changed_limit_is_caught() -> None:
+    corpus = _corpus()
+    joints = json.loads(CliRunner().invoke(app, ["joints", R2D2, "--json"]).stdout)
+    links = json.loads(CliRunner().invoke(app, ["links", R2D2, "--json"]).stdout)
+    raw = corpus.raw_load(joints["path"], joints["load_flags"], timeout=60.0)
+    assert raw["loaded"] and len(raw["joints"]) == len(joints["joints"]) == 15
+    assert corpus.compare(raw, joints, links) == []
+    prismatic = next(i for i, j in enumerate(raw["joints"]) if j["type"] == 1)
+    raw["joints"][prismatic]["upper"] += 0.01
+    raw["base_mass"] += 1.0
+    diffs = corpus.compare(raw, joints, links)
+    assert len(diffs) == 2 and "upper" in diffs[0] and "link -1 mass" in diffs[1]
