@@ -32,8 +32,8 @@ bench/corpus-example.json runs on pybullet_data's robots.
 
 Each non-zero exit is classified: `findings` (1), `refusal` (2; a *false refusal* when raw
 PyBullet loaded the file, unless the message names a PyBullet limit (128-link state); drive's
-refusals are about wheels and are judged by hand), `bug` (3), `crash` (killed by a signal or another
-code) or `timeout`.
+refusals are about wheels and are judged by hand), `bug` (3, a traceback on stderr, or --json output
+that does not parse), `crash` (killed by a signal or another code) or `timeout`.
 
 Output: a markdown table on stdout (robot, each command's result, equal to PyBullet, notes)
 and a JSON summary in DIR/summary.json (also per robot in DIR/results/NAME.json, so --resume
@@ -215,9 +215,17 @@ def run(cmd: list[str], env: dict[str, str], timeout: float) -> Run:
     if any(line.startswith("Traceback") for line in lines):
         first = next((line for line in reversed(lines) if not line.startswith("File ")), first)
     kinds = {0: "ok", 1: "findings", 2: "refusal", 3: "bug"}
-    return Run(
-        proc.returncode, seconds, first[:300], kinds.get(proc.returncode, "crash"), proc.stdout
-    )
+    kind = kinds.get(proc.returncode, "crash")
+    if kind in ("findings", "refusal") and any(line.startswith("Traceback") for line in lines):
+        kind = "bug"  # bad input gets one line, never a traceback
+    elif kind == "refusal" and len(lines) > 1 and not lines[-1].startswith("urdfkit: error"):
+        first = f"{first} (+{len(lines) - 1} more stderr lines)"
+    if kind in ("ok", "findings") and "--json" in cmd:
+        try:
+            json.loads(proc.stdout)
+        except json.JSONDecodeError:
+            kind, first = "bug", f"--json printed no JSON: {proc.stdout[:120]!r}"
+    return Run(proc.returncode, seconds, first[:300], kind, proc.stdout)
 
 
 def raw_load(path: str, flags: list[str], timeout: float) -> dict[str, Any]:

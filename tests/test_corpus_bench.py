@@ -36,6 +36,16 @@ def test_each_exit_is_classified(code: str, kind: str) -> None:
     assert run.kind == kind
 
 
+def test_a_traceback_or_json_that_does_not_parse_is_a_bug() -> None:
+    corpus = _corpus()
+    traceback = "import sys; sys.stderr.write('Traceback (most recent call last):\\n'); sys.exit(2)"
+    assert corpus.run([sys.executable, "-c", traceback], {}, timeout=10.0).kind == "bug"
+    not_json = [sys.executable, "-c", "print('{half')", "--json"]
+    assert corpus.run(not_json, {}, timeout=10.0).kind == "bug"
+    json_ok = [sys.executable, "-c", "print('{}')", "--json"]
+    assert corpus.run(json_ok, {}, timeout=10.0).kind == "ok"
+
+
 def test_urdfkit_equals_raw_pybullet_and_a_changed_limit_is_caught() -> None:
     corpus = _corpus()
     joints = json.loads(CliRunner().invoke(app, ["joints", R2D2, "--json"]).stdout)
