@@ -22,8 +22,9 @@ the load modest): check --json, joints --json, links --json, tree, info --json, 
 collisions --json, fix -o + diff, build -o (xacro input only), drive --json (wheeled only). For
 each it records the exit code, the first stderr line and the run time. The file is also loaded
 by a raw `p.loadURDF` in PyBullet DIRECT (a subprocess) with the flags urdfkit says it used
-(`load_flags` in joints --json); joint count, names, types, limits and link masses are compared
-with urdfkit's joints/links JSON. A xacro input is compared through `build`'s output.
+(`load_flags` in joints --json); joint count, names, types and limits, and each link's mass,
+inertia diagonal and inertial position (getDynamicsInfo) are compared with urdfkit's joints/links
+JSON. A xacro input is compared through `build`'s output.
 
 `fix` and `build` write NAME.corpus-fixed.urdf / NAME.corpus-built.urdf next to each source, so that
 relative and package:// mesh paths resolve from the written file: run it on a scratch copy of the
@@ -109,8 +110,9 @@ try:
             joints.append({"name": info[1].decode("utf-8", "replace"), "type": info[2],
                            "lower": info[8], "upper": info[9],
                            "mass": p.getDynamicsInfo(body, i, physicsClientId=cid)[0]})
-        base_mass = p.getDynamicsInfo(body, -1, physicsClientId=cid)[0]
-        out = {"loaded": True, "joints": joints, "base_mass": base_mass}
+        dyn = [p.getDynamicsInfo(body, i, physicsClientId=cid) for i in range(-1, len(joints))]
+        out = {"loaded": True, "joints": joints, "base_mass": dyn[0][0],
+               "inertia": [list(d[2]) for d in dyn], "inertial_pos": [list(d[3]) for d in dyn]}
     p.disconnect(cid)
 finally:
     os.dup2(saved, 1)
@@ -275,6 +277,15 @@ def compare(raw: dict[str, Any], joints: dict[str, Any], links: dict[str, Any]) 
             diffs.append(f"link {index} mass {masses[index]} vs raw {mass}")
         if index not in masses and links:
             diffs.append(f"link {index} missing from links --json")
+    by_index = {link["linkIndex"]: link for link in links.get("links", [])}
+    for key, rkey in (
+        ("local_inertia_diagonal", "inertia"),
+        ("local_inertial_pos", "inertial_pos"),
+    ):
+        for index, value in enumerate(raw.get(rkey, []), -1):
+            mine = by_index.get(index, {}).get(key)
+            if mine is not None and not all(map(_close, mine, value)):
+                diffs.append(f"link {index} {key} {mine} vs raw {value}")
     return diffs
 
 

@@ -46,7 +46,7 @@ def test_a_traceback_or_json_that_does_not_parse_is_a_bug() -> None:
     assert corpus.run(json_ok, {}, timeout=10.0).kind == "ok"
 
 
-def test_urdfkit_equals_raw_pybullet_and_a_changed_limit_is_caught() -> None:
+def test_urdfkit_equals_raw_pybullet_and_a_change_is_caught() -> None:
     corpus = _corpus()
     joints = json.loads(CliRunner().invoke(app, ["joints", R2D2, "--json"]).stdout)
     links = json.loads(CliRunner().invoke(app, ["links", R2D2, "--json"]).stdout)
@@ -56,5 +56,7 @@ def test_urdfkit_equals_raw_pybullet_and_a_changed_limit_is_caught() -> None:
     prismatic = next(i for i, j in enumerate(raw["joints"]) if j["type"] == 1)
     raw["joints"][prismatic]["upper"] += 0.01
     raw["base_mass"] += 1.0
+    raw["inertia"][3][1] *= 1.001
     diffs = corpus.compare(raw, joints, links)
-    assert len(diffs) == 2 and "upper" in diffs[0] and "link -1 mass" in diffs[1]
+    assert len(diffs) == 3 and "upper" in diffs[0] and "link -1 mass" in diffs[1]
+    assert "link 2 local_inertia_diagonal" in diffs[2]
