@@ -386,3 +386,25 @@ def test_a_mimic_multiplier_that_is_not_a_number_is_refused_not_sampled_freely(
     written = next(n for n, x in enumerate(path.read_text().splitlines(), 1)
                    if "multiplier" in x)
     assert f"m.urdf:{written}:" in line and "multiplier" in line and "\n" not in line
+
+
+def test_xacro_left_in_an_origin_is_read_as_pybullet_reads_it() -> None:
+    """`$(optenv X 0.5 0.2 0.3)` in a .urdf: PyBullet loads it (atof per token, the first three),
+    so collisions does too, with a warning, and finds the contact that reading makes."""
+    path = Path(__file__).parent / "fixtures" / "robots" / "xacro_residue.urdf"
+    result = CliRunner().invoke(app, ["collisions", str(path), "--json"])
+    assert result.exit_code == 1, result.output  # a pair in contact, not a refusal
+    report = json.loads(result.stdout)
+    assert [(x["link_a"], x["link_b"]) for x in report["pairs"]] == [("imu", "block")]
+    assert any("so '0 0 0.5'" in w and "xacro_residue.urdf:20" in w for w in report["warnings"])
+    import pybullet as p
+
+    c = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(str(path), useFixedBase=True, flags=p.URDF_USE_SELF_COLLISION,
+                          physicsClientId=c)
+        assert p.getJointInfo(body, 0, physicsClientId=c)[14] == pytest.approx((0, 0, 0.5))
+        assert p.getJointInfo(body, 0, physicsClientId=c)[15] == pytest.approx((0, 0, 0, 1))
+        assert p.getClosestPoints(body, body, 0.0, 0, 1, physicsClientId=c)  # raw: in contact
+    finally:
+        p.disconnect(c)

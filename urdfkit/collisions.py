@@ -25,6 +25,7 @@ mechanism does, so a gripper's mirrored fingers are never posed into each other 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -180,7 +181,7 @@ def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = 
     import numpy as np
 
     pinned = dict(joints or {})
-    _refuse_non_finite(resolved)
+    read_as = _refuse_non_finite(resolved)
     _refuse_mimic_cycles(resolved)
     with Session() as s:
         p, c = s.p, s.client
@@ -191,7 +192,7 @@ def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = 
         s.require_state_queries(body, resolved.name)
         table = joint_table(s, body, resolved.root)
         names = [base_link_name(s, body)] + [j.link_name for j in table]
-        warnings: list[str] = []
+        warnings: list[str] = list(read_as)
         pose_joints(p, c, body, table, pinned, warnings, resolved.name)
         sampler = _Sampler(table, resolved.root, pinned, warnings)
         sampler.follow(p, c, body, sampler.start())  # mimic joints follow at the start too
@@ -240,12 +241,32 @@ _PLACING = (("joint/origin", ("xyz", "rpy")), ("joint/axis", ("xyz",)),
             ("link/collision/geometry/mesh", ("scale",)))
 
 
-def _refuse_non_finite(resolved: Resolved) -> None:
+#: A number as C's atof reads the start of a token (PyBullet's URDF parser reads each
+#: space-separated token so, and 0 where none starts it: "$(optenv" is 0, "0.3)" is 0.3).
+_ATOF = re.compile(r"[+-]?(?:inf(?:inity)?|nan|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)", re.I)
+
+
+_VECTORS = frozenset({"xyz", "rpy", "size", "scale"})
+
+
+def _atof(token: str) -> float:
+    match = _ATOF.match(token)
+    return float(match.group()) if match else 0.0
+
+
+def _refuse_non_finite(resolved: Resolved) -> list[str]:
     """Refuse NaN or infinite positions, sizes and mimic factors before anything runs.
 
     PyBullet takes them and answers nonsense: a NaN box collides with nothing, so the report
-    would say "0 pairs in contact" of a robot whose finite twin collides.
+    would say "0 pairs in contact" of a robot whose finite twin collides. Text that is not
+    numbers (xacro left in a .urdf: ``$(optenv X 0.5 0 0.3)``) PyBullet reads token by token
+    as C's atof does, and loads; so does collisions, with a warning saying what it reads. A
+    mimic factor must be numbers: urdfkit's sampler reads it, PyBullet does not.
+
+    Returns:
+        One warning per attribute that is not plain numbers.
     """
+    warnings: list[str] = []
     for path, attrs in _PLACING:
         for el in resolved.root.iterfind(path):
             if ignored_shape(el):  # PyBullet never reads a shape after the first
@@ -254,16 +275,27 @@ def _refuse_non_finite(resolved: Resolved) -> None:
                 text = el.get(attr)
                 if text is None:
                     continue
-                try:
-                    values = [float(x) for x in text.split()]
-                except ValueError:
-                    values = [math.nan]  # not numbers at all: as unusable
-                if all(map(math.isfinite, values)):
-                    continue
+                values = [_atof(x) for x in text.split()]
                 shown = text if len(text) <= 60 else f"{text[:60]}... ({len(text)} characters)"
-                raise InputError(f"<{el.tag} {attr}={shown!r}> is not a finite number; "
-                                 "collisions cannot place or size a shape with it",
-                                 file=resolved.name, line=line_of(el))
+                if el.tag == "mimic":  # urdfkit's own sampler reads it, not PyBullet: numbers only
+                    try:
+                        values = [float(x) for x in text.split()]
+                    except ValueError:
+                        values = [math.nan]
+                if not all(map(math.isfinite, values)):
+                    raise InputError(f"<{el.tag} {attr}={shown!r}> is not a finite number; "
+                                     "collisions cannot place or size a shape with it",
+                                     file=resolved.name, line=line_of(el))
+                try:
+                    [float(x) for x in text.split()]
+                except ValueError:
+                    # Vectors take the first three tokens (measured), a scalar the first.
+                    used = values[:3] if attr in _VECTORS else values[:1]
+                    read = " ".join(f"{v:g}" for v in used)
+                    warnings.append(f"{resolved.name}:{line_of(el)}: <{el.tag} {attr}={shown!r}> "
+                                    f"is not numbers (xacro left in a .urdf?): PyBullet reads "
+                                    f"each token as a number or 0, so {read!r}")
+    return warnings
 
 
 def _refuse_mimic_cycles(resolved: Resolved) -> None:
