@@ -158,7 +158,7 @@ def test_a_urdf_holding_xacro_is_said_to_be_one_and_build_expands_it(tmp_path: P
     assert joints.returncode == 0, joints.stderr
     # Read literally, as PyBullet reads it, and said so.
     assert json.loads(joints.stdout)["joints"][0]["jointName"] == "${prefix}j"
-    assert f"{path}:2: holds xacro (xmlns:xacro=)" in joints.stderr and "(U009)" in joints.stderr
+    assert f"{path}:3: holds xacro (<xacro:)" in joints.stderr and "(U009)" in joints.stderr
     check = json.loads(_cli("check", str(path), "--json").stdout)
     assert [(f["code"], f["level"]) for f in check["findings"] if f["code"] == "U009"] == [
         ("U009", "warning")]
@@ -197,6 +197,9 @@ def test_the_marks_of_xacro_are_found(text: str) -> None:
 
     assert xacro_marker(f"<robot>\n\n{text}\n</robot>".encode()) is not None
     assert xacro_marker(b'<robot name="r"><link name="a$b{c}"/></robot>') is None
+    # xacro's own output keeps the namespace declaration: that alone is no xacro.
+    assert xacro_marker(b'<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                        b'<link name="a"/></robot>') is None
     # Commented out, it is not there (a real file kept its old <xacro:include> so).
     assert xacro_marker(f"<robot>\n<!-- {text} -->\n</robot>".encode()) is None
     after = xacro_marker(f"<robot><!-- c -->\n{text}</robot>".encode())
