@@ -4,11 +4,10 @@ what the page ends on is the run ``drive --json`` reports."""
 from __future__ import annotations
 
 import json
-import signal
 import subprocess
 import sys
 import time
-import urllib.request
+from typing import Any
 
 import pytest
 
@@ -60,27 +59,10 @@ def test_the_run_is_paced_to_its_speed() -> None:
     assert wall >= 0.5
 
 
-def test_cli_streams_prints_json_and_serves_until_ctrl_c() -> None:
-    proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "drive", "--steer", "0.2",
-                             "--seconds", "3", "--view", "--speed", "max", "--json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    err = ""
-    try:
-        deadline = time.monotonic() + 120
-        while "until Ctrl-C" not in err and time.monotonic() < deadline and \
-                proc.poll() is None:
-            err += proc.stderr.readline()  # type: ignore[union-attr]
-        assert "until Ctrl-C" in err, err
-        url = err.split("stays at ")[1].split()[0]
-        with urllib.request.urlopen(url, timeout=10) as r:
-            assert r.status == 200
-        proc.send_signal(signal.SIGINT)
-        out, rest = proc.communicate(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
-    assert proc.returncode == 0, rest  # the run finished clean: Ctrl-C only closed the page
+def test_cli_streams_prints_json_and_serves_until_ctrl_c(served_run: Any) -> None:
+    code, out, err = served_run("drive", "--steer", "0.2", "--seconds", "3", "--view",
+                                "--speed", "max", "--json")
+    assert code == 0, err  # the run finished clean: Ctrl-C only closed the page
     plain = subprocess.run([sys.executable, "-m", "urdfkit", "drive", "--steer", "0.2",
                             "--seconds", "3", "--json"], capture_output=True, text=True,
                            timeout=120)

@@ -3,10 +3,13 @@ against raw PyBullet on a small robot written here."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -21,19 +24,35 @@ def _cli(*args: str) -> subprocess.CompletedProcess[str]:
                           text=True, timeout=120)
 
 
-def _raw_shapes(path: Path) -> tuple[list, list]:
-    """(collision, visual) shape data of the base as raw PyBullet loads the file."""
+@contextlib.contextmanager
+def _raw(path: Path, flags: int = 0) -> Iterator[tuple[Any, int, int]]:
+    """``(pybullet, client, body)``: the file as raw ``p.loadURDF`` loads it, quietly.
+
+    A refusal raises ``pybullet.error``, as raw PyBullet does.
+    """
     import pybullet as p
 
     with quiet_stdout():
         c = p.connect(p.DIRECT)
     try:
         with quiet_stdout():
-            body = p.loadURDF(str(path), physicsClientId=c)
-        return (list(p.getCollisionShapeData(body, -1, physicsClientId=c)),
-                list(p.getVisualShapeData(body, physicsClientId=c)))
+            body = p.loadURDF(str(path), flags=flags, physicsClientId=c)
+        yield p, c, body
     finally:
         p.disconnect(physicsClientId=c)
+
+
+def _raw_shapes(path: Path) -> tuple[list, list]:
+    """(collision, visual) shape data of the base as raw PyBullet loads the file."""
+    with _raw(path) as (p, c, body):
+        return (list(p.getCollisionShapeData(body, -1, physicsClientId=c)),
+                list(p.getVisualShapeData(body, physicsClientId=c)))
+
+
+def _raw_joint_names(path: Path) -> list[str]:
+    with _raw(path) as (p, c, body):
+        return [p.getJointInfo(body, j, physicsClientId=c)[1].decode()
+                for j in range(p.getNumJoints(body, physicsClientId=c))]
 
 
 @pytest.mark.parametrize(("first", "second", "geom"), [
@@ -65,16 +84,10 @@ def test_two_shapes_in_one_geometry_load_as_pybullet_loads_them(
 
 
 def _raw_inertia(path: Path) -> list[float]:
-    import pybullet as p
+    import pybullet
 
-    with quiet_stdout():
-        c = p.connect(p.DIRECT)
-    try:
-        with quiet_stdout():
-            body = p.loadURDF(str(path), flags=p.URDF_USE_IMPLICIT_CYLINDER, physicsClientId=c)
+    with _raw(path, pybullet.URDF_USE_IMPLICIT_CYLINDER) as (p, c, body):
         return list(p.getDynamicsInfo(body, -1, physicsClientId=c)[2])
-    finally:
-        p.disconnect(physicsClientId=c)
 
 
 def test_a_geometry_without_a_shape_is_still_refused(tmp_path: Path) -> None:
@@ -83,13 +96,8 @@ def test_a_geometry_without_a_shape_is_still_refused(tmp_path: Path) -> None:
                     '</collision></link></robot>')
     import pybullet as p
 
-    with quiet_stdout():
-        c = p.connect(p.DIRECT)
-    try:
-        with quiet_stdout(), pytest.raises(p.error, match="Cannot load URDF"):
-            p.loadURDF(str(path), physicsClientId=c)
-    finally:
-        p.disconnect(physicsClientId=c)
+    with pytest.raises(p.error, match="Cannot load URDF"), _raw(path):
+        pass
     r = _cli("joints", str(path))
     assert r.returncode == 2 and "holds no shape" in r.stderr and r.stderr.count("\n") == 1
 
@@ -116,17 +124,7 @@ def test_undeclared_namespace_prefixes_are_read_as_pybullet_reads_them(tmp_path:
     path.write_text(NS.format(inertial=INERTIAL))
     with pytest.raises(etree.XMLSyntaxError, match="Namespace prefix sensor"):
         etree.fromstring(path.read_bytes())  # libxml2 refuses it...
-    import pybullet as p
-
-    with quiet_stdout():
-        c = p.connect(p.DIRECT)
-    try:
-        with quiet_stdout():
-            body = p.loadURDF(str(path), physicsClientId=c)  # ...PyBullet loads it
-        raw = [p.getJointInfo(body, j, physicsClientId=c)[1].decode()
-               for j in range(p.getNumJoints(body, physicsClientId=c))]
-    finally:
-        p.disconnect(physicsClientId=c)
+    raw = _raw_joint_names(path)  # ...PyBullet loads it
     joints = _cli("joints", str(path), "--json")
     assert joints.returncode == 0, joints.stderr
     assert [j["jointName"] for j in json.loads(joints.stdout)["joints"]] == raw == ["j"]
@@ -176,17 +174,7 @@ def test_prefixes_in_comments_and_attributes(tmp_path: Path) -> None:
                     '<link name="b"><![CDATA[ <plugin:x/> ]]></link>\n'
                     '<joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>\n'
                     '</robot>\n')
-    import pybullet as p
-
-    with quiet_stdout():
-        c = p.connect(p.DIRECT)
-    try:
-        with quiet_stdout():
-            body = p.loadURDF(str(path), physicsClientId=c)  # the attribute is ignored
-        raw = [p.getJointInfo(body, j, physicsClientId=c)[1].decode()
-               for j in range(p.getNumJoints(body, physicsClientId=c))]
-    finally:
-        p.disconnect(physicsClientId=c)
+    raw = _raw_joint_names(path)  # the attribute is ignored
     joints = _cli("joints", str(path), "--json")
     assert joints.returncode == 0, joints.stderr
     assert [j["jointName"] for j in json.loads(joints.stdout)["joints"]] == raw == ["j"]
@@ -212,19 +200,14 @@ def _mesh_robot(folder: Path, filename: str, name: str = "r.urdf") -> Path:
 
 def _raw_mesh_file(path: Path) -> str | None:
     """The mesh file raw PyBullet loaded for the base's visual, or None if it refused."""
-    import pybullet as p
+    import pybullet
 
-    with quiet_stdout():
-        c = p.connect(p.DIRECT)
     try:
-        with quiet_stdout():
-            try:
-                body = p.loadURDF(str(path), physicsClientId=c)
-            except p.error:
-                return None
-        return str(Path(p.getVisualShapeData(body, physicsClientId=c)[0][4].decode()).resolve())
-    finally:
-        p.disconnect(physicsClientId=c)
+        with _raw(path) as (p, c, body):
+            shape = p.getVisualShapeData(body, physicsClientId=c)[0][4].decode()
+    except pybullet.error:
+        return None
+    return str(Path(shape).resolve())
 
 
 @pytest.mark.parametrize(("written", "placed", "up"), [

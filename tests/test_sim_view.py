@@ -4,11 +4,10 @@ the same scenario run without a page ends."""
 from __future__ import annotations
 
 import json
-import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -47,25 +46,12 @@ def test_every_robot_ends_on_the_page_where_the_run_ends() -> None:
     assert len(stream.paths) == 2 and all(len(path) >= 2 for path in stream.paths)
 
 
-def test_cli_sim_view_prints_json_and_serves_until_ctrl_c(tmp_path: Path) -> None:
+def test_cli_sim_view_prints_json_and_serves_until_ctrl_c(tmp_path: Path,
+                                                          served_run: Any) -> None:
     out = tmp_path / "rows.jsonl"
-    proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "sim", str(TWO_CARS), "--view",
-                             "--speed", "max", "--json", "-o", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    err = ""
-    try:
-        deadline = time.monotonic() + 120
-        while "until Ctrl-C" not in err and time.monotonic() < deadline and \
-                proc.poll() is None:
-            err += proc.stderr.readline()  # type: ignore[union-attr]
-        assert "until Ctrl-C" in err, err
-        proc.send_signal(signal.SIGINT)
-        stdout, rest = proc.communicate(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
-    assert proc.returncode == 0, rest
+    code, stdout, err = served_run("sim", str(TWO_CARS), "--view", "--speed", "max", "--json",
+                                   "-o", str(out))
+    assert code == 0, err
     data = json.loads(stdout)
     assert data["steps"] == 720 and data["rows"] == 122
     assert len(out.read_text().splitlines()) == 122  # the rows file as without --view

@@ -92,7 +92,8 @@ def test_every_skip_says_why() -> None:
 
 def test_the_skip_checker_sees_a_reasonless_skip(tmp_path: Path) -> None:
     probe = tmp_path / "test_probe.py"
-    probe.write_text("import pytest\n\n@pytest.mark.skipif(True)\ndef test_a():\n    assert 1\n\n"
-                     "@pytest.mark.skipif(True, reason='why')\ndef test_b():\n    assert 1\n\n"
+    # The probe's test bodies are never run: only the decorators and calls are read.
+    probe.write_text("import pytest\n\n@pytest.mark.skipif(True)\ndef test_a():\n    pass\n\n"
+                     "@pytest.mark.skipif(True, reason='why')\ndef test_b():\n    pass\n\n"
                      "def test_c():\n    pytest.skip()\n")
     assert _skips_without_reason(probe) == [3, 12]

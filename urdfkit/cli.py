@@ -815,6 +815,16 @@ PlaneOpt = Annotated[str | None, typer.Option(
     help="Ground to drive on.", show_default="the built-in simpleplane")]
 UpOpt = Annotated[str, typer.Option(
     "--up", metavar="z|y|x", help="The car's up axis: y stands up a Y-up model.")]
+# drive --view and sim --view: the run streamed to a browser page (urdfkit/view.py).
+ViewOpt = Annotated[bool, typer.Option(
+    "--view", help="Stream the run to a browser page (urdfkit view) while it simulates "
+    "headless; the page stays up after the run until Ctrl-C.")]
+SpeedOpt = Annotated[str, typer.Option(
+    "--speed", metavar="FACTOR|max", help="With --view: simulated seconds per wall second "
+    "(max: no pacing).")]
+RunPortOpt = Annotated[int | None, typer.Option(
+    "--port", min=1, max=65535, help="With --view: the port to serve on.",
+    show_default="a free one")]
 
 
 @app.command(epilog=_examples(
@@ -861,15 +871,9 @@ def drive(
     limp: Annotated[bool, typer.Option(
         "--limp", help="Let joints that are neither wheels, hinges nor casters go limp "
         "instead of holding their start angle (with the URDF's effort).")] = False,
-    view: Annotated[bool, typer.Option(
-        "--view", help="Stream the run to a browser page (urdfkit view) while it simulates "
-        "headless; the page stays up after the run until Ctrl-C.")] = False,
-    speed: Annotated[str, typer.Option(
-        "--speed", metavar="FACTOR|max", help="With --view: simulated seconds per wall "
-        "second (max: no pacing).")] = "1",
-    port: Annotated[int | None, typer.Option(
-        "--port", min=1, max=65535, help="With --view: the port to serve on.",
-        show_default="a free one")] = None,
+    view: ViewOpt = False,
+    speed: SpeedOpt = "1",
+    port: RunPortOpt = None,
 ) -> None:
     """Drive a car headless at a fixed throttle and steer, and report where it went.
 
@@ -1008,10 +1012,15 @@ def _run_view(sc: Any, config: Any, pace: float | None, port: int | None) -> Any
     except BaseException:
         viewer.close()
         raise
+    _say_streaming("drive", viewer, pace)
+    return stream
+
+
+def _say_streaming(command: str, viewer: Any, pace: float | None) -> None:
+    """Where a run streams, and how fast (on stderr: stdout stays the command's own)."""
     pacing = "as fast as it goes" if pace is None else \
         ("in real time" if pace == 1 else f"at {pace:g}x real time")
-    show.line(f"urdfkit drive: {viewer.url} (the run streams there {pacing})", stderr=True)
-    return stream
+    show.line(f"urdfkit {command}: {viewer.url} (the run streams there {pacing})", stderr=True)
 
 
 def _run_view_summary(r: Any) -> str:
@@ -1498,15 +1507,9 @@ def sim(
         "--real-time", help="Pace the steps to the wall clock.")] = False,
     as_json: JsonOpt = False,
     force: ForceOpt = False,
-    view: Annotated[bool, typer.Option(
-        "--view", help="Stream the run to a browser page while it simulates headless; the "
-        "page stays up after the run until Ctrl-C.")] = False,
-    speed: Annotated[str, typer.Option(
-        "--speed", metavar="FACTOR|max", help="With --view: simulated seconds per wall "
-        "second (max: no pacing).")] = "1",
-    port: Annotated[int | None, typer.Option(
-        "--port", min=1, max=65535, help="With --view: the port to serve on.",
-        show_default="a free one")] = None,
+    view: ViewOpt = False,
+    speed: SpeedOpt = "1",
+    port: RunPortOpt = None,
 ) -> None:
     """Simulate a scenario of one or more robots and record their observations.
 
@@ -1624,9 +1627,7 @@ def _sim_view(s: Any, pace: float | None, port: int | None) -> Any:
     except BaseException:
         viewer.close()
         raise
-    pacing = "as fast as it goes" if pace is None else \
-        ("in real time" if pace == 1 else f"at {pace:g}x real time")
-    show.line(f"urdfkit sim: {viewer.url} (the run streams there {pacing})", stderr=True)
+    _say_streaming("sim", viewer, pace)
     return stream
 
 

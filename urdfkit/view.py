@@ -562,16 +562,6 @@ def _last_line(el: Any) -> int:
     return last
 
 
-def _rotate(q: Sequence[float], v: Sequence[float]) -> tuple[float, float, float]:
-    """``v`` turned by the quaternion ``q`` (x, y, z, w)."""
-    x, y, z, w = q
-    vx, vy, vz = v
-    # v + 2 w (u x v) + 2 u x (u x v), with u the vector part
-    cx, cy, cz = y * vz - z * vy, z * vx - x * vz, x * vy - y * vx
-    dx, dy, dz = y * cz - z * cy, z * cx - x * cz, x * cy - y * cx
-    return (vx + 2 * (w * cx + dx), vy + 2 * (w * cy + dy), vz + 2 * (w * cz + dz))
-
-
 def _wxyz(q: Sequence[float]) -> tuple[float, float, float, float]:
     return (float(q[3]), float(q[0]), float(q[1]), float(q[2]))
 
@@ -750,7 +740,10 @@ class Viewer:
                 f"{root}/axes", axes_length=size * 0.08, axes_radius=size * 0.004))
             joint = by_index.get(link.index)
             if joint is not None:  # PyBullet's axis is in the inertial frame: into the link's
-                axis = np.asarray(_rotate(link.inertial_quat, joint.axis), dtype=float)
+                from .spec import quat_to_matrix, rotate
+
+                axis = np.asarray(rotate(quat_to_matrix(link.inertial_quat), joint.axis),
+                                  dtype=float)
                 points = np.array([[-axis, axis]], dtype=np.float32) * size * 0.1
                 self._nodes["frames"].append(scene.add_line_segments(
                     f"{root}/joint_axis", points, (204, 121, 167), thickness=size * 0.006))
