@@ -207,3 +207,18 @@ def test_a_flipped_robot_gets_no_yaw_advice_and_made_up_mass_is_named(tmp_path: 
     assert len(made_up) == 1 and "camera_frame" in made_up[0]
     assert any(p.startswith("flipped over") for p in r.problems), r.problems
     assert not [w for w in r.warnings if "steering turns at" in w]
+
+
+def test_a_root_frame_without_inertial_gets_no_advice_to_zero_it(tmp_path: Path) -> None:
+    """A ROS base_footprint root without <inertial> weighs 1 kg in PyBullet too, but mass 0
+    would fix the base in place (fix never gives a root that): drive must not advise it.
+    Found on kobuki, whose 1 kg base_footprint is 29% of its simulated mass."""
+    body = _robot(tmp_path, "footprint").read_text()
+    path = tmp_path / "footprint_root.urdf"
+    path.write_text(body.replace('<link name="base_link">', '<link name="base_footprint"/>'
+                                 '<joint name="footprint" type="fixed"><parent '
+                                 'link="base_footprint"/><child link="base_link"/></joint>'
+                                 '<link name="base_link">', 1))
+    r = drive(DriveConfig(urdf=str(path), throttle=10, seconds=1))
+    assert r.drivetrain.steering == "differential"  # it drives as before
+    assert not [w for w in r.warnings if "without <inertial>" in w], r.warnings

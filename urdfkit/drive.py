@@ -673,8 +673,11 @@ class Scenario:
                         guard=self.config.guard, package_paths=self.config.package_paths) as res:
             self.warnings.extend(res.warnings)
             if self._phantom is None:  # the car, loaded first: links PyBullet gives 1 kg
+                # Not the root: mass 0 would fix the base in place, so fix never gives it
+                # that, and the advice below would be wrong for it (kobuki's base_footprint).
+                children = {c.get("link") for c in res.root.iterfind("joint/child")}
                 self._phantom = [el.get("name", "") for el in res.root.iterchildren("link")
-                                 if el.find("inertial") is None]
+                                 if el.find("inertial") is None and el.get("name") in children]
             return s.load_urdf(res.load_path, options, display=res.name)
 
     def _open(self) -> None:
