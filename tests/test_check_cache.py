@@ -203,7 +203,7 @@ def test_damaged_entries_are_never_trusted(cache: Path, tmp_path: Path,
     robot.write_text(ARM.format(mesh="missing.stl"))
     truth = _fresh([robot])
     check_paths([robot], jobs=1)
-    entries = list((cache / FOLDER).rglob("*.json"))
+    entries = [p for p in (cache / FOLDER).rglob("*.json") if p.parent.name != "runs"]
     assert len(entries) == 1
     for damage in (entries[0].read_bytes()[:20],  # cut short
                    b'{"deps": {}, "findings": [1, 2]}',  # the wrong shape
@@ -288,3 +288,109 @@ def test_the_keyed_size_limit_is_the_readers() -> None:
     from urdfkit import resultcache, xmlio
 
     assert resultcache.MAX_FILE_BYTES == xmlio.MAX_FILE_BYTES
+
+
+# The run manifest: one file per run that lets a re-run skip reading each file and its entry.
+
+def _age(*paths: Path) -> None:
+    """Give files an mtime an hour ago: older than any run, as a checked-out tree's are."""
+    old = (os.stat(paths[0]).st_mtime_ns - 3600 * 10**9,) * 2
+    for p in paths:
+        os.utime(p, ns=old)
+
+
+def _manifest_hits(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    from urdfkit.resultcache import RunManifest
+
+    hits: list[str] = []
+    lookup = RunManifest.lookup
+
+    def counted(self: RunManifest, display: str, path: str) -> object:
+        found = lookup(self, display, path)
+        if found is not None:
+            hits.append(Path(path).name)
+        return found
+
+    monkeypatch.setattr(RunManifest, "lookup", counted)
+    return hits
+
+
+def test_an_unchanged_tree_is_answered_from_the_manifest(
+        cache: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    _stl(tmp_path / "a.stl", 0.1)
+    (tmp_path / "r.urdf").write_text(ARM.format(mesh="a.stl"))
+    (tmp_path / "s.urdf").write_text(ARM.format(mesh="missing.stl"))
+    _age(tmp_path / "a.stl", tmp_path / "r.urdf", tmp_path / "s.urdf")
+    truth = _fresh([tmp_path])
+    hits = _manifest_hits(monkeypatch)
+    check_paths([tmp_path], jobs=1)
+    assert hits == []  # no manifest yet
+    # Remove every per-file entry: what is still a hit can only come from the manifest.
+    for entry in (cache / FOLDER).rglob("*.json"):
+        if entry.parent.name != "runs":
+            entry.unlink()
+    warm = check_paths([tmp_path], jobs=1)
+    assert sorted(hits) == ["r.urdf", "s.urdf"]
+    assert _cached(warm) == {"r.urdf": True, "s.urdf": True}
+    assert warm.to_dict()["findings"] == truth
+
+
+def test_the_manifest_misses_on_any_change(cache: Path, tmp_path: Path,
+                                           monkeypatch: pytest.MonkeyPatch) -> None:
+    _stl(tmp_path / "a.stl", 0.1)
+    robot, other = tmp_path / "r.urdf", tmp_path / "s.urdf"
+    robot.write_text(ARM.format(mesh="a.stl"))
+    other.write_text(ARM.format(mesh="missing.stl"))
+    _age(tmp_path / "a.stl", robot, other)
+    check_paths([tmp_path], jobs=1)
+    hits = _manifest_hits(monkeypatch)
+    # A mesh of another size: only the file that reads it misses, and its findings change.
+    _stl(tmp_path / "a.stl", 0.3)
+    _age(tmp_path / "a.stl")
+    result = check_paths([tmp_path], jobs=1)
+    assert hits == ["s.urdf"]
+    assert result.to_dict()["findings"] == _fresh([tmp_path])
+    # An edit that keeps the size and puts the mtime back: the ctime still tells.
+    hits.clear()
+    before = os.stat(robot)
+    text = robot.read_text().replace('upper="1"', 'upper="2"')
+    robot.write_text(text)
+    os.utime(robot, ns=(before.st_atime_ns, before.st_mtime_ns))
+    assert os.stat(robot).st_size == before.st_size
+    result = check_paths([tmp_path], jobs=1)
+    assert hits == ["s.urdf"]
+    assert result.to_dict()["findings"] == _fresh([tmp_path])
+
+
+def test_a_file_written_just_before_a_run_is_read_again(cache: Path, tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    # Within the clock's grain an edit can keep a file's stat (git's "racily clean" entry):
+    # a file modified less than two seconds before the run that recorded it is never trusted.
+    robot = tmp_path / "r.urdf"
+    robot.write_text(ARM.format(mesh="missing.stl"))
+    check_paths([robot], jobs=1)
+    hits = _manifest_hits(monkeypatch)
+    assert _cached(check_paths([robot], jobs=1)) == {"r.urdf": True}  # by its content
+    assert hits == []
+
+
+def test_a_damaged_manifest_is_never_trusted(cache: Path, tmp_path: Path) -> None:
+    robot = tmp_path / "r.urdf"
+    robot.write_text(ARM.format(mesh="missing.stl"))
+    _age(robot)
+    truth = _fresh([robot])
+    check_paths([robot], jobs=1)
+    (manifest,) = (cache / FOLDER / "runs").glob("*.json")
+    good = json.loads(manifest.read_bytes())
+    record = good["files"][str(robot)]
+    wrong_findings = [record[0], record[1], record[2], [{"code": "U999"}]]
+    for damage in (manifest.read_bytes()[:30], b"[]", b'{"started": "x", "files": {}}',
+                   json.dumps({"started": good["started"],
+                               "files": {str(robot): wrong_findings}}).encode(),
+                   json.dumps({"started": good["started"],
+                               "files": {str(robot): ["other.urdf", *record[1:]]}}).encode()):
+        manifest.write_bytes(damage)
+        assert check_paths([robot], jobs=1).to_dict()["findings"] == truth
+    manifest.unlink()
+    os.mkfifo(manifest)  # a FIFO in its place is skipped, not waited on
+    assert check_paths([robot], jobs=1).to_dict()["findings"] == truth

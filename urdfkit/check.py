@@ -15,10 +15,14 @@ import sys
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from .errors import InputError, ParameterError
 from .finding import LEVELS, Finding
 from .spec import PYBULLET_LINE_BYTES
+
+if TYPE_CHECKING:
+    from .resultcache import ResultCache, RunManifest
 
 #: File suffixes a folder search picks up.
 SUFFIXES = (".urdf", ".xacro")
@@ -36,6 +40,10 @@ class FileResult:
     findings: list[Finding] = field(default_factory=list)
     #: Whether the findings came from the result cache (not in the JSON).
     cached: bool = field(default=False, compare=False)
+    #: What the run's manifest keeps of a cacheable result: the file's stat, the paths it
+    #: read with their signatures, the findings as dicts (:class:`urdfkit.resultcache.RunManifest`).
+    entry: tuple[tuple[int, int, int, int], dict[str, Any], list[dict[str, Any]]] | None = \
+        field(default=None, compare=False, repr=False)
 
     def count(self, level: str) -> int:
         """How many findings of ``level``."""
@@ -283,21 +291,16 @@ _Job = tuple[str, str, str | None, dict[str, str], bool, dict[str, str], bool, b
 _caches: dict[tuple[object, ...], object] = {}
 
 
-def _check_one(job: _Job) -> FileResult:
-    display, path, problem, packages, no_exec, xacro_args, physics, use_cache = job
-    if problem is not None:
-        return FileResult(display, [Finding("U000", "error", problem, display)])
-    pkgs = {k: Path(v) for k, v in packages.items()} if packages else {}
-    if not use_cache:
-        return check_file(display, path, pkgs, no_exec, xacro_args, physics)
-    from . import deps
+def _result_cache(packages: Mapping[str, str], no_exec: bool, xacro_args: Mapping[str, str],
+                  physics: bool) -> ResultCache | None:
+    """The result cache for these options, made once per option set and process."""
     from .resultcache import ResultCache
 
     memo = (tuple(sorted(packages.items())), no_exec, tuple(sorted(xacro_args.items())),
             physics, os.environ.get("URDFKIT_CACHE_DIR"))
-    if memo not in _caches:  # one per option set and process (the key prefix is made once)
-        options: dict[str, object] = {"packages": packages, "no_exec": no_exec,
-                                      "xacro_args": xacro_args, "physics": physics}
+    if memo not in _caches:  # the key prefix is made once
+        options: dict[str, object] = {"packages": dict(packages), "no_exec": no_exec,
+                                      "xacro_args": dict(xacro_args), "physics": physics}
         if physics:  # U950/U951 come from PyBullet itself
             from importlib.metadata import version
 
@@ -305,16 +308,34 @@ def _check_one(job: _Job) -> FileResult:
         _caches[memo] = ResultCache.open(options)
     cache = _caches[memo]
     assert cache is None or isinstance(cache, ResultCache)
-    key = cache.key(display, path) if cache is not None else None
-    if cache is None or key is None:
+    return cache
+
+
+def _check_one(job: _Job) -> FileResult:
+    display, path, problem, packages, no_exec, xacro_args, physics, use_cache = job
+    if problem is not None:
+        return FileResult(display, [Finding("U000", "error", problem, display)])
+    pkgs = {k: Path(v) for k, v in packages.items()} if packages else {}
+    cache = _result_cache(packages, no_exec, xacro_args, physics) if use_cache else None
+    if cache is None:
         return check_file(display, path, pkgs, no_exec, xacro_args, physics)
-    hit = cache.get(key)
+    from . import deps
+    from .resultcache import file_stat
+
+    seen = file_stat(path)  # before the bytes are read: an edit after this misses next run
+    key = cache.key(display, path)
+    if key is None:
+        return check_file(display, path, pkgs, no_exec, xacro_args, physics)
+    hit = cache.get_entry(key)
     if hit is not None:
-        return FileResult(display, [Finding(**f) for f in hit], cached=True)
+        return FileResult(display, [Finding(**f) for f in hit[1]], cached=True,
+                          entry=(seen, *hit) if seen is not None else None)
     with deps.record() as recorded:  # the file itself is in the key, by its content
         result = check_file(display, path, pkgs, no_exec, xacro_args, physics)
     recorded.pop(os.path.abspath(path), None)
-    cache.put(key, recorded, [f.to_dict() for f in result.findings])
+    found = [f.to_dict() for f in result.findings]
+    if cache.put(key, recorded, found) and seen is not None:
+        result.entry = (seen, dict(recorded), found)
     return result
 
 
@@ -372,33 +393,36 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
     """
     if jobs is not None and (isinstance(jobs, bool) or jobs < 1):
         raise ParameterError(f"`jobs` must be 1 or more, got {jobs!r}", param="jobs")
-    files = discover(paths)
+    given = [os.fspath(p) for p in paths]
+    files = discover(given)
     pkgs = {k: str(v) for k, v in (packages or {}).items()}
     args = dict(xacro_args or {})
-    work = [(display, path, problem, pkgs, no_exec, args, physics, cache)
-            for display, path, problem in files]
-    workers = min(jobs or default_jobs(), max(1, len(work) // _PARALLEL_MIN))
-    if workers <= 1:
-        results = [_check_one(w) for w in work]
-    else:
-        import multiprocessing
-
-        # Large chunks: a URDF takes about a millisecond to check, less than a round trip.
-        chunk = max(1, len(work) // (workers * 4))
-        context = multiprocessing.get_context("fork" if sys.platform.startswith("linux")
-                                              else "spawn")
-        # The with block terminates the workers on the way out, normal or not (Ctrl-C).
-        with context.Pool(workers, initializer=worker_init) as pool:
-            results = pool.map(_check_one, work, chunksize=chunk)
-    if cache and not all(fr.cached for fr in results):
+    manifest = _manifest(given, pkgs, no_exec, args, physics) if cache else None
+    results: list[FileResult | None] = [None] * len(files)
+    todo = []
+    for n, (display, path, problem) in enumerate(files):
+        hit = manifest.lookup(display, path) if manifest and problem is None else None
+        if hit is not None:
+            results[n] = FileResult(display, [Finding(**f) for f in hit], cached=True)
+        else:
+            todo.append(n)
+    work = [(*files[n], pkgs, no_exec, args, physics, cache) for n in todo]
+    for n, fr in zip(todo, _run_jobs(work, jobs), strict=True):
+        results[n] = fr
+        if manifest is not None and files[n][2] is None:
+            manifest.add(files[n][0], files[n][1], fr.entry)
+    if manifest is not None:
+        manifest.save()
+    if cache and todo:
         from .resultcache import ResultCache
 
         store = ResultCache.open({})
         if store is not None:
             store.trim()  # new entries were written: keep the folder under its cap
+    done = [fr for fr in results if fr is not None]
     sel, ign = tuple(select), tuple(ignore)
     noted = False
-    for fr in results:
+    for fr in done:
         kept = []
         for f in fr.findings:
             if f.code in ONCE_PER_RUN:  # the same advice for every file: say it once
@@ -408,4 +432,30 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
             if _keep(f.code, sel, ign):
                 kept.append(f)
         fr.findings = kept
-    return CheckResult(results)
+    return CheckResult(done)
+
+
+def _manifest(paths: Sequence[str], packages: Mapping[str, str], no_exec: bool,
+              xacro_args: Mapping[str, str], physics: bool) -> RunManifest | None:
+    cache = _result_cache(packages, no_exec, xacro_args, physics)
+    if cache is None:
+        return None
+    from .resultcache import RunManifest
+
+    return RunManifest(cache, paths)
+
+
+def _run_jobs(work: list[_Job], jobs: int | None) -> list[FileResult]:
+    """Check each job, over ``jobs`` processes (default: every core) when there are enough."""
+    workers = min(jobs or default_jobs(), max(1, len(work) // _PARALLEL_MIN))
+    if workers <= 1:
+        return [_check_one(w) for w in work]
+    import multiprocessing
+
+    # Large chunks: a URDF takes about a millisecond to check, less than a round trip.
+    chunk = max(1, len(work) // (workers * 4))
+    context = multiprocessing.get_context("fork" if sys.platform.startswith("linux")
+                                          else "spawn")
+    # The with block terminates the workers on the way out, normal or not (Ctrl-C).
+    with context.Pool(workers, initializer=worker_init) as pool:
+        return pool.map(_check_one, work, chunksize=chunk)

@@ -103,32 +103,44 @@ def record() -> Iterator[dict[str, Signature]]:
         _active.remove(seen)
 
 
-def unchanged(recorded: Mapping[str, object]) -> bool:
-    """Whether every recorded path is as it was (see the module docstring)."""
+def unchanged(recorded: Mapping[str, object],
+              memo: dict[str, tuple[object, bool]] | None = None) -> bool:
+    """Whether every recorded path is as it was (see the module docstring).
+
+    ``memo`` keeps each path's verdict within one run, where many files share a mesh or an
+    include: a path judged once against the same recorded signature is not judged again.
+    """
+    if memo is None:
+        return all(_unchanged(path, was) for path, was in recorded.items())
     for path, was in recorded.items():
-        was = tuple(was) if isinstance(was, list) else was
-        if path.endswith(os.sep):  # a folder listing: its mtime
-            try:
-                now: object = ("listing", os.stat(path).st_mtime_ns)
-            except (OSError, ValueError):
-                now = None
-            if was != now:
-                return False
-            continue
-        try:
-            st = os.stat(path)
-        except (OSError, ValueError):
-            if was is not None:
-                return False
-            continue
-        if not stat.S_ISREG(st.st_mode):
-            if was != (("dir",) if stat.S_ISDIR(st.st_mode) else ("other", st.st_mode)):
-                return False
-            continue
-        if not (isinstance(was, tuple) and len(was) == 5):
-            return False
-        if was[:4] == (st.st_size, st.st_mtime_ns, st.st_ino, st.st_mode):
-            continue  # the same stat: the same file, as git's index judges it
-        if was[0] != st.st_size or not was[4] or digest(path, st.st_size) != was[4]:
+        known = memo.get(path)
+        if known is not None and known[0] == was:
+            ok = known[1]
+        else:
+            ok = _unchanged(path, was)
+            memo[path] = (was, ok)
+        if not ok:
             return False
     return True
+
+
+def _unchanged(path: str, was: object) -> bool:
+    """Whether one recorded path is as it was."""
+    was = tuple(was) if isinstance(was, list) else was
+    if path.endswith(os.sep):  # a folder listing: its mtime
+        try:
+            now: object = ("listing", os.stat(path).st_mtime_ns)
+        except (OSError, ValueError):
+            now = None
+        return was == now
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return was is None
+    if not stat.S_ISREG(st.st_mode):
+        return was == (("dir",) if stat.S_ISDIR(st.st_mode) else ("other", st.st_mode))
+    if not (isinstance(was, tuple) and len(was) == 5):
+        return False
+    if was[:4] == (st.st_size, st.st_mtime_ns, st.st_ino, st.st_mode):
+        return True  # the same stat: the same file, as git's index judges it
+    return bool(was[0] == st.st_size and was[4] and digest(path, st.st_size) == was[4])

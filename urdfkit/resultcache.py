@@ -26,7 +26,8 @@ import hashlib
 import json
 import os
 import stat
-from collections.abc import Mapping
+import time
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -98,6 +99,20 @@ def _read_regular(path: str, limit: int) -> bytes | None:
         os.close(fd)
 
 
+def valid_findings(findings: object) -> bool:
+    """Whether ``findings``, read from a cache file, has the shape of stored findings."""
+    if not isinstance(findings, list):
+        return False
+    for f in findings:
+        if not (isinstance(f, dict) and set(f) == set(_FIELDS)
+                and isinstance(f["code"], str) and isinstance(f["level"], str)
+                and isinstance(f["message"], str) and isinstance(f["file"], str)
+                and (f["line"] is None or type(f["line"]) is int)
+                and (f["origin"] is None or isinstance(f["origin"], str))):
+            return False
+    return True
+
+
 class ResultCache:
     """Entries under ``<cache>/check-v1``; see the module docstring."""
 
@@ -135,39 +150,43 @@ class ResultCache:
 
     def get(self, key: str) -> list[dict[str, Any]] | None:
         """The findings stored under ``key`` (as dicts), if every dependency is unchanged."""
+        entry = self.get_entry(key)
+        return entry[1] if entry is not None else None
+
+    def get_entry(self, key: str, memo: dict[str, tuple[object, bool]] | None = None
+                  ) -> tuple[dict[str, Any], list[dict[str, Any]]] | None:
+        """The dependencies and findings stored under ``key``, if every dependency is unchanged."""
         raw = _read_regular(self._entry(key), MAX_ENTRY_BYTES)
         if raw is None:
             return None
         try:
             entry = json.loads(raw)
             recorded, findings = entry["deps"], entry["findings"]
-            if not (isinstance(recorded, dict) and isinstance(findings, list)):
-                return None
-            for f in findings:
-                if not (isinstance(f, dict) and set(f) == set(_FIELDS)
-                        and isinstance(f["code"], str) and isinstance(f["level"], str)
-                        and isinstance(f["message"], str) and isinstance(f["file"], str)
-                        and (f["line"] is None or type(f["line"]) is int)
-                        and (f["origin"] is None or isinstance(f["origin"], str))):
-                    return None
         except (ValueError, KeyError, TypeError):  # damaged: a miss, never trusted
             return None
-        if not deps.unchanged(recorded):
+        if not (isinstance(recorded, dict) and valid_findings(findings)):
             return None
-        return findings
+        if not deps.unchanged(recorded, memo):
+            return None
+        return recorded, findings
 
     def put(self, key: str, recorded: Mapping[str, deps.Signature],
-            findings: list[dict[str, Any]]) -> None:
-        """Store a result (unless it depends on the machine's load)."""
+            findings: list[dict[str, Any]]) -> bool:
+        """Store a result, unless it depends on the machine's load.
+
+        Returns:
+            Whether the result may be kept (it is stored unless the folder cannot be written).
+        """
         if any(any(t in str(f.get("message")) for t in TRANSIENT) for f in findings):
-            return
+            return False
         try:
             data = json.dumps({"deps": recorded, "findings": findings}, allow_nan=False,
                               ensure_ascii=True).encode("ascii")
         except (ValueError, TypeError):
-            return
+            return False
         if write_entry(Path(self._entry(key)), data):
             self.wrote += 1
+        return True
 
     def trim(self, limit: int = MAX_BYTES) -> int:
         """Remove the oldest entries while the folder holds more than ``limit`` bytes.
@@ -202,3 +221,89 @@ class ResultCache:
                 total -= size
                 removed += 1
         return removed
+
+
+#: What a manifest keeps of a file's own ``stat``: size, mtime, inode, ctime.
+FileStat = tuple[int, int, int, int]
+#: A file modified this close to the start of the run that recorded it is read again, as git
+#: treats a "racily clean" index entry: within the clock's grain an edit can keep the stat.
+RACY_NS = 2_000_000_000
+
+
+def file_stat(path: str) -> FileStat | None:
+    """The signature a manifest keeps of a checked file, or None if it cannot be stat'ed."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return (st.st_size, st.st_mtime_ns, st.st_ino, st.st_ctime_ns)
+
+
+class RunManifest:
+    """One run's results, by path: a re-run over an unchanged tree reads one file, not one each.
+
+    The per-file entries stay the cache; the manifest only saves their lookups. A file whose
+    ``stat`` is what the last run saw (and was not modified within :data:`RACY_NS` of that run's
+    start) keeps the result recorded for it, if its dependencies are unchanged too; any other
+    file is looked up by its content as before. The manifest is read as untrusted (a record of
+    the wrong shape is a miss) and rewritten, atomically, after any run that was not all hits.
+    """
+
+    def __init__(self, cache: ResultCache, paths: Sequence[str]) -> None:
+        h = hashlib.blake2b(cache._prefix, digest_size=20)
+        for p in (os.getcwd(), *paths):
+            h.update(os.fsencode(p) + b"\0")
+        self.path = os.path.join(cache._root, "runs", f"{h.hexdigest()}.json")
+        self.started = time.time_ns()
+        self.memo: dict[str, tuple[object, bool]] = {}
+        self._old_started, self._old = self._load()
+        self._new: dict[str, list[Any]] = {}
+        self.misses = 0
+
+    def _load(self) -> tuple[int, dict[str, Any]]:
+        raw = _read_regular(self.path, MAX_ENTRY_BYTES)
+        if raw is None:
+            return 0, {}
+        try:
+            data = json.loads(raw)
+            started, files = data["started"], data["files"]
+        except (ValueError, KeyError, TypeError):
+            return 0, {}
+        if type(started) is not int or not isinstance(files, dict):
+            return 0, {}
+        return started, files
+
+    def lookup(self, display: str, path: str) -> list[dict[str, Any]] | None:
+        """The findings recorded for ``path`` if neither it nor anything it read changed."""
+        absolute = os.path.abspath(path)
+        record = self._old.get(absolute)
+        if not (isinstance(record, list) and len(record) == 4 and record[0] == display
+                and isinstance(record[1], list) and len(record[1]) == 4
+                and isinstance(record[2], dict)):
+            return None
+        now = file_stat(path)
+        if now is None or list(now) != record[1] or now[1] + RACY_NS >= self._old_started:
+            return None
+        if not valid_findings(record[3]) or not deps.unchanged(record[2], self.memo):
+            return None
+        self._new[absolute] = record
+        return record[3]
+
+    def add(self, display: str, path: str, entry: tuple[FileStat, dict[str, Any],
+                                                      list[dict[str, Any]]] | None) -> None:
+        """Record a result found another way (``entry`` None: not cacheable)."""
+        self.misses += 1
+        if entry is not None:
+            self._new[os.path.abspath(path)] = [display, list(entry[0]), entry[1], entry[2]]
+
+    def save(self) -> None:
+        """Write the manifest if this run found anything the old one did not hold."""
+        if not self.misses:
+            return
+        try:
+            data = json.dumps({"started": self.started, "files": self._new}, allow_nan=False,
+                              ensure_ascii=True).encode("ascii")
+        except (ValueError, TypeError):
+            return
+        if len(data) <= MAX_ENTRY_BYTES:
+            write_entry(Path(self.path), data)
