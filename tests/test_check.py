@@ -11,7 +11,8 @@ from typer.testing import CliRunner
 from urdfkit.check import check_file, check_paths, discover, parse_codes
 from urdfkit.cli import app
 from urdfkit.errors import ParameterError
-from urdfkit.validate import ALL_RULES, CODES, GUARD_RULES
+from urdfkit.guard import GUARD_RULES
+from urdfkit.validate import ALL_RULES, CODES
 
 INERTIAL = ('<inertial><mass value="1"/>'
             '<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>')

@@ -25,7 +25,8 @@ from typer.testing import CliRunner
 from urdfkit.check import CheckResult, FileResult
 from urdfkit.ci import FORMATS, github_commands, junit_xml, relative_path, sarif_log, xml_safe
 from urdfkit.cli import app
-from urdfkit.validate import CODES, Finding
+from urdfkit.finding import Finding
+from urdfkit.validate import CODES
 
 DATA = Path(__file__).parent / "data"
 ROOT = Path(__file__).parent.parent

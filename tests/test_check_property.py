@@ -11,7 +11,8 @@ from lxml import etree
 
 from urdfkit.builder import Box, Collision, Inertial, Joint, Limit, Link, Robot
 from urdfkit.errors import InputError
-from urdfkit.validate import ALL_RULES, guard, guard_findings, run_rules
+from urdfkit.guard import guard, guard_findings, run_rules
+from urdfkit.validate import ALL_RULES
 
 MUTATIONS = ("none", "drop_link", "duplicate_link", "duplicate_joint", "cycle", "corrupt_number")
 

@@ -20,11 +20,12 @@ for floor, names in enumerate([
     "errors deps finding spec style templatedir suggest output cache xmlio tomlio builder catalog"
     " displaymesh stdio jsontext",
     # sources: files, packages, xacro, and the guard every loader calls
-    "uris meshes resultcache _xacro_worker expand validate resolve",
+    "uris meshes resultcache _xacro_worker expand guard resolve",
     # the engine session
     "session",
     # run and draw
     "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
+    " validate"
     " diff collisions fix sweep view",
     # presentation and the command line
     "present ci cli __main__",

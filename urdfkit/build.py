@@ -18,9 +18,10 @@ from .catalog import TEMPLATES, build_template, parse_assignments
 from .errors import InputError, ParameterError
 from .expand import expand_xacro
 from .finding import Finding
+from .guard import GUARD_CODES, guard_findings, run_rules
 from .output import atomic_write
 from .resolve import locate
-from .validate import ALL_RULES, GUARD_CODES, guard_findings, run_rules
+from .validate import ALL_RULES
 from .xmlio import parse_xml, read_bytes, to_bytes, xacro_marker
 
 

@@ -187,7 +187,8 @@ def check_file(display: str, path: str | Path,
     from lxml import etree
 
     from .expand import XacroNotExpanded
-    from .validate import ALL_RULES, refuse_oversized, run_rules
+    from .guard import refuse_oversized, run_rules
+    from .validate import ALL_RULES
     from .xmlio import line_of, long_line, parse_xml, tolerate_quirks, xacro_marker, xacro_note
 
     path = Path(path)

@@ -394,9 +394,9 @@ class _Sampler:
 
 def _concave_links(resolved: Resolved, packages: Mapping[str, Path] | None) -> set[str]:
     """Links with a collision mesh PyBullet replaces by its convex hull, concave or not."""
+    from .guard import reference
     from .meshes import CONCAVE_FRACTION, properties
     from .spec import attr_vec
-    from .validate import reference
 
     base = resolved.source.resolve().parent
     out = set()

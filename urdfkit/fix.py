@@ -38,10 +38,11 @@ from typing import Any
 from lxml import etree
 
 from .errors import InputError, ParameterError
+from .guard import Report, refuse_oversized
 from .spec import attr_float as _num
 from .spec import attr_vec as _vec
 from .spec import rpy_to_matrix, sym_eigenvalues, transpose
-from .validate import ALL_RULES, STUB_SIZE, Report, Solid, link_solid, refuse_oversized
+from .validate import ALL_RULES, STUB_SIZE, Solid, link_solid
 from .xmlio import fmt_float, fmt_vec, parse_xml, read_bytes, start_tags
 
 #: Density (kg/m^3) that gives a link with no ``<inertial>`` its mass: water.

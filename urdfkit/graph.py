@@ -56,7 +56,7 @@ def dot_graph(root: etree._Element, name: str | None = None) -> str:
     """The kinematic graph of a guarded ``<robot>`` document as DOT text.
 
     Args:
-        root: The ``<robot>`` element (after :func:`urdfkit.validate.guard`, which rules out
+        root: The ``<robot>`` element (after :func:`urdfkit.guard.guard`, which rules out
             cycles and second parents).
         name: The graph's name; defaults to the robot's name attribute.
     """

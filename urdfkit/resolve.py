@@ -24,11 +24,12 @@ from lxml import etree
 
 from .errors import InputError
 from .expand import expand_xacro
+from .finding import Finding
+from .guard import GUARD_WARNINGS, STRICTER, reference, refuse_oversized
+from .guard import guard as run_guard
 from .spec import FILE_SHAPES, FILE_TAGS, PYBULLET_LINE_BYTES, ignored_shape
 from .uris import not_a_file, pybullet_data_path
 from .uris import parse_packages as parse_packages  # re-exported: callers import it here
-from .validate import GUARD_WARNINGS, STRICTER, Finding, reference, refuse_oversized
-from .validate import guard as run_guard
 from .xmlio import (
     line_of,
     long_line,
@@ -129,7 +130,7 @@ def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
     Returns whether PyBullet needs the rewritten copy: a ``package://`` or ``file://``
     reference, or a mesh found only in pybullet_data.
 
-    Each reference is judged by :func:`urdfkit.validate.reference`, the rule ``check`` runs:
+    Each reference is judged by :func:`urdfkit.guard.reference`, the rule ``check`` runs:
     a missing or unreadable mesh, a folder/FIFO/device, a format PyBullet does not read, an
     unknown package is one line naming the file and the URDF line, before PyBullet sees it
     (which would fail with "Could not parse visual element", hang or abort). A missing
@@ -156,7 +157,7 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
     """Locate, expand, parse, guard and package-resolve a URDF for loading.
 
     With ``guard=False`` the guard's refusals that are stricter than PyBullet (see
-    :data:`urdfkit.validate.LIFTABLE_CODES`) become :attr:`Resolved.warnings`; whatever
+    :data:`urdfkit.guard.LIFTABLE_CODES`) become :attr:`Resolved.warnings`; whatever
     crashes PyBullet is refused either way. ``strict_args=False`` lets a xacro file ignore
     ``xacro_args`` it does not take (``check`` passes one set to every file). With
     ``meshes=False`` (``tree``, which reads the file only) a mesh that cannot be found or

@@ -309,7 +309,7 @@ class Session:
                   display: str | None = None) -> int:
         """Load a URDF file that has already passed the guard; return the body id.
 
-        Callers must run :func:`urdfkit.validate.guard` first: PyBullet segfaults on some
+        Callers must run :func:`urdfkit.guard.guard` first: PyBullet segfaults on some
         malformed files instead of raising.
         """
         o = options or LoadOptions()

@@ -92,7 +92,7 @@ class TreeNode:
 def kinematic_tree(root: etree._Element) -> TreeNode:
     """The link tree of a guarded ``<robot>`` document, with PyBullet's joint indices.
 
-    Needs no PyBullet. The document must have passed :func:`urdfkit.validate.guard` (one
+    Needs no PyBullet. The document must have passed :func:`urdfkit.guard.guard` (one
     root, single parents, no cycle); :func:`urdfkit.resolve.resolve` ensures that.
     """
     links = [el.get("name", "") for el in children(root, "link")]
