@@ -18,7 +18,7 @@ LAYERS: dict[str, int] = {}
 for floor, names in enumerate([
     # spec and model
     "errors deps finding spec style templatedir suggest output cache xmlio tomlio builder catalog"
-    " displaymesh stdio jsontext",
+    " displaymesh stdio jsontext builder_elements",
     # sources: files, packages, xacro, and the guard every loader calls
     "uris meshes resultcache _xacro_worker expand guard resolve",
     # the engine session
