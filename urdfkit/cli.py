@@ -163,7 +163,7 @@ def _command(name: str, library_defaults: bool) -> Callable[..., Any]:
     module = importlib.import_module(f"urdfkit.commands.{COMMANDS[name]}")
     if library_defaults and hasattr(module, "use_library_defaults"):
         module.use_library_defaults()
-    return getattr(module, name)  # type: ignore[no-any-return]
+    return getattr(module, name)
 
 
 def _build(names: Iterable[str], *, library_defaults: bool = True,

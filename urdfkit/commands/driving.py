@@ -32,6 +32,7 @@ from urdfkit.commands.shared import (
     examples,
     flag_message,
     input_flags,
+    parse_speed,
     say_streaming,
     serve_until_interrupted,
     split_joints,
@@ -104,7 +105,7 @@ def drive(
 
     if view and gui:
         raise ParameterError("`view` replaces `gui`: give one of them", param="view")
-    pace = speed(speed) if view else None
+    pace = parse_speed(speed) if view else None
     if gui and not has_display():
         raise ParameterError("`gui` needs a display (DISPLAY is not set); drop it to drive "
                              "headless, or use --view", param="gui")

@@ -166,7 +166,7 @@ RunPortOpt = Annotated[int | None, typer.Option(
     show_default="a free one")]
 
 
-def speed(text: str) -> float | None:
+def parse_speed(text: str) -> float | None:
     """``--speed``: a positive factor, or None for ``max``."""
     import math
 

@@ -15,6 +15,7 @@ from urdfkit.commands.shared import (
     ViewOpt,
     command,
     examples,
+    parse_speed,
     say_streaming,
     serve_until_interrupted,
 )
@@ -75,7 +76,7 @@ def sim(
     if view and (gui or real_time):
         raise ParameterError("`view` paces the run itself (--speed) and replaces `gui`: drop "
                              "--gui and --real-time", param="view")
-    pace = speed(speed) if view else None
+    pace = parse_speed(speed) if view else None
     if gui and not has_display():
         raise ParameterError("`gui` needs a display (DISPLAY is not set); drop it to run "
                              "headless, or use --view", param="gui")
