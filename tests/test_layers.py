@@ -27,7 +27,7 @@ for floor, names in enumerate([
     "session",
     # run and draw
     "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
-    " diff collisions fix sweep_journal sweep view",
+    " diff collisions fix sweep_journal sweep sweep_run view",
     # presentation and the command line
     "present ci cli __main__ commands.shared commands.build commands.inspecting commands.checking"
     " commands.driving commands.drawing commands.simulating",

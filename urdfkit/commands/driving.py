@@ -1,6 +1,5 @@
 """drive and sweep: a headless throttle/steer run, and many runs (urdfkit/drive.py, sweep)."""
 
-from pathlib import Path
 from typing import Annotated, Any
 
 import typer
@@ -287,136 +286,41 @@ def sweep(
     rows are written as points finish. Exit 0: every point ran; 1: some failed (their rows say
     why); 2: bad input; 130: interrupted (the rows so far are kept). See docs/sweep.md.
     """
-    from urdfkit import sweep as sweeping
-    from urdfkit.errors import ParameterError
+    from urdfkit import sweep_run
 
-    if kind == "sim":
-        if scenario is None:
-            raise ParameterError("sweep sim needs the scenario file: urdfkit sweep sim "
-                                 "scenario.toml --vary PATH=VALUES", param="kind")
-        changed = [name for name, value, default in (
-            ("--throttle", throttle, 10.0), ("--steer", steer, 0.0),
-            ("--drivetrain", drivetrain, "differential"), ("--seconds", seconds, None),
-            ("--steps", steps, None), ("--time-step", time_step, 1.0 / 240.0),
-            ("--max-force", max_force, None), ("--urdf", urdf, None), ("--plane", plane, None),
-            ("--set", set_, None), ("--arg", arg, None), ("--package", package, None),
-            ("--package-path", package_path, None), ("--up", up, "z")) if value != default]
-        if changed:
-            raise ParameterError(f"{', '.join(changed)}: drive options; a sim sweep varies the "
-                                 "scenario's keys (--vary 'physics.time_step=...')")
-        base: Any = scenario
-    elif kind == "drive":
-        if scenario is not None:
-            raise ParameterError(f"sweep drive takes no scenario file (got {scenario!r}); "
-                                 "drive options are flags", param="kind")
-        if seconds is not None and steps is not None:
-            raise ParameterError("give `seconds` or `steps`, not both", param="seconds")
-        params = None
-        if set_:
-            from urdfkit.catalog import parse_assignments
-
-            params = parse_assignments(set_, "template_params")
-        base = {"throttle": throttle, "steer": steer, "drivetrain": drivetrain,
-                "seconds": 10.0 if seconds is None else seconds, "steps": steps,
-                "time_step": time_step, "max_force": 10.0 if max_force is None else max_force,
-                "urdf": urdf, "plane": plane, "template_params": params, "xacro_args": arg,
-                "packages": package, "package_paths": package_path, "up": up}
-    else:
-        raise ParameterError(f"`kind` must be drive or sim, got {kind!r}", param="kind")
-    if not vary:
-        raise ParameterError("give at least one --vary NAME=VALUES", param="vary")
-    if plot_file is not None and plot is None:
-        raise ParameterError("--plot-file says where --plot draws: give --plot METRIC too")
-    if kind == "drive":
-        given = {"throttle": throttle != 10.0, "steer": steer != 0.0,
-                 "drivetrain": drivetrain != "differential", "seconds": seconds is not None,
-                 "steps": steps is not None, "time_step": time_step != 1.0 / 240.0,
-                 "max_force": max_force is not None, "urdf": urdf is not None,
-                 "plane": plane is not None, "up": up != "z"}
-        set_names = {item.replace(":=", "=").partition("=")[0].strip() for item in set_ or []}
-        for item in vary:
-            name = item.partition("=")[0].strip()
-            if given.get(name) or name in set_names:
-                how = "--set" if name in set_names else "--" + name.replace("_", "-")
-                raise ParameterError(f"{name} is given both by {how} and by --vary; a varied "
-                                     "value replaces the fixed one in every point: drop one")
-    if resume and out is None:
-        raise ParameterError("--resume carries on the rows of --out: give --out",
-                             param="resume")
-    plan = sweeping.plan(kind, base, vary, zip_=zip_)  # every point checked before any runs
-    picture = None
-    if plot is not None:
-        from urdfkit.plot import check_plot_path
-
-        picture = plot_file or f"sweep-{plot}.png"
-        check_plot_path(picture, force=force)
-        if kind == "drive":  # known columns: refuse a typo before the run
-            sweeping.check_metric(kind, [], plan.names, plot)
-        else:
-            sweeping.check_sim_metric(plan, plot)
-    journal = None
-    if out is not None:
-        journal = sweeping.Journal(Path(out), plan.names, resume=resume, force=force,
-                                   assignments=plan.assignments)
-        journal.open()
-        for note in journal.notes:
-            show.warn(note)
-    noted = len(journal.notes) if journal is not None else 0
-    keep = out is None or plot is not None or as_json
-    rows: list[dict[str, Any]] = list(journal.done) if journal is not None and keep else []
-    skip = journal.finished if journal is not None and resume else None
-    total = len(plan.assignments)
-    before = total - sum(1 for a in plan.assignments if skip is not None and skip(a))
+    request = sweep_run.SweepRequest(
+        kind=kind, vary=vary, scenario=scenario, zip_=zip_, jobs=jobs, backend=backend,
+        address=address, out=out, resume=resume, plot=plot, plot_file=plot_file, force=force,
+        keep_rows=as_json, drive={
+            "throttle": throttle, "steer": steer, "drivetrain": drivetrain, "seconds": seconds,
+            "steps": steps, "time_step": time_step, "max_force": max_force, "urdf": urdf,
+            "plane": plane, "template_params": set_, "xacro_args": arg, "packages": package,
+            "package_paths": package_path, "up": up})
+    run = sweep_run.SweepRun(request)  # every option and point checked before any runs
+    for note in run.notes:
+        show.warn(note)
     progress, stop = show.progress("sweeping", "points", enabled=not as_json, rate=True)
-    failed = done = 0
-    interrupted = False
     try:
-        for row in sweeping.execute(plan, jobs=jobs, backend=backend, address=address,
-                                    skip=skip):
-            done += 1
-            failed += bool(row.get("error"))
-            if journal is not None:
-                journal.add(row)
-            if keep:
-                rows.append(row)
-            if progress is not None:
-                progress(done, before)
-    except KeyboardInterrupt:
-        interrupted = True
+        outcome = run.run(progress)
     finally:
         stop()
-        written = journal.finish() if journal is not None else None
-    for note in journal.notes[noted:] if journal is not None else []:
+    for note in outcome.notes:
         show.warn(note)
-    written_plot: Path | None = None
-    failed_plot = False
-    if picture is not None and rows:
-        from urdfkit.errors import UrdfkitError
-        from urdfkit.plot import write_sweep_plot
-
-        assert plot is not None
-        try:  # a scenario's joint names are known only now: the rows are kept either way
-            sweeping.check_metric(kind, rows, plan.names, plot)
-        except UrdfkitError as e:
-            show.warn(f"no plot: {input_flags(flag_message(e.message))}")
-            failed_plot = True
-        else:
-            written_plot = write_sweep_plot(rows, plan.names, plot, picture, force=force)
-    skipped = total - before
+    run.draw(outcome)
+    if outcome.plot_error is not None:
+        show.warn(f"no plot: {input_flags(flag_message(outcome.plot_error.message))}")
     if as_json:
-        show.print_json({"kind": kind, "points": total, "ran": done, "skipped": skipped,
-                         "failed": failed, "out": None if written is None else str(written),
-                         "plot": None if written_plot is None else str(written_plot),
-                         "interrupted": interrupted, "rows": rows})
+        show.print_json(outcome.to_dict())
     else:
-        show.sweep_report(plan, rows if out is None else [], done, failed, skipped, show_all)
-        for path in (written, written_plot):
+        show.sweep_report(outcome.plan, outcome.rows if out is None else [], outcome.ran,
+                          outcome.failed, outcome.skipped, show_all)
+        for path in (outcome.out, outcome.plot):
             if path is not None:
                 show.wrote(path)
-    if interrupted:
+    if outcome.interrupted:
         show.interrupted("interrupted; the rows so far are kept")
         raise typer.Exit(130)
-    if failed or failed_plot:
+    if outcome.failed or outcome.plot_error is not None:
         raise typer.Exit(1)
 
 
