@@ -6,6 +6,7 @@ import typer
 
 from urdfkit import present as show
 from urdfkit.commands.shared import (
+    FROM_LIBRARY,
     AllOpt,
     ArgOpt,
     DrivetrainOpt,
@@ -31,6 +32,7 @@ from urdfkit.commands.shared import (
     examples,
     flag_message,
     input_flags,
+    library_defaults,
     parse_speed,
     say_streaming,
     serve_until_interrupted,
@@ -44,16 +46,16 @@ from urdfkit.commands.shared import (
     "urdfkit drive --urdf husky/husky.urdf --steer 0.5   # skid steer: 0.5 rad/s of yaw",
     "urdfkit drive --steer 0.3 --trajectory run.csv --plot run.png"))
 def drive(
-    throttle: ThrottleOpt = 10.0,
-    steer: SteerOpt = 0.0,
-    drivetrain: DrivetrainOpt = "differential",
+    throttle: ThrottleOpt = FROM_LIBRARY,
+    steer: SteerOpt = FROM_LIBRARY,
+    drivetrain: DrivetrainOpt = FROM_LIBRARY,
     tutorial: Annotated[bool, typer.Option(
         "--tutorial", help="Reproduce the PyBullet tutorial's loop exactly: locked wheels, "
         "PyBullet's default motor force, no load flags, car at 0 0 0.1 before the plane.")]
     = False,
     seconds: SecondsOpt = None,
     steps: StepsOpt = None,
-    time_step: TimeStepOpt = 1.0 / 240.0,
+    time_step: TimeStepOpt = FROM_LIBRARY,
     max_force: MaxForceOpt = None,
     urdf: UrdfOpt = None,
     plane: PlaneOpt = None,
@@ -78,7 +80,7 @@ def drive(
         "--gui", help="Open the PyBullet GUI with Steering and Throttle sliders.")] = False,
     as_json: JsonOpt = False,
     no_guard: NoGuardOpt = False,
-    up: UpOpt = "z",
+    up: UpOpt = FROM_LIBRARY,
     limp: Annotated[bool, typer.Option(
         "--limp", help="Let joints that are neither wheels, hinges nor casters go limp "
         "instead of holding their start angle (with the URDF's effort).")] = False,
@@ -91,17 +93,76 @@ def drive(
     Wheels (continuous joints about a horizontal axis) and steering hinges (revolute joints
     about a vertical axis that carry wheels) are detected. See docs/drive.md.
     """
-    from urdfkit.drive import DriveConfig, Scenario, trajectory_format
+    from urdfkit.drive import DriveConfig, Scenario
+
+    pace = _check_drive_options(seconds=seconds, steps=steps, tutorial=tutorial,
+                                drivetrain=drivetrain, max_force=max_force, gui=gui, view=view,
+                                speed=speed, trajectory=trajectory, plot=plot, force=force)
+    params = None
+    if set_:
+        from urdfkit.catalog import parse_assignments  # imports the builder: only when needed
+
+        params = parse_assignments(set_, "template_params")
+    # seconds and max_force not given: DriveConfig's own defaults.
+    given: dict[str, Any] = {name: value for name, value in (("seconds", seconds),
+                                                           ("max_force", max_force))
+             if value is not None}
+    config = DriveConfig(
+        urdf=urdf, plane=plane, template_params=params,
+        packages=package, xacro_args=arg, steps=steps, time_step=time_step, throttle=throttle,
+        steer=steer, drivetrain=drivetrain, tutorial=tutorial, keep_trajectory=plot is not None,
+        wheels=split_joints(wheels), hinges=split_joints(hinges), sample_every=sample_every,
+        gui=gui, guard=not no_guard, package_paths=package_path, up=up, limp=limp, **given)
+    with Scenario(config) as sc:
+        _say_drivetrain(sc)
+        said = list(sc.warnings)
+        stream = _run_view(sc, config, pace, port) if view else None
+        result, written = _drive_run(sc, trajectory, force=force, stream=stream,
+                                     quiet=as_json or view)
+    if plot is not None:
+        from urdfkit.plot import write_plot
+
+        written.append(write_plot(result, plot, force=force))
+    if as_json:
+        data = result.to_dict()
+        data["files"] = [str(w) for w in written]
+        show.print_json(data)
+    else:
+        _drive_summary(result, said)
+        for path in written:
+            show.wrote(path)
+    _drive_exit(result, stream)
+
+
+def use_library_defaults() -> None:
+    """Give drive's and sweep's options DriveConfig's defaults (written once, in the library)."""
+    from dataclasses import fields
+
+    from urdfkit.drive import DriveConfig
+
+    defaults = {f.name: f.default for f in fields(DriveConfig)}
+    library_defaults(drive, defaults)
+    library_defaults(sweep, defaults)
+
+
+def _check_drive_options(*, seconds: float | None, steps: int | None, tutorial: bool,
+                         drivetrain: str, max_force: float | None, gui: bool, view: bool,
+                         speed: str, trajectory: str | None, plot: str | None,
+                         force: bool) -> float | None:
+    """Refuse what cannot run together, and unwritable outputs, before the run; the pace."""
+    from dataclasses import fields
+
+    from urdfkit.drive import DriveConfig, trajectory_format
     from urdfkit.errors import ParameterError
+    from urdfkit.session import has_display
 
     if seconds is not None and steps is not None:
         raise ParameterError("give `seconds` or `steps`, not both", param="seconds")
-    if tutorial and (drivetrain != "differential" or max_force is not None):
+    default = next(f.default for f in fields(DriveConfig) if f.name == "drivetrain")
+    if tutorial and (drivetrain != default or max_force is not None):
         raise ParameterError("`tutorial` fixes the drivetrain (locked) and the motor force "
                              "(PyBullet's default); drop --drivetrain and --max-force",
                              param="tutorial")
-    from urdfkit.session import has_display
-
     if view and gui:
         raise ParameterError("`view` replaces `gui`: give one of them", param="view")
     pace = parse_speed(speed) if view else None
@@ -118,65 +179,52 @@ def drive(
         from urdfkit.plot import check_plot_path
 
         check_plot_path(plot, force=force)
-    params = None
-    if set_:
-        from urdfkit.catalog import parse_assignments  # imports the builder: only when needed
+    return pace
 
-        params = parse_assignments(set_, "template_params")
-    config = DriveConfig(
-        urdf=urdf, plane=plane, template_params=params,
-        packages=package, xacro_args=arg, seconds=10.0 if seconds is None else seconds,
-        steps=steps, time_step=time_step, throttle=throttle, steer=steer,
-        max_force=10.0 if max_force is None else max_force, drivetrain=drivetrain,
-        tutorial=tutorial, keep_trajectory=plot is not None,
-        wheels=split_joints(wheels), hinges=split_joints(hinges), sample_every=sample_every,
-        gui=gui, guard=not no_guard, package_paths=package_path, up=up, limp=limp)
-    with Scenario(config) as sc:
-        t = sc.drivetrain
 
-        def names(joints: list[int]) -> str:
-            return ", ".join(t.joint_names[j] for j in joints) or "none"
+def _say_drivetrain(sc: Any) -> None:
+    """What was detected (wheels, hinges, casters, held and limp joints), and the warnings."""
+    t = sc.drivetrain
 
-        casters = [t.joint_names[j] for j in t.casters] + \
-            [t.link_names.get(k, str(k)) for k in t.caster_links]
-        show.note(f"{sc.model}: wheels {names(t.wheels)}; hinges {names(t.hinges)}; "
-                  f"casters {', '.join(casters) or 'none'}; held {names(list(sc.held))}; "
-                  f"limp {names(sc.limp)}; drivetrain {t.mode} ({t.steering} steering)")
-        for w in sc.warnings:
-            show.warn(w)
-        said = list(sc.warnings)
-        stream = _run_view(sc, config, pace, port) if view else None
-        progress, stop = show.progress("driving", "steps", enabled=not as_json and not view)
-        written = []
-        try:
-            if trajectory is None:
-                result = sc.run(progress, sink=stream)
-            else:
-                from urdfkit.drive import drive_to_file
+    def names(joints: list[int]) -> str:
+        return ", ".join(t.joint_names[j] for j in joints) or "none"
 
-                result, path = drive_to_file(sc, trajectory, force=force, progress=progress,
-                                             sink=stream)
-                written.append(path)
-            if stream is not None:
-                stream.finish(_run_view_summary(result))
-        except BaseException:
-            if stream is not None:
-                stream.viewer.close()
-            raise
-        finally:
-            stop()
-    if plot is not None:
-        from urdfkit.plot import write_plot
+    casters = [t.joint_names[j] for j in t.casters] + \
+        [t.link_names.get(k, str(k)) for k in t.caster_links]
+    show.note(f"{sc.model}: wheels {names(t.wheels)}; hinges {names(t.hinges)}; "
+              f"casters {', '.join(casters) or 'none'}; held {names(list(sc.held))}; "
+              f"limp {names(sc.limp)}; drivetrain {t.mode} ({t.steering} steering)")
+    for w in sc.warnings:
+        show.warn(w)
 
-        written.append(write_plot(result, plot, force=force))
-    if as_json:
-        data = result.to_dict()
-        data["files"] = [str(w) for w in written]
-        show.print_json(data)
-    else:
-        _drive_summary(result, said)
-        for path in written:
-            show.wrote(path)
+
+def _drive_run(sc: Any, trajectory: str | None, *, force: bool, stream: Any,
+               quiet: bool) -> tuple[Any, list[Any]]:
+    """The run, with a progress line (unless ``quiet``); the result and the files written."""
+    progress, stop = show.progress("driving", "steps", enabled=not quiet)
+    written = []
+    try:
+        if trajectory is None:
+            result = sc.run(progress, sink=stream)
+        else:
+            from urdfkit.drive import drive_to_file
+
+            result, path = drive_to_file(sc, trajectory, force=force, progress=progress,
+                                         sink=stream)
+            written.append(path)
+        if stream is not None:
+            stream.finish(_run_view_summary(result))
+    except BaseException:
+        if stream is not None:
+            stream.viewer.close()
+        raise
+    finally:
+        stop()
+    return result, written
+
+
+def _drive_exit(result: Any, stream: Any) -> None:
+    """130 interrupted; with --view, the page served until Ctrl-C; 1 a suspect run."""
     if result.interrupted:
         if stream is not None:
             stream.viewer.close()
@@ -264,12 +312,12 @@ def sweep(
     as_json: JsonOpt = False,
     show_all: AllOpt = False,
     force: ForceOpt = False,
-    throttle: ThrottleOpt = 10.0,
-    steer: SteerOpt = 0.0,
-    drivetrain: DrivetrainOpt = "differential",
+    throttle: ThrottleOpt = FROM_LIBRARY,
+    steer: SteerOpt = FROM_LIBRARY,
+    drivetrain: DrivetrainOpt = FROM_LIBRARY,
     seconds: SecondsOpt = None,
     steps: StepsOpt = None,
-    time_step: TimeStepOpt = 1.0 / 240.0,
+    time_step: TimeStepOpt = FROM_LIBRARY,
     max_force: MaxForceOpt = None,
     urdf: UrdfOpt = None,
     plane: PlaneOpt = None,
@@ -277,7 +325,7 @@ def sweep(
     arg: ArgOpt = None,
     package: PackageOpt = None,
     package_path: PackagePathOpt = None,
-    up: UpOpt = "z",
+    up: UpOpt = FROM_LIBRARY,
 ) -> None:
     """Run many drives or scenario runs, one row of results per point.
 

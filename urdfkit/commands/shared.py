@@ -15,9 +15,15 @@ from urdfkit import present as show
 
 F = TypeVar("F", bound=Callable[..., Any])
 
+class _FromLibrary:
+    def __repr__(self) -> str:
+        return "<the library's default>"
+
+
 #: A default the library owns (e.g. DriveConfig's): the command module puts the library's value
-#: in before typer builds the command (see :func:`library_defaults`).
-FROM_LIBRARY: Any = None
+#: in before typer builds the command (see :func:`library_defaults`). Only ``urdfkit --help``
+#: builds commands without it, and parses no option.
+FROM_LIBRARY: Any = _FromLibrary()
 
 
 def command(epilog: str) -> Callable[[F], F]:
