@@ -1,8 +1,9 @@
 """check, diff, fix, collisions: findings over files, two robots compared, repairs."""
 
 import sys
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -197,48 +198,18 @@ def fix(
     nothing left to fix; 1: findings were left (listed), or --diff shows changes; 2: bad
     input or usage.
     """
-    from urdfkit.check import parse_codes
-    from urdfkit.errors import ParameterError
-    from urdfkit.fix import FIXABLE, fix_file
-    from urdfkit.output import atomic_write, check_output
+    from urdfkit.fix import fix_file
+    from urdfkit.output import check_output
     from urdfkit.uris import parse_packages
 
-    if sum((output is not None, in_place, show_diff)) != 1:
-        raise ParameterError("say where the repaired file goes: -o OUT, --in-place, or --diff "
-                             "to preview (one of them)")
-    if as_json and (show_diff or output == "-"):
-        raise ParameterError("--json describes the fixes of -o FILE or --in-place; --diff and "
-                             "-o - print text on stdout")
-    if output is not None and not output.strip():
-        raise ParameterError("-o needs a file name (or - for stdout)")
-    codes = parse_codes(select, "`select`")
-    if any(not any(f.startswith(c) for f in FIXABLE) for c in codes):
-        raise ParameterError(f"`select`: fix repairs {', '.join(FIXABLE)} only")
+    codes = _check_fix_options(output, in_place, show_diff, as_json, select)
     backup = f"{file}.orig"
     if output not in (None, "-"):
         check_output(output, force=force)
     result = fix_file(file, balance=balance, density=density,
                       packages=parse_packages(package, package_path), select=codes)
-    # The file's mass, and the mass PyBullet loads (1 kg for each link without <inertial>):
-    # both said whenever they change. The file's changing by more than 1% writes nothing
-    # unless asked; PyBullet's alone changing is frames losing the kilogram PyBullet makes up
-    # for them (the file's own masses untouched): said, not refused (16 of 24 real robots
-    # would otherwise need the flag for fix to do anything).
-    for what, before, after, guarded in (
-            ("total mass", result.mass_before, result.mass_after, True),
-            ("mass as PyBullet loads it", result.loaded_before, result.loaded_after, False)):
-        if after == before:
-            continue
-        change = (f"{(after - before) / before:+.1%}" if before > 0 else "from none")
-        line = f"{file}: {what} {before:.6g} kg -> {after:.6g} kg ({change})"
-        if not guarded:
-            line += " (links without <inertial> no longer get PyBullet's 1 kg)"
-        moved = before <= 0 or abs(after - before) > 0.01 * before
-        if guarded and moved and not allow_mass_change and not show_diff:
-            raise ParameterError(f"{line}: more than 1%, so nothing was written; pass "
-                                 "--allow-mass-change to write it")
-        if not as_json:
-            show.note(line)
+    _say_mass_changes(file, result, refuse=not allow_mass_change and not show_diff,
+                      quiet=as_json)
     if in_place and result.changed:
         check_output(backup, force=force, what="the backup")
     to_stdout = output == "-" or show_diff
@@ -253,6 +224,67 @@ def fix(
         report()
         sys.stdout.write(result.diff())
         raise typer.Exit(1 if result.changed or result.left or result.other_errors else 0)
+    _write_fixed(file, result, output, in_place=in_place, force=force, as_json=as_json,
+                 report=report)
+    if result.left or result.other_errors:
+        raise typer.Exit(1)
+
+
+def _check_fix_options(output: str | None, in_place: bool, show_diff: bool, as_json: bool,
+                       select: list[str] | None) -> tuple[str, ...]:
+    """Refuse options that do not go together; the rule codes ``--select`` keeps."""
+    from urdfkit.check import parse_codes
+    from urdfkit.errors import ParameterError
+    from urdfkit.fix import FIXABLE
+
+    if sum((output is not None, in_place, show_diff)) != 1:
+        raise ParameterError("say where the repaired file goes: -o OUT, --in-place, or --diff "
+                             "to preview (one of them)")
+    if as_json and (show_diff or output == "-"):
+        raise ParameterError("--json describes the fixes of -o FILE or --in-place; --diff and "
+                             "-o - print text on stdout")
+    if output is not None and not output.strip():
+        raise ParameterError("-o needs a file name (or - for stdout)")
+    codes = parse_codes(select, "`select`")
+    if any(not any(f.startswith(c) for f in FIXABLE) for c in codes):
+        raise ParameterError(f"`select`: fix repairs {', '.join(FIXABLE)} only")
+    return codes
+
+
+def _say_mass_changes(file: str, result: Any, *, refuse: bool, quiet: bool) -> None:
+    """Say how the masses change; refuse (``refuse``) when the file's moves more than 1%.
+
+    The file's mass, and the mass PyBullet loads (1 kg for each link without <inertial>):
+    both said whenever they change. The file's changing by more than 1% writes nothing
+    unless asked; PyBullet's alone changing is frames losing the kilogram PyBullet makes up
+    for them (the file's own masses untouched): said, not refused (16 of 24 real robots
+    would otherwise need the flag for fix to do anything).
+    """
+    from urdfkit.errors import ParameterError
+
+    for what, before, after, guarded in (
+            ("total mass", result.mass_before, result.mass_after, True),
+            ("mass as PyBullet loads it", result.loaded_before, result.loaded_after, False)):
+        if after == before:
+            continue
+        change = (f"{(after - before) / before:+.1%}" if before > 0 else "from none")
+        line = f"{file}: {what} {before:.6g} kg -> {after:.6g} kg ({change})"
+        if not guarded:
+            line += " (links without <inertial> no longer get PyBullet's 1 kg)"
+        moved = before <= 0 or abs(after - before) > 0.01 * before
+        if guarded and moved and refuse:
+            raise ParameterError(f"{line}: more than 1%, so nothing was written; pass "
+                                 "--allow-mass-change to write it")
+        if not quiet:
+            show.note(line)
+
+
+def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, force: bool,
+                 as_json: bool, report: Callable[[], None]) -> None:
+    """Write the repaired file to stdout, in place (keeping FILE.orig) or to ``output``."""
+    from urdfkit.output import atomic_write
+
+    backup = f"{file}.orig"
     if output == "-":
         report()
         sys.stdout.buffer.write(result.fixed)
@@ -276,8 +308,6 @@ def fix(
         report()
         if not as_json:
             show.wrote(path, f"{len(result.repairs)} fix(es)")
-    if result.left or result.other_errors:
-        raise typer.Exit(1)
 
 
 # ---- drive: a headless throttle/steer run (urdfkit/drive.py, vehicle.py, plot.py)

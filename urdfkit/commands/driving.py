@@ -123,14 +123,7 @@ def drive(
         from urdfkit.plot import write_plot
 
         written.append(write_plot(result, plot, force=force))
-    if as_json:
-        data = result.to_dict()
-        data["files"] = [str(w) for w in written]
-        show.print_json(data)
-    else:
-        _drive_summary(result, said)
-        for path in written:
-            show.wrote(path)
+    _drive_report(result, written, said, as_json)
     _drive_exit(result, stream)
 
 
@@ -221,6 +214,18 @@ def _drive_run(sc: Any, trajectory: str | None, *, force: bool, stream: Any,
     finally:
         stop()
     return result, written
+
+
+def _drive_report(result: Any, written: list[Any], said: list[str], as_json: bool) -> None:
+    """The run's JSON object (with the files written), or its summary and the files."""
+    if as_json:
+        data = result.to_dict()
+        data["files"] = [str(w) for w in written]
+        show.print_json(data)
+    else:
+        _drive_summary(result, said)
+        for path in written:
+            show.wrote(path)
 
 
 def _drive_exit(result: Any, stream: Any) -> None:
@@ -345,6 +350,29 @@ def sweep(
             "plane": plane, "template_params": set_, "xacro_args": arg, "packages": package,
             "package_paths": package_path, "up": up})
     run = sweep_run.SweepRun(request)  # every option and point checked before any runs
+    outcome = _sweep_run(run, as_json)
+    _sweep_report(outcome, as_json, show_all, rows=out is None)
+    if outcome.interrupted:
+        show.interrupted("interrupted; the rows so far are kept")
+        raise typer.Exit(130)
+    if outcome.failed or outcome.plot_error is not None:
+        raise typer.Exit(1)
+
+
+def _sweep_report(outcome: Any, as_json: bool, show_all: bool, *, rows: bool) -> None:
+    """The sweep's JSON object, or its table (of the rows, unless they went to a file)."""
+    if as_json:
+        show.print_json(outcome.to_dict())
+        return
+    show.sweep_report(outcome.plan, outcome.rows if rows else [], outcome.ran, outcome.failed,
+                      outcome.skipped, show_all)
+    for path in (outcome.out, outcome.plot):
+        if path is not None:
+            show.wrote(path)
+
+
+def _sweep_run(run: Any, as_json: bool) -> Any:
+    """Run the sweep with a progress line, saying the journal's notes; draw its plot."""
     for note in run.notes:
         show.warn(note)
     progress, stop = show.progress("sweeping", "points", enabled=not as_json, rate=True)
@@ -357,19 +385,7 @@ def sweep(
     run.draw(outcome)
     if outcome.plot_error is not None:
         show.warn(f"no plot: {input_flags(flag_message(outcome.plot_error.message))}")
-    if as_json:
-        show.print_json(outcome.to_dict())
-    else:
-        show.sweep_report(outcome.plan, outcome.rows if out is None else [], outcome.ran,
-                          outcome.failed, outcome.skipped, show_all)
-        for path in (outcome.out, outcome.plot):
-            if path is not None:
-                show.wrote(path)
-    if outcome.interrupted:
-        show.interrupted("interrupted; the rows so far are kept")
-        raise typer.Exit(130)
-    if outcome.failed or outcome.plot_error is not None:
-        raise typer.Exit(1)
+    return outcome
 
 
 def _drive_summary(r: Any, said: list[str]) -> None:

@@ -55,55 +55,22 @@ def sim(
     too when there is no --out).
     """
     from urdfkit import sim as simulation
-    from urdfkit.errors import ParameterError
 
     if scenario == "convert":
-        if config is None:
-            raise ParameterError("convert needs the simulation_and_control config: "
-                                 "urdfkit sim convert conf.json -o scenario.toml",
-                                 param="scenario")
-        if gui or real_time or as_json or view:
-            raise ParameterError("convert writes a file; --gui, --real-time, --view and --json "
-                                 "do not apply", param="scenario")
+        _check_convert(config, gui or real_time or as_json or view)
+        assert config is not None
         _sim_convert(config, out, force)
         return
-    if config is not None:
-        raise ParameterError(f"one scenario at a time; got {scenario!r} and {config!r} (to "
-                             "convert a config: urdfkit sim convert conf.json)",
-                             param="scenario")
-    from urdfkit.session import has_display
-
-    if view and (gui or real_time):
-        raise ParameterError("`view` paces the run itself (--speed) and replaces `gui`: drop "
-                             "--gui and --real-time", param="view")
-    pace = parse_speed(speed) if view else None
-    if gui and not has_display():
-        raise ParameterError("`gui` needs a display (DISPLAY is not set); drop it to run "
-                             "headless, or use --view", param="gui")
+    pace = _check_sim_options(scenario, config, gui=gui, real_time=real_time, view=view,
+                              speed=speed)
     if out is not None:
         simulation.check_output(out, force=force)  # fail before the run, not after it
-    written = None
-    stream: Any = None
     with simulation.Simulation.from_file(scenario, gui=gui) as s:
         for note in s.config.notes:
             show.warn(note)
-        if view:
-            stream = _sim_view(s, pace, port)
-        tick = None if stream is None else (lambda _batch: stream.tick(s.t))
-        try:
-            if out is None:
-                result = s.run(real_time=real_time or gui, sink=tick)
-            else:
-                result, written = simulation.run_to_file(s, out, force=force,
-                                                         real_time=real_time or gui,
-                                                         also=tick)
-            if stream is not None:
-                stream.finish(f"**Done**: {result.steps:,} steps of {result.time_step:.5g} s "
-                              f"simulated, {result.row_count:,} rows")
-        except BaseException:
-            if stream is not None:
-                stream.viewer.close()
-            raise
+        stream = _sim_view(s, pace, port) if view else None
+        result, written = _sim_run(s, out, force=force, real_time=real_time or gui,
+                                   stream=stream)
     if stream is not None and result.interrupted:
         stream.viewer.close()
         stream = None
@@ -119,12 +86,73 @@ def sim(
         if written is None:
             data["observations"] = rows
         show.print_json(data)
-        if result.interrupted:
-            show.interrupted("interrupted; the rows cover the steps simulated")
-            raise typer.Exit(130)
+    else:
+        _sim_table(scenario, result, summaries, written)
+    if result.interrupted:
+        show.interrupted("interrupted; the rows cover the steps simulated")
+        raise typer.Exit(130)
+    if stream is not None:
+        serve_until_interrupted(stream.viewer, "the run is over; its page", "sim")
+
+
+def _check_convert(config: str | None, run_options: bool) -> None:
+    """``sim convert`` needs a config, and takes none of the run's options."""
+    from urdfkit.errors import ParameterError
+
+    if config is None:
+        raise ParameterError("convert needs the simulation_and_control config: "
+                             "urdfkit sim convert conf.json -o scenario.toml",
+                             param="scenario")
+    if run_options:
+        raise ParameterError("convert writes a file; --gui, --real-time, --view and --json "
+                             "do not apply", param="scenario")
+
+
+def _check_sim_options(scenario: str, config: str | None, *, gui: bool, real_time: bool,
+                       view: bool, speed: str) -> float | None:
+    """Refuse what cannot run together, before the run; the pace of ``--view``."""
+    from urdfkit.errors import ParameterError
+    from urdfkit.session import has_display
+
+    if config is not None:
+        raise ParameterError(f"one scenario at a time; got {scenario!r} and {config!r} (to "
+                             "convert a config: urdfkit sim convert conf.json)",
+                             param="scenario")
+    if view and (gui or real_time):
+        raise ParameterError("`view` paces the run itself (--speed) and replaces `gui`: drop "
+                             "--gui and --real-time", param="view")
+    pace = parse_speed(speed) if view else None
+    if gui and not has_display():
+        raise ParameterError("`gui` needs a display (DISPLAY is not set); drop it to run "
+                             "headless, or use --view", param="gui")
+    return pace
+
+
+def _sim_run(s: Any, out: str | None, *, force: bool, real_time: bool,
+             stream: Any) -> tuple[Any, Any]:
+    """The run, its rows to ``out`` if given, streamed to the page if any; result, file."""
+    from urdfkit import sim as simulation
+
+    written = None
+    tick = None if stream is None else (lambda _batch: stream.tick(s.t))
+    try:
+        if out is None:
+            result = s.run(real_time=real_time, sink=tick)
+        else:
+            result, written = simulation.run_to_file(s, out, force=force, real_time=real_time,
+                                                     also=tick)
         if stream is not None:
-            serve_until_interrupted(stream.viewer, "the run is over; its page", "sim")
-        return
+            stream.finish(f"**Done**: {result.steps:,} steps of {result.time_step:.5g} s "
+                          f"simulated, {result.row_count:,} rows")
+    except BaseException:
+        if stream is not None:
+            stream.viewer.close()
+        raise
+    return result, written
+
+
+def _sim_table(scenario: str, result: Any, summaries: list[Any], written: Any) -> None:
+    """The text summary: a row per robot, its final joints, the file written."""
     fixed = show.fixed
     show.table(f"sim {scenario}: {result.steps:,} steps of {result.time_step:.5g} s", [
         ("robot", 0, "left"), ("rows", 0, "right"), ("end x y z (m)", 0, "left"),
@@ -137,11 +165,6 @@ def sim(
             show.line((x.robot, "cyan"), f" final joints: {joints}")
     if written is not None:
         show.wrote(written, f"{result.row_count:,} rows")
-    if result.interrupted:
-        show.interrupted("interrupted; the rows cover the steps simulated")
-        raise typer.Exit(130)
-    if stream is not None:
-        serve_until_interrupted(stream.viewer, "the run is over; its page", "sim")
 
 
 def _sim_view(s: Any, pace: float | None, port: int | None) -> Any:
