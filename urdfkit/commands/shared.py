@@ -15,6 +15,7 @@ from urdfkit import present as show
 
 F = TypeVar("F", bound=Callable[..., Any])
 
+
 class _FromLibrary:
     def __repr__(self) -> str:
         return "<the library's default>"
