@@ -9,6 +9,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 import urdfkit
 
 PACKAGE = Path(urdfkit.__file__).parent
@@ -25,31 +27,59 @@ for floor, names in enumerate([
     "session",
     # run and draw
     "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
-    " validate"
-    " diff collisions fix sweep view",
+    " validate diff collisions fix sweep_journal sweep sweep_run view",
     # presentation and the command line
-    "present ci cli __main__",
+    "present ci cli __main__ commands.shared commands.build commands.inspecting commands.checking"
+    " commands.driving commands.drawing commands.simulating",
 ]):
     LAYERS.update(dict.fromkeys(names.split(), floor))
 
 
+#: Folders of modules (named "folder.module" here), besides the flat ones.
+FOLDERS = ("commands",)
+
+
 def _module_names() -> list[str]:
-    return sorted(p.stem for p in PACKAGE.glob("*.py") if p.stem != "__init__")
+    names = [p.stem for p in PACKAGE.glob("*.py") if p.stem != "__init__"]
+    names += [f"{d}.{p.stem}" for d in FOLDERS for p in (PACKAGE / d).glob("*.py")
+              if p.stem != "__init__"]
+    return sorted(names)
+
+
+def _path(name: str) -> Path:
+    return PACKAGE / (name.replace(".", "/") + ".py")
+
+
+def _dotted(module: str) -> str:
+    """``commands.shared.x`` -> ``commands.shared``; ``present`` -> ``present``."""
+    parts = module.split(".")
+    return ".".join(parts[:2]) if parts[0] in FOLDERS else parts[0]
 
 
 def _imports(name: str) -> set[str]:
-    tree = ast.parse((PACKAGE / f"{name}.py").read_text("utf-8"))
+    tree = ast.parse(_path(name).read_text("utf-8"))
+    package = name.rpartition(".")[0]  # "" for a flat module
     out: set[str] = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
-            if node.level == 1 and node.module:
-                out.add(node.module.split(".")[0])
-            elif node.level == 1:
-                out.update(a.name for a in node.names)
-            elif node.level == 0 and node.module and node.module.startswith("urdfkit."):
-                out.add(node.module.split(".")[1])
+            if node.level:
+                base = ".".join(package.split(".")[:len(package.split(".")) - node.level + 1]
+                                if package else [])
+                prefix = f"{base}." if base else ""
+                if node.module:
+                    out.add(_dotted(prefix + node.module))
+                else:
+                    out.update(_dotted(prefix + a.name) for a in node.names)
+            elif node.module == "urdfkit":
+                out.update(_dotted(a.name) for a in node.names)
+            elif node.module and node.module.startswith("urdfkit."):
+                module = node.module.split(".", 1)[1]
+                if module in FOLDERS:
+                    out.update(_dotted(f"{module}.{a.name}") for a in node.names)
+                else:
+                    out.add(_dotted(module))
         elif isinstance(node, ast.Import):
-            out.update(a.name.split(".")[1] for a in node.names
+            out.update(_dotted(a.name.split(".", 1)[1]) for a in node.names
                        if a.name.startswith("urdfkit."))
     return out & set(_module_names()) - {name}
 
@@ -112,9 +142,11 @@ def test_no_import_cycles() -> None:
     assert not cycles, f"import cycles: {cycles}"
 
 
-def test_the_cli_is_in_its_own_room() -> None:
-    """cli.py parses options and presents: it never touches lxml or PyBullet itself."""
-    tree = ast.parse((PACKAGE / "cli.py").read_text("utf-8"))
+@pytest.mark.parametrize("module", ["cli"] + [m for m in _module_names()
+                                    if m.startswith("commands.")])
+def test_the_cli_is_in_its_own_room(module: str) -> None:
+    """cli.py and the command modules parse options and present: no lxml or PyBullet."""
+    tree = ast.parse(_path(module).read_text("utf-8"))
     names = {a.name.split(".")[0] for n in ast.walk(tree) if isinstance(n, ast.Import)
              for a in n.names}
     names |= {(n.module or "").split(".")[0] for n in ast.walk(tree)
