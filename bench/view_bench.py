@@ -130,7 +130,8 @@ def slider_moves(path: Path, moves: int) -> list[float]:
 def drive_loops(seconds: float) -> tuple[float, float]:
     """Wall seconds of one simplecar run loop without, then with, the page's stream."""
     from urdfkit.drive import DriveConfig, Scenario
-    from urdfkit.view import RunStream, Viewer
+    from urdfkit.view import Viewer
+    from urdfkit.view_stream import RunStream
 
     config = DriveConfig(throttle=10, steer=0.2, seconds=seconds, keep_trajectory=False)
     with Scenario(config) as sc:

@@ -14,7 +14,8 @@ import pytest
 pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
 
 from urdfkit.sim import Simulation  # noqa: E402
-from urdfkit.view import RunStream, Viewer  # noqa: E402
+from urdfkit.view import Viewer  # noqa: E402
+from urdfkit.view_stream import RunStream  # noqa: E402
 
 TWO_CARS = Path(__file__).parent.parent / "examples" / "two_cars.toml"
 

@@ -25,6 +25,7 @@ import pytest
 
 pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
 
+from urdfkit import view_page  # noqa: E402
 from urdfkit.view import TINTS, TOUCHING_RGB, Viewer  # noqa: E402
 
 DOCS = Path(__file__).parent.parent / "docs"
@@ -270,7 +271,7 @@ def test_u604_error_tints_its_link_and_names_its_line(tmp_path: Path, viewer_of:
     assert v.nodes("visual", "base")[0].color == (0, 229, 0)
     u604 = [f for f in v.model.findings if f.code == "U604"]
     assert [f.line for f in u604] == [line]
-    assert f"{path}:{line}" in v._findings_text()
+    assert f"{path}:{line}" in view_page.findings(v.model)
 
 
 def test_edit_reloads_and_a_broken_file_keeps_the_last_robot(arm: Path, viewer_of: Any) -> None:

@@ -245,7 +245,8 @@ def _run_view(sc: Any, config: Any, pace: float | None, port: int | None) -> Any
     """Start the page a run streams to (drive --view), and say where it is."""
     import math
 
-    from urdfkit.view import RunStream, Viewer
+    from urdfkit.view import Viewer
+    from urdfkit.view_stream import RunStream
 
     total = config.total_steps * config.time_step
     reach = abs(config.throttle) * sc.drivetrain.reference_radius * total

@@ -169,7 +169,8 @@ def _sim_table(scenario: str, result: Any, summaries: list[Any], written: Any) -
 
 def _sim_view(s: Any, pace: float | None, port: int | None) -> Any:
     """Start the page a scenario streams to (sim --view): every robot, and say where."""
-    from urdfkit.view import RunStream, Viewer
+    from urdfkit.view import Viewer
+    from urdfkit.view_stream import RunStream
 
     bodies = [b for b in s.bodies.values() if b.loaded is not None]
     if not bodies:
