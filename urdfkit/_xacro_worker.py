@@ -29,7 +29,6 @@ PR_SET_CHILD_SUBREAPER = 36
 
 #: The namespace of the source tags (never in the output).
 ORIGIN_NS = "urn:urdfkit:origin"
-ORIGIN_ATTR = "urdfkit-origin:at"
 #: Files read so far (an origin names one by its index here).
 FILES: list[str] = []
 

@@ -38,83 +38,100 @@ def convex_hull(points: Any) -> tuple[Any, Any] | None:
     start = _tetrahedron(pts, eps)
     if start is None:
         return None
-    inside = pts[list(start)].mean(axis=0)
-    faces: dict[int, tuple[int, int, int]] = {}
-    planes: dict[int, tuple[Any, float]] = {}
-    outside: dict[int, Any] = {}
-    edge_face: dict[tuple[int, int], int] = {}  # directed edge -> the face it bounds
-    pending: list[int] = []  # faces that may have points outside
-    counter = [0]
+    hull = _Quickhull(pts, eps, pts[list(start)].mean(axis=0))
+    everything = np.arange(len(pts))
+    a, b, c, d = start
+    for tri in ((a, b, c), (a, b, d), (a, c, d), (b, c, d)):
+        hull.add_face(*tri, everything)
+    while hull.pending:
+        busy = hull.pending.pop()
+        if busy in hull.faces and len(hull.outside[busy]):
+            hull.lift(busy)
+    used = sorted({i for tri in hull.faces.values() for i in tri})
+    index = {old: new for new, old in enumerate(used)}
+    tris = np.array([[index[i] for i in tri] for tri in hull.faces.values()], dtype=np.int64)
+    return pts[used], tris
 
-    def add_face(a: int, b: int, c: int, candidates: Any) -> None:
+
+class _Quickhull:
+    """The faces of a hull being built, with the points still outside each (see the module)."""
+
+    def __init__(self, pts: Any, eps: float, inside: Any) -> None:
+        self.pts, self.eps, self.inside = pts, eps, inside
+        self.faces: dict[int, tuple[int, int, int]] = {}
+        self.planes: dict[int, tuple[Any, float]] = {}
+        self.outside: dict[int, Any] = {}
+        self.edge_face: dict[tuple[int, int], int] = {}  # directed edge -> the face it bounds
+        self.pending: list[int] = []  # faces that may have points outside
+        self.counter = 0
+
+    def add_face(self, a: int, b: int, c: int, candidates: Any) -> None:
+        """Add the face (a, b, c), wound outward, keeping the candidates outside it."""
+        import numpy as np
+
+        pts = self.pts
         normal = np.cross(pts[b] - pts[a], pts[c] - pts[a])
         norm = float(np.linalg.norm(normal))
         if norm == 0.0:
             return
         normal = normal / norm
         offset = float(normal @ pts[a])
-        if normal @ inside - offset > 0:  # wind it outward
+        if normal @ self.inside - offset > 0:  # wind it outward
             b, c, normal, offset = c, b, -normal, -offset
-        key = counter[0]
-        counter[0] += 1
-        faces[key] = (a, b, c)
-        planes[key] = (normal, offset)
+        key = self.counter
+        self.counter += 1
+        self.faces[key] = (a, b, c)
+        self.planes[key] = (normal, offset)
         for e in ((a, b), (b, c), (c, a)):
-            edge_face[e] = key
+            self.edge_face[e] = key
         if len(candidates):
             d = pts[candidates] @ normal - offset
-            outside[key] = candidates[d > eps]
+            self.outside[key] = candidates[d > self.eps]
         else:
-            outside[key] = candidates
-        if len(outside[key]):
-            pending.append(key)
+            self.outside[key] = candidates
+        if len(self.outside[key]):
+            self.pending.append(key)
 
-    everything = np.arange(len(pts))
-    a, b, c, d = start
-    for tri in ((a, b, c), (a, b, d), (a, c, d), (b, c, d)):
-        add_face(*tri, everything)
-    while pending:
-        busy = pending.pop()
-        if busy not in faces or not len(outside[busy]):
-            continue
-        normal, offset = planes[busy]
-        cand = outside[busy]
-        apex_point = pts[cand[np.argmax(pts[cand] @ normal - offset)]]
-        apex = int(cand[np.argmax(pts[cand] @ normal - offset)])
-        # The faces the apex sees form one patch around this one: walk it across edges.
+    def lift(self, busy: int) -> None:
+        """Replace the faces the farthest point outside ``busy`` sees by a fan from it."""
+        import numpy as np
+
+        normal, offset = self.planes[busy]
+        cand = self.outside[busy]
+        apex = int(cand[np.argmax(self.pts[cand] @ normal - offset)])
+        visible = self._visible(busy, self.pts[apex])
+        horizon = []
+        for k in visible:
+            x, y, z = self.faces[k]
+            for u, v in ((x, y), (y, z), (z, x)):
+                if self.edge_face.get((v, u)) not in visible:
+                    horizon.append((u, v))
+        orphans = np.unique(np.concatenate([self.outside[k] for k in visible]))
+        orphans = orphans[orphans != apex]
+        for k in visible:
+            x, y, z = self.faces[k]
+            for e in ((x, y), (y, z), (z, x)):
+                if self.edge_face.get(e) == k:
+                    del self.edge_face[e]
+            del self.faces[k], self.planes[k], self.outside[k]
+        for u, v in horizon:
+            self.add_face(u, v, apex, orphans)
+
+    def _visible(self, busy: int, apex_point: Any) -> set[int]:
+        """The faces the apex sees: one patch around ``busy``, walked across edges."""
         visible = {busy}
         stack = [busy]
         while stack:
-            k = stack.pop()
-            x, y, z = faces[k]
+            x, y, z = self.faces[stack.pop()]
             for u, v in ((x, y), (y, z), (z, x)):
-                other = edge_face.get((v, u))
+                other = self.edge_face.get((v, u))
                 if other is None or other in visible:
                     continue
-                n, o = planes[other]
-                if float(n @ apex_point) - o > eps:
+                n, o = self.planes[other]
+                if float(n @ apex_point) - o > self.eps:
                     visible.add(other)
                     stack.append(other)
-        horizon = []
-        for k in visible:
-            x, y, z = faces[k]
-            for u, v in ((x, y), (y, z), (z, x)):
-                if edge_face.get((v, u)) not in visible:
-                    horizon.append((u, v))
-        orphans = np.unique(np.concatenate([outside[k] for k in visible]))
-        orphans = orphans[orphans != apex]
-        for k in visible:
-            x, y, z = faces[k]
-            for e in ((x, y), (y, z), (z, x)):
-                if edge_face.get(e) == k:
-                    del edge_face[e]
-            del faces[k], planes[k], outside[k]
-        for u, v in horizon:
-            add_face(u, v, apex, orphans)
-    used = sorted({i for tri in faces.values() for i in tri})
-    index = {old: new for new, old in enumerate(used)}
-    tris = np.array([[index[i] for i in tri] for tri in faces.values()], dtype=np.int64)
-    return pts[used], tris
+        return visible
 
 
 def _tetrahedron(pts: Any, eps: float) -> tuple[int, int, int, int] | None:

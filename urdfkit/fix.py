@@ -155,55 +155,13 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
         InputError: the file cannot be read or parsed, or is xacro.
         ParameterError: a bad ``density``.
     """
-    display = str(path)
-    source = Path(path)
-    if density is not None and not (math.isfinite(density) and density > 0):
-        raise ParameterError(f"`density` must be a positive number of kg/m^3, got {density!r}",
-                             param="density")
-    if source.suffix == ".xacro":
-        raise InputError("fix edits URDF files, and a xacro file's values come from its macros "
-                         "and arguments: fix the macro, or expand the file first (urdfkit build "
-                         "or xacro) and fix that", file=display)
-    data = read_bytes(source)
-    refuse_oversized(data, display)
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as e:
-        raise InputError(f"not UTF-8 text (byte {e.start}); fix rewrites only UTF-8 files",
-                         file=display) from None
+    display, source, data, text = _read_source(path, density)
     root = parse_xml(data, display).getroot()
     report = Report(display, source.absolute().parent, packages)
     for rule in ALL_RULES:
         rule(root, report)
-    wanted = tuple(c.upper() for c in select)
-
-    def run(skip: Mapping[str, str]) -> tuple[_Plan, bytes]:
-        # A fresh tree each time (the plan edits the tree it is given); the findings' elements
-        # are the pristine ``root``'s, mapped to it by position.
-        tree = parse_xml(data, display).getroot()
-        plan = _Plan(text, tree, display, balance, density, report)
-        elements = _same_elements(root, tree)
-        found: dict[etree._Element, list[tuple[str, int | None]]] = {}
-        for f, el in zip(report.findings, report.elements, strict=True):
-            if f.code not in FIXABLE or el is None:
-                continue
-            if wanted and not any(f.code.startswith(w) for w in wanted):
-                continue
-            target = el if f.code in ("U706", "U708") else _link_of(el)
-            if target is not None:
-                found.setdefault(elements[target], []).append((f.code, f.line))
-        for el, codes in found.items():
-            if el.tag == "link" and el.get("name", "") in skip:
-                plan.left.append(Repair(codes[0][0], codes[0][1],
-                                        f"link {el.get('name', '')!r}: {skip[el.get('name', '')]}"))
-            elif el.tag == "link":
-                plan.fix_link(el, codes)
-            elif codes[0][0] == "U706":
-                plan.define_material(el, codes[0][1])
-            else:
-                plan.normalise_uri(el, codes[0][1], packages)
-        return plan, plan.finish()
-
+    run = _Fixing(data, text, display, root, report, balance, density, packages,
+                  tuple(c.upper() for c in select)).run
     plan, fixed = run({})
     # A fix counts only if check then passes its rule: re-check the repaired links, and redo
     # without those still flagged (a mass of 1e308 has no inertia a float can hold).
@@ -224,6 +182,74 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
                      repairs=sorted(plan.repairs, key=_by_line),
                      left=sorted(plan.left, key=_by_line), other_errors=others,
                      relative_paths=relative)
+
+
+def _read_source(path: str | Path, density: float | None) -> tuple[str, Path, bytes, str]:
+    """The file's name as shown, its path, bytes and text; refusals before any work."""
+    display = str(path)
+    source = Path(path)
+    if density is not None and not (math.isfinite(density) and density > 0):
+        raise ParameterError(f"`density` must be a positive number of kg/m^3, got {density!r}",
+                             param="density")
+    if source.suffix == ".xacro":
+        raise InputError("fix edits URDF files, and a xacro file's values come from its macros "
+                         "and arguments: fix the macro, or expand the file first (urdfkit build "
+                         "or xacro) and fix that", file=display)
+    data = read_bytes(source)
+    refuse_oversized(data, display)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise InputError(f"not UTF-8 text (byte {e.start}); fix rewrites only UTF-8 files",
+                         file=display) from None
+    return display, source, data, text
+
+
+@dataclass
+class _Fixing:
+    """One file's findings, and how to plan their repairs (:meth:`run`, maybe twice)."""
+
+    data: bytes
+    text: str
+    display: str
+    root: etree._Element
+    report: Report
+    balance: bool
+    density: float | None
+    packages: Mapping[str, Path] | None
+    wanted: tuple[str, ...]
+
+    def run(self, skip: Mapping[str, str]) -> tuple[_Plan, bytes]:
+        """Plan every repair (but those of the links in ``skip``, said why) and apply them."""
+        # A fresh tree each time (the plan edits the tree it is given); the findings' elements
+        # are the pristine ``root``'s, mapped to it by position.
+        tree = parse_xml(self.data, self.display).getroot()
+        plan = _Plan(self.text, tree, self.display, self.balance, self.density, self.report)
+        for el, codes in self._targets(_same_elements(self.root, tree)).items():
+            name = el.get("name", "")
+            if el.tag == "link" and name in skip:
+                plan.left.append(Repair(codes[0][0], codes[0][1], f"link {name!r}: {skip[name]}"))
+            elif el.tag == "link":
+                plan.fix_link(el, codes)
+            elif codes[0][0] == "U706":
+                plan.define_material(el, codes[0][1])
+            else:
+                plan.normalise_uri(el, codes[0][1], self.packages)
+        return plan, plan.finish()
+
+    def _targets(self, elements: Mapping[etree._Element, etree._Element]
+                 ) -> dict[etree._Element, list[tuple[str, int | None]]]:
+        """The elements to repair (in the fresh tree), each with its codes and lines."""
+        found: dict[etree._Element, list[tuple[str, int | None]]] = {}
+        for f, el in zip(self.report.findings, self.report.elements, strict=True):
+            if f.code not in FIXABLE or el is None:
+                continue
+            if self.wanted and not any(f.code.startswith(w) for w in self.wanted):
+                continue
+            target = el if f.code in ("U706", "U708") else _link_of(el)
+            if target is not None:
+                found.setdefault(elements[target], []).append((f.code, f.line))
+        return found
 
 
 def _total_mass(root: etree._Element, loaded: bool = False) -> float:
@@ -293,6 +319,33 @@ def balanced(tensor: Sequence[Sequence[float]]) -> float | None:
 _TOKEN = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|</[^>]*>|<(?=[^!?/])", re.DOTALL)
 
 
+
+#: Why a link's inertia was derived, by the code that found it wrong.
+_WHY = {"U609": "had no <inertia>", "U610": "had an incomplete <inertia>",
+        "U603": "had an inertia that is not positive definite",
+        "U604": "had an inertia that violates the triangle inequality",
+        "U605": "had an inertia far from what its shapes imply",
+        "U608": "had a singular inertia"}
+
+
+class _LinkJob:
+    """One link to repair: its first code by :data:`_INERTIA_ORDER`, and what it holds."""
+
+    def __init__(self, link: etree._Element, code: str, line: int | None,
+                 solid: Solid | None) -> None:
+        self.link, self.code, self.line, self.solid = link, code, line, solid
+        self.name = link.get("name", "")
+        self.inertial = link.find("inertial")
+        mass_el = self.inertial.find("mass") if self.inertial is not None else None
+        self.mass = _num(mass_el, "value")
+        self.origin = self.inertial.find("origin") if self.inertial is not None else None
+        self.frame = _vec(self.origin, "rpy", 3, (0.0, 0.0, 0.0)) or (0.0, 0.0, 0.0)
+
+    def skip(self, why: str) -> Repair:
+        """The repair left undone, and why."""
+        return Repair(self.code, self.line, f"link {self.name!r}: {why}")
+
+
 class _Plan:
     """The edits to one file: spliced into its text and made on its tree, side by side."""
 
@@ -332,73 +385,80 @@ class _Plan:
     def _fix_link(self, link: etree._Element, codes: list[tuple[str, int | None]]) -> None:
         by_code = dict(codes)
         code = next(c for c in _INERTIA_ORDER if c in by_code)
-        line = by_code[code]
-        name = link.get("name", "")
-        inertial = link.find("inertial")
-        mass_el = inertial.find("mass") if inertial is not None else None
-        mass = _num(mass_el, "value")
-        solid = link_solid(link, self.report)
-        origin = inertial.find("origin") if inertial is not None else None
-        frame = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0)) or (0.0, 0.0, 0.0)
+        job = _LinkJob(link, code, by_code[code], link_solid(link, self.report))
+        if code == "U606" and job.solid is None and self._fixed_leaf(link):
+            self._massless_frame(job)
+        elif code == "U602":
+            self._small_mass(job)
+        elif job.solid is None:
+            self.left.append(job.skip(
+                "no collision solid to derive inertia from (no <collision>, a capsule, plane "
+                "or SDF, or a mesh that is unreadable or not closed); write <inertial> by hand"))
+        elif code in ("U606", "U601"):
+            self._missing_mass(job, job.solid)
+        else:
+            self._inertia(job, job.solid)
 
-        def skip(why: str) -> None:
-            self.left.append(Repair(code, line, f"link {name!r}: {why}"))
+    def _massless_frame(self, job: _LinkJob) -> None:
+        """U606 on a frame: mass 0, so that PyBullet does not add 1 kg."""
+        self._insert_first_child(job.link, [
+            '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" '
+            'izz="0"/></inertial>'])
+        job.link.insert(0, etree.fromstring(
+            '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" '
+            'izz="0"/></inertial>'))
+        self.repairs.append(Repair(job.code, job.line, f"link {job.name!r} is a frame (no shapes, "
+                                   "fixed to its parent, only frames below it): gave it "
+                                   "mass 0, where PyBullet would add 1 kg"))
 
-        if code == "U606" and solid is None and self._fixed_leaf(link):
-            self._insert_first_child(link, [
-                '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" '
-                'izz="0"/></inertial>'])
-            link.insert(0, etree.fromstring(
-                '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" '
-                'izz="0"/></inertial>'))
-            self.repairs.append(Repair(code, line, f"link {name!r} is a frame (no shapes, "
-                                       "fixed to its parent, only frames below it): gave it "
-                                       "mass 0, where PyBullet would add 1 kg"))
+    def _small_mass(self, job: _LinkJob) -> None:
+        """U602: a moving link without mass gets a small one, with its shapes' inertia."""
+        solid = job.solid
+        tensor = solid.inertia(SMALL_MASS) if solid else _iso(SMALL_INERTIA)
+        self._write_inertial(job.link, SMALL_MASS, solid.com if solid and job.inertial is None
+                             else None, tensor, job.frame, keep_mass=False)
+        given = "the inertia of its shapes at that mass" if solid else "inertia 1e-06"
+        self.repairs.append(Repair(job.code, job.line, f"link {job.name!r} moves but had no "
+                                   f"mass: gave it {fmt_float(SMALL_MASS)} kg and {given}"))
+
+    def _missing_mass(self, job: _LinkJob, solid: Solid) -> None:
+        """U606 or U601: the mass of the shapes at ``--density``, or said why not."""
+        code = job.code
+        root = job.name not in {c.get("link") for c in self.root.iter("child")}
+        if solid.size < STUB_SIZE:
+            self.left.append(job.skip(
+                "its collision shapes are stubs (under 1 cm): no mass to derive from them; "
+                "write <inertial> by hand" + ("" if root else " (mass 0 for a frame)")))
             return
-        if code == "U602":
-            tensor = solid.inertia(SMALL_MASS) if solid else _iso(SMALL_INERTIA)
-            self._write_inertial(link, SMALL_MASS, solid.com if solid and inertial is None
-                                 else None, tensor, frame, keep_mass=False)
-            given = "the inertia of its shapes at that mass" if solid else "inertia 1e-06"
-            self.repairs.append(Repair(code, line, f"link {name!r} moves but had no mass: "
-                                       f"gave it {fmt_float(SMALL_MASS)} kg and {given}"))
-            return
-        if solid is None:
-            skip("no collision solid to derive inertia from (no <collision>, a capsule, plane "
-                 "or SDF, or a mesh that is unreadable or not closed); write <inertial> by hand")
-            return
-        if code in ("U606", "U601") and solid.size < STUB_SIZE:
-            root = link.get("name") not in {c.get("link") for c in self.root.iter("child")}
-            skip("its collision shapes are stubs (under 1 cm): no mass to derive from them; "
-                 "write <inertial> by hand" + ("" if root else " (mass 0 for a frame)"))
-            return
-        if code in ("U606", "U601") and self.density is None:
-            root = link.get("name") not in {c.get("link") for c in self.root.iter("child")}
+        if self.density is None:
             advice = ("it is the root link: mass 0 would make PyBullet fix the robot in place, "
                       "so give it its real <inertial>" if root else
                       "give it its real <inertial> (mass 0 if it is a frame)")
-            skip(f"{'no <inertial>' if code == 'U606' else 'no valid mass'} and fix invents no "
-                 f"mass: {advice}, or pass --density to give it the mass of its collision "
-                 "shapes at that density")
+            self.left.append(job.skip(
+                f"{'no <inertial>' if code == 'U606' else 'no valid mass'} and fix invents no "
+                f"mass: {advice}, or pass --density to give it the mass of its collision "
+                "shapes at that density"))
             return
-        if code in ("U606", "U601"):
-            assert self.density is not None
-            new_mass = self.density * solid.volume
-            self._write_inertial(link, new_mass, solid.com if inertial is None or origin is None
-                                 else None, solid.inertia(new_mass), frame,
-                                 keep_mass=False)
-            what = "had no <inertial>" if code == "U606" else "had no valid mass"
-            self.repairs.append(Repair(code, line, f"link {name!r} {what}: "
-                                       f"{fmt_float(new_mass, 4)} kg ({fmt_float(solid.volume, 4)}"
-                                       f" m^3 at {fmt_float(self.density)} kg/m^3) and the "
-                                       "inertia of its collision shapes"))
-            return
+        new_mass = self.density * solid.volume
+        self._write_inertial(job.link, new_mass, solid.com if job.inertial is None or
+                             job.origin is None else None, solid.inertia(new_mass), job.frame,
+                             keep_mass=False)
+        what = "had no <inertial>" if code == "U606" else "had no valid mass"
+        self.repairs.append(Repair(code, job.line, f"link {job.name!r} {what}: "
+                                   f"{fmt_float(new_mass, 4)} kg ({fmt_float(solid.volume, 4)}"
+                                   f" m^3 at {fmt_float(self.density)} kg/m^3) and the "
+                                   "inertia of its collision shapes"))
+
+    def _inertia(self, job: _LinkJob, solid: Solid) -> None:
+        """U603-U605, U608-U610: the inertia derived from the shapes (or balanced)."""
+        code, mass = job.code, job.mass
         if mass is None or mass <= 0:
-            skip("mass 0: no inertia to derive (a frame); give it a mass if it moves")
+            self.left.append(job.skip(
+                "mass 0: no inertia to derive (a frame); give it a mass if it moves"))
             return
-        inertia = inertial.find("inertia") if inertial is not None else None
+        inertia = job.inertial.find("inertia") if job.inertial is not None else None
         if self.balance and code in ("U605", "U608"):
-            skip(f"{code} left as it is: --balance keeps the file's values")
+            self.left.append(job.skip(f"{code} left as it is: --balance keeps the file's values"))
             return
         if self.balance and code == "U604" and inertia is not None:
             from .validate import _inertia_tensor
@@ -407,21 +467,20 @@ class _Plan:
             mean = balanced(file_tensor) if file_tensor is not None else None
             if mean is not None:
                 self._replace_inertia(inertia, _iso(mean))
-                self.repairs.append(Repair(code, line, f"link {name!r}: balanced its inertia "
-                                           "as MuJoCo's balanceinertia does (every principal "
-                                           f"moment set to their mean, {fmt_float(mean, 4)})"))
+                self.repairs.append(Repair(code, job.line, f"link {job.name!r}: balanced its "
+                                           "inertia as MuJoCo's balanceinertia does (every "
+                                           "principal moment set to their mean, "
+                                           f"{fmt_float(mean, 4)})"))
                 return
         if code == "U605" and solid.size < STUB_SIZE:
-            skip("its collision shapes are stubs (under 1 cm), nothing to derive inertia from")
+            self.left.append(job.skip(
+                "its collision shapes are stubs (under 1 cm), nothing to derive inertia from"))
             return
-        self._write_inertial(link, mass, None, solid.inertia(mass), frame, keep_mass=True)
-        why = {"U609": "had no <inertia>", "U610": "had an incomplete <inertia>",
-               "U603": "had an inertia that is not positive definite",
-               "U604": "had an inertia that violates the triangle inequality",
-               "U605": "had an inertia far from what its shapes imply",
-               "U608": "had a singular inertia"}[code]
-        self.repairs.append(Repair(code, line, f"link {name!r} {why}: derived it from its "
-                                   f"collision shapes at its mass {fmt_float(mass, 6)} kg"))
+        self._write_inertial(job.link, mass, None, solid.inertia(mass), job.frame,
+                             keep_mass=True)
+        self.repairs.append(Repair(code, job.line, f"link {job.name!r} {_WHY[code]}: derived it "
+                                   f"from its collision shapes at its mass {fmt_float(mass, 6)} "
+                                   "kg"))
 
     def _fixed_leaf(self, link: etree._Element) -> bool:
         """Whether ``link`` is a frame (a ``tool0``, a lidar mount with its optical frame).

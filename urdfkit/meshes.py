@@ -308,101 +308,26 @@ def _dae(data: bytes, path: Path) -> tuple[Any, Any]:
     """Vertices and triangles of a COLLADA file, placed as PyBullet places them.
 
     As PyBullet 3.2.7 reads it for collision: every ``<instance_geometry>`` of the scene's
-    visual scene, moved by its nodes' transforms (read PyBullet's way, see ``local``), then
-    scaled by ``<unit meter>``; ``<up_axis>`` is not applied. Checked against PyBullet's
-    getAABB of the same meshes in tests/test_meshes.py. Triangles, polylists and
-    polygons are read (fans for polygons); a geometry in any other primitive (strips) makes
-    the whole mesh unreadable rather than wrong. All one solid: PyBullet makes one hull.
+    visual scene, moved by its nodes' transforms (read PyBullet's way, see
+    :meth:`_Collada.local`), then scaled by ``<unit meter>``; ``<up_axis>`` is not applied.
+    Checked against PyBullet's getAABB of the same meshes in tests/test_meshes.py. Triangles,
+    polylists and polygons are read (fans for polygons); a geometry in any other primitive
+    (strips) makes the whole mesh unreadable rather than wrong. All one solid: PyBullet makes
+    one hull.
     """
     import numpy as np
 
-    from .xmlio import parse_xml
-
-    root = parse_xml(data, path).getroot()
-    by_id = {el.get("id"): el for el in root.iter() if el.get("id")}
-
-    def ref(url: str | None) -> Any:
-        return by_id[(url or "").lstrip("#")]
-
-    def numbers(el: Any, dtype: Any = float) -> Any:
-        return np.array((el.text or "").split(), dtype=dtype)
-
-    def geometry(geom: Any) -> tuple[Any, Any]:
-        mesh = geom.find("{*}mesh")
-        if mesh is None:
-            raise ValueError("not a mesh")
-        verts = mesh.find("{*}vertices")
-        position = next(i for i in verts.iterfind("{*}input") if i.get("semantic") == "POSITION")
-        source = ref(position.get("source"))
-        accessor = source.find("{*}technique_common/{*}accessor")
-        stride = int(accessor.get("stride", "3")) if accessor is not None else 3
-        points = numbers(source.find("{*}float_array")).reshape(-1, stride)[:, :3]
-        tris = []
-        for prim in mesh:
-            tag = etree_local(prim.tag)
-            if tag in ("source", "vertices", "extra", "lines", "linestrips"):
-                continue  # edges hold no faces (PyBullet skips them too)
-            if tag not in ("triangles", "polylist", "polygons"):
-                raise ValueError(f"COLLADA <{tag}> is not read")
-            inputs = prim.findall("{*}input")
-            width = max(int(i.get("offset", "0")) for i in inputs) + 1
-            at = next(int(i.get("offset", "0")) for i in inputs if i.get("semantic") == "VERTEX")
-            polys = [numbers(p_, np.int64).reshape(-1, width)[:, at]
-                     for p_ in prim.iterfind("{*}p")]
-            if tag == "triangles":
-                tris.append(np.concatenate(polys).reshape(-1, 3) if polys else np.zeros((0, 3)))
-                continue
-            if tag == "polylist":
-                counts = numbers(prim.find("{*}vcount"), np.int64)
-                polys = np.split(polys[0], np.cumsum(counts)[:-1]) if polys else []
-            for poly in polys:
-                tris += [np.array([[poly[0], poly[k], poly[k + 1]]])
-                         for k in range(1, len(poly) - 1)]
-        faces = np.concatenate(tris).astype(np.int64) if tris else np.zeros((0, 3), np.int64)
-        return points, faces
-
-    def local(node: Any) -> Any:
-        # PyBullet reads only the first <matrix>, <translate>, <scale> and <rotate> of a node
-        # (its loop steps to the node's sibling, not the element's), and composes them in that
-        # order whatever the file's order: a second <rotate> is ignored (measured).
-        m = np.eye(4)
-        for kind in ("matrix", "translate", "scale", "rotate"):
-            t = node.find("{*}" + kind)
-            if t is None or not (t.text or "").strip():
-                continue
-            step = np.eye(4)
-            if kind == "matrix":
-                step = numbers(t).reshape(4, 4)
-            elif kind == "translate":
-                step[:3, 3] = numbers(t)[:3]
-            elif kind == "scale":
-                step = np.diag([*numbers(t)[:3], 1.0])
-            else:
-                x, y, z, deg = numbers(t)[:4]
-                step[:3, :3] = axis_angle_matrix((x, y, z), math.radians(deg))
-            m = m @ step
-        return m
-
-    placed: list[tuple[Any, Any]] = []
-
-    def walk(node: Any, above: Any, depth: int) -> None:
-        if depth > 64:
-            raise ValueError("nodes nested too deep")
-        here = above @ local(node)
-        placed.extend((here, ref(g.get("url"))) for g in node.iterfind("{*}instance_geometry"))
-        for child in node.iterfind("{*}node"):  # (<instance_node> is not read by PyBullet)
-            walk(child, here, depth + 1)
-
-    scene_ref = root.find("{*}scene/{*}instance_visual_scene")
+    doc = _Collada(data, path)
+    scene_ref = doc.root.find("{*}scene/{*}instance_visual_scene")
     if scene_ref is not None:
-        for node in ref(scene_ref.get("url")).iterfind("{*}node"):
-            walk(node, np.eye(4), 0)
-    unit = root.find("{*}asset/{*}unit")
+        for node in doc.ref(scene_ref.get("url")).iterfind("{*}node"):
+            doc.walk(node, np.eye(4), 0)
+    unit = doc.root.find("{*}asset/{*}unit")
     world = np.eye(4) * float(unit.get("meter", "1") if unit is not None else 1.0)
     world[3, 3] = 1.0
     all_points, all_faces, count = [], [], 0
-    for transform, geom in placed:
-        points, faces = geometry(geom)
+    for transform, geom in doc.placed:
+        points, faces = doc.geometry(geom)
         m = world @ transform
         all_points.append(points @ m[:3, :3].T + m[:3, 3])
         all_faces.append(faces + count)
@@ -410,6 +335,107 @@ def _dae(data: bytes, path: Path) -> tuple[Any, Any]:
     if not all_points:
         raise ValueError("no geometry")
     return np.concatenate(all_points), np.concatenate(all_faces)
+
+
+class _Collada:
+    """One COLLADA document, read the way PyBullet reads it (see :func:`_dae`)."""
+
+    def __init__(self, data: bytes, path: Path) -> None:
+        from .xmlio import parse_xml
+
+        self.root = parse_xml(data, path).getroot()
+        self.by_id = {el.get("id"): el for el in self.root.iter() if el.get("id")}
+        #: (world transform, <geometry>) of every instance_geometry met by :meth:`walk`.
+        self.placed: list[tuple[Any, Any]] = []
+
+    def ref(self, url: str | None) -> Any:
+        """The element a ``#id`` URL points at."""
+        return self.by_id[(url or "").lstrip("#")]
+
+    @staticmethod
+    def numbers(el: Any, dtype: Any = float) -> Any:
+        """An element's text as a flat array."""
+        import numpy as np
+
+        return np.array((el.text or "").split(), dtype=dtype)
+
+    def geometry(self, geom: Any) -> tuple[Any, Any]:
+        """A ``<geometry>``'s points and triangles (vertex indices)."""
+        import numpy as np
+
+        mesh = geom.find("{*}mesh")
+        if mesh is None:
+            raise ValueError("not a mesh")
+        verts = mesh.find("{*}vertices")
+        position = next(i for i in verts.iterfind("{*}input") if i.get("semantic") == "POSITION")
+        source = self.ref(position.get("source"))
+        accessor = source.find("{*}technique_common/{*}accessor")
+        stride = int(accessor.get("stride", "3")) if accessor is not None else 3
+        points = self.numbers(source.find("{*}float_array")).reshape(-1, stride)[:, :3]
+        tris: list[Any] = []
+        for prim in mesh:
+            tag = etree_local(prim.tag)
+            if tag in ("source", "vertices", "extra", "lines", "linestrips"):
+                continue  # edges hold no faces (PyBullet skips them too)
+            if tag not in ("triangles", "polylist", "polygons"):
+                raise ValueError(f"COLLADA <{tag}> is not read")
+            tris += self.triangles(prim, tag)
+        faces = np.concatenate(tris).astype(np.int64) if tris else np.zeros((0, 3), np.int64)
+        return points, faces
+
+    def triangles(self, prim: Any, tag: str) -> list[Any]:
+        """The triangles of one ``<triangles>``, ``<polylist>`` or ``<polygons>`` (fans)."""
+        import numpy as np
+
+        inputs = prim.findall("{*}input")
+        width = max(int(i.get("offset", "0")) for i in inputs) + 1
+        at = next(int(i.get("offset", "0")) for i in inputs if i.get("semantic") == "VERTEX")
+        polys = [self.numbers(p_, np.int64).reshape(-1, width)[:, at]
+                 for p_ in prim.iterfind("{*}p")]
+        if tag == "triangles":
+            return [np.concatenate(polys).reshape(-1, 3) if polys else np.zeros((0, 3))]
+        if tag == "polylist":
+            counts = self.numbers(prim.find("{*}vcount"), np.int64)
+            polys = np.split(polys[0], np.cumsum(counts)[:-1]) if polys else []
+        return [np.array([[poly[0], poly[k], poly[k + 1]]])
+                for poly in polys for k in range(1, len(poly) - 1)]
+
+    def local(self, node: Any) -> Any:
+        """A node's own transform, as PyBullet reads it.
+
+        PyBullet reads only the first <matrix>, <translate>, <scale> and <rotate> of a node
+        (its loop steps to the node's sibling, not the element's), and composes them in that
+        order whatever the file's order: a second <rotate> is ignored (measured).
+        """
+        import numpy as np
+
+        m = np.eye(4)
+        for kind in ("matrix", "translate", "scale", "rotate"):
+            t = node.find("{*}" + kind)
+            if t is None or not (t.text or "").strip():
+                continue
+            step = np.eye(4)
+            if kind == "matrix":
+                step = self.numbers(t).reshape(4, 4)
+            elif kind == "translate":
+                step[:3, 3] = self.numbers(t)[:3]
+            elif kind == "scale":
+                step = np.diag([*self.numbers(t)[:3], 1.0])
+            else:
+                x, y, z, deg = self.numbers(t)[:4]
+                step[:3, :3] = axis_angle_matrix((x, y, z), math.radians(deg))
+            m = m @ step
+        return m
+
+    def walk(self, node: Any, above: Any, depth: int) -> None:
+        """Collect the node's geometry instances and its children's, with their transforms."""
+        if depth > 64:
+            raise ValueError("nodes nested too deep")
+        here = above @ self.local(node)
+        self.placed.extend((here, self.ref(g.get("url")))
+                           for g in node.iterfind("{*}instance_geometry"))
+        for child in node.iterfind("{*}node"):  # (<instance_node> is not read by PyBullet)
+            self.walk(child, here, depth + 1)
 
 
 def etree_local(tag: Any) -> str:
