@@ -259,12 +259,40 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
     rp = reader.section("robot_pybullet", ROBOT_KEYS)
     env = reader.section("env_pybullet", ENV_KEYS)
     pin = reader.section("robot_pin", PIN_KEYS)
-    notes = reader.notes
     for key, off in SIM_INDEXES.items():
         if key not in rp:
-            notes.append(f"robot_pybullet.{key}: missing; SimInterface stops with a KeyError "
-                         f"without it, urdfkit runs with {off}")
+            reader.notes.append(f"robot_pybullet.{key}: missing; SimInterface stops with a "
+                                f"KeyError without it, urdfkit runs with {off}")
+    time_step = _time_step(reader, sim, env)
+    if "robot_pybullet" not in data:
+        raise reader.fail("robot_pybullet", "required section is missing")
+    robots = _load_robots(reader, rp, base)
+    conv = _Converter(reader, sim, rp, len(robots))
+    out_robots = [conv.robot(i, robot) for i, robot in enumerate(robots)]
+    _damping(robots, out_robots, reader.notes)
+    if pin:
+        reader.notes.append("robot_pin: the Pinocchio model is not simulated; Simulation's "
+                            "mass_matrix, gravity_torques, coriolis_and_gravity and jacobian "
+                            "give PyBullet's own")
+    scenario: dict[str, Any] = {
+        # SimInterface's engine settings; contacts in the engine's own order, not sorted.
+        "physics": {"time_step": time_step, "gravity": [0.0, 0.0, -9.81],
+                    "solver_iterations": 30, "cone_friction": False,
+                    "deterministic_pairs": False},
+        "ground": "plane.urdf",
+        "record": conv.record(),
+        "robots": out_robots,
+    }
+    if "experiment_duration" in sim:
+        duration = _number(reader, "sim.experiment_duration", sim["experiment_duration"])
+        if duration <= 0:
+            raise reader.fail("sim.experiment_duration", "must be > 0 s")
+        scenario["duration"] = duration
+    return Imported(scenario, reader.notes)
 
+
+def _time_step(reader: _Reader, sim: Mapping[str, Any], env: Mapping[str, Any]) -> float:
+    """``sim.time_step``, after refusing an ``env_script_name`` (code urdfkit never runs)."""
     script = env.get("env_script_name", "")
     if script:
         raise reader.fail("env_pybullet.env_script_name",
@@ -276,15 +304,16 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
     time_step = _number(reader, "sim.time_step", sim["time_step"])
     if not 0 < time_step <= 1:
         raise reader.fail("sim.time_step", "must be in (0, 1] s")
+    return time_step
 
-    if "robot_pybullet" not in data:
-        raise reader.fail("robot_pybullet", "required section is missing")
+
+def _load_robots(reader: _Reader, rp: Mapping[str, Any], base: Path) -> list[_Robot]:
+    """Each ``urdf_path``, found as SimInterface finds it and loaded to read its joints."""
     paths = rp.get("urdf_path")
     if not isinstance(paths, list) or not paths:
         raise reader.fail("robot_pybullet.urdf_path", "expected a list of URDF files, one per "
                                                       "robot (SimInterface requires a list)")
-    count = len(paths)
-    models = reader.per_robot(rp, "robot_pybullet", "robot_description_model", count, "")
+    models = reader.per_robot(rp, "robot_pybullet", "robot_description_model", len(paths), "")
     robots: list[_Robot] = []
     for i, name in enumerate(paths):
         if models[i]:
@@ -303,44 +332,83 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
             raise reader.fail(where, f"joint {odd[0]!r} is neither revolute nor prismatic: "
                                      "SimInterface's motors need 1-DOF joints")
         robots.append(robot)
+    return robots
 
-    feet_names = reader.per_robot(sim, "sim", "feet_contact_names", count, [])
-    labels = {label: reader.per_robot(sim, "sim", label, count, []) for label in FOOT_LABELS}
-    out_robots: list[dict[str, Any]] = []
-    record: dict[str, Any] = {"motor_torques": True}
-    feet_record: dict[str, str] = {}
-    joint_forces: list[str] = []
-    link_poses: list[str] = []
-    used_names: set[str] = set()
 
-    def get(key: str, default: Any = None) -> list[Any]:
-        return reader.per_robot(rp, "robot_pybullet", key, count, default)
+class _Converter:
+    """The per-robot part of :func:`convert`: one native robot document per config robot."""
 
-    base_types = get("base_type", "floating")
-    for i, robot in enumerate(robots):
-        names = robot.active
-        n = len(names)
+    def __init__(self, reader: _Reader, sim: Mapping[str, Any], rp: Mapping[str, Any],
+                 count: int) -> None:
+        self.reader, self.sim, self.rp, self.count = reader, sim, rp, count
+        self.notes = reader.notes
+        self.feet_names = reader.per_robot(sim, "sim", "feet_contact_names", count, [])
+        self.labels = {label: reader.per_robot(sim, "sim", label, count, [])
+                       for label in FOOT_LABELS}
+        self.base_types = self.get("base_type", "floating")
+        self.feet_record: dict[str, str] = {}
+        self.joint_forces: list[str] = []
+        self.link_poses: list[str] = []
+        self.used_names: set[str] = set()
+
+    def get(self, key: str, default: Any = None) -> list[Any]:
+        """A ``robot_pybullet`` key, one value per robot."""
+        return self.reader.per_robot(self.rp, "robot_pybullet", key, self.count, default)
+
+    def record(self) -> dict[str, Any]:
+        """What the scenario records: torques, and the feet, forces and poses met."""
+        record: dict[str, Any] = {"motor_torques": True}
+        if self.feet_record:
+            record["feet"] = self.feet_record
+        if self.joint_forces:
+            record["joint_forces"] = self.joint_forces
+        if self.link_poses:
+            record["link_poses"] = self.link_poses
+        return record
+
+    def robot(self, i: int, robot: _Robot) -> dict[str, Any]:
+        """The native document of robot ``i``."""
         w = f"robot_pybullet.{{}}[{i}]"
+        doc = self._body(i, robot, w)
+        self._motors(doc, i, robot.active, w)
+        self._feet(doc, i, robot, w)
+        self._sensors(i, robot, w)
+        self._base_link(i, robot, w)
+        reader = self.reader
+        if _flag(reader, w.format("noise_flag"), self.get("noise_flag", False)[i]):
+            doc["noise"] = _noise(reader, w.format("robot_noise"),
+                                  self.get("robot_noise", {})[i], robot.active)
+        if _flag(reader, w.format("delay_measure_flag"),
+                 self.get("delay_measure_flag", False)[i]):
+            steps = self.get("delay_measure_steps")[i]
+            if isinstance(steps, bool) or not isinstance(steps, int) or steps < 0:
+                raise reader.fail(w.format("delay_measure_steps"),
+                                  f"expected an integer >= 0, got {steps!r}")
+            doc["delay"] = steps
+        return doc
+
+    def _body(self, i: int, robot: _Robot, w: str) -> dict[str, Any]:
+        """Name, file, base type, self-collision, start pose and base velocity."""
+        reader, get = self.reader, self.get
         doc: dict[str, Any] = {}
         stem = robot.path.stem or f"robot{i}"
-        name = stem if stem not in used_names else f"{stem}_{i}"
-        used_names.add(name)
+        name = stem if stem not in self.used_names else f"{stem}_{i}"
+        self.used_names.add(name)
         doc["name"] = name
         doc["urdf"] = str(robot.path)
         doc["implicit_cylinder"] = False  # SimInterface loads with URDF_USE_INERTIA_FROM_FILE
-        base_type = base_types[i]
+        base_type = self.base_types[i]
         if base_type not in ("fixed", "floating", "on_rack"):
             raise reader.fail(w.format("base_type"),
                               f"expected \"fixed\", \"floating\" or \"on_rack\", got "
                               f"{base_type!r}")
         doc["base"] = base_type
         if base_type == "on_rack":
-            notes.append(f"{w.format('base_type')}: on_rack: SimInterface pins its rack at "
-                         "the world origin and its Step then fails (no mass matrix for "
-                         "on_rack); urdfkit holds the base where it starts")
+            self.notes.append(f"{w.format('base_type')}: on_rack: SimInterface pins its rack at "
+                              "the world origin and its Step then fails (no mass matrix for "
+                              "on_rack); urdfkit holds the base where it starts")
         doc["self_collision"] = _flag(reader, w.format("collision_enable"),
                                       get("collision_enable", False)[i])
-
         # Pose: SimInterface's is the base's centre of mass (resetBasePositionAndOrientation).
         orientation = get("init_link_base_orientation", [])[i]
         if orientation:
@@ -350,8 +418,12 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
                                       get("init_link_base_position")[i], 3)
             doc["pose_frame"] = "com"
         if base_type == "floating":
-            doc.update(_base_velocity(reader, rp, notes))
+            doc.update(_base_velocity(reader, self.rp, self.notes))
+        return doc
 
+    def _motors(self, doc: dict[str, Any], i: int, names: list[str], w: str) -> None:
+        """Offsets, directions, initial joints (in the measured frame) and the servo."""
+        reader, get, n = self.reader, self.get, len(names)
         offsets = get("motor_offset", [])[i]
         directions = get("motor_direction", [])[i]
         offset = [0.0] * n if not offsets else \
@@ -379,7 +451,11 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
             k: {"position": (q - off) * d, "velocity": v * d}
             for k, q, v, off, d in zip(names, angles, velocities, offset, direction,
                                        strict=True)}
+        doc["motor"] = self._servo(i, names, w, any(offset) or any(d < 0 for d in direction))
 
+    def _servo(self, i: int, names: list[str], w: str, adjusted: bool) -> dict[str, Any]:
+        """The servo: gains through the mass matrix, friction and spring if enabled."""
+        reader, get = self.reader, self.get
         motor: dict[str, Any] = {
             "kp": _per_joint(reader, w.format("servo_pos_gains"), get("servo_pos_gains")[i],
                              names, one_ok=False, non_negative=True),
@@ -393,22 +469,25 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
             if _flag(reader, w.format(flag_key), get(flag_key, False)[i]):
                 motor[native] = _per_joint(reader, w.format(coeff_key), get(coeff_key, 0.0)[i],
                                            names, one_ok=True, non_negative=True)
-        if ("viscous_friction" in motor or "stiffness" in motor) and \
-                (any(offset) or any(d < 0 for d in direction)):
-            notes.append(f"{w.format('motor_damping')}: SimInterface multiplies the friction "
-                         "and spring torques by a mass matrix it computes at the offset and "
-                         "direction-adjusted angles, as if they were joint angles; urdfkit "
-                         "follows it for parity (the physical one is at the joint angles)")
+        if ("viscous_friction" in motor or "stiffness" in motor) and adjusted:
+            self.notes.append(f"{w.format('motor_damping')}: SimInterface multiplies the "
+                              "friction and spring torques by a mass matrix it computes at the "
+                              "offset and direction-adjusted angles, as if they were joint "
+                              "angles; urdfkit follows it for parity (the physical one is at "
+                              "the joint angles)")
         if _flag(reader, w.format("motor_inertia"), get("motor_inertia", False)[i]):
             coeff = _per_joint(reader, w.format("motor_inertia_coeff"),
                                get("motor_inertia_coeff", 0.0)[i], names, one_ok=True)
             if coeff:
-                notes.append(f"{w.format('motor_inertia')}: SimInterface's servo stores the "
-                             "motor inertia but never applies it; not applied here either "
-                             "(the native motor.inertia applies one)")
-        doc["motor"] = motor
+                self.notes.append(f"{w.format('motor_inertia')}: SimInterface's servo stores "
+                                  "the motor inertia but never applies it; not applied here "
+                                  "either (the native motor.inertia applies one)")
+        return motor
 
-        feet = feet_names[i]
+    def _feet(self, doc: dict[str, Any], i: int, robot: _Robot, w: str) -> None:
+        """Foot friction and restitution, and the feet recorded under their labels."""
+        reader, get = self.reader, self.get
+        feet = self.feet_names[i]
         if not isinstance(feet, list):
             raise reader.fail(f"sim.feet_contact_names[{i}]", "expected a list of link names")
         friction = _number(reader, w.format("foot_friction"), get("foot_friction", 1.0)[i])
@@ -417,85 +496,55 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
         dynamics: dict[str, Any] = {}
         for link in feet:
             if link not in robot.links:
-                notes.append(f"sim.feet_contact_names[{i}]: {robot.path.name} has no moving "
-                             f"link named {link!r}; SimInterface skips it, and so does urdfkit")
+                self.notes.append(f"sim.feet_contact_names[{i}]: {robot.path.name} has no "
+                                  f"moving link named {link!r}; SimInterface skips it, and so "
+                                  "does urdfkit")
                 continue
             dynamics[link] = {"lateral_friction": friction, "restitution": restitution}
-            label = next((lab for lab in FOOT_LABELS if isinstance(labels[lab][i], list)
-                          and link in labels[lab][i]), link)
-            if count > 1:
-                label = f"{name}.{label}"
-            feet_record[label] = link
+            label = next((lab for lab in FOOT_LABELS if isinstance(self.labels[lab][i], list)
+                          and link in self.labels[lab][i]), link)
+            if self.count > 1:
+                label = f"{doc['name']}.{label}"
+            self.feet_record[label] = link
         if dynamics:
             doc["link_dynamics"] = dynamics
 
-        sensors = get("enable_feet_joint_force_sensors", [])[i]
-        if sensors:
-            if not isinstance(sensors, list):
-                raise reader.fail(w.format("enable_feet_joint_force_sensors"),
-                                  "expected a list of joint names")
-            for lab in FOOT_LABELS:
-                frames = labels[lab][i]
-                if not (isinstance(frames, list) and set(frames) & set(sensors)):
-                    raise reader.fail(f"sim.{lab}[{i}]",
-                                      "names none of enable_feet_joint_force_sensors' joints "
-                                      "(SimInterface raises ValueError here too)")
-            for joint in sensors:
-                if joint not in robot.joints:  # SimInterface finds none and reads nothing
-                    notes.append(f"{w.format('enable_feet_joint_force_sensors')}: "
-                                 f"{robot.path.name} has no joint named {joint!r}; "
-                                 "SimInterface puts no sensor there, and neither does urdfkit")
-                    continue
-                if joint not in joint_forces:
-                    joint_forces.append(joint)
+    def _sensors(self, i: int, robot: _Robot, w: str) -> None:
+        """The joints whose reaction forces are recorded (SimInterface's foot sensors)."""
+        reader = self.reader
+        sensors = self.get("enable_feet_joint_force_sensors", [])[i]
+        if not sensors:
+            return
+        if not isinstance(sensors, list):
+            raise reader.fail(w.format("enable_feet_joint_force_sensors"),
+                              "expected a list of joint names")
+        for lab in FOOT_LABELS:
+            frames = self.labels[lab][i]
+            if not (isinstance(frames, list) and set(frames) & set(sensors)):
+                raise reader.fail(f"sim.{lab}[{i}]",
+                                  "names none of enable_feet_joint_force_sensors' joints "
+                                  "(SimInterface raises ValueError here too)")
+        for joint in sensors:
+            if joint not in robot.joints:  # SimInterface finds none and reads nothing
+                self.notes.append(f"{w.format('enable_feet_joint_force_sensors')}: "
+                                  f"{robot.path.name} has no joint named {joint!r}; "
+                                  "SimInterface puts no sensor there, and neither does urdfkit")
+                continue
+            if joint not in self.joint_forces:
+                self.joint_forces.append(joint)
 
-        base_joint = get("floating_base_name", "")[i]
-        if base_joint:
-            link = next((lk for lk, j in robot.links.items() if j == base_joint), None)
-            if link is None:  # SimInterface matches no joint and records no base link
-                notes.append(f"{w.format('floating_base_name')}: {robot.path.name} has no "
-                             f"joint named {base_joint!r}; SimInterface then records no "
-                             "floating-base link, and neither does urdfkit")
-            elif link not in link_poses:
-                link_poses.append(link)
-
-        if _flag(reader, w.format("noise_flag"), get("noise_flag", False)[i]):
-            doc["noise"] = _noise(reader, w.format("robot_noise"), get("robot_noise", {})[i],
-                                  names)
-        if _flag(reader, w.format("delay_measure_flag"), get("delay_measure_flag", False)[i]):
-            steps = get("delay_measure_steps")[i]
-            if isinstance(steps, bool) or not isinstance(steps, int) or steps < 0:
-                raise reader.fail(w.format("delay_measure_steps"),
-                                  f"expected an integer >= 0, got {steps!r}")
-            doc["delay"] = steps
-        out_robots.append(doc)
-
-    _damping(robots, out_robots, notes)
-    if feet_record:
-        record["feet"] = feet_record
-    if joint_forces:
-        record["joint_forces"] = joint_forces
-    if link_poses:
-        record["link_poses"] = link_poses
-    if pin:
-        notes.append("robot_pin: the Pinocchio model is not simulated; Simulation's "
-                     "mass_matrix, gravity_torques, coriolis_and_gravity and jacobian give "
-                     "PyBullet's own")
-    scenario: dict[str, Any] = {
-        # SimInterface's engine settings; contacts in the engine's own order, not sorted.
-        "physics": {"time_step": time_step, "gravity": [0.0, 0.0, -9.81],
-                    "solver_iterations": 30, "cone_friction": False,
-                    "deterministic_pairs": False},
-        "ground": "plane.urdf",
-        "record": record,
-        "robots": out_robots,
-    }
-    if "experiment_duration" in sim:
-        duration = _number(reader, "sim.experiment_duration", sim["experiment_duration"])
-        if duration <= 0:
-            raise reader.fail("sim.experiment_duration", "must be > 0 s")
-        scenario["duration"] = duration
-    return Imported(scenario, notes)
+    def _base_link(self, i: int, robot: _Robot, w: str) -> None:
+        """The floating-base link whose pose is recorded, named by its joint."""
+        base_joint = self.get("floating_base_name", "")[i]
+        if not base_joint:
+            return
+        link = next((lk for lk, j in robot.links.items() if j == base_joint), None)
+        if link is None:  # SimInterface matches no joint and records no base link
+            self.notes.append(f"{w.format('floating_base_name')}: {robot.path.name} has no "
+                              f"joint named {base_joint!r}; SimInterface then records no "
+                              "floating-base link, and neither does urdfkit")
+        elif link not in self.link_poses:
+            self.link_poses.append(link)
 
 
 def _base_velocity(reader: _Reader, rp: Mapping[str, Any], notes: list[str]) -> dict[str, Any]:
