@@ -51,13 +51,11 @@ from .vehicle import (
     Drivetrain,
     DrivetrainError,
     apply_drive,
-    base_link_pose,
     clamp_steer,
     detect_upright,
     disable_default_motors,
-    lowest_point,
-    set_base_link_pose,
 )
+from .vehicle_shapes import base_link_pose, lowest_point, set_base_link_pose
 
 #: Default simulated samples per second in the trajectory (and for the statistics): enough
 #: for a smooth path and a good circle fit, cheap enough to cost nothing next to the physics.

@@ -43,14 +43,24 @@ from typing import Any
 
 from .errors import ParameterError
 from .spec import quat_to_matrix, rotate
+from .vehicle_shapes import (
+    Vec,
+    base_link_pose,
+    lowest_point,
+    roundness,
+    set_base_link_pose,
+    shape_points,
+    vdot,
+    vsub,
+    vunit,
+)
 
 #: |axis . up| below this is "horizontal" (about 11 degrees of tilt allowed).
 HORIZONTAL_TOLERANCE = 0.2
 #: |axis . up| above this is "vertical".
 VERTICAL_TOLERANCE = 0.98
-#: A wheel is round: in every one of this many sectors around its axis, its shapes reach...
-ROUND_SECTORS = 12
-#: ...at least this fraction of its radius.
+#: A wheel is round: its shapes reach at least this fraction of its radius in every sector
+#: around its axis (:data:`urdfkit.vehicle_shapes.ROUND_SECTORS`).
 ROUND_FRACTION = 0.9
 #: A wheel's lowest point is within this fraction of its radius of the robot's lowest point.
 GROUND_FRACTION = 0.25
@@ -67,9 +77,7 @@ DRIVETRAINS = ("differential", "rear", "locked")
 
 _REVOLUTE = 0  # p.JOINT_REVOLUTE
 _PRISMATIC = 1  # p.JOINT_PRISMATIC
-_SPHERE, _BOX, _CYLINDER, _MESH, _CAPSULE = 2, 3, 4, 5, 7  # p.GEOM_*
 
-Vec = tuple[float, float, float]
 
 
 class DrivetrainError(ParameterError):
@@ -329,161 +337,6 @@ def _pick(spec: Sequence[str | int], names: dict[int, str], movable: list[int],
     return out
 
 
-def _shape_points(p: Any, body: int, link: int, client: int) -> list[Vec]:
-    """Points outlining a link's collision shapes, in world coordinates.
-
-    Meshes (and cylinders PyBullet turned into meshes) give their vertices; implicit
-    cylinders, capsules, spheres and boxes are outlined from their dimensions.
-    """
-    if link < 0:  # the base: getBasePositionAndOrientation is its inertial (COM) frame
-        pos_, orn_ = p.getBasePositionAndOrientation(body, physicsClientId=client)
-        com_pos, com_rot = tuple(pos_), quat_to_matrix(orn_)
-    else:
-        st = p.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=client)
-        com_pos, com_rot = st[0], quat_to_matrix(st[1])
-    out: list[Vec] = []
-    for k, shape in enumerate(p.getCollisionShapeData(body, link, physicsClientId=client)):
-        kind, dims, pos, orn = shape[2], shape[3], shape[5], shape[6]
-        local: list[Vec] = []
-        if kind == _MESH:
-            try:
-                count, verts = p.getMeshData(body, link, collisionShapeIndex=k,
-                                             physicsClientId=client)
-            except p.error:
-                count, verts = 0, []
-            if count:  # already in the link's inertial frame
-                out += [_add(com_pos, rotate(com_rot, v)) for v in verts]
-            continue
-        if kind == _SPHERE:
-            r = dims[0]
-            local = [(r * x, r * y, r * z) for x, y, z in _SPHERE_DIRECTIONS]
-        elif kind in (_CYLINDER, _CAPSULE):
-            length, r = dims[0], dims[1]
-            local = [(r * math.cos(a), r * math.sin(a), z)
-                     for a in (2 * math.pi * i / 24 for i in range(24))
-                     for z in (-length / 2, length / 2)]
-            if kind == _CAPSULE:  # and its two half-spheres, beyond the cylinder's ends
-                local += [(r * x, r * y, r * z + math.copysign(length / 2, z))
-                          for x, y, z in _SPHERE_DIRECTIONS]
-        elif kind == _BOX:
-            hx, hy, hz = (d / 2 for d in dims)
-            local = [(sx * hx, sy * hy, sz * hz) for sx in (-1, 1) for sy in (-1, 1)
-                     for sz in (-1, 1)]
-        shape_rot = quat_to_matrix(orn)
-        for v in local:
-            in_com = _add(pos, rotate(shape_rot, v))
-            out.append(_add(com_pos, rotate(com_rot, in_com)))
-    return out
-
-
-def base_link_pose(p: Any, body: int, client: int) -> tuple[Any, Any]:
-    """The base link frame's world pose (PyBullet reports the base's inertial frame).
-
-    With ``URDF_USE_INERTIA_FROM_FILE`` an ``<inertia>`` with products (ixy, ixz, iyz), or an
-    ``<inertial><origin>``, puts the inertial frame elsewhere than the link frame: its pose is
-    not the robot's.
-    """
-    pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
-    local = p.getDynamicsInfo(body, -1, physicsClientId=client)
-    inv_pos, inv_orn = p.invertTransform(local[3], local[4])
-    return p.multiplyTransforms(pos, orn, inv_pos, inv_orn)
-
-
-def set_base_link_pose(p: Any, body: int, client: int, pos: Sequence[float],
-                       orn: Sequence[float]) -> None:
-    """Place the base link frame.
-
-    ``resetBasePositionAndOrientation`` places the inertial frame; ``loadURDF`` the link frame.
-    """
-    local = p.getDynamicsInfo(body, -1, physicsClientId=client)
-    com_pos, com_orn = p.multiplyTransforms(pos, orn, local[3], local[4])
-    p.resetBasePositionAndOrientation(body, com_pos, com_orn, physicsClientId=client)
-
-
-def lowest_point(p: Any, body: int, client: int,
-                 points: dict[int, list[Vec]] | None = None) -> float:
-    """The lowest z of the body's collision shapes, from the shapes themselves.
-
-    Not from ``getAABB``: a link whose ``<inertia>`` has products gets a rotated inertial
-    frame, and its AABB grows with it (1.8 cm below a small car's real corners), which would
-    lift the start and disqualify the wheels as "above the robot's lowest point". A link
-    without collision shapes does not count; a body with none falls back to the AABB.
-    ``points`` (link index to :func:`_shape_points`) saves measuring them again.
-    """
-    n = p.getNumJoints(body, physicsClientId=client)
-    if points is None:
-        points = {link: _shape_points(p, body, link, client) for link in range(-1, n)}
-    zs = [pt[2] for pts in points.values() for pt in pts]
-    finite = [z for z in zs if math.isfinite(z)]
-    if finite:
-        return min(finite)
-    return min(p.getAABB(body, link, physicsClientId=client)[0][2] for link in range(-1, n))
-
-
-def _fibonacci_sphere(n: int) -> list[Vec]:
-    """``n`` unit vectors spread evenly over the sphere."""
-    golden = math.pi * (3.0 - math.sqrt(5.0))
-    out: list[Vec] = []
-    for i in range(n):
-        z = 1.0 - 2.0 * (i + 0.5) / n
-        r = math.sqrt(1.0 - z * z)
-        out.append((r * math.cos(golden * i), r * math.sin(golden * i), z))
-    return out
-
-
-#: Directions outlining a sphere. 100 spread evenly keep every one of the 12 sectors about
-#: ANY axis through the centre at >= 0.97 of the radius (measured over random axes), so a
-#: sphere wheel is round whichever way its joint turns; a few dozen on meridians are not.
-_SPHERE_DIRECTIONS = _fibonacci_sphere(100)
-
-
-def _add(a: Sequence[float], b: Sequence[float]) -> Vec:
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def _sub(a: Sequence[float], b: Sequence[float]) -> Vec:
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _dot(a: Sequence[float], b: Sequence[float]) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def _unit(a: Sequence[float]) -> Vec:
-    n = math.sqrt(_dot(a, a)) or 1.0
-    return (a[0] / n, a[1] / n, a[2] / n)
-
-
-def _roundness(points: list[Vec], origin: Vec, axis: Vec) -> tuple[float, float, Vec] | None:
-    """``(radius, worst sector fraction, centre on the axis)`` of points about an axis.
-
-    None for no points, or for points that are not all finite (a shape sized 1e309 is
-    infinite): nothing round can be measured from them.
-    """
-    if not points or not all(math.isfinite(c) for pt in points for c in pt) or \
-            not all(math.isfinite(c) for c in (*origin, *axis)):
-        return None
-    # Two directions perpendicular to the axis.
-    helper = (1.0, 0.0, 0.0) if abs(axis[0]) < 0.9 else (0.0, 1.0, 0.0)
-    u = _unit(_sub(helper, tuple(axis[i] * _dot(helper, axis) for i in range(3))))
-    v = (axis[1] * u[2] - axis[2] * u[1], axis[2] * u[0] - axis[0] * u[2],
-         axis[0] * u[1] - axis[1] * u[0])
-    reach = [0.0] * ROUND_SECTORS
-    along = 0.0
-    for pt in points:
-        d = _sub(pt, origin)
-        along += _dot(d, axis)
-        a, b = _dot(d, u), _dot(d, v)
-        sector = int((math.atan2(b, a) + math.pi) / (2 * math.pi) * ROUND_SECTORS) \
-            % ROUND_SECTORS
-        reach[sector] = max(reach[sector], math.hypot(a, b))
-    radius = max(reach)
-    if radius <= 0:
-        return None
-    mean = along / len(points)
-    return radius, min(reach) / radius, _add(origin, tuple(axis[i] * mean for i in range(3)))
-
-
 def detect_drivetrain(p: Any, body: int, client: int,
                       wheels: Sequence[str | int] | None = None,
                       hinges: Sequence[str | int] | None = None,
@@ -508,58 +361,119 @@ def detect_drivetrain(p: Any, body: int, client: int,
     if mode not in DRIVETRAINS:
         raise DrivetrainError(f"`drivetrain` must be one of {', '.join(DRIVETRAINS)}, got "
                               f"{mode!r}", param="drivetrain")
-    n = p.getNumJoints(body, physicsClientId=client)
-    infos = [p.getJointInfo(body, j, physicsClientId=client) for j in range(n)]
-    names = {j: info[1].decode("utf-8", "replace") for j, info in enumerate(infos)}
-    movable = [j for j, info in enumerate(infos) if info[2] in (_REVOLUTE, _PRISMATIC)]
-    states = {j: p.getLinkState(body, j, computeForwardKinematics=True, physicsClientId=client)
-              for j in movable}
-    origin = {j: tuple(states[j][4]) for j in movable}
-    # getJointInfo's axis is in the child's inertial frame (measured: with inertia products
-    # and URDF_USE_INERTIA_FROM_FILE a PR2 caster's vertical axis read 32 degrees off in the
-    # link frame), so it turns with the link's centre-of-mass orientation, not its URDF frame.
-    axes = {j: _unit(rotate(quat_to_matrix(states[j][1]), infos[j][13])) for j in movable}
-    base_pos, base_orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
-    dyn = p.getDynamicsInfo(body, -1, physicsClientId=client)
-    inv_pos, inv_orn = p.invertTransform(dyn[3], dyn[4])
-    base_link, base_link_orn = p.multiplyTransforms(base_pos, base_orn, inv_pos, inv_orn)
-    base_rot = quat_to_matrix(base_link_orn)
-    base_x, base_y = rotate(base_rot, (1.0, 0.0, 0.0)), rotate(base_rot, (0.0, 1.0, 0.0))
-    link_points = {link: _shape_points(p, body, link, client) for link in range(-1, n)}
-    lowest = lowest_point(p, body, client, link_points)
-
-    shapes: dict[int, tuple[float, float, Vec] | None] = {}
-
-    def round_about(j: int) -> tuple[float, float, Vec] | None:
-        if j not in shapes:
-            shapes[j] = _roundness(link_points[j], origin[j], axes[j])
-        return shapes[j]
-
-    rejected: list[str] = []
-    if wheels is not None:
-        wheel_list = _pick(wheels, names, movable, "wheels")
+    scan = _Scan(p, body, client)
+    names, movable, infos = scan.names, scan.movable, scan.infos
+    wheel_list = _pick(wheels, names, movable, "wheels") if wheels is not None \
+        else _find_wheels(scan)
+    casters: list[int] = []
+    if hinges is not None:
+        hinge_list = _pick(hinges, names, movable, "hinges")
     else:
-        wheel_list = []
-        for j in movable:
-            if not _is_continuous(infos[j]):
-                continue
-            if abs(axes[j][2]) >= HORIZONTAL_TOLERANCE:
-                rejected.append(f"{names[j]} (its axis is not horizontal)")
-                continue
-            shape = round_about(j)
-            if shape is None:
-                rejected.append(f"{names[j]} (its link has no collision shape to roll on)")
-                continue
-            size, fraction, centre = shape
-            if fraction < ROUND_FRACTION:
-                rejected.append(f"{names[j]} (its link is not round about the joint axis)")
-                continue
-            bottom = centre[2] - size * math.sqrt(max(0.0, 1 - axes[j][2] ** 2))
-            if bottom - lowest > max(GROUND_FRACTION * size, 0.005):
-                rejected.append(f"{names[j]} ({bottom - lowest:.2f} m above the robot's "
-                                "lowest point)")
-                continue
-            wheel_list.append(j)
+        wheel_list, hinge_list, casters = _find_hinges(scan, wheel_list, wheels is not None)
+    overlap = set(wheel_list) & set(hinge_list)
+    if overlap:
+        raise DrivetrainError(f"joint {names[min(overlap)]!r} cannot be both a wheel and a hinge",
+                              param="hinges")
+    forward = _forward([scan.axes[w] for w in wheel_list], scan.base_x, scan.base_y)
+    scan.face(forward)
+    radius, contact, wheel_signs = _wheel_geometry(scan, wheel_list, forward)
+    hinge_signs, hinge_limits, pivot = _hinge_geometry(scan, hinge_list)
+    carried_by = {w: scan.hinge_of(w, hinge_list) for w in wheel_list}
+    driven = set(wheel_list) | set(hinge_list)
+    passive = [j for j in movable if j not in driven]
+    in_base = (vdot(forward, scan.base_x), vdot(forward, scan.base_y))
+    n = scan.n
+    link_names = {k: infos[k][12].decode("utf-8", "replace") for k in range(n)}
+    link_names[-1] = p.getBodyInfo(body, physicsClientId=client)[0].decode("utf-8", "replace")
+    efforts = {j: float(infos[j][10]) for j in movable}
+    return Drivetrain(wheel_list, hinge_list, passive, names, hinge_limits, wheel_signs,
+                      hinge_signs, mode, radius, contact, carried_by, pivot, in_base,
+                      [j for j in movable if j in set(casters)],
+                      _caster_links(scan, wheel_list, casters), link_names, efforts)
+
+
+class _Scan:
+    """What detection reads of a body once: joints, their world axes and origins, shapes."""
+
+    def __init__(self, p: Any, body: int, client: int) -> None:
+        self.n = n = p.getNumJoints(body, physicsClientId=client)
+        self.infos = infos = [p.getJointInfo(body, j, physicsClientId=client) for j in range(n)]
+        self.names = {j: info[1].decode("utf-8", "replace") for j, info in enumerate(infos)}
+        self.movable = movable = [j for j, info in enumerate(infos)
+                                  if info[2] in (_REVOLUTE, _PRISMATIC)]
+        states = {j: p.getLinkState(body, j, computeForwardKinematics=True,
+                                    physicsClientId=client) for j in movable}
+        self.origin = {j: tuple(states[j][4]) for j in movable}
+        # getJointInfo's axis is in the child's inertial frame (measured: with inertia products
+        # and URDF_USE_INERTIA_FROM_FILE a PR2 caster's vertical axis read 32 degrees off in the
+        # link frame), so it turns with the link's centre-of-mass orientation, not its URDF
+        # frame.
+        self.axes = {j: vunit(rotate(quat_to_matrix(states[j][1]), infos[j][13]))
+                     for j in movable}
+        base_pos, base_orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
+        dyn = p.getDynamicsInfo(body, -1, physicsClientId=client)
+        inv_pos, inv_orn = p.invertTransform(dyn[3], dyn[4])
+        self.base_link, base_link_orn = p.multiplyTransforms(base_pos, base_orn, inv_pos,
+                                                             inv_orn)
+        base_rot = quat_to_matrix(base_link_orn)
+        self.base_x = rotate(base_rot, (1.0, 0.0, 0.0))
+        self.base_y = rotate(base_rot, (0.0, 1.0, 0.0))
+        self.link_points = {link: shape_points(p, body, link, client) for link in range(-1, n)}
+        self.lowest = lowest_point(p, body, client, self.link_points)
+        self._shapes: dict[int, tuple[float, float, Vec] | None] = {}
+        self.forward: Vec = (1.0, 0.0, 0.0)
+        self.left: Vec = (0.0, 1.0, 0.0)
+
+    def round_about(self, j: int) -> tuple[float, float, Vec] | None:
+        """How round joint ``j``'s link is about its axis (:func:`roundness`), once."""
+        if j not in self._shapes:
+            self._shapes[j] = roundness(self.link_points[j], self.origin[j], self.axes[j])
+        return self._shapes[j]
+
+    def hinge_of(self, w: int, candidates: Sequence[int]) -> int | None:
+        """The nearest joint above ``w`` (``w`` excluded) that is among ``candidates``."""
+        k = self.infos[w][16]
+        while k >= 0:
+            if k in candidates:
+                return k
+            k = self.infos[k][16]
+        return None
+
+    def face(self, forward: Vec) -> None:
+        """Set the vehicle's forward direction (for :meth:`planar`)."""
+        self.forward, self.left = forward, (-forward[1], forward[0], 0.0)
+
+    def planar(self, pt: Sequence[float]) -> tuple[float, float]:
+        """A world point in the vehicle's plane: (ahead of, left of) the base link."""
+        d = vsub(pt, self.base_link)
+        return (vdot(d, self.forward), vdot(d, self.left))
+
+
+def _find_wheels(scan: _Scan) -> list[int]:
+    """Continuous joints about a horizontal axis whose round link touches the ground."""
+    rejected: list[str] = []
+    wheel_list = []
+    names, axes = scan.names, scan.axes
+    for j in scan.movable:
+        if not _is_continuous(scan.infos[j]):
+            continue
+        if abs(axes[j][2]) >= HORIZONTAL_TOLERANCE:
+            rejected.append(f"{names[j]} (its axis is not horizontal)")
+            continue
+        shape = scan.round_about(j)
+        if shape is None:
+            rejected.append(f"{names[j]} (its link has no collision shape to roll on)")
+            continue
+        size, fraction, centre = shape
+        if fraction < ROUND_FRACTION:
+            rejected.append(f"{names[j]} (its link is not round about the joint axis)")
+            continue
+        bottom = centre[2] - size * math.sqrt(max(0.0, 1 - axes[j][2] ** 2))
+        if bottom - scan.lowest > max(GROUND_FRACTION * size, 0.005):
+            rejected.append(f"{names[j]} ({bottom - scan.lowest:.2f} m above the robot's "
+                            "lowest point)")
+            continue
+        wheel_list.append(j)
     if not wheel_list:
         why = f"; turning joints that are not wheels: {', '.join(rejected[:4])}" \
             if rejected else ""
@@ -568,98 +482,88 @@ def detect_drivetrain(p: Any, body: int, client: int,
                               f"round about it and touches the ground{why}. An arm or a "
                               "legged robot has none; name wheels with `wheels` (and "
                               "steering joints with `hinges`)", param="wheels")
-    wheel_set = set(wheel_list)
+    return wheel_list
 
-    def hinge_of(w: int, candidates: Sequence[int]) -> int | None:
-        k = infos[w][16]
-        while k >= 0:
-            if k in candidates:
-                return k
-            k = infos[k][16]
-        return None
 
+def _find_hinges(scan: _Scan, wheel_list: list[int], named_wheels: bool
+                 ) -> tuple[list[int], list[int], list[int]]:
+    """Steering hinges above the wheels, and casters: (wheels, hinges, casters)."""
+    infos, axes = scan.infos, scan.axes
+    verticals = [j for j in scan.movable if j not in set(wheel_list)
+                 and infos[j][2] == _REVOLUTE and abs(axes[j][2]) > VERTICAL_TOLERANCE]
+    carrying = [j for j in verticals if any(scan.hinge_of(w, [j]) == j for w in wheel_list)]
+    # A vertical joint that turns all the way round is a caster's swivel, not steering:
+    # it and the wheels it carries roll free (unless the user named those wheels).
+    swivels = [j for j in carrying if _is_continuous(infos[j])]
+    hinge_list = [j for j in carrying if j not in swivels]
     casters: list[int] = []
-    if hinges is not None:
-        hinge_list = _pick(hinges, names, movable, "hinges")
-    else:
-        verticals = [j for j in movable if j not in wheel_set and infos[j][2] == _REVOLUTE
-                     and abs(axes[j][2]) > VERTICAL_TOLERANCE]
-        carrying = [j for j in verticals if any(hinge_of(w, [j]) == j for w in wheel_list)]
-        # A vertical joint that turns all the way round is a caster's swivel, not steering:
-        # it and the wheels it carries roll free (unless the user named those wheels).
-        swivels = [j for j in carrying if _is_continuous(infos[j])]
-        hinge_list = [j for j in carrying if j not in swivels]
-        if swivels:
-            trailing = [w for w in wheel_list if hinge_of(w, swivels) is not None]
-            casters = swivels + ([] if wheels is not None else trailing)
-            if wheels is None:
-                wheel_list = [w for w in wheel_list if w not in trailing]
-                wheel_set = set(wheel_list)
-                if not wheel_list:
-                    raise DrivetrainError(
-                        "no wheels found: every wheel hangs from a swivel that turns all the "
-                        f"way round (casters: {', '.join(names[j] for j in casters)}); name "
-                        "the wheels to drive with `wheels` and the joints that steer them with "
-                        "`hinges`", param="wheels")
-    overlap = wheel_set & set(hinge_list)
-    if overlap:
-        raise DrivetrainError(f"joint {names[min(overlap)]!r} cannot be both a wheel and a hinge",
-                              param="hinges")
+    if swivels:
+        trailing = [w for w in wheel_list if scan.hinge_of(w, swivels) is not None]
+        casters = swivels + ([] if named_wheels else trailing)
+        if not named_wheels:
+            wheel_list = [w for w in wheel_list if w not in trailing]
+            if not wheel_list:
+                raise DrivetrainError(
+                    "no wheels found: every wheel hangs from a swivel that turns all the "
+                    f"way round (casters: {', '.join(scan.names[j] for j in casters)}); name "
+                    "the wheels to drive with `wheels` and the joints that steer them with "
+                    "`hinges`", param="wheels")
+    return wheel_list, hinge_list, casters
 
-    forward = _forward([axes[w] for w in wheel_list], base_x, base_y)
-    left = (-forward[1], forward[0], 0.0)
 
-    def planar(pt: Sequence[float]) -> tuple[float, float]:
-        d = _sub(pt, base_link)
-        return (_dot(d, forward), _dot(d, left))
-
+def _wheel_geometry(scan: _Scan, wheel_list: list[int], forward: Vec
+                    ) -> tuple[dict[int, float], dict[int, tuple[float, float]],
+                               dict[int, float]]:
+    """Each wheel's radius, ground contact in the vehicle plane, and spin sign."""
     radius: dict[int, float] = {}
     contact: dict[int, tuple[float, float]] = {}
     wheel_signs: dict[int, float] = {}
     for j in wheel_list:
-        shape = round_about(j)
+        shape = scan.round_about(j)
         if shape is not None:
             radius[j] = shape[0]
-            contact[j] = planar(shape[2])
+            contact[j] = scan.planar(shape[2])
         else:  # a named wheel without collision shapes: its height above the ground
-            radius[j] = max(origin[j][2] - lowest, 1e-3)
-            contact[j] = planar(origin[j])
-        a = axes[j]
+            radius[j] = max(scan.origin[j][2] - scan.lowest, 1e-3)
+            contact[j] = scan.planar(scan.origin[j])
+        a = scan.axes[j]
         # A wheel spinning positively about axis a moves the car along a x up.
         along = a[1] * forward[0] - a[0] * forward[1]
         wheel_signs[j] = -1.0 if along < 0 else 1.0
+    return radius, contact, wheel_signs
+
+
+def _hinge_geometry(scan: _Scan, hinge_list: list[int]
+                    ) -> tuple[dict[int, float], dict[int, tuple[float, float]],
+                               dict[int, tuple[float, float]]]:
+    """Each hinge's sign (its axis up or down), limits in that sense, and pivot."""
     hinge_signs: dict[int, float] = {}
     hinge_limits: dict[int, tuple[float, float]] = {}
     pivot: dict[int, tuple[float, float]] = {}
     for j in hinge_list:
-        sign = -1.0 if axes[j][2] < 0 else 1.0
+        sign = -1.0 if scan.axes[j][2] < 0 else 1.0
         hinge_signs[j] = sign
-        pivot[j] = planar(origin[j])
-        lower, upper = infos[j][8], infos[j][9]
+        pivot[j] = scan.planar(scan.origin[j])
+        lower, upper = scan.infos[j][8], scan.infos[j][9]
         if lower > upper:
             hinge_limits[j] = (-math.inf, math.inf)
         else:
             ends = sorted((lower * sign, upper * sign))
             hinge_limits[j] = (ends[0], ends[1])
-    carried_by = {w: hinge_of(w, hinge_list) for w in wheel_list}
-    driven = wheel_set | set(hinge_list)
-    passive = [j for j in movable if j not in driven]
-    in_base = (_dot(forward, base_x), _dot(forward, base_y))
-    # Links resting on the ground beside the wheels: a fixed caster ball or skid. The links
-    # the wheels and casters turn with are not among them, nor is the base itself.
+    return hinge_signs, hinge_limits, pivot
+
+
+def _caster_links(scan: _Scan, wheel_list: list[int], casters: list[int]) -> list[int]:
+    """Links resting on the ground beside the wheels: a fixed caster ball or skid.
+
+    The links the wheels and casters turn with are not among them, nor is the base itself.
+    """
     rolling = {j for j in wheel_list + casters}
-    for j in range(n):
-        if hinge_of(j, sorted(rolling)) is not None:
+    for j in range(scan.n):
+        if scan.hinge_of(j, sorted(rolling)) is not None:
             rolling.add(j)
-    caster_links = [k for k in range(n) if k not in rolling and link_points[k]
-                    and min(pt[2] for pt in link_points[k]) - lowest <= 0.005]
-    link_names = {k: infos[k][12].decode("utf-8", "replace") for k in range(n)}
-    link_names[-1] = p.getBodyInfo(body, physicsClientId=client)[0].decode("utf-8", "replace")
-    efforts = {j: float(infos[j][10]) for j in movable}
-    return Drivetrain(wheel_list, hinge_list, passive, names, hinge_limits, wheel_signs,
-                      hinge_signs, mode, radius, contact, carried_by, pivot, in_base,
-                      [j for j in movable if j in set(casters)], caster_links, link_names,
-                      efforts)
+    return [k for k in range(scan.n) if k not in rolling and scan.link_points[k]
+            and min(pt[2] for pt in scan.link_points[k]) - scan.lowest <= 0.005]
 
 
 def _forward(wheel_axes: list[Vec], base_x: Vec, base_y: Vec) -> Vec:
@@ -668,7 +572,7 @@ def _forward(wheel_axes: list[Vec], base_x: Vec, base_y: Vec) -> Vec:
     Wheels that roll along the base's y (r2d2's do) drive along +y: forward can only be a
     direction the wheels roll in.
     """
-    flat_x = _unit((base_x[0], base_x[1], 0.0))
+    flat_x = vunit((base_x[0], base_x[1], 0.0))
     ref = wheel_axes[0]
     total = [0.0, 0.0]
     for a in wheel_axes:
@@ -677,12 +581,12 @@ def _forward(wheel_axes: list[Vec], base_x: Vec, base_y: Vec) -> Vec:
         total[1] += s * a[1]
     if math.hypot(*total) < 1e-9:
         return flat_x
-    roll = _unit((-total[1], total[0], 0.0))  # up x axis: perpendicular in the ground plane
-    along_x = _dot(roll, flat_x)
+    roll = vunit((-total[1], total[0], 0.0))  # up x axis: perpendicular in the ground plane
+    along_x = vdot(roll, flat_x)
     if abs(along_x) >= 0.1:
         return roll if along_x > 0 else (-roll[0], -roll[1], 0.0)
     flat_y = (base_y[0], base_y[1], 0.0)
-    return roll if _dot(roll, flat_y) > 0 else (-roll[0], -roll[1], 0.0)
+    return roll if vdot(roll, flat_y) > 0 else (-roll[0], -roll[1], 0.0)
 
 
 def detect_upright(p: Any, body: int, client: int, upright: Sequence[float],
