@@ -17,7 +17,8 @@ from typer.testing import CliRunner
 
 from urdfkit.catalog import build_template
 from urdfkit.cli import app
-from urdfkit.drive import DriveConfig, DriveResult, Scenario, builtin_file, drive, fit_circle
+from urdfkit.drive import DriveConfig, Scenario, builtin_file, drive
+from urdfkit.drive_result import DriveResult, fit_circle
 from urdfkit.errors import ParameterError
 from urdfkit.session import LoadOptions, Session
 from urdfkit.vehicle import DrivetrainError, detect_drivetrain

@@ -20,7 +20,7 @@ from .output import atomic_write, check_output
 if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
 
-    from .drive import DriveResult
+    from .drive_result import DriveResult
 
 
 def _pyplot() -> Any:

@@ -145,7 +145,8 @@ def _check_drive_options(*, seconds: float | None, steps: int | None, tutorial: 
     """Refuse what cannot run together, and unwritable outputs, before the run; the pace."""
     from dataclasses import fields
 
-    from urdfkit.drive import DriveConfig, trajectory_format
+    from urdfkit.drive import DriveConfig
+    from urdfkit.drive_result import trajectory_format
     from urdfkit.errors import ParameterError
     from urdfkit.session import has_display
 
