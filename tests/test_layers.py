@@ -28,7 +28,7 @@ for floor, names in enumerate([
     # run and draw
     "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
     " validate diff collisions fix sweep_journal sweep sweep_run view view_model view_page"
-    " view_stream vehicle_shapes drive_result",
+    " view_stream vehicle_shapes drive_result scenario_models",
     # presentation and the command line
     "present ci cli __main__ commands.shared commands.build commands.inspecting commands.checking"
     " commands.driving commands.drawing commands.simulating",

@@ -16,15 +16,17 @@ from __future__ import annotations
 import functools
 import json
 import math
-import os
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import SimpleNamespace
-from typing import Annotated, Any, Literal, Union, get_args, get_origin
+from typing import TYPE_CHECKING, Annotated, Any, Union, get_args, get_origin
 
 from .errors import InputError, MissingDependencyError, ParameterError
 from .spec import MAX_STEPS
+
+if TYPE_CHECKING:
+    from .scenario_models import Robot, Scenario
 
 #: The observation fields that carry noise; each is a vector or a joint-keyed mapping.
 OBSERVATION_FIELDS = (
@@ -34,14 +36,13 @@ OBSERVATION_FIELDS = (
 )
 #: The noise fields of joint-keyed values, and of base 3-vectors.
 JOINT_NOISE_FIELDS = ("motor_angles", "motor_velocities", "motor_accelerations", "motor_torques")
-MODES = ("position", "velocity", "torque")
 
 _INSTALL_HINT = "urdfkit installs it; reinstall it: pip install --force-reinstall pydantic"
 
 
 @functools.cache
 def schema() -> SimpleNamespace:
-    """The pydantic models of a scenario, built on first use so pydantic loads lazily.
+    """The pydantic models of a scenario (:mod:`urdfkit.scenario_models`), imported on first use.
 
     Returns:
         A namespace with ``Scenario`` (the document) and the models it nests: ``Physics``,
@@ -52,245 +53,16 @@ def schema() -> SimpleNamespace:
         MissingDependencyError: pydantic is not installed.
     """
     try:
-        from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
+        import pydantic  # noqa: F401 - the dependency, checked before the models that need it
     except ImportError as e:
         raise MissingDependencyError(f"scenario files need pydantic: {_INSTALL_HINT}") from e
-
-    class Model(BaseModel):
-        # strict: "3" is not a number and 1 is not true; a typo must not pass silently.
-        # forbid: an unknown key is almost always a misspelt known one.
-        model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
-
-    vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
-    vec4 = Annotated[list[float], Field(min_length=4, max_length=4)]
-    positive = Annotated[float, Field(gt=0)]
-    non_negative = Annotated[float, Field(ge=0)]
-
-    class Physics(Model):
-        time_step: Annotated[float, Field(gt=0, le=1)] = 1.0 / 240.0
-        gravity: vec3 = Field(default_factory=lambda: [0.0, 0.0, -9.81])
-        solver_iterations: Annotated[int, Field(ge=1)] = 50
-        cone_friction: bool = True
-        # None: PyBullet's own 0.04 on every link (an undamped pendulum needs 0).
-        linear_damping: non_negative | None = None
-        angular_damping: non_negative | None = None
-        # PyBullet's deterministicOverlappingPairs: contacts met in a sorted order, so a
-        # reset in place replays the same run. simulation_and_control leaves it off.
-        deterministic_pairs: bool = True
-
-    class Ground(Model):
-        template: str | None = None
-        params: dict[str, Any] = Field(default_factory=dict)
-        urdf: str | None = None
-        position: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-
-        @model_validator(mode="before")
-        @classmethod
-        def _shorthand(cls, data: Any) -> Any:
-            # "ground": "simpleplane" or "ground": "plane.urdf".
-            if isinstance(data, str):
-                from .catalog import TEMPLATES
-
-                return {"template": data} if data in TEMPLATES else {"urdf": data}
-            return data
-
-    class Record(Model):
-        every: Annotated[int, Field(ge=1)] = 1
-        contact_links: list[str] = Field(default_factory=list)
-        joint_forces: list[str] = Field(default_factory=list)
-        motor_torques: bool = False
-        link_poses: list[str] = Field(default_factory=list)
-        # Feet: link names, or label -> link name ({"FL": "fl_foot", ...}).
-        feet: list[str] | dict[str, str] = Field(default_factory=list)
-
-    class LinkDynamics(Model):
-        lateral_friction: non_negative | None = None
-        restitution: non_negative | None = None
-        rolling_friction: non_negative | None = None
-        spinning_friction: non_negative | None = None
-
-    class DriveSegment(Model):
-        until: positive
-        throttle: float = 0.0
-        steer: float = 0.0
-
-    class Vehicle(Model):
-        wheels: list[str] | None = None
-        hinges: list[str] | None = None
-        max_force: positive = 10.0
-
-    Mode = Literal["position", "velocity", "torque"]
-
-    class JointSegment(Model):
-        until: positive
-        # One mode for every target, or joint name -> mode (every target named).
-        mode: Mode | dict[str, Mode] = "position"
-        targets: dict[str, float]
-        # Position mode: the velocity to track alongside each position (default 0).
-        velocities: dict[str, float] = Field(default_factory=dict)
-        max_force: positive | None = None
-
-    class Motor(Model):
-        # One gain for every joint, or joint name -> gain (joints not named get 0).
-        kp: non_negative | dict[str, non_negative] = 0.0
-        kd: non_negative | dict[str, non_negative] = 0.0
-        viscous_friction: non_negative | dict[str, non_negative] = 0.0
-        stiffness: non_negative | dict[str, non_negative] = 0.0
-        # The friction and spring torques multiplied by the joint-space mass matrix M(q)
-        # (simulation_and_control's servo): the coefficients are then accelerations' gains.
-        scale_by_mass_matrix: bool = False
-        # Where that M is taken: "joint" (the robot's joint angles, in the joint frame, D M D:
-        # the physics), or "measured" (simulation_and_control's: calculateMassMatrix given the
-        # offset/direction-adjusted angles as if they were joint angles, and no D).
-        mass_matrix_angles: Literal["joint", "measured"] = "joint"
-        inertia: non_negative = 0.0  # rotor inertia reflected to the joint, kg m^2
-        # None: the joint's effort limit; "unlimited": no clip.
-        max_torque: positive | Literal["unlimited"] | None = None
-        joints: list[str] | None = None
-        # The servo reads what the robot reports (delayed, noisy), as on a real robot.
-        measured_state: bool = False
-
-    class InitialJoint(Model):
-        position: float = 0.0
-        velocity: float = 0.0
-
-        @model_validator(mode="before")
-        @classmethod
-        def _shorthand(cls, data: Any) -> Any:
-            # "initial_joints": {"hinge": 0.3} means a position.
-            if isinstance(data, (int, float)) and not isinstance(data, bool):
-                return {"position": data}
-            if not isinstance(data, dict):
-                raise ValueError("expected a number, or an object with position and velocity")
-            return data
-
-    per_joint = non_negative | dict[str, non_negative]
-    per_axis = non_negative | Annotated[list[non_negative], Field(min_length=3, max_length=3)]
-
-    class Noise(Model):
-        # Standard deviations: one for every joint, or joint name -> value (others 0) ...
-        motor_angles: per_joint = 0.0
-        motor_velocities: per_joint = 0.0
-        motor_accelerations: per_joint = 0.0
-        motor_torques: per_joint = 0.0
-        # ... one for every axis, or [x, y, z]; base_orientation: a rotation's roll, pitch, yaw.
-        base_position: per_axis = 0.0
-        base_orientation: per_axis = 0.0
-        base_lin_vel: per_axis = 0.0
-        base_ang_vel: per_axis = 0.0
-        base_lin_vel_body_frame: per_axis = 0.0
-        base_ang_vel_body_frame: per_axis = 0.0
-
-    span = Annotated[list[float], Field(min_length=2, max_length=2)]
-
-    class Randomize(Model):
-        # Drawn anew at every ScenarioEnv reset, uniformly in [low, high]:
-        initial_joints: dict[str, span] = Field(default_factory=dict)  # measured frame
-        position: Annotated[list[span], Field(min_length=3, max_length=3)] | None = None
-        yaw: span | None = None  # rad, added to orientation_rpy's yaw
-        lateral_friction: dict[str, span] = Field(default_factory=dict)  # link -> mu
-        mass_scale: dict[str, span] = Field(default_factory=dict)  # link -> factor
-
-        @model_validator(mode="after")
-        def _ranges(self) -> Randomize:
-            groups: list[tuple[str, Any, float | None]] = [
-                ("initial_joints", self.initial_joints, None),
-                ("lateral_friction", self.lateral_friction, 0.0),
-                ("mass_scale", self.mass_scale, 1e-9)]
-            for label, table, floor in groups:
-                for key, (lo, hi) in table.items():
-                    if lo > hi:
-                        raise ValueError(f"{label}.{key}: low {lo} is above high {hi}")
-                    if floor is not None and lo < floor:
-                        raise ValueError(f"{label}.{key}: must be "
-                                         f"{'> 0' if floor else '>= 0'}, got {lo}")
-            for label, pair in (("yaw", self.yaw), *(
-                    (f"position[{i}]", r) for i, r in enumerate(self.position or []))):
-                if pair is not None and pair[0] > pair[1]:
-                    raise ValueError(f"{label}: low {pair[0]} is above high {pair[1]}")
-            return self
-
-    class Robot(Model):
-        name: Annotated[str, Field(min_length=1)] | None = None
-        template: str | None = None
-        params: dict[str, Any] = Field(default_factory=dict)
-        urdf: str | None = None
-        position: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-        orientation_rpy: vec3 | None = None
-        orientation_quat: vec4 | None = None
-        up: Literal["z", "y", "x"] = "z"
-        # What position/orientation place: the root link's URDF frame, or its centre of mass
-        # (PyBullet's base frame, as resetBasePositionAndOrientation takes it).
-        pose_frame: Literal["link", "com"] = "link"
-        base: Literal["floating", "fixed", "on_rack"] = "floating"
-        base_velocity: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-        base_angular_velocity: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-        link_dynamics: dict[str, LinkDynamics] = Field(default_factory=dict)
-        inertia_from_file: bool = True
-        implicit_cylinder: bool = True
-        self_collision: bool = False
-        # None: physics.linear_damping / angular_damping.
-        linear_damping: non_negative | None = None
-        angular_damping: non_negative | None = None
-        # Dry (Coulomb) friction per joint, N m or N: PyBullet's joint motor at velocity 0.
-        joint_friction: dict[str, non_negative] = Field(default_factory=dict)
-        initial_joints: dict[str, InitialJoint] = Field(default_factory=dict)
-        drive: list[DriveSegment] | None = None
-        vehicle: Vehicle | None = None
-        joints: list[JointSegment] | None = None
-        motor: Motor | None = None
-        motor_offsets: dict[str, float] = Field(default_factory=dict)
-        motor_directions: dict[str, Literal[1, -1]] = Field(default_factory=dict)
-        noise: Noise | None = None
-        delay: Annotated[int, Field(ge=0)] = 0
-        # Simulation.history keeps the last N reported observations, one per physics step.
-        history: Annotated[int, Field(ge=1, le=100_000)] = 1
-        # Per-episode randomisation, used by urdfkit.gym.ScenarioEnv's reset.
-        randomize: Randomize | None = None
-
-    class Scenario(Model):
-        physics: Physics = Field(default_factory=Physics)
-        ground: Ground | None = None
-        duration: positive = 1.0
-        seed: int = 0
-        record: Record = Field(default_factory=Record)
-        robots: Annotated[list[Robot], Field(min_length=1)]
-
-        _source: str | None = PrivateAttr(default=None)
-        _base_dir: Path = PrivateAttr(default_factory=Path.cwd)
-        _notes: list[str] = PrivateAttr(default_factory=list)
-
-        @property
-        def notes(self) -> list[str]:
-            """What importing a simulation_and_control config had to say (warnings)."""
-            return self._notes
-
-        @property
-        def source(self) -> str | None:
-            """The file this scenario came from (for messages), if any."""
-            return self._source
-
-        @property
-        def base_dir(self) -> Path:
-            """The folder relative ``urdf`` paths are resolved against."""
-            return self._base_dir
-
-        def path_of(self, name: str) -> str:
-            """A ``urdf`` value as a path: next to the scenario if there, else as given.
-
-            "As given" lets :func:`urdfkit.resolve.locate` find ``plane.urdf`` in pybullet_data.
-            """
-            candidate = self._base_dir / Path(name).expanduser()
-            try:
-                return str(candidate) if os.path.lexists(candidate) else name
-            except (OSError, ValueError):  # too long a name, a NUL byte: locate says so
-                return name
+    from . import scenario_models as m
 
     return SimpleNamespace(
-        Scenario=Scenario, Physics=Physics, Ground=Ground, Record=Record, Robot=Robot,
-        DriveSegment=DriveSegment, Vehicle=Vehicle, JointSegment=JointSegment, Motor=Motor,
-        InitialJoint=InitialJoint, Noise=Noise, LinkDynamics=LinkDynamics,
-        Randomize=Randomize,
+        Scenario=m.Scenario, Physics=m.Physics, Ground=m.Ground, Record=m.Record, Robot=m.Robot,
+        DriveSegment=m.DriveSegment, Vehicle=m.Vehicle, JointSegment=m.JointSegment,
+        Motor=m.Motor, InitialJoint=m.InitialJoint, Noise=m.Noise, LinkDynamics=m.LinkDynamics,
+        Randomize=m.Randomize,
     )
 
 
@@ -486,7 +258,7 @@ def read_document(path: str | Path) -> dict[str, Any]:
 
 
 def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
-                   base_dir: str | Path | None = None) -> Any:
+                   base_dir: str | Path | None = None) -> Scenario:
     """Validate plain data into a ``Scenario`` model and run the cross-field checks.
 
     Args:
@@ -520,7 +292,7 @@ def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
     return scenario
 
 
-def load_scenario(path: str | Path) -> Any:
+def load_scenario(path: str | Path) -> Scenario:
     """Read and validate a scenario file (``.json`` or ``.toml``).
 
     A simulation_and_control config (top-level ``sim``, ``robot_pybullet``, ...) is mapped
@@ -538,11 +310,11 @@ def load_scenario(path: str | Path) -> Any:
     return scenario
 
 
-def _fail(scenario: Any, path: str, message: str) -> InputError:
+def _fail(scenario: Scenario, path: str, message: str) -> InputError:
     return InputError(f"{path}: {message}", file=scenario.source)
 
 
-def _check_segments(scenario: Any, path: str, segments: Sequence[Any]) -> None:
+def _check_segments(scenario: Scenario, path: str, segments: Sequence[Any]) -> None:
     last = 0.0
     for i, seg in enumerate(segments):
         if seg.until <= last:
@@ -551,7 +323,7 @@ def _check_segments(scenario: Any, path: str, segments: Sequence[Any]) -> None:
         last = seg.until
 
 
-def _check_template(scenario: Any, path: str, name: str, params: Mapping[str, Any]) -> None:
+def _check_template(scenario: Scenario, path: str, name: str, params: Mapping[str, Any]) -> None:
     from .catalog import get_template
 
     try:
@@ -562,7 +334,7 @@ def _check_template(scenario: Any, path: str, name: str, params: Mapping[str, An
         raise _fail(scenario, where, str(e)) from None
 
 
-def _check_file(scenario: Any, path: str, name: str) -> None:
+def _check_file(scenario: Scenario, path: str, name: str) -> None:
     from .resolve import locate
 
     try:
@@ -580,7 +352,7 @@ def _check_file(scenario: Any, path: str, name: str) -> None:
 _TOO_DEEP = "nested deeper than Python's parser can follow (a config is a few levels deep)"
 
 
-def check(scenario: Any) -> None:
+def check(scenario: Scenario) -> None:
     """The checks pydantic's types cannot express; each error names its path.
 
     Raises:
@@ -588,14 +360,7 @@ def check(scenario: Any) -> None:
     """
     if scenario.ground is not None:
         g = scenario.ground
-        if (g.template is None) == (g.urdf is None):
-            raise _fail(scenario, "ground", "give either 'template' or 'urdf'")
-        if g.template is not None:
-            _check_template(scenario, "ground", g.template, g.params)
-        else:
-            if g.params:
-                raise _fail(scenario, "ground.params", "params are for templates only")
-            _check_file(scenario, "ground.urdf", g.urdf)
+        _check_source(scenario, "ground", g.template, g.urdf, g.params)
     steps = scenario.duration / scenario.physics.time_step
     if not steps <= MAX_STEPS:
         many = f"{steps:.3g}" if math.isfinite(steps) else "more than 1e308"
@@ -611,39 +376,51 @@ def check(scenario: Any) -> None:
             raise _fail(scenario, f"{path}.name",
                         f"{robot.name!r} is already the name of robots[{names[robot.name]}]")
         names[robot.name] = i
-        if (robot.template is None) == (robot.urdf is None):
-            raise _fail(scenario, path, "give either 'template' or 'urdf'")
-        if robot.template is not None:
-            _check_template(scenario, path, robot.template, robot.params)
-        else:
-            if robot.params:
-                raise _fail(scenario, f"{path}.params", "params are for templates only")
-            _check_file(scenario, f"{path}.urdf", robot.urdf)
+        _check_source(scenario, path, robot.template, robot.urdf, robot.params)
         if robot.orientation_rpy is not None and robot.orientation_quat is not None:
             raise _fail(scenario, path, "give orientation_rpy or orientation_quat, not both")
         if robot.orientation_quat is not None and \
                 math.fsum(q * q for q in robot.orientation_quat) < 1e-12:
             raise _fail(scenario, f"{path}.orientation_quat", "must not be all zeros")
-        if robot.drive is not None and robot.joints is not None:
-            raise _fail(scenario, path, "give one controller: 'drive' or 'joints', not both")
-        if robot.vehicle is not None and robot.drive is None:
-            raise _fail(scenario, f"{path}.vehicle", "only applies with 'drive'")
-        if robot.motor is not None and robot.drive is not None:
-            raise _fail(scenario, f"{path}.motor",
-                        "the servo model drives 'joints' targets; it cannot be used with 'drive'")
-        for key in ("drive", "joints"):
-            segments = getattr(robot, key)
-            if segments is not None:
-                if not segments:
-                    raise _fail(scenario, f"{path}.{key}", "needs at least one segment")
-                _check_segments(scenario, f"{path}.{key}", segments)
-        for k, seg in enumerate(robot.joints or []):
-            if isinstance(seg.mode, dict):
-                where = f"{path}.joints[{k}].mode"
-                missing = [name for name in seg.targets if name not in seg.mode]
-                if missing:
-                    raise _fail(scenario, where, f"no mode for target {missing[0]!r}: with a "
-                                                 "mode per joint, every target needs one")
-                extra = [name for name in seg.mode if name not in seg.targets]
-                if extra:
-                    raise _fail(scenario, f"{where}.{extra[0]}", "not a target of this segment")
+        _check_controllers(scenario, path, robot)
+
+
+def _check_source(scenario: Scenario, path: str, template: str | None, urdf: str | None,
+                  params: Mapping[str, Any]) -> None:
+    """A robot or the ground comes from exactly one of a template (with its params) or a file."""
+    if (template is None) == (urdf is None):
+        raise _fail(scenario, path, "give either 'template' or 'urdf'")
+    if template is not None:
+        _check_template(scenario, path, template, params)
+    else:
+        if params:
+            raise _fail(scenario, f"{path}.params", "params are for templates only")
+        assert urdf is not None
+        _check_file(scenario, f"{path}.urdf", urdf)
+
+
+def _check_controllers(scenario: Scenario, path: str, robot: Robot) -> None:
+    """One controller, its segments in time order, and a mode for every target."""
+    if robot.drive is not None and robot.joints is not None:
+        raise _fail(scenario, path, "give one controller: 'drive' or 'joints', not both")
+    if robot.vehicle is not None and robot.drive is None:
+        raise _fail(scenario, f"{path}.vehicle", "only applies with 'drive'")
+    if robot.motor is not None and robot.drive is not None:
+        raise _fail(scenario, f"{path}.motor",
+                    "the servo model drives 'joints' targets; it cannot be used with 'drive'")
+    for key in ("drive", "joints"):
+        segments = getattr(robot, key)
+        if segments is not None:
+            if not segments:
+                raise _fail(scenario, f"{path}.{key}", "needs at least one segment")
+            _check_segments(scenario, f"{path}.{key}", segments)
+    for k, seg in enumerate(robot.joints or []):
+        if isinstance(seg.mode, dict):
+            where = f"{path}.joints[{k}].mode"
+            missing = [name for name in seg.targets if name not in seg.mode]
+            if missing:
+                raise _fail(scenario, where, f"no mode for target {missing[0]!r}: with a "
+                                             "mode per joint, every target needs one")
+            extra = [name for name in seg.mode if name not in seg.targets]
+            if extra:
+                raise _fail(scenario, f"{where}.{extra[0]}", "not a target of this segment")
