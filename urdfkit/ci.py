@@ -20,7 +20,6 @@ from __future__ import annotations
 import os
 import re
 from typing import TYPE_CHECKING, Any
-from urllib.parse import quote
 
 from . import __version__
 from .finding import LEVELS
@@ -73,6 +72,8 @@ def artifact_location(file: str) -> dict[str, str]:
     The URI is percent-encoded from the file name's bytes, so spaces, ``#``, ``:`` and names
     that are not UTF-8 still make a valid URI reference.
     """
+    from urllib.parse import quote  # here: check --json imports this module for FORMATS only
+
     rel = relative_path(file)
     if rel is not None:
         return {"uri": quote(os.fsencode(rel), safe="/"), "uriBaseId": "%SRCROOT%"}

@@ -14,7 +14,6 @@ error and warning printers all live here, so every command looks and pipes alike
 from __future__ import annotations
 
 import gc
-import json
 import math
 import os
 import re
@@ -200,8 +199,10 @@ def json_text(data: Any) -> str:
     object's ``diagnostics`` list (created if needed) and printed as a warning. The common
     case pays one ``json.dumps``; only output that holds such numbers is walked.
     """
+    from .jsontext import dumps
+
     try:
-        return json.dumps(data, indent=2, allow_nan=False)
+        return dumps(data)  # json.dumps(data, indent=2, allow_nan=False)'s text, faster
     except ValueError:
         pass
     bad: list[str] = []
@@ -212,7 +213,7 @@ def json_text(data: Any) -> str:
         warn(message)
         if isinstance(clean, dict):
             clean["diagnostics"] = [*clean.get("diagnostics", []), message]
-    return json.dumps(clean, indent=2, allow_nan=False)
+    return dumps(clean)
 
 
 def print_json(data: Any) -> None:

@@ -22,7 +22,6 @@ xacro expansion stopped by its time or memory limit) are never stored. The folde
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import stat
@@ -32,6 +31,11 @@ from pathlib import Path
 from typing import Any
 
 from . import deps
+
+try:  # the BLAKE2 module alone: hashlib would also load OpenSSL (~2 ms of every cached run)
+    from _blake2 import blake2b
+except ImportError:  # pragma: no cover - a Python built without it
+    from hashlib import blake2b
 from .cache import MAX_ENTRY_BYTES, cache_dir, write_entry
 
 #: The largest file keyed (:data:`urdfkit.xmlio.MAX_FILE_BYTES`, not imported: lxml is slow
@@ -57,7 +61,7 @@ def code_key() -> str:
     if _code_key is None:
         from . import __version__
 
-        h = hashlib.blake2b(__version__.encode(), digest_size=16)
+        h = blake2b(__version__.encode(), digest_size=16)
         package = Path(__file__).parent
         with os.scandir(package) as it:
             for entry in sorted(it, key=lambda e: e.name):
@@ -139,7 +143,7 @@ class ResultCache:
         data = _read_regular(os.fspath(path), MAX_FILE_BYTES)
         if data is None:
             return None
-        h = hashlib.blake2b(self._prefix, digest_size=20)
+        h = blake2b(self._prefix, digest_size=20)
         where = f"\0{display}\0{os.path.abspath(path)}\0".encode("utf-8", "surrogateescape")
         h.update(where)
         h.update(data)
@@ -250,7 +254,7 @@ class RunManifest:
     """
 
     def __init__(self, cache: ResultCache, paths: Sequence[str]) -> None:
-        h = hashlib.blake2b(cache._prefix, digest_size=20)
+        h = blake2b(cache._prefix, digest_size=20)
         for p in (os.getcwd(), *paths):
             h.update(os.fsencode(p) + b"\0")
         self.path = os.path.join(cache._root, "runs", f"{h.hexdigest()}.json")

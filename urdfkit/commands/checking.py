@@ -90,7 +90,7 @@ def check(
 
     for fr in result.files:  # a xacro or package problem speaks of flags, not parameters
         fr.findings = [dataclasses.replace(f, message=input_flags(f.message))
-                       for f in fr.findings]
+                       if "`" in f.message else f for f in fr.findings]
     show.check_output(result, fmt, fail_on, show_all)
     raise typer.Exit(result.exit_code(fail_on))
 
