@@ -404,7 +404,7 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
     for n, (display, path, problem) in enumerate(files):
         hit = manifest.lookup(display, path) if manifest and problem is None else None
         if hit is not None:
-            results[n] = FileResult(display, [Finding(**f) for f in hit], cached=True)
+            results[n] = FileResult(display, hit, cached=True)
         else:
             todo.append(n)
     work = [(*files[n], pkgs, no_exec, args, physics, cache) for n in todo]

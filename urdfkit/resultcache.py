@@ -37,6 +37,7 @@ try:  # the BLAKE2 module alone: hashlib would also load OpenSSL (~2 ms of every
 except ImportError:  # pragma: no cover - a Python built without it
     from hashlib import blake2b
 from .cache import MAX_ENTRY_BYTES, cache_dir, write_entry
+from .finding import Finding
 
 #: The largest file keyed (:data:`urdfkit.xmlio.MAX_FILE_BYTES`, not imported: lxml is slow
 #: to load, and a cached run never needs it). A larger file is checked uncached.
@@ -243,6 +244,31 @@ def file_stat(path: str) -> FileStat | None:
     return (st.st_size, st.st_mtime_ns, st.st_ino, st.st_ctime_ns)
 
 
+def _pack(findings: list[dict[str, Any]], display: str) -> list[list[Any]]:
+    """Findings as rows ``[code, level, message, line, origin, file]``; file None: the file's own.
+
+    Half the size of dicts to read back: the manifest is read whole on every warm run.
+    """
+    return [[f["code"], f["level"], f["message"], f["line"], f["origin"],
+             None if f["file"] == display else f["file"]] for f in findings]
+
+
+def _unpack(rows: list[Any], display: str) -> list[Finding] | None:
+    """:func:`_pack`'s rows back as findings; None if any row has the wrong shape."""
+    out = []
+    for row in rows:
+        if not (type(row) is list and len(row) == 6):
+            return None
+        code, level, message, line, origin, file = row
+        if not (type(code) is str and type(level) is str and type(message) is str
+                and (line is None or type(line) is int)
+                and (origin is None or type(origin) is str)
+                and (file is None or type(file) is str)):
+            return None
+        out.append(Finding(code, level, message, display if file is None else file, line, origin))
+    return out
+
+
 class RunManifest:
     """One run's results, by path: a re-run over an unchanged tree reads one file, not one each.
 
@@ -277,28 +303,30 @@ class RunManifest:
             return 0, {}
         return started, files
 
-    def lookup(self, display: str, path: str) -> list[dict[str, Any]] | None:
+    def lookup(self, display: str, path: str) -> list[Finding] | None:
         """The findings recorded for ``path`` if neither it nor anything it read changed."""
         absolute = os.path.abspath(path)
         record = self._old.get(absolute)
         if not (isinstance(record, list) and len(record) == 4 and record[0] == display
                 and isinstance(record[1], list) and len(record[1]) == 4
-                and isinstance(record[2], dict)):
+                and isinstance(record[2], dict) and isinstance(record[3], list)):
             return None
         now = file_stat(path)
         if now is None or list(now) != record[1] or now[1] + RACY_NS >= self._old_started:
             return None
-        if not valid_findings(record[3]) or not deps.unchanged(record[2], self.memo):
+        findings = _unpack(record[3], display)
+        if findings is None or not deps.unchanged(record[2], self.memo):
             return None
         self._new[absolute] = record
-        return record[3]
+        return findings
 
     def add(self, display: str, path: str, entry: tuple[FileStat, dict[str, Any],
                                                       list[dict[str, Any]]] | None) -> None:
         """Record a result found another way (``entry`` None: not cacheable)."""
         self.misses += 1
         if entry is not None:
-            self._new[os.path.abspath(path)] = [display, list(entry[0]), entry[1], entry[2]]
+            self._new[os.path.abspath(path)] = [display, list(entry[0]), entry[1],
+                                                _pack(entry[2], display)]
 
     def save(self) -> None:
         """Write the manifest if this run found anything the old one did not hold."""
