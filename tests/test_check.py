@@ -497,3 +497,16 @@ def test_text_groups_repeated_codes_and_all_lists_them(tmp_path: Path) -> None:
     assert grouped.count("warning  U606  <link") == 3 and "4 more U606" in grouped
     assert "--all or --json lists every one" in grouped
     assert every.count("warning  U606  <link") == 7 and "more" not in every
+
+
+def test_a_findings_json_form_is_its_fields_in_order() -> None:
+    # CheckResult.to_dict hands the JSON writer each finding's own fields (no copy): they must
+    # be exactly Finding.to_dict, keys in the same order.
+    from urdfkit.check import CheckResult, FileResult
+    from urdfkit.finding import Finding
+
+    findings = [Finding("U201", "error", "m", "f.urdf", 3, None),
+                Finding("U601", "warning", "n", "g.urdf", None, "inc.xacro:4")]
+    data = CheckResult([FileResult("f.urdf", findings)]).to_dict()
+    assert [list(d.items()) for d in data["findings"]] == \
+        [list(f.to_dict().items()) for f in findings]  # type: ignore[union-attr]

@@ -294,11 +294,18 @@ class RunManifest:
         raw = _read_regular(self.path, MAX_ENTRY_BYTES)
         if raw is None:
             return 0, {}
+        import gc
+
+        collecting = gc.isenabled()
+        gc.disable()  # a large document of small containers: no collections while it parses
         try:
             data = json.loads(raw)
             started, files = data["started"], data["files"]
         except (ValueError, KeyError, TypeError):
             return 0, {}
+        finally:
+            if collecting:
+                gc.enable()
         if type(started) is not int or not isinstance(files, dict):
             return 0, {}
         return started, files
