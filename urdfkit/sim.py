@@ -454,8 +454,20 @@ class Simulation:
         return self.session.load_urdf(resolved.load_path, options, display=display)
 
     def _add_robot(self, i: int, cfg: Any) -> _Body:
-        p, client = self.session.p, self.session.client
         path = f"robots[{i}]"
+        body, loaded = self._load_robot(path, cfg)
+        b = self._new_body(i, path, cfg, body, loaded)
+        self._check_joint_names(b)
+        if cfg.drive is not None:
+            self._detect_train(b)
+        if cfg.randomize is not None:
+            self._check_randomize(b)
+        self._place(b)
+        return b
+
+    def _load_robot(self, path: str, cfg: Any) -> tuple[int, tuple[str, LoadOptions]]:
+        """Load the robot's URDF where the scenario puts it; refuse a body too big to query."""
+        p, client = self.session.p, self.session.client
         if cfg.orientation_quat is not None:
             norm = math.sqrt(math.fsum(q * q for q in cfg.orientation_quat))
             orientation = tuple(q / norm for q in cfg.orientation_quat)
@@ -479,7 +491,12 @@ class Simulation:
             self.session.require_state_queries(body, cfg.name)
         except EngineError as e:
             raise self._error(path, str(e)) from None
+        return body, loaded
 
+    def _new_body(self, i: int, path: str, cfg: Any, body: int,
+                  loaded: tuple[str, LoadOptions]) -> _Body:
+        """The robot's record: its joints and links as PyBullet loaded them."""
+        p, client = self.session.p, self.session.client
         joints: list[JointSpec] = []
         for j in range(p.getNumJoints(body, physicsClientId=client)):
             info = p.getJointInfo(body, j, physicsClientId=client)
@@ -494,19 +511,24 @@ class Simulation:
                   loaded=loaded)
         if cfg.history > 1:
             b.reports = deque(maxlen=cfg.history)
+        return b
 
-        def active_joint(where: str, name: str) -> JointSpec:
-            try:
-                spec = b.joint(name)
-            except KeyError:
-                known = ", ".join(j.name for j in active) or "none"
-                raise self._error(where, f"no joint named {name!r} in {cfg.name}; active "
-                                         f"joints: {known}") from None
-            if not spec.active:
-                kind = "fixed" if spec.type == _FIXED else "not a 1-DOF joint"
-                raise self._error(where, f"joint {name!r} is {kind} and cannot be moved")
-            return spec
+    def _active_joint(self, b: _Body, where: str, name: str) -> JointSpec:
+        """The movable joint ``name`` of ``b``; an error naming ``where`` otherwise."""
+        try:
+            spec = b.joint(name)
+        except KeyError:
+            known = ", ".join(j.name for j in b.active) or "none"
+            raise self._error(where, f"no joint named {name!r} in {b.config.name}; active "
+                                     f"joints: {known}") from None
+        if not spec.active:
+            kind = "fixed" if spec.type == _FIXED else "not a 1-DOF joint"
+            raise self._error(where, f"joint {name!r} is {kind} and cannot be moved")
+        return spec
 
+    def _check_joint_names(self, b: _Body) -> None:
+        """Every joint the robot's config names: offsets, directions, schedule, motor, noise."""
+        cfg, path, active_joint = b.config, b.path, functools.partial(self._active_joint, b)
         for name, value in cfg.motor_offsets.items():
             b.offsets[active_joint(f"{path}.motor_offsets.{name}", name).name] = value
         for name, value in cfg.motor_directions.items():
@@ -516,7 +538,7 @@ class Simulation:
                 active_joint(f"{path}.joints[{k}].targets.{name}", name)
         if cfg.motor is not None:
             names = cfg.motor.joints
-            b.servo = active if names is None else [
+            b.servo = b.active if names is None else [
                 active_joint(f"{path}.motor.joints", n) for n in names]
             for gain in ("kp", "kd", "viscous_friction", "stiffness"):
                 for name in getattr(cfg.motor, gain) if isinstance(
@@ -529,34 +551,44 @@ class Simulation:
                 for name in value if isinstance(value, dict) else ():
                     active_joint(f"{path}.noise.{key}.{name}", name)
 
-        if cfg.drive is not None:
-            from .vehicle import detect_upright
+    def _detect_train(self, b: _Body) -> None:
+        """The drive train of a driven robot: which joints are wheels, which steer."""
+        from .vehicle import detect_upright
 
-            v = cfg.vehicle
-            # Detection judges axes in the base frame, at load time: before any step.
-            try:
-                b.train = detect_upright(p, body, client, UP_AXES[cfg.up],
-                                         wheels=v.wheels if v else None,
-                                         hinges=v.hinges if v else None)
-            except ParameterError as e:
-                raise self._error(f"{path}.vehicle" if v else f"{path}.drive", e.message) \
-                    from None
+        cfg, path = b.config, b.path
+        v = cfg.vehicle
+        # Detection judges axes in the base frame, at load time: before any step.
+        try:
+            b.train = detect_upright(self.session.p, b.body, self.session.client,
+                                     UP_AXES[cfg.up], wheels=v.wheels if v else None,
+                                     hinges=v.hinges if v else None)
+        except ParameterError as e:
+            raise self._error(f"{path}.vehicle" if v else f"{path}.drive", e.message) \
+                from None
 
-        if cfg.randomize is not None:
-            r = cfg.randomize
-            for name in r.initial_joints:
-                active_joint(f"{path}.randomize.initial_joints.{name}", name)
-            for label, table in (("lateral_friction", r.lateral_friction),
-                                 ("mass_scale", r.mass_scale)):
-                for link in table:
-                    if link not in b.links:
-                        raise self._error(f"{path}.randomize.{label}.{link}",
-                                          f"{cfg.name} has no link named {link!r}")
-            if r.yaw is not None and cfg.orientation_quat is not None:
-                raise self._error(f"{path}.randomize.yaw", "needs the start given as "
-                                  "orientation_rpy, not orientation_quat")
+    def _check_randomize(self, b: _Body) -> None:
+        """The joints and links a ``randomize`` table names exist; a yaw needs an RPY start."""
+        cfg, path = b.config, b.path
+        r = cfg.randomize
+        for name in r.initial_joints:
+            self._active_joint(b, f"{path}.randomize.initial_joints.{name}", name)
+        for label, table in (("lateral_friction", r.lateral_friction),
+                             ("mass_scale", r.mass_scale)):
+            for link in table:
+                if link not in b.links:
+                    raise self._error(f"{path}.randomize.{label}.{link}",
+                                      f"{cfg.name} has no link named {link!r}")
+        if r.yaw is not None and cfg.orientation_quat is not None:
+            raise self._error(f"{path}.randomize.yaw", "needs the start given as "
+                              "orientation_rpy, not orientation_quat")
+
+    def _place(self, b: _Body) -> None:
+        """The start the config gives: joint friction, rack, link dynamics, initial joints."""
+        p, client = self.session.p, self.session.client
+        cfg, path, body = b.config, b.path, b.body
         for name, friction in cfg.joint_friction.items():
-            b.dry_friction[active_joint(f"{path}.joint_friction.{name}", name).index] = friction
+            b.dry_friction[self._active_joint(b, f"{path}.joint_friction.{name}",
+                                              name).index] = friction
         # PyBullet holds every joint with a velocity motor (target 0) until told otherwise.
         self._free(b)
         if any(cfg.base_velocity) or any(cfg.base_angular_velocity):
@@ -579,11 +611,10 @@ class Simulation:
             if values:
                 p.changeDynamics(body, b.links[link], physicsClientId=client, **values)
         for name, init in cfg.initial_joints.items():
-            spec = active_joint(f"{path}.initial_joints.{name}", name)
+            spec = self._active_joint(b, f"{path}.initial_joints.{name}", name)
             p.resetJointState(body, spec.index, self._to_physical(b, name, init.position),
                               init.velocity * b.directions.get(name, 1.0),
                               physicsClientId=client)
-        return b
 
     def _having_link(self, where: str, link: str) -> list[_Body]:
         """The robots with a link of that name; an error naming ``where`` if none has one."""
