@@ -33,6 +33,7 @@ from typing import Any
 from .errors import EngineError, InputError, ParameterError
 from .scenario import JOINT_NOISE_FIELDS, OBSERVATION_FIELDS, load_scenario, parse_scenario
 from .session import LoadOptions, Session, prime_resets, restore_clean
+from .sim_dynamics import Shadows
 from .sim_writers import (  # noqa: F401  (re-exported: urdfkit.sim's public names)
     OUTPUT_FORMATS,
     RowText,
@@ -329,6 +330,8 @@ class Simulation:
         self.ground: int | None = None
         self.bodies: dict[str, _Body] = {}
         self._resolved: list[Any] = []
+        #: The robots' dynamics models, each in a client of its own (:mod:`.sim_dynamics`).
+        self._shadows = Shadows()
         self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-sim-")
         self.session = Session(gui=gui)
         try:
@@ -356,10 +359,7 @@ class Simulation:
 
     def close(self) -> None:
         """Disconnect the client and remove temp files (safe to call twice)."""
-        shadows: dict[str, tuple[Session, int]] = self.__dict__.get("_shadows", {})
-        for shadow in shadows.values():
-            shadow[0].close()
-        shadows.clear()
+        self._shadows.close()
         if hasattr(self, "session"):
             self.session.close()
         for r in self._resolved:
@@ -1293,30 +1293,14 @@ class Simulation:
         later is ignored (measured on 3.2.7). So the dynamics run on a copy of the robot in a
         client of their own, rebuilt after every ``set_mass``/``set_inertia``.
         """
-        shadows: dict[str, tuple[Session, int]] = self.__dict__.setdefault("_shadows", {})
-        if b.name not in shadows:
-            assert b.loaded is not None
-            s = Session()
-            try:
-                ph = self.config.physics
-                s.p.setGravity(*ph.gravity, physicsClientId=s.client)
-                body = s.load_urdf(b.loaded[0], b.loaded[1], display=b.name)
-                for (link, key), value in b.changes.items():
-                    s.p.changeDynamics(body, link, physicsClientId=s.client, **{key: value})
-            except BaseException:
-                s.close()
-                raise
-            shadows[b.name] = (s, body)
-        s, body = shadows[b.name]
-        return s.p, s.client, body
+        assert b.loaded is not None
+        return self._shadows.model(b.name, b.loaded, self.config.physics.gravity, b.changes)
 
     def _changed(self, b: _Body, link: int, values: dict[str, Any]) -> None:
         """Remember a change to a robot's mass properties; its dynamics model is stale."""
         for key, value in values.items():
             b.changes[(link, key)] = value
-        shadow = self.__dict__.get("_shadows", {}).pop(b.name, None)
-        if shadow is not None:
-            shadow[0].close()
+        self._shadows.stale(b.name)
 
     def mass_matrix(self, robot: str) -> Any:
         """The joint-space mass matrix M(q) now (numpy, PyBullet's calculateMassMatrix).
