@@ -25,7 +25,7 @@ for floor, names in enumerate([
     "session",
     # run and draw
     "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
-    " diff collisions fix sweep view sim_writers sim_dynamics sim_state",
+    " diff collisions fix sweep view sim_writers sim_dynamics sim_state sim_control",
     # presentation and the command line
     "present ci cli __main__",
 ]):

@@ -310,3 +310,8 @@ class _Summary:
                 final_joints=dict(last.motor_angles), joint_min=dict(self.low.get(name, {})),
                 joint_max=dict(self.high.get(name, {}))))
         return out
+
+
+def _first(*values: float | None) -> float | None:
+    """The first of ``values`` that is given (a robot's own setting, then the world's)."""
+    return next((v for v in values if v is not None), None)
