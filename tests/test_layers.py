@@ -25,7 +25,8 @@ for floor, names in enumerate([
     "session",
     # run and draw
     "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
-    " diff collisions fix sweep view sim_writers sim_dynamics sim_state sim_control",
+    " diff collisions fix sweep view sim_writers sim_dynamics sim_state sim_control"
+    " sim_sensors sim_episode sim_setters",
     # presentation and the command line
     "present ci cli __main__",
 ]):

@@ -29,10 +29,10 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from . import sim_control
+from . import sim_control, sim_episode, sim_sensors, sim_setters
 from .errors import EngineError, InputError, ParameterError
-from .scenario import JOINT_NOISE_FIELDS, OBSERVATION_FIELDS, load_scenario, parse_scenario
-from .session import LoadOptions, Session, prime_resets, restore_clean
+from .scenario import JOINT_NOISE_FIELDS, load_scenario, parse_scenario
+from .session import LoadOptions, Session, prime_resets
 from .sim_dynamics import Shadows
 from .sim_state import (  # noqa: F401  (re-exported: urdfkit.sim's public names)
     _ACTIVE,
@@ -58,7 +58,7 @@ from .sim_writers import (  # noqa: F401  (re-exported: urdfkit.sim's public nam
     rows_to_bytes,
     write_rows,
 )
-from .spec import UP_AXES, quat_mul, quat_to_matrix, rotate_back, rpy_to_quat
+from .spec import UP_AXES, quat_mul
 
 # --------------------------------------------------------------------------- the simulation
 
@@ -496,109 +496,14 @@ class Simulation:
                 for b in lazy:
                     self._keep_velocities(b)
 
-    def _keep_velocities(self, b: _Body) -> None:
-        """Remember the joint velocities now, for the next measurement's accelerations."""
-        p, client = self.session.p, self.session.client
-        states = p.getJointStates(b.body, b.frame[0], physicsClientId=client)
-        b.previous_velocities = [st[1] for st in states]
-        b.previous_step = self.step_count
+    # ---- sensors: measuring, feet, noise, delay and history (urdfkit/sim_sensors.py)
+    _keep_velocities = sim_sensors._keep_velocities
+    _fresh = sim_sensors._fresh
+    _measure = sim_sensors._measure
+    _feet = sim_sensors._feet
+    _report = sim_sensors._report
+    _add_noise = sim_sensors._add_noise
 
-    def _fresh(self, b: _Body) -> Observation:
-        """The true observation at this step, measuring it now if it was not yet."""
-        if b.history[-1].step != self.step_count:
-            b.history.append(self._measure(b))
-        return b.history[-1]
-
-    def _measure(self, b: _Body) -> Observation:
-        """The true observation now, in the measured joint frame."""
-        p, client = self.session.p, self.session.client
-        pos, orn = p.getBasePositionAndOrientation(b.body, physicsClientId=client)
-        lin, ang = p.getBaseVelocity(b.body, physicsClientId=client)
-        matrix = quat_to_matrix(orn)
-        angles: dict[str, float] = {}
-        velocities: dict[str, float] = {}
-        accelerations: dict[str, float] = {}
-        forces: dict[str, list[float]] | None = None
-        torques: dict[str, float] | None = None
-        if b.active:
-            indices, names, signs, offsets = b.frame
-            states = p.getJointStates(b.body, indices, physicsClientId=client)
-            if self.config.record.motor_torques:  # the joint's own frame, as applied
-                torques = {n: b.torques.get(n, st[3]) for n, st in zip(names, states, strict=True)}
-            qd = [st[1] for st in states]
-            angles = {n: (st[0] - o) * s
-                      for n, st, s, o in zip(names, states, signs, offsets, strict=True)}
-            velocities = {n: v * s for n, v, s in zip(names, qd, signs, strict=True)}
-            # Over the time since the velocities were last taken (one step, when recording).
-            span = (self.step_count - b.previous_step) * self.time_step
-            before = b.previous_velocities
-            if before is None or span <= 0:
-                accelerations = dict.fromkeys(names, 0.0)
-            else:
-                accelerations = {n: (v - v0) * s / span for n, v, v0, s
-                                 in zip(names, qd, before, signs, strict=True)}
-            b.previous_velocities = qd
-            b.previous_step = self.step_count
-        if b.force_joints:
-            forces = {}
-            for name, index in b.force_joints.items():
-                state = p.getJointState(b.body, index, physicsClientId=client)
-                forces[name] = [float(x) for x in state[2]]
-        contacts = None
-        if b.contact_links:
-            contacts = {}
-            for link, index in b.contact_links.items():
-                kwargs: dict[str, Any] = {"bodyA": b.body, "linkIndexA": index}
-                if self.ground is not None:
-                    kwargs["bodyB"] = self.ground
-                points = p.getContactPoints(physicsClientId=client, **kwargs)
-                contacts[link] = {"normal_force": float(sum(pt[9] for pt in points)),
-                                  "count": len(points)}
-        feet = self._feet(b) if b.feet else None
-        poses = None
-        if b.pose_links:
-            poses = {}
-            for link in b.pose_links:
-                at, turn = self.link_pose(b.name, link)
-                poses[link] = {"position": at, "orientation": turn}
-        return Observation(
-            t=self.t, step=self.step_count, robot=b.name, motor_angles=angles,
-            motor_velocities=velocities, motor_accelerations=accelerations,
-            base_position=list(pos), base_orientation=list(orn), base_lin_vel=list(lin),
-            base_ang_vel=list(ang), base_lin_vel_body_frame=list(rotate_back(matrix, lin)),
-            base_ang_vel_body_frame=list(rotate_back(matrix, ang)), contacts=contacts,
-            joint_forces=forces, motor_torques=torques, link_poses=poses, feet=feet)
-
-    def _feet(self, b: _Body) -> dict[str, dict[str, Any]]:
-        """Each foot's contact forces from everything but its own robot (world and local)."""
-        p, client = self.session.p, self.session.client
-        out: dict[str, dict[str, Any]] = {}
-        for label, index in b.feet.items():
-            normal = [0.0, 0.0, 0.0]
-            friction = [0.0, 0.0, 0.0]
-            total = 0.0
-            count = 0
-            for pt in p.getContactPoints(bodyA=b.body, linkIndexA=index,
-                                         physicsClientId=client):
-                if pt[2] == b.body:
-                    continue  # self-contact: not a ground reaction
-                count += 1
-                total += pt[9]
-                # contactNormalOnB points from B to A: the push on the foot (A). The lateral
-                # friction directions are those of the force on B (measured: a box sliding
-                # along +x reads +mu m g), so the foot feels their opposite.
-                for k in range(3):
-                    normal[k] += pt[9] * pt[7][k]
-                    friction[k] -= pt[10] * pt[11][k] + pt[12] * pt[13][k]
-            if index == -1:  # the URDF frame, not the centre of mass
-                orn = self.link_pose(b.name, next(k for k, v in b.links.items() if v == -1))[1]
-            else:
-                orn = p.getLinkState(b.body, index, computeForwardKinematics=True,
-                                     physicsClientId=client)[5]
-            local = rotate_back(quat_to_matrix(orn), normal)
-            out[label] = {"contact": int(count > 0), "normal": total, "world": normal,
-                          "local": list(local), "friction_world": friction}
-        return out
 
     def _observe_one(self, robot: str, ideal: bool = False) -> Observation:
         out = self.observe(robot, ideal=ideal)
@@ -627,20 +532,6 @@ class Simulation:
         # A copy: a caller changing what it got must not change later observations.
         return self._report(b).copy()
 
-    def _report(self, b: _Body) -> Observation:
-        """What the robot reports now (delay, then noise); the same object all this step."""
-        if b.reported is None or b.reported[0] != self.step_count:
-            self._fresh(b)
-            # history ends with the current observation; the delayed one is `delay` before.
-            source = b.history[max(0, len(b.history) - 1 - b.config.delay)]
-            if b.config.delay:  # angles and velocities are delayed; torques are not
-                source = source._replace(motor_torques=b.history[-1].motor_torques)
-            if b.config.delay or b.config.noise is not None:
-                source = self._add_noise(b, source._replace(t=self.t, step=self.step_count))
-            b.reported = (self.step_count, source)
-            if b.reports is not None:
-                b.reports.append(b.reported[1])
-        return b.reported[1]
 
     def history(self, robot: str, *, ideal: bool = False) -> list[Observation]:
         """The robot's last ``history`` observations, one per physics step, oldest first.
@@ -659,121 +550,11 @@ class Simulation:
 
     # ---- reset in place
 
-    @staticmethod
-    def _robot_seed(seed: int, i: int) -> int:
-        return seed * 1_000_003 + i
+    # ---- episodes: reset in place and randomisation (urdfkit/sim_episode.py)
+    _robot_seed = staticmethod(sim_episode._robot_seed)
+    reset = sim_episode.reset
+    _reset_plan = sim_episode._reset_plan
 
-    def reset(self, seed: int | None = None,
-              overrides: Mapping[str, Mapping[str, Any]] | None = None) -> None:
-        """Go back to the starting state in place, deterministically.
-
-        Positions, velocities and contacts come back through PyBullet's saveState and
-        restoreState; time, observation history, delays, commands and noise generators
-        (reseeded with ``seed``, default the scenario's) start over, so the same seed and the
-        same actions give the same observations. Changes made with the ``set_*`` methods
-        stay: they change the robot, not its state.
-
-        Args:
-            seed: Reseeds the noise; default: the scenario's ``seed``.
-            overrides: Per robot name, a different start for this episode, with the
-                scenario's keys and meanings: ``initial_joints`` (joint -> position, or ->
-                ``{"position", "velocity"}``; measured frame), ``position`` and
-                ``orientation_rpy`` or ``orientation_quat`` (in the robot's ``pose_frame``),
-                ``base_velocity`` and ``base_angular_velocity``. What is not given is the
-                scenario's start.
-
-        Raises:
-            ParameterError: an unknown robot, key or joint, or a value of the wrong shape;
-                nothing is reset then.
-        """
-        p, client = self.session.p, self.session.client
-        plans = {self._body(robot).name: self._reset_plan(self._body(robot), changes)
-                 for robot, changes in (overrides or {}).items()}
-        restore_clean(p, client, self._start_state, [b.body for b in self.bodies.values()])
-        self.step_count = 0
-        base_seed = self.config.seed if seed is None else seed
-        for i, b in enumerate(self.bodies.values()):
-            b.rng = random.Random(self._robot_seed(base_seed, i))
-            b.history.clear()
-            if b.reports is not None:
-                b.reports.clear()
-            b.previous_velocities = None
-            b.previous_step = -1
-            b.applied = b.override = None
-            b.reported = None
-            self._free(b)
-            b.torques.clear()
-            for call in plans.get(b.name, ()):
-                call()
-            b.history.append(self._measure(b))
-
-    def _reset_plan(self, b: _Body, changes: Mapping[str, Any]) -> list[Callable[[], None]]:
-        """The PyBullet calls that start ``b`` as ``changes`` says, checked before any runs."""
-        p, client = self.session.p, self.session.client
-        known = ("initial_joints", "position", "orientation_rpy", "orientation_quat",
-                 "base_velocity", "base_angular_velocity")
-        for key in changes:
-            if key not in known:
-                raise ParameterError(f"`overrides`: unknown key {key!r} for {b.name}; known "
-                                     f"keys: {', '.join(known)}", param="overrides")
-
-        def vector(key: str, size: int) -> list[float] | None:
-            value = changes.get(key)
-            if value is None:
-                return None
-            try:
-                out = [float(v) for v in value]
-            except (TypeError, ValueError):
-                out = []
-            if len(out) != size or not all(math.isfinite(v) for v in out):
-                raise ParameterError(f"`overrides`: {b.name}.{key} needs {size} finite "
-                                     "numbers", param="overrides")
-            return out
-
-        calls: list[Callable[[], None]] = []
-        for name, value in (changes.get("initial_joints") or {}).items():
-            spec = next((j for j in b.active if j.name == name), None)
-            if spec is None:
-                raise ParameterError(f"`overrides`: {b.name} has no active joint named "
-                                     f"{name!r}", param="overrides")
-            position, velocity = (value.get("position", 0.0), value.get("velocity", 0.0)) \
-                if isinstance(value, Mapping) else (value, 0.0)
-            q = self._to_physical(b, name, float(position))
-            qd = float(velocity) * b.directions.get(name, 1.0)
-            calls.append(functools.partial(p.resetJointState, b.body, spec.index, q, qd,
-                                           physicsClientId=client))
-        position = vector("position", 3)
-        rpy = vector("orientation_rpy", 3)
-        quat = vector("orientation_quat", 4)
-        if rpy is not None and quat is not None:
-            raise ParameterError(f"`overrides`: give {b.name} orientation_rpy or "
-                                 "orientation_quat, not both", param="overrides")
-        if position is not None or rpy is not None or quat is not None:
-            cfg = b.config
-            if quat is None:
-                quat = list(rpy_to_quat(*rpy)) if rpy is not None else \
-                    list(cfg.orientation_quat) if cfg.orientation_quat is not None else \
-                    list(rpy_to_quat(*(cfg.orientation_rpy or (0.0, 0.0, 0.0))))
-            norm = math.sqrt(math.fsum(v * v for v in quat))
-            if norm < 1e-12:
-                raise ParameterError(f"`overrides`: {b.name}.orientation_quat must not be all "
-                                     "zeros", param="overrides")
-            orn = quat_mul([v / norm for v in quat], UP_AXES[cfg.up])
-            at = position if position is not None else list(cfg.position)
-            if cfg.pose_frame == "link":
-                # resetBasePositionAndOrientation places the centre of mass.
-                dyn = p.getDynamicsInfo(b.body, -1, physicsClientId=client)
-                at, orn = p.multiplyTransforms(at, orn, dyn[3], dyn[4])
-            calls.append(lambda: p.resetBasePositionAndOrientation(
-                b.body, at, orn, physicsClientId=client))
-        lin = vector("base_velocity", 3)
-        ang = vector("base_angular_velocity", 3)
-        if lin is not None or ang is not None:
-            velocity = (lin if lin is not None else list(b.config.base_velocity),
-                        ang if ang is not None else list(b.config.base_angular_velocity))
-            calls.append(lambda: p.resetBaseVelocity(b.body, *velocity,
-                                                     physicsClientId=client))
-        return calls
 
     # ---- state, kinematics and dynamics of one robot (SimInterface's, in Python's manners)
 
@@ -947,140 +728,20 @@ class Simulation:
 
     # ---- setters: the robot's physical parameters
 
-    def _link_index(self, b: _Body, link: str) -> int:
-        if link not in b.links:
-            from .suggest import hint
+    # ---- setters: a robot's physical parameters (urdfkit/sim_setters.py)
+    _link_index = sim_setters._link_index
+    _change = sim_setters._change
+    set_mass = sim_setters.set_mass
+    set_inertia = sim_setters.set_inertia
+    set_friction = sim_setters.set_friction
+    set_restitution = sim_setters.set_restitution
+    _joint_named = staticmethod(sim_setters._joint_named)
+    set_joint_damping = sim_setters.set_joint_damping
+    set_joint_friction = sim_setters.set_joint_friction
+    _motor_driven = sim_setters._motor_driven
+    set_link_damping = sim_setters.set_link_damping
+    set_motor_gains = sim_setters.set_motor_gains
 
-            raise ParameterError(f"`link`: {b.name} has no link named {link!r}"
-                                 f"{hint(link, b.links)}", param="link")
-        return b.links[link]
-
-    def _change(self, target: str, link: str | None, **values: Any) -> None:
-        p, client = self.session.p, self.session.client
-        if target == "ground":
-            if self.ground is None:
-                raise ParameterError("the scenario has no ground", param="robot")
-            p.changeDynamics(self.ground, -1, physicsClientId=client, **values)
-            return
-        b = self._body(target)
-        links = [self._link_index(b, link)] if link is not None else \
-            [-1, *range(len(b.joints))]
-        for index in links:
-            p.changeDynamics(b.body, index, physicsClientId=client, **values)
-
-    def set_mass(self, robot: str, link: str, mass: float) -> None:
-        """A link's mass, kg; its inertia scales with it (the same body, heavier).
-
-        PyBullet's changeDynamics(mass=...) alone throws the inertia away and recomputes it
-        from the collision shapes (a link without any gets ~1e-6): not what "heavier" means.
-        """
-        b = self._body(robot)
-        index = self._link_index(b, link)
-        p, client = self.session.p, self.session.client
-        info = p.getDynamicsInfo(b.body, index, physicsClientId=client)
-        old, diagonal = info[0], info[2]
-        scaled = [float(v) * float(mass) / old for v in diagonal] if old > 0 else None
-        for values in ({"mass": float(mass)},
-                       {"localInertiaDiagonal": scaled} if scaled is not None else {}):
-            if values:
-                p.changeDynamics(b.body, index, physicsClientId=client, **values)
-                self._changed(b, index, values)
-
-    def set_inertia(self, robot: str, link: str, diagonal: Sequence[float]) -> None:
-        """A link's principal moments of inertia, kg m^2 (in its inertial frame)."""
-        b = self._body(robot)
-        index = self._link_index(b, link)
-        values = {"localInertiaDiagonal": [float(v) for v in diagonal]}
-        p, client = self.session.p, self.session.client
-        p.changeDynamics(b.body, index, physicsClientId=client, **values)
-        self._changed(b, index, values)
-
-    def set_friction(self, robot: str, link: str | None, lateral: float) -> None:
-        """Lateral friction of a link (every link when ``link`` is None).
-
-        Robot ``"ground"`` is the floor.
-        """
-        self._change(robot, link, lateralFriction=float(lateral))
-
-    def set_restitution(self, robot: str, link: str | None, restitution: float) -> None:
-        """Restitution (bounciness) of a link, or of the floor with robot ``"ground"``."""
-        self._change(robot, link, restitution=float(restitution))
-
-    @staticmethod
-    def _joint_named(b: _Body, joint: str) -> JointSpec:
-        try:
-            return b.joint(joint)
-        except KeyError:
-            raise ParameterError(f"`joint`: {b.name} has no joint named {joint!r}",
-                                 param="joint") from None
-
-    def set_joint_damping(self, robot: str, joint: str, damping: float) -> None:
-        """PyBullet's joint damping of one joint (N m s/rad)."""
-        b = self._body(robot)
-        spec = self._joint_named(b, joint)
-        p, client = self.session.p, self.session.client
-        p.changeDynamics(b.body, spec.index, jointDamping=float(damping),
-                         physicsClientId=client)
-
-    def set_joint_friction(self, robot: str, joint: str, friction: float) -> None:
-        """A joint's dry (Coulomb) friction, N m (N for a prismatic joint); 0 removes it.
-
-        The joint holds against up to ``friction`` of torque and is slowed by that much when
-        it moves (PyBullet's joint motor at velocity 0 with that force limit). While a
-        PyBullet position or velocity command drives the joint (a ``joints`` segment without
-        a ``motor`` table, or a car's wheels and hinges), that command owns the motor; the
-        friction comes back when it ends. It stays across ``reset()``.
-        """
-        b = self._body(robot)
-        spec = self._joint_named(b, joint)
-        if spec not in b.active:
-            raise ParameterError(f"`joint`: {joint} of {robot} is fixed", param="joint")
-        if not (isinstance(friction, (int, float)) and math.isfinite(friction)
-                and friction >= 0):
-            raise ParameterError(f"`friction` must be a finite number >= 0, got {friction!r}",
-                                 param="friction")
-        b.dry_friction[spec.index] = float(friction)
-        if not self._motor_driven(b, spec):
-            self._free(b, [spec.index])
-
-    def _motor_driven(self, b: _Body, spec: JointSpec) -> bool:
-        """Whether a PyBullet position or velocity command holds this joint's motor now."""
-        cmd = b.applied
-        if cmd is None or b.servo:
-            return False
-        if cmd.kind == "drive":
-            return b.train is not None and spec.index in (*b.train.wheels, *b.train.hinges)
-        return spec.name in cmd.targets and cmd.mode_of(spec.name) != "torque"
-
-    def set_link_damping(self, robot: str, linear: float, angular: float) -> None:
-        """Every link's linear and angular velocity damping (PyBullet's default is 0.04)."""
-        self._change(robot, None, linearDamping=float(linear), angularDamping=float(angular))
-
-    def set_motor_gains(self, robot: str, kp: float | Mapping[str, float] | None = None,
-                        kd: float | Mapping[str, float] | None = None) -> None:
-        """The servo's position and velocity gains: one for every joint, or per joint name.
-
-        A gain not given keeps its value. Needs the robot's ``motor`` table (the servo).
-        """
-        b = self._body(robot)
-        if not b.servo:
-            raise ParameterError(f"`robot`: {robot} has no servo model; give it a 'motor' "
-                                 "table in the scenario", param="robot")
-        names = {j.name for j in b.servo}
-        for label, gain in (("kp", kp), ("kd", kd)):
-            if gain is None:
-                continue
-            values = dict(gain) if isinstance(gain, Mapping) else {"": gain}
-            for name, value in values.items():
-                if name and name not in names:
-                    raise ParameterError(f"`{label}`: {robot}'s servo drives no joint named "
-                                         f"{name!r}", param=label)
-                if not (isinstance(value, (int, float)) and math.isfinite(value)
-                        and value >= 0):
-                    raise ParameterError(f"`{label}` must be a finite number >= 0, got "
-                                         f"{value!r}", param=label)
-            setattr(b, label, {k: float(v) for k, v in values.items()}
-                    if isinstance(gain, Mapping) else float(gain))
 
     def set_time_step(self, time_step: float) -> None:
         """The physics time step, s (times already recorded keep theirs)."""
@@ -1091,35 +752,6 @@ class Simulation:
         p.setTimeStep(time_step, physicsClientId=client)
         self.time_step = float(time_step)
 
-    def _add_noise(self, b: _Body, obs: Observation) -> Observation:
-        """Independent Gaussian samples on the reported fields (standard deviations).
-
-        Joint fields take one value for every joint or one per joint; base vectors one for
-        every axis or one per axis. ``base_orientation`` is turned by a random rotation
-        (roll, pitch, yaw drawn with those deviations), so it stays a unit quaternion.
-        """
-        noise = b.config.noise
-        if noise is None:
-            return obs
-        gauss = b.rng.gauss
-        changes: dict[str, Any] = {}
-        for name in (*OBSERVATION_FIELDS, "motor_torques"):
-            std = getattr(noise, name)
-            value = getattr(obs, name)
-            if value is None or not std:
-                continue
-            if isinstance(value, dict):
-                changes[name] = {k: v + gauss(0.0, std.get(k, 0.0) if isinstance(std, dict)
-                                              else std) for k, v in value.items()}
-                continue
-            axes = std if isinstance(std, list) else [std] * 3
-            if name == "base_orientation":
-                turn = rpy_to_quat(*(gauss(0.0, a) if a > 0 else 0.0 for a in axes))
-                changes[name] = list(quat_mul(turn, value))
-            else:
-                changes[name] = [v + (gauss(0.0, a) if a > 0 else 0.0)
-                                 for v, a in zip(value, axes, strict=True)]
-        return obs._replace(**changes)
 
     def link_poses(self) -> list[list[tuple[Any, Any]]]:
         """Every robot's URDF link frames' world poses now, base first (``(xyz, xyzw)``).
