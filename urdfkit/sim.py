@@ -25,15 +25,14 @@ import random
 import tempfile
 import time
 from collections import deque
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-from . import sim_control, sim_episode, sim_sensors, sim_setters
+from . import sim_control, sim_dynamics, sim_episode, sim_sensors, sim_setters
 from .errors import EngineError, InputError, ParameterError
 from .scenario import JOINT_NOISE_FIELDS, load_scenario, parse_scenario
 from .session import LoadOptions, Session, prime_resets
-from .sim_dynamics import Shadows
 from .sim_state import (  # noqa: F401  (re-exported: urdfkit.sim's public names)
     _ACTIVE,
     _FIXED,
@@ -87,7 +86,7 @@ class Simulation:
         self.bodies: dict[str, _Body] = {}
         self._resolved: list[Any] = []
         #: The robots' dynamics models, each in a client of its own (:mod:`.sim_dynamics`).
-        self._shadows = Shadows()
+        self._shadows = sim_dynamics.Shadows()
         self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-sim-")
         self.session = Session(gui=gui)
         try:
@@ -606,125 +605,19 @@ class Simulation:
             pos, orn = st[4], st[5]
         return list(pos), list(orn)
 
-    def dynamics_joints(self, robot: str) -> list[str]:
-        """The joints the dynamics quantities are ordered by (PyBullet's order).
+    # ---- dynamics on shadow models (urdfkit/sim_dynamics.py)
+    dynamics_joints = sim_dynamics.dynamics_joints
+    _dynamics_joints = sim_dynamics._dynamics_joints
+    _physical_state = sim_dynamics._physical_state
+    _fixed = sim_dynamics._fixed
+    _model = sim_dynamics._model
+    _changed = sim_dynamics._changed
+    mass_matrix = sim_dynamics.mass_matrix
+    coriolis_and_gravity = sim_dynamics.coriolis_and_gravity
+    gravity_torques = sim_dynamics.gravity_torques
+    forward_dynamics = sim_dynamics.forward_dynamics
+    jacobian = sim_dynamics.jacobian
 
-        The movable joints; a floating base adds 6 base coordinates before them in
-        :meth:`mass_matrix`.
-        """
-        return [j.name for j in self._dynamics_joints(self._body(robot))]
-
-    def _dynamics_joints(self, b: _Body) -> list[JointSpec]:
-        movable = [j for j in b.joints if j.type != _FIXED]
-        odd = [j.name for j in movable if not j.active]
-        if odd:
-            raise ParameterError(f"{b.name}: the dynamics need 1-DOF joints; {odd[0]!r} is not",
-                                 param="robot")
-        return movable
-
-    def _physical_state(self, b: _Body) -> tuple[list[float], list[float]]:
-        p, client = self.session.p, self.session.client
-        states = p.getJointStates(b.body, [j.index for j in self._dynamics_joints(b)],
-                                  physicsClientId=client)
-        return [float(st[0]) for st in states], [float(st[1]) for st in states]
-
-    def _fixed(self, b: _Body, what: str) -> None:
-        p, client = self.session.p, self.session.client
-        moving_base = b.config.base != "fixed" and \
-            p.getDynamicsInfo(b.body, -1, physicsClientId=client)[0] > 0
-        if moving_base:
-            raise ParameterError(f"{b.name}: {what} needs a fixed base (PyBullet's "
-                                 "calculateInverseDynamics does not take a floating one); "
-                                 "use base = \"fixed\"", param="robot")
-
-    def _model(self, b: _Body) -> tuple[Any, int, int]:
-        """``(p, client, body)`` of the robot's dynamics model, as the robot is now.
-
-        PyBullet builds the model its calculateMassMatrix, calculateInverseDynamics and
-        calculateJacobian use once, at the first call, and never updates it: a mass changed
-        later is ignored (measured on 3.2.7). So the dynamics run on a copy of the robot in a
-        client of their own, rebuilt after every ``set_mass``/``set_inertia``.
-        """
-        assert b.loaded is not None
-        return self._shadows.model(b.name, b.loaded, self.config.physics.gravity, b.changes)
-
-    def _changed(self, b: _Body, link: int, values: dict[str, Any]) -> None:
-        """Remember a change to a robot's mass properties; its dynamics model is stale."""
-        for key, value in values.items():
-            b.changes[(link, key)] = value
-        self._shadows.stale(b.name)
-
-    def mass_matrix(self, robot: str) -> Any:
-        """The joint-space mass matrix M(q) now (numpy, PyBullet's calculateMassMatrix).
-
-        Physical joint coordinates, in :meth:`dynamics_joints` order; a floating base puts its
-        6 coordinates first, as PyBullet does.
-        """
-        import numpy as np
-
-        b = self._body(robot)
-        q, _ = self._physical_state(b)
-        p, client, body = self._model(b)
-        return np.array(p.calculateMassMatrix(body, q, physicsClientId=client))
-
-    def coriolis_and_gravity(self, robot: str) -> Any:
-        """C(q, qd) qd + g(q) now: the torques that hold the current motion (numpy)."""
-        import numpy as np
-
-        b = self._body(robot)
-        self._fixed(b, "coriolis_and_gravity")
-        q, qd = self._physical_state(b)
-        p, client, body = self._model(b)
-        return np.array(p.calculateInverseDynamics(body, q, qd, [0.0] * len(q),
-                                                   physicsClientId=client))
-
-    def gravity_torques(self, robot: str) -> Any:
-        """g(q) now: the torques that hold the robot still against gravity (numpy)."""
-        import numpy as np
-
-        b = self._body(robot)
-        self._fixed(b, "gravity_torques")
-        q, _ = self._physical_state(b)
-        p, client, body = self._model(b)
-        zero = [0.0] * len(q)
-        return np.array(p.calculateInverseDynamics(body, q, zero, zero,
-                                                   physicsClientId=client))
-
-    def forward_dynamics(self, robot: str, tau: Sequence[float]) -> Any:
-        """The joint accelerations ``tau`` would cause now, without contacts (numpy).
-
-        qdd = M^-1 (tau - C qd - g).
-        """
-        import numpy as np
-
-        b = self._body(robot)
-        torque = np.asarray(tau, dtype=float)
-        n = len(self._dynamics_joints(b))
-        if torque.shape != (n,):
-            raise ParameterError(f"`tau` needs {n} torques, one per dynamics joint of "
-                                 f"{robot}, got {torque.shape}", param="tau")
-        return np.linalg.solve(self.mass_matrix(robot), torque - self.coriolis_and_gravity(robot))
-
-    def jacobian(self, robot: str, link: str, point: Sequence[float] = (0.0, 0.0, 0.0)
-                 ) -> Any:
-        """The 6 x n Jacobian (linear rows, then angular) of a point of a link now (numpy).
-
-        ``point`` is in the link's URDF frame (the joint frame): PyBullet 3.2.7's
-        calculateJacobian takes it so, whatever its docs say of the centre of mass (measured:
-        the point (0, 0, 0) of a pendulum's bob link is on the hinge, J = 0).
-        """
-        import numpy as np
-
-        b = self._body(robot)
-        index = b.links.get(link)
-        if index is None or index == -1:
-            raise ParameterError(f"`link`: {robot} has no moving link named {link!r}",
-                                 param="link")
-        q, qd = self._physical_state(b)
-        p, client, body = self._model(b)
-        lin, ang = p.calculateJacobian(body, index, list(point), q, qd, [0.0] * len(q),
-                                       physicsClientId=client)
-        return np.vstack([np.array(lin), np.array(ang)])
 
     # ---- setters: the robot's physical parameters
 
