@@ -26,7 +26,7 @@ for floor, names in enumerate([
     # run and draw
     "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
     " diff collisions fix sweep view sim_writers sim_dynamics sim_state sim_control"
-    " sim_sensors sim_episode sim_setters sim_world",
+    " sim_sensors sim_episode sim_setters sim_world sim_record",
     # presentation and the command line
     "present ci cli __main__",
 ]):
