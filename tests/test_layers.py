@@ -28,7 +28,8 @@ for floor, names in enumerate([
     # run and draw
     "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
     " validate diff collisions fix sweep_journal sweep sweep_run view view_model view_page"
-    " view_stream vehicle_shapes drive_result scenario_models",
+    " view_stream vehicle_shapes drive_result scenario_models sim_writers sim_dynamics"
+    " sim_state sim_control sim_sensors sim_episode sim_setters sim_world sim_record",
     # presentation and the command line
     "present ci cli __main__ commands.shared commands.build commands.inspecting commands.checking"
     " commands.driving commands.drawing commands.simulating",

@@ -481,65 +481,15 @@ class ScenarioEnv(gym.Env):
 
     def _build_action_space(self, bounds: dict[str, tuple[float, float]]) -> None:
         b = self.sim.bodies[self.robot]
-        cfg = b.config
-        p, client = self.sim.session.p, self.sim.session.client
-        self.controller = self._controller(cfg)
-        names: list[str] = []
-        lows: list[float] = []
-        highs: list[float] = []
+        self.controller = self._controller(b.config)
         self.modes: dict[str, str] = {}
-
-        def default(name: str) -> tuple[float, float]:
-            if name in bounds:
-                return bounds.pop(name)
-            spec = b.joint(name)
-            info = p.getJointInfo(b.body, spec.index, physicsClientId=client)
-            lower, upper, effort, velocity = info[8], info[9], info[10], info[11]
-            mode = self.modes[name]
-            sign = b.directions.get(name, 1.0)
-            offset = b.offsets.get(name, 0.0)
-            if mode == "position":
-                if lower < upper:  # measured frame: (q - offset) * direction
-                    ends = sorted(((lower - offset) * sign, (upper - offset) * sign))
-                    return ends[0], ends[1]
-                if spec.type == p.JOINT_REVOLUTE:
-                    return -math.pi, math.pi
-                raise ParameterError(f"{name} has no position limits; give its range in "
-                                     "action_bounds", param="action_bounds")
-            if mode == "velocity":
-                v = velocity if velocity > 0 else DEFAULT_VELOCITY
-                return -v, v
-            motor = cfg.motor
-            limit = effort if effort > 0 else \
-                motor.max_torque if motor is not None and isinstance(motor.max_torque, float) \
-                else DEFAULT_TORQUE
-            return -limit, limit
-
         if self.controller == "drive":
-            from .vehicle import clamp_steer
-
-            train = b.train
-            lo, hi = train.steer_range() if train.hinges else (0.0, 0.0)
-            steer = bounds.pop("steer", (lo, hi))
-            throttle = bounds.pop("throttle", (-DEFAULT_THROTTLE, DEFAULT_THROTTLE))
-            names, lows, highs = ["throttle", "steer"], [throttle[0], steer[0]], \
-                [throttle[1], steer[1]]
-            self._clamp = clamp_steer
+            names, lows, highs = self._drive_action(b, bounds)
         else:
-            for seg in cfg.joints or []:
-                for name in seg.targets:
-                    mode = seg.mode if isinstance(seg.mode, str) else seg.mode[name]
-                    if self.modes.setdefault(name, mode) != mode:
-                        raise ParameterError(f"{self.robot}: joint {name} is commanded in "
-                                             f"both {self.modes[name]} and {mode} mode; an "
-                                             "action space needs one", param="scenario")
-            if not self.modes and cfg.motor is not None:
-                self.modes = {j.name: "position" for j in b.servo}
-            if not self.modes:
-                raise ParameterError(f"{self.robot} has no joint the agent could command",
-                                     param="robot")
+            self.modes = self._joint_modes(b)
+            names, lows, highs = [], [], []
             for name in self.modes:
-                lo, hi = default(name)
+                lo, hi = self._joint_bounds(b, name, bounds)
                 names.append(name)
                 lows.append(lo)
                 highs.append(hi)
@@ -557,6 +507,64 @@ class ScenarioEnv(gym.Env):
         self._by_mode: dict[str, list[int]] = {}
         for k, name in enumerate(names if self.controller == "joints" else []):
             self._by_mode.setdefault(self.modes[name], []).append(k)
+
+    def _drive_action(self, b: Any, bounds: dict[str, tuple[float, float]]
+                      ) -> tuple[list[str], list[float], list[float]]:
+        """Throttle and steer, the steer's range from the drive train unless ``bounds`` says."""
+        from .vehicle import clamp_steer
+
+        train = b.train
+        lo, hi = train.steer_range() if train.hinges else (0.0, 0.0)
+        steer = bounds.pop("steer", (lo, hi))
+        throttle = bounds.pop("throttle", (-DEFAULT_THROTTLE, DEFAULT_THROTTLE))
+        self._clamp = clamp_steer
+        return ["throttle", "steer"], [throttle[0], steer[0]], [throttle[1], steer[1]]
+
+    def _joint_modes(self, b: Any) -> dict[str, str]:
+        """The mode each commanded joint is driven in: one per joint, or the servo's joints."""
+        modes: dict[str, str] = {}
+        for seg in b.config.joints or []:
+            for name in seg.targets:
+                mode = seg.mode if isinstance(seg.mode, str) else seg.mode[name]
+                if modes.setdefault(name, mode) != mode:
+                    raise ParameterError(f"{self.robot}: joint {name} is commanded in "
+                                         f"both {modes[name]} and {mode} mode; an "
+                                         "action space needs one", param="scenario")
+        if not modes and b.config.motor is not None:
+            modes = {j.name: "position" for j in b.servo}
+        if not modes:
+            raise ParameterError(f"{self.robot} has no joint the agent could command",
+                                 param="robot")
+        return modes
+
+    def _joint_bounds(self, b: Any, name: str, bounds: dict[str, tuple[float, float]]
+                      ) -> tuple[float, float]:
+        """A joint's action range: from ``bounds``, else its URDF limits in the measured frame."""
+        if name in bounds:
+            return bounds.pop(name)
+        p, client = self.sim.session.p, self.sim.session.client
+        spec = b.joint(name)
+        info = p.getJointInfo(b.body, spec.index, physicsClientId=client)
+        lower, upper, effort, velocity = info[8], info[9], info[10], info[11]
+        mode = self.modes[name]
+        sign = b.directions.get(name, 1.0)
+        offset = b.offsets.get(name, 0.0)
+        if mode == "position":
+            if lower < upper:  # measured frame: (q - offset) * direction
+                ends = sorted(((lower - offset) * sign, (upper - offset) * sign))
+                return ends[0], ends[1]
+            if spec.type == p.JOINT_REVOLUTE:
+                return -math.pi, math.pi
+            raise ParameterError(f"{name} has no position limits; give its range in "
+                                 "action_bounds", param="action_bounds")
+        if mode == "velocity":
+            v = velocity if velocity > 0 else DEFAULT_VELOCITY
+            return -v, v
+        motor = b.config.motor
+        limit = effort if effort > 0 else \
+            motor.max_torque if motor is not None and isinstance(motor.max_torque, float) \
+            else DEFAULT_TORQUE
+        return -limit, limit
 
     def _field_names(self, field: str, value: Any) -> list[str]:
         if isinstance(value, dict):

@@ -19,286 +19,49 @@ servo model read the true joint state.
 
 from __future__ import annotations
 
-import csv
-import functools
-import io
-import json
-import math
-import random
 import tempfile
-import time
-from collections import deque
-from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-from .errors import EngineError, InputError, MissingDependencyError, OutputError, ParameterError
-from .scenario import JOINT_NOISE_FIELDS, OBSERVATION_FIELDS, load_scenario, parse_scenario
-from .session import LoadOptions, Session, prime_resets, restore_clean
-from .spec import UP_AXES, quat_mul, quat_to_matrix, rotate_back, rpy_to_quat
-
-_REVOLUTE, _PRISMATIC, _FIXED = 0, 1, 4  # p.JOINT_* values
-#: Joint types with one degree of freedom: what getJointState can report.
-_ACTIVE = (_REVOLUTE, _PRISMATIC)
-#: Suffixes for flattened vector columns, by vector length.
-_AXES = {3: ("x", "y", "z"), 4: ("x", "y", "z", "w"), 6: ("fx", "fy", "fz", "mx", "my", "mz")}
-OUTPUT_FORMATS = (".jsonl", ".csv", ".parquet")
-
-
-# --------------------------------------------------------------------------- observations
-
-
-@dataclass
-class Observation:
-    """One robot's state at one time: a row of the output.
-
-    Motor fields are keyed by joint name over the robot's active (revolute, continuous and
-    prismatic) joints, in the measured frame: ``(q - offset) * direction``. Base fields are
-    PyBullet's base frame, which is the root link's centre of mass.
-
-    Attributes:
-        t: Simulated time, s.
-        step: Physics steps since the start.
-        robot: The robot's name in the scenario.
-        motor_angles: Joint positions, rad or m.
-        motor_velocities: Joint velocities.
-        motor_accelerations: Finite difference of the velocities over one physics step.
-        base_position: World position, m.
-        base_orientation: World orientation, quaternion (x, y, z, w).
-        base_lin_vel: World linear velocity, m/s.
-        base_ang_vel: World angular velocity, rad/s.
-        base_lin_vel_body_frame: ``base_lin_vel`` rotated into the base frame.
-        base_ang_vel_body_frame: ``base_ang_vel`` rotated into the base frame.
-        contacts: For ``record.contact_links``: ``{link: {"normal_force", "count"}}``.
-        joint_forces: For ``record.joint_forces``: reaction ``[fx, fy, fz, mx, my, mz]``.
-        motor_torques: With ``record.motor_torques``: the torque each joint's motor applied in
-            the last step, in the joint's own frame (not the measured one), never delayed.
-        link_poses: For ``record.link_poses``: each link's URDF frame, ``{"position",
-            "orientation"}`` (world; quaternion x, y, z, w).
-        feet: For ``record.feet``: per foot (its label, else its link name), the contact
-            force the foot feels from everything but its own robot: ``{"contact": 0 or 1,
-            "normal": N (summed), "world": [fx, fy, fz] (the normal forces, world frame),
-            "local": the same in the foot link's frame, "friction_world": the lateral
-            friction forces, world frame}``.
-    """
-
-    t: float
-    step: int
-    robot: str
-    motor_angles: dict[str, float]
-    motor_velocities: dict[str, float]
-    motor_accelerations: dict[str, float]
-    base_position: list[float]
-    base_orientation: list[float]
-    base_lin_vel: list[float]
-    base_ang_vel: list[float]
-    base_lin_vel_body_frame: list[float]
-    base_ang_vel_body_frame: list[float]
-    contacts: dict[str, dict[str, float]] | None = None
-    joint_forces: dict[str, list[float]] | None = None
-    motor_torques: dict[str, float] | None = None
-    link_poses: dict[str, dict[str, list[float]]] | None = None
-    feet: dict[str, dict[str, Any]] | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON row (optional fields only when recorded)."""
-        row: dict[str, Any] = {"t": self.t, "step": self.step, "robot": self.robot}
-        for name in OBSERVATION_FIELDS:
-            value = getattr(self, name)
-            row[name] = dict(value) if isinstance(value, dict) else list(value)
-        if self.contacts is not None:
-            row["contacts"] = {k: dict(v) for k, v in self.contacts.items()}
-        if self.joint_forces is not None:
-            row["joint_forces"] = {k: list(v) for k, v in self.joint_forces.items()}
-        if self.motor_torques is not None:
-            row["motor_torques"] = dict(self.motor_torques)
-        if self.link_poses is not None:
-            row["link_poses"] = {k: {"position": list(v["position"]),
-                                     "orientation": list(v["orientation"])}
-                                 for k, v in self.link_poses.items()}
-        if self.feet is not None:
-            row["feet"] = _copy_feet(self.feet)
-        return row
-
-    def _replace(self, **changes: Any) -> Observation:
-        data = {**self.__dict__, **changes}
-        return Observation(**data)
-
-    def copy(self) -> Observation:
-        """A copy whose dicts and lists are its own: changing it changes nothing else."""
-        c, f, tq, lp, ft = (self.contacts, self.joint_forces, self.motor_torques,
-                            self.link_poses, self.feet)
-        return Observation(
-            self.t, self.step, self.robot, dict(self.motor_angles),
-            dict(self.motor_velocities), dict(self.motor_accelerations),
-            list(self.base_position), list(self.base_orientation), list(self.base_lin_vel),
-            list(self.base_ang_vel), list(self.base_lin_vel_body_frame),
-            list(self.base_ang_vel_body_frame),
-            None if c is None else {k: dict(v) for k, v in c.items()},
-            None if f is None else {k: list(v) for k, v in f.items()},
-            None if tq is None else dict(tq),
-            None if lp is None else {k: {"position": list(v["position"]),
-                                         "orientation": list(v["orientation"])}
-                                     for k, v in lp.items()},
-            None if ft is None else _copy_feet(ft))
-
-
-def _copy_feet(feet: Mapping[str, Mapping[str, Any]]) -> dict[str, dict[str, Any]]:
-    return {k: {key: list(x) if isinstance(x, list) else x for key, x in v.items()}
-            for k, v in feet.items()}
-
-
-# --------------------------------------------------------------------------- robots
-
-
-@dataclass
-class JointSpec:
-    """What the simulation needs to know of one joint of a loaded body."""
-
-    index: int
-    name: str
-    type: int
-    effort: float
-    child_link: str
-
-    @property
-    def active(self) -> bool:
-        """Whether the joint has one degree of freedom we measure and drive."""
-        return self.type in _ACTIVE
-
-
-@dataclass
-class _Command:
-    """A controller command: a drive (throttle, steer) or joint targets."""
-
-    kind: str  # "drive" or "joints"
-    throttle: float = 0.0
-    steer: float = 0.0
-    mode: str | dict[str, str] = "position"  # one for all targets, or per joint
-    targets: dict[str, float] = field(default_factory=dict)
-    max_force: float | None = None
-    velocities: dict[str, float] = field(default_factory=dict)
-
-    def mode_of(self, joint: str) -> str:
-        """The control mode of one target joint."""
-        return self.mode if isinstance(self.mode, str) else self.mode.get(joint, "position")
-
-    @property
-    def any_torque(self) -> bool:
-        """Whether some target is a torque (re-applied every step: torques last one step)."""
-        if isinstance(self.mode, str):
-            return self.mode == "torque" and self.kind == "joints"
-        return "torque" in self.mode.values()
-
-
-@dataclass
-class _Body:
-    """A loaded robot and the state the simulation keeps for it."""
-
-    name: str
-    path: str  # "robots[i]", for messages
-    config: Any
-    body: int
-    joints: list[JointSpec]
-    active: list[JointSpec]
-    links: dict[str, int]
-    offsets: dict[str, float]
-    directions: dict[str, float]
-    rng: random.Random
-    history: deque[Observation]
-    train: Any = None
-    servo: list[JointSpec] = field(default_factory=list)
-    contact_links: dict[str, int] = field(default_factory=dict)
-    force_joints: dict[str, int] = field(default_factory=dict)
-    pose_links: list[str] = field(default_factory=list)
-    # The active joints' physical velocities when last taken, and the step they were taken at.
-    previous_velocities: list[float] | None = None
-    previous_step: int = -1
-    applied: _Command | None = None
-    override: _Command | None = None
-    reported: tuple[int, Observation] | None = None
-    loaded: tuple[str, LoadOptions] | None = None  # the file PyBullet loaded, and how
-    # set_* changes to mass properties, (link, changeDynamics key) -> the latest value, in the
-    # order first made (mass before the inertia it rescales): bounded however often it is set.
-    changes: dict[tuple[int, str], Any] = field(default_factory=dict)
-    feet: dict[str, int] = field(default_factory=dict)  # label -> link index
-    kp: float | dict[str, float] = 0.0  # the servo's gains (set_motor_gains changes them)
-    kd: float | dict[str, float] = 0.0
-    reports: deque[Observation] | None = None  # the last N reported, with history N > 1
-    # Torques given in TORQUE_CONTROL for the coming step (physical frame): PyBullet reports
-    # 0 as a torque-controlled joint's applied torque.
-    torques: dict[str, float] = field(default_factory=dict)
-    dry_friction: dict[int, float] = field(default_factory=dict)  # joint index -> N m or N
-
-    @functools.cached_property
-    def frame(self) -> tuple[list[int], list[str], list[float], list[float]]:
-        """The active joints' indices, names, directions and offsets, in order (fixed)."""
-        return ([j.index for j in self.active], [j.name for j in self.active],
-                [self.directions.get(j.name, 1.0) for j in self.active],
-                [self.offsets.get(j.name, 0.0) for j in self.active])
-
-    def joint(self, name: str) -> JointSpec:
-        for j in self.joints:
-            if j.name == name:
-                return j
-        raise KeyError(name)
-
-
-@dataclass
-class RobotSummary:
-    """What a run did to one robot, for the summary table."""
-
-    robot: str
-    rows: int
-    start: list[float]
-    end: list[float]
-    distance: float
-    top_speed: float
-    heading_deg: float
-    final_joints: dict[str, float]
-    joint_min: dict[str, float] = field(default_factory=dict)
-    joint_max: dict[str, float] = field(default_factory=dict)
-
-    def to_dict(self) -> dict[str, Any]:
-        """The JSON form."""
-        return dict(self.__dict__)
-
-
-@dataclass
-class SimResult:
-    """The rows a run recorded.
-
-    Attributes:
-        rows: Reported observations (noise and delay applied), in time order.
-        ideal: The true observations at the same steps (for a robot without noise or
-            delay, the very objects in ``rows``: what it reports is the truth).
-        time_step: Physics time step, s.
-        steps: Physics steps taken.
-        interrupted: Ctrl-C (or SIGTERM in the CLI) ended the run early; the rows cover the
-            steps simulated.
-        row_count: Rows recorded (also when the run kept none: ``keep=False``).
-        summaries: Per robot: start, end, distance, top speed, final joints.
-    """
-
-    rows: list[Observation]
-    ideal: list[Observation]
-    time_step: float
-    steps: int
-    interrupted: bool = False
-    row_count: int = 0
-    summaries: list[RobotSummary] = field(default_factory=list)
-
-    def to_dicts(self) -> list[dict[str, Any]]:
-        """The reported rows as JSON-ready dicts."""
-        return [r.to_dict() for r in self.rows]
-
+from . import (
+    sim_control,
+    sim_dynamics,
+    sim_episode,
+    sim_record,
+    sim_sensors,
+    sim_setters,
+    sim_world,
+)
+from .errors import InputError, ParameterError
+from .scenario import OBSERVATION_FIELDS, load_scenario, parse_scenario  # noqa: F401 (re-exported)
+from .session import Session
+from .sim_state import (  # noqa: F401  (re-exported: urdfkit.sim's public names)
+    _ACTIVE,
+    _FIXED,
+    JointSpec,
+    Observation,
+    RobotSummary,
+    SimResult,
+    _Body,
+    _Command,
+    _copy_feet,
+    _first,
+    _Summary,
+)
+from .sim_writers import (  # noqa: F401  (re-exported: urdfkit.sim's public names)
+    OUTPUT_FORMATS,
+    RowText,
+    _ByteSink,
+    _columns,
+    _pyarrow,
+    check_output,
+    flatten,
+    rows_to_bytes,
+    write_rows,
+)
 
 # --------------------------------------------------------------------------- the simulation
-
-
-def _first(*values: float | None) -> float | None:
-    return next((v for v in values if v is not None), None)
 
 
 class Simulation:
@@ -324,6 +87,8 @@ class Simulation:
         self.ground: int | None = None
         self.bodies: dict[str, _Body] = {}
         self._resolved: list[Any] = []
+        #: The robots' dynamics models, each in a client of its own (:mod:`.sim_dynamics`).
+        self._shadows = sim_dynamics.Shadows()
         self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-sim-")
         self.session = Session(gui=gui)
         try:
@@ -351,10 +116,7 @@ class Simulation:
 
     def close(self) -> None:
         """Disconnect the client and remove temp files (safe to call twice)."""
-        shadows: dict[str, tuple[Session, int]] = self.__dict__.get("_shadows", {})
-        for shadow in shadows.values():
-            shadow[0].close()
-        shadows.clear()
+        self._shadows.close()
         if hasattr(self, "session"):
             self.session.close()
         for r in self._resolved:
@@ -380,238 +142,20 @@ class Simulation:
     def _error(self, path: str, message: str) -> InputError:
         return InputError(f"{path}: {message}", file=self.config.source)
 
-    # ---- setup
+    # ---- setup: loading the ground and the robots, checking names (urdfkit/sim_world.py)
+    _setup = sim_world._setup
+    _load = sim_world._load
+    _add_robot = sim_world._add_robot
+    _load_robot = sim_world._load_robot
+    _new_body = sim_world._new_body
+    _active_joint = sim_world._active_joint
+    _check_joint_names = sim_world._check_joint_names
+    _detect_train = sim_world._detect_train
+    _check_randomize = sim_world._check_randomize
+    _place = sim_world._place
+    _having_link = sim_world._having_link
+    _check_record = sim_world._check_record
 
-    def _setup(self) -> None:
-        p, client = self.session.p, self.session.client
-        ph = self.config.physics
-        p.setTimeStep(ph.time_step, physicsClientId=client)
-        p.setGravity(*ph.gravity, physicsClientId=client)
-        # Sorted overlapping pairs: without them the order the solver meets contacts in
-        # depends on the engine's history, and a reset in place is not reproducible. A
-        # simulation_and_control config turns them off, as SimInterface leaves them (else
-        # its contacts are solved in another order and the runs part after a few steps).
-        p.setPhysicsEngineParameter(deterministicOverlappingPairs=int(ph.deterministic_pairs),
-                                    physicsClientId=client)
-        p.setPhysicsEngineParameter(numSolverIterations=ph.solver_iterations,
-                                    enableConeFriction=int(ph.cone_friction),
-                                    physicsClientId=client)
-        if self.config.ground is not None:
-            g = self.config.ground
-            self.ground = self._load("ground", g.template, g.params, g.urdf,
-                                     LoadOptions(fixed_base=True,
-                                                 base_position=tuple(g.position)))
-        for i, robot in enumerate(self.config.robots):
-            self.bodies[robot.name] = self._add_robot(i, robot)
-        self._check_record()
-        for b in self.bodies.values():
-            # A robot's own damping, else the scenario's, else PyBullet's 0.04. PyBullet keeps
-            # one value per body (measured: setting any link's sets the whole body's).
-            damping = {key: value for key, value in (
-                ("linearDamping", _first(b.config.linear_damping, ph.linear_damping)),
-                ("angularDamping", _first(b.config.angular_damping, ph.angular_damping)))
-                if value is not None}
-            if damping:
-                p.changeDynamics(b.body, -1, physicsClientId=client, **damping)
-        for b in self.bodies.values():
-            b.history.append(self._measure(b))
-        # The starting state, for reset() in place (restoreState is ~100x cheaper than a new
-        # Simulation).
-        self._start_state = p.saveState(physicsClientId=client)
-        prime_resets(p, client, self._start_state, [b.body for b in self.bodies.values()])
-
-    def _load(self, path: str, template: str | None, params: Mapping[str, Any],
-              urdf: str | None, options: LoadOptions) -> int:
-        from .catalog import build_template
-        from .resolve import open_input
-
-        if template is not None:
-            from .drive import builtin_file
-
-            # Built templates are cached as drive's are (key: source, parameters, version).
-            text = {k: v if isinstance(v, str) else
-                    " ".join(map(str, v)) if isinstance(v, (list, tuple)) else str(v)
-                    for k, v in params.items()}
-            cached = builtin_file(template, text)
-            if cached is not None:
-                name = str(cached)
-            else:
-                folder = Path(self._tmp.name) / f"{len(self._resolved)}"
-                folder.mkdir()
-                name = str(build_template(template, params).write(folder / f"{template}.urdf"))
-            display = f"{path}: template {template}"
-        else:
-            assert urdf is not None
-            name = self.config.path_of(urdf)
-            display = urdf
-        resolved = open_input(name)
-        self._resolved.append(resolved)
-        return self.session.load_urdf(resolved.load_path, options, display=display)
-
-    def _add_robot(self, i: int, cfg: Any) -> _Body:
-        p, client = self.session.p, self.session.client
-        path = f"robots[{i}]"
-        if cfg.orientation_quat is not None:
-            norm = math.sqrt(math.fsum(q * q for q in cfg.orientation_quat))
-            orientation = tuple(q / norm for q in cfg.orientation_quat)
-        else:
-            orientation = tuple(p.getQuaternionFromEuler(cfg.orientation_rpy or (0, 0, 0)))
-        # A Y-up (or X-up) model is first stood up, then turned as the scenario says.
-        orientation = quat_mul(orientation, UP_AXES[cfg.up])
-        options = LoadOptions(fixed_base=cfg.base == "fixed",
-                              inertia_from_file=cfg.inertia_from_file,
-                              implicit_cylinder=cfg.implicit_cylinder,
-                              self_collision=cfg.self_collision,
-                              base_position=tuple(cfg.position), base_orientation=orientation)
-        body = self._load(path, cfg.template, cfg.params, cfg.urdf, options)
-        if cfg.pose_frame == "com":
-            # The pose is the base's centre of mass, as resetBasePositionAndOrientation takes it.
-            p.resetBasePositionAndOrientation(body, cfg.position, orientation,
-                                              physicsClientId=client)
-        loaded = (str(self._resolved[-1].load_path), options)
-        try:
-            # getBasePositionAndOrientation, getJointStates... all fail on 128+ link bodies.
-            self.session.require_state_queries(body, cfg.name)
-        except EngineError as e:
-            raise self._error(path, str(e)) from None
-
-        joints: list[JointSpec] = []
-        for j in range(p.getNumJoints(body, physicsClientId=client)):
-            info = p.getJointInfo(body, j, physicsClientId=client)
-            joints.append(JointSpec(j, info[1].decode("utf-8", "replace"), info[2],
-                                    float(info[10]), info[12].decode("utf-8", "replace")))
-        active = [j for j in joints if j.active]
-        links = {p.getBodyInfo(body, physicsClientId=client)[0].decode("utf-8", "replace"): -1}
-        links.update({j.child_link: j.index for j in joints})
-        seed = self._robot_seed(self.config.seed, i)
-        b = _Body(cfg.name, path, cfg, body, joints, active, links, {}, {},
-                  random.Random(seed), deque(maxlen=max(cfg.delay, cfg.history - 1) + 1),
-                  loaded=loaded)
-        if cfg.history > 1:
-            b.reports = deque(maxlen=cfg.history)
-
-        def active_joint(where: str, name: str) -> JointSpec:
-            try:
-                spec = b.joint(name)
-            except KeyError:
-                known = ", ".join(j.name for j in active) or "none"
-                raise self._error(where, f"no joint named {name!r} in {cfg.name}; active "
-                                         f"joints: {known}") from None
-            if not spec.active:
-                kind = "fixed" if spec.type == _FIXED else "not a 1-DOF joint"
-                raise self._error(where, f"joint {name!r} is {kind} and cannot be moved")
-            return spec
-
-        for name, value in cfg.motor_offsets.items():
-            b.offsets[active_joint(f"{path}.motor_offsets.{name}", name).name] = value
-        for name, value in cfg.motor_directions.items():
-            b.directions[active_joint(f"{path}.motor_directions.{name}", name).name] = value
-        for k, seg in enumerate(cfg.joints or []):
-            for name in seg.targets:
-                active_joint(f"{path}.joints[{k}].targets.{name}", name)
-        if cfg.motor is not None:
-            names = cfg.motor.joints
-            b.servo = active if names is None else [
-                active_joint(f"{path}.motor.joints", n) for n in names]
-            for gain in ("kp", "kd", "viscous_friction", "stiffness"):
-                for name in getattr(cfg.motor, gain) if isinstance(
-                        getattr(cfg.motor, gain), dict) else ():
-                    active_joint(f"{path}.motor.{gain}.{name}", name)
-            b.kp, b.kd = cfg.motor.kp, cfg.motor.kd
-        if cfg.noise is not None:
-            for key in JOINT_NOISE_FIELDS:
-                value = getattr(cfg.noise, key)
-                for name in value if isinstance(value, dict) else ():
-                    active_joint(f"{path}.noise.{key}.{name}", name)
-
-        if cfg.drive is not None:
-            from .vehicle import detect_upright
-
-            v = cfg.vehicle
-            # Detection judges axes in the base frame, at load time: before any step.
-            try:
-                b.train = detect_upright(p, body, client, UP_AXES[cfg.up],
-                                         wheels=v.wheels if v else None,
-                                         hinges=v.hinges if v else None)
-            except ParameterError as e:
-                raise self._error(f"{path}.vehicle" if v else f"{path}.drive", e.message) \
-                    from None
-
-        if cfg.randomize is not None:
-            r = cfg.randomize
-            for name in r.initial_joints:
-                active_joint(f"{path}.randomize.initial_joints.{name}", name)
-            for label, table in (("lateral_friction", r.lateral_friction),
-                                 ("mass_scale", r.mass_scale)):
-                for link in table:
-                    if link not in b.links:
-                        raise self._error(f"{path}.randomize.{label}.{link}",
-                                          f"{cfg.name} has no link named {link!r}")
-            if r.yaw is not None and cfg.orientation_quat is not None:
-                raise self._error(f"{path}.randomize.yaw", "needs the start given as "
-                                  "orientation_rpy, not orientation_quat")
-        for name, friction in cfg.joint_friction.items():
-            b.dry_friction[active_joint(f"{path}.joint_friction.{name}", name).index] = friction
-        # PyBullet holds every joint with a velocity motor (target 0) until told otherwise.
-        self._free(b)
-        if any(cfg.base_velocity) or any(cfg.base_angular_velocity):
-            p.resetBaseVelocity(body, cfg.base_velocity, cfg.base_angular_velocity,
-                                physicsClientId=client)
-        if cfg.base == "on_rack":
-            # Held in the air where it starts (simulation_and_control's rack): a fixed
-            # constraint between the base and the world; its joints still move.
-            pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
-            p.createConstraint(body, -1, -1, -1, p.JOINT_FIXED, [0, 0, 0], [0, 0, 0],
-                               pos, childFrameOrientation=orn, physicsClientId=client)
-        for link, dyn in cfg.link_dynamics.items():
-            if link not in b.links:
-                raise self._error(f"{path}.link_dynamics.{link}",
-                                  f"{cfg.name} has no link named {link!r}")
-            values = {key: value for key, value in (
-                ("lateralFriction", dyn.lateral_friction), ("restitution", dyn.restitution),
-                ("rollingFriction", dyn.rolling_friction),
-                ("spinningFriction", dyn.spinning_friction)) if value is not None}
-            if values:
-                p.changeDynamics(body, b.links[link], physicsClientId=client, **values)
-        for name, init in cfg.initial_joints.items():
-            spec = active_joint(f"{path}.initial_joints.{name}", name)
-            p.resetJointState(body, spec.index, self._to_physical(b, name, init.position),
-                              init.velocity * b.directions.get(name, 1.0),
-                              physicsClientId=client)
-        return b
-
-    def _having_link(self, where: str, link: str) -> list[_Body]:
-        """The robots with a link of that name; an error naming ``where`` if none has one."""
-        found = [b for b in self.bodies.values() if link in b.links]
-        if not found:
-            raise self._error(where, f"no robot has a link named {link!r}")
-        return found
-
-    def _check_record(self) -> None:
-        p, client = self.session.p, self.session.client
-        rec = self.config.record
-        for i, link in enumerate(rec.contact_links):
-            for b in self._having_link(f"record.contact_links[{i}]", link):
-                b.contact_links[link] = b.links[link]
-        for i, link in enumerate(rec.link_poses):
-            for b in self._having_link(f"record.link_poses[{i}]", link):
-                b.pose_links.append(link)
-        feet = rec.feet.items() if isinstance(rec.feet, dict) else \
-            ((link, link) for link in rec.feet)
-        for i, (label, link) in enumerate(feet):
-            where = f"record.feet.{label}" if isinstance(rec.feet, dict) else \
-                f"record.feet[{i}]"
-            for b in self._having_link(where, link):
-                b.feet[label] = b.links[link]
-        for i, name in enumerate(rec.joint_forces):
-            found = [b for b in self.bodies.values() if any(j.name == name for j in b.joints)]
-            if not found:
-                raise self._error(f"record.joint_forces[{i}]", f"no robot has a joint named "
-                                                               f"{name!r}")
-            for b in found:
-                index = b.joint(name).index
-                b.force_joints[name] = index
-                p.enableJointForceTorqueSensor(b.body, index, True, physicsClientId=client)
 
     # ---- frames
 
@@ -662,199 +206,14 @@ class Simulation:
             raise ParameterError(f"no robot named {robot!r}; robots: "
                                  f"{', '.join(self.bodies)}") from None
 
-    def _scheduled(self, b: _Body) -> _Command | None:
-        """The segment in force at the current time; the last one holds after it ends."""
-        t = self.t
-        if b.config.drive is not None:
-            segs = b.config.drive
-            seg = next((s for s in segs if t < s.until - 1e-9), segs[-1])
-            return _Command("drive", throttle=seg.throttle, steer=seg.steer)
-        if b.config.joints is not None:
-            segs = b.config.joints
-            seg = next((s for s in segs if t < s.until - 1e-9), segs[-1])
-            mode = dict(seg.mode) if isinstance(seg.mode, dict) else seg.mode
-            return _Command("joints", mode=mode, targets=dict(seg.targets),
-                            max_force=seg.max_force, velocities=dict(seg.velocities))
-        return None
+    # ---- control: the schedule, the motors, the servo model (urdfkit/sim_control.py)
+    _scheduled = sim_control._scheduled
+    _control = sim_control._control
+    _free = sim_control._free
+    _apply_motors = sim_control._apply_motors
+    _apply_servo = sim_control._apply_servo
+    _times_mass_matrix = sim_control._times_mass_matrix
 
-    def _control(self, b: _Body) -> None:
-        p, client = self.session.p, self.session.client
-        cmd = b.override or self._scheduled(b)
-        if cmd != b.applied:
-            if b.applied is not None:
-                # Free every joint before the new command: a position motor set by the last
-                # segment would otherwise keep fighting a torque command.
-                self._free(b)
-                b.torques.clear()
-            if cmd is not None and cmd.kind == "drive":
-                from .vehicle import apply_drive, clamp_steer
-
-                max_force = b.config.vehicle.max_force if b.config.vehicle else 10.0
-                # Motors persist in PyBullet: set once per change of command.
-                apply_drive(p, b.body, client, b.train, cmd.throttle,
-                            clamp_steer(b.train, cmd.steer)[0], max_force)
-                if b.dry_friction:  # apply_drive frees the undriven wheels
-                    self._free(b, [i for i in b.train.free if i in b.dry_friction])
-            elif cmd is not None and not b.servo:
-                self._apply_motors(b, cmd, torque=False)  # motors persist: set on change
-            b.applied = cmd
-        if cmd is not None and cmd.any_torque and not b.servo:
-            self._apply_motors(b, cmd, torque=True)  # torques last one step only
-        if b.servo:
-            self._apply_servo(b, cmd)
-
-    def _free(self, b: _Body, indices: Sequence[int] | None = None) -> None:
-        """Switch PyBullet's velocity motors to their joints' dry friction (0: free).
-
-        A velocity motor with target 0 and a force limit is Coulomb friction: it holds the
-        joint against up to that much torque and slows it by that much when it moves. It
-        works alongside TORQUE_CONTROL (the servo); PyBullet's position and velocity
-        commands use the same motor and replace it while they drive the joint.
-        """
-        p, client = self.session.p, self.session.client
-        joints = [j.index for j in b.active] if indices is None else list(indices)
-        if joints:
-            p.setJointMotorControlArray(
-                b.body, joints, p.VELOCITY_CONTROL, targetVelocities=[0.0] * len(joints),
-                forces=[b.dry_friction.get(j, 0.0) for j in joints], physicsClientId=client)
-
-    def _apply_motors(self, b: _Body, cmd: _Command, *, torque: bool) -> None:
-        """PyBullet's own motors for a ``joints`` command (no servo model).
-
-        ``torque``: the torque targets (every step), else the position and velocity ones.
-        """
-        p, client = self.session.p, self.session.client
-        for name, target in cmd.targets.items():
-            mode = cmd.mode_of(name)
-            if (mode == "torque") != torque:
-                continue
-            spec = b.joint(name)
-            sign = b.directions.get(name, 1.0)
-            if mode == "torque":
-                p.setJointMotorControl2(b.body, spec.index, p.TORQUE_CONTROL,
-                                        force=target * sign, physicsClientId=client)
-                b.torques[name] = target * sign
-                continue
-            force = cmd.max_force or (spec.effort if spec.effort > 0 else None)
-            kwargs: dict[str, Any] = {} if force is None else {"force": force}
-            if mode == "position":
-                p.setJointMotorControl2(b.body, spec.index, p.POSITION_CONTROL,
-                                        targetPosition=self._to_physical(b, name, target),
-                                        targetVelocity=cmd.velocities.get(name, 0.0) * sign,
-                                        physicsClientId=client, **kwargs)
-            else:
-                p.setJointMotorControl2(b.body, spec.index, p.VELOCITY_CONTROL,
-                                        targetVelocity=target * sign,
-                                        physicsClientId=client, **kwargs)
-
-    def _apply_servo(self, b: _Body, cmd: _Command | None) -> None:
-        """The servo model: a PD law plus viscous friction, a spring and rotor inertia.
-
-        In the measured frame (offsets and directions applied), per joint::
-
-            tau = -kp (q - q_des) - kd (qd - qd_des) + e - J qdd,   e = -b qd - k q
-
-        clipped to the effort limit (or ``max_torque``; not at all when "unlimited"). With
-        ``scale_by_mass_matrix`` the friction and spring terms are ``M(q) e`` instead of
-        ``e`` (simulation_and_control's servo; M over the servo joints, at the true state).
-        A position target sets q_des and qd_des (the segment's ``velocities``, default 0); a
-        velocity target sets qd_des and drops the kp term; a torque target is added as is.
-        Joints without a target feel only friction, the spring and the inertia. With
-        ``measured_state`` the law reads the reported state (delayed, noisy) instead of the
-        true one, as a real robot's servo does; ``qdd`` is the last measured acceleration.
-        """
-        p, client = self.session.p, self.session.client
-        m = b.config.motor
-        indices = [j.index for j in b.servo]
-        if m.measured_state:
-            seen = self._observe_one(b.name)
-            state_of = {spec.name: (seen.motor_angles[spec.name],
-                                    seen.motor_velocities[spec.name]) for spec in b.servo}
-            qdds = seen.motor_accelerations
-        else:
-            states = p.getJointStates(b.body, indices, physicsClientId=client)
-            state_of = {}
-            for spec, st in zip(b.servo, states, strict=True):
-                sign = b.directions.get(spec.name, 1.0)
-                state_of[spec.name] = ((st[0] - b.offsets.get(spec.name, 0.0)) * sign,
-                                       st[1] * sign)
-            qdds = self._fresh(b).motor_accelerations if m.inertia else {}
-
-        def per_joint(value: float | dict[str, float], name: str) -> float:
-            return value.get(name, 0.0) if isinstance(value, dict) else value
-
-        extra = [-per_joint(m.viscous_friction, spec.name) * state_of[spec.name][1]
-                 - per_joint(m.stiffness, spec.name) * state_of[spec.name][0]
-                 for spec in b.servo]
-        if m.scale_by_mass_matrix and any(extra):
-            extra = self._times_mass_matrix(b, extra)
-        torques = []
-        targets = cmd.targets if cmd is not None and cmd.kind == "joints" else {}
-        velocities = cmd.velocities if cmd is not None and cmd.kind == "joints" else {}
-        for spec, tau in zip(b.servo, extra, strict=True):
-            q, qd = state_of[spec.name]
-            if m.inertia:
-                tau -= m.inertia * qdds.get(spec.name, 0.0)
-            if spec.name in targets:
-                target = targets[spec.name]
-                mode = cmd.mode_of(spec.name) if cmd is not None else "position"
-                kd = per_joint(b.kd, spec.name)
-                if mode == "position":
-                    tau += -per_joint(b.kp, spec.name) * (q - target) \
-                        - kd * (qd - velocities.get(spec.name, 0.0))
-                elif mode == "velocity":
-                    tau += -kd * (qd - target)
-                else:
-                    tau += target
-            limit = math.inf if m.max_torque == "unlimited" else \
-                m.max_torque or (spec.effort if spec.effort > 0 else math.inf)
-            tau = min(max(tau, -limit), limit)
-            torques.append(tau * b.directions.get(spec.name, 1.0))
-        p.setJointMotorControlArray(b.body, indices, p.TORQUE_CONTROL, forces=torques,
-                                    physicsClientId=client)
-        b.torques.update(zip((spec.name for spec in b.servo), torques, strict=True))
-
-    def _times_mass_matrix(self, b: _Body, vector: list[float]) -> list[float]:
-        """``D M D v`` for the servo joints: M(q) at the true state, in the measured frame.
-
-        With ``mass_matrix_angles = "measured"`` (simulation_and_control's servo): ``M v``
-        with M from calculateMassMatrix given the measured angles ``(q - offset) * direction``
-        as if they were joint angles, and no ``D``; the same as ``D M D v`` when every offset
-        is 0 and every direction 1.
-        """
-        dyn = self._dynamics_joints(b)
-        q, _ = self._physical_state(b)
-        measured = b.config.motor is not None and \
-            b.config.motor.mass_matrix_angles == "measured"
-        if measured:
-            q = [(x - b.offsets.get(j.name, 0.0)) * b.directions.get(j.name, 1.0)
-                 for x, j in zip(q, dyn, strict=True)]
-        p, client, body = self._model(b)
-        matrix = p.calculateMassMatrix(body, q, physicsClientId=client)
-        skip = len(matrix) - len(dyn)  # a floating base's 6 coordinates come first
-        where = {j.name: skip + k for k, j in enumerate(dyn)}
-        rows = [where[spec.name] for spec in b.servo]
-        if measured and rows == list(range(skip, skip + len(rows))):
-            # As simulation_and_control computes it, to the last bit: a floating base's
-            # matrix at the base's true pose (flags=1 takes position and quaternion first;
-            # the quaternion's 4th row and column are zero and dropped), and numpy's matrix
-            # product (whose rounding differs from an exact sum by an ulp or two).
-            import numpy as np
-
-            if skip:
-                pos, orn = self.session.p.getBasePositionAndOrientation(
-                    b.body, physicsClientId=self.session.client)
-                full = np.asarray(p.calculateMassMatrix(body, [*pos, *orn, *q], flags=1,
-                                                        physicsClientId=client))
-                full = np.delete(np.delete(full, 6, 0), 6, 1)
-            else:
-                full = np.asarray(matrix)
-            block = full[skip:, skip:][:len(rows), :len(rows)]
-            return [float(x) for x in block @ np.asarray(vector, dtype=float)]
-        signs = [1.0 if measured else b.directions.get(spec.name, 1.0) for spec in b.servo]
-        return [signs[i] * math.fsum(matrix[r][c] * signs[k] * vector[k]
-                                     for k, c in enumerate(rows))
-                for i, r in enumerate(rows)]
 
     # ---- stepping and measuring
 
@@ -889,109 +248,14 @@ class Simulation:
                 for b in lazy:
                     self._keep_velocities(b)
 
-    def _keep_velocities(self, b: _Body) -> None:
-        """Remember the joint velocities now, for the next measurement's accelerations."""
-        p, client = self.session.p, self.session.client
-        states = p.getJointStates(b.body, b.frame[0], physicsClientId=client)
-        b.previous_velocities = [st[1] for st in states]
-        b.previous_step = self.step_count
+    # ---- sensors: measuring, feet, noise, delay and history (urdfkit/sim_sensors.py)
+    _keep_velocities = sim_sensors._keep_velocities
+    _fresh = sim_sensors._fresh
+    _measure = sim_sensors._measure
+    _feet = sim_sensors._feet
+    _report = sim_sensors._report
+    _add_noise = sim_sensors._add_noise
 
-    def _fresh(self, b: _Body) -> Observation:
-        """The true observation at this step, measuring it now if it was not yet."""
-        if b.history[-1].step != self.step_count:
-            b.history.append(self._measure(b))
-        return b.history[-1]
-
-    def _measure(self, b: _Body) -> Observation:
-        """The true observation now, in the measured joint frame."""
-        p, client = self.session.p, self.session.client
-        pos, orn = p.getBasePositionAndOrientation(b.body, physicsClientId=client)
-        lin, ang = p.getBaseVelocity(b.body, physicsClientId=client)
-        matrix = quat_to_matrix(orn)
-        angles: dict[str, float] = {}
-        velocities: dict[str, float] = {}
-        accelerations: dict[str, float] = {}
-        forces: dict[str, list[float]] | None = None
-        torques: dict[str, float] | None = None
-        if b.active:
-            indices, names, signs, offsets = b.frame
-            states = p.getJointStates(b.body, indices, physicsClientId=client)
-            if self.config.record.motor_torques:  # the joint's own frame, as applied
-                torques = {n: b.torques.get(n, st[3]) for n, st in zip(names, states, strict=True)}
-            qd = [st[1] for st in states]
-            angles = {n: (st[0] - o) * s
-                      for n, st, s, o in zip(names, states, signs, offsets, strict=True)}
-            velocities = {n: v * s for n, v, s in zip(names, qd, signs, strict=True)}
-            # Over the time since the velocities were last taken (one step, when recording).
-            span = (self.step_count - b.previous_step) * self.time_step
-            before = b.previous_velocities
-            if before is None or span <= 0:
-                accelerations = dict.fromkeys(names, 0.0)
-            else:
-                accelerations = {n: (v - v0) * s / span for n, v, v0, s
-                                 in zip(names, qd, before, signs, strict=True)}
-            b.previous_velocities = qd
-            b.previous_step = self.step_count
-        if b.force_joints:
-            forces = {}
-            for name, index in b.force_joints.items():
-                state = p.getJointState(b.body, index, physicsClientId=client)
-                forces[name] = [float(x) for x in state[2]]
-        contacts = None
-        if b.contact_links:
-            contacts = {}
-            for link, index in b.contact_links.items():
-                kwargs: dict[str, Any] = {"bodyA": b.body, "linkIndexA": index}
-                if self.ground is not None:
-                    kwargs["bodyB"] = self.ground
-                points = p.getContactPoints(physicsClientId=client, **kwargs)
-                contacts[link] = {"normal_force": float(sum(pt[9] for pt in points)),
-                                  "count": len(points)}
-        feet = self._feet(b) if b.feet else None
-        poses = None
-        if b.pose_links:
-            poses = {}
-            for link in b.pose_links:
-                at, turn = self.link_pose(b.name, link)
-                poses[link] = {"position": at, "orientation": turn}
-        return Observation(
-            t=self.t, step=self.step_count, robot=b.name, motor_angles=angles,
-            motor_velocities=velocities, motor_accelerations=accelerations,
-            base_position=list(pos), base_orientation=list(orn), base_lin_vel=list(lin),
-            base_ang_vel=list(ang), base_lin_vel_body_frame=list(rotate_back(matrix, lin)),
-            base_ang_vel_body_frame=list(rotate_back(matrix, ang)), contacts=contacts,
-            joint_forces=forces, motor_torques=torques, link_poses=poses, feet=feet)
-
-    def _feet(self, b: _Body) -> dict[str, dict[str, Any]]:
-        """Each foot's contact forces from everything but its own robot (world and local)."""
-        p, client = self.session.p, self.session.client
-        out: dict[str, dict[str, Any]] = {}
-        for label, index in b.feet.items():
-            normal = [0.0, 0.0, 0.0]
-            friction = [0.0, 0.0, 0.0]
-            total = 0.0
-            count = 0
-            for pt in p.getContactPoints(bodyA=b.body, linkIndexA=index,
-                                         physicsClientId=client):
-                if pt[2] == b.body:
-                    continue  # self-contact: not a ground reaction
-                count += 1
-                total += pt[9]
-                # contactNormalOnB points from B to A: the push on the foot (A). The lateral
-                # friction directions are those of the force on B (measured: a box sliding
-                # along +x reads +mu m g), so the foot feels their opposite.
-                for k in range(3):
-                    normal[k] += pt[9] * pt[7][k]
-                    friction[k] -= pt[10] * pt[11][k] + pt[12] * pt[13][k]
-            if index == -1:  # the URDF frame, not the centre of mass
-                orn = self.link_pose(b.name, next(k for k, v in b.links.items() if v == -1))[1]
-            else:
-                orn = p.getLinkState(b.body, index, computeForwardKinematics=True,
-                                     physicsClientId=client)[5]
-            local = rotate_back(quat_to_matrix(orn), normal)
-            out[label] = {"contact": int(count > 0), "normal": total, "world": normal,
-                          "local": list(local), "friction_world": friction}
-        return out
 
     def _observe_one(self, robot: str, ideal: bool = False) -> Observation:
         out = self.observe(robot, ideal=ideal)
@@ -1020,20 +284,6 @@ class Simulation:
         # A copy: a caller changing what it got must not change later observations.
         return self._report(b).copy()
 
-    def _report(self, b: _Body) -> Observation:
-        """What the robot reports now (delay, then noise); the same object all this step."""
-        if b.reported is None or b.reported[0] != self.step_count:
-            self._fresh(b)
-            # history ends with the current observation; the delayed one is `delay` before.
-            source = b.history[max(0, len(b.history) - 1 - b.config.delay)]
-            if b.config.delay:  # angles and velocities are delayed; torques are not
-                source = source._replace(motor_torques=b.history[-1].motor_torques)
-            if b.config.delay or b.config.noise is not None:
-                source = self._add_noise(b, source._replace(t=self.t, step=self.step_count))
-            b.reported = (self.step_count, source)
-            if b.reports is not None:
-                b.reports.append(b.reported[1])
-        return b.reported[1]
 
     def history(self, robot: str, *, ideal: bool = False) -> list[Observation]:
         """The robot's last ``history`` observations, one per physics step, oldest first.
@@ -1050,123 +300,11 @@ class Simulation:
             return [b.reported[1].copy()] if b.reported is not None else []
         return [o.copy() for o in b.reports]
 
-    # ---- reset in place
+    # ---- episodes: reset in place and randomisation (urdfkit/sim_episode.py)
+    _robot_seed = staticmethod(sim_episode._robot_seed)
+    reset = sim_episode.reset
+    _reset_plan = sim_episode._reset_plan
 
-    @staticmethod
-    def _robot_seed(seed: int, i: int) -> int:
-        return seed * 1_000_003 + i
-
-    def reset(self, seed: int | None = None,
-              overrides: Mapping[str, Mapping[str, Any]] | None = None) -> None:
-        """Go back to the starting state in place, deterministically.
-
-        Positions, velocities and contacts come back through PyBullet's saveState and
-        restoreState; time, observation history, delays, commands and noise generators
-        (reseeded with ``seed``, default the scenario's) start over, so the same seed and the
-        same actions give the same observations. Changes made with the ``set_*`` methods
-        stay: they change the robot, not its state.
-
-        Args:
-            seed: Reseeds the noise; default: the scenario's ``seed``.
-            overrides: Per robot name, a different start for this episode, with the
-                scenario's keys and meanings: ``initial_joints`` (joint -> position, or ->
-                ``{"position", "velocity"}``; measured frame), ``position`` and
-                ``orientation_rpy`` or ``orientation_quat`` (in the robot's ``pose_frame``),
-                ``base_velocity`` and ``base_angular_velocity``. What is not given is the
-                scenario's start.
-
-        Raises:
-            ParameterError: an unknown robot, key or joint, or a value of the wrong shape;
-                nothing is reset then.
-        """
-        p, client = self.session.p, self.session.client
-        plans = {self._body(robot).name: self._reset_plan(self._body(robot), changes)
-                 for robot, changes in (overrides or {}).items()}
-        restore_clean(p, client, self._start_state, [b.body for b in self.bodies.values()])
-        self.step_count = 0
-        base_seed = self.config.seed if seed is None else seed
-        for i, b in enumerate(self.bodies.values()):
-            b.rng = random.Random(self._robot_seed(base_seed, i))
-            b.history.clear()
-            if b.reports is not None:
-                b.reports.clear()
-            b.previous_velocities = None
-            b.previous_step = -1
-            b.applied = b.override = None
-            b.reported = None
-            self._free(b)
-            b.torques.clear()
-            for call in plans.get(b.name, ()):
-                call()
-            b.history.append(self._measure(b))
-
-    def _reset_plan(self, b: _Body, changes: Mapping[str, Any]) -> list[Callable[[], None]]:
-        """The PyBullet calls that start ``b`` as ``changes`` says, checked before any runs."""
-        p, client = self.session.p, self.session.client
-        known = ("initial_joints", "position", "orientation_rpy", "orientation_quat",
-                 "base_velocity", "base_angular_velocity")
-        for key in changes:
-            if key not in known:
-                raise ParameterError(f"`overrides`: unknown key {key!r} for {b.name}; known "
-                                     f"keys: {', '.join(known)}", param="overrides")
-
-        def vector(key: str, size: int) -> list[float] | None:
-            value = changes.get(key)
-            if value is None:
-                return None
-            try:
-                out = [float(v) for v in value]
-            except (TypeError, ValueError):
-                out = []
-            if len(out) != size or not all(math.isfinite(v) for v in out):
-                raise ParameterError(f"`overrides`: {b.name}.{key} needs {size} finite "
-                                     "numbers", param="overrides")
-            return out
-
-        calls: list[Callable[[], None]] = []
-        for name, value in (changes.get("initial_joints") or {}).items():
-            spec = next((j for j in b.active if j.name == name), None)
-            if spec is None:
-                raise ParameterError(f"`overrides`: {b.name} has no active joint named "
-                                     f"{name!r}", param="overrides")
-            position, velocity = (value.get("position", 0.0), value.get("velocity", 0.0)) \
-                if isinstance(value, Mapping) else (value, 0.0)
-            q = self._to_physical(b, name, float(position))
-            qd = float(velocity) * b.directions.get(name, 1.0)
-            calls.append(functools.partial(p.resetJointState, b.body, spec.index, q, qd,
-                                           physicsClientId=client))
-        position = vector("position", 3)
-        rpy = vector("orientation_rpy", 3)
-        quat = vector("orientation_quat", 4)
-        if rpy is not None and quat is not None:
-            raise ParameterError(f"`overrides`: give {b.name} orientation_rpy or "
-                                 "orientation_quat, not both", param="overrides")
-        if position is not None or rpy is not None or quat is not None:
-            cfg = b.config
-            if quat is None:
-                quat = list(rpy_to_quat(*rpy)) if rpy is not None else \
-                    list(cfg.orientation_quat) if cfg.orientation_quat is not None else \
-                    list(rpy_to_quat(*(cfg.orientation_rpy or (0.0, 0.0, 0.0))))
-            norm = math.sqrt(math.fsum(v * v for v in quat))
-            if norm < 1e-12:
-                raise ParameterError(f"`overrides`: {b.name}.orientation_quat must not be all "
-                                     "zeros", param="overrides")
-            orn = quat_mul([v / norm for v in quat], UP_AXES[cfg.up])
-            at = position if position is not None else list(cfg.position)
-            if cfg.pose_frame == "link":
-                # resetBasePositionAndOrientation places the centre of mass.
-                dyn = p.getDynamicsInfo(b.body, -1, physicsClientId=client)
-                at, orn = p.multiplyTransforms(at, orn, dyn[3], dyn[4])
-            calls.append(lambda: p.resetBasePositionAndOrientation(
-                b.body, at, orn, physicsClientId=client))
-        lin = vector("base_velocity", 3)
-        ang = vector("base_angular_velocity", 3)
-        if lin is not None or ang is not None:
-            velocity = (lin if lin is not None else list(b.config.base_velocity),
-                        ang if ang is not None else list(b.config.base_angular_velocity))
-            calls.append(lambda: p.resetBaseVelocity(b.body, *velocity,
-                                                     physicsClientId=client))
-        return calls
 
     # ---- state, kinematics and dynamics of one robot (SimInterface's, in Python's manners)
 
@@ -1218,278 +356,34 @@ class Simulation:
             pos, orn = st[4], st[5]
         return list(pos), list(orn)
 
-    def dynamics_joints(self, robot: str) -> list[str]:
-        """The joints the dynamics quantities are ordered by (PyBullet's order).
+    # ---- dynamics on shadow models (urdfkit/sim_dynamics.py)
+    dynamics_joints = sim_dynamics.dynamics_joints
+    _dynamics_joints = sim_dynamics._dynamics_joints
+    _physical_state = sim_dynamics._physical_state
+    _fixed = sim_dynamics._fixed
+    _model = sim_dynamics._model
+    _changed = sim_dynamics._changed
+    mass_matrix = sim_dynamics.mass_matrix
+    coriolis_and_gravity = sim_dynamics.coriolis_and_gravity
+    gravity_torques = sim_dynamics.gravity_torques
+    forward_dynamics = sim_dynamics.forward_dynamics
+    jacobian = sim_dynamics.jacobian
 
-        The movable joints; a floating base adds 6 base coordinates before them in
-        :meth:`mass_matrix`.
-        """
-        return [j.name for j in self._dynamics_joints(self._body(robot))]
 
-    def _dynamics_joints(self, b: _Body) -> list[JointSpec]:
-        movable = [j for j in b.joints if j.type != _FIXED]
-        odd = [j.name for j in movable if not j.active]
-        if odd:
-            raise ParameterError(f"{b.name}: the dynamics need 1-DOF joints; {odd[0]!r} is not",
-                                 param="robot")
-        return movable
+    # ---- setters: a robot's physical parameters (urdfkit/sim_setters.py)
+    _link_index = sim_setters._link_index
+    _change = sim_setters._change
+    set_mass = sim_setters.set_mass
+    set_inertia = sim_setters.set_inertia
+    set_friction = sim_setters.set_friction
+    set_restitution = sim_setters.set_restitution
+    _joint_named = staticmethod(sim_setters._joint_named)
+    set_joint_damping = sim_setters.set_joint_damping
+    set_joint_friction = sim_setters.set_joint_friction
+    _motor_driven = sim_setters._motor_driven
+    set_link_damping = sim_setters.set_link_damping
+    set_motor_gains = sim_setters.set_motor_gains
 
-    def _physical_state(self, b: _Body) -> tuple[list[float], list[float]]:
-        p, client = self.session.p, self.session.client
-        states = p.getJointStates(b.body, [j.index for j in self._dynamics_joints(b)],
-                                  physicsClientId=client)
-        return [float(st[0]) for st in states], [float(st[1]) for st in states]
-
-    def _fixed(self, b: _Body, what: str) -> None:
-        p, client = self.session.p, self.session.client
-        moving_base = b.config.base != "fixed" and \
-            p.getDynamicsInfo(b.body, -1, physicsClientId=client)[0] > 0
-        if moving_base:
-            raise ParameterError(f"{b.name}: {what} needs a fixed base (PyBullet's "
-                                 "calculateInverseDynamics does not take a floating one); "
-                                 "use base = \"fixed\"", param="robot")
-
-    def _model(self, b: _Body) -> tuple[Any, int, int]:
-        """``(p, client, body)`` of the robot's dynamics model, as the robot is now.
-
-        PyBullet builds the model its calculateMassMatrix, calculateInverseDynamics and
-        calculateJacobian use once, at the first call, and never updates it: a mass changed
-        later is ignored (measured on 3.2.7). So the dynamics run on a copy of the robot in a
-        client of their own, rebuilt after every ``set_mass``/``set_inertia``.
-        """
-        shadows: dict[str, tuple[Session, int]] = self.__dict__.setdefault("_shadows", {})
-        if b.name not in shadows:
-            assert b.loaded is not None
-            s = Session()
-            try:
-                ph = self.config.physics
-                s.p.setGravity(*ph.gravity, physicsClientId=s.client)
-                body = s.load_urdf(b.loaded[0], b.loaded[1], display=b.name)
-                for (link, key), value in b.changes.items():
-                    s.p.changeDynamics(body, link, physicsClientId=s.client, **{key: value})
-            except BaseException:
-                s.close()
-                raise
-            shadows[b.name] = (s, body)
-        s, body = shadows[b.name]
-        return s.p, s.client, body
-
-    def _changed(self, b: _Body, link: int, values: dict[str, Any]) -> None:
-        """Remember a change to a robot's mass properties; its dynamics model is stale."""
-        for key, value in values.items():
-            b.changes[(link, key)] = value
-        shadow = self.__dict__.get("_shadows", {}).pop(b.name, None)
-        if shadow is not None:
-            shadow[0].close()
-
-    def mass_matrix(self, robot: str) -> Any:
-        """The joint-space mass matrix M(q) now (numpy, PyBullet's calculateMassMatrix).
-
-        Physical joint coordinates, in :meth:`dynamics_joints` order; a floating base puts its
-        6 coordinates first, as PyBullet does.
-        """
-        import numpy as np
-
-        b = self._body(robot)
-        q, _ = self._physical_state(b)
-        p, client, body = self._model(b)
-        return np.array(p.calculateMassMatrix(body, q, physicsClientId=client))
-
-    def coriolis_and_gravity(self, robot: str) -> Any:
-        """C(q, qd) qd + g(q) now: the torques that hold the current motion (numpy)."""
-        import numpy as np
-
-        b = self._body(robot)
-        self._fixed(b, "coriolis_and_gravity")
-        q, qd = self._physical_state(b)
-        p, client, body = self._model(b)
-        return np.array(p.calculateInverseDynamics(body, q, qd, [0.0] * len(q),
-                                                   physicsClientId=client))
-
-    def gravity_torques(self, robot: str) -> Any:
-        """g(q) now: the torques that hold the robot still against gravity (numpy)."""
-        import numpy as np
-
-        b = self._body(robot)
-        self._fixed(b, "gravity_torques")
-        q, _ = self._physical_state(b)
-        p, client, body = self._model(b)
-        zero = [0.0] * len(q)
-        return np.array(p.calculateInverseDynamics(body, q, zero, zero,
-                                                   physicsClientId=client))
-
-    def forward_dynamics(self, robot: str, tau: Sequence[float]) -> Any:
-        """The joint accelerations ``tau`` would cause now, without contacts (numpy).
-
-        qdd = M^-1 (tau - C qd - g).
-        """
-        import numpy as np
-
-        b = self._body(robot)
-        torque = np.asarray(tau, dtype=float)
-        n = len(self._dynamics_joints(b))
-        if torque.shape != (n,):
-            raise ParameterError(f"`tau` needs {n} torques, one per dynamics joint of "
-                                 f"{robot}, got {torque.shape}", param="tau")
-        return np.linalg.solve(self.mass_matrix(robot), torque - self.coriolis_and_gravity(robot))
-
-    def jacobian(self, robot: str, link: str, point: Sequence[float] = (0.0, 0.0, 0.0)
-                 ) -> Any:
-        """The 6 x n Jacobian (linear rows, then angular) of a point of a link now (numpy).
-
-        ``point`` is in the link's URDF frame (the joint frame): PyBullet 3.2.7's
-        calculateJacobian takes it so, whatever its docs say of the centre of mass (measured:
-        the point (0, 0, 0) of a pendulum's bob link is on the hinge, J = 0).
-        """
-        import numpy as np
-
-        b = self._body(robot)
-        index = b.links.get(link)
-        if index is None or index == -1:
-            raise ParameterError(f"`link`: {robot} has no moving link named {link!r}",
-                                 param="link")
-        q, qd = self._physical_state(b)
-        p, client, body = self._model(b)
-        lin, ang = p.calculateJacobian(body, index, list(point), q, qd, [0.0] * len(q),
-                                       physicsClientId=client)
-        return np.vstack([np.array(lin), np.array(ang)])
-
-    # ---- setters: the robot's physical parameters
-
-    def _link_index(self, b: _Body, link: str) -> int:
-        if link not in b.links:
-            from .suggest import hint
-
-            raise ParameterError(f"`link`: {b.name} has no link named {link!r}"
-                                 f"{hint(link, b.links)}", param="link")
-        return b.links[link]
-
-    def _change(self, target: str, link: str | None, **values: Any) -> None:
-        p, client = self.session.p, self.session.client
-        if target == "ground":
-            if self.ground is None:
-                raise ParameterError("the scenario has no ground", param="robot")
-            p.changeDynamics(self.ground, -1, physicsClientId=client, **values)
-            return
-        b = self._body(target)
-        links = [self._link_index(b, link)] if link is not None else \
-            [-1, *range(len(b.joints))]
-        for index in links:
-            p.changeDynamics(b.body, index, physicsClientId=client, **values)
-
-    def set_mass(self, robot: str, link: str, mass: float) -> None:
-        """A link's mass, kg; its inertia scales with it (the same body, heavier).
-
-        PyBullet's changeDynamics(mass=...) alone throws the inertia away and recomputes it
-        from the collision shapes (a link without any gets ~1e-6): not what "heavier" means.
-        """
-        b = self._body(robot)
-        index = self._link_index(b, link)
-        p, client = self.session.p, self.session.client
-        info = p.getDynamicsInfo(b.body, index, physicsClientId=client)
-        old, diagonal = info[0], info[2]
-        scaled = [float(v) * float(mass) / old for v in diagonal] if old > 0 else None
-        for values in ({"mass": float(mass)},
-                       {"localInertiaDiagonal": scaled} if scaled is not None else {}):
-            if values:
-                p.changeDynamics(b.body, index, physicsClientId=client, **values)
-                self._changed(b, index, values)
-
-    def set_inertia(self, robot: str, link: str, diagonal: Sequence[float]) -> None:
-        """A link's principal moments of inertia, kg m^2 (in its inertial frame)."""
-        b = self._body(robot)
-        index = self._link_index(b, link)
-        values = {"localInertiaDiagonal": [float(v) for v in diagonal]}
-        p, client = self.session.p, self.session.client
-        p.changeDynamics(b.body, index, physicsClientId=client, **values)
-        self._changed(b, index, values)
-
-    def set_friction(self, robot: str, link: str | None, lateral: float) -> None:
-        """Lateral friction of a link (every link when ``link`` is None).
-
-        Robot ``"ground"`` is the floor.
-        """
-        self._change(robot, link, lateralFriction=float(lateral))
-
-    def set_restitution(self, robot: str, link: str | None, restitution: float) -> None:
-        """Restitution (bounciness) of a link, or of the floor with robot ``"ground"``."""
-        self._change(robot, link, restitution=float(restitution))
-
-    @staticmethod
-    def _joint_named(b: _Body, joint: str) -> JointSpec:
-        try:
-            return b.joint(joint)
-        except KeyError:
-            raise ParameterError(f"`joint`: {b.name} has no joint named {joint!r}",
-                                 param="joint") from None
-
-    def set_joint_damping(self, robot: str, joint: str, damping: float) -> None:
-        """PyBullet's joint damping of one joint (N m s/rad)."""
-        b = self._body(robot)
-        spec = self._joint_named(b, joint)
-        p, client = self.session.p, self.session.client
-        p.changeDynamics(b.body, spec.index, jointDamping=float(damping),
-                         physicsClientId=client)
-
-    def set_joint_friction(self, robot: str, joint: str, friction: float) -> None:
-        """A joint's dry (Coulomb) friction, N m (N for a prismatic joint); 0 removes it.
-
-        The joint holds against up to ``friction`` of torque and is slowed by that much when
-        it moves (PyBullet's joint motor at velocity 0 with that force limit). While a
-        PyBullet position or velocity command drives the joint (a ``joints`` segment without
-        a ``motor`` table, or a car's wheels and hinges), that command owns the motor; the
-        friction comes back when it ends. It stays across ``reset()``.
-        """
-        b = self._body(robot)
-        spec = self._joint_named(b, joint)
-        if spec not in b.active:
-            raise ParameterError(f"`joint`: {joint} of {robot} is fixed", param="joint")
-        if not (isinstance(friction, (int, float)) and math.isfinite(friction)
-                and friction >= 0):
-            raise ParameterError(f"`friction` must be a finite number >= 0, got {friction!r}",
-                                 param="friction")
-        b.dry_friction[spec.index] = float(friction)
-        if not self._motor_driven(b, spec):
-            self._free(b, [spec.index])
-
-    def _motor_driven(self, b: _Body, spec: JointSpec) -> bool:
-        """Whether a PyBullet position or velocity command holds this joint's motor now."""
-        cmd = b.applied
-        if cmd is None or b.servo:
-            return False
-        if cmd.kind == "drive":
-            return b.train is not None and spec.index in (*b.train.wheels, *b.train.hinges)
-        return spec.name in cmd.targets and cmd.mode_of(spec.name) != "torque"
-
-    def set_link_damping(self, robot: str, linear: float, angular: float) -> None:
-        """Every link's linear and angular velocity damping (PyBullet's default is 0.04)."""
-        self._change(robot, None, linearDamping=float(linear), angularDamping=float(angular))
-
-    def set_motor_gains(self, robot: str, kp: float | Mapping[str, float] | None = None,
-                        kd: float | Mapping[str, float] | None = None) -> None:
-        """The servo's position and velocity gains: one for every joint, or per joint name.
-
-        A gain not given keeps its value. Needs the robot's ``motor`` table (the servo).
-        """
-        b = self._body(robot)
-        if not b.servo:
-            raise ParameterError(f"`robot`: {robot} has no servo model; give it a 'motor' "
-                                 "table in the scenario", param="robot")
-        names = {j.name for j in b.servo}
-        for label, gain in (("kp", kp), ("kd", kd)):
-            if gain is None:
-                continue
-            values = dict(gain) if isinstance(gain, Mapping) else {"": gain}
-            for name, value in values.items():
-                if name and name not in names:
-                    raise ParameterError(f"`{label}`: {robot}'s servo drives no joint named "
-                                         f"{name!r}", param=label)
-                if not (isinstance(value, (int, float)) and math.isfinite(value)
-                        and value >= 0):
-                    raise ParameterError(f"`{label}` must be a finite number >= 0, got "
-                                         f"{value!r}", param=label)
-            setattr(b, label, {k: float(v) for k, v in values.items()}
-                    if isinstance(gain, Mapping) else float(gain))
 
     def set_time_step(self, time_step: float) -> None:
         """The physics time step, s (times already recorded keep theirs)."""
@@ -1500,164 +394,10 @@ class Simulation:
         p.setTimeStep(time_step, physicsClientId=client)
         self.time_step = float(time_step)
 
-    def _add_noise(self, b: _Body, obs: Observation) -> Observation:
-        """Independent Gaussian samples on the reported fields (standard deviations).
 
-        Joint fields take one value for every joint or one per joint; base vectors one for
-        every axis or one per axis. ``base_orientation`` is turned by a random rotation
-        (roll, pitch, yaw drawn with those deviations), so it stays a unit quaternion.
-        """
-        noise = b.config.noise
-        if noise is None:
-            return obs
-        gauss = b.rng.gauss
-        changes: dict[str, Any] = {}
-        for name in (*OBSERVATION_FIELDS, "motor_torques"):
-            std = getattr(noise, name)
-            value = getattr(obs, name)
-            if value is None or not std:
-                continue
-            if isinstance(value, dict):
-                changes[name] = {k: v + gauss(0.0, std.get(k, 0.0) if isinstance(std, dict)
-                                              else std) for k, v in value.items()}
-                continue
-            axes = std if isinstance(std, list) else [std] * 3
-            if name == "base_orientation":
-                turn = rpy_to_quat(*(gauss(0.0, a) if a > 0 else 0.0 for a in axes))
-                changes[name] = list(quat_mul(turn, value))
-            else:
-                changes[name] = [v + (gauss(0.0, a) if a > 0 else 0.0)
-                                 for v, a in zip(value, axes, strict=True)]
-        return obs._replace(**changes)
-
-    def link_poses(self) -> list[list[tuple[Any, Any]]]:
-        """Every robot's URDF link frames' world poses now, base first (``(xyz, xyzw)``).
-
-        Robots in the scenario's order; the base's pose is its link frame, not the inertial
-        frame ``getBasePositionAndOrientation`` reports.
-        """
-        p, client = self.session.p, self.session.client
-        out = []
-        for b in self.bodies.values():
-            pos, orn = p.getBasePositionAndOrientation(b.body, physicsClientId=client)
-            local = p.getDynamicsInfo(b.body, -1, physicsClientId=client)
-            inv = p.invertTransform(local[3], local[4])
-            poses = [p.multiplyTransforms(pos, orn, inv[0], inv[1])]
-            for j in range(p.getNumJoints(b.body, physicsClientId=client)):
-                st = p.getLinkState(b.body, j, computeForwardKinematics=True,
-                                    physicsClientId=client)
-                poses.append((st[4], st[5]))
-            out.append(poses)
-        return out
-
-    def run(self, duration: float | None = None,
-            sink: Callable[[list[Observation]], None] | None = None, *,
-            keep: bool = True, real_time: bool = False) -> SimResult:
-        """Step to ``duration`` (default: the scenario's), recording every ``record.every``.
-
-        Rows are taken at every step that is a multiple of ``record.every``, the starting
-        state included when the run starts at step 0. ``sink`` gets each batch of rows (one
-        per robot) as it is recorded, to stream them to disk; with ``keep=False`` the result
-        then holds no rows, only their count and the per-robot summary, so a run's memory
-        does not grow with its length. Ctrl-C ends the run early with ``interrupted`` set;
-        the rows so far are kept, as they are when the GUI window is closed. ``real_time``
-        paces the steps to the wall clock (to watch the run in the GUI).
-        """
-        end = self.total_steps if duration is None else \
-            self.step_count + max(0, round(duration / self.time_step))
-        every = self.config.record.every
-        rows: list[Observation] = []
-        ideal: list[Observation] = []
-        summary = _Summary()
-
-        bodies = list(self.bodies.values())
-
-        def record() -> None:
-            # As observe() gives them (copies), without its per-call lookups; one copy when
-            # what a robot reports is its true state.
-            truth = [self._fresh(b) for b in bodies]
-            batch = [self._report(b) for b in bodies]
-            for k, (seen, true) in enumerate(zip(batch, truth, strict=True)):
-                batch[k] = seen.copy()
-                truth[k] = batch[k] if seen is true else true.copy()
-            # Only whole batches count: an interrupt above drops this one entirely.
-            if keep:
-                rows.extend(batch)
-                ideal.extend(truth)
-            summary.add(truth)
-            if sink is not None:
-                sink(batch)
-
-        interrupted = False
-        p, client = self.session.p, self.session.client
-        # Real time: at most a 60th of a second of simulated time between two waits.
-        chunk = max(1, round(1 / 60 / self.time_step)) if real_time else end
-        start_wall, start_step = time.perf_counter(), self.step_count
-        try:
-            if self.step_count % every == 0:
-                record()
-            while self.step_count < end:
-                self.step(min(every - self.step_count % every, end - self.step_count, chunk))
-                if self.step_count % every == 0:
-                    record()
-                if real_time:
-                    ahead = start_wall + (self.step_count - start_step) * self.time_step \
-                        - time.perf_counter()
-                    if ahead > 0:
-                        time.sleep(ahead)
-        except KeyboardInterrupt:
-            interrupted = True
-        except p.error:
-            if not self.session.gui or p.isConnected(physicsClientId=client):
-                raise
-            interrupted = True  # the GUI window was closed
-        kept = min(len(rows), len(ideal))
-        whole = kept - kept % max(1, len(self.bodies))
-        return SimResult(rows[:whole], ideal[:whole], self.time_step, self.step_count,
-                         interrupted, summary.rows, summary.robots())
-
-
-class _Summary:
-    """Per robot, from the true rows as they come: first, last, count, top speed."""
-
-    def __init__(self) -> None:
-        self.first: dict[str, Observation] = {}
-        self.last: dict[str, Observation] = {}
-        self.count: dict[str, int] = {}
-        self.top: dict[str, float] = {}
-        self.low: dict[str, dict[str, float]] = {}
-        self.high: dict[str, dict[str, float]] = {}
-        self.rows = 0
-
-    def add(self, truth: list[Observation]) -> None:
-        for r in truth:
-            self.first.setdefault(r.robot, r)
-            self.last[r.robot] = r
-            self.count[r.robot] = self.count.get(r.robot, 0) + 1
-            self.top[r.robot] = max(self.top.get(r.robot, 0.0), math.hypot(*r.base_lin_vel))
-            low = self.low.setdefault(r.robot, {})
-            high = self.high.setdefault(r.robot, {})
-            for joint, angle in r.motor_angles.items():  # the range a joint swept: overshoot
-                if angle < low.get(joint, math.inf):
-                    low[joint] = angle
-                if angle > high.get(joint, -math.inf):
-                    high[joint] = angle
-        self.rows += len(truth)
-
-    def robots(self) -> list[RobotSummary]:
-        out = []
-        for name, first in self.first.items():
-            last = self.last[name]
-            x, y, z, w = last.base_orientation
-            heading = math.degrees(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
-            out.append(RobotSummary(
-                robot=name, rows=self.count[name], start=list(first.base_position),
-                end=list(last.base_position),
-                distance=math.dist(first.base_position, last.base_position),
-                top_speed=self.top[name], heading_deg=heading,
-                final_joints=dict(last.motor_angles), joint_min=dict(self.low.get(name, {})),
-                joint_max=dict(self.high.get(name, {}))))
-        return out
+    # ---- recording: the run loop and the link poses a viewer draws (urdfkit/sim_record.py)
+    link_poses = sim_record.link_poses
+    run = sim_record.run
 
 
 # --------------------------------------------------------------------------- summary
@@ -1666,110 +406,6 @@ class _Summary:
 def summarize(result: SimResult) -> list[RobotSummary]:
     """Per robot: where it started and ended, how far and fast it went, its final joints."""
     return list(result.summaries)
-
-
-# --------------------------------------------------------------------------- writers
-
-
-def flatten(row: Mapping[str, Any]) -> dict[str, Any]:
-    """A nested row as flat columns: ``motor_angles.hinge``, ``base_position.x``."""
-    out: dict[str, Any] = {}
-
-    def put(prefix: str, value: Any) -> None:
-        if isinstance(value, Mapping):
-            for k, v in value.items():
-                put(f"{prefix}.{k}", v)
-        elif isinstance(value, (list, tuple)):
-            names = _AXES.get(len(value), tuple(str(i) for i in range(len(value))))
-            for k, v in zip(names, value, strict=False):
-                out[f"{prefix}.{k}"] = v
-        else:
-            out[prefix] = value
-
-    for key, value in row.items():
-        put(key, value)
-    return out
-
-
-def _columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:
-    seen: dict[str, None] = {}
-    for row in rows:
-        seen.update(dict.fromkeys(row))
-    return list(seen)
-
-
-def _pyarrow() -> Any:
-    try:
-        import pyarrow
-        import pyarrow.parquet
-    except ImportError as e:
-        raise MissingDependencyError("writing .parquet needs pyarrow: "
-                                     "pip install 'urdfkit[parquet]'") from e
-    return pyarrow
-
-
-def check_output(path: str | Path, *, force: bool) -> None:
-    """Refuse a bad ``--out`` before simulating: unknown format, existing file, no pyarrow."""
-    from .output import check_output as check
-
-    check(path, force=force, suffixes=OUTPUT_FORMATS, what="the rows file")
-    if Path(path).suffix.lower() == ".parquet":
-        _pyarrow()
-
-
-class RowText:
-    """Rows as ``.jsonl`` (nested) or ``.csv`` (flattened) text, batch by batch.
-
-    The CSV columns are those of the first batch (every robot's first row): the robot set
-    and each robot's fields are fixed for a run.
-    """
-
-    def __init__(self, fmt: str):
-        if fmt not in (".jsonl", ".csv"):
-            raise OutputError(f"{fmt!r} cannot be written row by row; use .jsonl or .csv")
-        self.fmt = fmt
-        self.columns: list[str] | None = None
-
-    def encode(self, rows: Sequence[Mapping[str, Any]]) -> bytes:
-        """The text of ``rows`` (with the CSV header before the first batch)."""
-        if self.fmt == ".jsonl":
-            return "".join(json.dumps(r, allow_nan=False) + "\n" for r in rows).encode("utf-8")
-        flat = [flatten(r) for r in rows]
-        text = io.StringIO()
-        header = self.columns is None
-        if self.columns is None:
-            self.columns = _columns(flat)
-        writer = csv.DictWriter(text, fieldnames=self.columns, lineterminator="\n")
-        if header:
-            writer.writeheader()
-        writer.writerows(flat)
-        # A name that is not UTF-8 (a Latin-1 file name, read as surrogates) is written
-        # escaped (\udce9), so the file stays UTF-8 text, as the JSON rows are.
-        return text.getvalue().encode("utf-8", "backslashreplace")
-
-
-def rows_to_bytes(rows: Sequence[Mapping[str, Any]], fmt: str) -> bytes:
-    """Serialise rows as ``.jsonl`` (nested), ``.csv`` or ``.parquet`` (flattened)."""
-    if fmt in (".jsonl", ".csv"):
-        return RowText(fmt).encode(rows)
-    flat = [flatten(r) for r in rows]
-    columns = _columns(flat)
-    if fmt == ".parquet":
-        pa = _pyarrow()
-        table = pa.table({c: [r.get(c) for r in flat] for c in columns})
-        sink = pa.BufferOutputStream()
-        pa.parquet.write_table(table, sink)
-        return bytes(sink.getvalue().to_pybytes())
-    raise OutputError(f"unknown output format {fmt!r}; use {', '.join(OUTPUT_FORMATS)}")
-
-
-def write_rows(path: str | Path, rows: Sequence[Mapping[str, Any]], *, force: bool) -> Path:
-    """Write rows in the format the suffix names, atomically; never replace without ``force``."""
-    from .output import atomic_write
-
-    check_output(path, force=force)
-    return atomic_write(path, rows_to_bytes(rows, Path(path).suffix.lower()), force=force)
-
 
 def run_to_file(simulation: Simulation, path: str | Path, *, force: bool = False,
                 duration: float | None = None, real_time: bool = False,
@@ -1843,26 +479,3 @@ def _run_to_parquet(simulation: Simulation, path: str | Path, *, force: bool,
             flush()
         writer.close()  # the footer: a complete file, interrupted or not
     return result, out.path
-
-
-class _ByteSink:
-    """The file-like face pyarrow writes through, onto a StreamingFile."""
-
-    def __init__(self, out: Any):
-        self.out = out
-        self.closed = False
-        self.position = 0
-
-    def write(self, data: bytes) -> int:
-        self.out.write(bytes(data))
-        self.position += len(data)
-        return len(data)
-
-    def tell(self) -> int:
-        return self.position
-
-    def flush(self) -> None:
-        pass
-
-    def close(self) -> None:
-        self.closed = True
