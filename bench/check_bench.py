@@ -20,7 +20,7 @@ from pathlib import Path
 import pybullet_data
 from lxml import etree
 
-from urdfkit.check import check_paths, discover
+from urdfkit.checks.check import check_paths, discover
 
 GOAL = 3.0  # the goal, applied here to the rules alone (stricter than the CLI's)
 

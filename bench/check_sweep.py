@@ -28,7 +28,7 @@ def main() -> int:
     wall = time.perf_counter() - t0
     result = json.loads(proc.stdout)
     listed = sorted(result["files"])
-    from urdfkit.check import check_paths
+    from urdfkit.checks.check import check_paths
 
     t1 = time.perf_counter()
     check_paths([data], jobs=1)

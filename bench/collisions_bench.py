@@ -143,8 +143,8 @@ def cases(ctx: Context) -> list[Case]:
 if __name__ == "__main__":
     import tempfile
 
-    from urdfkit.collisions import self_collisions
-    from urdfkit.resolve import resolve
+    from urdfkit.checks.collisions import self_collisions
+    from urdfkit.sources.resolve import resolve
 
     with tempfile.TemporaryDirectory() as tmp, resolve(humanoid(Path(tmp))) as r:
         found = self_collisions(r, samples=100)

@@ -55,7 +55,7 @@ def main() -> int:
     ap.add_argument("--steps", type=int, default=20000)
     ap.add_argument("--repeat", type=int, default=5)
     a = ap.parse_args()
-    from urdfkit.catalog import build_template
+    from urdfkit.model.catalog import build_template
 
     with tempfile.TemporaryDirectory() as tmp:
         car, plane = Path(tmp) / "car.urdf", Path(tmp) / "plane.urdf"

@@ -33,7 +33,7 @@ URDFKIT = str(Path(sys.executable).with_name("urdfkit"))
 GOAL_BARE = 1.10
 
 # The baselines load with the same flags as `urdfkit drive`: implicit cylinders and the
-# file's inertia (see urdfkit/drive.py).
+# file's inertia (see urdfkit/motion/drive.py).
 BASELINE = """
 import sys
 import pybullet as p
@@ -85,7 +85,7 @@ def main() -> int:
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
 
-    from urdfkit.catalog import build_template
+    from urdfkit.model.catalog import build_template
 
     with tempfile.TemporaryDirectory(prefix="urdfkit-bench-") as tmp:
         folder = Path(tmp)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from run import Case, Context
 
-from urdfkit.catalog import build_template
+from urdfkit.model.catalog import build_template
 
 
 def cases(ctx: Context) -> list[Case]:

@@ -6,7 +6,7 @@ Goal from the issue: under 2 s. Two ways to run it:
   import cost included, as ratios against ``baselines/tutorial_render.py`` (the hand-written
   load + getCameraImage + Pillow script) measured in the same run;
 - standalone (``python bench/render_bench.py [-n ROUNDS]``): the same subprocess timing plus
-  the in-process cost of :func:`urdfkit.render.render` alone, checked against the 2 s budget.
+  the in-process cost of :func:`urdfkit.draw.render.render` alone, checked against the 2 s budget.
   Exit status 1 if the budget or a ratio goal is missed.
 """
 
@@ -24,7 +24,7 @@ sys.path.insert(0, str(BENCH))
 
 from run import Case, Context, report, time_once  # noqa: E402
 
-from urdfkit.catalog import build_template  # noqa: E402
+from urdfkit.model.catalog import build_template  # noqa: E402
 
 #: The issue's budget for one 800x600 picture of simplecar, seconds.
 BUDGET_S = 2.0
@@ -50,7 +50,7 @@ def cases(ctx: Context) -> list[Case]:
 
 def in_process(car: Path, rounds: int) -> list[float]:
     """Seconds for resolve + load + render at 800x600, imports already paid."""
-    from urdfkit.render import RenderOptions, render_file
+    from urdfkit.draw.render import RenderOptions, render_file
 
     render_file(car, RenderOptions())  # warm up: imports, page cache
     times = []

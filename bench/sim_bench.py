@@ -43,8 +43,8 @@ def hand_loop(steps: int, every: int) -> float:
 
     import pybullet as p
 
-    from urdfkit.catalog import build_template
-    from urdfkit.session import quiet_stdout
+    from urdfkit.engine.session import quiet_stdout
+    from urdfkit.model.catalog import build_template
 
     with tempfile.TemporaryDirectory() as tmp:
         plane = Path(tmp) / "plane.urdf"
@@ -99,8 +99,8 @@ def hand_rebuild(repeat: int) -> tuple[float, int]:
 
     import pybullet as p
 
-    from urdfkit.catalog import build_template
-    from urdfkit.session import quiet_stdout
+    from urdfkit.engine.session import quiet_stdout
+    from urdfkit.model.catalog import build_template
 
     with tempfile.TemporaryDirectory() as tmp:
         plane = Path(tmp) / "plane.urdf"

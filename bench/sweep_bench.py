@@ -5,7 +5,7 @@ Goals from the issue, each measured in one run:
 - one worker, 8 points: at most 0.8x eight separate ``urdfkit drive`` commands (start-up is
   paid once) -- subprocess cases, as a section of ``bench/run.py``;
 - two workers on this 2-core machine: at most 0.6x one worker -- likewise;
-- per-point overhead over the bare in-process :func:`urdfkit.drive.drive`: at most 5% --
+- per-point overhead over the bare in-process :func:`urdfkit.motion.drive.drive`: at most 5% --
   in-process, standalone (``python bench/sweep_bench.py``);
 - memory flat with the number of points -- peak RSS of sweeps of 8, 32 and 128 points;
 - the Ray backend's overhead per point on a local cluster (standalone, when Ray is
@@ -62,7 +62,7 @@ def in_process(rounds: int) -> tuple[float, float]:
     Interleaved round by round, so the machine's noise hits both alike.
     """
     from urdfkit import sweep
-    from urdfkit.drive import DriveConfig, drive
+    from urdfkit.motion.drive import DriveConfig, drive
 
     drive(DriveConfig(seconds=1.0, keep_trajectory=False))  # imports, template cache
     bare, swept = [], []

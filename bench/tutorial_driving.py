@@ -36,8 +36,8 @@ class TutorialDrivingEnv(gym.Env):
     def __init__(self, flags: int = 0, deterministic: bool = False):
         import pybullet as p
 
-        from urdfkit.catalog import build_template
-        from urdfkit.session import quiet_stdout
+        from urdfkit.engine.session import quiet_stdout
+        from urdfkit.model.catalog import build_template
 
         self.p = p
         self.flags = flags

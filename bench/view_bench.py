@@ -6,7 +6,7 @@ Standalone: ``python bench/view_bench.py [-n ROUNDS] [--moves 200]``. Measures
   Chromium page (Debian's ``chromium``, software WebGL), against the wall time of
   ``urdfkit render FILE`` on the same file (goal: at most 1.5x). The browser is started before
   the clock, as a user's browser is already open;
-- slider to scene on the server: :meth:`urdfkit.view.Viewer.set_joints` (resetJointState, mimic
+- slider to scene on the server: :meth:`urdfkit.draw.view.Viewer.set_joints` (resetJointState, mimic
   followers, getLinkState of every link, every link node moved, the joint vector texts),
   median over ``--moves`` moves (goal: at most 20 ms);
 - ``drive --view`` against ``drive``, both at ``--speed max`` (no pacing), simplecar for
@@ -111,7 +111,7 @@ def render_time(path: Path, out: Path) -> float:
 
 def slider_moves(path: Path, moves: int) -> list[float]:
     """Milliseconds of each of ``moves`` joint moves through the viewer's server API."""
-    from urdfkit.view import Viewer
+    from urdfkit.draw.view import Viewer
 
     v = Viewer(str(path))
     try:
@@ -129,9 +129,9 @@ def slider_moves(path: Path, moves: int) -> list[float]:
 
 def drive_loops(seconds: float) -> tuple[float, float]:
     """Wall seconds of one simplecar run loop without, then with, the page's stream."""
-    from urdfkit.drive import DriveConfig, Scenario
-    from urdfkit.view import Viewer
-    from urdfkit.view_stream import RunStream
+    from urdfkit.draw.view import Viewer
+    from urdfkit.draw.view_stream import RunStream
+    from urdfkit.motion.drive import DriveConfig, Scenario
 
     config = DriveConfig(throttle=10, steer=0.2, seconds=seconds, keep_trajectory=False)
     with Scenario(config) as sc:

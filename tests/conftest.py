@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from urdfkit.catalog import build_template
+from urdfkit.model.catalog import build_template
 
 TESTS = Path(__file__).parent
 
@@ -41,7 +41,7 @@ def simpleplane_urdf(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture
 def pb() -> Iterator[tuple[object, int]]:
     """A raw PyBullet DIRECT client: (pybullet module, client id); disconnected on teardown."""
-    from urdfkit.session import import_pybullet, quiet_stdout
+    from urdfkit.engine.session import import_pybullet, quiet_stdout
 
     p = import_pybullet()
     with quiet_stdout():

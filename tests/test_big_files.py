@@ -13,7 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
-from urdfkit.xmlio import line_of, parse_xml, start_tags
+from urdfkit.model.xmlio import line_of, parse_xml, start_tags
 
 BAD = ('<link name="late{k}"><inertial><mass value="-1"/><inertia ixx="1" iyy="1" izz="1" '
        'ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.1 0.1 0.1"/>'

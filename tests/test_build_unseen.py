@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from urdfkit.session import quiet_stdout
+from urdfkit.engine.session import quiet_stdout
 
 INERTIAL = ('<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" '
             'ixz="0" iyz="0"/></inertial>')
@@ -193,7 +193,7 @@ def test_a_plain_urdf_is_still_already_urdf(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("text", ['<link name="${x}"/>', "$(arg y)", "<xacro:if value='1'>"])
 def test_the_marks_of_xacro_are_found(text: str) -> None:
-    from urdfkit.xmlio import xacro_marker
+    from urdfkit.model.xmlio import xacro_marker
 
     assert xacro_marker(f"<robot>\n\n{text}\n</robot>".encode()) is not None
     assert xacro_marker(b'<robot name="r"><link name="a$b{c}"/></robot>') is None

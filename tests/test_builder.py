@@ -29,7 +29,7 @@ from urdfkit.builder import (
     Visual,
     as_written,
 )
-from urdfkit.errors import ModelError
+from urdfkit.core.errors import ModelError
 
 
 def full_robot() -> Robot:

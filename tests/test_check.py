@@ -8,11 +8,11 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit.check import check_file, check_paths, discover, parse_codes
+from urdfkit.checks.check import check_file, check_paths, discover, parse_codes
+from urdfkit.checks.validate import ALL_RULES, CODES
 from urdfkit.cli import app
-from urdfkit.errors import ParameterError
-from urdfkit.guard import GUARD_RULES
-from urdfkit.validate import ALL_RULES, CODES
+from urdfkit.core.errors import ParameterError
+from urdfkit.sources.guard import GUARD_RULES
 
 INERTIAL = ('<inertial><mass value="1"/>'
             '<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>')
@@ -208,8 +208,8 @@ def test_u208_many_links(tmp_path: Path) -> None:
 
 
 def test_u209_huge_body_refused_by_guard(tmp_path: Path) -> None:
-    from urdfkit.errors import InputError
-    from urdfkit.resolve import resolve
+    from urdfkit.core.errors import InputError
+    from urdfkit.sources.resolve import resolve
 
     n = 1001
     path = tmp_path / "chain.urdf"
@@ -478,7 +478,7 @@ def test_a_used_but_undeclared_xacro_arg_can_be_given(tmp_path: Path) -> None:
     assert [f.code for f in missing] == ["U000"] and "DEBUG:=VALUE" in missing[0].message
     given = check_file(str(path), path, xacro_args={"DEBUG": "false"}).findings
     assert not [f for f in given if f.level == "error"]
-    from urdfkit.resolve import resolve
+    from urdfkit.sources.resolve import resolve
 
     with resolve(path, xacro_args={"DEBUG": "true"}) as r:  # strict: the name is known
         assert [x.get("name") for x in r.root.iter("link")] == ["a", "debug"]
@@ -502,8 +502,8 @@ def test_text_groups_repeated_codes_and_all_lists_them(tmp_path: Path) -> None:
 def test_a_findings_json_form_is_its_fields_in_order() -> None:
     # CheckResult.to_dict hands the JSON writer each finding's own fields (no copy): they must
     # be exactly Finding.to_dict, keys in the same order.
-    from urdfkit.check import CheckResult, FileResult
-    from urdfkit.finding import Finding
+    from urdfkit.checks.check import CheckResult, FileResult
+    from urdfkit.core.finding import Finding
 
     findings = [Finding("U201", "error", "m", "f.urdf", 3, None),
                 Finding("U601", "warning", "n", "g.urdf", None, "inc.xacro:4")]

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from urdfkit.check import check_paths
-from urdfkit.resultcache import FOLDER, ResultCache
+from urdfkit.checks.check import check_paths
+from urdfkit.checks.resultcache import FOLDER, ResultCache
 
 
 @pytest.fixture
@@ -285,7 +285,8 @@ def test_a_fresh_checkout_hits_and_a_same_size_edit_misses(cache: Path, tmp_path
 
 
 def test_the_keyed_size_limit_is_the_readers() -> None:
-    from urdfkit import resultcache, xmlio
+    from urdfkit.checks import resultcache
+    from urdfkit.model import xmlio
 
     assert resultcache.MAX_FILE_BYTES == xmlio.MAX_FILE_BYTES
 
@@ -300,7 +301,7 @@ def _age(*paths: Path) -> None:
 
 
 def _manifest_hits(monkeypatch: pytest.MonkeyPatch) -> list[str]:
-    from urdfkit.resultcache import RunManifest
+    from urdfkit.checks.resultcache import RunManifest
 
     hits: list[str] = []
     lookup = RunManifest.lookup

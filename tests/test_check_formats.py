@@ -22,11 +22,18 @@ import pytest
 from lxml import etree
 from typer.testing import CliRunner
 
-from urdfkit.check import CheckResult, FileResult
-from urdfkit.ci import FORMATS, github_commands, junit_xml, relative_path, sarif_log, xml_safe
+from urdfkit.checks.check import CheckResult, FileResult
+from urdfkit.checks.ci import (
+    FORMATS,
+    github_commands,
+    junit_xml,
+    relative_path,
+    sarif_log,
+    xml_safe,
+)
+from urdfkit.checks.validate import CODES
 from urdfkit.cli import app
-from urdfkit.finding import Finding
-from urdfkit.validate import CODES
+from urdfkit.core.finding import Finding
 
 DATA = Path(__file__).parent / "data"
 ROOT = Path(__file__).parent.parent
@@ -196,7 +203,7 @@ def test_junit_one_case_per_file_failures_at_fail_on(repo: Path) -> None:
     assert (root.get("tests"), root.get("failures")) == ("3", "1")
     cases = {c.get("name"): c for c in suite.findall("testcase")}
     assert set(cases) == {"robots/good.urdf", "robots/sub/bad.urdf", "robots/arm.urdf.xacro"}
-    assert {c.get("classname") for c in cases.values()} == {"urdfkit.check"}
+    assert {c.get("classname") for c in cases.values()} == {"urdfkit.checks.check"}
     [failure] = cases["robots/sub/bad.urdf"].findall("failure")
     assert failure.get("message") == "U102" and failure.get("type") == "U102"
     assert failure.text.splitlines() == [

@@ -10,9 +10,9 @@ from hypothesis import strategies as st
 from lxml import etree
 
 from urdfkit.builder import Box, Collision, Inertial, Joint, Limit, Link, Robot
-from urdfkit.errors import InputError
-from urdfkit.guard import guard, guard_findings, run_rules
-from urdfkit.validate import ALL_RULES
+from urdfkit.checks.validate import ALL_RULES
+from urdfkit.core.errors import InputError
+from urdfkit.sources.guard import guard, guard_findings, run_rules
 
 MUTATIONS = ("none", "drop_link", "duplicate_link", "duplicate_joint", "cycle", "corrupt_number")
 
@@ -82,7 +82,7 @@ def test_check_and_guard_agree(robot: Robot, how: str, pick: int, tmp_path_facto
         assert "U401" in check_codes or "U402" in check_codes
     if not refused:
         # What the guard lets through must not crash PyBullet (it may refuse it politely).
-        from urdfkit.session import Session
+        from urdfkit.engine.session import Session
 
         path = tmp_path_factory.mktemp("prop") / "p.urdf"
         path.write_bytes(etree.tostring(root))

@@ -8,7 +8,7 @@ from pathlib import Path
 import pybullet as p
 import pytest
 
-from urdfkit.check import check_paths
+from urdfkit.checks.check import check_paths
 
 FOOTPRINT = """<?xml version="1.0"?>
 <robot name="base">

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from urdfkit.check import check_paths
+from urdfkit.checks.check import check_paths
 
 GOOD = Path(__file__).parent / "golden" / "simplecar.urdf"
 
@@ -158,7 +158,7 @@ def test_a_worker_dies_with_its_parent_even_when_idle(tmp_path: Path) -> None:
     pidfile = tmp_path / "worker.pid"
     code = f"""
 import os, time
-from urdfkit.check import worker_init
+from urdfkit.checks.check import worker_init
 if os.fork() == 0:
     worker_init()
     with open({str(pidfile)!r}, "w") as f:

@@ -120,8 +120,8 @@ def test_build_validates_the_result_before_writing(runner: CliRunner, in_tmp: Pa
 
 
 def test_xacro_expansion_is_time_limited(in_tmp: Path) -> None:
-    from urdfkit.errors import InputError
-    from urdfkit.resolve import expand_xacro
+    from urdfkit.core.errors import InputError
+    from urdfkit.sources.resolve import expand_xacro
 
     slow = in_tmp / "slow.urdf.xacro"
     slow.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'

@@ -12,11 +12,11 @@ import pytest
 from lxml import etree
 from typer.testing import CliRunner
 
-from urdfkit.check import check_paths
+from urdfkit.checks.check import check_paths
+from urdfkit.checks.collisions import self_collisions
 from urdfkit.cli import app
-from urdfkit.collisions import self_collisions
-from urdfkit.errors import ParameterError
-from urdfkit.resolve import resolve
+from urdfkit.core.errors import ParameterError
+from urdfkit.sources.resolve import resolve
 
 MESHES = Path(__file__).parent / "fixtures" / "meshes"
 INERTIAL = ('<inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" '
@@ -273,8 +273,8 @@ def test_check_physics_reports_the_zero_pose_pair_on_the_link_line(gripper: Path
 
 def test_check_physics_turns_a_pybullet_refusal_into_u951(gripper: Path,
                                                            monkeypatch: pytest.MonkeyPatch) -> None:
-    from urdfkit.errors import EngineError
-    from urdfkit.session import Session
+    from urdfkit.core.errors import EngineError
+    from urdfkit.engine.session import Session
 
     def refuse(self: Session, path: object, *args: object, **kwargs: object) -> int:
         raise EngineError("PyBullet could not load it: Could not parse visual element",

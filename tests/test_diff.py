@@ -23,10 +23,10 @@ from urdfkit.builder import (
     Sphere,
     Visual,
 )
+from urdfkit.checks.diff import DiffResult, diff_files, diff_robots
 from urdfkit.cli import app
-from urdfkit.diff import DiffResult, diff_files, diff_robots
-from urdfkit.errors import InputError, ModelError, ParameterError
-from urdfkit.resolve import pybullet_data_path
+from urdfkit.core.errors import InputError, ModelError, ParameterError
+from urdfkit.sources.resolve import pybullet_data_path
 
 INERTIAL = ('<inertial><mass value="{m}"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" '
             'iyz="0" izz="0.01"/></inertial>')

@@ -1,4 +1,4 @@
-"""The viewer's own convex hull and decimation (urdfkit.displaymesh), against qhull (scipy)
+"""The viewer's own convex hull and decimation (urdfkit.draw.displaymesh), against qhull (scipy)
 and geometry: no scipy at run time, the same hull."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
-from urdfkit.displaymesh import HULL_POINTS, convex_hull, decimate
+from urdfkit.draw.displaymesh import HULL_POINTS, convex_hull, decimate
 
 
 def _volume(v: np.ndarray, f: np.ndarray) -> float:

@@ -15,13 +15,13 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit.catalog import build_template
 from urdfkit.cli import app
-from urdfkit.drive import DriveConfig, Scenario, builtin_file, drive
-from urdfkit.drive_result import DriveResult, fit_circle
-from urdfkit.errors import ParameterError
-from urdfkit.session import LoadOptions, Session
-from urdfkit.vehicle import DrivetrainError, detect_drivetrain
+from urdfkit.core.errors import ParameterError
+from urdfkit.engine.session import LoadOptions, Session
+from urdfkit.model.catalog import build_template
+from urdfkit.motion.drive import DriveConfig, Scenario, builtin_file, drive
+from urdfkit.motion.drive_result import DriveResult, fit_circle
+from urdfkit.motion.vehicle import DrivetrainError, detect_drivetrain
 
 WHEEL_RADIUS = 0.1  # simplecar default
 WHEELBASE = 0.4
@@ -303,7 +303,7 @@ def test_detects_the_tutorial_indices_of_simplecar(simplecar_urdf: Path) -> None
 
 
 def test_detects_racecar_wheels_and_hinges_with_rotated_joint_frames() -> None:
-    from urdfkit.resolve import open_input
+    from urdfkit.sources.resolve import open_input
 
     with open_input("racecar/racecar.urdf") as res, Session() as s:
         body = s.load_urdf(res.load_path)

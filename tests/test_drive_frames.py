@@ -12,8 +12,8 @@ from pathlib import Path
 import pybullet as p
 import pytest
 
-from urdfkit.catalog import build_template
-from urdfkit.drive import DriveConfig, drive
+from urdfkit.model.catalog import build_template
+from urdfkit.motion.drive import DriveConfig, drive
 
 
 def _car(tmp_path: Path, name: str, inertial: str | None = None,

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from urdfkit.drive import DriveConfig, Scenario, drive
+from urdfkit.motion.drive import DriveConfig, Scenario, drive
 
 WHEEL_R = 0.08  # every wheel's radius below
 

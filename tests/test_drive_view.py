@@ -13,9 +13,9 @@ import pytest
 
 pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
 
-from urdfkit.drive import DriveConfig, Scenario, drive  # noqa: E402
-from urdfkit.view import Viewer  # noqa: E402
-from urdfkit.view_stream import RunStream  # noqa: E402
+from urdfkit.draw.view import Viewer  # noqa: E402
+from urdfkit.draw.view_stream import RunStream  # noqa: E402
+from urdfkit.motion.drive import DriveConfig, Scenario, drive  # noqa: E402
 
 
 def _streamed(config: DriveConfig, speed: float | None) -> tuple[object, RunStream, float]:

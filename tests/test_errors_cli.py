@@ -14,10 +14,10 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit import present
 from urdfkit.cli import app, flag_message
-from urdfkit.drive import DriveConfig
-from urdfkit.errors import ParameterError
+from urdfkit.commands import present
+from urdfkit.core.errors import ParameterError
+from urdfkit.motion.drive import DriveConfig
 
 runner = CliRunner()
 
@@ -43,12 +43,12 @@ def one_error_line(err: str) -> str:
 
 def test_a_bug_exits_3_with_one_line_and_a_debug_switch(monkeypatch: pytest.MonkeyPatch,
                                                         simplecar_urdf: Path) -> None:
-    import urdfkit.report
+    import urdfkit.engine.report
 
     def broken(*_a: object, **_k: object) -> None:
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(urdfkit.report, "inspect_file", broken)
+    monkeypatch.setattr(urdfkit.engine.report, "inspect_file", broken)
     code, out, err = invoke("joints", str(simplecar_urdf))
     assert code == 3 and out == ""
     line = one_error_line(err)
@@ -61,9 +61,9 @@ def test_a_bug_exits_3_with_one_line_and_a_debug_switch(monkeypatch: pytest.Monk
 def test_a_crash_in_check_is_not_a_finding(monkeypatch: pytest.MonkeyPatch,
                                            simplecar_urdf: Path) -> None:
     # CI must tell "your URDF has errors" (1) from "urdfkit broke" (3).
-    import urdfkit.check
+    import urdfkit.checks.check
 
-    monkeypatch.setattr(urdfkit.check, "check_paths",
+    monkeypatch.setattr(urdfkit.checks.check, "check_paths",
                         lambda *a, **k: (_ for _ in ()).throw(KeyError("rule")))
     code, _, err = invoke("check", str(simplecar_urdf))
     assert code == 3 and "a bug in urdfkit" in one_error_line(err)

@@ -11,10 +11,10 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit.check import check_paths
+from urdfkit.checks.check import check_paths
 from urdfkit.cli import app
-from urdfkit.errors import InputError, ParameterError
-from urdfkit.expand import NO_EXEC_ENV, XacroNotExpanded, execution_allowed, expand_xacro
+from urdfkit.core.errors import InputError, ParameterError
+from urdfkit.sources.expand import NO_EXEC_ENV, XacroNotExpanded, execution_allowed, expand_xacro
 
 runner = CliRunner()
 

@@ -13,7 +13,7 @@ from typing import Any
 
 import pytest
 
-from urdfkit.session import quiet_stdout
+from urdfkit.engine.session import quiet_stdout
 
 INERTIAL = ('<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" '
             'ixz="0" iyz="0"/></inertial>')
@@ -232,8 +232,8 @@ def test_mesh_paths_are_found_where_pybullet_finds_them(tmp_path: Path, written:
     links = _cli("links", str(path), "--json")
     assert links.returncode == 0, links.stderr
     # urdfkit's own load draws the same mesh file as raw PyBullet's.
-    from urdfkit.resolve import open_input
-    from urdfkit.session import Session
+    from urdfkit.engine.session import Session
+    from urdfkit.sources.resolve import open_input
 
     with open_input(str(path)) as res, Session() as s:
         body = s.load_urdf(res.load_path)
@@ -248,7 +248,7 @@ def test_the_deepest_match_wins_and_a_mesh_nowhere_is_still_refused(tmp_path: Pa
         (folder / "m" / "w.obj").write_text(TETRA.replace("0.1", scale))
     path = _mesh_robot(deep, "m/w.obj")
     assert _raw_mesh_file(path) == str((deep / "m" / "w.obj").resolve())
-    from urdfkit.uris import resolve_uri
+    from urdfkit.sources.uris import resolve_uri
 
     assert resolve_uri("m/w.obj", deep).path == deep / "m" / "w.obj"
     (deep / "m" / "w.obj").unlink()  # now only the one two folders up
@@ -326,7 +326,7 @@ def test_render_frames_the_shape_pybullet_draws() -> None:
     import numpy as np
     from lxml import etree
 
-    from urdfkit.render import _half_extent
+    from urdfkit.draw.render import _half_extent
 
     geometry = etree.fromstring('<geometry><sphere radius="0.5"/><box size="4 4 4"/></geometry>')
     assert _half_extent(geometry, np.eye(3)) == pytest.approx([0.5, 0.5, 0.5])
@@ -345,8 +345,8 @@ def test_a_mesh_found_above_gives_the_shapes_raw_pybullet_gives(tmp_path: Path) 
                     f'<collision>{shape}</collision></link></robot>')
     raw_collision, raw_visual = _raw_shapes(path)
     assert raw_collision and raw_visual  # PyBullet loads it
-    from urdfkit.resolve import open_input
-    from urdfkit.session import LoadOptions, Session
+    from urdfkit.engine.session import LoadOptions, Session
+    from urdfkit.sources.resolve import open_input
 
     with open_input(str(path)) as res, Session() as s:
         body = s.load_urdf(res.load_path, LoadOptions(implicit_cylinder=False))

@@ -11,12 +11,12 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit.check import check_file
+from urdfkit.checks.check import check_file
+from urdfkit.checks.diff import diff_files
+from urdfkit.checks.fix import FIXABLE, balanced, fix_file
 from urdfkit.cli import app
-from urdfkit.diff import diff_files
-from urdfkit.errors import InputError, ParameterError
-from urdfkit.fix import FIXABLE, balanced, fix_file
-from urdfkit.spec import rpy_to_matrix
+from urdfkit.core.errors import InputError, ParameterError
+from urdfkit.model.spec import rpy_to_matrix
 
 MESHES = Path(__file__).parent / "fixtures" / "meshes"
 

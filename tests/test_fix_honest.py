@@ -7,9 +7,9 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit.check import check_paths
+from urdfkit.checks.check import check_paths
 from urdfkit.cli import app
-from urdfkit.errors import OutputError
+from urdfkit.core.errors import OutputError
 
 runner = CliRunner()
 
@@ -69,12 +69,12 @@ def test_an_empty_output_name_is_a_usage_error(tmp_path: Path) -> None:
 
 def test_nothing_is_said_fixed_when_the_write_fails(tmp_path: Path,
                                                    monkeypatch: pytest.MonkeyPatch) -> None:
-    import urdfkit.output
+    import urdfkit.core.output
 
     def full(path: object, *_a: object, **_k: object) -> None:
         raise OutputError("cannot write: no space left on device", file=str(path))
 
-    monkeypatch.setattr(urdfkit.output, "atomic_write", full)
+    monkeypatch.setattr(urdfkit.core.output, "atomic_write", full)
     src = tmp_path / "r.urdf"
     src.write_text(ROBOT.format(mass="1"))
     for args in (["-o", str(tmp_path / "f.urdf")], ["--in-place"]):
@@ -114,7 +114,7 @@ def test_the_mass_pybullet_loads_is_guarded_too(tmp_path: Path) -> None:
 
     import pybullet as p
 
-    from urdfkit.session import quiet_stdout
+    from urdfkit.engine.session import quiet_stdout
 
     frames = "".join(f'<link name="f{k}"/><joint name="jf{k}" type="fixed"><parent link="box"/>'
                      f'<child link="f{k}"/></joint>' for k in range(3))

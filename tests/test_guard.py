@@ -22,7 +22,7 @@ import pytest
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
-from urdfkit.spec import CRASH_NAME_BYTES, MAX_NAME_BYTES
+from urdfkit.model.spec import CRASH_NAME_BYTES, MAX_NAME_BYTES
 
 
 def robot(link: str = "b", joint: str = "j", name: str = "r", jtype: str = "fixed",

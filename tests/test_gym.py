@@ -18,7 +18,7 @@ gym = pytest.importorskip("gymnasium")
 
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 
-from urdfkit.errors import InputError, ParameterError  # noqa: E402
+from urdfkit.core.errors import InputError, ParameterError  # noqa: E402
 from urdfkit.gym import SIMPLE_DRIVING_ID, ScenarioEnv, SimpleDrivingEnv  # noqa: E402
 
 ROOT = Path(__file__).parent.parent

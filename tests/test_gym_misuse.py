@@ -11,7 +11,7 @@ import pytest
 
 gym = pytest.importorskip("gymnasium", reason="urdfkit.gym needs the gym extra")
 
-from urdfkit.errors import ParameterError  # noqa: E402
+from urdfkit.core.errors import ParameterError  # noqa: E402
 from urdfkit.gym import ScenarioEnv, SimpleDrivingEnv  # noqa: E402
 
 PENDULUM = Path(__file__).resolve().parents[1] / "examples" / "pendulum_servo.json"

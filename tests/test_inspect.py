@@ -7,13 +7,13 @@ from pathlib import Path
 
 import pytest
 
-from urdfkit.errors import ParameterError
+from urdfkit.core.errors import ParameterError
+from urdfkit.draw.tree import kinematic_tree
+from urdfkit.engine.report import inspect_file, tidy_diagnostics
+from urdfkit.engine.session import LoadOptions
 from urdfkit.inspect import JOINT_INFO_FIELDS, filter_joints
-from urdfkit.report import inspect_file, tidy_diagnostics
-from urdfkit.resolve import open_input, resolve
-from urdfkit.session import LoadOptions
-from urdfkit.spec import quat_to_rpy
-from urdfkit.tree import kinematic_tree
+from urdfkit.model.spec import quat_to_rpy
+from urdfkit.sources.resolve import open_input, resolve
 
 # A link with an off-diagonal <inertia> and an offset, rotated inertial frame, and a child link
 # with no <inertial> at all (which PyBullet gives 1 kg and complains about on stdout).
@@ -174,7 +174,7 @@ def test_quat_to_rpy_matches_pybullet(pb) -> None:
 
 
 def test_a_session_reloads_a_file_edited_since_it_loaded_it(tmp_path: Path, pb) -> None:
-    from urdfkit.session import Session
+    from urdfkit.engine.session import Session
 
     def write(child: str) -> None:
         path.write_text(f'<robot name="r"><link name="a"/><link name="{child}"/><joint name="j" '

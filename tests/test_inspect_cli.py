@@ -12,12 +12,12 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit import present as show
 from urdfkit.cli import app
+from urdfkit.commands import present as show
+from urdfkit.engine.session import LoadOptions
 from urdfkit.inspect import JOINT_INFO_FIELDS
-from urdfkit.resolve import pybullet_data_path
-from urdfkit.session import LoadOptions
-from urdfkit.spec import PYBULLET_JOINT_CODES as JOINT_TYPE_NAMES
+from urdfkit.model.spec import PYBULLET_JOINT_CODES as JOINT_TYPE_NAMES
+from urdfkit.sources.resolve import pybullet_data_path
 
 ROOT = Path(__file__).resolve().parent.parent
 GOLDEN = Path(__file__).parent / "golden"

@@ -1,4 +1,4 @@
-"""urdfkit.jsontext writes exactly what ``json.dumps(indent=2)`` writes (the standard library is
+"""urdfkit's jsontext writes exactly what ``json.dumps(indent=2)`` writes (the standard library is
 the reference), and raises where it raises."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from urdfkit.jsontext import dumps
+from urdfkit.core.jsontext import dumps
 
 # Strings with the characters the fast path relies on the encoder escaping.
 TEXT = st.text(alphabet=st.sampled_from(list('ab,{}[]:" \\\x00\x01\n\tü€😀')), max_size=8)

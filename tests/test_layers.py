@@ -1,7 +1,8 @@
-"""Imports flow one way: spec and model, then sources, then the engine, then run/draw, then CLI.
+"""The package's folders are its floors: imports flow one way, from the command line down.
 
 Every import between urdfkit's modules counts, lazy ones inside functions included: a lazy import
-that goes the wrong way is still a step living in the wrong room.
+that goes the wrong way is still a step living in the wrong room. docs/architecture.md draws the
+same tree.
 """
 
 from __future__ import annotations
@@ -15,86 +16,87 @@ import urdfkit
 
 PACKAGE = Path(urdfkit.__file__).parent
 
-#: The house's floors, lowest first. A module may import from its own floor or below.
-LAYERS: dict[str, int] = {}
-for floor, names in enumerate([
-    # spec and model
-    "errors deps finding spec style templatedir suggest output cache xmlio tomlio builder catalog"
-    " displaymesh stdio jsontext builder_elements",
-    # sources: files, packages, xacro, and the guard every loader calls
-    "uris meshes resultcache _xacro_worker expand guard resolve",
-    # the engine session
-    "session",
-    # run and draw
-    "inspect body tree report graph vehicle drive sac scenario sim gym render plot check build"
-    " validate diff collisions fix sweep_journal sweep sweep_run view view_model view_page"
-    " view_stream vehicle_shapes drive_result scenario_models sim_writers sim_dynamics"
-    " sim_state sim_control sim_sensors sim_episode sim_setters sim_world sim_record",
-    # presentation and the command line
-    "present ci cli __main__ commands.shared commands.build commands.inspecting commands.checking"
-    " commands.driving commands.drawing commands.simulating",
-]):
-    LAYERS.update(dict.fromkeys(names.split(), floor))
-
-
-#: Folders of modules (named "folder.module" here), besides the flat ones.
-FOLDERS = ("commands",)
+#: The floors, lowest first, and the folders on each: a module may import from its own floor
+#: or below, never above. The three capabilities (checks, motion, draw) share a floor: they
+#: may use each other (a sweep checks its robot, a plot reads a drive's trajectory), without
+#: cycles between modules.
+FLOOR_FOLDERS = [["core"], ["model"], ["sources"], ["engine"], ["checks", "motion", "draw"],
+                 ["commands"]]
+FLOORS: dict[str, int] = {name: n for n, names in enumerate(FLOOR_FOLDERS) for name in names}
+FOLDERS = [name for names in FLOOR_FOLDERS for name in names]
+#: The public modules at the top of the package, each on the floor of what it fronts. The last
+#: four only re-export what README and docs/ import from them (tests/test_public_api.py).
+TOP: dict[str, str] = {"builder": "model", "inspect": "engine", "sim": "motion",
+                       "gym": "motion", "sweep": "motion", "cli": "commands",
+                       "__main__": "commands", "render": "draw", "diff": "checks",
+                       "collisions": "checks", "resolve": "sources"}
 
 
 def _module_names() -> list[str]:
-    names = [p.stem for p in PACKAGE.glob("*.py") if p.stem != "__init__"]
-    names += [f"{d}.{p.stem}" for d in FOLDERS for p in (PACKAGE / d).glob("*.py")
-              if p.stem != "__init__"]
-    return sorted(names)
+    """Every module, dotted below urdfkit: ``cli``, ``model.spec``, ``commands.drive``."""
+    names = [p.relative_to(PACKAGE).with_suffix("").as_posix().replace("/", ".")
+             for p in PACKAGE.rglob("*.py")]
+    return sorted(n for n in names if n != "__init__" and not n.endswith(".__init__"))
 
 
-def _path(name: str) -> Path:
-    return PACKAGE / (name.replace(".", "/") + ".py")
+def _floor(module: str) -> int:
+    folder = module.split(".")[0]
+    return FLOORS[TOP.get(folder, folder)]
 
 
-def _dotted(module: str) -> str:
-    """``commands.shared.x`` -> ``commands.shared``; ``present`` -> ``present``."""
-    parts = module.split(".")
-    return ".".join(parts[:2]) if parts[0] in FOLDERS else parts[0]
+def _path(module: str) -> Path:
+    return PACKAGE.joinpath(*module.split(".")).with_suffix(".py")
 
 
 def _imports(name: str) -> set[str]:
     tree = ast.parse(_path(name).read_text("utf-8"))
-    package = name.rpartition(".")[0]  # "" for a flat module
+    modules = set(_module_names())
     out: set[str] = set()
+
+    def add(dotted: str) -> None:
+        # `from urdfkit.model import spec` names a module; `from urdfkit.model.spec import X`
+        # names one too. Keep the longest prefix that is a module.
+        parts = dotted.split(".")
+        for n in range(len(parts), 0, -1):
+            if ".".join(parts[:n]) in modules:
+                out.add(".".join(parts[:n]))
+                return
+
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
             if node.level:
-                base = ".".join(package.split(".")[:len(package.split(".")) - node.level + 1]
-                                if package else [])
-                prefix = f"{base}." if base else ""
-                if node.module:
-                    out.add(_dotted(prefix + node.module))
-                else:
-                    out.update(_dotted(prefix + a.name) for a in node.names)
-            elif node.module == "urdfkit":
-                out.update(_dotted(a.name) for a in node.names)
-            elif node.module and node.module.startswith("urdfkit."):
-                module = node.module.split(".", 1)[1]
-                if module in FOLDERS:
-                    out.update(_dotted(f"{module}.{a.name}") for a in node.names)
-                else:
-                    out.add(_dotted(module))
+                package = name.split(".")[: -node.level]
+                base = ".".join(package + ([node.module] if node.module else []))
+            elif node.module and node.module.startswith("urdfkit"):
+                base = node.module.removeprefix("urdfkit").lstrip(".")
+            else:
+                continue
+            for a in node.names:
+                add(f"{base}.{a.name}" if base else a.name)
         elif isinstance(node, ast.Import):
-            out.update(_dotted(a.name.split(".", 1)[1]) for a in node.names
-                       if a.name.startswith("urdfkit."))
-    return out & set(_module_names()) - {name}
+            for a in node.names:
+                if a.name.startswith("urdfkit."):
+                    add(a.name.removeprefix("urdfkit."))
+    return out - {name}
 
 
-def test_every_module_has_a_floor() -> None:
-    missing = [m for m in _module_names() if m not in LAYERS]
-    assert not missing, f"add {missing} to LAYERS in tests/test_layers.py"
+def test_every_module_lives_in_a_floor() -> None:
+    loose = [m for m in _module_names() if m.split(".")[0] not in FLOORS | TOP]
+    assert not loose, f"put {loose} in one of {FOLDERS}, or name it in TOP"
+    folders = {p.name for p in PACKAGE.iterdir() if p.is_dir() and (p / "__init__.py").exists()}
+    assert folders - {"templates"} <= set(FOLDERS), folders
+
+
+def test_package_init_files_import_nothing() -> None:
+    for init in PACKAGE.rglob("__init__.py"):
+        tree = ast.parse(init.read_text("utf-8"))
+        imports = [n for n in ast.walk(tree) if isinstance(n, (ast.Import, ast.ImportFrom))]
+        assert not imports, f"{init} imports; start-up pays for every import it makes"
 
 
 def test_imports_never_go_up_a_floor() -> None:
-    wrong = [f"{m} (floor {LAYERS[m]}) imports {i} (floor {LAYERS[i]})"
-             for m in _module_names() for i in sorted(_imports(m))
-             if m in LAYERS and i in LAYERS and LAYERS[i] > LAYERS[m]]
+    wrong = [f"{m} (floor {_floor(m)}) imports {i} (floor {_floor(i)})"
+             for m in _module_names() for i in sorted(_imports(m)) if _floor(i) > _floor(m)]
     assert not wrong, "\n".join(wrong)
 
 

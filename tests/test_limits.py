@@ -14,9 +14,9 @@ from typer.testing import CliRunner
 
 from urdfkit import sweep
 from urdfkit.cli import app
-from urdfkit.drive import DriveConfig
-from urdfkit.errors import ParameterError
-from urdfkit.spec import MAX_STEPS
+from urdfkit.core.errors import ParameterError
+from urdfkit.model.spec import MAX_STEPS
+from urdfkit.motion.drive import DriveConfig
 
 runner = CliRunner()
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -230,7 +230,7 @@ RING = """<?xml version="1.0"?>
 
 
 def test_check_flags_a_ring_of_mimic_joints_once_and_a_chain_not_at_all(tmp_path: Path) -> None:
-    from urdfkit.check import check_paths
+    from urdfkit.checks.check import check_paths
 
     ring, chain = tmp_path / "ring.urdf", tmp_path / "chain.urdf"
     ring.write_text(RING.format(lead="j1"))

@@ -1,4 +1,4 @@
-"""Mesh mass properties (urdfkit.meshes): against closed forms, trimesh, and the cache's rules."""
+"""Mesh mass properties (sources/meshes.py): against closed forms, trimesh, the cache's rules."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import numpy as np
 import pybullet_data
 import pytest
 
-from urdfkit import meshes
-from urdfkit.spec import solid_inertia, solid_volume
+from urdfkit.model.spec import solid_inertia, solid_volume
+from urdfkit.sources import meshes
 
 DATA = Path(pybullet_data.getDataPath())
 FIXTURES = Path(__file__).parent / "fixtures" / "meshes"

@@ -12,7 +12,7 @@ import pytest
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
-from urdfkit.uris import PackageIndex
+from urdfkit.sources.uris import PackageIndex
 
 runner = CliRunner()
 PACKAGES = Path(__file__).parent / "fixtures" / "packages"
@@ -223,7 +223,7 @@ def test_findings_in_xacro_input_name_where_the_element_was_written(tmp_path: Pa
     text = runner.invoke(app, ["check", str(main), "--select", "U601"]).stdout
     assert f"(written at {parts}:4)" in text
     # The tags never reach an output: the expansion is plain URDF.
-    from urdfkit.expand import expand_xacro
+    from urdfkit.sources.expand import expand_xacro
 
     expanded = expand_xacro(main)
     assert b"urdfkit-origin" not in expanded and b"a_part" in expanded

@@ -137,7 +137,7 @@ def test_a_sweep_journal_that_is_not_a_regular_file(kind: str, tmp_path: Path,
 def test_scenario_env_refuses_a_scenario_that_is_not_a_regular_file(
         kind: str, tmp_path: Path, alarm: None) -> None:
     pytest.importorskip("gymnasium", reason="urdfkit.gym needs the gym extra")
-    from urdfkit.errors import InputError
+    from urdfkit.core.errors import InputError
     from urdfkit.gym import ScenarioEnv
 
     bad = tmp_path / "bad.json"

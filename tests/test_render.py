@@ -13,10 +13,10 @@ import pytest
 from PIL import Image
 from typer.testing import CliRunner
 
-from urdfkit import style
 from urdfkit.cli import app
-from urdfkit.errors import MissingDependencyError, OutputError, ParameterError
-from urdfkit.render import (
+from urdfkit.core.errors import MissingDependencyError, OutputError, ParameterError
+from urdfkit.draw import style
+from urdfkit.draw.render import (
     ALL_VIEWS,
     Camera,
     RenderOptions,
@@ -115,7 +115,7 @@ def test_golden_image(simplecar_urdf: Path) -> None:
 def _project(cam: Camera, points: list[tuple[float, float, float]]
              ) -> tuple[np.ndarray, np.ndarray]:
     """Pixel x, y of world points, with a reported camera and PyBullet's own matrices."""
-    from urdfkit.session import import_pybullet
+    from urdfkit.engine.session import import_pybullet
 
     p = import_pybullet()
     view = np.array(p.computeViewMatrix(cam.eye, cam.target, cam.up)).reshape(4, 4).T
@@ -405,8 +405,8 @@ def test_visual_bounds_match_pybullet_aabb(tmp_path: Path) -> None:
     """Our box around primitive visuals equals PyBullet's getAABB of identical collisions."""
     from lxml import etree
 
-    from urdfkit.render import _visual_bounds, link_frames
-    from urdfkit.session import LoadOptions, Session
+    from urdfkit.draw.render import _visual_bounds, link_frames
+    from urdfkit.engine.session import LoadOptions, Session
 
     shapes = ['<box size="0.4 0.1 0.2"/>', '<cylinder radius="0.1" length="0.5"/>',
               '<sphere radius="0.15"/>']
@@ -485,9 +485,9 @@ def test_link_frames_equal_getlinkstate(name: str, pb) -> None:
     # frame must equal getLinkState's URDF link frame, posed and turned.
     import pybullet_data
 
-    from urdfkit.render import link_frames
-    from urdfkit.spec import UP_AXES
-    from urdfkit.xmlio import parse_xml, read_bytes
+    from urdfkit.draw.render import link_frames
+    from urdfkit.model.spec import UP_AXES
+    from urdfkit.model.xmlio import parse_xml, read_bytes
 
     p, c = pb
     path = os.path.join(pybullet_data.getDataPath(), name)

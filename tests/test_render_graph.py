@@ -12,9 +12,9 @@ from lxml import etree
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
-from urdfkit.errors import MissingDependencyError, OutputError
-from urdfkit.graph import dot_graph, quote, write_graph
-from urdfkit.resolve import open_input
+from urdfkit.core.errors import MissingDependencyError, OutputError
+from urdfkit.draw.graph import dot_graph, quote, write_graph
+from urdfkit.sources.resolve import open_input
 
 runner = CliRunner()
 needs_dot = pytest.mark.skipif(shutil.which("dot") is None,

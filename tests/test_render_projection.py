@@ -12,7 +12,7 @@ import pybullet as p
 import pytest
 from matplotlib.path import Path as Polygon
 
-from urdfkit.render import RenderOptions, render_file
+from urdfkit.draw.render import RenderOptions, render_file
 
 BOX = """<robot name="box"><material name="red"><color rgba="0.9 0.1 0.1 1"/></material>
 <link name="b"><visual><geometry><box size="0.4 0.2 0.1"/></geometry><material name="red"/>
@@ -74,7 +74,7 @@ def test_a_known_box_covers_exactly_its_projected_corners(tmp_path: Path, view: 
 
 def _ink_share(img: np.ndarray) -> np.ndarray:
     """Pixels that are neither the background nor the grid (test_render.py's measure)."""
-    from urdfkit import style
+    from urdfkit.draw import style
 
     far_bg = np.abs(img.astype(int) - np.array(style.rgb255(style.BACKGROUND))).sum(axis=2) > 30
     far_grid = np.abs(img.astype(int) - np.array(style.rgb255(style.GRID))).sum(axis=2) > 30
@@ -95,7 +95,7 @@ def test_the_robots_share_of_the_frame_is_what_pybullet_sees(tmp_path: Path, rob
     the hull of the box's eight projected corners.
     """
     if robot == "simplecar":
-        from urdfkit.catalog import build_template
+        from urdfkit.model.catalog import build_template
 
         path = tmp_path / "simplecar.urdf"
         build_template("simplecar").write(path)

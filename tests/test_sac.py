@@ -1,4 +1,4 @@
-"""simulation_and_control configs run as they are (urdfkit/sac.py).
+"""simulation_and_control configs run as they are (urdfkit/motion/sac.py).
 
 The two configs in tests/fixtures/sac/configs are written in simulation_and_control's format
 (a pendulum; a Unitree-like quadruped with foot sensors, noise and delay). The rows urdfkit
@@ -23,9 +23,9 @@ import pybullet as p
 import pybullet_data
 import pytest
 
-from urdfkit import sac
-from urdfkit.errors import InputError
-from urdfkit.scenario import load_scenario
+from urdfkit.core.errors import InputError
+from urdfkit.motion import sac
+from urdfkit.motion.scenario import load_scenario
 from urdfkit.sim import Simulation
 
 if sys.version_info >= (3, 11):

@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit import sac
 from urdfkit.cli import app
+from urdfkit.motion import sac
 from urdfkit.sim import Simulation
 
 FIXTURES = Path(__file__).parent / "fixtures" / "sac"

@@ -12,7 +12,7 @@ from typing import Any
 
 import pytest
 
-from urdfkit.errors import MissingDependencyError, OutputError, ParameterError
+from urdfkit.core.errors import MissingDependencyError, OutputError, ParameterError
 from urdfkit.sim import (
     Observation,
     SimResult,
@@ -435,7 +435,7 @@ def test_unknown_output_format(tmp_path: Path, rows: list[dict[str, Any]]) -> No
 @pytest.fixture(autouse=True)
 def _no_leaked_clients() -> Iterator[None]:
     """Every Simulation disconnects its client: none outlives its test."""
-    from urdfkit.session import import_pybullet
+    from urdfkit.engine.session import import_pybullet
 
     p = import_pybullet()
 
@@ -458,7 +458,7 @@ def test_pybullet_data_models_load_by_name() -> None:
 
 def test_bodies_too_large_for_state_queries_are_refused(tmp_path: Path) -> None:
     from urdfkit.builder import Box, Collision, Inertial, Joint, Limit, Link, Origin, Robot
-    from urdfkit.errors import InputError
+    from urdfkit.core.errors import InputError
 
     chain = Robot("chain")
     chain.add_link(Link("l0", inertial=Inertial(1.0), collisions=[Collision(Box((0.1,) * 3))]))

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from urdfkit.errors import InputError, ParameterError
+from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.sim import Simulation
 
 M, L, INERTIA = 2.0, 0.5, 0.01  # bob mass (kg), rod length (m), inertia about its centre

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from urdfkit.errors import InputError, ParameterError
+from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.sim import Simulation
 
 ROOT = Path(__file__).parent.parent

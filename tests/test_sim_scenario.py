@@ -11,8 +11,8 @@ from typing import Any
 
 import pytest
 
-from urdfkit import scenario as sc
-from urdfkit.errors import InputError, MissingDependencyError
+from urdfkit.core.errors import InputError, MissingDependencyError
+from urdfkit.motion import scenario as sc
 from urdfkit.sim import Simulation
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
@@ -230,8 +230,8 @@ def test_missing_pydantic_says_what_to_install(monkeypatch: pytest.MonkeyPatch) 
 
 
 def test_up_stands_a_y_up_robot_before_its_orientation(tmp_path: Path) -> None:
-    from urdfkit.session import import_pybullet
-    from urdfkit.spec import UP_AXES, quat_mul
+    from urdfkit.engine.session import import_pybullet
+    from urdfkit.model.spec import UP_AXES, quat_mul
 
     p = import_pybullet()
     # quat_mul agrees with PyBullet's own composition.
@@ -252,8 +252,8 @@ def test_up_stands_a_y_up_robot_before_its_orientation(tmp_path: Path) -> None:
 
 
 def test_errors_name_document_keys_not_pydantic_union_members() -> None:
-    from urdfkit.errors import InputError
-    from urdfkit.scenario import parse_scenario
+    from urdfkit.core.errors import InputError
+    from urdfkit.motion.scenario import parse_scenario
 
     doc = {"robots": [{"name": "a", "template": "simplecar", "motor": {"kp": "abc"}}]}
     with pytest.raises(InputError) as e:

@@ -13,9 +13,9 @@ import pytest
 
 pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
 
+from urdfkit.draw.view import Viewer  # noqa: E402
+from urdfkit.draw.view_stream import RunStream  # noqa: E402
 from urdfkit.sim import Simulation  # noqa: E402
-from urdfkit.view import Viewer  # noqa: E402
-from urdfkit.view_stream import RunStream  # noqa: E402
 
 TWO_CARS = Path(__file__).parent.parent / "examples" / "two_cars.toml"
 

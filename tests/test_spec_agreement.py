@@ -17,8 +17,8 @@ from typer.testing import CliRunner
 
 from urdfkit.builder import Robot
 from urdfkit.cli import app
-from urdfkit.errors import ModelError
-from urdfkit.spec import JOINT_TYPES, PYBULLET_JOINT_TYPES, PYBULLET_SHAPES, SHAPES
+from urdfkit.core.errors import ModelError
+from urdfkit.model.spec import JOINT_TYPES, PYBULLET_JOINT_TYPES, PYBULLET_SHAPES, SHAPES
 
 runner = CliRunner()
 

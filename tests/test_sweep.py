@@ -12,8 +12,8 @@ from typer.testing import CliRunner
 
 from urdfkit import sweep
 from urdfkit.cli import app
-from urdfkit.drive import DriveConfig, drive
-from urdfkit.errors import InputError, MissingDependencyError, ParameterError
+from urdfkit.core.errors import InputError, MissingDependencyError, ParameterError
+from urdfkit.motion.drive import DriveConfig, drive
 from urdfkit.sim import Simulation
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -292,7 +292,7 @@ def test_ctrl_c_inside_a_drive_stops_the_sweep(tmp_path: Path,
                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     # drive() catches Ctrl-C itself and returns an interrupted result: the sweep must stop
     # there, not record half a drive and go on to the next point.
-    import urdfkit.drive as driving
+    import urdfkit.motion.drive as driving
 
     real, calls = driving.drive, []
 

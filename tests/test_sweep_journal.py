@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 
 from urdfkit import sweep
 from urdfkit.cli import app
-from urdfkit.errors import InputError, OutputError
+from urdfkit.core.errors import InputError, OutputError
 
 VARY = ["--vary", "steer=0.1,0.2", "--seconds", "0.2", "--jobs", "1"]
 

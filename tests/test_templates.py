@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from urdfkit.builder import Inertial, Robot
-from urdfkit.catalog import TEMPLATES, build_template, get_template
-from urdfkit.errors import ParameterError
+from urdfkit.core.errors import ParameterError
+from urdfkit.model.catalog import TEMPLATES, build_template, get_template
 
 GOLDEN = Path(__file__).parent / "golden"
 

@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from urdfkit.tomlio import dumps
+from urdfkit.model.tomlio import dumps
 
 if sys.version_info >= (3, 11):
     import tomllib

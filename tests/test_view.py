@@ -25,8 +25,8 @@ import pytest
 
 pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
 
-from urdfkit import view_page  # noqa: E402
-from urdfkit.view import TINTS, TOUCHING_RGB, Viewer  # noqa: E402
+from urdfkit.draw import view_page  # noqa: E402
+from urdfkit.draw.view import TINTS, TOUCHING_RGB, Viewer  # noqa: E402
 
 DOCS = Path(__file__).parent.parent / "docs"
 CHROMIUM = os.environ.get("URDFKIT_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
@@ -483,7 +483,7 @@ def test_finding_and_reload_error_shown_in_the_page(browser: Any, tmp_path: Path
 
 def test_selecting_a_link_highlights_it_and_shows_its_joint_row(tmp_path: Path,
                                                                 viewer_of: Any) -> None:
-    from urdfkit.view import NO_LINK, SELECTED_RGB
+    from urdfkit.draw.view import NO_LINK, SELECTED_RGB
 
     path = tmp_path / "bad.urdf"
     path.write_text(U604)

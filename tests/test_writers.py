@@ -1,4 +1,4 @@
-"""Nothing is lost, nothing is clobbered: every writer goes through urdfkit/output.py."""
+"""Nothing is lost, nothing is clobbered: every writer goes through urdfkit/core/output.py."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit import output
 from urdfkit.cli import app
-from urdfkit.errors import OutputError
-from urdfkit.output import StreamingFile, atomic_write, check_output
+from urdfkit.core import output
+from urdfkit.core.errors import OutputError
+from urdfkit.core.output import StreamingFile, atomic_write, check_output
 
 runner = CliRunner()
 

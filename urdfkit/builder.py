@@ -7,7 +7,7 @@ so a bad value fails at the line that set it, naming the tag and the attribute::
     >>> Box(size=(1, -2, 3))
     Traceback (most recent call last):
     ...
-    urdfkit.errors.ModelError: during assignment to attribute 'size' of element <box>: ...
+    urdfkit.core.errors.ModelError: during assignment to attribute 'size' of element <box>: ...
 
 Inertia is derived from the collision shapes and the mass (solid box, cylinder, sphere, with
 shape offsets and rotations) unless it is given explicitly; see :meth:`Inertial.from_shapes`.
@@ -35,7 +35,9 @@ from typing import Any
 
 from lxml import etree
 
-from .builder_elements import (
+from urdfkit.core.errors import ModelError
+from urdfkit.core.output import atomic_write
+from urdfkit.model.builder_elements import (
     SHAPE_CLASSES,
     Box,
     Calibration,
@@ -71,10 +73,8 @@ from .builder_elements import (
     _origin,
     as_written,
 )
-from .builder_elements import Joint as Joint
-from .errors import ModelError
-from .output import atomic_write
-from .spec import (
+from urdfkit.model.builder_elements import Joint as Joint
+from urdfkit.model.spec import (
     JOINT_TYPES,
     LIMITED_JOINT_TYPES,
     SHAPE_SIZES,
@@ -82,9 +82,9 @@ from .spec import (
     depth_first,
     rpy_to_matrix,
 )
-from .xmlio import fmt_float, fmt_vec, line_of, load_xml, parse_xml, to_bytes
+from urdfkit.model.xmlio import fmt_float, fmt_vec, line_of, load_xml, parse_xml, to_bytes
 
-#: The model API: every element class (defined in :mod:`urdfkit.builder_elements`), the robot,
+#: The model API: every element class (defined in :mod:`urdfkit.model.builder_elements`), the robot,
 #: and what spec lends it.
 __all__ = ["JOINT_TYPES", "LIMITED_JOINT_TYPES", "SHAPE_CLASSES", "Box", "Calibration",
            "Capsule", "Cdf", "Collision", "Contact", "Cylinder", "Dynamics", "Geometry",

@@ -1,12 +1,13 @@
 """The ``urdfkit`` command line: parse options, call the library, hand the result to present.
 
 cli.py holds the app and the error handler; each command lives in a module of
-:mod:`urdfkit.commands` (options and calls), what the output looks like in :mod:`urdfkit.present`,
+:mod:`urdfkit.commands` (options and calls), what the output looks like in
+:mod:`urdfkit.commands.present`,
 and every error takes one road: :class:`UrdfkitGroup.main` is the only place that catches,
 turning each outcome into one line on stderr and an exit code:
 
 - 0 ok; 1 findings at or above ``--fail-on`` (check); 2 bad input or usage (a
-  :class:`~urdfkit.errors.UrdfkitError`, or a bad option value); 3 an internal error, a
+  :class:`~urdfkit.core.errors.UrdfkitError`, or a bad option value); 3 an internal error, a
   bug (``URDFKIT_DEBUG=1`` shows the traceback); 130 interrupted (Ctrl-C, SIGTERM, SIGHUP).
 - The library names Python parameters in its messages (`` `time_step` ``); the handler shows
   the flag that feeds it (``--time-step``).
@@ -27,9 +28,9 @@ import typer
 from typer.core import TyperGroup
 
 from urdfkit import __version__
-from urdfkit import present as show
+from urdfkit.commands import present as show
 from urdfkit.commands.shared import flag_message, input_flags
-from urdfkit.errors import UrdfkitError
+from urdfkit.core.errors import UrdfkitError
 
 DEBUG_ENV = "URDFKIT_DEBUG"
 
@@ -56,7 +57,7 @@ def _usage_message(e: Any) -> str:
     text = " ".join(e.format_message().split())  # one line, however click wrapped it
     option = getattr(e, "option_name", None)
     if option and not getattr(e, "possibilities", None) and ctx is not None:
-        from .suggest import hint
+        from urdfkit.core.suggest import hint
 
         flags = [o for p in ctx.command.params for o in getattr(p, "opts", [])
                  if o.startswith("--")]

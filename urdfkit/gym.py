@@ -22,7 +22,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .errors import MissingDependencyError, ParameterError
+from urdfkit.core.errors import MissingDependencyError, ParameterError
 
 try:
     import gymnasium as gym
@@ -32,7 +32,7 @@ except ImportError as e:  # pragma: no cover - the [gym] extra installs it
     raise MissingDependencyError("urdfkit.gym needs gymnasium: pip install 'urdfkit[gym]'") \
         from e
 
-from .session import LoadOptions, Session, prime_resets, restore_clean
+from urdfkit.engine.session import LoadOptions, Session, prime_resets, restore_clean
 
 __all__ = ["SIMPLE_DRIVING_ID", "ScenarioEnv", "SimpleDrivingEnv"]
 
@@ -96,7 +96,7 @@ def _gui(render_mode: str | None) -> bool:
     """
     if render_mode != "human":
         return False
-    from .session import has_display
+    from urdfkit.engine.session import has_display
 
     if has_display():
         return True
@@ -180,7 +180,7 @@ class SimpleDrivingEnv(gym.Env):
         self._last_frame = 0.0
 
     def _setup(self, implicit_cylinder: bool) -> None:
-        from .drive import builtin_file
+        from urdfkit.motion.drive import builtin_file
 
         s = self._session
         p, c = s.p, s.client
@@ -194,7 +194,7 @@ class SimpleDrivingEnv(gym.Env):
         if plane is None or car is None:  # no writable cache: build into a temp folder
             import tempfile
 
-            from .catalog import build_template
+            from urdfkit.model.catalog import build_template
 
             self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-gym-")
             plane = build_template("simpleplane").write(Path(self._tmp.name) / "plane.urdf")
@@ -397,7 +397,7 @@ class ScenarioEnv(gym.Env):
                  fields: Sequence[str] | None = None,
                  action_bounds: Mapping[str, tuple[float, float]] | None = None,
                  width: int = 320, height: int = 240):
-        from .sim import OBSERVATION_FIELDS, Simulation
+        from urdfkit.sim import OBSERVATION_FIELDS, Simulation
 
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(f"render_mode must be rgb_array, human or None, got "
@@ -511,7 +511,7 @@ class ScenarioEnv(gym.Env):
     def _drive_action(self, b: Any, bounds: dict[str, tuple[float, float]]
                       ) -> tuple[list[str], list[float], list[float]]:
         """Throttle and steer, the steer's range from the drive train unless ``bounds`` says."""
-        from .vehicle import clamp_steer
+        from urdfkit.motion.vehicle import clamp_steer
 
         train = b.train
         lo, hi = train.steer_range() if train.hinges else (0.0, 0.0)

@@ -1,8 +1,9 @@
 """Turn a loaded body into plain data: the joint table, and the report every command fills.
 
 Everything here returns dataclasses; nothing prints. ``cli.py`` presents them as rich tables
-or JSON. The link table and the summary live in :mod:`urdfkit.body`, the kinematic tree (no
-PyBullet) in :mod:`urdfkit.tree`, and loading a file into a report in :mod:`urdfkit.report`,
+or JSON. The link table and the summary live in :mod:`urdfkit.engine.body`, the kinematic tree (no
+PyBullet) in :mod:`urdfkit.draw.tree`, and loading a file into a report in
+:mod:`urdfkit.engine.report`,
 so that ``urdfkit joints`` loads only what it shows.
 
 The joint table carries all 17 fields of ``p.getJointInfo`` under the names the PyBullet
@@ -27,9 +28,9 @@ from typing import Any
 
 from lxml import etree
 
-from .session import Session
-from .spec import JOINT_TYPE_FILTERS, attr_vec, pybullet_joint_type, quat_to_rpy
-from .xmlio import children
+from urdfkit.engine.session import Session
+from urdfkit.model.spec import JOINT_TYPE_FILTERS, attr_vec, pybullet_joint_type, quat_to_rpy
+from urdfkit.model.xmlio import children
 
 #: The 17 ``getJointInfo`` fields, in tuple order, as the Quickstart Guide names them.
 JOINT_INFO_FIELDS = (
@@ -187,8 +188,8 @@ def filter_joints(joints: Sequence[JointInfo], *, movable: bool = False,
     wanted = {t.lower() for t in types}
     unknown = sorted(wanted - set(JOINT_TYPE_FILTERS))
     if unknown:
-        from .errors import ParameterError
-        from .suggest import hint
+        from urdfkit.core.errors import ParameterError
+        from urdfkit.core.suggest import hint
 
         raise ParameterError(f"`types` {unknown[0]!r} is not a joint type"
                              f"{hint(unknown[0], JOINT_TYPE_FILTERS)} (use one of "
@@ -214,7 +215,7 @@ def pose_joints(p: Any, client: int, body: int, joints: Sequence[JointInfo],
     Raises:
         ParameterError: an unknown name, a fixed joint, or a multi-DOF joint.
     """
-    from .errors import ParameterError
+    from urdfkit.core.errors import ParameterError
 
     by_name = {j.joint_name: j for j in joints}
     movable = [j.joint_name for j in joints if j.movable]
@@ -227,7 +228,7 @@ def pose_joints(p: Any, client: int, body: int, joints: Sequence[JointInfo],
                                  file=file, param="joints")
         info = by_name.get(name)
         if info is None:
-            from .suggest import hint
+            from urdfkit.core.suggest import hint
 
             known = ", ".join(movable) or "none"
             raise ParameterError(f"`joints`: no joint named {name!r}{hint(name, movable)} "

@@ -1,6 +1,7 @@
 """Config-driven simulation: a scenario in, per-step observations out.
 
-:class:`Simulation` sets up one PyBullet client of its own (a :class:`~urdfkit.session.Session`,
+:class:`Simulation` sets up one PyBullet client of its own (a
+:class:`~urdfkit.engine.session.Session`,
 so several simulations in one process never share a world: every call passes
 ``physicsClientId``), loads the ground and the robots of a scenario, and steps them under their
 controllers. It is the library behind ``urdfkit sim`` and is meant to be driven from a notebook
@@ -24,7 +25,9 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-from . import (
+from urdfkit.core.errors import InputError, ParameterError
+from urdfkit.engine.session import Session
+from urdfkit.motion import (
     sim_control,
     sim_dynamics,
     sim_episode,
@@ -33,10 +36,12 @@ from . import (
     sim_setters,
     sim_world,
 )
-from .errors import InputError, ParameterError
-from .scenario import OBSERVATION_FIELDS, load_scenario, parse_scenario  # noqa: F401 (re-exported)
-from .session import Session
-from .sim_state import (  # noqa: F401  (re-exported: urdfkit.sim's public names)
+from urdfkit.motion.scenario import (  # noqa: F401 (re-exported)
+    OBSERVATION_FIELDS,
+    load_scenario,
+    parse_scenario,
+)
+from urdfkit.motion.sim_state import (  # noqa: F401  (re-exported: urdfkit.sim's public names)
     _ACTIVE,
     _FIXED,
     JointSpec,
@@ -49,7 +54,7 @@ from .sim_state import (  # noqa: F401  (re-exported: urdfkit.sim's public names
     _first,
     _Summary,
 )
-from .sim_writers import (  # noqa: F401  (re-exported: urdfkit.sim's public names)
+from urdfkit.motion.sim_writers import (  # noqa: F401  (re-exported: urdfkit.sim's public names)
     OUTPUT_FORMATS,
     RowText,
     _ByteSink,
@@ -68,7 +73,7 @@ class Simulation:
     """A scenario running in its own PyBullet client.
 
     Args:
-        config: A validated scenario (:func:`urdfkit.scenario.load_scenario`) or the plain
+        config: A validated scenario (:func:`urdfkit.motion.scenario.load_scenario`) or the plain
             dict of one, which is validated here.
         base_dir: Where relative ``urdf`` paths of a dict ``config`` are resolved.
         gui: Open PyBullet's GUI window to watch the run (needs a display).
@@ -101,7 +106,7 @@ class Simulation:
     def from_file(cls, path: str | Path, *, gui: bool = False) -> Simulation:
         """Load and validate a ``.json`` or ``.toml`` scenario and set it up.
 
-        A simulation_and_control config is imported (:mod:`urdfkit.sac`); what the import
+        A simulation_and_control config is imported (:mod:`urdfkit.motion.sac`); what the import
         had to say is in ``simulation.config.notes``.
         """
         return cls(load_scenario(path), gui=gui)
@@ -341,7 +346,7 @@ class Simulation:
         p, client = self.session.p, self.session.client
         index = b.links.get(link)
         if index is None:
-            from .suggest import hint
+            from urdfkit.core.suggest import hint
 
             raise ParameterError(f"`link`: {robot} has no link named {link!r}"
                                  f"{hint(link, b.links)}", param="link")
@@ -419,7 +424,7 @@ def run_to_file(simulation: Simulation, path: str | Path, *, force: bool = False
     every complete row so far (a parquet file gets its footer). Nothing is replaced without
     ``force``. ``also`` gets every batch too, after it is written.
     """
-    from .output import StreamingFile
+    from urdfkit.core.output import StreamingFile
 
     check_output(path, force=force)
     fmt = Path(path).suffix.lower()
@@ -445,7 +450,7 @@ def _run_to_parquet(simulation: Simulation, path: str | Path, *, force: bool,
                     duration: float | None, real_time: bool,
                     also: Callable[[list[Observation]], None] | None = None
                     ) -> tuple[SimResult, Path]:
-    from .output import StreamingFile
+    from urdfkit.core.output import StreamingFile
 
     pa = _pyarrow()
     import pyarrow.parquet as pq

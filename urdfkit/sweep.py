@@ -9,7 +9,8 @@ Design, for what the issue asks of it:
 
 - **Every point is built and validated before any runs** (:func:`plan`): a bad name, path or
   value is one error naming the point, not a failure an hour in.
-- **Each point is the single run it stands for.** A drive point is :func:`urdfkit.drive.drive`
+- **Each point is the single run it stands for.** A drive point is
+:func:`urdfkit.motion.drive.drive`
   on a fresh PyBullet client with exactly the options ``urdfkit drive`` would pass; a sim point
   is a fresh :class:`urdfkit.sim.Simulation` of the edited document. Rows hold what their
   ``--json`` prints (the same rounding), less what is not deterministic (wall time).
@@ -34,19 +35,14 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
-from .errors import (
-    InputError,
-    MissingDependencyError,
-    ParameterError,
-    UrdfkitError,
-)
+from urdfkit.core.errors import InputError, MissingDependencyError, ParameterError, UrdfkitError
 
 # The rows file lives in sweep_journal; its names stay importable from here.
-from .sweep_journal import MAX_ROWS_BYTES as MAX_ROWS_BYTES
-from .sweep_journal import Journal as Journal
-from .sweep_journal import clip as clip
-from .sweep_journal import parse_value as parse_value
-from .sweep_journal import read_rows as read_rows
+from urdfkit.motion.sweep_journal import MAX_ROWS_BYTES as MAX_ROWS_BYTES
+from urdfkit.motion.sweep_journal import Journal as Journal
+from urdfkit.motion.sweep_journal import clip as clip
+from urdfkit.motion.sweep_journal import parse_value as parse_value
+from urdfkit.motion.sweep_journal import read_rows as read_rows
 
 KINDS = ("drive", "sim")
 BACKENDS = ("local", "ray")
@@ -240,7 +236,7 @@ def plan(kind: str, base: Any, vary: Sequence[Vary | str], *, zip_: bool = False
     together (``seconds`` and ``time_step`` too many steps apart) fails that point's row.
 
     Args:
-        kind: ``drive`` (base: a dict of :class:`urdfkit.drive.DriveConfig` fields, with
+        kind: ``drive`` (base: a dict of :class:`urdfkit.motion.drive.DriveConfig` fields, with
             ``template_params`` for the built-in simplecar) or ``sim`` (base: a scenario
             file, or ``(document, base_dir)``).
         base: What every point starts from.
@@ -251,7 +247,7 @@ def plan(kind: str, base: Any, vary: Sequence[Vary | str], *, zip_: bool = False
         ParameterError, InputError: a bad kind, name, path or value, naming the point.
     """
     if kind not in KINDS:
-        from .suggest import hint
+        from urdfkit.core.suggest import hint
 
         raise ParameterError(f"`kind` must be drive or sim, got {kind!r}{hint(kind, KINDS)}",
                              param="kind")
@@ -284,7 +280,7 @@ def _point_label(i: int, values: Mapping[str, Any]) -> str:
 
 
 def _drive_base(base: Any) -> dict[str, Any]:
-    from .drive import DriveConfig
+    from urdfkit.motion.drive import DriveConfig
 
     if isinstance(base, DriveConfig):
         options = {f.name: getattr(base, f.name) for f in fields(DriveConfig)}
@@ -301,8 +297,8 @@ def _drive_base(base: Any) -> dict[str, Any]:
 
 def _drive_point(base: Mapping[str, Any], values: Mapping[str, Any], i: int) -> dict[str, Any]:
     """The DriveConfig fields of one point, checked (a template's parameters included)."""
-    from .catalog import get_template
-    from .drive import DriveConfig
+    from urdfkit.model.catalog import get_template
+    from urdfkit.motion.drive import DriveConfig
 
     options = dict(base)
     params = dict(options.get("template_params") or {})
@@ -317,7 +313,7 @@ def _drive_point(base: Mapping[str, Any], values: Mapping[str, Any], i: int) -> 
                                      "and this sweep drives a --urdf file", param="vary")
             params[name] = str(value)
         else:
-            from .suggest import hint
+            from urdfkit.core.suggest import hint
 
             raise ParameterError(
                 f"`vary` {name!r}: not a drive option or simplecar parameter"
@@ -328,7 +324,7 @@ def _drive_point(base: Mapping[str, Any], values: Mapping[str, Any], i: int) -> 
         options["template_params"] = params
     where = _point_label(i, values)
     if options.get("urdf") is not None:
-        from .resolve import locate
+        from urdfkit.sources.resolve import locate
 
         locate(options["urdf"])  # a missing file, a FIFO or a folder: refused before any runs
     try:
@@ -344,8 +340,8 @@ def _drive_point(base: Mapping[str, Any], values: Mapping[str, Any], i: int) -> 
 
 def _sim_base(base: Any) -> tuple[dict[str, Any], str, str]:
     if isinstance(base, (str, Path)):
-        from . import sac
-        from .scenario import read_document
+        from urdfkit.motion import sac
+        from urdfkit.motion.scenario import read_document
 
         document = read_document(base)
         if sac.is_config(document):
@@ -413,7 +409,7 @@ def set_path(document: dict[str, Any], path: str, value: Any) -> None:
 
 def _sim_point(document: Mapping[str, Any], base_dir: str, source: str,
                values: Mapping[str, Any], i: int) -> dict[str, Any]:
-    from .scenario import parse_scenario
+    from urdfkit.motion.scenario import parse_scenario
 
     edited = copy.deepcopy(dict(document))
     for name, value in values.items():
@@ -454,7 +450,7 @@ _DRIVE_SKIP = ("model", "drivetrain", "simulated", "wall_time", "real_time_facto
 
 
 def _drive_metrics(options: Mapping[str, Any]) -> dict[str, Any]:
-    from .drive import DriveConfig, drive
+    from urdfkit.motion.drive import DriveConfig, drive
 
     result = drive(DriveConfig(**options))
     if result.interrupted:  # drive() stops early on Ctrl-C and says so: so does the sweep
@@ -476,7 +472,7 @@ def _drive_metrics(options: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _sim_metrics(payload: Mapping[str, Any]) -> dict[str, Any]:
-    from .sim import Simulation
+    from urdfkit.sim import Simulation
 
     with Simulation(payload["document"], base_dir=payload["base_dir"]) as s:
         result = s.run(keep=False)
@@ -588,8 +584,8 @@ def _local_rows(todo: Iterable[tuple[int, str, Any]], count: int, jobs: int | No
         return
     import multiprocessing
 
-    from .check import worker_init
-    from .session import import_pybullet
+    from urdfkit.checks.check import worker_init
+    from urdfkit.engine.session import import_pybullet
 
     import_pybullet()  # once, here: the forked workers inherit it, warm
     context = multiprocessing.get_context("fork" if sys.platform.startswith("linux")
@@ -695,7 +691,7 @@ def check_sim_metric(sweep: Plan, metric: str) -> None:
         return
     known = ["steps", "rows", *(f"{r}.{f}" for r in robots for f in SIM_FIELDS),
              *(f"{r}.{f}.JOINT" for r in robots for f in SIM_JOINT_FIELDS)]
-    from .suggest import hint
+    from urdfkit.core.suggest import hint
 
     raise ParameterError(f"`plot` {metric!r} is not a column of this sweep"
                          f"{hint(metric, known)} (columns: {', '.join(known)})", param="plot")
@@ -710,7 +706,7 @@ def check_metric(kind: str, rows: Sequence[Mapping[str, Any]], names: Sequence[s
     """
     known = list(DRIVE_METRICS) if kind == "drive" else metric_names(rows, names)
     if metric not in known:
-        from .suggest import hint
+        from urdfkit.core.suggest import hint
 
         raise ParameterError(f"`plot` {metric!r} is not a numeric column of these rows"
                              f"{hint(metric, known)} (columns: {', '.join(known) or 'none'})",

@@ -193,7 +193,7 @@ def seeds(extra: list[Path] | None = None) -> dict[str, bytes]:
     """Our own robot fixtures, plus real robots from pybullet_data (read, never copied)."""
     here = Path(__file__).parent.parent / "fixtures" / "robots"
     out = {p.name: p.read_bytes() for p in sorted(here.rglob("*.urdf"))}
-    from urdfkit.uris import pybullet_data_path
+    from urdfkit.sources.uris import pybullet_data_path
 
     data = pybullet_data_path()
     for rel in ("r2d2.urdf", "racecar/racecar.urdf", "kuka_iiwa/model.urdf",
@@ -202,7 +202,7 @@ def seeds(extra: list[Path] | None = None) -> dict[str, bytes]:
             out[rel] = (data / rel).read_bytes()
     for p in extra or []:
         out[p.name] = p.read_bytes()
-    from urdfkit.xmlio import tolerate_quirks
+    from urdfkit.model.xmlio import tolerate_quirks
 
     # pybullet_data holds XML quirks (trailing NUL bytes...): mutate the repaired text.
     return {name: tolerate_quirks(data)[0] for name, data in out.items()}

@@ -5,7 +5,7 @@ from typing import Annotated
 
 import typer
 
-from urdfkit import present as show
+from urdfkit.commands import present as show
 from urdfkit.commands.shared import (
     ArgOpt,
     ForceOpt,
@@ -42,8 +42,8 @@ def build(
     docs/security.md). What PyBullet loads is written: check's errors on it are warnings
     (--strict refuses them); what would crash PyBullet is refused.
     """
-    from urdfkit import build as building
-    from urdfkit.uris import parse_packages
+    from urdfkit.checks import build as building
+    from urdfkit.sources.uris import parse_packages
 
     result = building.build(target, params=set_, xacro_args=arg,
                             packages=parse_packages(package, package_path), strict=strict)
@@ -63,7 +63,7 @@ def templates(
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """List the built-in templates with their parameters and defaults."""
-    from urdfkit.catalog import TEMPLATES
+    from urdfkit.model.catalog import TEMPLATES
 
     if as_json:
         show.print_json({"templates": [

@@ -7,7 +7,7 @@ from typing import Annotated, Any
 
 import typer
 
-from urdfkit import present as show
+from urdfkit.commands import present as show
 from urdfkit.commands.shared import (
     AllOpt,
     ArgOpt,
@@ -72,12 +72,12 @@ def check(
     Exit 0: nothing at or above --fail-on; 1: findings at or above it; 2: unusable
     invocation; 3: a bug in urdfkit. See docs/check.md for every rule code.
     """
-    from urdfkit.check import check_paths, parse_codes
-    from urdfkit.errors import ParameterError
-    from urdfkit.uris import parse_packages
+    from urdfkit.checks.check import check_paths, parse_codes
+    from urdfkit.core.errors import ParameterError
+    from urdfkit.sources.uris import parse_packages
 
     if fail_on not in ("error", "warning", "info"):
-        from urdfkit.suggest import hint
+        from urdfkit.core.suggest import hint
 
         raise ParameterError(f"`fail_on` expects error, warning or info, got {fail_on!r}"
                              f"{hint(fail_on, ('error', 'warning', 'info'))}", param="fail_on")
@@ -96,11 +96,11 @@ def check(
 
 
 def _check_format(output_format: str | None, as_json: bool) -> str:
-    from urdfkit.ci import FORMATS
-    from urdfkit.errors import ParameterError
+    from urdfkit.checks.ci import FORMATS
+    from urdfkit.core.errors import ParameterError
 
     if output_format is not None and output_format not in FORMATS:
-        from urdfkit.suggest import hint
+        from urdfkit.core.suggest import hint
 
         raise ParameterError(f"`format` expects {', '.join(FORMATS)}, got {output_format!r}"
                              f"{hint(output_format, FORMATS)}", param="format")
@@ -113,7 +113,7 @@ def _check_format(output_format: str | None, as_json: bool) -> str:
 def _xacro_args(items: list[str] | None) -> dict[str, str]:
     if not items:
         return {}
-    from urdfkit.catalog import parse_assignments  # imports the builder: only when needed
+    from urdfkit.model.catalog import parse_assignments  # imports the builder: only when needed
 
     return parse_assignments(items, "xacro_args")
 
@@ -146,7 +146,7 @@ def diff(
     alone; PyBullet is not loaded. Exit 0 when the robots are the same, 1 when they differ.
     --package, --package-path and --arg apply to both files; see docs/diff.md.
     """
-    from urdfkit.diff import diff_files
+    from urdfkit.checks.diff import diff_files
 
     result = diff_files(old, new, tolerance=tolerance, packages=package, xacro_args=arg,
                         guard=not no_guard, package_paths=package_path)
@@ -198,9 +198,9 @@ def fix(
     nothing left to fix; 1: findings were left (listed), or --diff shows changes; 2: bad
     input or usage.
     """
-    from urdfkit.fix import fix_file
-    from urdfkit.output import check_output
-    from urdfkit.uris import parse_packages
+    from urdfkit.checks.fix import fix_file
+    from urdfkit.core.output import check_output
+    from urdfkit.sources.uris import parse_packages
 
     codes = _check_fix_options(output, in_place, show_diff, as_json, select)
     backup = f"{file}.orig"
@@ -233,9 +233,9 @@ def fix(
 def _check_fix_options(output: str | None, in_place: bool, show_diff: bool, as_json: bool,
                        select: list[str] | None) -> tuple[str, ...]:
     """Refuse options that do not go together; the rule codes ``--select`` keeps."""
-    from urdfkit.check import parse_codes
-    from urdfkit.errors import ParameterError
-    from urdfkit.fix import FIXABLE
+    from urdfkit.checks.check import parse_codes
+    from urdfkit.checks.fix import FIXABLE
+    from urdfkit.core.errors import ParameterError
 
     if sum((output is not None, in_place, show_diff)) != 1:
         raise ParameterError("say where the repaired file goes: -o OUT, --in-place, or --diff "
@@ -260,7 +260,7 @@ def _say_mass_changes(file: str, result: Any, *, refuse: bool, quiet: bool) -> N
     for them (the file's own masses untouched): said, not refused (16 of 24 real robots
     would otherwise need the flag for fix to do anything).
     """
-    from urdfkit.errors import ParameterError
+    from urdfkit.core.errors import ParameterError
 
     for what, before, after, guarded in (
             ("total mass", result.mass_before, result.mass_after, True),
@@ -282,7 +282,7 @@ def _say_mass_changes(file: str, result: Any, *, refuse: bool, quiet: bool) -> N
 def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, force: bool,
                  as_json: bool, report: Callable[[], None]) -> None:
     """Write the repaired file to stdout, in place (keeping FILE.orig) or to ``output``."""
-    from urdfkit.output import atomic_write
+    from urdfkit.core.output import atomic_write
 
     backup = f"{file}.orig"
     if output == "-":
@@ -348,10 +348,10 @@ def collisions(
     0, they print filters. Parent-child pairs are skipped: PyBullet never tests them. See
     docs/collisions.md.
     """
-    from urdfkit.collisions import self_collisions
-    from urdfkit.errors import ParameterError
-    from urdfkit.render import parse_joint_positions
-    from urdfkit.uris import parse_packages
+    from urdfkit.checks.collisions import self_collisions
+    from urdfkit.core.errors import ParameterError
+    from urdfkit.draw.render import parse_joint_positions
+    from urdfkit.sources.uris import parse_packages
 
     if sum((as_json, srdf, python)) > 1:
         raise ParameterError("--json, --srdf and --python are exclusive: pick one")

@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from urdfkit import present as show
+from urdfkit.commands import present as show
 from urdfkit.commands.shared import (
     ArgOpt,
     FileArg,
@@ -56,7 +56,7 @@ def render(
     no_guard: NoGuardOpt = False,
 ) -> None:
     """Draw a robot to a PNG, headless (PyBullet's TinyRenderer: no GPU, no display)."""
-    from urdfkit import render as rendering
+    from urdfkit.draw import render as rendering
 
     width, height = rendering.parse_size(size)
     if views is None:
@@ -114,7 +114,7 @@ def view(
     the page reloads when the file or its includes and meshes change.
     Serves until Ctrl-C (exit 130). See docs/view.md.
     """
-    from urdfkit.view import Viewer
+    from urdfkit.draw.view import Viewer
 
     viewer = Viewer(file, packages=package, package_paths=package_path, xacro_args=arg,
                     inertia_from_file=inertia_from_file, host=host, port=port)

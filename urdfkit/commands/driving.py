@@ -4,7 +4,7 @@ from typing import Annotated, Any
 
 import typer
 
-from urdfkit import present as show
+from urdfkit.commands import present as show
 from urdfkit.commands.shared import (
     FROM_LIBRARY,
     AllOpt,
@@ -93,14 +93,14 @@ def drive(
     Wheels (continuous joints about a horizontal axis) and steering hinges (revolute joints
     about a vertical axis that carry wheels) are detected. See docs/drive.md.
     """
-    from urdfkit.drive import DriveConfig, Scenario
+    from urdfkit.motion.drive import DriveConfig, Scenario
 
     pace = _check_drive_options(seconds=seconds, steps=steps, tutorial=tutorial,
                                 drivetrain=drivetrain, max_force=max_force, gui=gui, view=view,
                                 speed=speed, trajectory=trajectory, plot=plot, force=force)
     params = None
     if set_:
-        from urdfkit.catalog import parse_assignments  # imports the builder: only when needed
+        from urdfkit.model.catalog import parse_assignments  # imports the builder: only when needed
 
         params = parse_assignments(set_, "template_params")
     # seconds and max_force not given: DriveConfig's own defaults.
@@ -120,7 +120,7 @@ def drive(
         result, written = _drive_run(sc, trajectory, force=force, stream=stream,
                                      quiet=as_json or view)
     if plot is not None:
-        from urdfkit.plot import write_plot
+        from urdfkit.draw.plot import write_plot
 
         written.append(write_plot(result, plot, force=force))
     _drive_report(result, written, said, as_json)
@@ -131,7 +131,7 @@ def use_library_defaults() -> None:
     """Give drive's and sweep's options DriveConfig's defaults (written once, in the library)."""
     from dataclasses import fields
 
-    from urdfkit.drive import DriveConfig
+    from urdfkit.motion.drive import DriveConfig
 
     defaults = {f.name: f.default for f in fields(DriveConfig)}
     library_defaults(drive, defaults)
@@ -145,10 +145,10 @@ def _check_drive_options(*, seconds: float | None, steps: int | None, tutorial: 
     """Refuse what cannot run together, and unwritable outputs, before the run; the pace."""
     from dataclasses import fields
 
-    from urdfkit.drive import DriveConfig
-    from urdfkit.drive_result import trajectory_format
-    from urdfkit.errors import ParameterError
-    from urdfkit.session import has_display
+    from urdfkit.core.errors import ParameterError
+    from urdfkit.engine.session import has_display
+    from urdfkit.motion.drive import DriveConfig
+    from urdfkit.motion.drive_result import trajectory_format
 
     if seconds is not None and steps is not None:
         raise ParameterError("give `seconds` or `steps`, not both", param="seconds")
@@ -165,12 +165,12 @@ def _check_drive_options(*, seconds: float | None, steps: int | None, tutorial: 
                              "headless, or use --view", param="gui")
     # Check the outputs before a long run, not after it.
     if trajectory is not None:
-        from urdfkit.output import check_output
+        from urdfkit.core.output import check_output
 
         trajectory_format(trajectory)
         check_output(trajectory, force=force)
     if plot is not None:
-        from urdfkit.plot import check_plot_path
+        from urdfkit.draw.plot import check_plot_path
 
         check_plot_path(plot, force=force)
     return pace
@@ -201,7 +201,7 @@ def _drive_run(sc: Any, trajectory: str | None, *, force: bool, stream: Any,
         if trajectory is None:
             result = sc.run(progress, sink=stream)
         else:
-            from urdfkit.drive import drive_to_file
+            from urdfkit.motion.drive import drive_to_file
 
             result, path = drive_to_file(sc, trajectory, force=force, progress=progress,
                                          sink=stream)
@@ -246,8 +246,8 @@ def _run_view(sc: Any, config: Any, pace: float | None, port: int | None) -> Any
     """Start the page a run streams to (drive --view), and say where it is."""
     import math
 
-    from urdfkit.view import Viewer
-    from urdfkit.view_stream import RunStream
+    from urdfkit.draw.view import Viewer
+    from urdfkit.draw.view_stream import RunStream
 
     total = config.total_steps * config.time_step
     reach = abs(config.throttle) * sc.drivetrain.reference_radius * total
@@ -341,7 +341,7 @@ def sweep(
     rows are written as points finish. Exit 0: every point ran; 1: some failed (their rows say
     why); 2: bad input; 130: interrupted (the rows so far are kept). See docs/sweep.md.
     """
-    from urdfkit import sweep_run
+    from urdfkit.motion import sweep_run
 
     request = sweep_run.SweepRequest(
         kind=kind, vary=vary, scenario=scenario, zip_=zip_, jobs=jobs, backend=backend,

@@ -5,7 +5,7 @@ from typing import Annotated, Any
 
 import typer
 
-from urdfkit import present as show
+from urdfkit.commands import present as show
 from urdfkit.commands.shared import (
     AllOpt,
     ArgOpt,
@@ -29,12 +29,12 @@ def _inspect(file: str, package: list[str] | None, arg: list[str] | None, *,
              fixed_base: bool = False, inertia_from_file: bool = False,
              links: bool = False, info: bool = False, no_guard: bool = False,
              package_path: list[str] | None = None, flags: str | None = None) -> Any:
-    from urdfkit.report import inspect_file
-    from urdfkit.session import LoadOptions, parse_flags
+    from urdfkit.engine.report import inspect_file
+    from urdfkit.engine.session import LoadOptions, parse_flags
 
     if flags is not None:
         if inertia_from_file:
-            from urdfkit.errors import ParameterError
+            from urdfkit.core.errors import ParameterError
 
             raise ParameterError("give --inertia-from-file or --flags (with "
                                  "URDF_USE_INERTIA_FROM_FILE in it), not both", param="flags")
@@ -201,7 +201,7 @@ def tree(
     Read from the file alone; PyBullet is not loaded. \[n] is the index PyBullet will give
     the joint. --json is flat: every joint with its parent and child link, in index order.
     """
-    from urdfkit.tree import kinematic_tree
+    from urdfkit.draw.tree import kinematic_tree
 
     if dot or output is not None:
         _tree_dot(file, package, arg, output, force, as_json, no_guard, package_path)
@@ -262,8 +262,8 @@ def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
               output: str | None, force: bool, as_json: bool, no_guard: bool,
               package_path: list[str] | None) -> None:
     """``tree --dot`` / ``tree -o graph.svg``: the kinematic graph as DOT text or a drawing."""
-    from urdfkit.errors import ParameterError
-    from urdfkit.graph import check_output, dot_graph, write_graph
+    from urdfkit.core.errors import ParameterError
+    from urdfkit.draw.graph import check_output, dot_graph, write_graph
 
     if as_json:
         raise ParameterError("--json and --dot/-o are different outputs; choose one")

@@ -11,7 +11,7 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 
-from urdfkit import present as show
+from urdfkit.commands import present as show
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -121,7 +121,7 @@ FileArg = Annotated[str, typer.Argument(
 def open_input(file: str, package: list[str] | None, arg: list[str] | None, no_guard: bool,
                package_path: list[str] | None = None, meshes: bool = True) -> Any:
     """The robot file resolved (xacro expanded, packages found, guarded), warnings said."""
-    from urdfkit.resolve import open_input as resolve_input
+    from urdfkit.sources.resolve import open_input as resolve_input
 
     resolved = resolve_input(file, package, arg, guard=not no_guard,
                              package_paths=package_path, meshes=meshes)
@@ -177,7 +177,7 @@ def parse_speed(text: str) -> float | None:
     """``--speed``: a positive factor, or None for ``max``."""
     import math
 
-    from urdfkit.errors import ParameterError
+    from urdfkit.core.errors import ParameterError
 
     if text.strip().lower() == "max":
         return None

@@ -6,7 +6,7 @@ from typing import Annotated, Any
 
 import typer
 
-from urdfkit import present as show
+from urdfkit.commands import present as show
 from urdfkit.commands.shared import (
     ForceOpt,
     JsonOpt,
@@ -97,7 +97,7 @@ def sim(
 
 def _check_convert(config: str | None, run_options: bool) -> None:
     """``sim convert`` needs a config, and takes none of the run's options."""
-    from urdfkit.errors import ParameterError
+    from urdfkit.core.errors import ParameterError
 
     if config is None:
         raise ParameterError("convert needs the simulation_and_control config: "
@@ -111,8 +111,8 @@ def _check_convert(config: str | None, run_options: bool) -> None:
 def _check_sim_options(scenario: str, config: str | None, *, gui: bool, real_time: bool,
                        view: bool, speed: str) -> float | None:
     """Refuse what cannot run together, before the run; the pace of ``--view``."""
-    from urdfkit.errors import ParameterError
-    from urdfkit.session import has_display
+    from urdfkit.core.errors import ParameterError
+    from urdfkit.engine.session import has_display
 
     if config is not None:
         raise ParameterError(f"one scenario at a time; got {scenario!r} and {config!r} (to "
@@ -169,12 +169,12 @@ def _sim_table(scenario: str, result: Any, summaries: list[Any], written: Any) -
 
 def _sim_view(s: Any, pace: float | None, port: int | None) -> Any:
     """Start the page a scenario streams to (sim --view): every robot, and say where."""
-    from urdfkit.view import Viewer
-    from urdfkit.view_stream import RunStream
+    from urdfkit.draw.view import Viewer
+    from urdfkit.draw.view_stream import RunStream
 
     bodies = [b for b in s.bodies.values() if b.loaded is not None]
     if not bodies:
-        from urdfkit.errors import ParameterError
+        from urdfkit.core.errors import ParameterError
 
         raise ParameterError("the scenario has no robot to show", param="view")
     first, options = bodies[0].loaded
@@ -195,10 +195,10 @@ def _sim_view(s: Any, pace: float | None, port: int | None) -> Any:
 
 def _sim_convert(config: str, out: str | None, force: bool) -> None:
     """``sim convert``: a simulation_and_control config as a native TOML scenario."""
-    from urdfkit import sac
-    from urdfkit.errors import InputError
-    from urdfkit.output import atomic_write, check_output
-    from urdfkit.scenario import read_document
+    from urdfkit.core.errors import InputError
+    from urdfkit.core.output import atomic_write, check_output
+    from urdfkit.motion import sac
+    from urdfkit.motion.scenario import read_document
 
     if out is not None and out != "-":
         check_output(out, force=force, suffixes=(".toml",), what="the scenario")
@@ -208,7 +208,7 @@ def _sim_convert(config: str, out: str | None, force: bool) -> None:
                          "env_pybullet or robot_pin section); it is already a scenario",
                          file=config)
     imported = sac.convert(data, source=config)
-    from urdfkit.scenario import parse_scenario
+    from urdfkit.motion.scenario import parse_scenario
 
     parse_scenario(imported.scenario, source=config)  # what is written must load
     for note in imported.notes:

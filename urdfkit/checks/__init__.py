@@ -1,0 +1,1 @@
+"""urdfkit.checks: see docs/architecture.md. Imports nothing."""

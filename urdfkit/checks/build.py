@@ -1,0 +1,149 @@
+"""``urdfkit build``: a template or a xacro file in, checked URDF bytes out.
+
+A template is built by urdfkit's own model, strictly. A xacro file is expanded and written as
+PyBullet would load it: what would crash PyBullet (the guard's refusals) is refused, with the
+file and line it was written on; every other ``check`` error (an inertia that is not positive
+definite, a mass of 0 on a moving link) is reported as a warning and the file is written, as
+PyBullet loads it. ``strict`` makes such errors refuse the build instead (exit 1, nothing
+written).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from urdfkit.checks.validate import ALL_RULES
+from urdfkit.core.errors import InputError, ParameterError
+from urdfkit.core.finding import Finding
+from urdfkit.core.output import atomic_write
+from urdfkit.model.catalog import TEMPLATES, build_template, parse_assignments
+from urdfkit.model.xmlio import parse_xml, read_bytes, to_bytes, xacro_marker
+from urdfkit.sources.expand import expand_xacro
+from urdfkit.sources.guard import GUARD_CODES, guard_findings, run_rules
+from urdfkit.sources.resolve import locate
+
+
+@dataclass
+class BuildResult:
+    """A built URDF, not yet written.
+
+    Attributes:
+        data: The URDF bytes.
+        default_output: The file name to write when none is given.
+        links: How many links it has.
+        joints: How many joints.
+        warnings: ``check``'s errors on it (a xacro build writes them as warnings), each
+            ``file[:line]: message (code)`` with the file and line it was written on.
+    """
+
+    data: bytes
+    default_output: str
+    links: int
+    joints: int
+    warnings: list[str] = field(default_factory=list)
+
+
+class BuildFindings(InputError):
+    """``strict``: the expanded file has ``check`` errors; nothing is written (exit 1)."""
+
+    exit_code = 1
+
+
+def _where(f: Finding) -> str:
+    """Where a finding on xacro output was written: its origin, else the file alone."""
+    return f.origin if f.origin else f.file
+
+
+def build(target: str, params: list[str] | None = None,
+          xacro_args: list[str] | None = None,
+          packages: Mapping[str, Path] | None = None, strict: bool = False) -> BuildResult:
+    """Build ``target``: a built-in template name, or a path to a ``.xacro`` file.
+
+    ``packages`` (a :class:`~urdfkit.sources.uris.PackageIndex` or ``NAME: PATH`` pairs) answers the
+    file's ``$(find NAME)`` and ``package://NAME`` references, as in every loading command.
+    A ``.urdf`` that holds xacro (``${...}``, ``$(arg ...)``, ``<xacro:...>``) is expanded
+    like a ``.xacro``. ``strict``: see the module docstring.
+
+    Raises:
+        InputError: the file cannot be expanded, or holds what crashes PyBullet.
+        BuildFindings: ``strict``, and ``check`` finds errors in the expanded file.
+    """
+    if target in TEMPLATES:
+        if xacro_args:
+            raise ParameterError("`xacro_args` are for xacro files, not templates",
+                                 param="xacro_args")
+        robot = build_template(target, parse_assignments(params))
+        data = robot.to_bytes()
+        default = f"{target}.urdf"
+        name = f"template {target}"
+        base = None
+    else:
+        path = Path(target)
+        if path.suffix != ".xacro" and not path.exists():
+            from urdfkit.core.suggest import files, hint
+
+            known = ", ".join(TEMPLATES)
+            close = [repr(f) for f in files(target)]
+            more = hint(target, TEMPLATES) or (f"; did you mean {' or '.join(close)}?"
+                                               if close else "")
+            raise ParameterError(f"'{target}' is neither a template ({known}) nor a file{more}")
+        if params:
+            raise ParameterError("`params` are for built-in templates; xacro files take "
+                                 "`xacro_args`", param="params")
+        source = locate(target)
+        if source.suffix != ".xacro" and xacro_marker(read_bytes(source)) is None:
+            raise InputError("build takes a template name or a xacro file; this file is "
+                             "already URDF (it holds no xacro)", file=target)
+        return _build_xacro(source, target, parse_assignments(xacro_args, "xacro_args"),
+                            packages, strict)
+    # The same rules `urdfkit check` runs: what build writes, check accepts.
+    tree = parse_xml(data, name)
+    errors = [f for f in run_rules(tree.getroot(), name, ALL_RULES, base=base, packages=packages)
+              if f.level == "error"]
+    if errors:
+        raise InputError(f"the built URDF is invalid: {errors[0].message} ({errors[0].code})",
+                         file=name)
+    return BuildResult(data, default, len(robot.links), len(robot.joints))
+
+
+def _build_xacro(source: Path, target: str, args: Mapping[str, str],
+                 packages: Mapping[str, Path] | None, strict: bool) -> BuildResult:
+    """Expand, refuse only what crashes PyBullet, and report check's errors as warnings."""
+    expanded = expand_xacro(source, args, display=target, packages=packages)
+    tree = parse_xml(expanded, target)
+    root = tree.getroot()
+    origins = expanded.origins
+    refused = [f for f in guard_findings(root, target, origins) if f.code in GUARD_CODES]
+    if refused:
+        f = refused[0]
+        # The line of xacro's output means nothing to the user: the element's own file and
+        # line when xacro says where it was written, else the file alone.
+        at, _, line = (f.origin or "").rpartition(":")
+        raise InputError(f.message, file=at or target,
+                         line=int(line) if at and line.isdigit() else None)
+    findings = run_rules(root, target, ALL_RULES, base=source.resolve().parent,
+                         packages=packages, origins=origins)
+    errors = [f for f in findings if f.level == "error"]
+    if strict and errors:
+        f = errors[0]
+        more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+        raise BuildFindings(f"{f.message} ({f.code}){more}; nothing written (--strict)",
+                            file=_where(f))
+    if source.suffix == ".xacro":
+        default = source.name.removesuffix(".xacro")
+        if not default.endswith(".urdf"):
+            default += ".urdf"
+    else:  # a .urdf holding xacro: never the input's own name
+        default = f"{source.stem}.expanded.urdf"
+    warnings = [f"{_where(f)}: {f.message} ({f.code}); PyBullet loads it as written"
+                for f in errors]
+    links = sum(1 for el in root if el.tag == "link")
+    joints = sum(1 for el in root if el.tag == "joint")
+    return BuildResult(to_bytes(root), default, links, joints, warnings)
+
+
+def write_output(path: str, data: bytes, *, force: bool) -> Path:
+    """Write atomically, never replacing a file without ``force``."""
+    return atomic_write(path, data, force=force)

@@ -1,0 +1,471 @@
+"""``urdfkit check``: run every validation rule over many files, in parallel, never crashing.
+
+Folders are searched recursively for ``*.urdf`` and ``*.xacro``; xacro is expanded in a
+subprocess (:func:`urdfkit.sources.expand.expand_xacro`). Each file is checked on its own: a file
+that cannot be read, expanded or parsed becomes a ``U000`` error finding for that file, never
+an exception, so one broken file cannot stop a sweep over a thousand others. PyBullet is never
+loaded: checking is pure lxml, which is what makes it safe on hostile input and fast.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import sys
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from urdfkit.core.errors import InputError, ParameterError
+from urdfkit.core.finding import LEVELS, Finding
+from urdfkit.model.spec import PYBULLET_LINE_BYTES
+
+if TYPE_CHECKING:
+    from urdfkit.checks.resultcache import ResultCache, RunManifest
+
+#: File suffixes a folder search picks up.
+SUFFIXES = (".urdf", ".xacro")
+#: Findings that say the same thing of every file: reported once per run, on the first file.
+ONCE_PER_RUN = frozenset({"U607"})
+#: Below this many files a process pool costs more than it saves.
+_PARALLEL_MIN = 8
+
+
+@dataclass
+class FileResult:
+    """The findings of one file."""
+
+    file: str
+    findings: list[Finding] = field(default_factory=list)
+    #: Whether the findings came from the result cache (not in the JSON).
+    cached: bool = field(default=False, compare=False)
+    #: What the run's manifest keeps of a cacheable result: the file's stat, the paths it
+    #: read with their signatures, the findings as dicts
+    #: (:class:`urdfkit.checks.resultcache.RunManifest`).
+    entry: tuple[tuple[int, int, int, int], dict[str, Any], list[dict[str, Any]]] | None = \
+        field(default=None, compare=False, repr=False)
+
+    def count(self, level: str) -> int:
+        """How many findings of ``level``."""
+        return sum(1 for f in self.findings if f.level == level)
+
+
+@dataclass
+class CheckResult:
+    """The findings of a whole ``check`` run, file by file in discovery order."""
+
+    files: list[FileResult]
+
+    @property
+    def findings(self) -> list[Finding]:
+        """Every finding, file by file."""
+        return [f for fr in self.files for f in fr.findings]
+
+    def summary(self) -> dict[str, int]:
+        """Counts for the summary line and the JSON ``summary``."""
+        return {
+            "files": len(self.files),
+            "files_with_errors": sum(1 for fr in self.files if fr.count("error")),
+            **{level: sum(fr.count(level) for fr in self.files) for level in reversed(LEVELS)},
+        }
+
+    def exit_code(self, fail_on: str = "error") -> int:
+        """0 if nothing is at or above ``fail_on``, else 1."""
+        threshold = LEVELS.index(fail_on)
+        return int(any(LEVELS.index(f.level) >= threshold for f in self.findings))
+
+    def to_dict(self) -> dict[str, object]:
+        """The ``--json`` form."""
+        # A finding's fields are its dict (Finding.to_dict's keys, in its order), read-only here.
+        return {"files": [fr.file for fr in self.files],
+                "findings": [vars(f) for f in self.findings],
+                "summary": self.summary()}
+
+
+def parse_codes(items: Sequence[str] | None, option: str) -> tuple[str, ...]:
+    """Parse ``--select``/``--ignore`` values: codes or code prefixes, comma-separated.
+
+    A prefix selects a family (``U6`` is every mass and inertia rule).
+
+    Raises:
+        ParameterError: a value matches no known code.
+    """
+    if not items:
+        return ()
+    from urdfkit.checks.validate import CODES
+
+    out: list[str] = []
+    for item in items:
+        for code in (c.strip().upper() for c in item.split(",")):
+            if not code:
+                continue
+            if not any(k.startswith(code) for k in CODES):
+                raise ParameterError(f"{option} {code}: no such rule code (see docs/check.md; "
+                                     f"codes run {min(CODES)}..{max(CODES)})")
+            out.append(code)
+    return tuple(out)
+
+
+def discover(paths: Iterable[str | Path]) -> list[tuple[str, str, str | None]]:
+    """Expand the command-line paths into ``(display name, path, problem)`` triples.
+
+    A folder is walked with ``os.scandir`` (not following symlinked folders, so a link loop
+    cannot trap the walk), entries sorted per folder. Every entry named ``*.urdf`` or
+    ``*.xacro`` is listed whatever it is (a FIFO, a device, a folder): reading reports what it
+    really is. A folder that cannot be listed comes back with its ``problem``, to be reported,
+    never skipped.
+
+    Raises:
+        ParameterError: a path given on the command line does not exist (exit code 2).
+    """
+    out: list[tuple[str, str, str | None]] = []
+    seen: set[str] = set()
+
+    def add(display: str, path: str, problem: str | None = None) -> None:
+        key = os.path.abspath(path)
+        if key not in seen:
+            seen.add(key)
+            out.append((display, path, problem))
+
+    for item in paths:
+        path = Path(item)
+        if not os.path.lexists(path):
+            raise ParameterError(f"{item}: no such file or folder")
+        if path.is_dir() and path.suffix not in SUFFIXES:
+            stack = [str(path)]
+            while stack:
+                folder = stack.pop()
+                try:
+                    with os.scandir(folder) as it:
+                        entries = sorted(it, key=lambda e: e.name)
+                except OSError as e:
+                    add(folder, folder, f"cannot list this folder: {e.strerror}")
+                    continue
+                subdirs = []
+                for entry in entries:
+                    try:
+                        is_dir = entry.is_dir(follow_symlinks=False)
+                    except OSError:
+                        is_dir = False
+                    if entry.name.endswith(SUFFIXES):
+                        add(entry.path, entry.path)
+                    elif is_dir:
+                        subdirs.append(entry.path)
+                stack.extend(reversed(subdirs))
+        else:
+            add(str(item), str(path))
+    return out
+
+
+def _read(path: Path, display: str, no_exec: bool = False,
+          packages: Mapping[str, Path] | None = None,
+          xacro_args: Mapping[str, str] | None = None) -> bytes:
+    from urdfkit.model.xmlio import read_bytes
+    from urdfkit.sources.expand import expand_xacro
+
+    if path.suffix == ".xacro":
+        from urdfkit.sources.uris import not_a_file
+
+        why = not_a_file(path)
+        if why is not None:  # never hand xacro a FIFO to block on
+            raise InputError(f"is {why}, not a regular file; urdfkit reads only regular files"
+                             if why != "missing" else "no such file", file=display)
+        return expand_xacro(path, xacro_args, display=display, no_exec=no_exec,
+                            packages=packages, strict_args=False)
+    return read_bytes(path)
+
+
+def check_file(display: str, path: str | Path,
+               packages: Mapping[str, Path] | None = None, no_exec: bool = False,
+               xacro_args: Mapping[str, str] | None = None,
+               physics: bool = False) -> FileResult:
+    """Run every rule on one file; any failure to read it becomes a ``U000`` finding.
+
+    With ``no_exec`` (or URDFKIT_NO_EXEC set) a xacro file is not expanded: it gets one
+    ``U006`` warning saying so, and is otherwise unchecked. With ``physics`` a file with no
+    error is also loaded in PyBullet and tested for self-collision at its zero pose (U950).
+    """
+    from lxml import etree
+
+    from urdfkit.checks.validate import ALL_RULES
+    from urdfkit.model.xmlio import (
+        line_of,
+        long_line,
+        parse_xml,
+        tolerate_quirks,
+        xacro_marker,
+        xacro_note,
+    )
+    from urdfkit.sources.expand import XacroNotExpanded
+    from urdfkit.sources.guard import refuse_oversized, run_rules
+
+    path = Path(path)
+    result = FileResult(display)
+    try:
+        data = _read(path, display, no_exec, packages, xacro_args)
+        refuse_oversized(data, display)
+        _, quirks = tolerate_quirks(data)
+        tree = parse_xml(data, display)
+    except XacroNotExpanded as e:
+        result.findings.append(Finding("U006", "warning", e.message, display))
+        return result
+    except InputError as e:
+        code = getattr(e, "code", "U000")  # U209 for a body refused before parsing
+        result.findings.append(Finding(code, "error", e.message, display, e.line))
+        return result
+    except (OSError, ValueError, etree.LxmlError) as e:  # belt and braces: never crash a sweep
+        result.findings.append(Finding("U000", "error", f"cannot check: {e}", display))
+        return result
+    result.findings.extend(Finding("U004", "warning", note, display, line)
+                           for line, note in quirks)
+    xacro = xacro_marker(data) if path.suffix != ".xacro" else None
+    if xacro is not None:
+        result.findings.append(Finding("U009", "warning", xacro_note(xacro[1]), display,
+                                       xacro[0]))
+    too_long = long_line(data) if path.suffix != ".xacro" else None
+    if too_long is not None:
+        result.findings.append(Finding(
+            "U008", "warning", f"line {too_long[0]} is {too_long[1]} bytes long: PyBullet reads "
+            f"lines in {PYBULLET_LINE_BYTES}-byte pieces and breaks them there, so p.loadURDF "
+            "refuses or misreads the file when a break falls inside a name (urdfkit loads a "
+            "reformatted copy); put one element per line", display, too_long[0]))
+    if path.suffix == ".xacro" and _macro_library(tree.getroot()):
+        result.findings.append(Finding("U007", "info", "a xacro macro library (no links of its "
+                                       "own): checked through the files that include it",
+                                       display))
+        return result
+    found = run_rules(tree.getroot(), display, ALL_RULES, base=path.absolute().parent,
+                      packages=packages, origins=getattr(data, "origins", None))
+    if path.suffix == ".xacro":
+        # Lines of xacro's output are not lines of the file the user wrote: none, not a false
+        # one (each message names its element).
+        found = [dataclasses.replace(f, line=None) for f in found]
+    result.findings.extend(found)
+    if physics and not any(f.level == "error" for f in result.findings):
+        lines = {} if path.suffix == ".xacro" else \
+            {el.get("name"): line_of(el) for el in tree.getroot().iterchildren("link")}
+        result.findings.extend(physics_findings(display, path, lines, packages, xacro_args))
+    result.findings.sort(key=lambda f: f.line or 0)
+    return result
+
+
+def physics_findings(display: str, path: Path, lines: Mapping[str | None, int | None],
+                     packages: Mapping[str, Path] | None = None,
+                     xacro_args: Mapping[str, str] | None = None) -> list[Finding]:
+    """``check --physics``: load the file in PyBullet and test its zero pose (U950, U951).
+
+    Only files with no error finding get here: the rules have ruled out every crash class.
+    """
+    from urdfkit.checks.collisions import self_collisions
+    from urdfkit.core.errors import UrdfkitError
+    from urdfkit.sources.resolve import resolve
+
+    try:
+        with resolve(path, packages=packages, xacro_args=xacro_args,
+                     strict_args=False) as resolved:
+            resolved.name = display
+            found = self_collisions(resolved, packages=packages)
+    except UrdfkitError as e:
+        return [Finding("U951", "error", f"PyBullet cannot load it: {e.message}", display,
+                        e.line)]
+    args = " with the same --arg values" if xacro_args and path.suffix == ".xacro" else ""
+    out = []
+    for x in found.pairs:
+        hull = (f"; {' and '.join(x.hull)} collide{'s' if len(x.hull) == 1 else ''} as a "
+                "convex hull, so the contact may be in a dip of the mesh") if x.hull else ""
+        out.append(Finding(
+            "U950", "warning", f"links {x.link_a!r} and {x.link_b!r} "
+            f"{'interpenetrate by' if x.distance < 0 else 'touch at'} "
+            f"{abs(x.distance) * 1000:.3g} mm at the zero pose: once self-collision is on "
+            "(URDF_USE_SELF_COLLISION) PyBullet pushes them apart every step and the robot "
+            f"jitters; fix the shapes, or disable the pair (urdfkit collisions {display} --python "
+            f"or --srdf{args}){hull}", display, lines.get(x.link_a)))
+    return out
+
+
+def _macro_library(root: object) -> bool:
+    """A xacro file that only defines macros or properties: after expansion, no <link>.
+
+    Real libraries carry a ``name`` (franka_description's franka_arm.xacro) or use ROS 1's
+    ``<root>`` element (pr2_description's sensors); what marks them is that expanding them
+    alone makes nothing.
+    """
+    from lxml import etree
+
+    assert isinstance(root, etree._Element)
+    return root.tag in ("robot", "root") and root.find("link") is None
+
+
+_Job = tuple[str, str, str | None, dict[str, str], bool, dict[str, str], bool, bool]
+_caches: dict[tuple[object, ...], object] = {}
+
+
+def _result_cache(packages: Mapping[str, str], no_exec: bool, xacro_args: Mapping[str, str],
+                  physics: bool) -> ResultCache | None:
+    """The result cache for these options, made once per option set and process."""
+    from urdfkit.checks.resultcache import ResultCache
+
+    memo = (tuple(sorted(packages.items())), no_exec, tuple(sorted(xacro_args.items())),
+            physics, os.environ.get("URDFKIT_CACHE_DIR"))
+    if memo not in _caches:  # the key prefix is made once
+        options: dict[str, object] = {"packages": dict(packages), "no_exec": no_exec,
+                                      "xacro_args": dict(xacro_args), "physics": physics}
+        if physics:  # U950/U951 come from PyBullet itself
+            from importlib.metadata import version
+
+            options["pybullet"] = version("pybullet")
+        _caches[memo] = ResultCache.open(options)
+    cache = _caches[memo]
+    assert cache is None or isinstance(cache, ResultCache)
+    return cache
+
+
+def _check_one(job: _Job) -> FileResult:
+    display, path, problem, packages, no_exec, xacro_args, physics, use_cache = job
+    if problem is not None:
+        return FileResult(display, [Finding("U000", "error", problem, display)])
+    pkgs = {k: Path(v) for k, v in packages.items()} if packages else {}
+    cache = _result_cache(packages, no_exec, xacro_args, physics) if use_cache else None
+    if cache is None:
+        return check_file(display, path, pkgs, no_exec, xacro_args, physics)
+    from urdfkit.checks.resultcache import file_stat
+    from urdfkit.core import deps
+
+    seen = file_stat(path)  # before the bytes are read: an edit after this misses next run
+    key = cache.key(display, path)
+    if key is None:
+        return check_file(display, path, pkgs, no_exec, xacro_args, physics)
+    hit = cache.get_entry(key)
+    if hit is not None:
+        return FileResult(display, [Finding(**f) for f in hit[1]], cached=True,
+                          entry=(seen, *hit) if seen is not None else None)
+    with deps.record() as recorded:  # the file itself is in the key, by its content
+        result = check_file(display, path, pkgs, no_exec, xacro_args, physics)
+    recorded.pop(os.path.abspath(path), None)
+    found = [f.to_dict() for f in result.findings]
+    if cache.put(key, recorded, found) and seen is not None:
+        result.entry = (seen, dict(recorded), found)
+    return result
+
+
+def worker_init() -> None:
+    """Pool workers die with their parent and never hold the caller's stdout open."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C for everyone
+    for sig in (signal.SIGTERM, signal.SIGHUP):  # the pool ends workers with SIGTERM: just die
+        signal.signal(sig, signal.SIG_DFL)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)  # a `check ... | cat` pipe ends when the parent does
+    os.close(devnull)
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG: killed when the parent dies
+        except (OSError, AttributeError):  # pragma: no cover - no prctl
+            pass
+        if os.getppid() == 1:  # the parent died before prctl: do not linger
+            os._exit(1)
+
+
+def default_jobs() -> int:
+    """Worker processes for ``check``: the cores this process may run on."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(1, len(os.sched_getaffinity(0)))
+    return os.cpu_count() or 1
+
+
+def _keep(code: str, select: tuple[str, ...], ignore: tuple[str, ...]) -> bool:
+    if select and not any(code.startswith(s) for s in select):
+        return False
+    return not any(code.startswith(i) for i in ignore)
+
+
+def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | None = None,
+                select: Sequence[str] = (), ignore: Sequence[str] = (),
+                jobs: int | None = None, no_exec: bool = False,
+                xacro_args: Mapping[str, str] | None = None,
+                physics: bool = False, cache: bool = True) -> CheckResult:
+    """Check every file under ``paths``, over ``jobs`` processes (default: every core).
+
+    ``physics`` loads each file without errors in PyBullet for the U95x rules. ``cache``
+    reuses a file's findings while neither it nor anything it read changed
+    (:mod:`urdfkit.checks.resultcache`; also off when ``URDFKIT_CACHE_DIR`` is empty).
+
+    Workers are killed with the parent (Ctrl-C, SIGTERM, even SIGKILL on Linux) and never
+    hold its stdout.
+
+    Raises:
+        ParameterError: a path does not exist, or ``jobs`` is not positive.
+    """
+    if jobs is not None and (isinstance(jobs, bool) or jobs < 1):
+        raise ParameterError(f"`jobs` must be 1 or more, got {jobs!r}", param="jobs")
+    given = [os.fspath(p) for p in paths]
+    files = discover(given)
+    pkgs = {k: str(v) for k, v in (packages or {}).items()}
+    args = dict(xacro_args or {})
+    manifest = _manifest(given, pkgs, no_exec, args, physics) if cache else None
+    results: list[FileResult | None] = [None] * len(files)
+    todo = []
+    for n, (display, path, problem) in enumerate(files):
+        hit = manifest.lookup(display, path) if manifest and problem is None else None
+        if hit is not None:
+            results[n] = FileResult(display, hit, cached=True)
+        else:
+            todo.append(n)
+    work = [(*files[n], pkgs, no_exec, args, physics, cache) for n in todo]
+    for n, fr in zip(todo, _run_jobs(work, jobs), strict=True):
+        results[n] = fr
+        if manifest is not None and files[n][2] is None:
+            manifest.add(files[n][0], files[n][1], fr.entry)
+    if manifest is not None:
+        manifest.save()
+    if cache and todo:
+        from urdfkit.checks.resultcache import ResultCache
+
+        store = ResultCache.open({})
+        if store is not None:
+            store.trim()  # new entries were written: keep the folder under its cap
+    done = [fr for fr in results if fr is not None]
+    sel, ign = tuple(select), tuple(ignore)
+    noted = False
+    for fr in done:
+        kept = []
+        for f in fr.findings:
+            if f.code in ONCE_PER_RUN:  # the same advice for every file: say it once
+                if noted:
+                    continue
+                noted = True
+            if _keep(f.code, sel, ign):
+                kept.append(f)
+        fr.findings = kept
+    return CheckResult(done)
+
+
+def _manifest(paths: Sequence[str], packages: Mapping[str, str], no_exec: bool,
+              xacro_args: Mapping[str, str], physics: bool) -> RunManifest | None:
+    cache = _result_cache(packages, no_exec, xacro_args, physics)
+    if cache is None:
+        return None
+    from urdfkit.checks.resultcache import RunManifest
+
+    return RunManifest(cache, paths)
+
+
+def _run_jobs(work: list[_Job], jobs: int | None) -> list[FileResult]:
+    """Check each job, over ``jobs`` processes (default: every core) when there are enough."""
+    workers = min(jobs or default_jobs(), max(1, len(work) // _PARALLEL_MIN))
+    if workers <= 1:
+        return [_check_one(w) for w in work]
+    import multiprocessing
+
+    # Large chunks: a URDF takes about a millisecond to check, less than a round trip.
+    chunk = max(1, len(work) // (workers * 4))
+    context = multiprocessing.get_context("fork" if sys.platform.startswith("linux")
+                                          else "spawn")
+    # The with block terminates the workers on the way out, normal or not (Ctrl-C).
+    with context.Pool(workers, initializer=worker_init) as pool:
+        return pool.map(_check_one, work, chunksize=chunk)

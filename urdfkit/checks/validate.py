@@ -1,0 +1,640 @@
+"""Validation of URDF documents: ``check``'s rules beyond the guard.
+
+Rules work on the lxml tree (not on a parsed model) so that every finding can carry the line
+it comes from, and so that broken files are described rather than refused at the first error.
+The rules every loader runs, and the :class:`~urdfkit.sources.guard.Report` they all write to, are
+in
+:mod:`urdfkit.sources.guard`; :data:`ALL_RULES` is the guard's rules followed by these.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from lxml import etree
+
+from urdfkit.model.spec import (
+    FILE_TAGS,
+    LIMITED_JOINT_TYPES,
+    MAX_STATE_LINKS,
+    NUMERIC,
+    OPAQUE,
+    SCHEMA,
+    SHAPES,
+    SOLIDS,
+    Matrix3,
+    extension_note,
+    ignored_shape,
+    matmul,
+    rotate,
+    rpy_to_matrix,
+    solid_inertia,
+    solid_volume,
+    sym_eigenvalues,
+    transpose,
+    used_shape,
+)
+from urdfkit.model.spec import attr_float as _num
+from urdfkit.model.spec import attr_vec as _vec
+from urdfkit.model.xmlio import children
+from urdfkit.sources.guard import GUARD_RULES, Report, Rule, label
+
+_elements = children
+
+
+# --------------------------------------------------------------------------- structural rules
+# These are the rules PyBullet crashes on when they are broken; the guard runs exactly these.
+
+
+def rule_link_count(root: etree._Element, r: Report) -> None:
+    """U208: 128 links or more break PyBullet's state queries."""
+    n = sum(1 for _ in _elements(root, "link"))
+    if n >= MAX_STATE_LINKS:
+        r.add("U208", "error", f"{n} links: PyBullet's getJointState/getLinkState fail on "
+              f"bodies with {MAX_STATE_LINKS} links or more (MAX_DEGREE_OF_FREEDOM); split "
+              "the model", root)
+
+
+# --------------------------------------------------------------------------- values and physics
+# Numbers are parsed once per attribute by _num/_vec, which never report: rule_numbers reports
+# every malformed number once, and the other rules simply skip what does not parse.
+
+#: Drake's tolerance unit for inertia checks (DBL_EPSILON).
+_DBL_EPSILON = sys.float_info.epsilon
+
+
+def rule_elements(root: etree._Element, r: Report) -> None:
+    """U401-U402 and U801-U802, in one pass over the tree.
+
+    Numbers parse, are finite and have the right length; tags and attributes are known
+    (typos, or extensions PyBullet ignores). Comments, namespaced elements (xacro leftovers,
+    extensions) and opaque subtrees (another tool's: gazebo, transmission, ...) are skipped
+    whole. Each parent checks its own children's tags, so no element asks for its parent.
+    """
+    tag = root.tag
+    if isinstance(tag, str) and tag[0] != "{" and tag not in OPAQUE:
+        _elements_below(root, tag, r)
+
+
+def _elements_below(el: etree._Element, tag: str, r: Report) -> None:
+    known = SCHEMA.get(tag)
+    numeric = _NUMERIC_BY_TAG.get(tag)
+    if known is not None or numeric is not None:
+        for attr, text in el.items():
+            n = numeric.get(attr) if numeric is not None else None
+            if n is not None:
+                try:
+                    vals = [float(x) for x in text.split()]
+                except ValueError:
+                    vals = None
+                if vals is None or not all(map(math.isfinite, vals)):
+                    r.add("U401", "error", f"<{tag} {attr}={text!r}>: expected "
+                          f"{'a finite number' if n == 1 else f'{n} finite numbers'}", el)
+                elif len(vals) != n:
+                    r.add("U402", "error", f"<{tag} {attr}={text!r}>: expected {n} numbers, "
+                          f"got {len(vals)}", el)
+            if known is not None and attr not in known[0] and attr[0] != "{":
+                r.add("U802", "warning", f"<{tag}> has unknown attribute {attr!r}; PyBullet "
+                      "ignores it", el)
+    allowed = known[1] if known is not None else None
+    for child in el:
+        ctag = child.tag
+        if not isinstance(ctag, str) or ctag[0] == "{":
+            continue  # comments, processing instructions, namespaced elements
+        if allowed is not None and ctag not in allowed:
+            r.add("U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
+                  "ignores it", child)
+        if ctag not in OPAQUE and not (tag == "geometry" and ignored_shape(child)):
+            _elements_below(child, ctag, r)  # a shape after the first is never read (U507)
+
+
+#: NUMERIC by tag: {tag: {attribute: how many numbers}}, for one lookup per element.
+_NUMERIC_BY_TAG: dict[str, dict[str, int]] = {}
+for (_tag, _attr), _n in NUMERIC.items():
+    _NUMERIC_BY_TAG.setdefault(_tag, {})[_attr] = _n
+
+
+def _mass_of(link: etree._Element) -> float | None:
+    """The mass PyBullet gives a link: its <mass>, or 1 kg if there is no <inertial>."""
+    inertial = link.find("inertial")
+    if inertial is None:
+        return 1.0
+    return _num(inertial.find("mass"), "value")
+
+
+def rule_mass(root: etree._Element, r: Report) -> None:
+    """U601-U602, U606: mass >= 0, > 0 on links that move; warn on missing <inertial>."""
+    links = {el.get("name"): el for el in _elements(root, "link") if el.get("name")}
+    fixed_children: dict[str, list[str]] = {}
+    moving: list[tuple[str, etree._Element]] = []
+    for j in _elements(root, "joint"):
+        parent, child = j.find("parent"), j.find("child")
+        if parent is None or child is None:
+            continue
+        if j.get("type") == "fixed":
+            fixed_children.setdefault(parent.get("link", ""), []).append(child.get("link", ""))
+        else:
+            moving.append((child.get("link", ""), j))
+    child_names = {c.get("link") for j in _elements(root, "joint") for c in j.findall("child")}
+    for link in links.values():
+        inertial = link.find("inertial")
+        if inertial is None:
+            # Never "mass 0" for the root: PyBullet fixes a mass-0 base in place (U611).
+            advice = ("add <inertial> with its real mass (mass 0 would fix the robot in place)"
+                      if link.get("name") not in child_names else
+                      "add <inertial> (mass 0 for a frame)")
+            r.add("U606", "warning", f"{label(link)} has no <inertial>; PyBullet silently gives "
+                  f"it 1 kg and unit inertia: {advice}", link)
+            continue
+        mass_el = inertial.find("mass")
+        mass = _num(mass_el, "value")
+        if mass_el is None or mass_el.get("value") is None:
+            r.add("U601", "error", f"<inertial> of {label(link)} has no <mass value=...>",
+                  inertial)
+        elif mass is not None and mass < 0:
+            r.add("U601", "error", f"{label(link)} has negative mass {mass:g}; mass must be "
+                  ">= 0", mass_el)
+    def rigid_mass(name: str) -> float:
+        # A link moves with everything fixed to it: it is massless only if all of them are.
+        total, stack, seen = 0.0, [name], set()
+        while stack:
+            n = stack.pop()
+            if n in seen or n not in links:
+                continue
+            seen.add(n)
+            total += max(0.0, _mass_of(links[n]) or 0.0)
+            stack.extend(fixed_children.get(n, []))
+        return total
+
+    for name, j in moving:
+        if name in links and rigid_mass(name) == 0:
+            r.add("U602", "error", f"{label(links[name])} moves (joint {j.get('name')!r} is "
+                  f"{j.get('type')}) but has mass 0; give it a mass > 0", links[name])
+    roots = [link for name, link in links.items() if name not in child_names]
+    # PyBullet judges the root link's own mass: 0 fixes the base in place, whatever its fixed
+    # children weigh (a mass-0 base_footprint over a 28 kg base_link hangs in the air). A
+    # root with no <inertial> gets 1 kg, so it moves (U606 says so).
+    own = _mass_of(roots[0]) if len(roots) == 1 and roots[0].find("inertial") is not None \
+        else None
+    if own is not None and own == 0:
+        base, static = roots[0], not moving
+        carried = rigid_mass(base.get("name", ""))
+        held = (f"; its fixed links weigh {carried:g} kg, and PyBullet ignores that: it looks "
+                "at the root's own mass" if carried > 0 else "")
+        r.add("U611", "info" if static and not carried else "warning",
+              f"root {label(base)} has mass 0: PyBullet makes the base static, fixed where it "
+              "is loaded" + (" (right for a static object such as ground)"
+                             if static and not carried else
+                             "; right for an arm bolted to the world, wrong for a robot "
+                             "that should fall or drive: give the root link a mass, or make "
+                             "the massive link the root") + held, base)
+
+
+def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | None:
+    vals = [_num(inertia, a) for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")]
+    if any(v is None for v in vals):
+        return None
+    ixx, ixy, ixz, iyy, iyz, izz = vals
+    return ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))  # type: ignore[return-value]
+
+
+def rule_material_colours(root: etree._Element, r: Report) -> None:
+    """U710: one material name given several colours; PyBullet draws them all in one.
+
+    Measured on PyBullet 3.2.7: every visual whose material has that name (``""`` included,
+    at the top level or inline) is drawn in the colour written last in the file.
+    """
+    colours: dict[str, list[tuple[str, etree._Element]]] = {}
+    for m in root.iter("material"):
+        name, color = m.get("name"), m.find("color")
+        if name is None or color is None or color.get("rgba") is None:
+            continue
+        colours.setdefault(name, []).append((" ".join(color.get("rgba", "").split()), color))
+    for name, found in colours.items():
+        distinct = list(dict.fromkeys(c for c, _ in found))
+        if len(distinct) < 2:
+            continue
+        shown = ", ".join(distinct[:4]) + (f" and {len(distinct) - 4} more"
+                                           if len(distinct) > 4 else "")
+        r.add("U710", "warning", f"material name {name!r} is given {len(distinct)} colours "
+              f"({shown}): PyBullet draws every visual named so in the last one written, "
+              f"rgba {found[-1][0]}; give each colour its own name", found[1][1])
+
+
+def rule_references(root: etree._Element, r: Report) -> None:
+    """U308, U706-U708: references that lead nowhere, and limits PyBullet reads differently.
+
+    A ``<material name>`` used but never defined, a ``<transmission>`` naming a missing joint,
+    an empty ``<texture/>``, ``package:///`` without a package name, and a revolute or
+    prismatic ``<limit>`` without lower/upper (PyBullet: unlimited; the URDF spec: 0..0).
+    """
+    defined = {m.get("name") for m in root.iter("material")
+               if m.find("color") is not None or m.find("texture") is not None}
+    for m in root.iter("material"):
+        parent = m.getparent()
+        if (parent is not None and parent.tag == "visual" and m.get("name")
+                and m.find("color") is None and m.find("texture") is None
+                and m.get("name") not in defined):
+            r.add("U706", "warning", f"<material name={m.get('name')!r}> is used but never "
+                  "defined with a <color> or <texture>; PyBullet draws the default colour", m)
+    for t in root.iter("texture"):
+        if not (t.get("filename") or "").strip():
+            r.add("U707", "warning", "<texture> without a filename; remove it or name the "
+                  "image", t)
+    for el in root.iter(*FILE_TAGS):
+        if (el.get("filename") or "").strip().startswith("package:///"):
+            r.add("U708", "info", f"<{el.tag} filename={el.get('filename')!r}>: package:/// "
+                  "has no package name; PyBullet and urdfkit look the path up beside the file "
+                  "and in every folder above, ROS tools refuse it", el)
+    joints = {j.get("name") for j in _elements(root, "joint")}
+    for t in root.iter("transmission"):
+        for j in t.iter("joint"):
+            if j.get("name") and j.get("name") not in joints:
+                r.add("U709", "warning", f"<transmission name={t.get('name')!r}> names joint "
+                      f"{j.get('name')!r}, which does not exist", j)
+    for j in _elements(root, "joint"):
+        limit = j.find("limit")
+        if (j.get("type") in LIMITED_JOINT_TYPES and limit is not None
+                and (limit.get("lower") is None or limit.get("upper") is None)):
+            missing = " and ".join(a for a in ("lower", "upper") if limit.get(a) is None)
+            r.add("U308", "warning", f"<limit> of {label(j)} has no {missing}: PyBullet reads "
+                  "it as unlimited, the URDF spec (and ROS) as 0; give both", limit)
+
+
+def rule_inertia(root: etree._Element, r: Report) -> None:
+    """U603-U605, U607: inertia positive definite, triangle inequality, plausible for shapes.
+
+    Tolerance as in Drake's ``RotationalInertia::CouldBePhysicallyValid``:
+    ``eps = 10 * DBL_EPSILON * max(1, trace / 2)``, on the principal moments.
+    """
+    noted = False
+    for link in _elements(root, "link"):
+        inertial = link.find("inertial")
+        inertia = inertial.find("inertia") if inertial is not None else None
+        if inertia is None:
+            continue
+        if not noted:
+            r.add("U607", "info", "PyBullet ignores <inertia> from the file and recomputes it "
+                  "from the collision shapes unless loaded with URDF_USE_INERTIA_FROM_FILE "
+                  "(urdfkit: --inertia-from-file)", inertia)
+            noted = True
+        tensor = _inertia_tensor(inertia)
+        mass = _num(inertial.find("mass"), "value")
+        if tensor is None:
+            continue
+        trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
+        eps = 10 * _DBL_EPSILON * max(1.0, trace / 2)
+        a, b, c = sym_eigenvalues(tensor)
+        moments = _moments((a, b, c), max(abs(a), abs(b), abs(c)))
+        shapes = _shape_trace(link, mass, r)
+        fix = (f"; its collision shapes and mass imply a trace of {shapes[0]:.4g}, e.g. "
+               f"ixx=iyy=izz={shapes[0] / 3:.4g} with products 0"
+               if shapes and shapes[1] >= STUB_SIZE else "")
+        if a < -eps:
+            r.add("U603", "error", f"inertia of {label(link)} is not positive definite "
+                  f"(principal moments {moments}); every principal moment must be > 0{fix}",
+                  inertia)
+            continue
+        if mass is not None and mass > 0 and a <= eps:
+            r.add("U608", "warning", f"inertia of {label(link)} is singular (principal moments "
+                  f"{moments}): a point or a thin rod, not a solid; with "
+                  f"URDF_USE_INERTIA_FROM_FILE the solver may blow up{fix}", inertia)
+        if a + b < c - eps:
+            r.add("U604", "error", f"inertia of {label(link)} violates the triangle inequality: "
+                  f"principal moments {moments} (the two smaller sum to less than the largest); "
+                  f"no rigid body has it: lower the largest to at most {a + b:.4g}{fix}",
+                  inertia)
+            continue
+        if shapes and shapes[0] > 0 and trace > 0 and not 0.1 <= trace / shapes[0] <= 10:
+            ratio = f"inertia of {label(link)} is {trace / shapes[0]:.3g} times what its " \
+                    f"collision shapes and mass {mass:g} kg imply"
+            if shapes[1] < STUB_SIZE:
+                r.add("U605", "warning", f"{ratio}, but those shapes are stubs (largest size "
+                      f"{shapes[1]:.3g} m): PyBullet recomputes inertia from them unless loaded "
+                      "with URDF_USE_INERTIA_FROM_FILE; give real collision shapes", inertia)
+            else:
+                r.add("U605", "warning", f"{ratio}; check the units and the mass", inertia)
+
+
+#: Collision shapes smaller than this (m, largest size) are placeholders, not the body.
+STUB_SIZE = 0.01
+
+
+def _moments(values: Sequence[float], scale: float) -> str:
+    """Principal moments for a message: round-off (-4.2e-22 beside 0.1) printed as 0."""
+    return ", ".join("0" if abs(v) <= 1e-9 * scale else f"{v:.4g}" for v in values)
+
+
+@dataclass(frozen=True)
+class Solid:
+    """A link's collision shapes as one solid of uniform density.
+
+    Attributes:
+        volume: m^3.
+        com: Centre of mass in the link frame.
+        tensor: Inertia about ``com``, in link axes, per unit density (multiply by
+            mass / volume for a mass).
+        size: The largest size of any part, m (stub shapes are tiny).
+    """
+
+    volume: float
+    com: tuple[float, float, float]
+    tensor: tuple[tuple[float, float, float], ...]
+    size: float
+
+    def inertia(self, mass: float) -> tuple[tuple[float, float, float], ...]:
+        """The inertia tensor about ``com`` for a total ``mass``."""
+        k = mass / self.volume
+        return tuple((row[0] * k, row[1] * k, row[2] * k) for row in self.tensor)
+
+    def trace(self, mass: float) -> float:
+        """Trace of :meth:`inertia`."""
+        return sum(self.tensor[i][i] for i in range(3)) * mass / self.volume
+
+
+def link_solid(link: etree._Element, r: Report | None = None) -> Solid | None:
+    """The solid the link's collision shapes make: what ``U605`` and ``urdfkit fix`` use.
+
+    Primitive shapes use spec's closed forms; STL, OBJ and COLLADA meshes (with ``scale``)
+    are integrated by :mod:`urdfkit.sources.meshes` when ``r`` knows the file's folder. Each part's
+    tensor is rotated into the link frame and moved to the common centre of mass (parallel
+    axes). None if unknown: no collision, a capsule, plane or SDF, a mesh that cannot be read
+    or is not closed, a bad size.
+    """
+    parts: list[tuple[float, tuple[float, ...], Matrix3, float]] = []
+    for col in link.findall("collision"):
+        shape = next((c for c in col.iterfind("geometry/*") if c.tag in SHAPES), None)
+        origin = col.find("origin")
+        xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
+        rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
+        if shape is None or xyz is None or rpy is None:
+            return None
+        rot = rpy_to_matrix(rpy)
+        if shape.tag == "mesh":
+            part = _mesh_part(shape, xyz, rot, r)
+            if part is None:
+                return None
+            parts.append(part)
+            continue
+        if shape.tag not in SOLIDS or shape.tag == "capsule":
+            return None  # planes, SDFs: no volume
+        raw: Sequence[float | None] | None = (
+            _vec(shape, "size", 3) if shape.tag == "box"
+            else [_num(shape, attr) for attr in SOLIDS[shape.tag]])
+        dims = [d for d in raw or () if d is not None and math.isfinite(d) and d > 0]
+        if raw is None or len(dims) != len(raw):
+            return None  # U401/U501 say why
+        volume = solid_volume(shape.tag, dims)
+        size = max(dims) if shape.tag == "box" else max([2 * dims[0], *dims[1:]])
+        d = solid_inertia(shape.tag, dims, volume)
+        diag = ((d[0], 0.0, 0.0), (0.0, d[1], 0.0), (0.0, 0.0, d[2]))
+        parts.append((volume, tuple(xyz), matmul(matmul(rot, diag), transpose(rot)), size))
+    total = sum(p[0] for p in parts)
+    if not parts or not 0 < total < math.inf:
+        return None
+    com = tuple(sum(v * c[i] for v, c, _, _ in parts) / total for i in range(3))
+    acc = [[0.0] * 3 for _ in range(3)]
+    for volume, centre, tensor, _ in parts:
+        dv = [centre[i] - com[i] for i in range(3)]
+        d2 = sum(x * x for x in dv)
+        for i in range(3):
+            for j in range(3):
+                acc[i][j] += tensor[i][j] + volume * ((d2 if i == j else 0.0) - dv[i] * dv[j])
+    out = tuple((row[0], row[1], row[2]) for row in acc)
+    if not all(math.isfinite(x) for row in out for x in row):
+        return None
+    return Solid(total, (com[0], com[1], com[2]), out, max(p[3] for p in parts))
+
+
+def _shape_trace(link: etree._Element, mass: float | None,
+                 r: Report | None = None) -> tuple[float, float] | None:
+    """Trace of the inertia of the link's collision solids for ``mass``, and their size."""
+    if mass is None or mass <= 0:
+        return None
+    solid = link_solid(link, r)
+    if solid is None:
+        return None
+    trace = solid.trace(mass)
+    return (trace, solid.size) if math.isfinite(trace) else None
+
+
+def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3,
+               r: Report | None) -> tuple[float, tuple[float, ...], Matrix3, float] | None:
+    """A collision mesh as (volume, centre in the link, tensor per unit density, size)."""
+    fn = (shape.get("filename") or "").strip()
+    if r is None or r.base is None or not fn:
+        return None
+    ref = r.reference("mesh", fn)
+    scale = _vec(shape, "scale", 3, (1.0, 1.0, 1.0))
+    if ref.load_path is None or scale is None:
+        return None
+    from urdfkit.sources.meshes import properties
+
+    props = properties(ref.load_path, (scale[0], scale[1], scale[2]))
+    if props is None:
+        return None
+    if not props.closed:
+        r.add("U612", "warning", f"collision mesh {fn!r} is not closed (some edges do not "
+              "join two triangles): it has no volume, so its inertia cannot be derived and "
+              "PyBullet's recomputed inertia is unreliable; close it or give <inertia> and load "
+              "with URDF_USE_INERTIA_FROM_FILE", shape)
+        return None
+    if props.volume <= 0:
+        return None
+    centre = rotate(rot, props.com)
+    t = props.inertia
+    own = ((t[0][0], t[0][1], t[0][2]), (t[1][0], t[1][1], t[1][2]), (t[2][0], t[2][1], t[2][2]))
+    return (props.volume, tuple(xyz[i] + centre[i] for i in range(3)),
+            matmul(matmul(rot, own), transpose(rot)), max(props.extent))
+
+
+def rule_meshes(root: etree._Element, r: Report) -> None:
+    """U701-U705: mesh and texture files exist, are files, in formats PyBullet reads."""
+    if r.base is None:
+        return
+    for el in root.iter(*FILE_TAGS):
+        fn = (el.get("filename") or "").strip()
+        if fn and not ignored_shape(el):  # a mesh after the first shape is never opened
+            ref = r.reference(el.tag, fn)
+            if ref.code is not None:
+                r.add(ref.code, ref.level, ref.message, el)
+
+
+#: A mesh this many times larger (or smaller) than the robot's typical joint spacing is in
+#: the wrong units (millimetres read as metres gives 1000x).
+UNITS_RATIO = 200.0
+
+
+def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
+    """U613-U614: meshes in the wrong units; concave collision meshes on links that move.
+
+    Units are judged against the robot's own scale: the median distance between joint
+    frames (a model with fewer than two offset joints has no scale, and is not judged).
+    PyBullet collides with the convex hull of a mesh (one per OBJ object), so a concave
+    collision mesh on a moving link touches where it has a dip; the root's rigid group is not
+    judged (a static or bolted base may use ``<collision concave="yes">`` instead).
+    """
+    if r.base is None:
+        return
+    from urdfkit.sources.meshes import CONCAVE_FRACTION, properties
+
+    offsets = sorted(math.sqrt(sum(x * x for x in xyz)) for j in _elements(root, "joint")
+                     if (xyz := _vec(j.find("origin"), "xyz", 3)) is not None and any(xyz))
+    spacing = offsets[len(offsets) // 2] if len(offsets) >= 2 else None
+    moving = _moving_links(root)
+    for link in _elements(root, "link"):
+        for part in link:
+            if part.tag not in ("visual", "collision"):
+                continue
+            mesh = used_shape(part.find("geometry"))
+            fn = (mesh.get("filename") or "").strip() if mesh is not None and \
+                mesh.tag == "mesh" else ""
+            if not fn or (ref := r.reference("mesh", fn)).load_path is None:
+                continue
+            scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
+            props = properties(ref.load_path, (scale[0], scale[1], scale[2])) if scale else None
+            if props is None:
+                continue
+            size = max(props.extent)
+            if spacing and size > 0 and not 1 / UNITS_RATIO <= size / spacing <= UNITS_RATIO:
+                ratio = size / spacing
+                fix = ("probably in millimetres: add scale=\"0.001 0.001 0.001\"" if ratio > 1
+                       else "probably scaled twice, or in metres where millimetres were meant: "
+                       "check its scale")
+                r.add("U613", "warning", f"mesh {fn!r} of {label(link)} is {size:.3g} m across, "
+                      f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
+                      f"{fix}", mesh)
+            if (part.tag == "collision" and link.get("name") in moving and props.closed
+                    and props.concavity > CONCAVE_FRACTION * size):
+                r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
+                      f"concave (it is {size:.3g} m across, and parts of it stand up to "
+                      f"{props.concavity:.3g} m in front of its own faces' planes): PyBullet "
+                      "collides with its convex hull, so contacts happen in mid-air over the "
+                      "dips; split it into convex parts (p.vhacd, or one OBJ object per part) "
+                      "or use primitives", mesh)
+
+
+def _moving_links(root: etree._Element) -> set[str]:
+    """Links outside the root's rigid group: each moves through a joint that is not fixed."""
+    below: dict[str, list[tuple[str, bool]]] = {}
+    children = set()
+    for j in _elements(root, "joint"):
+        parent, child = j.find("parent"), j.find("child")
+        if parent is None or child is None:
+            continue
+        below.setdefault(parent.get("link", ""), []).append(
+            (child.get("link", ""), j.get("type") == "fixed"))
+        children.add(child.get("link", ""))
+    names = [link.get("name", "") for link in _elements(root, "link")]
+    roots = [n for n in names if n not in children]
+    still, stack = set(), roots[:1]
+    while stack:
+        n = stack.pop()
+        if n not in still:
+            still.add(n)
+            stack.extend(c for c, fixed in below.get(n, ()) if fixed)
+    return set(names) - still
+
+
+def rule_portability(root: etree._Element, r: Report) -> None:
+    """U901: PyBullet-only joint types and shapes, which other URDF tools refuse (info)."""
+    for j in _elements(root, "joint"):
+        note = extension_note("joint", j.get("type", ""))
+        if note:
+            r.add("U901", "info", f"{label(j)}: {note}", j)
+    for geom in root.iter("geometry"):
+        for shape in geom:
+            note = extension_note("shape", shape.tag) if isinstance(shape.tag, str) else None
+            if note:
+                r.add("U901", "info", note, shape)
+
+
+#: Every rule ``urdfkit check`` runs, in order.
+ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
+                               rule_inertia, rule_meshes, rule_mesh_shapes, rule_references,
+                               rule_material_colours, rule_portability)
+
+#: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
+CODES: dict[str, str] = {
+    "U000": "file unreadable or not well-formed XML",
+    "U004": "XML quirk PyBullet tolerates but other parsers refuse",
+    "U005": "elements nested deeper than PyBullet's XML parser reads (98 levels)",
+    "U006": "xacro not expanded: executing it is disabled (--no-exec, URDFKIT_NO_EXEC)",
+    "U007": "xacro macro library (no links of its own): checked through its includers",
+    "U008": "line longer than 8191 bytes: PyBullet breaks it and may misread the file",
+    "U009": "a file not named .xacro that holds xacro: read literally ('${prefix}base')",
+    "U001": "root element is not <robot>",
+    "U002": "<robot> has no name",
+    "U003": "no <link>",
+    "U101": "link, joint or material without a name",
+    "U102": "duplicate link name",
+    "U103": "duplicate joint name",
+    "U104": "'%' in a link name (crashes PyBullet)",
+    "U105": "duplicate material name",
+    "U106": "name near PyBullet's crash length (joint 1200, link 2200, robot 1024 bytes)",
+    "U107": "'%' in a joint, material or robot name (refused; --no-guard lifts it)",
+    "U108": "name over 1000 bytes (refused; --no-guard lifts it)",
+    "U109": "top-level <material> without a name (PyBullet skips it; warning)",
+    "U110": "<material> of a <visual> without a name attribute (PyBullet refuses the file)",
+    "U201": "joint without <parent> or <child>",
+    "U202": "joint refers to a missing link",
+    "U203": "joint joins a link to itself",
+    "U204": "link with two parents",
+    "U205": "more than one root link",
+    "U206": "no root link (cycle)",
+    "U207": "kinematic cycle",
+    "U208": "128 links or more",
+    "U209": "more than 1000 links (refused before loading)",
+    "U301": "unknown joint type",
+    "U302": "revolute/prismatic joint without <limit>",
+    "U303": "<limit> without effort or velocity",
+    "U304": "limit lower > upper",
+    "U305": "zero joint axis",
+    "U306": "joint axis not unit length",
+    "U307": "mimic refers to a missing joint",
+    "U309": "mimic joints follow each other in a ring",
+    "U308": "revolute/prismatic <limit> without lower or upper (PyBullet: unlimited)",
+    "U401": "number does not parse or is not finite",
+    "U402": "vector of the wrong length",
+    "U501": "missing or non-positive shape size",
+    "U502": "<geometry> without a shape",
+    "U503": "mesh without filename",
+    "U504": "<origin> inside <geometry> (ignored by PyBullet)",
+    "U505": "<geometry> whose first element is not the shape",
+    "U506": "<visual> or <collision> without <geometry>",
+    "U507": "<geometry> with more than one shape (PyBullet uses the first)",
+    "U601": "negative or missing mass",
+    "U602": "moving link with mass 0",
+    "U603": "inertia not positive definite",
+    "U604": "inertia violates the triangle inequality",
+    "U605": "inertia far from what shapes and mass imply",
+    "U606": "link without <inertial>",
+    "U607": "file inertia ignored without URDF_USE_INERTIA_FROM_FILE",
+    "U608": "singular inertia (a zero principal moment) with positive mass",
+    "U609": "<inertial> without <inertia>",
+    "U610": "<inertia> missing a component",
+    "U611": "mass-0 root link: PyBullet makes the base static",
+    "U612": "collision mesh not closed: no volume, inertia cannot be derived",
+    "U613": "mesh in the wrong units (200x larger or smaller than the joint spacing)",
+    "U614": "concave collision mesh on a moving link (PyBullet collides with its hull)",
+    "U701": "mesh or texture file not found",
+    "U702": "package:// package not found",
+    "U703": "mesh found only through pybullet_data's search path",
+    "U704": "mesh or texture is a directory, FIFO, device or unreadable",
+    "U705": "mesh in a format PyBullet does not read (it reads .stl, .obj, .dae)",
+    "U706": "material used but never defined",
+    "U707": "<texture> without a filename",
+    "U708": "package:/// without a package name",
+    "U709": "transmission names a missing joint",
+    "U710": "one material name given several colours (PyBullet draws them all in the last)",
+    "U801": "unknown tag",
+    "U802": "unknown attribute",
+    "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
+    "U950": "links in contact at the zero pose (check --physics: self-collision jitters)",
+    "U951": "PyBullet cannot load the file (check --physics)",
+}
+
+

@@ -1,0 +1,1 @@
+"""urdfkit.core: see docs/architecture.md. Imports nothing."""

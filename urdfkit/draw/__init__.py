@@ -1,0 +1,1 @@
+"""urdfkit.draw: see docs/architecture.md. Imports nothing."""

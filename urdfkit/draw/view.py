@@ -1,0 +1,478 @@
+"""``urdfkit view``: the robot in a browser, as PyBullet loaded it, with ``check``'s findings on it.
+
+Three parts:
+
+- :class:`~urdfkit.draw.view_model.Model` (view_model.py) reads a loaded body into plain data:
+shapes,
+  inertial frames, movable joints, findings mapped to links. It never computes kinematics.
+- :class:`Viewer` (here) shows a Model with viser (a web server whose client ships in its
+  wheel, so it works offline), and reloads it when the file or anything it read changes; the
+  page's text is written by view_page.py.
+- :class:`~urdfkit.draw.view_stream.RunStream` (view_stream.py) streams a simulated run to the page.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from urdfkit.core.errors import EngineError, MissingDependencyError, UrdfkitError
+from urdfkit.draw import view_page as page
+from urdfkit.draw.view_model import TINTS, Model, Vec3
+from urdfkit.draw.view_stream import RunDisplay, add_shapes, wxyz
+
+#: Links touching another at the current pose (self-collision pairs).
+TOUCHING_RGB = (200, 0, 200)
+#: The selected link.
+SELECTED_RGB = (86, 180, 233)
+#: The selection dropdown's entry for no link.
+NO_LINK = "(none)"
+#: How often the watcher looks at the files the robot was read from (s).
+POLL_SECONDS = 0.25
+
+
+def _viser() -> Any:
+    try:
+        import viser
+    except ImportError as e:
+        raise MissingDependencyError("urdfkit view needs viser: pip install viser") from e
+    return viser
+
+
+SERVER_START_TIMEOUT = 60.0
+
+
+def _start_server(viser: Any, host: str, port: int) -> Any:
+    """``viser.ViserServer``, started in a thread of its own.
+
+    Waited for at most :data:`SERVER_START_TIMEOUT` seconds (TimeoutError past it); its
+    errors are re-raised here.
+    """
+    box: dict[str, Any] = {}
+
+    def start() -> None:
+        try:
+            with _quiet():  # viser prints a banner with rich whatever `verbose` says
+                box["server"] = viser.ViserServer(host=host, port=port, verbose=False)
+        except BaseException as e:  # handed to the caller's thread
+            box["error"] = e
+
+    thread = threading.Thread(target=start, name="urdfkit-view-start", daemon=True)
+    thread.start()
+    thread.join(SERVER_START_TIMEOUT)
+    if thread.is_alive():
+        raise TimeoutError
+    if "error" in box:
+        raise box["error"]
+    return box["server"]
+
+
+def free_port(host: str) -> int:
+    """A TCP port nothing listens on now."""
+    import socket
+
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    with socket.socket(family, socket.SOCK_STREAM) as sock:
+        sock.bind((host, 0))
+        return int(sock.getsockname()[1])
+
+
+class Viewer(RunDisplay):
+    """A viser server showing a :class:`Model`, reloaded when its files change.
+
+    The server never dies on a bad file: a load that fails keeps the last good robot and shows
+    the error in the page (:attr:`error`).
+
+    Attributes:
+        model: The robot on show (the last one that loaded).
+        error: The last reload's error message, or None.
+        url: Where the page is.
+        reloads: How many times the robot was reloaded.
+    """
+
+    def __init__(self, file: str, *, packages: Sequence[str] | None = None,
+                 package_paths: Sequence[str] | None = None,
+                 xacro_args: Sequence[str] | None = None, inertia_from_file: bool = False,
+                 host: str = "127.0.0.1", port: int | None = None, watch: bool = True,
+                 ground: float = 4.0) -> None:
+        self._load_args: dict[str, Any] = {
+            "packages": packages, "package_paths": package_paths, "xacro_args": xacro_args,
+            "inertia_from_file": inertia_from_file}
+        self.file = file
+        self.model = Model(file, **self._load_args)  # a bad file fails here, before serving
+        self.error: str | None = None
+        self.reloads = 0
+        self._failed: dict[str, Any] | None = None
+        self._lock = threading.RLock()
+        self._setting = False
+        self._nodes: dict[str, list[Any]] = {}
+        self._frames: list[Any] = []
+        #: The page shows poses given from outside (a run, :meth:`show_poses`): the model's
+        #: own joints no longer move the scene, even from a late slider callback.
+        self.external_poses = False
+        #: More robots on the page (sim --view): each model and its link frames.
+        self.extra: list[tuple[Model, list[Any]]] = []
+        self._gui: list[Any] = []
+        self.sliders: dict[str, Any] = {}
+        viser = _viser()
+        self.host = host
+        self.port = free_port(host) if not port else port
+        try:
+            self.server = _start_server(viser, host, self.port)
+        except OSError as e:
+            self.model.close()
+            raise EngineError(f"cannot serve on {host}:{self.port}: {e.strerror or e}",
+                              param="port") from None
+        except TimeoutError:
+            self.model.close()
+            raise EngineError(f"the server on {host}:{self.port} did not start within "
+                              f"{SERVER_START_TIMEOUT:g} s", param="port") from None
+        self.port = int(self.server.get_port())
+        self.url = f"http://{'localhost' if host in ('127.0.0.1', '::1') else host}:{self.port}"
+        self.server.scene.set_up_direction("+z")
+        self.server.scene.add_grid("/ground", width=ground, height=ground,
+                                   cell_size=0.1 if ground <= 4.0 else 0.5, section_size=1.0)
+        self._static_gui()
+        self._show_model()
+        # Mimic joints to their leaders' zero pose (offsets included). Self-collisions are
+        # first measured by the watcher, so their second load does not delay the first draw.
+        self.set_joints(self.zero(), touching=False)
+        self._aim_camera()
+        self._stop = threading.Event()
+        # A run on show (drive --view) is not reloaded under it: no watcher then.
+        self._watcher = threading.Thread(target=self._watch if watch else lambda: None,
+                                         name="urdfkit-view-watch", daemon=True)
+        self._watcher.start()
+
+    # ------------------------------------------------------------------ the page
+
+    def _static_gui(self) -> None:
+        gui = self.server.gui
+        self.status = gui.add_markdown("", order=0)
+        with gui.add_folder("Show", order=1):
+            self.show_visual = gui.add_checkbox("Visual", True)
+            self.show_collision = gui.add_checkbox("Collision", False)
+            self.show_frames = gui.add_checkbox("Frames and axes", False)
+            self.show_inertia = gui.add_checkbox("COM and inertia boxes", False)
+            self.show_touching = gui.add_checkbox(
+                "Self-collisions", True, hint="Links touching at this pose, as urdfkit "
+                "collisions measures them, in magenta")
+            self.touching_text = gui.add_markdown("")
+        for box in (self.show_visual, self.show_collision, self.show_frames, self.show_inertia):
+            box.on_update(lambda _event: self.apply_toggles())
+        self.show_touching.on_update(lambda _event: self.update_touching())
+        self.touching: list[tuple[str, str, float]] = []
+        self.selected: str | None = None
+        with gui.add_folder("Selection", order=1.5):
+            self.select_link = gui.add_dropdown(
+                "Link", [NO_LINK], initial_value=NO_LINK,
+                hint="Or click a link in the scene, or a finding")
+            self.selected_text = gui.add_markdown("")
+        self.select_link.on_update(lambda _event: self._dropdown_moved())
+        self.joints_folder = gui.add_folder("Joints", order=2)
+        with self.joints_folder:
+            self.reset_button = gui.add_button("Reset to zero")
+            self.reset_button.on_click(lambda _event: self.reset())
+            self.vector_text = gui.add_text("Python list", "[]", disabled=True)
+            self.joints_text = gui.add_text("--joints", "", disabled=True)
+        self.findings_folder = gui.add_folder("Findings", order=3)
+        self.table_folder = gui.add_folder("Joint table", order=4, expand_by_default=False)
+
+    def _show_model(self) -> None:
+        """Put the model's shapes and controls on the page (replacing the previous ones)."""
+        for h in self._frames + self._gui:  # a link's frame takes its shapes with it
+            h.remove()
+        self._nodes = {"visual": [], "collision": [], "frames": [], "inertia": []}
+        self._frames, self._gui, self.sliders = [], [], {}
+        self._draw_links()
+        self.apply_toggles()
+        listed, flags = self.model.joint_vector()
+        self.vector_text.value, self.joints_text.value = listed, flags
+        self._add_sliders()
+        self._add_findings()
+        names = [lk.name for lk in self.model.links]
+        self.select_link.options = [NO_LINK, *names]
+        if self.selected not in names:
+            self.selected = None
+        self.select(self.selected)
+        with self.table_folder:
+            self._gui.append(self.server.gui.add_markdown(page.joint_table(self.model)))
+        self._refresh_status()
+
+    def _draw_links(self) -> None:
+        """Each link's frame, shapes, axes, joint axis, centre of mass and inertia box."""
+        import numpy as np
+
+        from urdfkit.model.spec import quat_to_matrix, rotate
+
+        scene, m = self.server.scene, self.model
+        size = max(max(hi - lo for lo, hi in zip(*m.bounds(), strict=True)), 0.05)
+        by_index = {j.link: j for j in m.joints}
+        for link, (pos, quat) in zip(m.links, m.link_poses(), strict=True):
+            root = f"/robot/link{link.index + 1}"
+            self._frames.append(scene.add_frame(root, show_axes=False, position=pos,
+                                                wxyz=wxyz(quat)))
+            for kind, mesh in add_shapes(scene, root, link, TINTS.get(link.level or "")):
+                # Clicking a link in the scene selects it (and its joint's row).
+                mesh.on_click(lambda _event, name=link.name: self.select(name))
+                self._nodes[kind].append(mesh)
+            self._nodes["frames"].append(scene.add_frame(
+                f"{root}/axes", axes_length=size * 0.08, axes_radius=size * 0.004))
+            joint = by_index.get(link.index)
+            if joint is not None:  # PyBullet's axis is in the inertial frame: into the link's
+                axis = np.asarray(rotate(quat_to_matrix(link.inertial_quat), joint.axis),
+                                  dtype=float)
+                points = np.array([[-axis, axis]], dtype=np.float32) * size * 0.1
+                self._nodes["frames"].append(scene.add_line_segments(
+                    f"{root}/joint_axis", points, (204, 121, 167), thickness=size * 0.006))
+            self._nodes["inertia"].append(scene.add_frame(
+                f"{root}/com", show_axes=False, position=link.inertial_pos,
+                wxyz=wxyz(link.inertial_quat)))
+            self._nodes["inertia"].append(scene.add_icosphere(
+                f"{root}/com/dot", radius=size * 0.012, color=(20, 20, 20)))
+            if link.inertia_box is not None:
+                self._nodes["inertia"].append(scene.add_box(
+                    f"{root}/com/box", dimensions=link.inertia_box, color=(0, 114, 178),
+                    opacity=0.35))
+
+    def _add_sliders(self) -> None:
+        """One slider per movable joint (mimic joints shown, not movable)."""
+        gui, now = self.server.gui, self.model.positions()
+        with self.joints_folder:
+            for j in self.model.joints:
+                step = (j.upper - j.lower) / 1000 if j.upper > j.lower else 0.001
+                hint = f"{j.urdf_type}, PyBullet joint {j.index}"
+                if j.mimic is not None:
+                    hint += f"; mimics {j.mimic[0]} x {j.mimic[1]:g} + {j.mimic[2]:g}"
+                s = gui.add_slider(j.name, min=j.lower, max=max(j.upper, j.lower + step),
+                                   step=step, initial_value=min(max(now[j.name], j.lower), j.upper),
+                                   disabled=j.mimic is not None, hint=hint)
+                s.on_update(lambda _event, name=j.name: self._slider_moved(name))
+                self.sliders[j.name] = s
+                self._gui.append(s)
+
+    def _add_findings(self) -> None:
+        """The findings' text, and one button per finding on a link that selects it."""
+        gui, m = self.server.gui, self.model
+        with self.findings_folder:
+            self._gui.append(gui.add_markdown(page.findings(m)))
+            for f in (f for f in m.findings if f.level in TINTS):
+                links = m.finding_links(f)
+                if not links:
+                    continue
+                where = f"line {f.line}" if f.line is not None else f.file
+                button = gui.add_button(f"{f.code} {where}: {links[0]}",
+                                        hint=f.text[:300])
+                button.on_click(lambda _event, name=links[0]: self.select(name))
+                self._gui.append(button)
+
+    def _refresh_status(self) -> None:
+        self.status.content = page.status(self.model, self.error)
+
+    def _aim_camera(self) -> None:
+        lo, hi = self.model.bounds()
+        mid = [(a + b) / 2 for a, b in zip(lo, hi, strict=True)]
+        size = max(max(b - a for a, b in zip(lo, hi, strict=True)), 0.1)
+        cam = self.server.initial_camera
+        cam.look_at = tuple(mid)
+        cam.position = (mid[0] + 1.3 * size, mid[1] - 1.3 * size, mid[2] + 0.9 * size)
+
+    def apply_toggles(self) -> None:
+        """Show or hide each layer as the Show checkboxes say."""
+        with self._lock:
+            want = {"visual": self.show_visual.value, "collision": self.show_collision.value,
+                    "frames": self.show_frames.value, "inertia": self.show_inertia.value}
+            for kind, handles in self._nodes.items():
+                for h in handles:
+                    h.visible = bool(want[kind])
+
+    def visible(self, kind: str) -> bool:
+        """Whether a layer (visual, collision, frames, inertia) is shown."""
+        handles = self._nodes.get(kind, [])
+        return bool(handles) and all(h.visible for h in handles)
+
+    # ------------------------------------------------------------------ moving
+
+    def _slider_moved(self, name: str) -> None:
+        if self._setting:
+            return
+        self.set_joints({name: float(self.sliders[name].value)})
+
+    def set_joints(self, values: Mapping[str, float], touching: bool = True
+                   ) -> dict[str, float]:
+        """Move joints (by name) in PyBullet and update the scene; return the new positions.
+
+        ``touching=False`` leaves the self-collision highlight as it was.
+        """
+        with self._lock:
+            now = self.model.set_positions(values)
+            self._setting = True
+            try:
+                for name, value in now.items():
+                    s = self.sliders.get(name)
+                    if s is not None and abs(float(s.value) - value) > 1e-12:
+                        s.value = value
+            finally:
+                self._setting = False
+            self.update_poses()
+            if touching:
+                self.update_touching()
+            listed, flags = self.model.joint_vector()
+            self.vector_text.value = listed
+            self.joints_text.value = flags
+            return now
+
+    def update_poses(self) -> None:
+        """Move every link node to the pose PyBullet reports (not while a run is shown)."""
+        if self.external_poses:
+            return
+        with self._lock, self.server.atomic():
+            for frame, (pos, quat) in zip(self._frames, self.model.link_poses(), strict=True):
+                frame.position = pos
+                frame.wxyz = wxyz(quat)
+
+    def _recolour(self) -> None:
+        """Each link's colour: selected, else touching, else its findings' tint, else its own."""
+        with self._lock:
+            hit = {name for a, b, _ in self.touching for name in (a, b)}
+            for link, k in zip(self.model.links, range(len(self.model.links)), strict=True):
+                base = TINTS.get(link.level or "")
+                for kind, shapes in (("visual", link.visuals), ("collision", link.collisions)):
+                    handles = [h for h in self._nodes.get(kind, [])
+                               if h.name.startswith(f"/robot/link{k}/")]
+                    for h, sh in zip(handles, shapes, strict=True):
+                        want = SELECTED_RGB if link.name == self.selected else \
+                            TOUCHING_RGB if link.name in hit else (base or sh.rgb)
+                        if tuple(h.color) != tuple(want):
+                            h.color = want
+
+    def _dropdown_moved(self) -> None:
+        if self._setting:
+            return
+        value = str(self.select_link.value)
+        self.select(None if value == NO_LINK else value)
+
+    def select(self, link: str | None) -> None:
+        """Select a link (None: none): highlight it, show its joint's row and its findings.
+
+        Clicking the link in the scene, choosing it in the Selection dropdown, or clicking a
+        finding about it all come here.
+        """
+        with self._lock:
+            m = self.model
+            if link is not None and link not in {lk.name for lk in m.links}:
+                raise KeyError(link)
+            self.selected = link
+            self._setting = True
+            try:
+                want = NO_LINK if link is None else link
+                if self.select_link.value != want:
+                    self.select_link.value = want
+            finally:
+                self._setting = False
+            self._recolour()
+            if link is None:
+                self.selected_text.content = ""
+                return
+            self.selected_text.content = page.selection(m, link)
+
+    def update_touching(self) -> None:
+        """Measure the touching pairs (when shown) and colour their links magenta."""
+        with self._lock:
+            self.touching = self.model.touching() if self.show_touching.value else []
+            self._recolour()
+            self.touching_text.content = page.touching(self.touching)
+
+    def zero(self) -> dict[str, float]:
+        """Every joint at zero, or at its nearest limit when zero is outside them."""
+        return {j.name: min(max(0.0, j.lower), j.upper) for j in self.model.joints}
+
+    def reset(self) -> None:
+        """Every joint to :meth:`zero`."""
+        self.set_joints(self.zero())
+
+    def link_pose(self, name: str) -> tuple[Vec3, tuple[float, float, float, float]]:
+        """A link node's pose in the scene: (position, wxyz)."""
+        for link, frame in zip(self.model.links, self._frames, strict=True):
+            if link.name == name:
+                return (tuple(float(x) for x in frame.position),  # type: ignore[return-value]
+                        tuple(float(x) for x in frame.wxyz))
+        raise KeyError(name)
+
+    def nodes(self, kind: str, link: str) -> list[Any]:
+        """The scene handles of one layer of one link (for tests and tools)."""
+        index = next(i for i, lk in enumerate(self.model.links) if lk.name == link)
+        prefix = f"/robot/link{index}/"
+        return [h for h in self._nodes.get(kind, []) if h.name.startswith(prefix)]
+
+    # ------------------------------------------------------------------ reloading
+
+    def _watch(self) -> None:
+        from urdfkit.core import deps
+
+        try:
+            self.update_touching()
+        except Exception as e:  # noqa: BLE001 - the server outlives a probe that fails
+            self.error = f"self-collisions not measured: {e}"
+            self._refresh_status()
+        while not self._stop.wait(POLL_SECONDS):
+            recorded = self._failed if self._failed is not None else self.model.depends
+            try:
+                if deps.unchanged(recorded):
+                    continue
+                self.reload()
+            except Exception as e:  # noqa: BLE001 - the server outlives any bad file
+                self.error = f"{type(e).__name__}: {e}"
+                self._refresh_status()
+
+    def reload(self) -> bool:
+        """Load the file again; on success show it, keeping joint values by name.
+
+        Returns whether the new robot is on show. A failure keeps the old one and sets
+        :attr:`error`; the next change of any file tried is retried.
+        """
+        from urdfkit.core import deps
+
+        kept = self.model.positions()
+        try:
+            model = Model(self.file, **self._load_args)
+        except Exception as e:  # noqa: BLE001 - any failure keeps the last good robot
+            self.error = str(e) if isinstance(e, UrdfkitError) else \
+                f"internal error (a bug in urdfkit): {type(e).__name__}: {e}"
+            # Not retried until a file changes again: a bad file is not loaded 4 times a second.
+            with deps.record() as recorded:  # what the failed attempt depends on
+                deps.note(self.file)
+                for path in self.model.depends:
+                    deps.note(path)
+            self._failed = recorded
+            self._refresh_status()
+            return False
+        with self._lock:
+            old, self.model = self.model, model
+            self._failed = None
+            self.error = None
+            self.reloads += 1
+            self._show_model()
+            old.close()
+            self.set_joints({k: v for k, v in kept.items()
+                             if k in {j.name for j in model.joints}})
+        return True
+
+    def close(self) -> None:
+        """Stop watching and serving, and disconnect PyBullet."""
+        self._stop.set()
+        self._watcher.join(timeout=5)
+        with _quiet():
+            self.server.stop()
+        self.model.close()
+        for m, _ in self.extra:
+            m.close()
+
+
+def _quiet() -> Any:
+    """Keep what viser prints on sys.stdout (its banner, "Server stopped") off ours."""
+    import contextlib
+    import io
+
+    return contextlib.redirect_stdout(io.StringIO())

@@ -1,0 +1,543 @@
+"""The robot as ``urdfkit view`` shows it: read from PyBullet into plain data.
+
+:class:`Model` reads a loaded body into plain data: every link's visual and collision shapes
+(from ``getVisualShapeData`` and ``getCollisionShapeData``, so colours follow PyBullet's
+material rules and collision meshes are the convex hulls PyBullet collides with), its inertial
+frame, mass and principal moments, the movable joints in PyBullet's index order, mimic joints,
+and the findings of ``check`` mapped to links. It poses the body with ``resetJointState`` and
+reads link poses back from PyBullet; it never computes kinematics.
+
+Frames, measured on PyBullet 3.2.7 and relied on here: ``getVisualShapeData``'s local frame is
+relative to the URDF link frame; ``getCollisionShapeData``'s is relative to the link's inertial
+frame (its centre of mass), as is ``getDynamicsInfo``'s diagonal inertia, which PyBullet has
+already turned to principal axes; ``getBasePositionAndOrientation`` is the base's inertial
+frame. A fixed base reads mass 0, so the body is loaded free and never stepped.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import threading
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from urdfkit.core.errors import UrdfkitError
+from urdfkit.core.finding import Finding
+
+#: Tints of links with findings (RGB 0..255): check's error red and warning amber.
+TINTS = {"error": (220, 38, 38), "warning": (245, 158, 11)}
+#: Colour of collision shapes; of those PyBullet replaces by a hull of a concave mesh.
+COLLISION_RGB = (213, 94, 0)
+CONCAVE_RGB = (204, 121, 167)
+#: Meshes with more triangles than this are thinned for display (only: PyBullet keeps all).
+MAX_DISPLAY_FACES = 200_000
+
+# PyBullet's geometry codes (p.GEOM_*), spelled here so reading them needs no import.
+_SPHERE, _BOX, _CYLINDER, _MESH, _PLANE, _CAPSULE = 2, 3, 4, 5, 6, 7
+
+Vec3 = tuple[float, float, float]
+Quat = tuple[float, float, float, float]  # x, y, z, w as PyBullet gives them
+
+
+@dataclass
+class Shape:
+    """One visual or collision shape, ready to draw: triangles in the shape's own frame.
+
+    Attributes:
+        kind: ``box``, ``sphere``, ``cylinder``, ``capsule``, ``mesh`` or ``plane``.
+        vertices: N x 3 float array (metres, scale applied).
+        faces: M x 3 int array.
+        pos: Position in the link frame.
+        quat: Orientation in the link frame (x, y, z, w).
+        rgb: Colour, 0..255.
+        opacity: 1 for opaque.
+        note: What the page should say about it (a hull of a concave mesh, a thinned mesh).
+    """
+
+    kind: str
+    vertices: Any
+    faces: Any
+    pos: Vec3
+    quat: Quat
+    rgb: tuple[int, int, int]
+    opacity: float = 1.0
+    note: str = ""
+
+
+@dataclass
+class LinkView:
+    """A link as PyBullet holds it.
+
+    Attributes:
+        index: PyBullet's link index (-1: the base).
+        name: The link's name.
+        visuals: Visual shapes, posed in the link frame.
+        collisions: Collision shapes, posed in the link frame.
+        mass: PyBullet's mass (kg).
+        inertial_pos: The inertial frame (centre of mass) in the link frame.
+        inertial_quat: Its orientation: the principal axes.
+        moments: PyBullet's principal moments of inertia (kg m^2).
+        level: ``error`` or ``warning`` when check found something on this link, else None.
+    """
+
+    index: int
+    name: str
+    visuals: list[Shape] = field(default_factory=list)
+    collisions: list[Shape] = field(default_factory=list)
+    mass: float = 0.0
+    inertial_pos: Vec3 = (0.0, 0.0, 0.0)
+    inertial_quat: Quat = (0.0, 0.0, 0.0, 1.0)
+    moments: Vec3 = (0.0, 0.0, 0.0)
+    level: str | None = None
+
+    @property
+    def inertia_box(self) -> Vec3 | None:
+        """Sides of the uniform box with this mass and these principal moments, or None.
+
+        For a box of sides a, b, c: I1 = m (b^2 + c^2) / 12 and so on, so
+        a^2 = 6 (I2 + I3 - I1) / m. A negative square (moments that break the triangle
+        inequality, which no body has) is drawn as 0.
+        """
+        if not self.mass > 0 or not all(math.isfinite(v) for v in self.moments):
+            return None
+        i1, i2, i3 = self.moments
+        sq = (6 * (i2 + i3 - i1) / self.mass, 6 * (i1 + i3 - i2) / self.mass,
+              6 * (i1 + i2 - i3) / self.mass)
+        return (math.sqrt(max(sq[0], 0.0)), math.sqrt(max(sq[1], 0.0)),
+                math.sqrt(max(sq[2], 0.0)))
+
+
+@dataclass
+class JointControl:
+    """A movable joint: what its slider shows.
+
+    Attributes:
+        index: PyBullet's joint index.
+        name: The joint's name.
+        urdf_type: ``revolute``, ``continuous`` or ``prismatic``.
+        lower: The slider's lower end (continuous: -pi).
+        upper: The slider's upper end (continuous: pi).
+        axis: The joint axis in the child link frame.
+        link: The child link's index.
+        mimic: (leader joint name, multiplier, offset) for a mimic joint.
+    """
+
+    index: int
+    name: str
+    urdf_type: str
+    lower: float
+    upper: float
+    axis: Vec3
+    link: int
+    mimic: tuple[str, float, float] | None = None
+
+
+def _primitive(kind: int, dims: Sequence[float]) -> tuple[str, Any, Any] | None:
+    import trimesh
+
+    if kind == _BOX:
+        m = trimesh.creation.box(extents=[abs(float(d)) for d in dims[:3]])
+        return "box", m.vertices, m.faces
+    if kind == _SPHERE:
+        m = trimesh.creation.icosphere(subdivisions=2, radius=abs(float(dims[0])))
+        return "sphere", m.vertices, m.faces
+    if kind == _CYLINDER:
+        m = trimesh.creation.cylinder(radius=abs(float(dims[1])), height=abs(float(dims[0])),
+                                      sections=32)
+        return "cylinder", m.vertices, m.faces
+    if kind == _CAPSULE:
+        m = trimesh.creation.capsule(height=abs(float(dims[0])), radius=abs(float(dims[1])))
+        return "capsule", m.vertices, m.faces
+    if kind == _PLANE:
+        m = trimesh.creation.box(extents=[20.0, 20.0, 0.001])
+        return "plane", m.vertices, m.faces
+    return None
+
+
+def read_mesh(path: str | Path) -> tuple[Any, Any] | None:
+    """Vertices and triangles of an STL, OBJ or DAE file as urdfkit reads them for PyBullet.
+
+    DAE files are placed and scaled the way PyBullet does (see :mod:`urdfkit.sources.meshes`).
+    None when the file cannot be read.
+    """
+    import struct
+
+    from urdfkit.core import deps
+    from urdfkit.core.errors import InputError
+    from urdfkit.model.xmlio import read_regular
+    from urdfkit.sources.meshes import MAX_MESH_BYTES, _dae, _obj, _stl
+
+    path = Path(path)
+    deps.note(path)
+    suffix = path.suffix.lower()
+    try:
+        data = read_regular(path, limit=MAX_MESH_BYTES, kind="mesh")
+        if suffix == ".stl":
+            return _stl(data)
+        if suffix == ".obj":
+            vertices, faces, _ = _obj(data)
+            return vertices, faces
+        if suffix == ".dae":
+            return _dae(data, path)
+    except (InputError, ValueError, struct.error, IndexError, OverflowError, KeyError,
+            AttributeError, StopIteration, TypeError):
+        return None
+    return None
+
+
+class Model:
+    """A file loaded in its own PyBullet session, read into what the viewer draws.
+
+    Attributes:
+        resolved: The resolved file (:func:`urdfkit.sources.resolve.open_input`).
+        session: The PyBullet session holding the body; closed by :meth:`close`.
+        body: The body id.
+        links: Every link, base first (index -1).
+        joints: The movable joints in PyBullet's index order.
+        table: The whole joint table (as ``urdfkit joints`` shows it).
+        findings: ``check``'s findings on the file.
+        notes: What the page should say (unreadable meshes, PyBullet's warnings).
+        depends: Every path the model was read from, with its signature (for live reload).
+    """
+
+    def __init__(self, file: str, *, packages: Sequence[str] | None = None,
+                 package_paths: Sequence[str] | None = None,
+                 xacro_args: Sequence[str] | None = None,
+                 inertia_from_file: bool = False) -> None:
+        from urdfkit.core import deps
+        from urdfkit.engine.session import LoadOptions, Session
+        from urdfkit.sources.resolve import open_input
+
+        self.file = file
+        self.notes: list[str] = []
+        self.lock = threading.RLock()
+        self.session: Any = None
+        self._probe: tuple[Any, int, list[tuple[int, int]]] | None = None
+        with deps.record() as recorded:
+            deps.note(file)
+            try:
+                self.resolved = open_input(file, list(packages or []), list(xacro_args or []),
+                                           package_paths=list(package_paths or []))
+                deps.note(self.resolved.source)
+                self.session = Session()
+                options = LoadOptions(inertia_from_file=inertia_from_file)
+                self.body = self.session.load_urdf(self.resolved.load_path, options,
+                                                   display=self.resolved.name)
+                self.session.require_state_queries(self.body, self.resolved.name)
+                self._read()
+                self.findings = self._check(packages, package_paths, xacro_args)
+            except BaseException:
+                self.depends = dict(recorded)
+                self.close()
+                raise
+        self.depends = dict(recorded)
+
+    # ------------------------------------------------------------------ reading
+
+    def _read(self) -> None:
+        from urdfkit.engine.session import quiet_stdout
+        from urdfkit.inspect import base_link_name, joint_table
+
+        s, body = self.session, self.body
+        p, c = s.p, s.client
+        with quiet_stdout() as out:
+            self.table = joint_table(s, body, self.resolved.root)
+            names = [base_link_name(s, body)] + [j.link_name for j in self.table]
+            self.links = [LinkView(i, names[i + 1]) for i in range(-1, len(self.table))]
+            for link in self.links:
+                info = p.getDynamicsInfo(body, link.index, physicsClientId=c)
+                link.mass = float(info[0])
+                link.moments = tuple(float(v) for v in info[2])  # type: ignore[assignment]
+                link.inertial_pos = tuple(float(v) for v in info[3])  # type: ignore[assignment]
+                link.inertial_quat = tuple(float(v) for v in info[4])  # type: ignore[assignment]
+            for v in p.getVisualShapeData(body, physicsClientId=c):
+                shape = self._shape(v[2], v[3], v[4], v[5], v[6], collision=False,
+                                    rgba=v[7])
+                if shape is not None:
+                    self.links[v[1] + 1].visuals.append(shape)
+            concave = self._concave()
+            for link in self.links:
+                for v in p.getCollisionShapeData(body, link.index, physicsClientId=c):
+                    # Relative to the inertial frame: move it into the link frame.
+                    pos, quat = p.multiplyTransforms(link.inertial_pos, link.inertial_quat,
+                                                     v[5], v[6])
+                    shape = self._shape(v[2], v[3], v[4], pos, quat, collision=True,
+                                        concave=link.name in concave)
+                    if shape is not None:
+                        link.collisions.append(shape)
+        self.session.diagnostics.extend(out.lines)
+        self.joints = self._controls()
+        self.notes.extend(self.resolved.warnings)
+
+    def _shape(self, kind: int, dims: Sequence[float], filename: bytes,
+               pos: Sequence[float], quat: Sequence[float], *, collision: bool,
+               rgba: Sequence[float] = (1.0, 1.0, 1.0, 1.0), concave: bool = False
+               ) -> Shape | None:
+        import numpy as np
+
+        note = ""
+        if kind == _MESH:
+            name = filename.decode("utf-8", "replace") if isinstance(filename, bytes) \
+                else str(filename)
+            if not name:  # a cylinder PyBullet made a mesh of: nothing to read back
+                return None
+            mesh = read_mesh(name)
+            if mesh is None:
+                self.notes.append(f"cannot read mesh {name}: not drawn")
+                return None
+            vertices = np.asarray(mesh[0], dtype=float) * np.asarray(dims[:3], dtype=float)
+            faces = np.asarray(mesh[1], dtype=np.int64)
+            kind_name = "mesh"
+            if collision:  # what PyBullet collides with: the hull (urdfkit.draw.displaymesh)
+                from urdfkit.draw.displaymesh import HULL_POINTS, convex_hull
+
+                hull = convex_hull(vertices)
+                if hull is not None:
+                    thinned = len(vertices) > HULL_POINTS
+                    vertices, faces = hull
+                    note = ("convex hull of a concave mesh" if concave else "convex hull") + \
+                        (" (of its points thinned on a grid, for display)" if thinned else "")
+            elif len(faces) > MAX_DISPLAY_FACES:
+                from urdfkit.draw.displaymesh import decimate
+
+                before = len(faces)
+                vertices, faces = decimate(vertices, faces, MAX_DISPLAY_FACES)
+                note = (f"{Path(name).name}: {before} triangles, drawn as {len(faces)} "
+                        "(vertex clustering, for display only: PyBullet keeps them all)")
+                self.notes.append(note)
+        else:
+            made = _primitive(kind, dims)
+            if made is None:
+                return None
+            kind_name, vertices, faces = made
+        if collision:
+            rgb = CONCAVE_RGB if concave else COLLISION_RGB
+            opacity = 0.6
+        else:
+            rgb = tuple(int(round(min(max(float(x), 0.0), 1.0) * 255)) for x in rgba[:3])  # type: ignore[assignment]
+            opacity = float(rgba[3]) if len(rgba) > 3 else 1.0
+        return Shape(kind_name, np.asarray(vertices, dtype=np.float32),
+                     np.asarray(faces, dtype=np.uint32), tuple(float(x) for x in pos),  # type: ignore[arg-type]
+                     tuple(float(x) for x in quat), rgb, opacity, note)  # type: ignore[arg-type]
+
+    def _concave(self) -> set[str]:
+        from urdfkit.checks.collisions import _concave_links
+
+        try:
+            return _concave_links(self.resolved, None)
+        except UrdfkitError:
+            return set()
+
+    def _controls(self) -> list[JointControl]:
+        from urdfkit.model.spec import vector
+
+        elements = {j.get("name"): j for j in self.resolved.root.iterchildren("joint")}
+        out = []
+        for j in self.table:
+            if j.joint_type not in ("REVOLUTE", "PRISMATIC"):
+                continue
+            kind = j.urdf_type or j.joint_type.lower()
+            if j.limited:
+                lower, upper = j.joint_lower_limit, j.joint_upper_limit
+            else:
+                lower, upper = -math.pi, math.pi
+            mimic = None
+            el = elements.get(j.joint_name)
+            m = el.find("mimic") if el is not None else None
+            if m is not None and m.get("joint"):
+                mult = vector(m.get("multiplier"), 1) or [1.0]
+                off = vector(m.get("offset"), 1) or [0.0]
+                mimic = (str(m.get("joint")), float(mult[0]), float(off[0]))
+            out.append(JointControl(j.joint_index, j.joint_name, kind, float(lower),
+                                    float(upper), tuple(float(a) for a in j.joint_axis),  # type: ignore[arg-type]
+                                    j.joint_index, mimic))
+        names = {jc.name for jc in out}
+        for jc in out:  # a mimic of a joint that cannot move is just a joint
+            if jc.mimic is not None and jc.mimic[0] not in names:
+                jc.mimic = None
+        return out
+
+    def _check(self, packages: Sequence[str] | None, package_paths: Sequence[str] | None,
+               xacro_args: Sequence[str] | None) -> list[Finding]:
+        """Run ``check`` on the file and tint the links its findings are about."""
+        from urdfkit.checks.check import check_file
+        from urdfkit.sources.uris import parse_packages
+
+        args: dict[str, str] = {}
+        if xacro_args:
+            from urdfkit.model.catalog import parse_assignments
+
+            args = dict(parse_assignments(list(xacro_args), "xacro_args"))
+        result = check_file(self.resolved.name, self.resolved.source,
+                            parse_packages(list(packages or []), list(package_paths or [])),
+                            xacro_args=args)
+        by_name = {link.name: link for link in self.links}
+        child_of = {j.joint_name: j.link_name for j in self.table}
+        for f in result.findings:
+            if f.level not in TINTS:
+                continue
+            for name in self.finding_links(f, child_of):
+                link = by_name.get(name)
+                if link is not None and link.level != "error":
+                    link.level = f.level
+        return result.findings
+
+    def finding_links(self, f: Finding, child_of: Mapping[str, str] | None = None
+                      ) -> list[str]:
+        """The links a finding is about: the element on its line, else those it names.
+
+        A joint's finding marks its child link, the one the joint moves.
+        """
+        from urdfkit.model.xmlio import line_of
+
+        if child_of is None:
+            child_of = {j.joint_name: j.link_name for j in self.table}
+        found: list[str] = []
+        if f.line is not None and self.resolved.source.suffix != ".xacro":
+            for el in self.resolved.root.iter("link", "joint"):
+                first, last = line_of(el), _last_line(el)
+                if first is not None and first <= f.line <= last:
+                    found.append(str(el.get("name")) if el.tag == "link"
+                                 else child_of.get(str(el.get("name")), ""))
+                    break
+        if not found:
+            for tag, _, name in _NAMED.findall(f.message):
+                found.append(name if tag == "link" else child_of.get(name, ""))
+        return [n for n in found if n]
+
+    # ------------------------------------------------------------------ posing
+
+    def set_positions(self, values: Mapping[str, float]) -> dict[str, float]:
+        """Set joints by name with ``resetJointState``; mimic joints follow their leader.
+
+        Returns every movable joint's position as PyBullet now reports it.
+        """
+        with self.lock:
+            p, c = self.session.p, self.session.client
+            by_name = {j.name: j for j in self.joints}
+            wanted = {k: float(v) for k, v in values.items() if k in by_name}
+            for name, value in wanted.items():
+                if by_name[name].mimic is None:
+                    p.resetJointState(self.body, by_name[name].index, value, physicsClientId=c)
+            now = self.positions()
+            for j in self.joints:  # leaders first in a chain: index order is depth order
+                if j.mimic is not None and j.mimic[0] in now:
+                    value = now[j.mimic[0]] * j.mimic[1] + j.mimic[2]
+                    p.resetJointState(self.body, j.index, value, physicsClientId=c)
+                    now[j.name] = value
+            return self.positions()
+
+    def positions(self) -> dict[str, float]:
+        """Every movable joint's position, read from PyBullet (``getJointState``)."""
+        with self.lock:
+            p, c = self.session.p, self.session.client
+            return {j.name: float(p.getJointState(self.body, j.index, physicsClientId=c)[0])
+                    for j in self.joints}
+
+    def link_poses(self) -> list[tuple[Vec3, Quat]]:
+        """World pose of every URDF link frame, base first, as PyBullet reports it."""
+        with self.lock:
+            p, c = self.session.p, self.session.client
+            pos, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=c)
+            base = self.links[0]
+            inv = p.invertTransform(base.inertial_pos, base.inertial_quat)
+            out = [p.multiplyTransforms(pos, orn, inv[0], inv[1])]
+            for link in self.links[1:]:
+                state = p.getLinkState(self.body, link.index, computeForwardKinematics=1,
+                                       physicsClientId=c)
+                out.append((state[4], state[5]))
+            return [(tuple(float(x) for x in a), tuple(float(x) for x in b))  # type: ignore[misc]
+                    for a, b in out]
+
+    def bounds(self) -> tuple[Vec3, Vec3]:
+        """The posed robot's box (union of getAABB over links), for the camera."""
+        with self.lock:
+            p, c = self.session.p, self.session.client
+            lo, hi = [math.inf] * 3, [-math.inf] * 3
+            for link in self.links:
+                a, b = p.getAABB(self.body, link.index, physicsClientId=c)
+                if all(math.isfinite(x) for x in (*a, *b)) and all(
+                        b[k] >= a[k] for k in range(3)):
+                    lo = [min(lo[k], a[k]) for k in range(3)]
+                    hi = [max(hi[k], b[k]) for k in range(3)]
+            if not all(math.isfinite(x) for x in lo + hi):
+                return (-0.5, -0.5, -0.5), (0.5, 0.5, 0.5)
+            return tuple(lo), tuple(hi)  # type: ignore[return-value]
+
+    def touching(self) -> list[tuple[str, str, float]]:
+        """Link pairs touching or interpenetrating at the current pose, as ``collisions`` sees them.
+
+        Measured in a second body loaded with URDF_USE_SELF_COLLISION (without it PyBullet's
+        getClosestPoints finds nothing between a body's own links) and pinned, posed like the
+        shown one; links joined by a joint are not tested, as in ``urdfkit collisions``.
+        Returns (link a, link b, signed distance in m), deepest first.
+        """
+        with self.lock:
+            if self._probe is None:
+                self._probe = self._open_probe()
+            session, body, pairs = self._probe
+            p, c = session.p, session.client
+            for j in self.joints:
+                p.resetJointState(body, j.index, p.getJointState(
+                    self.body, j.index, physicsClientId=self.session.client)[0],
+                    physicsClientId=c)
+            out = []
+            for a, b in pairs:
+                points = p.getClosestPoints(body, body, 0.0, a, b, physicsClientId=c)
+                if points:
+                    out.append((self.links[a + 1].name, self.links[b + 1].name,
+                                float(min(pt[8] for pt in points))))
+            return sorted(out, key=lambda x: x[2])
+
+    def _open_probe(self) -> tuple[Any, int, list[tuple[int, int]]]:
+        from urdfkit.engine.session import LoadOptions, Session
+
+        session = Session()
+        try:
+            body = session.load_urdf(self.resolved.load_path, LoadOptions(
+                fixed_base=True, self_collision=True), display=self.resolved.name)
+        except BaseException:
+            session.close()
+            raise
+        shaped = [lk.index for lk in self.links if lk.collisions]
+        parent = {j.joint_index: j.parent_index for j in self.table}
+        pairs = [(a, b) for k, a in enumerate(shaped) for b in shaped[k + 1:]
+                 if parent.get(b) != a and parent.get(a) != b]
+        return session, body, pairs
+
+    def joint_vector(self) -> tuple[str, str]:
+        """The current joints as a Python list (index order) and as ``--joints`` text."""
+        now = self.positions()
+        values = [round(now[j.name], 6) for j in self.joints]
+        text = ",".join(f"{j.name}={round(now[j.name], 6):g}" for j in self.joints)
+        return repr(values), f"--joints {text}" if text else ""
+
+    def close(self) -> None:
+        """Disconnect the session and drop the resolved temp copy."""
+        if self.session is not None:
+            self.session.close()
+            self.session = None
+        probe = getattr(self, "_probe", None)
+        if probe is not None:
+            probe[0].close()
+            self._probe = None
+        resolved = getattr(self, "resolved", None)
+        if resolved is not None:
+            resolved.close()
+
+
+#: ``<link name='x'>`` / ``<joint name="x">`` as check's messages name elements.
+_NAMED = re.compile(r"<(link|joint) name=(['\"])(.*?)\2>")
+
+
+def _last_line(el: Any) -> int:
+    from urdfkit.model.xmlio import line_of
+
+    last = line_of(el) or 0
+    for sub in el.iter():
+        last = max(last, line_of(sub) or 0)
+    return last
+

@@ -1,0 +1,1 @@
+"""urdfkit.engine: see docs/architecture.md. Imports nothing."""

@@ -1,0 +1,1 @@
+"""urdfkit.model: see docs/architecture.md. Imports nothing."""

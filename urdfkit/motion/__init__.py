@@ -1,0 +1,1 @@
+"""urdfkit.motion: see docs/architecture.md. Imports nothing."""

@@ -1,0 +1,1 @@
+"""urdfkit.sources: see docs/architecture.md. Imports nothing."""

@@ -1,0 +1,509 @@
+"""Mass properties of mesh files, for the mesh-aware physics checks (no trimesh needed).
+
+About half of the links of real robots collide only through meshes. :func:`properties` reads
+an STL (binary or ASCII), OBJ or COLLADA (.dae) file, placed as PyBullet places it, applies
+``<mesh scale>``, and returns the solid's volume, centre of mass and inertia per unit density
+by the signed-tetrahedron method (each triangle with the origin spans a tetrahedron; summed
+with signs, they give the closed solid's integrals). It also says whether the surface is
+closed (every edge shared by exactly two triangles), since a mesh with holes has no
+meaningful volume.
+
+Reading and integrating a mesh costs far more than checking the URDF that names it, so the
+integrals are kept, unscaled, in urdfkit's cache (:mod:`urdfkit.sources.cache`), keyed by the file's
+absolute path, size, modification time and inode: a second ``check`` of the same robots reads
+no mesh. Any ``scale`` is applied to the integrals in closed form.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import re
+import struct
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from urdfkit.core import deps
+from urdfkit.core.errors import InputError
+from urdfkit.model.spec import axis_angle_matrix
+from urdfkit.sources.cache import cache_dir, read_entry, write_entry
+
+#: Largest mesh file read for checks; bigger ones are skipped (checks must stay fast).
+MAX_MESH_BYTES = 16 * 1024 * 1024
+
+
+@dataclass(frozen=True)
+class MeshProperties:
+    """A closed triangle mesh as a solid of unit density (scaled).
+
+    Attributes:
+        volume: m^3 (positive for outward-facing triangles).
+        com: Centre of mass in the mesh frame.
+        inertia: 3x3 inertia tensor about ``com`` per kg/m^3 (multiply by mass / volume).
+        extent: Size of the bounding box along x, y, z.
+        closed: Every edge is shared by exactly two triangles.
+        triangles: How many triangles.
+        concavity: How far (m, about, under non-uniform scale) the surface lies inside the
+            convex hull PyBullet collides with: the largest distance of a vertex in front of
+            the plane of a triangle of its own piece. 0 for a convex mesh.
+        pieces: Convex hulls PyBullet makes of it (one per ``o``/``g`` object of an OBJ).
+    """
+
+    volume: float
+    com: tuple[float, float, float]
+    inertia: tuple[tuple[float, ...], ...]
+    extent: tuple[float, float, float]
+    closed: bool
+    triangles: int
+    concavity: float = 0.0
+    pieces: int = 1
+
+    def trace_for_mass(self, mass: float) -> float | None:
+        """Trace of the inertia of this solid with ``mass``, or None without a volume."""
+        if not self.closed or self.volume <= 0:
+            return None
+        t = self.inertia
+        return (t[0][0] + t[1][1] + t[2][2]) * mass / self.volume
+
+
+@dataclass(frozen=True)
+class Integrals:
+    """A mesh's volume integrals as read, unscaled and signed (what the cache keeps).
+
+    Attributes:
+        volume: Signed volume (negative when the triangles face inward).
+        first: Integrals of x, y, z over the solid.
+        second: Integrals of xx, yy, zz, xy, xz, yz over the solid.
+        low, high: Corners of the bounding box of the vertices the triangles use.
+        closed, triangles, concavity, pieces: As in :class:`MeshProperties` (concavity
+            unscaled).
+    """
+
+    volume: float
+    first: tuple[float, float, float]
+    second: tuple[float, float, float, float, float, float]
+    low: tuple[float, float, float]
+    high: tuple[float, float, float]
+    closed: bool
+    triangles: int
+    concavity: float = 0.0
+    pieces: int = 1
+
+    _FORMAT = struct.Struct("<17d?II")
+
+    def pack(self) -> bytes:
+        """The cache entry's bytes."""
+        return _ENTRY + self._FORMAT.pack(self.volume, *self.first, *self.second, *self.low,
+                                          *self.high, self.concavity, self.closed,
+                                          self.triangles, self.pieces)
+
+    @classmethod
+    def unpack(cls, data: bytes) -> Integrals:
+        """Read a cache entry; ValueError if it is not one."""
+        if len(data) != len(_ENTRY) + cls._FORMAT.size or not data.startswith(_ENTRY):
+            raise ValueError("not a mesh cache entry")
+        v = cls._FORMAT.unpack_from(data, len(_ENTRY))
+        return cls(v[0], v[1:4], v[4:10], v[10:13], v[13:16], v[17], v[18], v[16], v[19])
+
+    def scaled(self, scale: tuple[float, float, float]) -> MeshProperties | None:
+        """The solid under ``<mesh scale>``: integrals scale as powers of each factor."""
+        sx, sy, sz = scale
+        det = sx * sy * sz
+        if det == 0:
+            return None
+        volume = self.volume * det
+        first = [f * k * det for f, k in zip(self.first, scale, strict=True)]
+        xx, yy, zz, xy, xz, yz = self.second
+        m = [[xx * sx * sx, xy * sx * sy, xz * sx * sz],
+             [xy * sx * sy, yy * sy * sy, yz * sy * sz],
+             [xz * sx * sz, yz * sy * sz, zz * sz * sz]]
+        sign = -1.0 if volume < 0 else 1.0  # inward triangles: the same solid, inside out
+        volume *= sign
+        com = [sign * f / volume if volume else 0.0 for f in first]
+        about = [[sign * det * m[i][j] - volume * com[i] * com[j] for j in range(3)]
+                 for i in range(3)]
+        trace = about[0][0] + about[1][1] + about[2][2]
+        tensor = tuple(tuple((trace if i == j else 0.0) - about[i][j] for j in range(3))
+                       for i in range(3))
+        (x0, y0, z0), (x1, y1, z1) = self.low, self.high
+        extent = (abs(sx) * (x1 - x0), abs(sy) * (y1 - y0), abs(sz) * (z1 - z0))
+        return MeshProperties(volume, (com[0], com[1], com[2]), tensor,
+                              extent, self.closed, self.triangles,
+                              self.concavity * max(abs(sx), abs(sy), abs(sz)), self.pieces)
+
+
+#: Cache entries start with this; a new layout is a new prefix and a new folder.
+_ENTRY = b"M2"
+_FOLDER = "meshes-2"
+_MEMORY: dict[str, Integrals | None] = {}
+_MISSING = object()
+
+
+def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+               ) -> MeshProperties | None:
+    """Mass properties of an STL or OBJ mesh, or None if unreadable, unsupported or empty."""
+    suffix = path.suffix.lower()
+    if suffix not in (".stl", ".obj", ".dae"):
+        return None
+    deps.note(path)
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    if st.st_size > MAX_MESH_BYTES:
+        return None
+    key = f"{os.path.abspath(path)}\0{st.st_size}\0{st.st_mtime_ns}\0{st.st_ino}"
+    found = _MEMORY.get(key, _MISSING)
+    if found is _MISSING:
+        found = _MEMORY[key] = _integrals(path, suffix, key)
+    assert found is None or isinstance(found, Integrals)
+    return found.scaled(scale) if found is not None else None
+
+
+def _integrals(path: Path, suffix: str, key: str) -> Integrals | None:
+    folder = cache_dir()
+    entry = (folder / _FOLDER / hashlib.sha1(key.encode("utf-8", "surrogateescape")
+                                                ).hexdigest()) if folder else None
+    if entry is not None:
+        data = read_entry(entry)
+        if data == _ENTRY + b"-":
+            return None
+        if data is not None:
+            try:
+                return Integrals.unpack(data)
+            except (ValueError, struct.error):
+                pass  # a damaged entry: read the mesh again and rewrite it
+    found = read_integrals(path, suffix)
+    if entry is not None:
+        write_entry(entry, found.pack() if found is not None else _ENTRY + b"-")
+    return found
+
+
+def read_integrals(path: Path, suffix: str | None = None) -> Integrals | None:
+    """Read a mesh and integrate it (no cache); None if unreadable, unsupported or empty."""
+    import numpy as np
+
+    from urdfkit.model.xmlio import read_regular
+
+    suffix = (suffix or path.suffix).lower()
+    try:  # a FIFO or device named like a mesh must not hang or fill memory
+        data = read_regular(path, limit=MAX_MESH_BYTES, kind="mesh")
+    except InputError:
+        return None
+    starts: list[int] = []
+    try:
+        if suffix == ".stl":
+            vertices, faces = _stl(data)
+        elif suffix == ".obj":
+            vertices, faces, starts = _obj(data)
+        elif suffix == ".dae":
+            vertices, faces = _dae(data, path)
+        else:
+            return None
+    except (ValueError, struct.error, IndexError, OverflowError, KeyError, InputError,
+            AttributeError, StopIteration, TypeError):
+        return None
+    if (vertices is None or faces is None or len(faces) == 0 or len(vertices) == 0
+            or faces.min() < 0 or faces.max() >= len(vertices)
+            or not np.isfinite(vertices).all()):
+        return None
+    return _solid(vertices, faces, starts)
+
+
+def _stl(data: bytes) -> tuple[Any, Any]:
+    import numpy as np
+
+    if len(data) >= 84:
+        count = struct.unpack_from("<I", data, 80)[0]
+        if 84 + 50 * count == len(data):  # binary: 50 bytes per triangle
+            rec = np.frombuffer(data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)),
+                                                      ("a", "<u2")]), count=count, offset=84)
+            return _weld(rec["v"].reshape(-1, 3).astype(float))
+    words = data.decode("ascii", "replace").split()
+    coords = [float(words[i + 1]) for i in range(len(words)) if words[i] == "vertex"
+              for i in (i, i + 1, i + 2)]
+    return _weld(np.array(coords, dtype=float).reshape(-1, 3))
+
+
+def _weld(corners: Any) -> tuple[Any, Any]:
+    """Shared vertices from per-triangle corners (STL repeats them), for the closed test."""
+    import numpy as np
+
+    unique, index = np.unique(corners, axis=0, return_inverse=True)
+    return unique, index.reshape(-1, 3)
+
+
+_OBJ_INDEX_TAIL = re.compile(rb"/\S*")
+_OBJ_OBJECT = re.compile(rb"^[og][ \t]", re.M)
+_OBJ_FACE_LINE = re.compile(rb"^f[ \t]", re.M)  # "7/3/2" -> "7": texture and normal indices go
+
+
+def _numbers(lines: list[bytes], dtype: Any, per_line: int) -> Any:
+    """The numbers after each line's keyword, ``per_line`` of them per line.
+
+    The common case (every line holds exactly ``per_line`` numbers) is parsed in one C call;
+    anything else (vertex colours, polygons, junk) line by line, which raises ValueError on
+    text that is not a number.
+    """
+    import warnings
+
+    import numpy as np
+
+    joined = b" ".join(line.split(None, 1)[1] if b" " in line or b"\t" in line else b""
+                       for line in lines)
+    if dtype is not float and b"/" in joined:
+        joined = _OBJ_INDEX_TAIL.sub(b"", joined)
+    with warnings.catch_warnings():  # numpy warns when it stops early: counted below
+        warnings.simplefilter("ignore", DeprecationWarning)
+        values = np.fromstring(joined, dtype=dtype, sep=" ")
+    if values.size == per_line * len(lines):
+        return values.reshape(-1, per_line)
+    raise ValueError("irregular")
+
+
+def _obj(data: bytes) -> tuple[Any, Any, list[int]]:
+    """Vertices, triangles, and the first triangle of each ``o``/``g`` object after the first.
+
+    PyBullet collides with one convex hull per object of an OBJ (a V-HACD decomposition is
+    many convex objects in one file), so the objects matter to the concavity test.
+    """
+    import numpy as np
+
+    vlines: list[bytes] = []
+    flines: list[bytes] = []
+    starts: list[int] = []  # f-line index where each object after the first begins
+    for ln in data.split(b"\n"):
+        head = ln[:2]
+        if head in (b"v ", b"v\t"):
+            vlines.append(ln)
+        elif head in (b"f ", b"f\t"):
+            flines.append(ln)
+        elif head in (b"o ", b"g ", b"o\t", b"g\t") and flines and (
+                not starts or starts[-1] != len(flines)):
+            starts.append(len(flines))
+    try:
+        vertices = _numbers(vlines, float, 3)
+    except ValueError:  # "v x y z w" or "v x y z r g b": the first three are the position
+        vertices = np.array([[float(x) for x in ln.split()[1:4]] for ln in vlines],
+                            dtype=float).reshape(-1, 3)
+    count = len(vertices)
+    try:
+        tri = _numbers(flines, np.int64, 3)
+    except ValueError:  # polygons: fans of triangles (object starts move to triangle counts)
+        faces: list[tuple[int, int, int]] = []
+        first_triangle = []
+        for line in flines:
+            first_triangle.append(len(faces))
+            idx = [int(p.split(b"/", 1)[0]) for p in line.split()[1:]]
+            faces += [(idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
+        tri = np.array(faces, dtype=np.int64).reshape(-1, 3)
+        starts = [first_triangle[i] for i in starts]
+    # 1-based; negative counts from the end
+    return vertices, np.where(tri > 0, tri - 1, count + tri), starts
+
+
+def _dae(data: bytes, path: Path) -> tuple[Any, Any]:
+    """Vertices and triangles of a COLLADA file, placed as PyBullet places them.
+
+    As PyBullet 3.2.7 reads it for collision: every ``<instance_geometry>`` of the scene's
+    visual scene, moved by its nodes' transforms (read PyBullet's way, see
+    :meth:`_Collada.local`), then scaled by ``<unit meter>``; ``<up_axis>`` is not applied.
+    Checked against PyBullet's getAABB of the same meshes in tests/test_meshes.py. Triangles,
+    polylists and polygons are read (fans for polygons); a geometry in any other primitive
+    (strips) makes the whole mesh unreadable rather than wrong. All one solid: PyBullet makes
+    one hull.
+    """
+    import numpy as np
+
+    doc = _Collada(data, path)
+    scene_ref = doc.root.find("{*}scene/{*}instance_visual_scene")
+    if scene_ref is not None:
+        for node in doc.ref(scene_ref.get("url")).iterfind("{*}node"):
+            doc.walk(node, np.eye(4), 0)
+    unit = doc.root.find("{*}asset/{*}unit")
+    world = np.eye(4) * float(unit.get("meter", "1") if unit is not None else 1.0)
+    world[3, 3] = 1.0
+    all_points, all_faces, count = [], [], 0
+    for transform, geom in doc.placed:
+        points, faces = doc.geometry(geom)
+        m = world @ transform
+        all_points.append(points @ m[:3, :3].T + m[:3, 3])
+        all_faces.append(faces + count)
+        count += len(points)
+    if not all_points:
+        raise ValueError("no geometry")
+    return np.concatenate(all_points), np.concatenate(all_faces)
+
+
+class _Collada:
+    """One COLLADA document, read the way PyBullet reads it (see :func:`_dae`)."""
+
+    def __init__(self, data: bytes, path: Path) -> None:
+        from urdfkit.model.xmlio import parse_xml
+
+        self.root = parse_xml(data, path).getroot()
+        self.by_id = {el.get("id"): el for el in self.root.iter() if el.get("id")}
+        #: (world transform, <geometry>) of every instance_geometry met by :meth:`walk`.
+        self.placed: list[tuple[Any, Any]] = []
+
+    def ref(self, url: str | None) -> Any:
+        """The element a ``#id`` URL points at."""
+        return self.by_id[(url or "").lstrip("#")]
+
+    @staticmethod
+    def numbers(el: Any, dtype: Any = float) -> Any:
+        """An element's text as a flat array."""
+        import numpy as np
+
+        return np.array((el.text or "").split(), dtype=dtype)
+
+    def geometry(self, geom: Any) -> tuple[Any, Any]:
+        """A ``<geometry>``'s points and triangles (vertex indices)."""
+        import numpy as np
+
+        mesh = geom.find("{*}mesh")
+        if mesh is None:
+            raise ValueError("not a mesh")
+        verts = mesh.find("{*}vertices")
+        position = next(i for i in verts.iterfind("{*}input") if i.get("semantic") == "POSITION")
+        source = self.ref(position.get("source"))
+        accessor = source.find("{*}technique_common/{*}accessor")
+        stride = int(accessor.get("stride", "3")) if accessor is not None else 3
+        points = self.numbers(source.find("{*}float_array")).reshape(-1, stride)[:, :3]
+        tris: list[Any] = []
+        for prim in mesh:
+            tag = etree_local(prim.tag)
+            if tag in ("source", "vertices", "extra", "lines", "linestrips"):
+                continue  # edges hold no faces (PyBullet skips them too)
+            if tag not in ("triangles", "polylist", "polygons"):
+                raise ValueError(f"COLLADA <{tag}> is not read")
+            tris += self.triangles(prim, tag)
+        faces = np.concatenate(tris).astype(np.int64) if tris else np.zeros((0, 3), np.int64)
+        return points, faces
+
+    def triangles(self, prim: Any, tag: str) -> list[Any]:
+        """The triangles of one ``<triangles>``, ``<polylist>`` or ``<polygons>`` (fans)."""
+        import numpy as np
+
+        inputs = prim.findall("{*}input")
+        width = max(int(i.get("offset", "0")) for i in inputs) + 1
+        at = next(int(i.get("offset", "0")) for i in inputs if i.get("semantic") == "VERTEX")
+        polys = [self.numbers(p_, np.int64).reshape(-1, width)[:, at]
+                 for p_ in prim.iterfind("{*}p")]
+        if tag == "triangles":
+            return [np.concatenate(polys).reshape(-1, 3) if polys else np.zeros((0, 3))]
+        if tag == "polylist":
+            counts = self.numbers(prim.find("{*}vcount"), np.int64)
+            polys = np.split(polys[0], np.cumsum(counts)[:-1]) if polys else []
+        return [np.array([[poly[0], poly[k], poly[k + 1]]])
+                for poly in polys for k in range(1, len(poly) - 1)]
+
+    def local(self, node: Any) -> Any:
+        """A node's own transform, as PyBullet reads it.
+
+        PyBullet reads only the first <matrix>, <translate>, <scale> and <rotate> of a node
+        (its loop steps to the node's sibling, not the element's), and composes them in that
+        order whatever the file's order: a second <rotate> is ignored (measured).
+        """
+        import numpy as np
+
+        m = np.eye(4)
+        for kind in ("matrix", "translate", "scale", "rotate"):
+            t = node.find("{*}" + kind)
+            if t is None or not (t.text or "").strip():
+                continue
+            step = np.eye(4)
+            if kind == "matrix":
+                step = self.numbers(t).reshape(4, 4)
+            elif kind == "translate":
+                step[:3, 3] = self.numbers(t)[:3]
+            elif kind == "scale":
+                step = np.diag([*self.numbers(t)[:3], 1.0])
+            else:
+                x, y, z, deg = self.numbers(t)[:4]
+                step[:3, :3] = axis_angle_matrix((x, y, z), math.radians(deg))
+            m = m @ step
+        return m
+
+    def walk(self, node: Any, above: Any, depth: int) -> None:
+        """Collect the node's geometry instances and its children's, with their transforms."""
+        if depth > 64:
+            raise ValueError("nodes nested too deep")
+        here = above @ self.local(node)
+        self.placed.extend((here, self.ref(g.get("url")))
+                           for g in node.iterfind("{*}instance_geometry"))
+        for child in node.iterfind("{*}node"):  # (<instance_node> is not read by PyBullet)
+            self.walk(child, here, depth + 1)
+
+
+def etree_local(tag: Any) -> str:
+    """A tag without its namespace ("" for comments)."""
+    return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
+
+
+#: A mesh whose surface dips more than this fraction of its size inside its hull is concave.
+CONCAVE_FRACTION = 0.02
+#: Vertex-by-plane tests per piece for the concavity depth; bigger pieces test a sample of
+#: their triangles' planes (a concave mesh has many planes with vertices in front).
+_CONCAVITY_BUDGET = 4_000_000
+
+
+def _concavity(vertices: Any, faces: Any, starts: list[int], det: Any) -> float:
+    """Largest distance of a vertex in front of a triangle's plane, within each piece.
+
+    ``det`` is each triangle's signed-volume term (6 x its tetrahedron with the origin), whose
+    sum per piece says which side of its triangles is out.
+    """
+    import numpy as np
+
+    a, b, c = vertices[faces.T]
+    normal = np.cross(b - a, c - a)
+    length = np.linalg.norm(normal, axis=1)
+    length[length == 0] = np.inf  # a degenerate triangle has no plane: it tests nothing
+    normal /= length[:, None]
+    offset = np.einsum("ij,ij->i", normal, a)
+    worst = 0.0
+    bounds = [0, *starts, len(faces)]
+    for lo, hi in zip(bounds, bounds[1:], strict=False):
+        if hi - lo < 4:
+            continue
+        sign = -1.0 if det[lo:hi].sum() < 0 else 1.0  # inward triangles: out is the other side
+        points = vertices[np.unique(faces[lo:hi])]
+        step = max(1, -(-(hi - lo) * len(points) // _CONCAVITY_BUDGET))
+        depth = sign * (points @ normal[lo:hi:step].T - offset[lo:hi:step])
+        worst = max(worst, float(depth.max()))
+    return worst
+
+
+def _solid(vertices: Any, faces: Any, starts: list[int] | None = None) -> Integrals:
+    import numpy as np
+
+    p = vertices[faces.T]  # (corner, triangle, xyz)
+    a, b, c = p
+    det = np.einsum("ij,ij->i", a, np.cross(b, c))  # 6 x signed tetrahedron volumes
+    s = a + b + c
+    # Second moments of each tetrahedron (origin, a, b, c): (aa' + bb' + cc' + ss') det / 120.
+    q = p.transpose(2, 0, 1).reshape(3, -1)
+    second = ((q * np.tile(det, 3)) @ q.T + (s.T * det) @ s) / 120.0
+    first = s.T @ det / 24.0
+    # Closed: every undirected edge in exactly two triangles. Sorted corners give each edge
+    # one int64 key; sorted keys must then come in equal pairs, each pair unlike the next.
+    e = np.sort(faces, axis=1).astype(np.int64)
+    n = int(e[:, 2].max()) + 1
+    keys = np.sort(np.concatenate([e[:, 0] * n + e[:, 1], e[:, 1] * n + e[:, 2],
+                                   e[:, 0] * n + e[:, 2]]))
+    closed = bool(len(keys) % 2 == 0 and (keys[0::2] == keys[1::2]).all()
+                  and (keys[2::2] != keys[1:-1:2]).all())
+    used = np.zeros(len(vertices), dtype=bool)
+    used[faces.ravel()] = True
+    corners = vertices[used]
+    low, high = corners.min(axis=0), corners.max(axis=0)
+    starts = starts or []
+    return Integrals(float(det.sum()) / 6.0, (float(first[0]), float(first[1]), float(first[2])),
+                     (float(second[0, 0]), float(second[1, 1]), float(second[2, 2]),
+                      float(second[0, 1]), float(second[0, 2]), float(second[1, 2])),
+                     (float(low[0]), float(low[1]), float(low[2])),
+                     (float(high[0]), float(high[1]), float(high[2])), closed, len(faces),
+                     _concavity(vertices, faces, starts, det) if closed else 0.0, len(starts) + 1)
