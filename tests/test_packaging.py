@@ -22,6 +22,11 @@ def test_wheel_ships_templates_as_package_data(tmp_path: Path) -> None:
         assert f"urdfkit/templates/{template.name}" in names
     assert "urdfkit/py.typed" in names
     assert "urdfkit/cli.py" in names
+    # Every module of every folder: a folder missing from pyproject's packages list would
+    # leave a plain install unable to import urdfkit.cli at all.
+    package = ROOT / "urdfkit"
+    modules = {p.relative_to(ROOT).as_posix() for p in package.rglob("*.py")}
+    assert modules <= names, sorted(modules - names)
     # Every command on a plain install: sim (pydantic) and render (Pillow) need no extra;
     # yourdfpy (trimesh, scipy, ...) is a test tool, not a runtime dependency.
     with zipfile.ZipFile(wheel) as zf:
