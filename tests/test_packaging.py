@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -11,8 +12,19 @@ ROOT = Path(__file__).parent.parent
 
 
 def test_wheel_ships_templates_as_package_data(tmp_path: Path) -> None:
+    # Built from a copy of what the wheel is made of: a build/ folder left in the checkout
+    # would otherwise lend the wheel files its own configuration leaves out.
+    source = tmp_path / "src"
+    source.mkdir()
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
+        if (ROOT / name).exists():
+            shutil.copy2(ROOT / name, source / name)
+    for folder in ("urdfkit", "templates"):
+        shutil.copytree(ROOT / folder, source / folder,
+                        ignore=shutil.ignore_patterns("__pycache__"))
     out = subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(tmp_path), str(ROOT)],
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(tmp_path),
+         str(source)],
         capture_output=True, text=True, timeout=300,
     )
     assert out.returncode == 0, out.stderr
