@@ -96,8 +96,8 @@ def test_a_geometry_without_a_shape_is_still_refused(tmp_path: Path) -> None:
                     '</collision></link></robot>')
     import pybullet as p
 
-    with pytest.raises(p.error, match="Cannot load URDF"), _raw(path):
-        pass
+    with pytest.raises(p.error, match="Cannot load URDF"), _raw(path) as (_, _, body):
+        pytest.fail(f"raw PyBullet loaded a <geometry> with no shape (body {body})")
     r = _cli("joints", str(path))
     assert r.returncode == 2 and "holds no shape" in r.stderr and r.stderr.count("\n") == 1
 

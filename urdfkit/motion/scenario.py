@@ -19,7 +19,7 @@ import math
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from types import SimpleNamespace
+from types import ModuleType
 from typing import TYPE_CHECKING, Annotated, Any, Union, get_args, get_origin
 
 from urdfkit.core.errors import InputError, MissingDependencyError, ParameterError
@@ -41,13 +41,13 @@ _INSTALL_HINT = "urdfkit installs it; reinstall it: pip install --force-reinstal
 
 
 @functools.cache
-def schema() -> SimpleNamespace:
+def schema() -> ModuleType:
     """The pydantic models of a scenario (:mod:`~urdfkit.motion.scenario_models`), imported lazily.
 
     Returns:
-        A namespace with ``Scenario`` (the document) and the models it nests: ``Physics``,
+        The module: ``Scenario`` (the document) and the models it nests, ``Physics``,
         ``Ground``, ``Record``, ``Robot``, ``DriveSegment``, ``Vehicle``, ``JointSegment``,
-        ``Motor``, ``InitialJoint``, ``Noise``.
+        ``Motor``, ``InitialJoint``, ``Noise``, ``LinkDynamics``, ``Randomize``.
 
     Raises:
         MissingDependencyError: pydantic is not installed.
@@ -56,14 +56,9 @@ def schema() -> SimpleNamespace:
         import pydantic  # noqa: F401 - the dependency, checked before the models that need it
     except ImportError as e:
         raise MissingDependencyError(f"scenario files need pydantic: {_INSTALL_HINT}") from e
-    from urdfkit.motion import scenario_models as m
+    from urdfkit.motion import scenario_models
 
-    return SimpleNamespace(
-        Scenario=m.Scenario, Physics=m.Physics, Ground=m.Ground, Record=m.Record, Robot=m.Robot,
-        DriveSegment=m.DriveSegment, Vehicle=m.Vehicle, JointSegment=m.JointSegment,
-        Motor=m.Motor, InitialJoint=m.InitialJoint, Noise=m.Noise, LinkDynamics=m.LinkDynamics,
-        Randomize=m.Randomize,
-    )
+    return scenario_models
 
 
 # --------------------------------------------------------------------------- error paths
