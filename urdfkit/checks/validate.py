@@ -13,16 +13,15 @@ import math
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from lxml import etree
 
+from urdfkit.model.index import Doc, LinkView
 from urdfkit.model.spec import (
-    FILE_TAGS,
     LIMITED_JOINT_TYPES,
     MAX_STATE_LINKS,
-    NUMERIC,
-    OPAQUE,
-    SCHEMA,
     SHAPES,
     SOLIDS,
     Matrix3,
@@ -39,10 +38,11 @@ from urdfkit.model.spec import (
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.model.xmlio import children
 from urdfkit.sources.guard import GUARD_RULES, Report, Rule, label
 
-_elements = children
+if TYPE_CHECKING:
+    from urdfkit.sources.meshes import MeshProperties
+
 
 
 # --------------------------------------------------------------------------- structural rules
@@ -51,7 +51,7 @@ _elements = children
 
 def rule_link_count(root: etree._Element, r: Report) -> None:
     """U208: 128 links or more break PyBullet's state queries."""
-    n = sum(1 for _ in _elements(root, "link"))
+    n = len(r.doc(root).links)
     if n >= MAX_STATE_LINKS:
         r.add("U208", "error", f"{n} links: PyBullet's getJointState/getLinkState fail on "
               f"bodies with {MAX_STATE_LINKS} links or more (MAX_DEGREE_OF_FREEDOM); split "
@@ -67,80 +67,42 @@ _DBL_EPSILON = sys.float_info.epsilon
 
 
 def rule_elements(root: etree._Element, r: Report) -> None:
-    """U401-U402 and U801-U802, in one pass over the tree.
+    """U401-U402 and U801-U802: numbers and names of tags and attributes.
 
     Numbers parse, are finite and have the right length; tags and attributes are known
-    (typos, or extensions PyBullet ignores). Comments, namespaced elements (xacro leftovers,
-    extensions) and opaque subtrees (another tool's: gazebo, transmission, ...) are skipped
-    whole. Each parent checks its own children's tags, so no element asks for its parent.
+    (typos, or extensions PyBullet ignores). Judged on the document's one walk
+    (:class:`~urdfkit.model.index.Doc`), which skips comments, namespaced elements (xacro
+    leftovers, extensions), opaque subtrees (another tool's: gazebo, transmission, ...) and
+    shapes after the first in a ``<geometry>``.
     """
-    tag = root.tag
-    if isinstance(tag, str) and tag[0] != "{" and tag not in OPAQUE:
-        _elements_below(root, tag, r)
+    for code, level, message, el in r.doc(root).element_findings:
+        r.add(code, level, message, el)
 
 
-def _elements_below(el: etree._Element, tag: str, r: Report) -> None:
-    known = SCHEMA.get(tag)
-    numeric = _NUMERIC_BY_TAG.get(tag)
-    if known is not None or numeric is not None:
-        for attr, text in el.items():
-            n = numeric.get(attr) if numeric is not None else None
-            if n is not None:
-                try:
-                    vals = [float(x) for x in text.split()]
-                except ValueError:
-                    vals = None
-                if vals is None or not all(map(math.isfinite, vals)):
-                    r.add("U401", "error", f"<{tag} {attr}={text!r}>: expected "
-                          f"{'a finite number' if n == 1 else f'{n} finite numbers'}", el)
-                elif len(vals) != n:
-                    r.add("U402", "error", f"<{tag} {attr}={text!r}>: expected {n} numbers, "
-                          f"got {len(vals)}", el)
-            if known is not None and attr not in known[0] and attr[0] != "{":
-                r.add("U802", "warning", f"<{tag}> has unknown attribute {attr!r}; PyBullet "
-                      "ignores it", el)
-    allowed = known[1] if known is not None else None
-    for child in el:
-        ctag = child.tag
-        if not isinstance(ctag, str) or ctag[0] == "{":
-            continue  # comments, processing instructions, namespaced elements
-        if allowed is not None and ctag not in allowed:
-            r.add("U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
-                  "ignores it", child)
-        if ctag not in OPAQUE and not (tag == "geometry" and ignored_shape(child)):
-            _elements_below(child, ctag, r)  # a shape after the first is never read (U507)
-
-
-#: NUMERIC by tag: {tag: {attribute: how many numbers}}, for one lookup per element.
-_NUMERIC_BY_TAG: dict[str, dict[str, int]] = {}
-for (_tag, _attr), _n in NUMERIC.items():
-    _NUMERIC_BY_TAG.setdefault(_tag, {})[_attr] = _n
-
-
-def _mass_of(link: etree._Element) -> float | None:
+def _mass_of(link: LinkView) -> float | None:
     """The mass PyBullet gives a link: its <mass>, or 1 kg if there is no <inertial>."""
-    inertial = link.find("inertial")
-    if inertial is None:
+    if link.inertial is None:
         return 1.0
-    return _num(inertial.find("mass"), "value")
+    return _num(link.mass, "value")
 
 
 def rule_mass(root: etree._Element, r: Report) -> None:
     """U601-U602, U606: mass >= 0, > 0 on links that move; warn on missing <inertial>."""
-    links = {el.get("name"): el for el in _elements(root, "link") if el.get("name")}
+    doc = r.doc(root)
+    views = {v.name: v for v in doc.links if v.name}
     fixed_children: dict[str, list[str]] = {}
     moving: list[tuple[str, etree._Element]] = []
-    for j in _elements(root, "joint"):
-        parent, child = j.find("parent"), j.find("child")
+    for jv in doc.joints:
+        parent, child = jv.parent, jv.child
         if parent is None or child is None:
             continue
-        if j.get("type") == "fixed":
+        if jv.type == "fixed":
             fixed_children.setdefault(parent.get("link", ""), []).append(child.get("link", ""))
         else:
-            moving.append((child.get("link", ""), j))
-    child_names = {c.get("link") for j in _elements(root, "joint") for c in j.findall("child")}
-    for link in links.values():
-        inertial = link.find("inertial")
+            moving.append((child.get("link", ""), jv.el))
+    child_names = {c.get("link") for jv in doc.joints for c in jv.children}
+    for view in views.values():
+        link, inertial = view.el, view.inertial
         if inertial is None:
             # Never "mass 0" for the root: PyBullet fixes a mass-0 base in place (U611).
             advice = ("add <inertial> with its real mass (mass 0 would fix the robot in place)"
@@ -149,7 +111,7 @@ def rule_mass(root: etree._Element, r: Report) -> None:
             r.add("U606", "warning", f"{label(link)} has no <inertial>; PyBullet silently gives "
                   f"it 1 kg and unit inertia: {advice}", link)
             continue
-        mass_el = inertial.find("mass")
+        mass_el = view.mass
         mass = _num(mass_el, "value")
         if mass_el is None or mass_el.get("value") is None:
             r.add("U601", "error", f"<inertial> of {label(link)} has no <mass value=...>",
@@ -162,25 +124,24 @@ def rule_mass(root: etree._Element, r: Report) -> None:
         total, stack, seen = 0.0, [name], set()
         while stack:
             n = stack.pop()
-            if n in seen or n not in links:
+            if n in seen or n not in views:
                 continue
             seen.add(n)
-            total += max(0.0, _mass_of(links[n]) or 0.0)
+            total += max(0.0, _mass_of(views[n]) or 0.0)
             stack.extend(fixed_children.get(n, []))
         return total
 
     for name, j in moving:
-        if name in links and rigid_mass(name) == 0:
-            r.add("U602", "error", f"{label(links[name])} moves (joint {j.get('name')!r} is "
-                  f"{j.get('type')}) but has mass 0; give it a mass > 0", links[name])
-    roots = [link for name, link in links.items() if name not in child_names]
+        if name in views and rigid_mass(name) == 0:
+            r.add("U602", "error", f"{label(views[name].el)} moves (joint {j.get('name')!r} is "
+                  f"{j.get('type')}) but has mass 0; give it a mass > 0", views[name].el)
+    roots = [view for name, view in views.items() if name not in child_names]
     # PyBullet judges the root link's own mass: 0 fixes the base in place, whatever its fixed
     # children weigh (a mass-0 base_footprint over a 28 kg base_link hangs in the air). A
     # root with no <inertial> gets 1 kg, so it moves (U606 says so).
-    own = _mass_of(roots[0]) if len(roots) == 1 and roots[0].find("inertial") is not None \
-        else None
+    own = _mass_of(roots[0]) if len(roots) == 1 and roots[0].inertial is not None else None
     if own is not None and own == 0:
-        base, static = roots[0], not moving
+        base, static = roots[0].el, not moving
         carried = rigid_mass(base.get("name", ""))
         held = (f"; its fixed links weigh {carried:g} kg, and PyBullet ignores that: it looks "
                 "at the root's own mass" if carried > 0 else "")
@@ -208,7 +169,7 @@ def rule_material_colours(root: etree._Element, r: Report) -> None:
     at the top level or inline) is drawn in the colour written last in the file.
     """
     colours: dict[str, list[tuple[str, etree._Element]]] = {}
-    for m in root.iter("material"):
+    for m in r.doc(root).all_materials:
         name, color = m.get("name"), m.find("color")
         if name is None or color is None or color.get("rgba") is None:
             continue
@@ -231,33 +192,34 @@ def rule_references(root: etree._Element, r: Report) -> None:
     an empty ``<texture/>``, ``package:///`` without a package name, and a revolute or
     prismatic ``<limit>`` without lower/upper (PyBullet: unlimited; the URDF spec: 0..0).
     """
-    defined = {m.get("name") for m in root.iter("material")
+    doc = r.doc(root)
+    defined = {m.get("name") for m in doc.all_materials
                if m.find("color") is not None or m.find("texture") is not None}
-    for m in root.iter("material"):
+    for m in doc.all_materials:
         parent = m.getparent()
         if (parent is not None and parent.tag == "visual" and m.get("name")
                 and m.find("color") is None and m.find("texture") is None
                 and m.get("name") not in defined):
             r.add("U706", "warning", f"<material name={m.get('name')!r}> is used but never "
                   "defined with a <color> or <texture>; PyBullet draws the default colour", m)
-    for t in root.iter("texture"):
-        if not (t.get("filename") or "").strip():
+    for t in doc.files:
+        if t.tag == "texture" and not (t.get("filename") or "").strip():
             r.add("U707", "warning", "<texture> without a filename; remove it or name the "
                   "image", t)
-    for el in root.iter(*FILE_TAGS):
+    for el in doc.files:
         if (el.get("filename") or "").strip().startswith("package:///"):
             r.add("U708", "info", f"<{el.tag} filename={el.get('filename')!r}>: package:/// "
                   "has no package name; PyBullet and urdfkit look the path up beside the file "
                   "and in every folder above, ROS tools refuse it", el)
-    joints = {j.get("name") for j in _elements(root, "joint")}
-    for t in root.iter("transmission"):
+    joints = {jv.name for jv in doc.joints}
+    for t in doc.transmissions:
         for j in t.iter("joint"):
             if j.get("name") and j.get("name") not in joints:
                 r.add("U709", "warning", f"<transmission name={t.get('name')!r}> names joint "
                       f"{j.get('name')!r}, which does not exist", j)
-    for j in _elements(root, "joint"):
-        limit = j.find("limit")
-        if (j.get("type") in LIMITED_JOINT_TYPES and limit is not None
+    for jv in doc.joints:
+        j, limit = jv.el, jv.limit
+        if (jv.type in LIMITED_JOINT_TYPES and limit is not None
                 and (limit.get("lower") is None or limit.get("upper") is None)):
             missing = " and ".join(a for a in ("lower", "upper") if limit.get(a) is None)
             r.add("U308", "warning", f"<limit> of {label(j)} has no {missing}: PyBullet reads "
@@ -271,10 +233,9 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
     ``eps = 10 * DBL_EPSILON * max(1, trace / 2)``, on the principal moments.
     """
     noted = False
-    for link in _elements(root, "link"):
-        inertial = link.find("inertial")
-        inertia = inertial.find("inertia") if inertial is not None else None
-        if inertia is None:
+    for view in r.doc(root).links:
+        link, inertial, inertia = view.el, view.inertial, view.inertia
+        if inertial is None or inertia is None:
             continue
         if not noted:
             r.add("U607", "info", "PyBullet ignores <inertia> from the file and recomputes it "
@@ -282,7 +243,7 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
                   "(urdfkit: --inertia-from-file)", inertia)
             noted = True
         tensor = _inertia_tensor(inertia)
-        mass = _num(inertial.find("mass"), "value")
+        mass = _num(view.mass, "value")
         if tensor is None:
             continue
         trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
@@ -395,18 +356,28 @@ def link_solid(link: etree._Element, r: Report | None = None) -> Solid | None:
     total = sum(p[0] for p in parts)
     if not parts or not 0 < total < math.inf:
         return None
-    com = tuple(sum(v * c[i] for v, c, _, _ in parts) / total for i in range(3))
-    acc = [[0.0] * 3 for _ in range(3)]
-    for volume, centre, tensor, _ in parts:
-        dv = [centre[i] - com[i] for i in range(3)]
-        d2 = sum(x * x for x in dv)
-        for i in range(3):
-            for j in range(3):
-                acc[i][j] += tensor[i][j] + volume * ((d2 if i == j else 0.0) - dv[i] * dv[j])
-    out = tuple((row[0], row[1], row[2]) for row in acc)
-    if not all(math.isfinite(x) for row in out for x in row):
+    cx = sum(v * c[0] for v, c, _, _ in parts) / total
+    cy = sum(v * c[1] for v, c, _, _ in parts) / total
+    cz = sum(v * c[2] for v, c, _, _ in parts) / total
+    # Parallel axes: each part's tensor moved from its centre to the common one.
+    xx = xy = xz = yx = yy = yz = zx = zy = zz = 0.0
+    for volume, centre, t, _ in parts:
+        dx, dy, dz = centre[0] - cx, centre[1] - cy, centre[2] - cz
+        d2 = dx * dx + dy * dy + dz * dz
+        (t00, t01, t02), (t10, t11, t12), (t20, t21, t22) = t
+        xx += t00 + volume * (d2 - dx * dx)
+        xy += t01 + volume * (0.0 - dx * dy)
+        xz += t02 + volume * (0.0 - dx * dz)
+        yx += t10 + volume * (0.0 - dy * dx)
+        yy += t11 + volume * (d2 - dy * dy)
+        yz += t12 + volume * (0.0 - dy * dz)
+        zx += t20 + volume * (0.0 - dz * dx)
+        zy += t21 + volume * (0.0 - dz * dy)
+        zz += t22 + volume * (d2 - dz * dz)
+    out = ((xx, xy, xz), (yx, yy, yz), (zx, zy, zz))
+    if not all(map(math.isfinite, (xx, xy, xz, yx, yy, yz, zx, zy, zz))):
         return None
-    return Solid(total, (com[0], com[1], com[2]), out, max(p[3] for p in parts))
+    return Solid(total, (cx, cy, cz), out, max(p[3] for p in parts))
 
 
 def _shape_trace(link: etree._Element, mass: float | None,
@@ -431,9 +402,7 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3,
     scale = _vec(shape, "scale", 3, (1.0, 1.0, 1.0))
     if ref.load_path is None or scale is None:
         return None
-    from urdfkit.sources.meshes import properties
-
-    props = properties(ref.load_path, (scale[0], scale[1], scale[2]))
+    props = _properties(r, ref.load_path, scale)
     if props is None:
         return None
     if not props.closed:
@@ -451,11 +420,27 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3,
             matmul(matmul(rot, own), transpose(rot)), max(props.extent))
 
 
+def _properties(r: Report, path: Path, scale: Sequence[float]) -> MeshProperties | None:
+    """:func:`urdfkit.sources.meshes.properties`, once per mesh and scale per file.
+
+    The inertia and mesh-shape rules both ask.
+    """
+    key = ("mesh", path, scale[0], scale[1], scale[2])
+    memo = r.memo
+    if key in memo:
+        found: MeshProperties | None = memo[key]
+        return found
+    from urdfkit.sources.meshes import properties
+
+    found = memo[key] = properties(path, (scale[0], scale[1], scale[2]))
+    return found
+
+
 def rule_meshes(root: etree._Element, r: Report) -> None:
     """U701-U705: mesh and texture files exist, are files, in formats PyBullet reads."""
     if r.base is None:
         return
-    for el in root.iter(*FILE_TAGS):
+    for el in r.doc(root).files:
         fn = (el.get("filename") or "").strip()
         if fn and not ignored_shape(el):  # a mesh after the first shape is never opened
             ref = r.reference(el.tag, fn)
@@ -479,23 +464,23 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
     """
     if r.base is None:
         return
-    from urdfkit.sources.meshes import CONCAVE_FRACTION, properties
+    from urdfkit.sources.meshes import CONCAVE_FRACTION
 
-    offsets = sorted(math.sqrt(sum(x * x for x in xyz)) for j in _elements(root, "joint")
-                     if (xyz := _vec(j.find("origin"), "xyz", 3)) is not None and any(xyz))
+    doc = r.doc(root)
+    offsets = sorted(math.sqrt(sum(x * x for x in xyz)) for jv in doc.joints
+                     if (xyz := _vec(jv.origin, "xyz", 3)) is not None and any(xyz))
     spacing = offsets[len(offsets) // 2] if len(offsets) >= 2 else None
-    moving = _moving_links(root)
-    for link in _elements(root, "link"):
-        for part in link:
-            if part.tag not in ("visual", "collision"):
-                continue
+    moving = _moving_links(doc)
+    for view in doc.links:
+        link = view.el
+        for part in view.parts:
             mesh = used_shape(part.find("geometry"))
             fn = (mesh.get("filename") or "").strip() if mesh is not None and \
                 mesh.tag == "mesh" else ""
             if not fn or (ref := r.reference("mesh", fn)).load_path is None:
                 continue
             scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
-            props = properties(ref.load_path, (scale[0], scale[1], scale[2])) if scale else None
+            props = _properties(r, ref.load_path, scale) if scale else None
             if props is None:
                 continue
             size = max(props.extent)
@@ -517,18 +502,18 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
                       "or use primitives", mesh)
 
 
-def _moving_links(root: etree._Element) -> set[str]:
+def _moving_links(doc: Doc) -> set[str]:
     """Links outside the root's rigid group: each moves through a joint that is not fixed."""
     below: dict[str, list[tuple[str, bool]]] = {}
     children = set()
-    for j in _elements(root, "joint"):
-        parent, child = j.find("parent"), j.find("child")
+    for jv in doc.joints:
+        parent, child = jv.parent, jv.child
         if parent is None or child is None:
             continue
         below.setdefault(parent.get("link", ""), []).append(
-            (child.get("link", ""), j.get("type") == "fixed"))
+            (child.get("link", ""), jv.type == "fixed"))
         children.add(child.get("link", ""))
-    names = [link.get("name", "") for link in _elements(root, "link")]
+    names = [view.name if view.name is not None else "" for view in doc.links]
     roots = [n for n in names if n not in children]
     still, stack = set(), roots[:1]
     while stack:
@@ -541,11 +526,12 @@ def _moving_links(root: etree._Element) -> set[str]:
 
 def rule_portability(root: etree._Element, r: Report) -> None:
     """U901: PyBullet-only joint types and shapes, which other URDF tools refuse (info)."""
-    for j in _elements(root, "joint"):
-        note = extension_note("joint", j.get("type", ""))
+    doc = r.doc(root)
+    for jv in doc.joints:
+        note = extension_note("joint", jv.type if jv.type is not None else "")
         if note:
-            r.add("U901", "info", f"{label(j)}: {note}", j)
-    for geom in root.iter("geometry"):
+            r.add("U901", "info", f"{label(jv.el)}: {note}", jv.el)
+    for geom in doc.geometries:
         for shape in geom:
             note = extension_note("shape", shape.tag) if isinstance(shape.tag, str) else None
             if note:

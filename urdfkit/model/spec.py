@@ -361,15 +361,21 @@ def _clean(x: float) -> float:
 
 
 def matmul(a: Matrix3, b: Matrix3) -> Matrix3:
-    """The product of two 3x3 matrices."""
-    return tuple(  # type: ignore[return-value]
-        tuple(sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)) for i in range(3)
-    )
+    """The product of two 3x3 matrices (written out: check computes several per link)."""
+    (a0, a1, a2), (a3, a4, a5), (a6, a7, a8) = a
+    (b0, b1, b2), (b3, b4, b5), (b6, b7, b8) = b
+    return ((a0 * b0 + a1 * b3 + a2 * b6, a0 * b1 + a1 * b4 + a2 * b7,
+             a0 * b2 + a1 * b5 + a2 * b8),
+            (a3 * b0 + a4 * b3 + a5 * b6, a3 * b1 + a4 * b4 + a5 * b7,
+             a3 * b2 + a4 * b5 + a5 * b8),
+            (a6 * b0 + a7 * b3 + a8 * b6, a6 * b1 + a7 * b4 + a8 * b7,
+             a6 * b2 + a7 * b5 + a8 * b8))
 
 
 def transpose(a: Matrix3) -> Matrix3:
     """The transpose (for a rotation, its inverse)."""
-    return tuple(tuple(a[j][i] for j in range(3)) for i in range(3))  # type: ignore[return-value]
+    (a0, a1, a2), (a3, a4, a5), (a6, a7, a8) = a
+    return ((a0, a3, a6), (a1, a4, a7), (a2, a5, a8))
 
 
 def rotate(m: Matrix3, v: Sequence[float]) -> Vec3:

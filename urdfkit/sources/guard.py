@@ -10,15 +10,20 @@ builds on the :class:`Report` and the runner here.
 from __future__ import annotations
 
 import math
+import os
 import re
+import stat
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from lxml import etree
 
+from urdfkit.core import deps
 from urdfkit.core.errors import InputError
 from urdfkit.core.finding import Finding
+from urdfkit.model.index import Doc
 from urdfkit.model.spec import (
     CRASH_NAME_BYTES,
     CRASH_PERCENT_TAGS,
@@ -34,10 +39,8 @@ from urdfkit.model.spec import (
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.model.xmlio import children, line_of
+from urdfkit.model.xmlio import line_of
 from urdfkit.sources.uris import not_a_file, pybullet_data_path, resolve_uri
-
-_elements = children
 
 
 class Report:
@@ -61,6 +64,16 @@ class Report:
         #: repairs elements, and lines cannot tell apart two elements on one line).
         self.elements: list[etree._Element | None] = []
         self._references: dict[tuple[str, str], Reference] = {}
+        self._doc: Doc | None = None
+        #: Results rules share within this file (a mesh's properties at a scale).
+        self.memo: dict[object, Any] = {}
+
+    def doc(self, root: etree._Element) -> Doc:
+        """The one walk over ``root`` every rule reads (:class:`~urdfkit.model.index.Doc`)."""
+        doc = self._doc
+        if doc is None or doc.root is not root:
+            doc = self._doc = Doc(root)
+        return doc
 
     def reference(self, tag: str, fn: str) -> Reference:
         """:func:`reference` from this file's folder, judged once per file (several rules ask)."""
@@ -108,17 +121,6 @@ LIFTABLE_CODES = frozenset({"U107", "U108"})
 STRICTER = " (PyBullet 3.2.7 loads this, but the guard refuses it; `guard=False` lifts it)"
 
 
-#: An XPath that finds the elements one level below what PyBullet's XML parser reads: a path
-#: step per level, evaluated in C, pruned at every leaf (linear, and ~free on real files).
-_TOO_DEEP = etree.XPath("/*" * (MAX_XML_DEPTH + 1))
-
-
-def _too_deep(root: etree._Element) -> etree._Element | None:
-    """The first element nested deeper than PyBullet reads, or None."""
-    found = _TOO_DEEP(root)
-    return found[0] if isinstance(found, list) and found else None
-
-
 def rule_document(root: etree._Element, r: Report) -> None:
     """U001-U003: root is <robot>, has a name, and has links."""
     if root.tag != "robot":
@@ -126,12 +128,13 @@ def rule_document(root: etree._Element, r: Report) -> None:
         return
     if not root.get("name"):
         r.add("U002", "error", "<robot> has no name attribute; add name=\"...\"", root)
-    deep = _too_deep(root)
+    doc = r.doc(root)
+    deep = doc.too_deep
     if deep is not None:
         r.add("U005", "error", f"elements are nested more than {MAX_XML_DEPTH} deep; PyBullet's "
               "XML parser stops there and refuses the file", deep)
-    if next(_elements(root, "link"), None) is None:
-        soft = next(_elements(root, "deformable"), None) is not None
+    if not doc.links:
+        soft = doc.deformables > 0
         r.add("U003", "error", "<robot> has no <link>; a robot needs at least one link" +
               (" (this is a PyBullet soft body, <deformable>: load it with loadSoftBody)"
                if soft else ""), root)
@@ -184,19 +187,21 @@ def rule_names(root: etree._Element, r: Report) -> None:
     if robot_name:  # a missing robot name is U002
         _check_percent(root, robot_name, r)
         _check_length(root, robot_name, r)
-    for tag, code in (("link", "U102"), ("joint", "U103")):
+    doc = r.doc(root)
+    for views, code in ((doc.links, "U102"), (doc.joints, "U103")):
         seen: dict[str, etree._Element] = {}
-        for el in _elements(root, tag):
+        for view in views:
+            el = view.el
             name = _check_name(el, r)
             if name is None:
                 continue
             if name in seen:
-                r.add(code, "error", f"duplicate {tag} name {name!r} (first on line "
+                r.add(code, "error", f"duplicate {el.tag} name {name!r} (first on line "
                       f"{line_of(seen[name])}); names must be unique", el)
             else:
                 seen[name] = el
     seen_mat: dict[str, etree._Element] = {}
-    for el in _elements(root, "material"):
+    for el in doc.materials:
         if el.get("name") is None or not el.get("name", "").strip():
             # PyBullet warns ("Material must contain a name attribute") and loads the file;
             # nothing can refer to a nameless material, so its colour is never drawn.
@@ -210,10 +215,10 @@ def rule_names(root: etree._Element, r: Report) -> None:
             r.add("U105", "error", f"duplicate material name {name!r} (first on line "
                   f"{line_of(seen_mat[name])})", el)
         seen_mat[name] = el
-    for el in root.iter("material"):
-        if el.getparent() is root:
-            continue
+    for el in doc.all_materials:
         visual = el.getparent()
+        if visual is root:
+            continue
         # Only a link's visual: PyBullet ignores <gazebo> and what is in it (a Gazebo
         # <visual><material><ambient> has no name and loads; found on linorobot2).
         if el.get("name") is None and visual is not None and visual.tag == "visual" and \
@@ -231,14 +236,15 @@ def rule_tree(root: etree._Element, r: Report) -> None:
     """U201-U207: joints reference links; exactly one root; single parents; no cycles."""
     if root.tag != "robot":
         return
-    links = {el.get("name"): el for el in _elements(root, "link") if el.get("name")}
+    doc = r.doc(root)
+    links = {v.name: v.el for v in doc.links if v.name}
     parent_of: dict[str, tuple[str, etree._Element]] = {}
     children: dict[str, list[str]] = {}
-    for j in _elements(root, "joint"):
-        jname = j.get("name", "?")
+    for view in doc.joints:
+        j = view.el
+        jname = view.name if view.name is not None else "?"
         ends: dict[str, str | None] = {}
-        for role in ("parent", "child"):
-            sub = j.find(role)
+        for role, sub in (("parent", view.parent), ("child", view.child)):
             if sub is None or not sub.get("link"):
                 r.add("U201", "error", f"{label(j)} has no <{role} link=\"...\">", j)
                 ends[role] = None
@@ -293,14 +299,15 @@ def rule_tree(root: etree._Element, r: Report) -> None:
 
 def rule_joints(root: etree._Element, r: Report) -> None:
     """U301-U307, U309: joint type, limits, axis; a mimic's leader exists and leads somewhere."""
-    joints = {j.get("name") for j in _elements(root, "joint")}
+    views = r.doc(root).joints
+    joints = {v.name for v in views}
     leaders: dict[str | None, tuple[str | None, etree._Element]] = {}
-    for j in _elements(root, "joint"):
-        jtype = j.get("type")
+    for view in views:
+        j, jtype = view.el, view.type
         if jtype not in JOINT_TYPES:
             r.add("U301", "error", f"{label(j)} has type {jtype!r}; use one of "
                   f"{', '.join(JOINT_TYPES)}", j)
-        limit = j.find("limit")
+        limit = view.limit
         if jtype in LIMITED_JOINT_TYPES:
             if limit is None:
                 r.add("U302", "error", f"{label(j)} is {jtype} but has no <limit>, which the "
@@ -316,7 +323,7 @@ def rule_joints(root: etree._Element, r: Report) -> None:
             r.add("U304", "error", f"<limit> of {label(j)} has lower {lower:g} above upper "
                   f"{upper:g}; swap them (PyBullet reads lower > upper as 'no limit', other "
                   "tools refuse it)", limit)
-        axis_el = j.find("axis")
+        axis_el = view.axis
         axis = _vec(axis_el, "xyz", 3)
         if axis is not None and jtype != "fixed":
             norm = math.sqrt(sum(a * a for a in axis))
@@ -327,14 +334,14 @@ def rule_joints(root: etree._Element, r: Report) -> None:
                 r.add("U306", "warning", f"<axis> of {label(j)} has length {norm:.6g}, not 1; "
                       "PyBullet normalises it, other tools may not: write a unit vector",
                       axis_el)
-        mimic = j.find("mimic")
+        mimic = view.mimic
         if mimic is not None:
             target = mimic.get("joint")
-            if target not in joints or target == j.get("name"):
+            if target not in joints or target == view.name:
                 r.add("U307", "error", f"<mimic> of {label(j)} follows joint {target!r}, which "
                       "does not exist (or is itself); name another joint", mimic)
             else:
-                leaders[j.get("name")] = (target, mimic)
+                leaders[view.name] = (target, mimic)
     reported: set[str | None] = set()
     for start in leaders:
         ring, name = [start], leaders[start][0]
@@ -351,12 +358,13 @@ def rule_joints(root: etree._Element, r: Report) -> None:
 
 def rule_geometry(root: etree._Element, r: Report) -> None:
     """U501-U506: one shape per <geometry>, first; positive sizes; meshes have a filename."""
-    for link in _elements(root, "link"):
-        for part in link:
-            if part.tag in ("visual", "collision") and part.find("geometry") is None:
-                r.add("U506", "error", f"<{part.tag}> of {label(link)} has no <geometry>, "
+    doc = r.doc(root)
+    for view in doc.links:
+        for part in view.parts:
+            if part.find("geometry") is None:
+                r.add("U506", "error", f"<{part.tag}> of {label(view.el)} has no <geometry>, "
                       "which PyBullet refuses; add one or remove the element", part)
-    for geom in root.iter("geometry"):
+    for geom in doc.geometries:
         elements = [c for c in geom if isinstance(c.tag, str)]
         if elements and elements[0].tag not in SHAPES and any(c.tag in SHAPES for c in elements):
             r.add("U505", "error", f"<{elements[0].tag}> comes before the shape in <geometry>; "
@@ -394,11 +402,10 @@ def rule_geometry(root: etree._Element, r: Report) -> None:
 
 def rule_inertial(root: etree._Element, r: Report) -> None:
     """U609-U610: <inertial> has an <inertia> with all six components (PyBullet refuses less)."""
-    for link in _elements(root, "link"):
-        inertial = link.find("inertial")
+    for view in r.doc(root).links:
+        link, inertial, inertia = view.el, view.inertial, view.inertia
         if inertial is None:
             continue
-        inertia = inertial.find("inertia")
         if inertia is None:
             r.add("U609", "error", f"<inertial> of {label(link)} has no <inertia>, which "
                   "PyBullet refuses; add <inertia ixx=... iyy=... izz=... ixy ixz iyz>",
@@ -435,6 +442,17 @@ def reference(tag: str, fn: str, base: Path, packages: Mapping[str, Path] | None
     it to the search path, so loaders point PyBullet there), U705 a mesh format PyBullet does
     not read.
     """
+    if ":" not in fn and not fn.startswith("/"):
+        # The common case, a plain relative path to a regular file: one stat answers what
+        # resolve_uri and not_a_file would ask (the same path, the same notes to deps).
+        path = base / fn
+        deps.note(path)
+        try:
+            regular = stat.S_ISREG(os.stat(path).st_mode)
+        except (OSError, ValueError):
+            regular = False
+        if regular and (tag != "mesh" or path.suffix.lower() in MESH_FORMATS):
+            return Reference(path, path)
     label = f"<{tag} filename={fn!r}>"
     target = resolve_uri(fn, base, packages)
     if target.path is None:
@@ -466,7 +484,7 @@ def _too_many_links(n: int) -> str:
 
 def rule_link_limit(root: etree._Element, r: Report) -> None:
     """U209: refuse bodies so large that loading and stepping them takes minutes."""
-    n = sum(1 for _ in _elements(root, "link"))
+    n = len(r.doc(root).links)
     if n > MAX_LOADABLE_LINKS:
         # Measured: `urdfkit joints` on a 5000-link chain ran for 2 minutes (a hang to a user).
         r.add("U209", "error", _too_many_links(n), root)

@@ -1,0 +1,281 @@
+"""One walk over a URDF document, feeding every rule: the check's single pass (issue 30).
+
+``check`` runs some twenty rules on each file. Each used to find its own elements again
+(``root.iter("material")``, ``link.find("inertial")``, a recursive walk for the element
+rules, an XPath for the depth): fifteen walks of the same tree, and the same numbers parsed
+by several rules. :class:`Doc` walks the tree once, in document order, and keeps what the
+rules read:
+
+- the top-level links, joints and materials, each link and joint with the children the
+  rules look at (:class:`LinkView`, :class:`JointView`);
+- every ``<material>``, ``<geometry>``, file reference (mesh, cdf, texture) and
+  ``<transmission>`` anywhere, as ``root.iter(tag)`` would list them;
+- the first element deeper than PyBullet's XML parser reads;
+- the element rules' findings (U401-U402 numbers, U801-U802 unknown tags and attributes),
+  made on the way, for ``rule_elements`` to report in its turn.
+
+Numbers are parsed once per distinct text for the whole process (:func:`floats`): real
+files repeat ``"0 0 0"`` and ``"1"`` thousands of times.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from urdfkit.model.spec import (
+    FILE_TAGS,
+    MAX_XML_DEPTH,
+    NUMERIC,
+    OPAQUE,
+    SCHEMA,
+    used_shape,
+)
+
+El = Any  # an lxml element; this module never imports lxml
+
+
+#: Parsed numbers by attribute text, for the whole process: the text's floats, or None when
+#: one word is not a number. Bounded: emptied when it grows past _FLOATS_MAX.
+_FLOATS: dict[str, tuple[float, ...] | None] = {}
+_FLOATS_MAX = 65536
+
+
+def floats(text: str) -> tuple[float, ...] | None:
+    """The numbers in ``text`` (``float`` of each whitespace-separated word), or None.
+
+    Infinities and NaN are returned as they parse; callers judge finiteness.
+    """
+    found = _FLOATS.get(text, _UNSEEN)
+    if found is not _UNSEEN:
+        return found  # type: ignore[return-value]
+    try:
+        found = tuple(map(float, text.split()))
+    except ValueError:
+        found = None
+    if len(_FLOATS) >= _FLOATS_MAX:
+        _FLOATS.clear()
+    _FLOATS[text] = found
+    return found
+
+
+_UNSEEN = object()
+
+#: NUMERIC by tag: {tag: {attribute: how many numbers}}, one lookup per element.
+NUMERIC_BY_TAG: dict[str, dict[str, int]] = {}
+for (_tag, _attr), _n in NUMERIC.items():
+    NUMERIC_BY_TAG.setdefault(_tag, {})[_attr] = _n
+
+#: Where each collected tag goes (top-level link, joint and material are told apart later).
+_ANYWHERE = frozenset({"material", "geometry", "transmission", *FILE_TAGS})
+_TOP = frozenset({"link", "joint", "material", "deformable"})
+
+
+class LinkView:
+    """A top-level ``<link>`` and the children the rules read (first of each, as lxml's find).
+
+    Attributes:
+        el: The element. name: Its ``name`` (None when absent).
+        inertial, mass, inertia: The first ``<inertial>``, and its first ``<mass>`` and
+            ``<inertia>`` (None when absent).
+        parts: Its ``<visual>`` and ``<collision>`` children, in order.
+    """
+
+    __slots__ = ("el", "name", "inertial", "mass", "inertia", "parts")
+
+    def __init__(self, el: El) -> None:
+        self.el = el
+        self.name: str | None = el.get("name")
+        self.inertial: El = None
+        self.mass: El = None
+        self.inertia: El = None
+        self.parts: list[El] = []
+        for c in el:
+            tag = c.tag
+            if tag == "visual" or tag == "collision":
+                self.parts.append(c)
+            elif tag == "inertial" and self.inertial is None:
+                self.inertial = c
+                for k in c:
+                    if k.tag == "mass" and self.mass is None:
+                        self.mass = k
+                    elif k.tag == "inertia" and self.inertia is None:
+                        self.inertia = k
+
+
+class JointView:
+    """A top-level ``<joint>`` and its children the rules read (the first of each).
+
+    Attributes:
+        el, name, type: The element and its attributes.
+        parent, child: The first ``<parent>`` and ``<child>`` elements (None when absent).
+        children: Every ``<child>`` element (a malformed joint may hold two).
+        limit, axis, origin, mimic: The first of each, or None.
+    """
+
+    __slots__ = ("el", "name", "type", "parent", "child", "children", "limit", "axis",
+                 "origin", "mimic")
+
+    def __init__(self, el: El) -> None:
+        self.el = el
+        self.name: str | None = el.get("name")
+        self.type: str | None = el.get("type")
+        self.parent: El = None
+        self.child: El = None
+        self.children: list[El] = []
+        self.limit: El = None
+        self.axis: El = None
+        self.origin: El = None
+        self.mimic: El = None
+        for c in el:
+            tag = c.tag
+            if tag == "child":
+                self.children.append(c)
+                if self.child is None:
+                    self.child = c
+            elif tag in _JOINT_SLOTS and getattr(self, tag) is None:
+                setattr(self, tag, c)
+
+
+_JOINT_SLOTS = frozenset({"parent", "limit", "axis", "origin", "mimic"})
+
+
+class Doc:
+    """Everything the rules read from one document, collected in one walk.
+
+    Attributes:
+        root: The root element.
+        links, joints: :class:`LinkView` and :class:`JointView` of the root's children.
+        materials: The root's ``<material>`` children.
+        deformables: How many ``<deformable>`` children the root has.
+        all_materials, geometries, files, transmissions: Every ``<material>``,
+            ``<geometry>``, ``<mesh>``/``<cdf>``/``<texture>`` and ``<transmission>`` in
+            the document, in document order (as ``root.iter(tag)``).
+        too_deep: The first element nested deeper than PyBullet reads, or None.
+        element_findings: ``(code, level, message, element)`` of the element rules.
+    """
+
+    __slots__ = ("root", "links", "joints", "materials", "deformables", "all_materials",
+                 "geometries", "files", "transmissions", "too_deep", "element_findings",
+                 "link_names")
+
+    def __init__(self, root: El) -> None:
+        self.root = root
+        self.links: list[LinkView] = []
+        self.joints: list[JointView] = []
+        self.materials: list[El] = []
+        self.deformables = 0
+        self.all_materials: list[El] = []
+        self.geometries: list[El] = []
+        self.files: list[El] = []
+        self.transmissions: list[El] = []
+        self.too_deep: El = None
+        self.element_findings: list[tuple[str, str, str, El]] = []
+        tag = root.tag
+        if isinstance(tag, str):
+            checked = tag[0] != "{" and tag not in OPAQUE
+            if tag in _ANYWHERE:
+                self._collect(root, tag)
+            self._walk(root, tag, checked, 1)
+        #: Names of the top-level links (None for a nameless one is left out).
+        self.link_names = {v.name for v in self.links if v.name}
+
+    def _collect(self, el: El, tag: str) -> None:
+        if tag == "material":
+            self.all_materials.append(el)
+        elif tag == "geometry":
+            self.geometries.append(el)
+        elif tag == "transmission":
+            self.transmissions.append(el)
+        else:
+            self.files.append(el)
+
+    def _walk(self, el: El, tag: str, checked: bool, depth: int) -> None:
+        """Visit ``el``'s subtree once: collect, and check elements when ``checked``.
+
+        The element checks skip what ``rule_elements`` always skipped: comments, namespaced
+        elements (xacro leftovers, extensions) and opaque subtrees (another tool's), and a
+        shape after the first in a ``<geometry>`` (PyBullet never reads it). Collection
+        goes everywhere ``root.iter`` goes.
+        """
+        if checked:
+            self._check(el, tag)
+            known = SCHEMA.get(tag)
+            allowed = known[1] if known is not None else None
+        else:
+            allowed = None
+        top = depth == 1
+        first_shape = tag == "geometry" and checked
+        for child in el:
+            ctag = child.tag
+            if not isinstance(ctag, str):
+                continue  # comments, processing instructions, entities
+            if depth == MAX_XML_DEPTH and self.too_deep is None:
+                self.too_deep = child
+            if top and ctag in _TOP:
+                if ctag == "link":
+                    self.links.append(LinkView(child))
+                elif ctag == "joint":
+                    self.joints.append(JointView(child))
+                elif ctag == "material":
+                    self.materials.append(child)
+                else:
+                    self.deformables += 1
+            if ctag in _ANYWHERE:
+                self._collect(child, ctag)
+            if not checked or ctag[0] == "{":
+                self._walk(child, ctag, False, depth + 1)
+                continue
+            if allowed is not None and ctag not in allowed:
+                self.element_findings.append((
+                    "U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
+                    "ignores it", child))
+            if first_shape:
+                ignored = used_shape(el) is not child  # a shape after the first (U507)
+                self._walk(child, ctag, ctag not in OPAQUE and not ignored, depth + 1)
+            else:
+                self._walk(child, ctag, ctag not in OPAQUE, depth + 1)
+
+    def _check(self, el: El, tag: str) -> None:
+        """U401-U402 and U801-U802 of one element's attributes."""
+        items = el.items()
+        if not items:
+            return
+        key = (tag, *items)
+        found = _VERDICTS.get(key)
+        if found is None:
+            found = _verdict(tag, items)
+            if len(_VERDICTS) >= _VERDICTS_MAX:
+                _VERDICTS.clear()
+            _VERDICTS[key] = found
+        for code, level, message in found:
+            self.element_findings.append((code, level, message, el))
+
+
+#: The element rules' verdict on a tag with its attributes, for the whole process: real files
+#: repeat ``<origin rpy="0 0 0" xyz="0 0 0"/>`` thousands of times. Bounded like _FLOATS.
+_VERDICTS: dict[tuple[Any, ...], tuple[tuple[str, str, str], ...]] = {}
+_VERDICTS_MAX = 65536
+
+
+def _verdict(tag: str, items: list[tuple[str, str]]) -> tuple[tuple[str, str, str], ...]:
+    """U401-U402 and U801-U802 findings of an element with ``tag`` and attributes ``items``."""
+    known = SCHEMA.get(tag)
+    numeric = NUMERIC_BY_TAG.get(tag)
+    if known is None and numeric is None:
+        return ()
+    out = []
+    for attr, text in items:
+        n = numeric.get(attr) if numeric is not None else None
+        if n is not None:
+            vals = floats(text)
+            if vals is None or not all(map(math.isfinite, vals)):
+                out.append(("U401", "error", f"<{tag} {attr}={text!r}>: expected "
+                            f"{'a finite number' if n == 1 else f'{n} finite numbers'}"))
+            elif len(vals) != n:
+                out.append(("U402", "error", f"<{tag} {attr}={text!r}>: expected {n} numbers, "
+                            f"got {len(vals)}"))
+        if known is not None and attr not in known[0] and attr[0] != "{":
+            out.append(("U802", "warning", f"<{tag}> has unknown attribute {attr!r}; PyBullet "
+                        "ignores it"))
+    return tuple(out)
