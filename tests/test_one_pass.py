@@ -1,0 +1,153 @@
+"""check's one walk (urdfkit.model.index.Doc) against lxml's own walks and a plain oracle.
+
+The rules used to find their elements with ``root.iter(tag)``, ``root.iterchildren(tag)``,
+``find`` and an XPath for the depth; the Doc must list exactly what those list, in the same
+order, on real files and on random trees. The element findings (U401-U402, U801-U802) are
+compared with the rule as it was written before the walk was shared: a recursion that says
+what it skips (comments, namespaced elements, opaque subtrees, shapes after the first).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pybullet_data
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from lxml import etree
+
+from urdfkit.model.index import Doc, floats
+from urdfkit.model.spec import FILE_TAGS, MAX_XML_DEPTH, NUMERIC, OPAQUE, SCHEMA, used_shape
+from urdfkit.model.xmlio import parse_xml, read_bytes
+
+DATA = Path(pybullet_data.getDataPath())
+FIXTURES = Path(__file__).parent / "fixtures"
+
+
+def oracle_findings(root: etree._Element) -> list[tuple[str, str, etree._Element]]:
+    """U401/U402/U801/U802 as (code, message, element), by the plain recursive rule."""
+    out: list[tuple[str, str, etree._Element]] = []
+
+    def below(el: etree._Element, tag: str) -> None:
+        known = SCHEMA.get(tag)
+        for attr, text in el.items():
+            n = NUMERIC.get((tag, attr))
+            if n is not None:
+                try:
+                    vals = [float(x) for x in text.split()]
+                except ValueError:
+                    vals = None
+                if vals is None or not all(math.isfinite(v) for v in vals):
+                    out.append(("U401", f"<{tag} {attr}={text!r}>: expected "
+                                f"{'a finite number' if n == 1 else f'{n} finite numbers'}", el))
+                elif len(vals) != n:
+                    out.append(("U402", f"<{tag} {attr}={text!r}>: expected {n} numbers, "
+                                f"got {len(vals)}", el))
+            if known is not None and attr not in known[0] and not attr.startswith("{"):
+                out.append(("U802", f"<{tag}> has unknown attribute {attr!r}; PyBullet "
+                            "ignores it", el))
+        for child in el:
+            ctag = child.tag
+            if not isinstance(ctag, str) or ctag.startswith("{"):
+                continue
+            if known is not None and ctag not in known[1]:
+                out.append(("U801", f"<{ctag}> is not known inside <{tag}>; PyBullet "
+                            "ignores it", child))
+            skipped = tag == "geometry" and used_shape(el) is not child
+            if ctag not in OPAQUE and not skipped:
+                below(child, ctag)
+
+    tag = root.tag
+    if isinstance(tag, str) and not tag.startswith("{") and tag not in OPAQUE:
+        below(root, tag)
+    return out
+
+
+def assert_same_as_lxml(root: etree._Element) -> None:
+    doc = Doc(root)
+    assert [v.el for v in doc.links] == list(root.iterchildren("link"))
+    assert [v.el for v in doc.joints] == list(root.iterchildren("joint"))
+    assert doc.materials == list(root.iterchildren("material"))
+    assert doc.deformables == len(list(root.iterchildren("deformable")))
+    assert doc.all_materials == list(root.iter("material"))
+    assert doc.geometries == list(root.iter("geometry"))
+    assert doc.files == list(root.iter(*FILE_TAGS))
+    assert doc.transmissions == list(root.iter("transmission"))
+    deep = etree.XPath("/*" * (MAX_XML_DEPTH + 1))(root)
+    assert doc.too_deep is (deep[0] if deep else None)
+    for view in doc.links:
+        inertial = view.el.find("inertial")
+        assert view.inertial is inertial
+        assert view.mass is (inertial.find("mass") if inertial is not None else None)
+        assert view.inertia is (inertial.find("inertia") if inertial is not None else None)
+        assert view.parts == [p for p in view.el if p.tag in ("visual", "collision")]
+    for jv in doc.joints:
+        for tag in ("parent", "child", "limit", "axis", "origin", "mimic"):
+            assert getattr(jv, tag) is jv.el.find(tag), tag
+        assert jv.children == jv.el.findall("child")
+    got = [(code, message, el) for code, _, message, el in doc.element_findings]
+    assert got == oracle_findings(root)
+
+
+REAL = sorted(p for p in DATA.rglob("*.urdf") if "random_urdfs" not in p.parts) + \
+    sorted(DATA.glob("random_urdfs/00*/*.urdf")) + sorted(FIXTURES.rglob("*.urdf"))
+
+
+@pytest.mark.parametrize("path", REAL, ids=lambda p: str(p.relative_to(p.parents[1])))
+def test_the_walk_lists_what_lxml_lists_on_real_files(path: Path) -> None:
+    assert_same_as_lxml(parse_xml(read_bytes(path), path).getroot())
+
+
+TAGS = [*SCHEMA, *OPAQUE, "sensor", "{urn:x}thing", "plugin"]
+ATTRS = sorted({a for attrs, _ in SCHEMA.values() for a in attrs} | {"bogus", "{urn:x}a"})
+VALUES = ["0", "1", "0 0 0", " 1  2\t3 ", "1 2", "nan", "-inf", "1e999", "x", "", "1_0",
+          "0.5 0.5 0.5 1", "base"]
+
+
+@st.composite
+def trees(draw: st.DrawFn, depth: int = 0) -> etree._Element:
+    tag = draw(st.sampled_from(TAGS if depth else ["robot", "robot", "link", "gazebo"]))
+    el = etree.Element(tag)
+    for attr in draw(st.lists(st.sampled_from(ATTRS), max_size=3, unique=True)):
+        el.set(attr, draw(st.sampled_from(VALUES)))
+    if depth < 5:
+        for _ in range(draw(st.integers(0, 4 if depth < 3 else 2))):
+            if draw(st.integers(0, 9)) == 0:
+                el.append(etree.Comment("c"))
+            else:
+                el.append(draw(trees(depth + 1)))
+    return el
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(trees())
+def test_the_walk_lists_what_lxml_lists_on_random_trees(root: etree._Element) -> None:
+    assert_same_as_lxml(root)
+
+
+def test_the_depth_limit_is_found_where_the_xpath_finds_it() -> None:
+    for extra in (0, 1, 2):
+        root = etree.Element("robot")
+        el = root
+        for _ in range(MAX_XML_DEPTH - 1 + extra):
+            el = etree.SubElement(el, "link")
+        etree.SubElement(root, "link")
+        assert_same_as_lxml(root)
+        assert (Doc(root).too_deep is not None) == (extra > 0)
+
+
+@given(st.text(alphabet="0123456789.eE+-_ \tinfa,x", max_size=12))
+def test_numbers_are_parsed_as_float_parses_them(text: str) -> None:
+    try:
+        expected: tuple[float, ...] | None = tuple(float(x) for x in text.split())
+    except ValueError:
+        expected = None
+    for _ in range(2):  # the first call parses, the second reads the memo
+        got = floats(text)
+        assert (got is None) == (expected is None)
+        if got is not None and expected is not None:
+            assert len(got) == len(expected)
+            assert all(a == b or (math.isnan(a) and math.isnan(b))
+                       for a, b in zip(got, expected, strict=True))
