@@ -205,8 +205,8 @@ def check_file(display: str, path: str | Path,
     try:
         data = _read(path, display, no_exec, packages, xacro_args)
         refuse_oversized(data, display)
-        _, quirks = tolerate_quirks(data)
-        tree = parse_xml(data, display)
+        fixed, quirks = tolerate_quirks(data)
+        tree = parse_xml(fixed, display, tolerated=True)
     except XacroNotExpanded as e:
         result.findings.append(Finding("U006", "warning", e.message, display))
         return result

@@ -66,9 +66,6 @@ NUMERIC_BY_TAG: dict[str, dict[str, int]] = {}
 for (_tag, _attr), _n in NUMERIC.items():
     NUMERIC_BY_TAG.setdefault(_tag, {})[_attr] = _n
 
-#: Where each collected tag goes (top-level link, joint and material are told apart later).
-_ANYWHERE = frozenset({"material", "geometry", "transmission", *FILE_TAGS})
-_TOP = frozenset({"link", "joint", "material", "deformable"})
 
 
 class LinkView:
@@ -157,7 +154,7 @@ class Doc:
 
     __slots__ = ("root", "links", "joints", "materials", "deformables", "all_materials",
                  "geometries", "files", "transmissions", "too_deep", "element_findings",
-                 "link_names")
+                 "link_names", "_buckets")
 
     def __init__(self, root: El) -> None:
         self.root = root
@@ -171,24 +168,29 @@ class Doc:
         self.transmissions: list[El] = []
         self.too_deep: El = None
         self.element_findings: list[tuple[str, str, str, El]] = []
+        #: Where each collected tag's elements go.
+        self._buckets = {"material": self.all_materials, "geometry": self.geometries,
+                         "transmission": self.transmissions,
+                         **{t: self.files for t in FILE_TAGS}}
         tag = root.tag
         if isinstance(tag, str):
-            checked = tag[0] != "{" and tag not in OPAQUE
-            if tag in _ANYWHERE:
-                self._collect(root, tag)
-            self._walk(root, tag, checked, 1)
-        #: Names of the top-level links (None for a nameless one is left out).
+            bucket = self._buckets.get(tag)
+            if bucket is not None:
+                bucket.append(root)
+            for child in root:  # the root's own children are also the top-level lists
+                ctag = child.tag
+                if ctag == "link":
+                    self.links.append(LinkView(child))
+                elif ctag == "joint":
+                    self.joints.append(JointView(child))
+                elif ctag == "material":
+                    self.materials.append(child)
+                elif ctag == "deformable":
+                    self.deformables += 1
+            self._walk(root, tag, tag[0] != "{" and tag not in OPAQUE, 1)
+        del self._buckets
+        #: Names of the top-level links (a nameless one is left out).
         self.link_names = {v.name for v in self.links if v.name}
-
-    def _collect(self, el: El, tag: str) -> None:
-        if tag == "material":
-            self.all_materials.append(el)
-        elif tag == "geometry":
-            self.geometries.append(el)
-        elif tag == "transmission":
-            self.transmissions.append(el)
-        else:
-            self.files.append(el)
 
     def _walk(self, el: El, tag: str, checked: bool, depth: int) -> None:
         """Visit ``el``'s subtree once: collect, and check elements when ``checked``.
@@ -198,43 +200,40 @@ class Doc:
         shape after the first in a ``<geometry>`` (PyBullet never reads it). Collection
         goes everywhere ``root.iter`` goes.
         """
+        allowed = None
         if checked:
             self._check(el, tag)
             known = SCHEMA.get(tag)
-            allowed = known[1] if known is not None else None
-        else:
-            allowed = None
-        top = depth == 1
-        first_shape = tag == "geometry" and checked
+            if known is not None:
+                allowed = known[1]
+        if depth == MAX_XML_DEPTH and self.too_deep is None:
+            self.too_deep = next((c for c in el if isinstance(c.tag, str)), None)
+        buckets = self._buckets
+        first = used_shape(el) if checked and tag == "geometry" else None
+        depth += 1
         for child in el:
             ctag = child.tag
             if not isinstance(ctag, str):
                 continue  # comments, processing instructions, entities
-            if depth == MAX_XML_DEPTH and self.too_deep is None:
-                self.too_deep = child
-            if top and ctag in _TOP:
-                if ctag == "link":
-                    self.links.append(LinkView(child))
-                elif ctag == "joint":
-                    self.joints.append(JointView(child))
-                elif ctag == "material":
-                    self.materials.append(child)
-                else:
-                    self.deformables += 1
-            if ctag in _ANYWHERE:
-                self._collect(child, ctag)
+            bucket = buckets.get(ctag)
+            if bucket is not None:
+                bucket.append(child)
             if not checked or ctag[0] == "{":
-                self._walk(child, ctag, False, depth + 1)
+                if len(child):  # nothing to check, but more to collect
+                    self._walk(child, ctag, False, depth)
                 continue
             if allowed is not None and ctag not in allowed:
                 self.element_findings.append((
                     "U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
                     "ignores it", child))
-            if first_shape:
-                ignored = used_shape(el) is not child  # a shape after the first (U507)
-                self._walk(child, ctag, ctag not in OPAQUE and not ignored, depth + 1)
-            else:
-                self._walk(child, ctag, ctag not in OPAQUE, depth + 1)
+            # A shape after the first in a <geometry> is never read (U507).
+            if ctag in OPAQUE or (first is not None and child is not first):
+                if len(child):
+                    self._walk(child, ctag, False, depth)
+            elif len(child):
+                self._walk(child, ctag, True, depth)
+            else:  # a leaf: its attributes are all there is to check
+                self._check(child, ctag)
 
     def _check(self, el: El, tag: str) -> None:
         """U401-U402 and U801-U802 of one element's attributes."""

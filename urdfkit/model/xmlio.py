@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -30,6 +31,22 @@ BIG_LINES = 65535
 
 
 def _parser(lines: int = 0) -> etree.XMLParser:
+    """The parser for a document of ``lines`` lines, made once per thread for each kind."""
+    big = lines >= BIG_LINES
+    parsers = getattr(_PARSERS, "made", None)
+    if parsers is None:
+        parsers = _PARSERS.made = {}
+    parser = parsers.get(big)
+    if parser is None:
+        parser = parsers[big] = _new_parser(big)
+    return parser
+
+
+#: lxml parsers are not shared between threads (the viewer parses in its own).
+_PARSERS = threading.local()
+
+
+def _new_parser(big: bool) -> etree.XMLParser:
     return etree.XMLParser(
         resolve_entities=False,
         no_network=True,
@@ -39,7 +56,7 @@ def _parser(lines: int = 0) -> etree.XMLParser:
         remove_comments=False,
         # Blank text is dropped for speed, except in a file long enough that findings past
         # line 65,535 need it to carry their line (nothing reads URDF element text).
-        remove_blank_text=lines < BIG_LINES,
+        remove_blank_text=not big,
     )
 
 
@@ -183,6 +200,8 @@ def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
     start tag (no newline added, so no line number moves; declarations further in still
     shadow it), and noted.
     """
+    if b":" not in data:
+        return data, notes  # no prefix anywhere
     root = _START.search(data)
     prefixes = set(_PREFIXED.findall(data)) - {b"xml", b"xmlns"}
     if root is None or not prefixes:
@@ -325,11 +344,16 @@ def _declaration_quirks(data: bytes) -> tuple[bytes, list[tuple[int, str]]]:
     return data, notes
 
 
-def parse_xml(data: bytes, file: str | Path) -> etree._ElementTree:
-    """Parse XML bytes safely; malformed input raises :class:`InputError` with the line."""
+def parse_xml(data: bytes, file: str | Path, *, tolerated: bool = False) -> etree._ElementTree:
+    """Parse XML bytes safely; malformed input raises :class:`InputError` with the line.
+
+    ``tolerated``: ``data`` already went through :func:`tolerate_quirks` (check reads its
+    notes first), so it is not repaired twice.
+    """
     if not data.strip():
         raise InputError("file is empty", file=file)
-    data, _ = tolerate_quirks(data)
+    if not tolerated:
+        data, _ = tolerate_quirks(data)
     try:
         lines = data.count(b"\n")
         root = etree.fromstring(data, _parser(lines))
