@@ -239,3 +239,98 @@ def test_real_dae_meshes_are_placed_as_pybullet_places_them(tmp_path: Path, pb) 
         lo, hi = (np.array(v) for v in pybullet_aabb(p, client, mesh, tmp_path))
         assert used.min(axis=0) == pytest.approx(lo + 0.002, abs=1e-4), mesh.name
         assert used.max(axis=0) == pytest.approx(hi - 0.002, abs=1e-4), mesh.name
+
+
+def _new_process(monkeypatch: pytest.MonkeyPatch) -> None:
+    """What a new process starts with: no entries in memory, none used, no pack read."""
+    monkeypatch.setattr(meshes, "_MEMORY", {})
+    monkeypatch.setattr(meshes, "USED", {})
+    monkeypatch.setattr(meshes, "_PACKED", set())
+
+
+def _robot_with_box(folder: Path, size: tuple[float, float, float]) -> Path:
+    folder.mkdir(exist_ok=True)
+    (folder / "box.obj").write_text(box_obj(size))
+    urdf = folder / "r.urdf"
+    urdf.write_text('<robot name="r"><link name="a"><inertial><mass value="1"/>'
+                    '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'
+                    '<collision><geometry><mesh filename="box.obj"/></geometry></collision>'
+                    '</link></robot>')
+    return urdf
+
+
+def test_a_run_s_pack_serves_the_next_run_and_follows_edits(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from urdfkit.checks.check import check_paths
+
+    folder = tmp_path / "robot"
+    _robot_with_box(folder, (1.0, 2.0, 3.0))
+    _new_process(monkeypatch)
+    check_paths([folder], jobs=1, cache=False)
+    packs = list((tmp_path / "cache" / "mesh-packs-1").iterdir())
+    assert len(packs) == 1
+    # The next run reads the pack alone: no entry file, no mesh.
+    for entry in (tmp_path / "cache" / "meshes-2").iterdir():
+        entry.unlink()
+    _new_process(monkeypatch)
+
+    def refuse(*_: object) -> None:
+        raise AssertionError("the mesh was read again")
+
+    monkeypatch.setattr(meshes, "read_integrals", refuse)
+    assert meshes.load_pack([str(folder)]) == 1
+    check_box(meshes.properties(folder / "box.obj"), (1.0, 2.0, 3.0))
+    monkeypatch.undo()
+    monkeypatch.setenv("URDFKIT_CACHE_DIR", str(tmp_path / "cache"))
+    # An edited mesh misses the pack: its new values, never the packed ones.
+    (folder / "box.obj").write_text(box_obj((3.0, 2.0, 1.0)))
+    os.utime(folder / "box.obj", ns=(1, 1))
+    _new_process(monkeypatch)
+    meshes.load_pack([str(folder)])
+    check_box(meshes.properties(folder / "box.obj"), (3.0, 2.0, 1.0))
+
+
+def test_a_damaged_pack_is_ignored_whole(tmp_path: Path,
+                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    from urdfkit.checks.check import check_paths
+
+    folder = tmp_path / "robot"
+    _robot_with_box(folder, (1.0, 2.0, 3.0))
+    _new_process(monkeypatch)
+    check_paths([folder], jobs=1, cache=False)
+    (pack,) = (tmp_path / "cache" / "mesh-packs-1").iterdir()
+    good = pack.read_bytes()
+    for damaged in (good[:-1], good[:20] + bytes([good[20] ^ 1]) + good[21:], b"MP1\n",
+                    b"garbage"):
+        pack.write_bytes(damaged)
+        _new_process(monkeypatch)
+        assert meshes.load_pack([str(folder)]) == 0
+        assert meshes._MEMORY == {}
+
+
+def test_packs_are_capped(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    folder = tmp_path / "robot"
+    _robot_with_box(folder, (1.0, 1.0, 1.0))
+    monkeypatch.setattr(meshes, "MAX_PACKS", 3)
+    for n in range(6):
+        _new_process(monkeypatch)
+        meshes.properties(folder / "box.obj")
+        assert meshes.save_pack([str(folder), f"run{n}"])
+    assert len(list((tmp_path / "cache" / "mesh-packs-1").iterdir())) == 3
+    _new_process(monkeypatch)
+    meshes.properties(folder / "box.obj")
+    assert meshes.load_pack([str(folder), "run5"]) == 1
+    assert not meshes.save_pack([str(folder), "run5"])  # the same entries: not rewritten
+
+
+def test_workers_hand_their_entries_to_the_run_s_pack(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from urdfkit.checks.check import check_paths
+
+    (tmp_path / "robots").mkdir()
+    for n in range(16):  # enough files for a pool of two
+        _robot_with_box(tmp_path / "robots" / f"r{n}", (1.0 + n, 1.0, 1.0))
+    _new_process(monkeypatch)
+    check_paths([tmp_path / "robots"], jobs=2, cache=False)
+    _new_process(monkeypatch)
+    assert meshes.load_pack([str(tmp_path / "robots")]) == 16

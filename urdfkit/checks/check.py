@@ -45,6 +45,8 @@ class FileResult:
     #: (:class:`urdfkit.checks.resultcache.RunManifest`).
     entry: tuple[tuple[int, int, int, int], dict[str, Any], list[dict[str, Any]]] | None = \
         field(default=None, compare=False, repr=False)
+    #: The mesh cache entries a worker process used, for the run's pack (not in the JSON).
+    meshes: dict[str, Any] | None = field(default=None, compare=False, repr=False)
 
     def count(self, level: str) -> int:
         """How many findings of ``level``."""
@@ -417,10 +419,18 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
         else:
             todo.append(n)
     work = [(*files[n], pkgs, no_exec, args, physics, cache) for n in todo]
+    if todo:
+        from urdfkit.sources import meshes
+
+        meshes.load_pack(given)  # before workers fork: they inherit it
     for n, fr in zip(todo, _run_jobs(work, jobs), strict=True):
         results[n] = fr
         if manifest is not None and files[n][2] is None:
             manifest.add(files[n][0], files[n][1], fr.entry)
+        if fr.meshes:
+            meshes.USED.update(fr.meshes)
+    if todo:
+        meshes.save_pack(given)
     if manifest is not None:
         manifest.save()
     if cache and todo:
@@ -468,4 +478,14 @@ def _run_jobs(work: list[_Job], jobs: int | None) -> list[FileResult]:
                                           else "spawn")
     # The with block terminates the workers on the way out, normal or not (Ctrl-C).
     with context.Pool(workers, initializer=worker_init) as pool:
-        return pool.map(_check_one, work, chunksize=chunk)
+        return pool.map(_check_in_worker, work, chunksize=chunk)
+
+
+def _check_in_worker(job: _Job) -> FileResult:
+    """:func:`_check_one` in a pool worker, handing back the mesh entries it used."""
+    from urdfkit.sources import meshes
+
+    meshes.USED.clear()
+    result = _check_one(job)
+    result.meshes = dict(meshes.USED)
+    return result

@@ -21,6 +21,7 @@ import math
 import os
 import re
 import struct
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -134,6 +135,17 @@ class Integrals:
                               self.concavity * max(abs(sx), abs(sy), abs(sz)), self.pieces)
 
 
+def _cache_dir() -> Path | None:
+    """:func:`cache_dir`, worked out once per value of the variables it reads."""
+    env = (os.environ.get("URDFKIT_CACHE_DIR"), os.environ.get("XDG_CACHE_HOME"),
+           os.environ.get("HOME"))
+    if env not in _CACHE_DIRS:
+        _CACHE_DIRS[env] = cache_dir()
+    return _CACHE_DIRS[env]
+
+
+_CACHE_DIRS: dict[tuple[str | None, ...], Path | None] = {}
+
 #: Cache entries start with this; a new layout is a new prefix and a new folder.
 _ENTRY = b"M2"
 _FOLDER = "meshes-2"
@@ -159,11 +171,94 @@ def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
     if found is _MISSING:
         found = _MEMORY[key] = _integrals(path, suffix, key)
     assert found is None or isinstance(found, Integrals)
+    USED[key] = found
     return found.scaled(scale) if found is not None else None
 
 
-def _integrals(path: Path, suffix: str, key: str) -> Integrals | None:
+# --------------------------------------------------------------------------- a run's pack
+# One check run reads every mesh's entry on its own: a thousand small files. The run's pack
+# keeps the entries it used in one file, read once at the next run over the same paths. A
+# pack entry is keyed like any entry (path, size, mtime, inode), so an edited mesh misses it
+# and is looked up as before; a pack that is damaged in any byte is ignored whole.
+
+_PACKS = "mesh-packs-1"
+_PACK_MAGIC = b"MP1\n"
+#: Packs kept; the oldest beyond this are removed when a new one is written.
+MAX_PACKS = 64
+#: The entries this process used (its own, and its workers' once merged), by key.
+USED: dict[str, Integrals | None] = {}
+_PACKED: set[str] = set()
+
+
+def _pack_path(paths: Sequence[str]) -> Path | None:
     folder = cache_dir()
+    if folder is None:
+        return None
+    h = hashlib.blake2b(_PACK_MAGIC, digest_size=20)
+    for p in (os.getcwd(), *paths):
+        h.update(os.fsencode(os.path.abspath(p)) + b"\0")
+    return folder / _PACKS / h.hexdigest()
+
+
+def load_pack(paths: Sequence[str]) -> int:
+    """Read the pack of the last run over ``paths`` into memory; how many entries it held."""
+    path = _pack_path(paths)
+    raw = read_entry(path) if path is not None else None
+    if raw is None or not raw.startswith(_PACK_MAGIC) or len(raw) < len(_PACK_MAGIC) + 16:
+        return 0
+    body, check = raw[len(_PACK_MAGIC):-16], raw[-16:]
+    if hashlib.blake2b(body, digest_size=16).digest() != check:
+        return 0  # damaged: trust none of it
+    found: dict[str, Integrals | None] = {}
+    at = 0
+    try:
+        while at < len(body):
+            klen, elen = struct.unpack_from("<IH", body, at)
+            at += 6
+            key = body[at:at + klen].decode("utf-8", "surrogateescape")
+            entry = body[at + klen:at + klen + elen]
+            at += klen + elen
+            found[key] = None if entry == _ENTRY + b"-" else Integrals.unpack(entry)
+    except (ValueError, struct.error):
+        return 0
+    for key, value in found.items():
+        _MEMORY.setdefault(key, value)
+    _PACKED.clear()
+    _PACKED.update(found)
+    return len(found)
+
+
+def save_pack(paths: Sequence[str]) -> bool:
+    """Write the entries this run used as the pack for ``paths``; True if written.
+
+    Nothing is written when the last pack holds exactly these entries.
+    """
+    if set(USED) == _PACKED:
+        return False
+    path = _pack_path(paths)
+    if path is None:
+        return False
+    parts = []
+    for key, value in USED.items():
+        k = key.encode("utf-8", "surrogateescape")
+        e = value.pack() if value is not None else _ENTRY + b"-"
+        parts.append(struct.pack("<IH", len(k), len(e)) + k + e)
+    body = b"".join(parts)
+    if not write_entry(path, _PACK_MAGIC + body + hashlib.blake2b(body, digest_size=16).digest()):
+        return False
+    try:
+        with os.scandir(path.parent) as it:
+            packs = sorted((e.stat().st_mtime_ns, e.path) for e in it
+                           if e.is_file(follow_symlinks=False))
+        for _, old in packs[:-MAX_PACKS]:
+            os.unlink(old)
+    except OSError:
+        pass
+    return True
+
+
+def _integrals(path: Path, suffix: str, key: str) -> Integrals | None:
+    folder = _cache_dir()
     entry = (folder / _FOLDER / hashlib.sha1(key.encode("utf-8", "surrogateescape")
                                                 ).hexdigest()) if folder else None
     if entry is not None:
