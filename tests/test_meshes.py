@@ -9,6 +9,8 @@ from pathlib import Path
 import numpy as np
 import pybullet_data
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from urdfkit.model.spec import solid_inertia, solid_volume
 from urdfkit.sources import meshes
@@ -117,6 +119,8 @@ def test_real_meshes_agree_with_trimesh() -> None:
     "v 0 0 0\nv 1 0 0\nf 1 2\n",                       # a face of two corners
     "",                                                 # empty
     "v 1e999 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",        # overflow
+    # Two and four numbers make six, as two vertices would: lines are counted one by one.
+    "v 0 0\nv 0 0 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 2 3 4\nf 1 2 4\nf 1 3 4\n",
 ])
 def test_broken_meshes_are_unreadable_not_a_crash(tmp_path: Path, text: str) -> None:
     path = tmp_path / "bad.obj"
@@ -334,3 +338,29 @@ def test_workers_hand_their_entries_to_the_run_s_pack(
     check_paths([tmp_path / "robots"], jobs=2, cache=False)
     _new_process(monkeypatch)
     assert meshes.load_pack([str(tmp_path / "robots")]) == 16
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.lists(st.integers(1, 9), min_size=1, max_size=7), min_size=1, max_size=12),
+       st.lists(st.integers(0, 11), max_size=3), st.sampled_from(["", "/1", "/1/2", "//3"]),
+       st.sampled_from([" ", "\t", "  "]))
+def test_obj_polygons_become_the_fans_pybullet_makes(
+        polygons: list[list[int]], objects: list[int], tail: str, gap: str) -> None:
+    """Any mix of polygons, index styles and object starts: triangles (p0, pk, pk+1), as a
+    plain loop over the lines makes them, and each object's first triangle."""
+    lines = [f"v {i} {i * i} {i % 3}" for i in range(1, 10)]
+    oracle: list[tuple[int, int, int]] = []
+    first_of_object: list[int] = []  # triangles before each object's first face line
+    last_line = -1
+    for n, poly in enumerate(polygons):
+        if n in objects and n > 0 and n != last_line:
+            first_of_object.append(len(oracle))
+            last_line = n
+        if n in objects:
+            lines.append(f"o part{n}")
+        lines.append("f" + gap + gap.join(f"{i}{tail}" for i in poly))
+        oracle += [(poly[0] - 1, poly[k] - 1, poly[k + 1] - 1) for k in range(1, len(poly) - 1)]
+    vertices, faces, starts = meshes._obj(("\n".join(lines) + "\n").encode())
+    assert len(vertices) == 9
+    assert [tuple(f) for f in faces.tolist()] == oracle
+    assert starts == first_of_object

@@ -330,73 +330,124 @@ def _weld(corners: Any) -> tuple[Any, Any]:
     return unique, index.reshape(-1, 3)
 
 
+#: "7/3/2" -> "7": texture and normal indices go.
 _OBJ_INDEX_TAIL = re.compile(rb"/\S*")
-_OBJ_OBJECT = re.compile(rb"^[og][ \t]", re.M)
-_OBJ_FACE_LINE = re.compile(rb"^f[ \t]", re.M)  # "7/3/2" -> "7": texture and normal indices go
+#: The text after each keyword at a line's start (the data gets a leading newline, so every
+#: pattern starts with a literal the regex engine searches for fast): vertex positions,
+#: faces, object starts.
+_OBJ_V = re.compile(rb"\nv[ \t]([^\r\n]*)")
+_OBJ_F = re.compile(rb"\nf[ \t]([^\r\n]*)")
+_OBJ_FACE = re.compile(rb"\nf[ \t]")
+_OBJ_OBJECT = re.compile(rb"\n[og][ \t]")
 
 
 def _numbers(lines: list[bytes], dtype: Any, per_line: int) -> Any:
-    """The numbers after each line's keyword, ``per_line`` of them per line.
+    """The numbers of each line (the text after its keyword), ``per_line`` of them per line.
 
-    The common case (every line holds exactly ``per_line`` numbers) is parsed in one C call;
-    anything else (vertex colours, polygons, junk) line by line, which raises ValueError on
-    text that is not a number.
+    The common case (every line holds exactly ``per_line`` words) is parsed in one C call;
+    anything else raises ValueError, for the caller to read line by line. Lines are counted
+    one by one (in numpy): "v 1 2" beside "v 3 4 5 6" is two bad lines, not two vertices.
     """
     import warnings
 
     import numpy as np
 
-    joined = b" ".join(line.split(None, 1)[1] if b" " in line or b"\t" in line else b""
-                       for line in lines)
-    if dtype is not float and b"/" in joined:
-        joined = _OBJ_INDEX_TAIL.sub(b"", joined)
+    text = b"\n".join(lines)
+    if not (_words_per_line(text, len(lines)) == per_line).all():
+        raise ValueError("irregular")
+    if dtype is not float and b"/" in text:
+        text = _OBJ_INDEX_TAIL.sub(b"", text)
     with warnings.catch_warnings():  # numpy warns when it stops early: counted below
         warnings.simplefilter("ignore", DeprecationWarning)
-        values = np.fromstring(joined, dtype=dtype, sep=" ")
+        values = np.fromstring(text, dtype=dtype, sep=" ")
     if values.size == per_line * len(lines):
         return values.reshape(-1, per_line)
     raise ValueError("irregular")
+
+
+def _words_per_line(text: bytes, lines: int) -> Any:
+    """How many words (as ``bytes.split`` finds them) each newline-separated line holds."""
+    import numpy as np
+
+    if not _SPACE:
+        _SPACE.append(_space_table())
+    chars = np.frombuffer(text, dtype=np.uint8)
+    space = _SPACE[0][chars]
+    word = ~space
+    word[1:] &= space[:-1]  # a word starts after a space, or at the start
+    line_of = np.cumsum(chars == 10)
+    return np.bincount(line_of[word], minlength=lines)
+
+
+_SPACE: list[Any] = []  # the table below, made on first use (numpy loads lazily)
+
+
+def _space_table() -> Any:
+    import numpy as np
+
+    table = np.zeros(256, dtype=bool)
+    table[list(b" \t\n\r\x0b\x0c")] = True
+    return table
 
 
 def _obj(data: bytes) -> tuple[Any, Any, list[int]]:
     """Vertices, triangles, and the first triangle of each ``o``/``g`` object after the first.
 
     PyBullet collides with one convex hull per object of an OBJ (a V-HACD decomposition is
-    many convex objects in one file), so the objects matter to the concavity test.
+    many convex objects in one file), so the objects matter to the concavity test. Lines are
+    found by regular expressions and their numbers parsed by numpy, so no Python runs per
+    line in the common case (triangles); polygons are cut into fans with array arithmetic.
     """
     import numpy as np
 
-    vlines: list[bytes] = []
-    flines: list[bytes] = []
+    data = b"\n" + data
+    vlines = _OBJ_V.findall(data)
+    flines = _OBJ_F.findall(data)
     starts: list[int] = []  # f-line index where each object after the first begins
-    for ln in data.split(b"\n"):
-        head = ln[:2]
-        if head in (b"v ", b"v\t"):
-            vlines.append(ln)
-        elif head in (b"f ", b"f\t"):
-            flines.append(ln)
-        elif head in (b"o ", b"g ", b"o\t", b"g\t") and flines and (
-                not starts or starts[-1] != len(flines)):
-            starts.append(len(flines))
+    objects = [m.start() for m in _OBJ_OBJECT.finditer(data)]
+    first_face = _OBJ_FACE.search(data) if objects and flines else None
+    if first_face is not None and objects[-1] > first_face.start():  # objects after faces
+        face_at = np.array([m.start() for m in _OBJ_FACE.finditer(data)])
+        for before in np.searchsorted(face_at, objects).tolist():
+            if before and (not starts or starts[-1] != before):
+                starts.append(before)
     try:
         vertices = _numbers(vlines, float, 3)
     except ValueError:  # "v x y z w" or "v x y z r g b": the first three are the position
-        vertices = np.array([[float(x) for x in ln.split()[1:4]] for ln in vlines],
+        vertices = np.array([[float(x) for x in ln.split()[:3]] for ln in vlines],
                             dtype=float).reshape(-1, 3)
     count = len(vertices)
     try:
         tri = _numbers(flines, np.int64, 3)
     except ValueError:  # polygons: fans of triangles (object starts move to triangle counts)
-        faces: list[tuple[int, int, int]] = []
-        first_triangle = []
-        for line in flines:
-            first_triangle.append(len(faces))
-            idx = [int(p.split(b"/", 1)[0]) for p in line.split()[1:]]
-            faces += [(idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
-        tri = np.array(faces, dtype=np.int64).reshape(-1, 3)
-        starts = [first_triangle[i] for i in starts]
+        tri, first_triangle = _fans(flines)
+        starts = [int(first_triangle[i]) for i in starts]
     # 1-based; negative counts from the end
     return vertices, np.where(tri > 0, tri - 1, count + tri), starts
+
+
+def _fans(flines: list[bytes]) -> tuple[Any, Any]:
+    """Polygons as fans of triangles ``(p0, pk, pk+1)``, and each line's first triangle."""
+    import warnings
+
+    import numpy as np
+
+    text = b"\n".join(flines)
+    sizes = _words_per_line(text, len(flines)).astype(np.int64)
+    with warnings.catch_warnings():  # numpy warns when it stops early: counted below
+        warnings.simplefilter("ignore", DeprecationWarning)
+        flat = np.fromstring(_OBJ_INDEX_TAIL.sub(b"", text), dtype=np.int64, sep=" ")
+    if len(flat) != int(sizes.sum()):
+        raise ValueError("irregular")
+    per_line = np.maximum(sizes - 2, 0)
+    first_triangle = np.concatenate([[0], np.cumsum(per_line)])
+    total = int(first_triangle[-1])
+    line = np.repeat(np.arange(len(flines)), per_line)
+    k = np.arange(total) - first_triangle[:-1][line] + 1
+    at = (np.cumsum(sizes) - sizes)[line]
+    tri = np.stack([flat[at], flat[at + k], flat[at + k + 1]], axis=1) if total else \
+        np.zeros((0, 3), dtype=np.int64)
+    return tri, first_triangle
 
 
 def _dae(data: bytes, path: Path) -> tuple[Any, Any]:
