@@ -364,3 +364,15 @@ def test_obj_polygons_become_the_fans_pybullet_makes(
     assert len(vertices) == 9
     assert [tuple(f) for f in faces.tolist()] == oracle
     assert starts == first_of_object
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.tuples(*[st.sampled_from([0.0, -0.0, 1.0, 0.5, -2.25, 3e-9])] * 3),
+                min_size=3, max_size=60).filter(lambda c: len(c) % 3 == 0))
+def test_welding_stl_corners_groups_equal_points_as_numpy_unique_does(
+        corners: list[tuple[float, float, float]]) -> None:
+    array = np.array(corners, dtype=float)
+    unique, index = meshes._weld(array)
+    expected = np.unique(array, axis=0)  # compares floats: -0.0 is 0.0
+    assert len(unique) == len(expected)
+    assert np.array_equal(unique[index.ravel()], array)  # every corner is its own point
