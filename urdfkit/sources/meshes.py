@@ -384,8 +384,8 @@ def _words_per_line(text: bytes, lines: int) -> Any:
     space = _SPACE[0][chars]
     word = ~space
     word[1:] &= space[:-1]  # a word starts after a space, or at the start
-    line_of = np.cumsum(chars == 10)
-    return np.bincount(line_of[word], minlength=lines)
+    line = np.searchsorted(np.flatnonzero(chars == 10), np.flatnonzero(word))
+    return np.bincount(line, minlength=lines)
 
 
 _SPACE: list[Any] = []  # the table below, made on first use (numpy loads lazily)
