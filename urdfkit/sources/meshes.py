@@ -624,11 +624,14 @@ def _concavity(vertices: Any, faces: Any, starts: list[int], det: Any) -> float:
     for lo, hi in zip(bounds, bounds[1:], strict=False):
         if hi - lo < 4:
             continue
-        sign = -1.0 if det[lo:hi].sum() < 0 else 1.0  # inward triangles: out is the other side
-        points = vertices[np.unique(faces[lo:hi])]
+        inward = det[lo:hi].sum() < 0  # inward triangles: out is the other side
+        # The piece's vertices, in index order (as np.unique gives them, without a sort).
+        points = vertices[np.flatnonzero(np.bincount(faces[lo:hi].ravel(),
+                                                     minlength=len(vertices)))]
         step = max(1, -(-(hi - lo) * len(points) // _CONCAVITY_BUDGET))
-        depth = sign * (points @ normal[lo:hi:step].T - offset[lo:hi:step])
-        worst = max(worst, float(depth.max()))
+        height = points @ normal[lo:hi:step].T  # one (points x planes) array, no temporaries:
+        height -= offset[lo:hi:step]  # in place, and the side picked by min or max
+        worst = max(worst, -float(height.min()) if inward else float(height.max()))
     return worst
 
 
