@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -430,6 +431,32 @@ def test_concave_meshes_are_judged_on_moving_links_only(tmp_path: Path) -> None:
     # A V-HACD decomposition: concave overall, but PyBullet makes one hull per object.
     assert "U614" not in _codes(tmp_path, on("b", data / "duck_vhacd.obj"))
     assert "U614" in _codes(tmp_path, on("b", data / "torus" / "torus_textured.obj"))
+
+
+def test_a_mesh_first_seen_on_a_static_link_is_still_judged_concave_on_a_moving_one(
+        tmp_path: Path) -> None:
+    """The concavity depth is worked out only where a rule needs it: a cache entry made for
+    a static link (no depth) is completed, not trusted, when a moving link uses the mesh."""
+    from urdfkit.sources import meshes
+
+    bracket = tmp_path / "bracket.obj"  # a mesh no other test has cached
+    bracket.write_bytes((MESHES / "l_bracket.obj").read_bytes())
+    body = (f'<collision><geometry><mesh filename="{bracket}" scale="0.1 0.1 0.1"/></geometry>'
+            '</collision>')
+    static = doc(link("a", body=body), link("b", body=BOX), J)
+    moving = doc(link("a", body=BOX), link("b", body=body), J)
+    assert "U614" not in _codes(tmp_path, static)
+    memory = dict(meshes._MEMORY)
+    (entry,) = [v for k, v in memory.items() if k.startswith(f"{bracket}\0")]
+    assert entry is not None and math.isnan(entry.concavity)  # not worked out for the base
+    meshes._MEMORY.clear()  # a new process: only the cache folder remembers
+    path = tmp_path / "r.urdf"
+    path.write_text(moving)
+    found = [f for f in check_paths([path], jobs=1, cache=False).findings if f.code == "U614"]
+    assert len(found) == 1
+    expected = meshes.read_integrals(bracket)
+    assert expected is not None and expected.concavity > 0
+    assert f"{expected.concavity * 0.1:.3g} m in front" in found[0].message
 
 
 def test_millimetre_meshes_are_flagged_until_scaled(tmp_path: Path) -> None:

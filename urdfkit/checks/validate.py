@@ -14,7 +14,7 @@ import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from lxml import etree
 
@@ -335,7 +335,9 @@ def link_solid(link: etree._Element, r: Report | None = None) -> Solid | None:
             return None
         rot = rpy_to_matrix(rpy)
         if shape.tag == "mesh":
-            part = _mesh_part(shape, xyz, rot, r)
+            # The mesh-shape rule will want a moving link's concavity: read it in one go.
+            concave = r is not None and link.get("name") in _moving(r)
+            part = _mesh_part(shape, xyz, rot, r, concave)
             if part is None:
                 return None
             parts.append(part)
@@ -393,7 +395,8 @@ def _shape_trace(link: etree._Element, mass: float | None,
 
 
 def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3,
-               r: Report | None) -> tuple[float, tuple[float, ...], Matrix3, float] | None:
+               r: Report | None, concavity: bool = False
+               ) -> tuple[float, tuple[float, ...], Matrix3, float] | None:
     """A collision mesh as (volume, centre in the link, tensor per unit density, size)."""
     fn = (shape.get("filename") or "").strip()
     if r is None or r.base is None or not fn:
@@ -402,7 +405,7 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3,
     scale = _vec(shape, "scale", 3, (1.0, 1.0, 1.0))
     if ref.load_path is None or scale is None:
         return None
-    props = _properties(r, ref.load_path, scale)
+    props = _properties(r, ref.load_path, scale, concavity)
     if props is None:
         return None
     if not props.closed:
@@ -420,20 +423,34 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3,
             matmul(matmul(rot, own), transpose(rot)), max(props.extent))
 
 
-def _properties(r: Report, path: Path, scale: Sequence[float]) -> MeshProperties | None:
+def _properties(r: Report, path: Path, scale: Sequence[float],
+                concavity: bool = False) -> MeshProperties | None:
     """:func:`urdfkit.sources.meshes.properties`, once per mesh and scale per file.
 
-    The inertia and mesh-shape rules both ask.
+    The inertia and mesh-shape rules both ask. ``concavity``: the concavity depth is needed
+    (a collision mesh of a moving link); it is worked out only then.
     """
     key = ("mesh", path, scale[0], scale[1], scale[2])
     memo = r.memo
-    if key in memo:
-        found: MeshProperties | None = memo[key]
-        return found
-    from urdfkit.sources.meshes import properties
+    found: MeshProperties | None = memo.get(key, _UNSEEN)
+    if found is _UNSEEN or (concavity and found is not None and math.isnan(found.concavity)):
+        from urdfkit.sources.meshes import properties
 
-    found = memo[key] = properties(path, (scale[0], scale[1], scale[2]))
+        found = memo[key] = properties(path, (scale[0], scale[1], scale[2]),
+                                       concavity=concavity)
     return found
+
+
+_UNSEEN: Any = object()
+
+
+def _moving(r: Report) -> set[str]:
+    """:func:`_moving_links` of the report's document, once per file."""
+    moving: set[str] | None = r.memo.get("moving links")
+    if moving is None:
+        doc = r._doc
+        moving = r.memo["moving links"] = _moving_links(doc) if doc is not None else set()
+    return moving
 
 
 def rule_meshes(root: etree._Element, r: Report) -> None:
@@ -470,7 +487,7 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
     offsets = sorted(math.sqrt(sum(x * x for x in xyz)) for jv in doc.joints
                      if (xyz := _vec(jv.origin, "xyz", 3)) is not None and any(xyz))
     spacing = offsets[len(offsets) // 2] if len(offsets) >= 2 else None
-    moving = _moving_links(doc)
+    moving = _moving(r)
     for view in doc.links:
         link = view.el
         for part in view.parts:
@@ -480,7 +497,8 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
             if not fn or (ref := r.reference("mesh", fn)).load_path is None:
                 continue
             scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
-            props = _properties(r, ref.load_path, scale) if scale else None
+            concave_matters = part.tag == "collision" and link.get("name") in moving
+            props = _properties(r, ref.load_path, scale, concave_matters) if scale else None
             if props is None:
                 continue
             size = max(props.extent)
@@ -492,7 +510,7 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
                 r.add("U613", "warning", f"mesh {fn!r} of {label(link)} is {size:.3g} m across, "
                       f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
                       f"{fix}", mesh)
-            if (part.tag == "collision" and link.get("name") in moving and props.closed
+            if (concave_matters and props.closed
                     and props.concavity > CONCAVE_FRACTION * size):
                 r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
                       f"concave (it is {size:.3g} m across, and parts of it stand up to "

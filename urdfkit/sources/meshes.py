@@ -48,7 +48,8 @@ class MeshProperties:
         triangles: How many triangles.
         concavity: How far (m, about, under non-uniform scale) the surface lies inside the
             convex hull PyBullet collides with: the largest distance of a vertex in front of
-            the plane of a triangle of its own piece. 0 for a convex mesh.
+            the plane of a triangle of its own piece. 0 for a convex mesh; NaN when it was not
+            asked for (``properties(..., concavity=True)``).
         pieces: Convex hulls PyBullet makes of it (one per ``o``/``g`` object of an OBJ).
     """
 
@@ -147,15 +148,20 @@ def _cache_dir() -> Path | None:
 _CACHE_DIRS: dict[tuple[str | None, ...], Path | None] = {}
 
 #: Cache entries start with this; a new layout is a new prefix and a new folder.
-_ENTRY = b"M2"
-_FOLDER = "meshes-2"
+_ENTRY = b"M3"
+_FOLDER = "meshes-3"
 _MEMORY: dict[str, Integrals | None] = {}
 _MISSING = object()
 
 
-def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
-               ) -> MeshProperties | None:
-    """Mass properties of an STL or OBJ mesh, or None if unreadable, unsupported or empty."""
+def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *,
+               concavity: bool = False) -> MeshProperties | None:
+    """Mass properties of an STL or OBJ mesh, or None if unreadable, unsupported or empty.
+
+    The concavity depth costs as much as the rest together and only the concave-mesh rules
+    read it, so it is worked out when ``concavity`` asks for it, once per mesh (the cache
+    entry is then rewritten with it); otherwise it may be NaN.
+    """
     suffix = path.suffix.lower()
     if suffix not in (".stl", ".obj", ".dae"):
         return None
@@ -168,8 +174,9 @@ def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
         return None
     key = f"{os.path.abspath(path)}\0{st.st_size}\0{st.st_mtime_ns}\0{st.st_ino}"
     found = _MEMORY.get(key, _MISSING)
-    if found is _MISSING:
-        found = _MEMORY[key] = _integrals(path, suffix, key)
+    if found is _MISSING or (concavity and isinstance(found, Integrals)
+                             and math.isnan(found.concavity)):
+        found = _MEMORY[key] = _integrals(path, suffix, key, concavity)
     assert found is None or isinstance(found, Integrals)
     USED[key] = found
     return found.scaled(scale) if found is not None else None
@@ -181,8 +188,8 @@ def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
 # pack entry is keyed like any entry (path, size, mtime, inode), so an edited mesh misses it
 # and is looked up as before; a pack that is damaged in any byte is ignored whole.
 
-_PACKS = "mesh-packs-1"
-_PACK_MAGIC = b"MP1\n"
+_PACKS = "mesh-packs-2"
+_PACK_MAGIC = b"MP2\n"
 #: Packs kept; the oldest beyond this are removed when a new one is written.
 MAX_PACKS = 64
 #: The entries this process used (its own, and its workers' once merged), by key.
@@ -257,7 +264,7 @@ def save_pack(paths: Sequence[str]) -> bool:
     return True
 
 
-def _integrals(path: Path, suffix: str, key: str) -> Integrals | None:
+def _integrals(path: Path, suffix: str, key: str, concavity: bool) -> Integrals | None:
     folder = _cache_dir()
     entry = (folder / _FOLDER / hashlib.sha1(key.encode("utf-8", "surrogateescape")
                                                 ).hexdigest()) if folder else None
@@ -267,17 +274,24 @@ def _integrals(path: Path, suffix: str, key: str) -> Integrals | None:
             return None
         if data is not None:
             try:
-                return Integrals.unpack(data)
+                cached = Integrals.unpack(data)
             except (ValueError, struct.error):
                 pass  # a damaged entry: read the mesh again and rewrite it
-    found = read_integrals(path, suffix)
+            else:
+                if not (concavity and math.isnan(cached.concavity)):
+                    return cached
+    found = read_integrals(path, suffix, concavity=concavity)
     if entry is not None:
         write_entry(entry, found.pack() if found is not None else _ENTRY + b"-")
     return found
 
 
-def read_integrals(path: Path, suffix: str | None = None) -> Integrals | None:
-    """Read a mesh and integrate it (no cache); None if unreadable, unsupported or empty."""
+def read_integrals(path: Path, suffix: str | None = None, *,
+                   concavity: bool = True) -> Integrals | None:
+    """Read a mesh and integrate it (no cache); None if unreadable, unsupported or empty.
+
+    ``concavity`` False leaves the concavity depth NaN (unless the mesh is open: 0).
+    """
     import numpy as np
 
     from urdfkit.model.xmlio import read_regular
@@ -304,7 +318,7 @@ def read_integrals(path: Path, suffix: str | None = None) -> Integrals | None:
             or faces.min() < 0 or faces.max() >= len(vertices)
             or not np.isfinite(vertices).all()):
         return None
-    return _solid(vertices, faces, starts)
+    return _solid(vertices, faces, starts, concavity=concavity)
 
 
 def _stl(data: bytes) -> tuple[Any, Any]:
@@ -635,7 +649,8 @@ def _concavity(vertices: Any, faces: Any, starts: list[int], det: Any) -> float:
     return worst
 
 
-def _solid(vertices: Any, faces: Any, starts: list[int] | None = None) -> Integrals:
+def _solid(vertices: Any, faces: Any, starts: list[int] | None = None, *,
+           concavity: bool = True) -> Integrals:
     import numpy as np
 
     p = vertices[faces.T]  # (corner, triangle, xyz)
@@ -664,4 +679,5 @@ def _solid(vertices: Any, faces: Any, starts: list[int] | None = None) -> Integr
                       float(second[0, 1]), float(second[0, 2]), float(second[1, 2])),
                      (float(low[0]), float(low[1]), float(low[2])),
                      (float(high[0]), float(high[1]), float(high[2])), closed, len(faces),
-                     _concavity(vertices, faces, starts, det) if closed else 0.0, len(starts) + 1)
+                     (_concavity(vertices, faces, starts, det) if concavity else math.nan)
+                     if closed else 0.0, len(starts) + 1)
