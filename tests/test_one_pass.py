@@ -18,7 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lxml import etree
 
-from urdfkit.model.index import Doc, floats
+from urdfkit.model.index import Doc
 from urdfkit.model.spec import FILE_TAGS, MAX_XML_DEPTH, NUMERIC, OPAQUE, SCHEMA, used_shape
 from urdfkit.model.xmlio import parse_xml, read_bytes
 
@@ -136,18 +136,3 @@ def test_the_depth_limit_is_found_where_the_xpath_finds_it() -> None:
         etree.SubElement(root, "link")
         assert_same_as_lxml(root)
         assert (Doc(root).too_deep is not None) == (extra > 0)
-
-
-@given(st.text(alphabet="0123456789.eE+-_ \tinfa,x", max_size=12))
-def test_numbers_are_parsed_as_float_parses_them(text: str) -> None:
-    try:
-        expected: tuple[float, ...] | None = tuple(float(x) for x in text.split())
-    except ValueError:
-        expected = None
-    for _ in range(2):  # the first call parses, the second reads the memo
-        got = floats(text)
-        assert (got is None) == (expected is None)
-        if got is not None and expected is not None:
-            assert len(got) == len(expected)
-            assert all(a == b or (math.isnan(a) and math.isnan(b))
-                       for a, b in zip(got, expected, strict=True))

@@ -336,7 +336,8 @@ def link_solid(link: etree._Element, r: Report | None = None) -> Solid | None:
         rot = rpy_to_matrix(rpy)
         if shape.tag == "mesh":
             # The mesh-shape rule will want a moving link's concavity: read it in one go.
-            concave = r is not None and link.get("name") in _moving(r)
+            concave = r is not None and \
+                link.get("name") in _moving(r, link.getroottree().getroot())
             part = _mesh_part(shape, xyz, rot, r, concave)
             if part is None:
                 return None
@@ -444,12 +445,11 @@ def _properties(r: Report, path: Path, scale: Sequence[float],
 _UNSEEN: Any = object()
 
 
-def _moving(r: Report) -> set[str]:
-    """:func:`_moving_links` of the report's document, once per file."""
+def _moving(r: Report, root: etree._Element) -> set[str]:
+    """:func:`_moving_links` of the document, once per file."""
     moving: set[str] | None = r.memo.get("moving links")
     if moving is None:
-        doc = r._doc
-        moving = r.memo["moving links"] = _moving_links(doc) if doc is not None else set()
+        moving = r.memo["moving links"] = _moving_links(r.doc(root))
     return moving
 
 
@@ -487,7 +487,7 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
     offsets = sorted(math.sqrt(sum(x * x for x in xyz)) for jv in doc.joints
                      if (xyz := _vec(jv.origin, "xyz", 3)) is not None and any(xyz))
     spacing = offsets[len(offsets) // 2] if len(offsets) >= 2 else None
-    moving = _moving(r)
+    moving = _moving(r, root)
     for view in doc.links:
         link = view.el
         for part in view.parts:

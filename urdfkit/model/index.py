@@ -15,8 +15,8 @@ rules read:
   made on the way, for ``rule_elements`` to report in its turn.
 
 The element rules judge each distinct element (its tag and attributes) once for the whole
-process, parsing each distinct number text once (:func:`floats`): real files repeat
-``<origin rpy="0 0 0" xyz="0 0 0"/>`` thousands of times. Both memos are bounded.
+process (a bounded memo): real files repeat ``<origin rpy="0 0 0" xyz="0 0 0"/>`` thousands
+of times.
 """
 
 from __future__ import annotations
@@ -30,37 +30,13 @@ from urdfkit.model.spec import (
     NUMERIC,
     OPAQUE,
     SCHEMA,
+    numbers,
     used_shape,
 )
 
 El = Any  # an lxml element; this module never imports lxml
 
 
-#: Parsed numbers by attribute text, for the whole process: the text's floats, or None when
-#: one word is not a number. Bounded: emptied when it grows past _FLOATS_MAX.
-_FLOATS: dict[str, tuple[float, ...] | None] = {}
-_FLOATS_MAX = 65536
-
-
-def floats(text: str) -> tuple[float, ...] | None:
-    """The numbers in ``text`` (``float`` of each whitespace-separated word), or None.
-
-    Infinities and NaN are returned as they parse; callers judge finiteness.
-    """
-    found = _FLOATS.get(text, _UNSEEN)
-    if found is not _UNSEEN:
-        return found  # type: ignore[return-value]
-    try:
-        found = tuple(map(float, text.split()))
-    except ValueError:
-        found = None
-    if len(_FLOATS) >= _FLOATS_MAX:
-        _FLOATS.clear()
-    _FLOATS[text] = found
-    return found
-
-
-_UNSEEN = object()
 
 #: NUMERIC by tag: {tag: {attribute: how many numbers}}, one lookup per element.
 NUMERIC_BY_TAG: dict[str, dict[str, int]] = {}
@@ -251,7 +227,7 @@ class Doc:
 
 
 #: The element rules' verdict on a tag with its attributes, for the whole process: real files
-#: repeat ``<origin rpy="0 0 0" xyz="0 0 0"/>`` thousands of times. Bounded like _FLOATS.
+#: repeat ``<origin rpy="0 0 0" xyz="0 0 0"/>`` thousands of times. Emptied past _VERDICTS_MAX.
 _VERDICTS: dict[tuple[Any, ...], tuple[tuple[str, str, str], ...]] = {}
 _VERDICTS_MAX = 65536
 
@@ -266,7 +242,7 @@ def _verdict(tag: str, items: list[tuple[str, str]]) -> tuple[tuple[str, str, st
     for attr, text in items:
         n = numeric.get(attr) if numeric is not None else None
         if n is not None:
-            vals = floats(text)
+            vals = numbers(text)
             if vals is None or not all(map(math.isfinite, vals)):
                 out.append(("U401", "error", f"<{tag} {attr}={text!r}>: expected "
                             f"{'a finite number' if n == 1 else f'{n} finite numbers'}"))
