@@ -17,9 +17,22 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from urdfkit.core.errors import InputError, ParameterError
+from lxml import etree
+
+from urdfkit.checks.validate import ALL_RULES
+from urdfkit.core.errors import InputError, ParameterError, XacroNotExpanded
 from urdfkit.core.finding import LEVELS, Finding
 from urdfkit.model.spec import PYBULLET_LINE_BYTES
+from urdfkit.model.xmlio import (
+    line_of,
+    long_line,
+    parse_xml,
+    read_bytes,
+    tolerate_quirks,
+    xacro_marker,
+    xacro_note,
+)
+from urdfkit.sources.guard import refuse_oversized, run_rules
 
 if TYPE_CHECKING:
     from urdfkit.checks.resultcache import ResultCache, RunManifest
@@ -160,20 +173,24 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, str, str | None]]:
     return out
 
 
-def _read(path: Path, display: str, no_exec: bool = False,
+def _is_xacro(name: str) -> bool:
+    """Whether ``Path(name).suffix == ".xacro"``, without making the Path."""
+    base = name.rpartition(os.sep)[2]
+    return base.endswith(".xacro") and len(base) > 6
+
+
+def _read(path: str, display: str, no_exec: bool = False,
           packages: Mapping[str, Path] | None = None,
           xacro_args: Mapping[str, str] | None = None) -> bytes:
-    from urdfkit.model.xmlio import read_bytes
-    from urdfkit.sources.expand import expand_xacro
-
-    if path.suffix == ".xacro":
+    if _is_xacro(path):
+        from urdfkit.sources.expand import expand_xacro
         from urdfkit.sources.uris import not_a_file
 
-        why = not_a_file(path)
+        why = not_a_file(Path(path))
         if why is not None:  # never hand xacro a FIFO to block on
             raise InputError(f"is {why}, not a regular file; urdfkit reads only regular files"
                              if why != "missing" else "no such file", file=display)
-        return expand_xacro(path, xacro_args, display=display, no_exec=no_exec,
+        return expand_xacro(Path(path), xacro_args, display=display, no_exec=no_exec,
                             packages=packages, strict_args=False)
     return read_bytes(path)
 
@@ -188,24 +205,11 @@ def check_file(display: str, path: str | Path,
     ``U006`` warning saying so, and is otherwise unchecked. With ``physics`` a file with no
     error is also loaded in PyBullet and tested for self-collision at its zero pose (U950).
     """
-    from lxml import etree
-
-    from urdfkit.checks.validate import ALL_RULES
-    from urdfkit.model.xmlio import (
-        line_of,
-        long_line,
-        parse_xml,
-        tolerate_quirks,
-        xacro_marker,
-        xacro_note,
-    )
-    from urdfkit.sources.expand import XacroNotExpanded
-    from urdfkit.sources.guard import refuse_oversized, run_rules
-
-    path = Path(path)
+    name = os.fspath(path)
+    xacro_file = _is_xacro(name)
     result = FileResult(display)
     try:
-        data = _read(path, display, no_exec, packages, xacro_args)
+        data = _read(name, display, no_exec, packages, xacro_args)
         refuse_oversized(data, display)
         fixed, quirks = tolerate_quirks(data)
         tree = parse_xml(fixed, display, tolerated=True)
@@ -219,37 +223,43 @@ def check_file(display: str, path: str | Path,
     except (OSError, ValueError, etree.LxmlError) as e:  # belt and braces: never crash a sweep
         result.findings.append(Finding("U000", "error", f"cannot check: {e}", display))
         return result
-    result.findings.extend(Finding("U004", "warning", note, display, line)
-                           for line, note in quirks)
-    xacro = xacro_marker(data) if path.suffix != ".xacro" else None
-    if xacro is not None:
-        result.findings.append(Finding("U009", "warning", xacro_note(xacro[1]), display,
-                                       xacro[0]))
-    too_long = long_line(data) if path.suffix != ".xacro" else None
-    if too_long is not None:
-        result.findings.append(Finding(
-            "U008", "warning", f"line {too_long[0]} is {too_long[1]} bytes long: PyBullet reads "
-            f"lines in {PYBULLET_LINE_BYTES}-byte pieces and breaks them there, so p.loadURDF "
-            "refuses or misreads the file when a break falls inside a name (urdfkit loads a "
-            "reformatted copy); put one element per line", display, too_long[0]))
-    if path.suffix == ".xacro" and _macro_library(tree.getroot()):
-        result.findings.append(Finding("U007", "info", "a xacro macro library (no links of its "
-                                       "own): checked through the files that include it",
-                                       display))
+    findings = result.findings
+    for line, note in quirks:
+        findings.append(Finding("U004", "warning", note, display, line))
+    if not xacro_file:
+        xacro = xacro_marker(data)
+        if xacro is not None:
+            findings.append(Finding("U009", "warning", xacro_note(xacro[1]), display, xacro[0]))
+        too_long = long_line(data)
+        if too_long is not None:
+            findings.append(Finding(
+                "U008", "warning", f"line {too_long[0]} is {too_long[1]} bytes long: PyBullet "
+                f"reads lines in {PYBULLET_LINE_BYTES}-byte pieces and breaks them there, so "
+                "p.loadURDF refuses or misreads the file when a break falls inside a name "
+                "(urdfkit loads a reformatted copy); put one element per line", display,
+                too_long[0]))
+    root = tree.getroot()
+    if xacro_file and _macro_library(root):
+        findings.append(Finding("U007", "info", "a xacro macro library (no links of its "
+                                "own): checked through the files that include it", display))
         return result
-    found = run_rules(tree.getroot(), display, ALL_RULES, base=path.absolute().parent,
+    found = run_rules(root, display, ALL_RULES, base=Path(name).absolute().parent,
                       packages=packages, origins=getattr(data, "origins", None))
-    if path.suffix == ".xacro":
+    if xacro_file:
         # Lines of xacro's output are not lines of the file the user wrote: none, not a false
         # one (each message names its element).
         found = [dataclasses.replace(f, line=None) for f in found]
-    result.findings.extend(found)
-    if physics and not any(f.level == "error" for f in result.findings):
-        lines = {} if path.suffix == ".xacro" else \
-            {el.get("name"): line_of(el) for el in tree.getroot().iterchildren("link")}
-        result.findings.extend(physics_findings(display, path, lines, packages, xacro_args))
-    result.findings.sort(key=lambda f: f.line or 0)
+    findings.extend(found)
+    if physics and not any(f.level == "error" for f in findings):
+        lines = {} if xacro_file else \
+            {el.get("name"): line_of(el) for el in root.iterchildren("link")}
+        findings.extend(physics_findings(display, Path(name), lines, packages, xacro_args))
+    findings.sort(key=_line_key)
     return result
+
+
+def _line_key(f: Finding) -> int:
+    return f.line or 0
 
 
 def physics_findings(display: str, path: Path, lines: Mapping[str | None, int | None],
@@ -293,8 +303,6 @@ def _macro_library(root: object) -> bool:
     ``<root>`` element (pr2_description's sensors); what marks them is that expanding them
     alone makes nothing.
     """
-    from lxml import etree
-
     assert isinstance(root, etree._Element)
     return root.tag in ("robot", "root") and root.find("link") is None
 

@@ -10,6 +10,7 @@ in
 from __future__ import annotations
 
 import math
+import os
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -326,18 +327,29 @@ def link_solid(link: etree._Element, r: Report | None = None) -> Solid | None:
     or is not closed, a bad size.
     """
     parts: list[tuple[float, tuple[float, ...], Matrix3, float]] = []
-    for col in link.findall("collision"):
-        shape = next((c for c in col.iterfind("geometry/*") if c.tag in SHAPES), None)
-        origin = col.find("origin")
+    moving: set[str] | None = None
+    for col in link:
+        if col.tag != "collision":
+            continue
+        # As col.iterfind("geometry/*") and col.find("origin"), in one look at the children.
+        shape = origin = None
+        for c in col:
+            tag = c.tag
+            if tag == "geometry":
+                if shape is None:
+                    shape = next((s for s in c if s.tag in SHAPES), None)
+            elif tag == "origin" and origin is None:
+                origin = c
         xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
         rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
         if shape is None or xyz is None or rpy is None:
             return None
-        rot = rpy_to_matrix(rpy)
+        rot = None if rpy == (0.0, 0.0, 0.0) else rpy_to_matrix(rpy)  # None: no rotation
         if shape.tag == "mesh":
             # The mesh-shape rule will want a moving link's concavity: read it in one go.
-            concave = r is not None and \
-                link.get("name") in _moving(r, link.getroottree().getroot())
+            if r is not None and moving is None:
+                moving = _moving(r, link)
+            concave = moving is not None and link.get("name") in moving
             part = _mesh_part(shape, xyz, rot, r, concave)
             if part is None:
                 return None
@@ -355,7 +367,8 @@ def link_solid(link: etree._Element, r: Report | None = None) -> Solid | None:
         size = max(dims) if shape.tag == "box" else max([2 * dims[0], *dims[1:]])
         d = solid_inertia(shape.tag, dims, volume)
         diag = ((d[0], 0.0, 0.0), (0.0, d[1], 0.0), (0.0, 0.0, d[2]))
-        parts.append((volume, tuple(xyz), matmul(matmul(rot, diag), transpose(rot)), size))
+        parts.append((volume, xyz, diag if rot is None else
+                      matmul(matmul(rot, diag), transpose(rot)), size))
     total = sum(p[0] for p in parts)
     if not parts or not 0 < total < math.inf:
         return None
@@ -395,10 +408,13 @@ def _shape_trace(link: etree._Element, mass: float | None,
     return (trace, solid.size) if math.isfinite(trace) else None
 
 
-def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3,
+def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
                r: Report | None, concavity: bool = False
                ) -> tuple[float, tuple[float, ...], Matrix3, float] | None:
-    """A collision mesh as (volume, centre in the link, tensor per unit density, size)."""
+    """A collision mesh as (volume, centre in the link, tensor per unit density, size).
+
+    ``rot``: the collision's rotation, None for none.
+    """
     fn = (shape.get("filename") or "").strip()
     if r is None or r.base is None or not fn:
         return None
@@ -406,7 +422,7 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3,
     scale = _vec(shape, "scale", 3, (1.0, 1.0, 1.0))
     if ref.load_path is None or scale is None:
         return None
-    props = _properties(r, ref.load_path, scale, concavity)
+    props = _properties(r, ref.load_path, scale, concavity, ref.stat)
     if props is None:
         return None
     if not props.closed:
@@ -417,19 +433,24 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3,
         return None
     if props.volume <= 0:
         return None
-    centre = rotate(rot, props.com)
     t = props.inertia
     own = ((t[0][0], t[0][1], t[0][2]), (t[1][0], t[1][1], t[1][2]), (t[2][0], t[2][1], t[2][2]))
-    return (props.volume, tuple(xyz[i] + centre[i] for i in range(3)),
+    com = props.com
+    if rot is None:
+        return (props.volume, (xyz[0] + com[0], xyz[1] + com[1], xyz[2] + com[2]), own,
+                max(props.extent))
+    centre = rotate(rot, com)
+    return (props.volume, (xyz[0] + centre[0], xyz[1] + centre[1], xyz[2] + centre[2]),
             matmul(matmul(rot, own), transpose(rot)), max(props.extent))
 
 
-def _properties(r: Report, path: Path, scale: Sequence[float],
-                concavity: bool = False) -> MeshProperties | None:
+def _properties(r: Report, path: Path, scale: Sequence[float], concavity: bool = False,
+                st: os.stat_result | None = None) -> MeshProperties | None:
     """:func:`urdfkit.sources.meshes.properties`, once per mesh and scale per file.
 
     The inertia and mesh-shape rules both ask. ``concavity``: the concavity depth is needed
-    (a collision mesh of a moving link); it is worked out only then.
+    (a collision mesh of a moving link); it is worked out only then. ``st``: the path's
+    ``os.stat``, when the reference already took it.
     """
     key = ("mesh", path, scale[0], scale[1], scale[2])
     memo = r.memo
@@ -438,18 +459,18 @@ def _properties(r: Report, path: Path, scale: Sequence[float],
         from urdfkit.sources.meshes import properties
 
         found = memo[key] = properties(path, (scale[0], scale[1], scale[2]),
-                                       concavity=concavity)
+                                       concavity=concavity, stat=st)
     return found
 
 
 _UNSEEN: Any = object()
 
 
-def _moving(r: Report, root: etree._Element) -> set[str]:
-    """:func:`_moving_links` of the document, once per file."""
+def _moving(r: Report, el: etree._Element) -> set[str]:
+    """:func:`_moving_links` of the document ``el`` belongs to, once per file."""
     moving: set[str] | None = r.memo.get("moving links")
     if moving is None:
-        moving = r.memo["moving links"] = _moving_links(r.doc(root))
+        moving = r.memo["moving links"] = _moving_links(r.doc(el.getroottree().getroot()))
     return moving
 
 
@@ -498,7 +519,8 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
                 continue
             scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
             concave_matters = part.tag == "collision" and link.get("name") in moving
-            props = _properties(r, ref.load_path, scale, concave_matters) if scale else None
+            props = _properties(r, ref.load_path, scale, concave_matters, ref.stat) \
+                if scale else None
             if props is None:
                 continue
             size = max(props.extent)

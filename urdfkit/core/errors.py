@@ -44,6 +44,10 @@ class InputError(UrdfkitError):
     """An input file is missing, unreadable, malformed or unsafe to load."""
 
 
+class XacroNotExpanded(InputError):
+    """xacro was not expanded because executing it is disabled (``--no-exec``)."""
+
+
 class ModelError(UrdfkitError, ValueError):
     """A value given to the builder model is invalid (raised where it is set)."""
 

@@ -246,16 +246,34 @@ def numbers(text: str | None) -> list[float] | None:
 
 
 def vector(text: str | None, n: int) -> tuple[float, ...] | None:
-    """Exactly ``n`` finite numbers from ``text``, else None (missing, malformed, wrong length)."""
+    """Exactly ``n`` finite numbers from ``text``, else None (missing, malformed, wrong length).
+
+    Answers are kept per process (bounded): real files repeat ``"0 0 0"`` thousands of times.
+    """
     if text is None:
         return None
+    key = (text, n)
+    found = _VECTORS.get(key, _NONE)
+    if found is not _NONE:
+        return found  # type: ignore[no-any-return]
     try:
-        vals = tuple(map(float, text.split()))
+        vals: tuple[float, ...] | None = tuple(map(float, text.split()))
     except ValueError:
-        return None
-    if len(vals) != n or not all(map(math.isfinite, vals)):
-        return None
+        vals = None
+    if vals is not None and (len(vals) != n or not all(map(math.isfinite, vals))):
+        vals = None
+    if len(_VECTORS) >= _VECTORS_MAX:
+        _VECTORS.clear()
+    _VECTORS[key] = vals
     return vals
+
+
+#: :func:`vector`'s answers by (text, n); emptied past _VECTORS_MAX.
+_VECTORS: dict[tuple[str, int], tuple[float, ...] | None] = {}
+_VECTORS_MAX = 4096
+_NONE: Any = object()
+#: Defaults of :func:`attr_vec` as float tuples, made once each.
+_DEFAULTS: dict[tuple[float, ...], tuple[float, ...]] = {}
 
 
 def attr_vec(el: _HasGet | None, attr: str, n: int,
@@ -264,7 +282,15 @@ def attr_vec(el: _HasGet | None, attr: str, n: int,
     vals = vector(el.get(attr), n) if el is not None else None
     if vals is not None:
         return vals
-    return None if default is None else tuple(float(v) for v in default)
+    if default is None:
+        return None
+    key = tuple(default)
+    made = _DEFAULTS.get(key)
+    if made is None:
+        made = tuple(float(v) for v in default)
+        if len(_DEFAULTS) < 64:  # the code's own constants; anything else is not kept
+            _DEFAULTS[key] = made
+    return made
 
 
 def attr_float(el: _HasGet | None, attr: str, default: float | None = None) -> float | None:

@@ -7,9 +7,11 @@ through an entity or exhaust memory with a billion-laughs bomb.
 
 from __future__ import annotations
 
+import errno
 import math
 import os
 import re
+import stat
 import threading
 from collections.abc import Iterator
 from pathlib import Path
@@ -78,54 +80,60 @@ def read_regular(path: str | Path, *, limit: int = MAX_FILE_BYTES,
     Raises:
         InputError: one line naming the file.
     """
-    import errno
-    import stat
-
-    path = Path(path)
+    name = os.fspath(path)
     if track:  # check's result cache: this result depends on the file (cache entries do not)
-        _deps.note(path)
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+        _deps.note(name)
     try:
-        fd = os.open(path, flags)
+        fd = os.open(name, _READ_FLAGS)
     except FileNotFoundError:
-        dangling = os.path.islink(path)
+        dangling = os.path.islink(name)
         raise InputError("no such file: it is a symlink to nothing" if dangling
-                         else "no such file", file=path) from None
+                         else "no such file", file=Path(name)) from None
     except IsADirectoryError:
-        raise InputError(f"is a directory, not a {kind}", file=path) from None
+        raise InputError(f"is a directory, not a {kind}", file=Path(name)) from None
     except OSError as e:
         why = {errno.ENAMETOOLONG: "a path component is longer than the file system allows",
                errno.EACCES: "permission denied", errno.ELOOP: "a symlink loop"}
         raise InputError(f"cannot read: {why.get(e.errno or 0, e.strerror)}",
-                         file=path) from None
+                         file=Path(name)) from None
     except ValueError:  # a NUL byte in the name
-        raise InputError("cannot read: the path holds a NUL byte", file=path) from None
+        raise InputError("cannot read: the path holds a NUL byte", file=Path(name)) from None
     try:
-        mode = os.fstat(fd).st_mode
+        st = os.fstat(fd)
+        mode = st.st_mode
         if not stat.S_ISREG(mode):
             what = ("a directory" if stat.S_ISDIR(mode) else "a FIFO (named pipe)"
                     if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or
                     stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else "special")
             raise InputError(f"is {what}, not a regular file; urdfkit reads only regular "
-                             "files", file=path)
+                             "files", file=Path(name))
         chunks, size = [], 0
+        # Ask for one byte more than the file holds: a shorter answer is the end of the file,
+        # so the common case is one read, not two (a file growing meanwhile reads on).
+        want = min(st.st_size, limit) + 1
         while True:
             try:
-                chunk = os.read(fd, 1 << 20)
+                chunk = os.read(fd, want)
             except BlockingIOError:  # pragma: no cover - regular files never block
                 continue
             except OSError as e:
-                raise InputError(f"cannot read: {e.strerror}", file=path) from None
+                raise InputError(f"cannot read: {e.strerror}", file=Path(name)) from None
             if not chunk:
                 break
             size += len(chunk)
             if size > limit:
                 raise InputError(f"file is over {_size(limit)}; urdfkit refuses larger "
-                                 f"{kind}s", file=path)
+                                 f"{kind}s", file=Path(name))
             chunks.append(chunk)
-        return b"".join(chunks)
+            if len(chunk) < want and size >= st.st_size:
+                break
+            want = 1 << 20
+        return chunks[0] if len(chunks) == 1 else b"".join(chunks)
     finally:
         os.close(fd)
+
+
+_READ_FLAGS = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
 
 
 def _size(n: int) -> str:
@@ -137,19 +145,26 @@ def _size(n: int) -> str:
 _DECL = re.compile(rb"<\?xml\s[^>]*?\?>")
 
 
-_LONG_LINE = re.compile(rb"[^\n]{%d}" % (PYBULLET_LINE_BYTES + 1))
+#: A line after the first that PyBullet would break: the leading newline lets the search jump
+#: from line to line (a pattern starting with a literal is searched for at C speed).
+_LONG_LINE = re.compile(rb"\n[^\n]{%d}" % (PYBULLET_LINE_BYTES + 1))
 
 
 def long_line(data: bytes) -> tuple[int, int] | None:
     """The first line PyBullet would break (longer than PYBULLET_LINE_BYTES): (line, bytes)."""
-    if len(data) <= PYBULLET_LINE_BYTES:
+    size = len(data)
+    if size <= PYBULLET_LINE_BYTES:
         return None
-    m = _LONG_LINE.search(data)
-    if m is None:
-        return None
-    start = data.rfind(b"\n", 0, m.start()) + 1
-    end = data.find(b"\n", m.start())
-    return data.count(b"\n", 0, m.start()) + 1, (len(data) if end < 0 else end) - start
+    first = data.find(b"\n")
+    if (size if first < 0 else first) > PYBULLET_LINE_BYTES:
+        start = 0
+    else:
+        m = _LONG_LINE.search(data)
+        if m is None:
+            return None
+        start = m.start() + 1
+    end = data.find(b"\n", start)
+    return data.count(b"\n", 0, start) + 1, (size if end < 0 else end) - start
 
 
 def tolerate_quirks(data: bytes) -> tuple[bytes, list[tuple[int, str]]]:
@@ -281,6 +296,8 @@ def xacro_marker(data: bytes) -> tuple[int, str] | None:
     A ``.urdf`` holding xacro (ROS 2 packages ship these) is URDF to nobody: read as it is,
     its links are named ``${prefix}base_link``.
     """
+    if b"$" not in data and b"<xacro:" not in data:
+        return None  # what every match needs (a scan at C speed)
     m = _XACRO.search(data)
     while m is not None:
         opened = data.rfind(b"<!--", 0, m.start())

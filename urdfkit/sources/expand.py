@@ -30,7 +30,7 @@ import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
-from urdfkit.core.errors import InputError
+from urdfkit.core.errors import InputError, XacroNotExpanded
 
 #: Seconds a xacro expansion may take before it is killed.
 XACRO_TIMEOUT = float(os.environ.get("URDFKIT_XACRO_TIMEOUT", "20"))
@@ -40,10 +40,6 @@ XACRO_MEMORY = 2 * 1024**3
 BAD_ARGS = 3
 #: Set to 1 (true, yes) to refuse executing xacro anywhere (CI over untrusted repositories).
 NO_EXEC_ENV = "URDFKIT_NO_EXEC"
-
-
-class XacroNotExpanded(InputError):
-    """xacro was not expanded because executing it is disabled."""
 
 
 def execution_allowed(no_exec: bool = False) -> bool:

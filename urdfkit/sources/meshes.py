@@ -110,30 +110,46 @@ class Integrals:
         return cls(v[0], v[1:4], v[4:10], v[10:13], v[13:16], v[17], v[18], v[16], v[19])
 
     def scaled(self, scale: tuple[float, float, float]) -> MeshProperties | None:
-        """The solid under ``<mesh scale>``: integrals scale as powers of each factor."""
+        """The solid under ``<mesh scale>``: integrals scale as powers of each factor.
+
+        Written out term by term (check asks once per mesh and file): the same arithmetic, in
+        the same order, as the matrix form ``about = sign det S M S - volume com com^T``.
+        """
         sx, sy, sz = scale
         det = sx * sy * sz
         if det == 0:
             return None
         volume = self.volume * det
-        first = [f * k * det for f, k in zip(self.first, scale, strict=True)]
+        f0, f1, f2 = self.first
+        f0, f1, f2 = f0 * sx * det, f1 * sy * det, f2 * sz * det
         xx, yy, zz, xy, xz, yz = self.second
-        m = [[xx * sx * sx, xy * sx * sy, xz * sx * sz],
-             [xy * sx * sy, yy * sy * sy, yz * sy * sz],
-             [xz * sx * sz, yz * sy * sz, zz * sz * sz]]
+        m00, m01, m02 = xx * sx * sx, xy * sx * sy, xz * sx * sz
+        m11, m12, m22 = yy * sy * sy, yz * sy * sz, zz * sz * sz
         sign = -1.0 if volume < 0 else 1.0  # inward triangles: the same solid, inside out
         volume *= sign
-        com = [sign * f / volume if volume else 0.0 for f in first]
-        about = [[sign * det * m[i][j] - volume * com[i] * com[j] for j in range(3)]
-                 for i in range(3)]
-        trace = about[0][0] + about[1][1] + about[2][2]
-        tensor = tuple(tuple((trace if i == j else 0.0) - about[i][j] for j in range(3))
-                       for i in range(3))
+        if volume:
+            c0, c1, c2 = sign * f0 / volume, sign * f1 / volume, sign * f2 / volume
+        else:
+            c0 = c1 = c2 = 0.0
+        k = sign * det
+        a00 = k * m00 - volume * c0 * c0
+        a01 = k * m01 - volume * c0 * c1
+        a02 = k * m02 - volume * c0 * c2
+        a10 = k * m01 - volume * c1 * c0
+        a11 = k * m11 - volume * c1 * c1
+        a12 = k * m12 - volume * c1 * c2
+        a20 = k * m02 - volume * c2 * c0
+        a21 = k * m12 - volume * c2 * c1
+        a22 = k * m22 - volume * c2 * c2
+        trace = a00 + a11 + a22
+        tensor = ((trace - a00, 0.0 - a01, 0.0 - a02),
+                  (0.0 - a10, trace - a11, 0.0 - a12),
+                  (0.0 - a20, 0.0 - a21, trace - a22))
         (x0, y0, z0), (x1, y1, z1) = self.low, self.high
         extent = (abs(sx) * (x1 - x0), abs(sy) * (y1 - y0), abs(sz) * (z1 - z0))
-        return MeshProperties(volume, (com[0], com[1], com[2]), tensor,
-                              extent, self.closed, self.triangles,
-                              self.concavity * max(abs(sx), abs(sy), abs(sz)), self.pieces)
+        return MeshProperties(volume, (c0, c1, c2), tensor, extent, self.closed,
+                              self.triangles, self.concavity * max(abs(sx), abs(sy), abs(sz)),
+                              self.pieces)
 
 
 def _cache_dir() -> Path | None:
@@ -155,28 +171,33 @@ _MISSING = object()
 
 
 def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *,
-               concavity: bool = False) -> MeshProperties | None:
+               concavity: bool = False,
+               stat: os.stat_result | None = None) -> MeshProperties | None:
     """Mass properties of an STL or OBJ mesh, or None if unreadable, unsupported or empty.
 
     The concavity depth costs as much as the rest together and only the concave-mesh rules
     read it, so it is worked out when ``concavity`` asks for it, once per mesh (the cache
-    entry is then rewritten with it); otherwise it may be NaN.
+    entry is then rewritten with it); otherwise it may be NaN. ``stat``: ``os.stat(path)``
+    when the caller has just taken it.
     """
-    suffix = path.suffix.lower()
+    name = os.fspath(path)
+    suffix = os.path.splitext(name)[1].lower()
     if suffix not in (".stl", ".obj", ".dae"):
         return None
-    deps.note(path)
-    try:
-        st = os.stat(path)
-    except (OSError, ValueError):
-        return None
+    deps.note(name)
+    st = stat
+    if st is None:
+        try:
+            st = os.stat(name)
+        except (OSError, ValueError):
+            return None
     if st.st_size > MAX_MESH_BYTES:
         return None
-    key = f"{os.path.abspath(path)}\0{st.st_size}\0{st.st_mtime_ns}\0{st.st_ino}"
+    key = f"{os.path.abspath(name)}\0{st.st_size}\0{st.st_mtime_ns}\0{st.st_ino}"
     found = _MEMORY.get(key, _MISSING)
     if found is _MISSING or (concavity and isinstance(found, Integrals)
                              and math.isnan(found.concavity)):
-        found = _MEMORY[key] = _integrals(path, suffix, key, concavity)
+        found = _MEMORY[key] = _integrals(Path(name), suffix, key, concavity)
     assert found is None or isinstance(found, Integrals)
     USED[key] = found
     return found.scaled(scale) if found is not None else None
