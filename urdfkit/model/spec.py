@@ -255,7 +255,7 @@ def vector(text: str | None, n: int) -> tuple[float, ...] | None:
     key = (text, n)
     found = _VECTORS.get(key, _NONE)
     if found is not _NONE:
-        return found  # type: ignore[no-any-return]
+        return found
     try:
         vals: tuple[float, ...] | None = tuple(map(float, text.split()))
     except ValueError:
