@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 from lxml import etree
 
-from urdfkit.model.index import Doc, LinkView
+from urdfkit.model.index import Doc, LinkView, first
 from urdfkit.model.spec import (
     LIMITED_JOINT_TYPES,
     MAX_STATE_LINKS,
@@ -171,7 +171,7 @@ def rule_material_colours(root: etree._Element, r: Report) -> None:
     """
     colours: dict[str, list[tuple[str, etree._Element]]] = {}
     for m in r.doc(root).all_materials:
-        name, color = m.get("name"), m.find("color")
+        name, color = m.get("name"), first(m, "color")
         if name is None or color is None or color.get("rgba") is None:
             continue
         colours.setdefault(name, []).append((" ".join(color.get("rgba", "").split()), color))
@@ -195,11 +195,11 @@ def rule_references(root: etree._Element, r: Report) -> None:
     """
     doc = r.doc(root)
     defined = {m.get("name") for m in doc.all_materials
-               if m.find("color") is not None or m.find("texture") is not None}
+               if first(m, "color") is not None or first(m, "texture") is not None}
     for m in doc.all_materials:
         parent = m.getparent()
         if (parent is not None and parent.tag == "visual" and m.get("name")
-                and m.find("color") is None and m.find("texture") is None
+                and first(m, "color") is None and first(m, "texture") is None
                 and m.get("name") not in defined):
             r.add("U706", "warning", f"<material name={m.get('name')!r}> is used but never "
                   "defined with a <color> or <texture>; PyBullet draws the default colour", m)
@@ -512,13 +512,15 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
     for view in doc.links:
         link = view.el
         for part in view.parts:
-            mesh = used_shape(part.find("geometry"))
+            concave_matters = part.tag == "collision" and link.get("name") in moving
+            if not spacing and not concave_matters:
+                continue  # neither finding can be made of this mesh
+            mesh = used_shape(first(part, "geometry"))
             fn = (mesh.get("filename") or "").strip() if mesh is not None and \
                 mesh.tag == "mesh" else ""
             if not fn or (ref := r.reference("mesh", fn)).load_path is None:
                 continue
             scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
-            concave_matters = part.tag == "collision" and link.get("name") in moving
             props = _properties(r, ref.load_path, scale, concave_matters, ref.stat) \
                 if scale else None
             if props is None:

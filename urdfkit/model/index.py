@@ -38,6 +38,11 @@ El = Any  # an lxml element; this module never imports lxml
 
 
 
+def first(el: El, tag: str) -> El:
+    """``el.find(tag)`` for a plain tag name, filtered in C (``find`` goes through ElementPath)."""
+    return next(el.iterchildren(tag), None)
+
+
 #: NUMERIC by tag: {tag: {attribute: how many numbers}}, one lookup per element.
 NUMERIC_BY_TAG: dict[str, dict[str, int]] = {}
 for (_tag, _attr), _n in NUMERIC.items():

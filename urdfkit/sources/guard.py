@@ -23,7 +23,7 @@ from lxml import etree
 from urdfkit.core import deps
 from urdfkit.core.errors import InputError
 from urdfkit.core.finding import Finding
-from urdfkit.model.index import Doc
+from urdfkit.model.index import Doc, first
 from urdfkit.model.spec import (
     CRASH_NAME_BYTES,
     CRASH_PERCENT_TAGS,
@@ -361,12 +361,13 @@ def rule_geometry(root: etree._Element, r: Report) -> None:
     doc = r.doc(root)
     for view in doc.links:
         for part in view.parts:
-            if part.find("geometry") is None:
+            if first(part, "geometry") is None:
                 r.add("U506", "error", f"<{part.tag}> of {label(view.el)} has no <geometry>, "
                       "which PyBullet refuses; add one or remove the element", part)
     for geom in doc.geometries:
         elements = [c for c in geom if isinstance(c.tag, str)]
-        if elements and elements[0].tag not in SHAPES and any(c.tag in SHAPES for c in elements):
+        shapes = [c for c in elements if c.tag in SHAPES]
+        if shapes and elements[0].tag not in SHAPES:
             r.add("U505", "error", f"<{elements[0].tag}> comes before the shape in <geometry>; "
                   "PyBullet reads the first element as the shape and refuses the file",
                   elements[0])
@@ -374,30 +375,32 @@ def rule_geometry(root: etree._Element, r: Report) -> None:
             if c.tag == "origin":
                 r.add("U504", "warning", "<origin> inside <geometry> is ignored by PyBullet; put "
                       "it in the enclosing <visual> or <collision>", c)
-        shapes = [c for c in geom if isinstance(c.tag, str) and c.tag in SHAPES]
-        owner = geom.getparent()
-        what = f"<{owner.tag}> of {label(owner.getparent())}" if owner is not None \
-            and owner.getparent() is not None else "<geometry>"
-        if not shapes:
-            r.add("U502", "error", f"<geometry> in {what} holds no shape, which PyBullet "
-                  f"refuses; it needs one of {', '.join(SHAPES[:4])}", geom)
-        elif len(shapes) > 1:
+        if len(shapes) != 1:
+            owner = geom.getparent()
+            what = f"<{owner.tag}> of {label(owner.getparent())}" if owner is not None \
+                and owner.getparent() is not None else "<geometry>"
+            if not shapes:
+                r.add("U502", "error", f"<geometry> in {what} holds no shape, which PyBullet "
+                      f"refuses; it needs one of {', '.join(SHAPES[:4])}", geom)
+                continue
             # Measured (PyBullet 3.2.7): the file loads, visual and collision alike built from
             # the first shape; the others are ignored.
             r.add("U507", "warning", f"<geometry> in {what} holds {len(shapes)} shapes "
                   f"({', '.join(f'<{c.tag}>' for c in shapes)}); PyBullet uses the first, "
                   f"<{shapes[0].tag}>, and ignores the rest: keep one", shapes[1])
-        for shape in shapes[:1]:  # PyBullet reads none after the first (measured)
-            for attr in SHAPE_SIZES.get(shape.tag, ()):
-                vals = numbers(shape.get(attr))
-                if shape.get(attr) is None:
-                    r.add("U501", "error", f"<{shape.tag}> has no {attr}; add {attr}=\"...\"",
-                          shape)
-                elif vals and all(math.isfinite(v) for v in vals) and min(vals) <= 0:
-                    r.add("U501", "error", f"<{shape.tag} {attr}={shape.get(attr)!r}>: sizes must "
-                          "be > 0", shape)
-            if shape.tag in ("mesh", "cdf") and not (shape.get("filename") or "").strip():
-                r.add("U503", "error", f"<{shape.tag}> has no filename", shape)
+        shape = shapes[0]  # PyBullet reads none after the first (measured)
+        for attr in SHAPE_SIZES.get(shape.tag, ()):
+            text = shape.get(attr)
+            if text is None:
+                r.add("U501", "error", f"<{shape.tag}> has no {attr}; add {attr}=\"...\"",
+                      shape)
+                continue
+            vals = numbers(text)
+            if vals and all(math.isfinite(v) for v in vals) and min(vals) <= 0:
+                r.add("U501", "error", f"<{shape.tag} {attr}={text!r}>: sizes must be > 0",
+                      shape)
+        if shape.tag in ("mesh", "cdf") and not (shape.get("filename") or "").strip():
+            r.add("U503", "error", f"<{shape.tag}> has no filename", shape)
 
 
 def rule_inertial(root: etree._Element, r: Report) -> None:
