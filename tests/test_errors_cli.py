@@ -14,8 +14,9 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit.cli import app, flag_message
+from urdfkit.cli import app
 from urdfkit.commands import present
+from urdfkit.commands.flags import flag_message
 from urdfkit.core.errors import ParameterError
 from urdfkit.motion.drive import DriveConfig
 

@@ -28,8 +28,8 @@ FOLDERS = [name for names in FLOOR_FOLDERS for name in names]
 #: four only re-export what README and docs/ import from them (tests/test_public_api.py).
 TOP: dict[str, str] = {"builder": "model", "inspect": "engine", "sim": "motion",
                        "gym": "motion", "sweep": "motion", "cli": "commands",
-                       "__main__": "commands", "render": "draw", "diff": "checks",
-                       "collisions": "checks", "resolve": "sources"}
+                       "__main__": "commands", "entry": "commands", "render": "draw",
+                       "diff": "checks", "collisions": "checks", "resolve": "sources"}
 
 
 def _module_names() -> list[str]:

@@ -1,5 +1,5 @@
 """``python -m urdfkit`` runs the command-line tool."""
 
-from urdfkit.cli import main
+from urdfkit.entry import main
 
 main()

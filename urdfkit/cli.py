@@ -16,10 +16,8 @@ Nothing heavy is imported at module level: ``urdfkit --help`` must not pay for P
 numpy, yourdfpy or trimesh.
 """
 
-import gc
 import importlib
 import os
-import signal
 import sys
 from collections.abc import Callable, Iterable, Sequence
 from typing import Annotated, Any
@@ -29,10 +27,9 @@ from typer.core import TyperGroup
 
 from urdfkit import __version__
 from urdfkit.commands import present as show
-from urdfkit.commands.shared import flag_message, input_flags
+from urdfkit.commands.check_run import outcome
+from urdfkit.commands.startup import prepare
 from urdfkit.core.errors import UrdfkitError
-
-DEBUG_ENV = "URDFKIT_DEBUG"
 
 #: Every command, in the order of ``urdfkit --help``, and the module of :mod:`urdfkit.commands`
 #: that holds it. Only the invoked command's module is imported.
@@ -67,12 +64,6 @@ def _usage_message(e: Any) -> str:
     return where + text
 
 
-def _on_signal(signum: int, _frame: Any) -> None:
-    # SIGTERM (a CI timeout, `kill`) and SIGHUP (a closed terminal) stop a run the way
-    # Ctrl-C does: drive and sim keep the rows simulated so far, temp files are removed.
-    raise KeyboardInterrupt(signal.Signals(signum).name)
-
-
 class UrdfkitGroup(TyperGroup):
     """urdfkit's click group: its :meth:`main` is the one error handler of the CLI."""
 
@@ -97,32 +88,20 @@ def run(command: Any, argv: list[str], prog_name: str, extra: dict[str, Any]) ->
         return 0
     except typer.Exit as e:
         return e.exit_code
-    except UrdfkitError as e:
-        # Only errors about a parameter speak of flags; a scenario file's `wheels` stays a key.
-        show.error(flag_message(str(e)) if e.param is not None else input_flags(str(e)))
-        return e.exit_code
-    except (KeyboardInterrupt, typer.Abort):
+    except typer.Abort:
         show.interrupted()
         return 130
-    except BrokenPipeError:
-        # `urdfkit joints big.urdf | head`: the reader went away; that is not an error.
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        return 0
     except Exception as e:  # noqa: BLE001 - the last line of defence: a bug, said so
-        if _click_error(e):
+        if not isinstance(e, (UrdfkitError, OSError)) and _click_error(e):
             context = getattr(e, "ctx", None)
             if context is not None and type(e).__name__ == "NoArgsIsHelpError":
                 sys.stdout.write(context.get_help() + "\n")  # a bare `urdfkit`: the help
             else:
                 show.error(_usage_message(e))
             return 2
-        if os.environ.get(DEBUG_ENV):
-            import traceback
-
-            traceback.print_exc()
-        show.bug(e)
-        return 3
+        return outcome(e)  # an error's one line, a broken pipe, or a bug
+    except KeyboardInterrupt as e:
+        return outcome(e)
 
 
 def _new_app(**settings: Any) -> typer.Typer:
@@ -213,18 +192,12 @@ def __getattr__(name: str) -> Any:
 
 
 def main() -> None:
-    """Entry point of the ``urdfkit`` console script."""
-    # numpy (imported by pybullet) starts an OpenBLAS thread pool whose workers spin on the
-    # second core: ~70 ms of CPU per `urdfkit joints`, for nothing, since no command does large
-    # linear algebra. One thread, unless the user asks otherwise. Set here, not on import, so
-    # library users keep their own setting.
-    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    for sig in (signal.SIGTERM, signal.SIGHUP):
-        signal.signal(sig, _on_signal)
-    # What is loaded by now (typer, click, this module) lives until exit. Freezing it keeps the
-    # cyclic GC from re-scanning it in every full collection that the imports of numpy and
-    # pybullet trigger: ~8 ms of a `urdfkit joints` run. Later garbage is collected as usual.
-    gc.freeze()
+    """The command line through typer.
+
+    :func:`urdfkit.entry.main`, the console script, comes here for all but plain ``check``
+    runs.
+    """
+    prepare()
     argv = sys.argv[1:]
     if argv and argv[0] in COMMANDS:
         # typer builds the click command of every registered command on each run (signature

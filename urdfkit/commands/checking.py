@@ -19,7 +19,6 @@ from urdfkit.commands.shared import (
     PackagePathOpt,
     command,
     examples,
-    input_flags,
     open_input,
 )
 
@@ -72,50 +71,10 @@ def check(
     Exit 0: nothing at or above --fail-on; 1: findings at or above it; 2: unusable
     invocation; 3: a bug in urdfkit. See docs/check.md for every rule code.
     """
-    from urdfkit.checks.check import check_paths, parse_codes
-    from urdfkit.core.errors import ParameterError
-    from urdfkit.sources.uris import parse_packages
+    from urdfkit.commands.check_run import run_check
 
-    if fail_on not in ("error", "warning", "info"):
-        from urdfkit.core.suggest import hint
-
-        raise ParameterError(f"`fail_on` expects error, warning or info, got {fail_on!r}"
-                             f"{hint(fail_on, ('error', 'warning', 'info'))}", param="fail_on")
-    fmt = _check_format(output_format, as_json)
-    result = check_paths(paths, packages=parse_packages(package, package_path),
-                         select=parse_codes(select, "`select`"),
-                         ignore=parse_codes(ignore, "`ignore`"), jobs=jobs, no_exec=no_exec,
-                         xacro_args=_xacro_args(arg), physics=physics, cache=not no_cache)
-    import dataclasses
-
-    for fr in result.files:  # a xacro or package problem speaks of flags, not parameters
-        fr.findings = [dataclasses.replace(f, message=input_flags(f.message))
-                       if "`" in f.message else f for f in fr.findings]
-    show.check_output(result, fmt, fail_on, show_all)
-    raise typer.Exit(result.exit_code(fail_on))
-
-
-def _check_format(output_format: str | None, as_json: bool) -> str:
-    from urdfkit.checks.ci import FORMATS
-    from urdfkit.core.errors import ParameterError
-
-    if output_format is not None and output_format not in FORMATS:
-        from urdfkit.core.suggest import hint
-
-        raise ParameterError(f"`format` expects {', '.join(FORMATS)}, got {output_format!r}"
-                             f"{hint(output_format, FORMATS)}", param="format")
-    if as_json and output_format not in (None, "json"):
-        raise ParameterError(f"`json` means `format` json; it cannot be combined with "
-                             f"`format` {output_format}", param="format")
-    return "json" if as_json else output_format or "text"
-
-
-def _xacro_args(items: list[str] | None) -> dict[str, str]:
-    if not items:
-        return {}
-    from urdfkit.model.catalog import parse_assignments  # imports the builder: only when needed
-
-    return parse_assignments(items, "xacro_args")
+    raise typer.Exit(run_check(paths, as_json, output_format, fail_on, package, package_path,
+                               select, ignore, jobs, arg, no_exec, show_all, physics, no_cache))
 
 
 # ---- diff: two robots compared in meaning (urdfkit/diff.py)

@@ -5,6 +5,7 @@ from typing import Annotated, Any
 import typer
 
 from urdfkit.commands import present as show
+from urdfkit.commands.flags import flag_message, input_flags
 from urdfkit.commands.shared import (
     FROM_LIBRARY,
     AllOpt,
@@ -30,8 +31,6 @@ from urdfkit.commands.shared import (
     ViewOpt,
     command,
     examples,
-    flag_message,
-    input_flags,
     library_defaults,
     parse_speed,
     say_streaming,

@@ -5,13 +5,13 @@ Every command module under :mod:`urdfkit.commands` builds its signature from the
 heavy is imported here: ``urdfkit --help`` imports every command module.
 """
 
-import re
 from collections.abc import Callable
 from typing import Annotated, Any, TypeVar
 
 import typer
 
 from urdfkit.commands import present as show
+from urdfkit.commands.flags import input_flags
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -46,35 +46,6 @@ def library_defaults(func: Callable[..., Any], defaults: dict[str, Any]) -> None
     old = func.__defaults__ or ()
     func.__defaults__ = tuple(defaults.get(n, d) if d is FROM_LIBRARY else d
                               for n, d in zip(names[len(names) - len(old):], old, strict=True))
-
-
-#: Library parameter -> the flag that feeds it, for messages (`time_step` -> --time-step).
-#: A parameter not listed maps to ``--`` plus its name with dashes.
-FLAGS = {
-    "params": "--set", "template_params": "--set", "xacro_args": "--arg",
-    "packages": "--package", "package_paths": "--package-path", "types": "--type",
-    "urdf": "--urdf", "force=True": "--force",
-    "force": "--force", "joints": "--joints", "views": "--views", "guard=False": "--no-guard",
-    "kind": "KIND",
-}
-
-
-def flag_message(message: str) -> str:
-    """A library message with its backquoted parameter names shown as CLI flags."""
-    return re.sub(r"`([A-Za-z_][\w]*(?:=True|=False)?)`",
-                  lambda m: FLAGS.get(m.group(1), "--" + m.group(1).replace("_", "-")),
-                  message)
-
-
-#: Parameters every loading command takes from the same flags: their names are translated in
-#: any message (a xacro or package error deep in a load, a check finding), not only in errors
-#: about a parameter. None of them is ever a scenario key.
-INPUT_PARAMS = ("xacro_args", "packages", "package_paths")
-
-
-def input_flags(message: str) -> str:
-    """A message with the input parameters (``xacro_args``) shown as their flags (``--arg``)."""
-    return re.sub(r"`(" + "|".join(INPUT_PARAMS) + r")`", lambda m: FLAGS[m.group(1)], message)
 
 
 def examples(*lines: str) -> str:
