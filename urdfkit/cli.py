@@ -27,8 +27,7 @@ from typer.core import TyperGroup
 
 from urdfkit import __version__
 from urdfkit.commands import present as show
-from urdfkit.commands.check_run import outcome
-from urdfkit.commands.startup import prepare
+from urdfkit.commands.startup import outcome, prepare
 from urdfkit.core.errors import UrdfkitError
 
 #: Every command, in the order of ``urdfkit --help``, and the module of :mod:`urdfkit.commands`
@@ -92,7 +91,7 @@ def run(command: Any, argv: list[str], prog_name: str, extra: dict[str, Any]) ->
         show.interrupted()
         return 130
     except Exception as e:  # noqa: BLE001 - the last line of defence: a bug, said so
-        if not isinstance(e, (UrdfkitError, OSError)) and _click_error(e):
+        if not isinstance(e, (UrdfkitError, BrokenPipeError)) and _click_error(e):
             context = getattr(e, "ctx", None)
             if context is not None and type(e).__name__ == "NoArgsIsHelpError":
                 sys.stdout.write(context.get_help() + "\n")  # a bare `urdfkit`: the help

@@ -8,19 +8,15 @@ line that is not plain (``--help``, a usage error), goes to :func:`urdfkit.cli.m
 
 import sys
 
-from urdfkit.commands.startup import prepare
-
 
 def main() -> None:
     """Entry point of the ``urdfkit`` console script (and ``python -m urdfkit``)."""
     argv = sys.argv[1:]
     if argv[:1] == ["check"]:
-        from urdfkit.commands.check_run import fast_main, parse_argv
+        from urdfkit.commands.check_run import fast_main
 
-        if parse_argv(argv[1:]) is not None:
-            prepare()
-            code = fast_main(argv[1:])
-            assert code is not None
+        code = fast_main(argv[1:])
+        if code is not None:
             sys.exit(code)
     from urdfkit.cli import main as typer_main
 

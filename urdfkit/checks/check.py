@@ -186,11 +186,12 @@ def _read(path: str, display: str, no_exec: bool = False,
         from urdfkit.sources.expand import expand_xacro
         from urdfkit.sources.uris import not_a_file
 
-        why = not_a_file(Path(path))
+        source = Path(path)
+        why = not_a_file(source)
         if why is not None:  # never hand xacro a FIFO to block on
             raise InputError(f"is {why}, not a regular file; urdfkit reads only regular files"
                              if why != "missing" else "no such file", file=display)
-        return expand_xacro(Path(path), xacro_args, display=display, no_exec=no_exec,
+        return expand_xacro(source, xacro_args, display=display, no_exec=no_exec,
                             packages=packages, strict_args=False)
     return read_bytes(path)
 

@@ -14,16 +14,11 @@ Nothing heavy is imported here, and no typer.
 
 from __future__ import annotations
 
-import os
-import sys
 from typing import Any
 
 from urdfkit.commands import present as show
-from urdfkit.commands.flags import flag_message, input_flags
-from urdfkit.core.errors import UrdfkitError
-
-#: Set (to anything) to print the traceback of a bug.
-DEBUG_ENV = "URDFKIT_DEBUG"
+from urdfkit.commands.flags import input_flags
+from urdfkit.commands.startup import outcome, prepare
 
 #: Flags of ``check`` (no value), by option name: the keyword of :func:`run_check`.
 FLAG_OPTIONS = {"--json": "as_json", "--no-exec": "no_exec", "--all": "show_all",
@@ -142,38 +137,14 @@ def parse_argv(args: list[str]) -> dict[str, Any] | None:
 def fast_main(args: list[str]) -> int | None:
     """Run ``urdfkit check`` with ``args`` without typer; None when typer must parse them.
 
-    Errors take the road of :func:`urdfkit.cli.run`: one line on stderr and the exit code.
+    Set up as every run of the command line is (:func:`~urdfkit.commands.startup.prepare`);
+    errors take the road of :func:`urdfkit.cli.run`: one line on stderr and the exit code.
     """
     options = parse_argv(args)
     if options is None:
         return None
+    prepare()
     try:
         return run_check(**options)
     except BaseException as e:  # noqa: BLE001 - handled as the typer command's are
         return outcome(e)
-
-
-def outcome(e: BaseException) -> int:
-    """The exit code of an exception out of a command, its one line said (see cli.run)."""
-    if isinstance(e, UrdfkitError):
-        # Only errors about a parameter speak of flags; a scenario file's `wheels` stays a key.
-        show.error(flag_message(str(e)) if e.param is not None else input_flags(str(e)))
-        return e.exit_code
-    if isinstance(e, KeyboardInterrupt):
-        show.interrupted()
-        return 130
-    if isinstance(e, BrokenPipeError):
-        # `urdfkit check . | head`: the reader went away; that is not an error.
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        return 0
-    if isinstance(e, SystemExit):
-        raise e
-    if not isinstance(e, Exception):
-        raise e  # GeneratorExit and the like: not ours to turn into a code
-    if os.environ.get(DEBUG_ENV):
-        import traceback
-
-        traceback.print_exception(e)
-    show.bug(e)
-    return 3

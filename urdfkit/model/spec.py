@@ -272,8 +272,6 @@ def vector(text: str | None, n: int) -> tuple[float, ...] | None:
 _VECTORS: dict[tuple[str, int], tuple[float, ...] | None] = {}
 _VECTORS_MAX = 4096
 _NONE: Any = object()
-#: Defaults of :func:`attr_vec` as float tuples, made once each.
-_DEFAULTS: dict[tuple[float, ...], tuple[float, ...]] = {}
 
 
 def attr_vec(el: _HasGet | None, attr: str, n: int,
@@ -282,15 +280,7 @@ def attr_vec(el: _HasGet | None, attr: str, n: int,
     vals = vector(el.get(attr), n) if el is not None else None
     if vals is not None:
         return vals
-    if default is None:
-        return None
-    key = tuple(default)
-    made = _DEFAULTS.get(key)
-    if made is None:
-        made = tuple(float(v) for v in default)
-        if len(_DEFAULTS) < 64:  # the code's own constants; anything else is not kept
-            _DEFAULTS[key] = made
-    return made
+    return None if default is None else tuple(map(float, default))
 
 
 def attr_float(el: _HasGet | None, attr: str, default: float | None = None) -> float | None:
