@@ -133,7 +133,7 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     path = tmp_path / "box.obj"
     path.write_text(box_obj((1.0, 2.0, 3.0)))
     check_box(meshes.properties(path), (1.0, 2.0, 3.0))
-    entries = list((tmp_path / "cache" / "meshes-3").iterdir())
+    entries = list((tmp_path / "cache" / "meshes-4").iterdir())
     assert len(entries) == 1
     # A new process (empty memory) reads the entry, not the mesh.
     monkeypatch.setattr(meshes, "_MEMORY", {})
@@ -151,12 +151,12 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     os.utime(path, ns=(1, 1))
     check_box(meshes.properties(path), (3.0, 2.0, 1.0))
     # A damaged entry is read past and rewritten.
-    for entry in (tmp_path / "cache" / "meshes-3").iterdir():
+    for entry in (tmp_path / "cache" / "meshes-4").iterdir():
         entry.write_bytes(b"garbage")
     monkeypatch.setattr(meshes, "_MEMORY", {})
     check_box(meshes.properties(path), (3.0, 2.0, 1.0))
-    good = [e for e in (tmp_path / "cache" / "meshes-3").iterdir()
-            if e.read_bytes().startswith(b"M3")]
+    good = [e for e in (tmp_path / "cache" / "meshes-4").iterdir()
+            if e.read_bytes().startswith(b"M4")]
     assert len(good) == 1  # the current key's, rewritten (the first box's stays unused)
 
 
@@ -274,7 +274,7 @@ def test_a_run_s_pack_serves_the_next_run_and_follows_edits(
     packs = list((tmp_path / "cache" / "mesh-packs-2").iterdir())
     assert len(packs) == 1
     # The next run reads the pack alone: no entry file, no mesh.
-    for entry in (tmp_path / "cache" / "meshes-3").iterdir():
+    for entry in (tmp_path / "cache" / "meshes-4").iterdir():
         entry.unlink()
     _new_process(monkeypatch)
 
@@ -376,3 +376,40 @@ def test_welding_stl_corners_groups_equal_points_as_numpy_unique_does(
     expected = np.unique(array, axis=0)  # compares floats: -0.0 is 0.0
     assert len(unique) == len(expected)
     assert np.array_equal(unique[index.ravel()], array)  # every corner is its own point
+
+
+def _stl_box(path: Path, size: float, crack: float = 0.0, drop: int | None = None) -> Path:
+    """A binary STL box (float32, as STL stores it): one corner of its first triangle moved by
+    ``crack`` along x (a seam that CAD export left a rounding step open), or triangle
+    ``drop`` left out (a real hole)."""
+    corners = np.array(CORNERS) * size
+    tris = [t for quad in QUADS for t in ((quad[0], quad[1], quad[2]), (quad[0], quad[2], quad[3]))]
+    data = np.array([[corners[i - 1] for i in t] for t in tris], dtype=np.float64)
+    data[0, 0, 0] += crack
+    if drop is not None:
+        data = np.delete(data, drop, axis=0)
+    rows = np.zeros(len(data), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rows["v"] = data.astype(np.float32)
+    path.write_bytes(b"\0" * 80 + np.uint32(len(data)).tobytes() + rows.tobytes())
+    return path
+
+
+def test_a_seam_open_by_a_rounding_step_is_closed(tmp_path: Path) -> None:
+    """fetch_description's laser_link.STL: two corners of one seam a float32 step apart (9.3e-10
+    m on a 7.5 cm part). That is no hole: the box keeps the closed form's volume and inertia."""
+    size = 0.075
+    step = float(np.spacing(np.float32(size)))  # one float32 step at the box's far corner
+    path = _stl_box(tmp_path / "cracked.stl", size, crack=step)
+    raw = np.frombuffer(path.read_bytes()[84:], dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)),
+                                                       ("a", "<u2")])["v"].reshape(-1, 3)
+    assert len(np.unique(raw, axis=0)) == 9  # the crack is really in the file: 9 points, not 8
+    check_box(meshes.properties(path), (size, size, size))
+
+
+@pytest.mark.parametrize("how", ["wide crack", "missing triangle"])
+def test_a_real_gap_stays_open(tmp_path: Path, how: str) -> None:
+    size = 0.075
+    path = _stl_box(tmp_path / "open.stl", size, crack=size * 1e-3) if how == "wide crack" \
+        else _stl_box(tmp_path / "open.stl", size, drop=3)
+    props = meshes.properties(path)
+    assert props is not None and not props.closed

@@ -164,8 +164,8 @@ def _cache_dir() -> Path | None:
 _CACHE_DIRS: dict[tuple[str | None, ...], Path | None] = {}
 
 #: Cache entries start with this; a new layout is a new prefix and a new folder.
-_ENTRY = b"M3"
-_FOLDER = "meshes-3"
+_ENTRY = b"M4"
+_FOLDER = "meshes-4"
 _MEMORY: dict[str, Integrals | None] = {}
 _MISSING = object()
 
@@ -670,6 +670,58 @@ def _concavity(vertices: Any, faces: Any, starts: list[int], det: Any) -> float:
     return worst
 
 
+#: Vertices closer than this fraction of a mesh's size are one point for the closed test: STL
+#: stores float32 (7 digits), and CAD exports leave the two sides of a seam a rounding step
+#: apart (fetch_description's laser_link.STL: two corners 9.3e-10 m apart on a 7.5 cm part).
+CRACK_FRACTION = 1e-6
+#: Open-edge vertices beyond this many are not compared pairwise (a mesh with real holes).
+_CRACK_VERTICES = 2000
+
+
+def _closed(faces: Any) -> bool:
+    """Every undirected edge in exactly two triangles.
+
+    Sorted corners give each edge one int64 key; sorted keys must then come in equal pairs,
+    each pair unlike the next.
+    """
+    import numpy as np
+
+    e = np.sort(faces, axis=1).astype(np.int64)
+    n = int(e[:, 2].max()) + 1
+    keys = np.sort(np.concatenate([e[:, 0] * n + e[:, 1], e[:, 1] * n + e[:, 2],
+                                   e[:, 0] * n + e[:, 2]]))
+    return bool(len(keys) % 2 == 0 and (keys[0::2] == keys[1::2]).all()
+                and (keys[2::2] != keys[1:-1:2]).all())
+
+
+def _weld_cracks(vertices: Any, faces: Any, tolerance: float) -> Any:
+    """``faces`` with the vertices of open edges that lie within ``tolerance`` made one.
+
+    Only vertices on edges not shared by exactly two triangles are compared (pairwise: a
+    cracked seam has few); triangles that the merge collapses are dropped. None when there
+    are too many such vertices, or none within reach of another.
+    """
+    import numpy as np
+
+    e = np.sort(faces, axis=1).astype(np.int64)
+    edges = np.concatenate([e[:, [0, 1]], e[:, [1, 2]], e[:, [0, 2]]])
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    loose = np.unique(unique[counts != 2])
+    if len(loose) < 2 or len(loose) > _CRACK_VERTICES or not tolerance > 0:
+        return None
+    p = vertices[loose]
+    near = np.sqrt(((p[:, None, :] - p[None, :, :]) ** 2).sum(axis=2)) <= tolerance
+    first = near.argmax(axis=1)  # the lowest-numbered vertex within reach (itself at worst)
+    if (first == np.arange(len(loose))).all():
+        return None
+    mapping = np.arange(len(vertices))
+    mapping[loose] = loose[first]
+    welded = mapping[faces]
+    keep = (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & \
+        (welded[:, 0] != welded[:, 2])
+    return welded[keep] if keep.any() else None
+
+
 def _solid(vertices: Any, faces: Any, starts: list[int] | None = None, *,
            concavity: bool = True) -> Integrals:
     import numpy as np
@@ -682,18 +734,14 @@ def _solid(vertices: Any, faces: Any, starts: list[int] | None = None, *,
     q = p.transpose(2, 0, 1).reshape(3, -1)
     second = ((q * np.tile(det, 3)) @ q.T + (s.T * det) @ s) / 120.0
     first = s.T @ det / 24.0
-    # Closed: every undirected edge in exactly two triangles. Sorted corners give each edge
-    # one int64 key; sorted keys must then come in equal pairs, each pair unlike the next.
-    e = np.sort(faces, axis=1).astype(np.int64)
-    n = int(e[:, 2].max()) + 1
-    keys = np.sort(np.concatenate([e[:, 0] * n + e[:, 1], e[:, 1] * n + e[:, 2],
-                                   e[:, 0] * n + e[:, 2]]))
-    closed = bool(len(keys) % 2 == 0 and (keys[0::2] == keys[1::2]).all()
-                  and (keys[2::2] != keys[1:-1:2]).all())
     used = np.zeros(len(vertices), dtype=bool)
     used[faces.ravel()] = True
     corners = vertices[used]
     low, high = corners.min(axis=0), corners.max(axis=0)
+    closed = _closed(faces)
+    if not closed:  # a crack narrower than the file's own rounding is no hole
+        welded = _weld_cracks(vertices, faces, CRACK_FRACTION * float((high - low).max()))
+        closed = welded is not None and _closed(welded)
     starts = starts or []
     return Integrals(float(det.sum()) / 6.0, (float(first[0]), float(first[1]), float(first[2])),
                      (float(second[0, 0]), float(second[1, 1]), float(second[2, 2]),
