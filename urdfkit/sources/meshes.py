@@ -674,8 +674,8 @@ def _concavity(vertices: Any, faces: Any, starts: list[int], det: Any) -> float:
 #: stores float32 (7 digits), and CAD exports leave the two sides of a seam a rounding step
 #: apart (fetch_description's laser_link.STL: two corners 9.3e-10 m apart on a 7.5 cm part).
 CRACK_FRACTION = 1e-6
-#: Open-edge vertices beyond this many are not compared pairwise (a mesh with real holes).
-_CRACK_VERTICES = 2000
+#: Open-edge vertices beyond this many are not compared (a mesh with real holes, not a seam).
+_CRACK_VERTICES = 20000
 
 
 def _closed(faces: Any) -> bool:
@@ -697,8 +697,8 @@ def _closed(faces: Any) -> bool:
 def _weld_cracks(vertices: Any, faces: Any, tolerance: float) -> Any:
     """``faces`` with the vertices of open edges that lie within ``tolerance`` made one.
 
-    Only vertices on edges not shared by exactly two triangles are compared (pairwise: a
-    cracked seam has few); triangles that the merge collapses are dropped. None when there
+    Only vertices on edges not shared by exactly two triangles are compared; triangles that
+    the merge collapses are dropped. None when there
     are too many such vertices, or none within reach of another.
     """
     import numpy as np
@@ -710,12 +710,22 @@ def _weld_cracks(vertices: Any, faces: Any, tolerance: float) -> Any:
     if len(loose) < 2 or len(loose) > _CRACK_VERTICES or not tolerance > 0:
         return None
     p = vertices[loose]
-    near = np.sqrt(((p[:, None, :] - p[None, :, :]) ** 2).sum(axis=2)) <= tolerance
-    first = near.argmax(axis=1)  # the lowest-numbered vertex within reach (itself at worst)
-    if (first == np.arange(len(loose))).all():
+    # Pairs within reach, found along x: sorted by x, a vertex's partner is among the next few
+    # (those less than ``tolerance`` further along x); each offset is one vectorised step.
+    order = np.argsort(p[:, 0], kind="stable")
+    q = p[order]
+    target = np.arange(len(q))  # each sorted vertex's partner, the first one within reach
+    for k in range(1, len(q)):
+        ahead = q[k:, 0] - q[:-k, 0] <= tolerance
+        if not ahead.any():
+            break
+        close = ahead & (((q[k:] - q[:-k]) ** 2).sum(axis=1) <= tolerance * tolerance)
+        later = np.nonzero(close)[0] + k
+        target[later] = np.minimum(target[later], target[later - k])
+    if (target == np.arange(len(q))).all():
         return None
     mapping = np.arange(len(vertices))
-    mapping[loose] = loose[first]
+    mapping[loose[order]] = loose[order[target]]
     welded = mapping[faces]
     keep = (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & \
         (welded[:, 0] != welded[:, 2])
