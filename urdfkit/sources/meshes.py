@@ -676,6 +676,8 @@ def _concavity(vertices: Any, faces: Any, starts: list[int], det: Any) -> float:
 CRACK_FRACTION = 1e-6
 #: Open-edge vertices beyond this many are not compared (a mesh with real holes, not a seam).
 _CRACK_VERTICES = 20000
+#: How far along the sorted open-edge vertices a partner is looked for.
+_CRACK_AHEAD = 16
 
 
 def _closed(faces: Any) -> bool:
@@ -704,18 +706,21 @@ def _weld_cracks(vertices: Any, faces: Any, tolerance: float) -> Any:
     import numpy as np
 
     e = np.sort(faces, axis=1).astype(np.int64)
-    edges = np.concatenate([e[:, [0, 1]], e[:, [1, 2]], e[:, [0, 2]]])
-    unique, counts = np.unique(edges, axis=0, return_counts=True)
-    loose = np.unique(unique[counts != 2])
+    n = int(e[:, 2].max()) + 1
+    keys, counts = np.unique(np.concatenate([e[:, 0] * n + e[:, 1], e[:, 1] * n + e[:, 2],
+                                             e[:, 0] * n + e[:, 2]]), return_counts=True)
+    open_edges = keys[counts != 2]
+    loose = np.unique(np.concatenate([open_edges // n, open_edges % n]))
     if len(loose) < 2 or len(loose) > _CRACK_VERTICES or not tolerance > 0:
         return None
     p = vertices[loose]
-    # Pairs within reach, found along x: sorted by x, a vertex's partner is among the next few
-    # (those less than ``tolerance`` further along x); each offset is one vectorised step.
-    order = np.argsort(p[:, 0], kind="stable")
+    # Pairs within reach, found in (x, y, z) order: a vertex's partner is among the next few
+    # (less than ``tolerance`` further along x); each offset is one vectorised step, and at
+    # most _CRACK_AHEAD of them are looked at (a pair further apart in that order stays open).
+    order = np.lexsort((p[:, 2], p[:, 1], p[:, 0]))
     q = p[order]
     target = np.arange(len(q))  # each sorted vertex's partner, the first one within reach
-    for k in range(1, len(q)):
+    for k in range(1, min(len(q), _CRACK_AHEAD + 1)):
         ahead = q[k:, 0] - q[:-k, 0] <= tolerance
         if not ahead.any():
             break
