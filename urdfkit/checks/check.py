@@ -92,9 +92,8 @@ class CheckResult:
 
     def to_dict(self) -> dict[str, object]:
         """The ``--json`` form."""
-        # A finding's fields are its dict (Finding.to_dict's keys, in its order), read-only here.
         return {"files": [fr.file for fr in self.files],
-                "findings": [vars(f) for f in self.findings],
+                "findings": [f.to_dict() for f in self.findings],
                 "summary": self.summary()}
 
 

@@ -14,7 +14,6 @@ import os
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from lxml import etree
@@ -307,6 +306,10 @@ class Solid:
     tensor: tuple[tuple[float, float, float], ...]
     size: float
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        # For pickle: mypyc's compiled frozen dataclasses cannot be unpickled field by field.
+        return (Solid, (self.volume, self.com, self.tensor, self.size))
+
     def inertia(self, mass: float) -> tuple[tuple[float, float, float], ...]:
         """The inertia tensor about ``com`` for a total ``mass``."""
         k = mass / self.volume
@@ -420,9 +423,9 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
         return None
     ref = r.reference("mesh", fn)
     scale = _vec(shape, "scale", 3, (1.0, 1.0, 1.0))
-    if ref.load_path is None or scale is None:
+    if ref.load is None or scale is None:
         return None
-    props = _properties(r, ref.load_path, scale, concavity, ref.stat)
+    props = _properties(r, ref.load, scale, concavity, ref.stat)
     if props is None:
         return None
     if not props.closed:
@@ -444,7 +447,7 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
             matmul(matmul(rot, own), transpose(rot)), max(props.extent))
 
 
-def _properties(r: Report, path: Path, scale: Sequence[float], concavity: bool = False,
+def _properties(r: Report, path: str, scale: Sequence[float], concavity: bool = False,
                 st: os.stat_result | None = None) -> MeshProperties | None:
     """:func:`urdfkit.sources.meshes.properties`, once per mesh and scale per file.
 
@@ -518,10 +521,10 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
             mesh = used_shape(first(part, "geometry"))
             fn = (mesh.get("filename") or "").strip() if mesh is not None and \
                 mesh.tag == "mesh" else ""
-            if not fn or (ref := r.reference("mesh", fn)).load_path is None:
+            if not fn or (ref := r.reference("mesh", fn)).load is None:
                 continue
             scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
-            props = _properties(r, ref.load_path, scale, concave_matters, ref.stat) \
+            props = _properties(r, ref.load, scale, concave_matters, ref.stat) \
                 if scale else None
             if props is None:
                 continue

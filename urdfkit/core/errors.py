@@ -48,6 +48,16 @@ class XacroNotExpanded(InputError):
     """xacro was not expanded because executing it is disabled (``--no-exec``)."""
 
 
+class Oversized(InputError):
+    """A body over MAX_LOADABLE_LINKS links, refused before parsing (finding U209).
+
+    Here, not beside the guard that raises it: a class attribute of a class that mypyc
+    compiles (setup.py) on a plain-Python base is not seen by ``getattr``.
+    """
+
+    code = "U209"
+
+
 class ModelError(UrdfkitError, ValueError):
     """A value given to the builder model is invalid (raised where it is set)."""
 

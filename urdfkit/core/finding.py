@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 #: Finding levels, lowest first.
 LEVELS = ("info", "warning", "error")
@@ -27,6 +28,12 @@ class Finding:
     file: str
     line: int | None = None
     origin: str | None = None
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # For pickle (check's worker processes hand findings back): a frozen dataclass
+        # compiled by mypyc (setup.py) cannot be unpickled field by field.
+        return (Finding, (self.code, self.level, self.message, self.file, self.line,
+                          self.origin))
 
     def to_dict(self) -> dict[str, object]:
         """The JSON form."""

@@ -170,7 +170,6 @@ class Doc:
                 elif ctag == "deformable":
                     self.deformables += 1
             self._walk(root, tag, tag[0] != "{" and tag not in OPAQUE, 1)
-        del self._buckets
 
     def _walk(self, el: El, tag: str, checked: bool, depth: int) -> None:
         """Visit ``el``'s subtree once: collect, and check elements when ``checked``.

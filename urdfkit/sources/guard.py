@@ -21,7 +21,7 @@ from typing import Any
 from lxml import etree
 
 from urdfkit.core import deps
-from urdfkit.core.errors import InputError
+from urdfkit.core.errors import InputError, Oversized
 from urdfkit.core.finding import Finding
 from urdfkit.model.index import Doc, first
 from urdfkit.model.spec import (
@@ -425,19 +425,38 @@ def rule_inertial(root: etree._Element, r: Report) -> None:
 class Reference:
     """What a ``filename`` attribute points at, and what is wrong with it, if anything.
 
+    Paths are kept as strings (check resolves one per mesh of every file; a Path costs ~4 us
+    to make) and given as Paths by :attr:`path` and :attr:`load_path`.
+
     Attributes:
-        path: The file it means (for loading: ``load_path`` is what PyBullet must be given).
+        file: The file it means, or None (an unknown package).
+        load: What PyBullet must be given, or None when it cannot be loaded.
         code, level, message: The finding, or ``code`` None when the file is fine.
     """
 
-    path: Path | None
-    load_path: Path | None
+    file: str | None
+    load: str | None
     code: str | None = None
     level: str = "error"
     message: str = ""
-    #: ``os.stat`` of ``load_path`` when it was taken on the way (the common case), for the
-    #: mesh rules not to ask again.
+    #: ``os.stat`` of ``load`` when it was taken on the way (the common case), for the mesh
+    #: rules not to ask again.
     stat: os.stat_result | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def path(self) -> Path | None:
+        """The file it means."""
+        return None if self.file is None else Path(self.file)
+
+    @property
+    def load_path(self) -> Path | None:
+        """What PyBullet must be given."""
+        return None if self.load is None else Path(self.load)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # For pickle: mypyc's compiled frozen dataclasses cannot be unpickled field by field.
+        return (Reference, (self.file, self.load, self.code, self.level, self.message,
+                            self.stat))
 
 
 def reference(tag: str, fn: str, base: Path, packages: Mapping[str, Path] | None) -> Reference:
@@ -451,15 +470,16 @@ def reference(tag: str, fn: str, base: Path, packages: Mapping[str, Path] | None
     if ":" not in fn and not fn.startswith("/"):
         # The common case, a plain relative path to a regular file: one stat answers what
         # resolve_uri and not_a_file would ask (the same path, the same notes to deps).
-        path = base / fn
-        deps.note(path)
+        name = os.path.join(os.fspath(base), fn)
+        deps.note(name)
         try:
-            st: os.stat_result | None = os.stat(path)
+            st: os.stat_result | None = os.stat(name)
         except (OSError, ValueError):
             st = None
+        # A regular file's name is its last part, so fn's suffix is the path's.
         if st is not None and stat.S_ISREG(st.st_mode) and (
-                tag != "mesh" or path.suffix.lower() in MESH_FORMATS):
-            return Reference(path, path, stat=st)
+                tag != "mesh" or os.path.splitext(fn)[1].lower() in MESH_FORMATS):
+            return Reference(name, name, stat=st)
     label = f"<{tag} filename={fn!r}>"
     target = resolve_uri(fn, base, packages)
     if target.path is None:
@@ -469,18 +489,18 @@ def reference(tag: str, fn: str, base: Path, packages: Mapping[str, Path] | None
     if why == "missing":
         data = pybullet_data_path()
         if target.package is None and data is not None and not_a_file(data / fn) is None:
-            return Reference(path, data / fn, "U703", "warning", f"{label}: not beside the "
-                             "file, found only in pybullet_data's search path; make the path "
-                             "relative to the file")
-        return Reference(path, None, "U701", "error", f"{label}: file not found ({path}); "
+            return Reference(str(path), str(data / fn), "U703", "warning", f"{label}: not "
+                             "beside the file, found only in pybullet_data's search path; make "
+                             "the path relative to the file")
+        return Reference(str(path), None, "U701", "error", f"{label}: file not found ({path}); "
                          "PyBullet refuses a URDF whose mesh is missing")
     if why is not None:
-        return Reference(path, None, "U704", "error", f"{label}: {path} is {why}; PyBullet "
-                         "hangs, aborts or fails on it")
+        return Reference(str(path), None, "U704", "error", f"{label}: {path} is {why}; "
+                         "PyBullet hangs, aborts or fails on it")
     if tag == "mesh" and path.suffix.lower() not in MESH_FORMATS:
-        return Reference(path, None, "U705", "error", f"{label}: PyBullet reads "
+        return Reference(str(path), None, "U705", "error", f"{label}: PyBullet reads "
                          f"{', '.join(MESH_FORMATS)} meshes, not {path.suffix or 'this file'}")
-    return Reference(path, path)
+    return Reference(str(path), str(path))
 
 
 def _too_many_links(n: int) -> str:
@@ -498,12 +518,6 @@ def rule_link_limit(root: etree._Element, r: Report) -> None:
 
 
 _LINK_TAG = re.compile(rb"<link[\s/>]")
-
-
-class Oversized(InputError):
-    """A body over MAX_LOADABLE_LINKS links, refused before parsing (finding U209)."""
-
-    code = "U209"
 
 
 def refuse_oversized(data: bytes, file: str) -> None:

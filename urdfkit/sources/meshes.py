@@ -170,7 +170,8 @@ _MEMORY: dict[str, Integrals | None] = {}
 _MISSING = object()
 
 
-def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *,
+def properties(path: str | os.PathLike[str],
+               scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *,
                concavity: bool = False,
                stat: os.stat_result | None = None) -> MeshProperties | None:
     """Mass properties of an STL or OBJ mesh, or None if unreadable, unsupported or empty.
@@ -193,7 +194,10 @@ def properties(path: Path, scale: tuple[float, float, float] = (1.0, 1.0, 1.0), 
             return None
     if st.st_size > MAX_MESH_BYTES:
         return None
-    key = f"{os.path.abspath(name)}\0{st.st_size}\0{st.st_mtime_ns}\0{st.st_ino}"
+    # An absolute name is its own key (normalizing it would cost more than the rare second
+    # entry a spelling like "a/../m.stl" makes).
+    where = name if os.path.isabs(name) else os.path.abspath(name)
+    key = f"{where}\0{st.st_size}\0{st.st_mtime_ns}\0{st.st_ino}"
     found = _MEMORY.get(key, _MISSING)
     if found is _MISSING or (concavity and isinstance(found, Integrals)
                              and math.isnan(found.concavity)):
