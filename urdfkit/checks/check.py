@@ -136,8 +136,8 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, str, str | None]]:
     out: list[tuple[str, str, str | None]] = []
     seen: set[str] = set()
 
-    def add(display: str, path: str, problem: str | None = None) -> None:
-        key = os.path.abspath(path)
+    def add(display: str, path: str, problem: str | None = None, key: str | None = None) -> None:
+        key = os.path.abspath(path) if key is None else key
         if key not in seen:
             seen.add(key)
             out.append((display, path, problem))
@@ -147,7 +147,11 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, str, str | None]]:
         if not os.path.lexists(path):
             raise ParameterError(f"{item}: no such file or folder")
         if path.is_dir() and path.suffix not in SUFFIXES:
-            stack = [str(path)]
+            # An entry's abspath is the walk's, then its own part of the path (no "." or ".."
+            # in an entry's name, no trailing "/" on a Path's): one abspath per walk.
+            top = str(path)
+            top_key = os.path.abspath(top)
+            stack = [top]
             while stack:
                 folder = stack.pop()
                 try:
@@ -163,7 +167,7 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, str, str | None]]:
                     except OSError:
                         is_dir = False
                     if entry.name.endswith(SUFFIXES):
-                        add(entry.path, entry.path)
+                        add(entry.path, entry.path, key=top_key + entry.path[len(top):])
                     elif is_dir:
                         subdirs.append(entry.path)
                 stack.extend(reversed(subdirs))
@@ -243,7 +247,9 @@ def check_file(display: str, path: str | Path,
         findings.append(Finding("U007", "info", "a xacro macro library (no links of its "
                                 "own): checked through the files that include it", display))
         return result
-    found = run_rules(root, display, ALL_RULES, base=Path(name).absolute().parent,
+    # Path(name).absolute().parent, as a string (no Path: ~3 us a file).
+    folder = os.path.dirname(name if os.path.isabs(name) else os.path.join(os.getcwd(), name))
+    found = run_rules(root, display, ALL_RULES, base=folder,
                       packages=packages, origins=getattr(data, "origins", None))
     if xacro_file:
         # Lines of xacro's output are not lines of the file the user wrote: none, not a false

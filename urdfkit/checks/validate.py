@@ -419,7 +419,7 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
     ``rot``: the collision's rotation, None for none.
     """
     fn = (shape.get("filename") or "").strip()
-    if r is None or r.base is None or not fn:
+    if r is None or r.folder is None or not fn:
         return None
     ref = r.reference("mesh", fn)
     scale = _vec(shape, "scale", 3, (1.0, 1.0, 1.0))
@@ -479,7 +479,7 @@ def _moving(r: Report, el: etree._Element) -> set[str]:
 
 def rule_meshes(root: etree._Element, r: Report) -> None:
     """U701-U705: mesh and texture files exist, are files, in formats PyBullet reads."""
-    if r.base is None:
+    if r.folder is None:
         return
     for el in r.doc(root).files:
         fn = (el.get("filename") or "").strip()
@@ -503,7 +503,7 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
     collision mesh on a moving link touches where it has a dip; the root's rigid group is not
     judged (a static or bolted base may use ``<collision concave="yes">`` instead).
     """
-    if r.base is None:
+    if r.folder is None:
         return
     from urdfkit.sources.meshes import CONCAVE_FRACTION
 

@@ -3,9 +3,8 @@
 The standard library formats indented JSON in pure Python: for ``check --json`` over
 pybullet_data (2,940 findings) that is 11 ms of a 125 ms warm re-run. Here each run of simple
 values, and each list of flat rows, is written by one call to the C encoder, the indentation
-carried by its separators (8 ms). JSON strings cannot hold a raw control character (the
-encoder escapes them), so a NUL or SOH byte in the encoded text can only be a separator or
-marker put there.
+carried by its separators. JSON strings cannot hold a raw control character (the encoder
+escapes them), so a newline in the encoded text can only be a separator put there.
 """
 
 from __future__ import annotations
@@ -40,10 +39,11 @@ def _write(value: Any, depth: int, out: list[str]) -> None:
         text = json.dumps(value, separators=("," + inner, ": "), allow_nan=False)
         out.append(text[0] + inner + text[1:-1] + pad + text[-1])
     elif (type(value) is list or type(value) is tuple) and _records(value):
-        text = json.dumps(value, separators=(",\x00", ": "), allow_nan=False)[2:-2]
+        # Every separator written as within a row; a row's end is then the one place a
+        # separator follows "}" (a row's values are scalars, and no string holds a newline).
         deeper = inner + "  "
-        text = text.replace("},\x00{", "\x01").replace(",\x00", "," + deeper)
-        text = text.replace("\x01", inner + "}," + inner + "{" + deeper)
+        text = json.dumps(value, separators=("," + deeper, ": "), allow_nan=False)[2:-2]
+        text = text.replace("}," + deeper + "{", inner + "}," + inner + "{" + deeper)
         out.append("[" + inner + "{" + deeper + text + inner + "}" + pad + "]")
     elif type(value) is dict and all(type(k) is str for k in value):
         out.append("{")

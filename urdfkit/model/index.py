@@ -219,7 +219,18 @@ class Doc:
         items = el.items()
         if not items:
             return
-        key = (tag, *items)
+        # The verdict depends on the attributes' names and on the values of the numeric
+        # ones only: names and file names (unique to each file) stay out of the key, or
+        # every link and mesh would miss. Decodable: the tag fixes which names hold values.
+        numeric = NUMERIC_BY_TAG.get(tag)
+        if numeric is None and tag not in SCHEMA:
+            return  # an element no rule knows: nothing to say of its attributes
+        parts: list[str] = [tag]
+        for attr, text in items:
+            parts.append(attr)
+            if numeric is not None and attr in numeric:
+                parts.append(text)
+        key = tuple(parts)
         found = _VERDICTS.get(key)
         if found is None:
             found = _verdict(tag, items)
@@ -232,7 +243,7 @@ class Doc:
 
 #: The element rules' verdict on a tag with its attributes, for the whole process: real files
 #: repeat ``<origin rpy="0 0 0" xyz="0 0 0"/>`` thousands of times. Emptied past _VERDICTS_MAX.
-_VERDICTS: dict[tuple[Any, ...], tuple[tuple[str, str, str], ...]] = {}
+_VERDICTS: dict[tuple[str, ...], tuple[tuple[str, str, str], ...]] = {}
 _VERDICTS_MAX = 65536
 
 

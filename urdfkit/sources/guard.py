@@ -48,15 +48,16 @@ class Report:
 
     Attributes:
         file: The file, as the user named it.
-        base: The folder relative mesh paths start from; None skips the file-system rules.
+        folder: The folder relative mesh paths start from (:attr:`base` as a Path); None
+            skips the file-system rules.
         packages: ``--package NAME=PATH`` mappings for ``package://`` URIs.
     """
 
-    def __init__(self, file: str, base: Path | None = None,
+    def __init__(self, file: str, base: Path | str | None = None,
                  packages: Mapping[str, Path] | None = None,
                  origins: Mapping[etree._Element, str] | None = None):
         self.file = file
-        self.base = base
+        self.folder = None if base is None else os.fspath(base)
         self.packages = dict(packages or {})
         self.origins = origins
         self.findings: list[Finding] = []
@@ -68,6 +69,11 @@ class Report:
         #: Results rules share within this file (a mesh's properties at a scale).
         self.memo: dict[object, Any] = {}
 
+    @property
+    def base(self) -> Path | None:
+        """The folder relative mesh paths start from, or None."""
+        return None if self.folder is None else Path(self.folder)
+
     def doc(self, root: etree._Element) -> Doc:
         """The one walk over ``root`` every rule reads (:class:`~urdfkit.model.index.Doc`)."""
         doc = self._doc
@@ -77,11 +83,11 @@ class Report:
 
     def reference(self, tag: str, fn: str) -> Reference:
         """:func:`reference` from this file's folder, judged once per file (several rules ask)."""
-        assert self.base is not None
+        assert self.folder is not None
         key = (tag, fn)
         ref = self._references.get(key)
         if ref is None:
-            ref = self._references[key] = reference(tag, fn, self.base, self.packages)
+            ref = self._references[key] = reference(tag, fn, self.folder, self.packages)
         return ref
 
     def add(self, code: str, level: str, message: str, el: etree._Element | None = None,
@@ -459,7 +465,8 @@ class Reference:
                             self.stat))
 
 
-def reference(tag: str, fn: str, base: Path, packages: Mapping[str, Path] | None) -> Reference:
+def reference(tag: str, fn: str, base: Path | str,
+              packages: Mapping[str, Path] | None) -> Reference:
     """Resolve and judge one file reference: the one rule check and the loaders share.
 
     U702 unknown package, U704 not a regular file (folder, FIFO, device, unreadable), U701
@@ -470,7 +477,7 @@ def reference(tag: str, fn: str, base: Path, packages: Mapping[str, Path] | None
     if ":" not in fn and not fn.startswith("/"):
         # The common case, a plain relative path to a regular file: one stat answers what
         # resolve_uri and not_a_file would ask (the same path, the same notes to deps).
-        name = os.path.join(os.fspath(base), fn)
+        name = os.path.join(base if isinstance(base, str) else os.fspath(base), fn)
         deps.note(name)
         try:
             st: os.stat_result | None = os.stat(name)
@@ -481,6 +488,7 @@ def reference(tag: str, fn: str, base: Path, packages: Mapping[str, Path] | None
                 tag != "mesh" or os.path.splitext(fn)[1].lower() in MESH_FORMATS):
             return Reference(name, name, stat=st)
     label = f"<{tag} filename={fn!r}>"
+    base = Path(base)
     target = resolve_uri(fn, base, packages)
     if target.path is None:
         return Reference(None, None, "U702", "error", f"{label}: {target.problem}")
@@ -579,7 +587,7 @@ GUARD_CODES = frozenset({"U001", "U002", "U003", "U005", "U101", "U102", "U103",
 
 
 def run_rules(root: etree._Element, file: str, rules: tuple[Rule, ...], *,
-              base: Path | None = None,
+              base: Path | str | None = None,
               packages: Mapping[str, Path] | None = None,
               origins: Sequence[str | None] | None = None) -> list[Finding]:
     """Run ``rules`` over a document root and return the findings.
