@@ -12,7 +12,8 @@ They stay plain Python, with the same behaviour, when:
 - mypyc is not there (a build without isolation and without mypy), or the C compiler fails
   (no ``cc``, no Python headers): the build says so on stderr and ships the sources.
 
-``python -m urdfkit.core.compiled`` says which kind an install is.
+A compiled module's ``__file__`` ends in ``.so``; ``bench/run.py`` prints which kind it
+measures, and tests/test_build.py fails in CI if the install is not the kind CI asked for.
 """
 
 from __future__ import annotations
