@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 #: Finding levels, lowest first.
 LEVELS = ("info", "warning", "error")
@@ -29,7 +28,7 @@ class Finding:
     line: int | None = None
     origin: str | None = None
 
-    def __reduce__(self) -> tuple[Any, ...]:
+    def __reduce__(self) -> tuple[object, ...]:
         # For pickle (check's worker processes hand findings back): a frozen dataclass
         # compiled by mypyc (setup.py) cannot be unpickled field by field.
         return (Finding, (self.code, self.level, self.message, self.file, self.line,
