@@ -3,6 +3,7 @@
 Everything else is in pyproject.toml. The modules in :data:`COMPILED` are the ones every file
 ``check`` reads goes through (the one walk, the rules, the findings): compiled, a
 ``check --no-cache`` run over pybullet_data takes ~25% less time (bench/README.md, issue 30).
+Beside them, ``urdfkit/model/_walk.c`` does the one walk itself over libxml2's nodes.
 
 They stay plain Python, with the same behaviour, when:
 
@@ -65,6 +66,25 @@ class OptionalBuildExt(build_ext):
                              "installing plain Python (check is ~25% slower)\n")
 
 
+def _walk_extension() -> list:
+    """``urdfkit.model._walk``: the one walk of check in C, over lxml's public C API.
+
+    Built against the lxml of the build environment (pyproject.toml's build requirements);
+    at run time it refuses to load under another major version of lxml, and index.py then
+    walks in Python.
+    """
+    try:
+        import lxml
+    except ImportError:
+        sys.stderr.write("urdfkit: lxml is not in the build environment; the walk stays "
+                         "in Python\n")
+        return []
+    from setuptools import Extension
+
+    return [Extension("urdfkit.model._walk", ["urdfkit/model/_walk.c"],
+                      include_dirs=lxml.get_include(), extra_compile_args=["-O2"])]
+
+
 def _ext_modules() -> list:
     why = _why_pure()
     if why is not None:
@@ -73,11 +93,12 @@ def _ext_modules() -> list:
     from mypyc.build import mypycify
 
     try:
-        return mypycify(COMPILED, opt_level="3", debug_level="0")
+        compiled = mypycify(COMPILED, opt_level="3", debug_level="0")
     except BaseException as e:  # noqa: BLE001 - mypyc's own failure (a type error) exits
         sys.stderr.write(f"urdfkit: mypyc could not compile the check path ({e!r}); "
                          "installing plain Python\n")
         return []
+    return [*compiled, *_walk_extension()]
 
 
 setup(ext_modules=_ext_modules(), cmdclass={"build_ext": OptionalBuildExt})

@@ -1,4 +1,5 @@
-"""The build: check's hot path compiled by mypyc (setup.py), and what compiling must not break.
+"""The build: check's hot path compiled by mypyc and its walk in C (setup.py), and what
+compiling must not break.
 
 CI runs the suite twice: against a regular install (compiled, URDFKIT_CI=1) and, in its second
 environment, against a plain-Python one (URDFKIT_PURE=1). Each asserts it got what it asked for,
@@ -45,12 +46,16 @@ def test_the_compiled_list_names_real_modules() -> None:
 
 @pytest.mark.skipif(not os.environ.get("URDFKIT_CI"), reason="what CI installed")
 def test_ci_tests_the_build_it_asked_for() -> None:
+    from urdfkit.model import index
+
     modules = _compiled_modules()
     if os.environ.get("URDFKIT_PURE"):
         assert not any(_is_extension(m) for m in modules)
+        assert not index.NATIVE_WALK
     else:
         assert all(_is_extension(m) for m in modules), \
             [m for m in modules if not _is_extension(m)]
+        assert index.NATIVE_WALK  # the walk in C (urdfkit/model/_walk.c) was built and loads
 
 
 def test_frozen_records_pickle() -> None:

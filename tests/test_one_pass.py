@@ -65,8 +65,8 @@ def oracle_findings(root: etree._Element) -> list[tuple[str, str, etree._Element
     return out
 
 
-def assert_same_as_lxml(root: etree._Element) -> None:
-    doc = Doc(root)
+def assert_same_as_lxml(root: etree._Element, native: bool = True) -> None:
+    doc = Doc(root, native=native)
     assert [v.el for v in doc.links] == list(root.iterchildren("link"))
     assert [v.el for v in doc.joints] == list(root.iterchildren("joint"))
     assert doc.materials == list(root.iterchildren("material"))
@@ -95,9 +95,15 @@ REAL = sorted(p for p in DATA.rglob("*.urdf") if "random_urdfs" not in p.parts) 
     sorted(DATA.glob("random_urdfs/00*/*.urdf")) + sorted(FIXTURES.rglob("*.urdf"))
 
 
+#: Both walks: in C (urdfkit.model._walk, where it is built: tests/test_build.py requires it
+#: of CI's compiled install) and in Python.
+WALKS = pytest.mark.parametrize("native", [True, False], ids=["c-walk", "python-walk"])
+
+
+@WALKS
 @pytest.mark.parametrize("path", REAL, ids=lambda p: str(p.relative_to(p.parents[1])))
-def test_the_walk_lists_what_lxml_lists_on_real_files(path: Path) -> None:
-    assert_same_as_lxml(parse_xml(read_bytes(path), path).getroot())
+def test_the_walk_lists_what_lxml_lists_on_real_files(path: Path, native: bool) -> None:
+    assert_same_as_lxml(parse_xml(read_bytes(path), path).getroot(), native)
 
 
 TAGS = [*SCHEMA, *OPAQUE, "sensor", "{urn:x}thing", "plugin"]
@@ -114,25 +120,66 @@ def trees(draw: st.DrawFn, depth: int = 0) -> etree._Element:
         el.set(attr, draw(st.sampled_from(VALUES)))
     if depth < 5:
         for _ in range(draw(st.integers(0, 4 if depth < 3 else 2))):
-            if draw(st.integers(0, 9)) == 0:
+            kind = draw(st.integers(0, 19))
+            if kind == 0:
                 el.append(etree.Comment("c"))
+            elif kind == 1:
+                el.append(etree.ProcessingInstruction("pi", "x"))
             else:
                 el.append(draw(trees(depth + 1)))
     return el
 
 
+@WALKS
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(trees())
-def test_the_walk_lists_what_lxml_lists_on_random_trees(root: etree._Element) -> None:
-    assert_same_as_lxml(root)
+@given(root=trees())
+def test_the_walk_lists_what_lxml_lists_on_random_trees(root: etree._Element,
+                                                       native: bool) -> None:
+    assert_same_as_lxml(root, native)
 
 
-def test_the_depth_limit_is_found_where_the_xpath_finds_it() -> None:
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(trees(), st.booleans())
+def test_both_walks_name_the_same_elements(root: etree._Element, memo_first: bool) -> None:
+    # The same findings on the same element objects, whichever walk fills the shared memo.
+    order = (True, False) if memo_first else (False, True)
+    docs = {native: Doc(root, native=native) for native in order}
+    c, py = docs[True], docs[False]
+    assert [(code, level, message) for code, level, message, _ in c.element_findings] == \
+        [(code, level, message) for code, level, message, _ in py.element_findings]
+    assert all(a[3] is b[3] for a, b in zip(c.element_findings, py.element_findings,
+                                            strict=True))
+    assert c.too_deep is py.too_deep
+    assert (c.all_materials, c.geometries, c.files, c.transmissions) == \
+        (py.all_materials, py.geometries, py.files, py.transmissions)
+
+
+@WALKS
+def test_the_depth_limit_is_found_where_the_xpath_finds_it(native: bool) -> None:
     for extra in (0, 1, 2):
         root = etree.Element("robot")
         el = root
         for _ in range(MAX_XML_DEPTH - 1 + extra):
             el = etree.SubElement(el, "link")
         etree.SubElement(root, "link")
-        assert_same_as_lxml(root)
-        assert (Doc(root).too_deep is not None) == (extra > 0)
+        assert_same_as_lxml(root, native)
+        assert (Doc(root, native=native).too_deep is not None) == (extra > 0)
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(trees(), st.sampled_from([*TAGS, "color", "texture", "nothing"]))
+def test_first_finds_what_iterchildren_finds(root: etree._Element, tag: str) -> None:
+    from urdfkit.model.index import first
+
+    for el in root.iter(etree.Element):
+        assert first(el, tag) is next(el.iterchildren(tag), None)
+
+
+def test_first_keeps_lxml_namespace_rules() -> None:
+    from urdfkit.model.index import first
+
+    root = etree.fromstring(b'<r xmlns:a="urn:a"><a:color/><color/><a:thing/></r>')
+    assert first(root, "color") is root[1]  # a plain name is no namespace's
+    assert first(root, "{urn:a}color") is root[0]
+    assert first(root, "{*}thing") is root[2]
+    assert first(etree.fromstring(b'<r xmlns="urn:d"><color/></r>'), "color") is None

@@ -459,14 +459,28 @@ def _properties(r: Report, path: str, scale: Sequence[float], concavity: bool = 
     memo = r.memo
     found: MeshProperties | None = memo.get(key, _UNSEEN)
     if found is _UNSEEN or (concavity and found is not None and math.isnan(found.concavity)):
-        from urdfkit.sources.meshes import properties
-
-        found = memo[key] = properties(path, (scale[0], scale[1], scale[2]),
-                                       concavity=concavity, stat=st)
+        found = memo[key] = _meshes().properties(path, (scale[0], scale[1], scale[2]),
+                                                 concavity=concavity, stat=st)
     return found
 
 
 _UNSEEN: Any = object()
+_MESHES: Any = None
+
+
+def _meshes() -> Any:
+    """:mod:`urdfkit.sources.meshes`, imported on first use and kept.
+
+    Not at module level (``build`` and ``fix`` import these rules, and most of their runs
+    read no mesh); not an import statement in each rule either: compiled, every such
+    statement goes through the import machinery (several us, once per mesh of every file).
+    """
+    global _MESHES
+    if _MESHES is None:
+        from urdfkit.sources import meshes
+
+        _MESHES = meshes
+    return _MESHES
 
 
 def _moving(r: Report, el: etree._Element) -> set[str]:
@@ -505,8 +519,6 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
     """
     if r.folder is None:
         return
-    from urdfkit.sources.meshes import CONCAVE_FRACTION
-
     doc = r.doc(root)
     offsets = sorted(math.sqrt(sum(x * x for x in xyz)) for jv in doc.joints
                      if (xyz := _vec(jv.origin, "xyz", 3)) is not None and any(xyz))
@@ -538,7 +550,7 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
                       f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
                       f"{fix}", mesh)
             if (concave_matters and props.closed
-                    and props.concavity > CONCAVE_FRACTION * size):
+                    and props.concavity > _meshes().CONCAVE_FRACTION * size):
                 r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
                       f"concave (it is {size:.3g} m across, and parts of it stand up to "
                       f"{props.concavity:.3g} m in front of its own faces' planes): PyBullet "

@@ -36,10 +36,20 @@ from urdfkit.model.spec import (
 
 El = Any  # an lxml element; this module never imports lxml
 
+_native: Any
+try:  # the walk over libxml2's nodes (_walk.c), built with the compiled check path
+    from urdfkit.model import _walk as _native
+except ImportError:  # a plain-Python install, or an lxml whose C API it was not built for
+    _native = None
+
+#: Whether :class:`Doc` walks in C (``urdfkit.model._walk``) rather than in Python.
+NATIVE_WALK = _native is not None
 
 
 def first(el: El, tag: str) -> El:
     """``el.find(tag)`` for a plain tag name, filtered in C (``find`` goes through ElementPath)."""
+    if _native is not None and tag.isalnum():  # a plain name ("{ns}x", "*": lxml's rules)
+        return _native.first(el, tag)  # without making an iterator
     return next(el.iterchildren(tag), None)
 
 
@@ -122,6 +132,9 @@ _JOINT_SLOTS = frozenset({"parent", "limit", "axis", "origin", "mimic"})
 class Doc:
     """Everything the rules read from one document, collected in one walk.
 
+    The walk is :meth:`_walk`, done in C where ``urdfkit.model._walk`` is built (``native``
+    False walks in Python, for the tests that hold the two to each other).
+
     Attributes:
         root: The root element.
         links, joints: :class:`LinkView` and :class:`JointView` of the root's children.
@@ -138,7 +151,7 @@ class Doc:
                  "geometries", "files", "transmissions", "too_deep", "element_findings",
                  "_buckets")
 
-    def __init__(self, root: El) -> None:
+    def __init__(self, root: El, native: bool = True) -> None:
         self.root = root
         self.links: list[LinkView] = []
         self.joints: list[JointView] = []
@@ -169,7 +182,14 @@ class Doc:
                     self.materials.append(child)
                 elif ctag == "deformable":
                     self.deformables += 1
-            self._walk(root, tag, tag[0] != "{" and tag not in OPAQUE, 1)
+            checked = tag[0] != "{" and tag not in OPAQUE
+            if native and _native is not None:
+                # The same walk, step for step, without a proxy per element (_walk.c).
+                self.too_deep = _native.walk(
+                    root, tag, checked, self._buckets, self.element_findings, SCHEMA,
+                    NUMERIC_BY_TAG, OPAQUE, MAX_XML_DEPTH, _VERDICTS, _VERDICTS_MAX, _verdict)
+            else:
+                self._walk(root, tag, checked, 1)
 
     def _walk(self, el: El, tag: str, checked: bool, depth: int) -> None:
         """Visit ``el``'s subtree once: collect, and check elements when ``checked``.
