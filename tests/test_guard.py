@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
@@ -235,3 +237,13 @@ def test_a_line_pybullet_breaks_is_loaded_from_a_formatted_copy(tmp_path: Path,
     assert [f["line"] for f in found["findings"] if f["code"] == "U008"] == [1]
     assert not [f for f in json.loads(CliRunner().invoke(
         app, ["check", str(control), "--json"]).stdout)["findings"] if f["code"] == "U008"]
+
+
+@settings(max_examples=500, deadline=None)
+@given(st.text(alphabet="ab./\\OoBbJjSsTtLlDdAaEe", max_size=12))
+def test_mesh_suffix_reads_as_splitext(fn: str) -> None:
+    # reference()'s fast path tells a mesh format by its suffix without os.path.splitext.
+    from urdfkit.model.spec import MESH_FORMATS
+    from urdfkit.sources.guard import _mesh_suffix
+
+    assert _mesh_suffix(fn) == (os.path.splitext(fn)[1].lower() in MESH_FORMATS)

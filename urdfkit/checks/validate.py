@@ -119,20 +119,8 @@ def rule_mass(root: etree._Element, r: Report) -> None:
         elif mass is not None and mass < 0:
             r.add("U601", "error", f"{label(link)} has negative mass {mass:g}; mass must be "
                   ">= 0", mass_el)
-    def rigid_mass(name: str) -> float:
-        # A link moves with everything fixed to it: it is massless only if all of them are.
-        total, stack, seen = 0.0, [name], set()
-        while stack:
-            n = stack.pop()
-            if n in seen or n not in views:
-                continue
-            seen.add(n)
-            total += max(0.0, _mass_of(views[n]) or 0.0)
-            stack.extend(fixed_children.get(n, []))
-        return total
-
     for name, j in moving:
-        if name in views and rigid_mass(name) == 0:
+        if name in views and _rigid_mass(name, views, fixed_children) == 0:
             r.add("U602", "error", f"{label(views[name].el)} moves (joint {j.get('name')!r} is "
                   f"{j.get('type')}) but has mass 0; give it a mass > 0", views[name].el)
     roots = [view for name, view in views.items() if name not in child_names]
@@ -142,7 +130,7 @@ def rule_mass(root: etree._Element, r: Report) -> None:
     own = _mass_of(roots[0]) if len(roots) == 1 and roots[0].inertial is not None else None
     if own is not None and own == 0:
         base, static = roots[0].el, not moving
-        carried = rigid_mass(base.get("name", ""))
+        carried = _rigid_mass(base.get("name", ""), views, fixed_children)
         held = (f"; its fixed links weigh {carried:g} kg, and PyBullet ignores that: it looks "
                 "at the root's own mass" if carried > 0 else "")
         r.add("U611", "info" if static and not carried else "warning",
@@ -152,6 +140,25 @@ def rule_mass(root: etree._Element, r: Report) -> None:
                              "; right for an arm bolted to the world, wrong for a robot "
                              "that should fall or drive: give the root link a mass, or make "
                              "the massive link the root") + held, base)
+
+
+def _rigid_mass(name: str, views: dict[str, LinkView],
+                fixed_children: dict[str, list[str]]) -> float:
+    """The mass of link ``name`` with everything fixed to it: massless only if all of them are.
+
+    A module function, not one nested in rule_mass: compiled, a nested function's
+    environment holds every local of its caller and the function holds the environment, a
+    cycle that kept each file's whole document alive until the collector ran.
+    """
+    total, stack, seen = 0.0, [name], set()
+    while stack:
+        n = stack.pop()
+        if n in seen or n not in views:
+            continue
+        seen.add(n)
+        total += max(0.0, _mass_of(views[n]) or 0.0)
+        stack.extend(fixed_children.get(n, []))
+    return total
 
 
 def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | None:

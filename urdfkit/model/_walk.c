@@ -15,6 +15,7 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <stdint.h>
 #include "lxml-version.h"
 #include "etree_defs.h"
 #include "lxml.etree.h"
@@ -45,11 +46,12 @@ static PyTypeObject *element_type;  /* lxml.etree._Element */
  * reused for another name once a dictionary is freed), so a hit is always right; a miss
  * makes the string as lxml does. The strings keep their hash: dict lookups on them are
  * cheap. */
-#define NAMES 1024
+#define NAMES 1024  /* 2 ** (64 - 54) */
 static struct { const xmlChar *at; PyObject *str; } names[NAMES];
 
 static PyObject *name_of(const xmlChar *at) {
-    size_t slot = ((size_t)at >> 4) % NAMES;
+    /* Names sit side by side in libxml2's pools: mix every bit of the address. */
+    size_t slot = (size_t)(((uint64_t)(uintptr_t)at * 0x9E3779B97F4A7C15ULL) >> 54);
     PyObject *str = names[slot].str;
     if (str != NULL && names[slot].at == at) {
         const char *utf8 = PyUnicode_AsUTF8(str);

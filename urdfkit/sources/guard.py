@@ -465,6 +465,24 @@ class Reference:
                             self.stat))
 
 
+#: What ends a folder's name (os.path.join adds no separator after one).
+_SEPARATORS = (os.sep, os.altsep) if os.altsep else (os.sep,)
+
+
+def _mesh_suffix(fn: str) -> bool:
+    """Whether ``os.path.splitext(fn)[1].lower() in MESH_FORMATS``, without splitting.
+
+    Every format is a dot and three letters; splitext gives a suffix only where something
+    other than dots stands before it in the file's name (".obj" alone has none).
+    """
+    if not fn[-4:].lower().endswith(MESH_FORMATS):
+        return False
+    stem = fn[:-4]
+    for sep in _SEPARATORS:
+        stem = stem.rpartition(sep)[2]
+    return stem.strip(".") != ""
+
+
 def reference(tag: str, fn: str, base: Path | str,
               packages: Mapping[str, Path] | None) -> Reference:
     """Resolve and judge one file reference: the one rule check and the loaders share.
@@ -477,7 +495,9 @@ def reference(tag: str, fn: str, base: Path | str,
     if ":" not in fn and not fn.startswith("/"):
         # The common case, a plain relative path to a regular file: one stat answers what
         # resolve_uri and not_a_file would ask (the same path, the same notes to deps).
-        name = os.path.join(base if isinstance(base, str) else os.fspath(base), fn)
+        folder = base if isinstance(base, str) else os.fspath(base)
+        name = folder + fn if folder.endswith(_SEPARATORS) or not folder else \
+            folder + os.sep + fn  # os.path.join for a relative fn, without its checks
         deps.note(name)
         try:
             st: os.stat_result | None = os.stat(name)
@@ -485,7 +505,7 @@ def reference(tag: str, fn: str, base: Path | str,
             st = None
         # A regular file's name is its last part, so fn's suffix is the path's.
         if st is not None and stat.S_ISREG(st.st_mode) and (
-                tag != "mesh" or os.path.splitext(fn)[1].lower() in MESH_FORMATS):
+                tag != "mesh" or _mesh_suffix(fn)):
             return Reference(name, name, stat=st)
     label = f"<{tag} filename={fn!r}>"
     base = Path(base)
