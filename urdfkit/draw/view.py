@@ -448,15 +448,19 @@ class Viewer(RunDisplay):
             self._failed = recorded
             self._refresh_status()
             return False
+        names = {j.name for j in model.joints}
+        keep = {k: v for k, v in kept.items() if k in names}
+        # The joints are set before the new robot is published: a reader that sees the new
+        # model (or the new count) never sees it at zero.
+        model.set_positions(keep)
         with self._lock:
             old, self.model = self.model, model
             self._failed = None
             self.error = None
-            self.reloads += 1
             self._show_model()
             old.close()
-            self.set_joints({k: v for k, v in kept.items()
-                             if k in {j.name for j in model.joints}})
+            self.set_joints(keep)
+            self.reloads += 1  # last: the count says the reload is complete
         return True
 
     def close(self) -> None:
