@@ -40,7 +40,9 @@ def test_every_robot_ends_on_the_page_where_the_run_ends() -> None:
     assert result.steps == 720 and not result.interrupted
     for k in range(2):  # every link of both cars, on the page as in the run and in a plain one
         for page, run, alone in zip(shown[k], end[k], plain[k], strict=True):
-            assert list(page) == pytest.approx(list(run[0]), abs=1e-6)
+            # viser skips a move that np.allclose calls no move (rel 1e-5, abs 1e-8), so a
+            # parked car's last microns of settling may not reach the page.
+            assert list(page) == pytest.approx(list(run[0]), rel=1e-5, abs=1e-8)
             assert list(run[0]) == pytest.approx(list(alone[0]), abs=1e-9)
     # The driving car moved, the parked one did not: the page shows two different paths.
     assert abs(end[1][0][0][1] - 2.0) > 0.5 and abs(end[0][0][0][1] + 2.0) < 0.01
