@@ -437,7 +437,7 @@ def test_a_mesh_first_seen_on_a_static_link_is_still_judged_concave_on_a_moving_
         tmp_path: Path) -> None:
     """The concavity depth is worked out only where a rule needs it: a cache entry made for
     a static link (no depth) is completed, not trusted, when a moving link uses the mesh."""
-    from urdfkit.sources import meshes
+    from urdfkit.sources import meshes, meshstore
 
     bracket = tmp_path / "bracket.obj"  # a mesh no other test has cached
     bracket.write_bytes((MESHES / "l_bracket.obj").read_bytes())
@@ -446,10 +446,10 @@ def test_a_mesh_first_seen_on_a_static_link_is_still_judged_concave_on_a_moving_
     static = doc(link("a", body=body), link("b", body=BOX), J)
     moving = doc(link("a", body=BOX), link("b", body=body), J)
     assert "U614" not in _codes(tmp_path, static)
-    memory = dict(meshes._MEMORY)
+    memory = dict(meshstore._MEMORY)
     (entry,) = [v for k, v in memory.items() if k.startswith(f"{bracket}\0")]
     assert entry is not None and math.isnan(entry.concavity)  # not worked out for the base
-    meshes._MEMORY.clear()  # a new process: only the cache folder remembers
+    meshstore._MEMORY.clear()  # a new process: only the cache folder remembers
     path = tmp_path / "r.urdf"
     path.write_text(moving)
     found = [f for f in check_paths([path], jobs=1, cache=False).findings if f.code == "U614"]

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from urdfkit.model.spec import solid_inertia, solid_volume
-from urdfkit.sources import meshes
+from urdfkit.sources import meshes, meshstore
 
 DATA = Path(pybullet_data.getDataPath())
 FIXTURES = Path(__file__).parent / "fixtures" / "meshes"
@@ -58,7 +58,7 @@ def check_box(props: meshes.MeshProperties | None, size: tuple[float, float, flo
 
 @pytest.fixture(autouse=True)
 def fresh_memory(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    monkeypatch.setattr(meshes, "_MEMORY", {})
+    monkeypatch.setattr(meshstore, "_MEMORY", {})
     monkeypatch.setenv("URDFKIT_CACHE_DIR", str(tmp_path / "cache"))
 
 
@@ -136,7 +136,7 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     entries = list((tmp_path / "cache" / "meshes-4").iterdir())
     assert len(entries) == 1
     # A new process (empty memory) reads the entry, not the mesh.
-    monkeypatch.setattr(meshes, "_MEMORY", {})
+    monkeypatch.setattr(meshstore, "_MEMORY", {})
 
     def refuse(*_: object) -> None:
         raise AssertionError("the mesh was read again")
@@ -145,7 +145,7 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     check_box(meshes.properties(path, (2.0, 2.0, 2.0)), (2.0, 4.0, 6.0))
     monkeypatch.undo()
     monkeypatch.setenv("URDFKIT_CACHE_DIR", str(tmp_path / "cache"))
-    monkeypatch.setattr(meshes, "_MEMORY", {})
+    monkeypatch.setattr(meshstore, "_MEMORY", {})
     # An edit (new size and time) is a new key: the new box, never the old one's values.
     path.write_text(box_obj((3.0, 2.0, 1.0)))
     os.utime(path, ns=(1, 1))
@@ -153,7 +153,7 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     # A damaged entry is read past and rewritten.
     for entry in (tmp_path / "cache" / "meshes-4").iterdir():
         entry.write_bytes(b"garbage")
-    monkeypatch.setattr(meshes, "_MEMORY", {})
+    monkeypatch.setattr(meshstore, "_MEMORY", {})
     check_box(meshes.properties(path), (3.0, 2.0, 1.0))
     good = [e for e in (tmp_path / "cache" / "meshes-4").iterdir()
             if e.read_bytes().startswith(b"M4")]
@@ -247,9 +247,9 @@ def test_real_dae_meshes_are_placed_as_pybullet_places_them(tmp_path: Path, pb) 
 
 def _new_process(monkeypatch: pytest.MonkeyPatch) -> None:
     """What a new process starts with: no entries in memory, none used, no pack read."""
-    monkeypatch.setattr(meshes, "_MEMORY", {})
-    monkeypatch.setattr(meshes, "USED", {})
-    monkeypatch.setattr(meshes, "_PACKED", set())
+    monkeypatch.setattr(meshstore, "_MEMORY", {})
+    monkeypatch.setattr(meshstore, "USED", {})
+    monkeypatch.setattr(meshstore, "_PACKED", set())
 
 
 def _robot_with_box(folder: Path, size: tuple[float, float, float]) -> Path:
@@ -309,13 +309,13 @@ def test_a_damaged_pack_is_ignored_whole(tmp_path: Path,
         pack.write_bytes(damaged)
         _new_process(monkeypatch)
         assert meshes.load_pack([str(folder)]) == 0
-        assert meshes._MEMORY == {}
+        assert meshstore._MEMORY == {}
 
 
 def test_packs_are_capped(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     folder = tmp_path / "robot"
     _robot_with_box(folder, (1.0, 1.0, 1.0))
-    monkeypatch.setattr(meshes, "MAX_PACKS", 3)
+    monkeypatch.setattr(meshstore, "MAX_PACKS", 3)
     for n in range(6):
         _new_process(monkeypatch)
         meshes.properties(folder / "box.obj")

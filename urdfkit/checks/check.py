@@ -434,7 +434,7 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
             todo.append(n)
     work = [(*files[n], pkgs, no_exec, args, physics, cache) for n in todo]
     if todo:
-        from urdfkit.sources import meshes
+        from urdfkit.sources import meshstore as meshes
 
         meshes.load_pack(given)  # before workers fork: they inherit it
     for n, fr in zip(todo, _run_jobs(work, jobs), strict=True):
@@ -497,7 +497,7 @@ def _run_jobs(work: list[_Job], jobs: int | None) -> list[FileResult]:
 
 def _check_in_worker(job: _Job) -> FileResult:
     """:func:`_check_one` in a pool worker, handing back the mesh entries it used."""
-    from urdfkit.sources import meshes
+    from urdfkit.sources import meshstore as meshes
 
     meshes.USED.clear()
     result = _check_one(job)

@@ -14,7 +14,7 @@ import os
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from lxml import etree
 
@@ -39,11 +39,8 @@ from urdfkit.model.spec import (
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
 from urdfkit.sources.guard import GUARD_RULES, Report, Rule, label
-
-if TYPE_CHECKING:
-    from urdfkit.sources.meshes import MeshProperties
-
-
+from urdfkit.sources.meshstore import CONCAVE_FRACTION, MeshProperties
+from urdfkit.sources.meshstore import properties as mesh_properties
 
 # --------------------------------------------------------------------------- structural rules
 # These are the rules PyBullet crashes on when they are broken; the guard runs exactly these.
@@ -256,25 +253,22 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
         trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
         eps = 10 * _DBL_EPSILON * max(1.0, trace / 2)
         a, b, c = sym_eigenvalues(tensor)
-        moments = _moments((a, b, c), max(abs(a), abs(b), abs(c)))
         shapes = _shape_trace(link, mass, r)
-        fix = (f"; its collision shapes and mass imply a trace of {shapes[0]:.4g}, e.g. "
-               f"ixx=iyy=izz={shapes[0] / 3:.4g} with products 0"
-               if shapes and shapes[1] >= STUB_SIZE else "")
         if a < -eps:
             r.add("U603", "error", f"inertia of {label(link)} is not positive definite "
-                  f"(principal moments {moments}); every principal moment must be > 0{fix}",
-                  inertia)
+                  f"(principal moments {_moments((a, b, c))}); every principal moment must be "
+                  f"> 0{_shapes_fix(shapes)}", inertia)
             continue
         if mass is not None and mass > 0 and a <= eps:
             r.add("U608", "warning", f"inertia of {label(link)} is singular (principal moments "
-                  f"{moments}): a point or a thin rod, not a solid; with "
-                  f"URDF_USE_INERTIA_FROM_FILE the solver may blow up{fix}", inertia)
+                  f"{_moments((a, b, c))}): a point or a thin rod, not a solid; with "
+                  f"URDF_USE_INERTIA_FROM_FILE the solver may blow up{_shapes_fix(shapes)}",
+                  inertia)
         if a + b < c - eps:
             r.add("U604", "error", f"inertia of {label(link)} violates the triangle inequality: "
-                  f"principal moments {moments} (the two smaller sum to less than the largest); "
-                  f"no rigid body has it: lower the largest to at most {a + b:.4g}{fix}",
-                  inertia)
+                  f"principal moments {_moments((a, b, c))} (the two smaller sum to less than "
+                  f"the largest); no rigid body has it: lower the largest to at most "
+                  f"{a + b:.4g}{_shapes_fix(shapes)}", inertia)
             continue
         if shapes and shapes[0] > 0 and trace > 0 and not 0.1 <= trace / shapes[0] <= 10:
             ratio = f"inertia of {label(link)} is {trace / shapes[0]:.3g} times what its " \
@@ -291,9 +285,21 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
 STUB_SIZE = 0.01
 
 
-def _moments(values: Sequence[float], scale: float) -> str:
+def _moments(values: Sequence[float]) -> str:
     """Principal moments for a message: round-off (-4.2e-22 beside 0.1) printed as 0."""
+    scale = max(abs(v) for v in values)
     return ", ".join("0" if abs(v) <= 1e-9 * scale else f"{v:.4g}" for v in values)
+
+
+def _shapes_fix(shapes: tuple[float, float] | None) -> str:
+    """The inertia the collision shapes imply, as a message's advice ("" for stubs or none).
+
+    Written only into a finding: most links have none, and formatting is not free.
+    """
+    if not shapes or shapes[1] < STUB_SIZE:
+        return ""
+    return (f"; its collision shapes and mass imply a trace of {shapes[0]:.4g}, e.g. "
+            f"ixx=iyy=izz={shapes[0] / 3:.4g} with products 0")
 
 
 @dataclass(frozen=True)
@@ -456,7 +462,7 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
 
 def _properties(r: Report, path: str, scale: Sequence[float], concavity: bool = False,
                 st: os.stat_result | None = None) -> MeshProperties | None:
-    """:func:`urdfkit.sources.meshes.properties`, once per mesh and scale per file.
+    """:func:`urdfkit.sources.meshstore.properties`, once per mesh and scale per file.
 
     The inertia and mesh-shape rules both ask. ``concavity``: the concavity depth is needed
     (a collision mesh of a moving link); it is worked out only then. ``st``: the path's
@@ -464,30 +470,15 @@ def _properties(r: Report, path: str, scale: Sequence[float], concavity: bool = 
     """
     key = ("mesh", path, scale[0], scale[1], scale[2])
     memo = r.memo
-    found: MeshProperties | None = memo.get(key, _UNSEEN)
+    found: Any = memo.get(key, _UNSEEN)  # Any: the marker is not a MeshProperties
     if found is _UNSEEN or (concavity and found is not None and math.isnan(found.concavity)):
-        found = memo[key] = _meshes().properties(path, (scale[0], scale[1], scale[2]),
-                                                 concavity=concavity, stat=st)
+        props = memo[key] = mesh_properties(path, (scale[0], scale[1], scale[2]),
+                                            concavity=concavity, stat=st)
+        return props
     return found
 
 
 _UNSEEN: Any = object()
-_MESHES: Any = None
-
-
-def _meshes() -> Any:
-    """:mod:`urdfkit.sources.meshes`, imported on first use and kept.
-
-    Not at module level (``build`` and ``fix`` import these rules, and most of their runs
-    read no mesh); not an import statement in each rule either: compiled, every such
-    statement goes through the import machinery (several us, once per mesh of every file).
-    """
-    global _MESHES
-    if _MESHES is None:
-        from urdfkit.sources import meshes
-
-        _MESHES = meshes
-    return _MESHES
 
 
 def _moving(r: Report, el: etree._Element) -> set[str]:
@@ -557,7 +548,7 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
                       f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
                       f"{fix}", mesh)
             if (concave_matters and props.closed
-                    and props.concavity > _meshes().CONCAVE_FRACTION * size):
+                    and props.concavity > CONCAVE_FRACTION * size):
                 r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
                       f"concave (it is {size:.3g} m across, and parts of it stand up to "
                       f"{props.concavity:.3g} m in front of its own faces' planes): PyBullet "

@@ -1,0 +1,343 @@
+"""Mesh mass properties as check asks for them: the lookup, the cache entries, a run's pack.
+
+Compiled with the check path (setup.py): ``check`` asks once per mesh of every file, and a
+warm run answers every one of them from memory or the run's pack, so this lookup is the
+mesh rules' whole cost then. Reading and integrating a mesh, on a miss, is
+:mod:`urdfkit.sources.meshes` (imported only then: it loads numpy and its patterns).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import struct
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from urdfkit.core import deps
+from urdfkit.sources.cache import cache_dir, read_entry, write_entry
+
+try:  # hashlib's own blake2b, without loading OpenSSL for the other digests (2.5 ms)
+    from _blake2 import blake2b
+except ImportError:  # pragma: no cover - a Python built without it
+    from hashlib import blake2b
+
+#: Largest mesh file read for checks; bigger ones are skipped (checks must stay fast).
+MAX_MESH_BYTES = 16 * 1024 * 1024
+#: A mesh whose surface dips more than this fraction of its size inside its hull is concave.
+CONCAVE_FRACTION = 0.02
+#: The formats integrated: PyBullet's mesh formats.
+MESH_SUFFIXES = (".stl", ".obj", ".dae")
+
+
+@dataclass(frozen=True)
+class MeshProperties:
+    """A closed triangle mesh as a solid of unit density (scaled).
+
+    Attributes:
+        volume: m^3 (positive for outward-facing triangles).
+        com: Centre of mass in the mesh frame.
+        inertia: 3x3 inertia tensor about ``com`` per kg/m^3 (multiply by mass / volume).
+        extent: Size of the bounding box along x, y, z.
+        closed: Every edge is shared by exactly two triangles.
+        triangles: How many triangles.
+        concavity: How far (m, about, under non-uniform scale) the surface lies inside the
+            convex hull PyBullet collides with: the largest distance of a vertex in front of
+            the plane of a triangle of its own piece. 0 for a convex mesh; NaN when it was not
+            asked for (``properties(..., concavity=True)``).
+        pieces: Convex hulls PyBullet makes of it (one per ``o``/``g`` object of an OBJ).
+    """
+
+    volume: float
+    com: tuple[float, float, float]
+    inertia: tuple[tuple[float, ...], ...]
+    extent: tuple[float, float, float]
+    closed: bool
+    triangles: int
+    concavity: float = 0.0
+    pieces: int = 1
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # For pickle: mypyc's compiled frozen dataclasses cannot be unpickled field by field.
+        return (MeshProperties, (self.volume, self.com, self.inertia, self.extent, self.closed,
+                                 self.triangles, self.concavity, self.pieces))
+
+    def trace_for_mass(self, mass: float) -> float | None:
+        """Trace of the inertia of this solid with ``mass``, or None without a volume."""
+        if not self.closed or self.volume <= 0:
+            return None
+        t = self.inertia
+        return (t[0][0] + t[1][1] + t[2][2]) * mass / self.volume
+
+
+@dataclass(frozen=True)
+class Integrals:
+    """A mesh's volume integrals as read, unscaled and signed (what the cache keeps).
+
+    Attributes:
+        volume: Signed volume (negative when the triangles face inward).
+        first: Integrals of x, y, z over the solid.
+        second: Integrals of xx, yy, zz, xy, xz, yz over the solid.
+        low, high: Corners of the bounding box of the vertices the triangles use.
+        closed, triangles, concavity, pieces: As in :class:`MeshProperties` (concavity
+            unscaled).
+    """
+
+    volume: float
+    first: tuple[float, float, float]
+    second: tuple[float, float, float, float, float, float]
+    low: tuple[float, float, float]
+    high: tuple[float, float, float]
+    closed: bool
+    triangles: int
+    concavity: float = 0.0
+    pieces: int = 1
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # For pickle (check's workers hand their entries back), as MeshProperties.
+        return (Integrals, (self.volume, self.first, self.second, self.low, self.high,
+                            self.closed, self.triangles, self.concavity, self.pieces))
+
+    def pack(self) -> bytes:
+        """The cache entry's bytes."""
+        return _ENTRY + _FORMAT.pack(self.volume, *self.first, *self.second, *self.low,
+                                          *self.high, self.concavity, self.closed,
+                                          self.triangles, self.pieces)
+
+    @classmethod
+    def unpack(cls, data: bytes) -> Integrals:
+        """Read a cache entry; ValueError if it is not one."""
+        if len(data) != len(_ENTRY) + _FORMAT.size or not data.startswith(_ENTRY):
+            raise ValueError("not a mesh cache entry")
+        v = _FORMAT.unpack_from(data, len(_ENTRY))
+        return cls(v[0], v[1:4], v[4:10], v[10:13], v[13:16], v[17], v[18], v[16], v[19])
+
+    def scaled(self, scale: tuple[float, float, float]) -> MeshProperties | None:
+        """The solid under ``<mesh scale>``: integrals scale as powers of each factor.
+
+        Written out term by term (check asks once per mesh and file): the same arithmetic, in
+        the same order, as the matrix form ``about = sign det S M S - volume com com^T``.
+        """
+        sx, sy, sz = scale
+        det = sx * sy * sz
+        if det == 0:
+            return None
+        volume = self.volume * det
+        f0, f1, f2 = self.first
+        f0, f1, f2 = f0 * sx * det, f1 * sy * det, f2 * sz * det
+        xx, yy, zz, xy, xz, yz = self.second
+        m00, m01, m02 = xx * sx * sx, xy * sx * sy, xz * sx * sz
+        m11, m12, m22 = yy * sy * sy, yz * sy * sz, zz * sz * sz
+        sign = -1.0 if volume < 0 else 1.0  # inward triangles: the same solid, inside out
+        volume *= sign
+        if volume:
+            c0, c1, c2 = sign * f0 / volume, sign * f1 / volume, sign * f2 / volume
+        else:
+            c0 = c1 = c2 = 0.0
+        k = sign * det
+        a00 = k * m00 - volume * c0 * c0
+        a01 = k * m01 - volume * c0 * c1
+        a02 = k * m02 - volume * c0 * c2
+        a10 = k * m01 - volume * c1 * c0
+        a11 = k * m11 - volume * c1 * c1
+        a12 = k * m12 - volume * c1 * c2
+        a20 = k * m02 - volume * c2 * c0
+        a21 = k * m12 - volume * c2 * c1
+        a22 = k * m22 - volume * c2 * c2
+        trace = a00 + a11 + a22
+        tensor = ((trace - a00, 0.0 - a01, 0.0 - a02),
+                  (0.0 - a10, trace - a11, 0.0 - a12),
+                  (0.0 - a20, 0.0 - a21, trace - a22))
+        (x0, y0, z0), (x1, y1, z1) = self.low, self.high
+        extent = (abs(sx) * (x1 - x0), abs(sy) * (y1 - y0), abs(sz) * (z1 - z0))
+        return MeshProperties(volume, (c0, c1, c2), tensor, extent, self.closed,
+                              self.triangles, self.concavity * max(abs(sx), abs(sy), abs(sz)),
+                              self.pieces)
+
+
+def _cache_dir() -> Path | None:
+    """:func:`cache_dir`, worked out once per value of the variables it reads."""
+    env = (os.environ.get("URDFKIT_CACHE_DIR"), os.environ.get("XDG_CACHE_HOME"),
+           os.environ.get("HOME"))
+    if env not in _CACHE_DIRS:
+        _CACHE_DIRS[env] = cache_dir()
+    return _CACHE_DIRS[env]
+
+
+_CACHE_DIRS: dict[tuple[str | None, ...], Path | None] = {}
+
+#: Cache entries start with this; a new layout is a new prefix and a new folder.
+_ENTRY = b"M4"
+_FOLDER = "meshes-4"
+_MEMORY: dict[str, Integrals | None] = {}
+_MISSING = object()
+
+
+def properties(path: str | os.PathLike[str],
+               scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *,
+               concavity: bool = False,
+               stat: os.stat_result | None = None) -> MeshProperties | None:
+    """Mass properties of an STL or OBJ mesh, or None if unreadable, unsupported or empty.
+
+    The concavity depth costs as much as the rest together and only the concave-mesh rules
+    read it, so it is worked out when ``concavity`` asks for it, once per mesh (the cache
+    entry is then rewritten with it); otherwise it may be NaN. ``stat``: ``os.stat(path)``
+    when the caller has just taken it.
+    """
+    name = os.fspath(path)
+    suffix = _suffix(name)
+    if not suffix:
+        return None
+    deps.note(name)
+    st = stat
+    if st is None:
+        try:
+            st = os.stat(name)
+        except (OSError, ValueError):
+            return None
+    if st.st_size > MAX_MESH_BYTES:
+        return None
+    # An absolute name is its own key (normalizing it would cost more than the rare second
+    # entry a spelling like "a/../m.stl" makes).
+    where = name if name.startswith(_ROOT) else os.path.abspath(name)
+    key = f"{where}\0{st.st_size}\0{st.st_mtime_ns}\0{st.st_ino}"
+    found = _MEMORY.get(key, _MISSING)
+    if found is _MISSING or (concavity and isinstance(found, Integrals)
+                             and math.isnan(found.concavity)):
+        found = _MEMORY[key] = _integrals(Path(name), suffix, key, concavity)
+    assert found is None or isinstance(found, Integrals)
+    USED[key] = found
+    return found.scaled(scale) if found is not None else None
+
+
+# --------------------------------------------------------------------------- a run's pack
+# One check run reads every mesh's entry on its own: a thousand small files. The run's pack
+# keeps the entries it used in one file, read once at the next run over the same paths. A
+# pack entry is keyed like any entry (path, size, mtime, inode), so an edited mesh misses it
+# and is looked up as before; a pack that is damaged in any byte is ignored whole.
+
+_PACKS = "mesh-packs-2"
+_PACK_MAGIC = b"MP2\n"
+#: Packs kept; the oldest beyond this are removed when a new one is written.
+MAX_PACKS = 64
+#: The entries this process used (its own, and its workers' once merged), by key.
+USED: dict[str, Integrals | None] = {}
+_PACKED: set[str] = set()
+
+
+def _pack_path(paths: Sequence[str]) -> Path | None:
+    folder = cache_dir()
+    if folder is None:
+        return None
+    h = blake2b(_PACK_MAGIC, digest_size=20)
+    for p in (os.getcwd(), *paths):
+        h.update(os.fsencode(os.path.abspath(p)) + b"\0")
+    return folder / _PACKS / h.hexdigest()
+
+
+def load_pack(paths: Sequence[str]) -> int:
+    """Read the pack of the last run over ``paths`` into memory; how many entries it held."""
+    path = _pack_path(paths)
+    raw = read_entry(path) if path is not None else None
+    if raw is None or not raw.startswith(_PACK_MAGIC) or len(raw) < len(_PACK_MAGIC) + 16:
+        return 0
+    body, check = raw[len(_PACK_MAGIC):-16], raw[-16:]
+    if blake2b(body, digest_size=16).digest() != check:
+        return 0  # damaged: trust none of it
+    found: dict[str, Integrals | None] = {}
+    at = 0
+    try:
+        while at < len(body):
+            klen, elen = struct.unpack_from("<IH", body, at)
+            at += 6
+            key = body[at:at + klen].decode("utf-8", "surrogateescape")
+            entry = body[at + klen:at + klen + elen]
+            at += klen + elen
+            found[key] = None if entry == _ENTRY + b"-" else Integrals.unpack(entry)
+    except (ValueError, struct.error):
+        return 0
+    for key, value in found.items():
+        _MEMORY.setdefault(key, value)
+    _PACKED.clear()
+    _PACKED.update(found)
+    return len(found)
+
+
+def save_pack(paths: Sequence[str]) -> bool:
+    """Write the entries this run used as the pack for ``paths``; True if written.
+
+    Nothing is written when the last pack holds exactly these entries.
+    """
+    if set(USED) == _PACKED:
+        return False
+    path = _pack_path(paths)
+    if path is None:
+        return False
+    parts = []
+    for key, value in USED.items():
+        k = key.encode("utf-8", "surrogateescape")
+        e = value.pack() if value is not None else _ENTRY + b"-"
+        parts.append(struct.pack("<IH", len(k), len(e)) + k + e)
+    body = b"".join(parts)
+    if not write_entry(path, _PACK_MAGIC + body + blake2b(body, digest_size=16).digest()):
+        return False
+    try:
+        with os.scandir(path.parent) as it:
+            packs = sorted((e.stat().st_mtime_ns, e.path) for e in it
+                           if e.is_file(follow_symlinks=False))
+        for _, old in packs[:-MAX_PACKS]:
+            os.unlink(old)
+    except OSError:
+        pass
+    return True
+
+
+def _integrals(path: Path, suffix: str, key: str, concavity: bool) -> Integrals | None:
+    """The integrals of a mesh missing from memory: its cache entry, else the mesh read."""
+    import hashlib
+
+    from urdfkit.sources import meshes  # the readers (numpy), on a miss only
+
+    folder = _cache_dir()
+    entry = (folder / _FOLDER / hashlib.sha1(key.encode("utf-8", "surrogateescape")
+                                                ).hexdigest()) if folder else None
+    if entry is not None:
+        data = read_entry(entry)
+        if data == _ENTRY + b"-":
+            return None
+        if data is not None:
+            try:
+                cached = Integrals.unpack(data)
+            except (ValueError, struct.error):
+                pass  # a damaged entry: read the mesh again and rewrite it
+            else:
+                if not (concavity and math.isnan(cached.concavity)):
+                    return cached
+    found = meshes.read_integrals(path, suffix, concavity=concavity)
+    if entry is not None:
+        write_entry(entry, found.pack() if found is not None else _ENTRY + b"-")
+    return found
+
+
+#: An absolute path starts with this (``os.path.isabs`` on POSIX, without its call).
+_ROOT = os.sep if os.sep == "/" else ("/", os.sep)
+_SEPS = (os.sep, os.altsep) if os.altsep else (os.sep,)
+#: Integrals' cache entry layout, after the prefix.
+_FORMAT = struct.Struct("<17d?II")
+
+
+def _suffix(name: str) -> str:
+    """``os.path.splitext(name)[1].lower()`` when it is a mesh format, else "".
+
+    Every format is a dot and three letters; splitext gives a suffix only where something
+    other than dots stands before it in the file's name (".obj" alone has none).
+    """
+    suffix = name[-4:].lower()
+    if suffix not in MESH_SUFFIXES:
+        return ""
+    stem = name[:-4]
+    for sep in _SEPS:
+        stem = stem.rpartition(sep)[2]
+    return suffix if stem.strip(".") else ""
