@@ -19,6 +19,7 @@ import pytest
 from urdfkit.checks.validate import Solid
 from urdfkit.core.finding import Finding
 from urdfkit.sources.guard import Reference
+from urdfkit.sources.meshstore import Integrals
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -58,14 +59,28 @@ def test_ci_tests_the_build_it_asked_for() -> None:
         assert index.NATIVE_WALK  # the walk in C (urdfkit/model/_walk.c) was built and loads
 
 
-def test_frozen_records_pickle() -> None:
-    # check's worker processes hand findings back by pickle; mypyc's frozen dataclasses
-    # cannot be unpickled field by field (a pool whose results cannot be read hangs).
+def test_records_pickle_compare_and_hash() -> None:
+    # check's worker processes hand findings and mesh entries back by pickle (a pool whose
+    # results cannot be read hangs). The records are plain classes (compiled, a frozen
+    # dataclass is built through Python: 1.5 us against 0.03), compared and hashed by value.
     f = Finding("U605", "warning", "m", "a.urdf", 3, "b.xacro:4")
     assert pickle.loads(pickle.dumps(f)) == f
+    assert hash(pickle.loads(pickle.dumps(f))) == hash(f) and len({f, Finding(*_fields(f))}) == 1
+    assert f != Finding("U605", "warning", "m", "a.urdf", 4, "b.xacro:4") and f != _fields(f)
+    assert repr(f) == ("Finding(code='U605', level='warning', message='m', file='a.urdf', "
+                       "line=3, origin='b.xacro:4')")
+    entry = Integrals(1.0, (0.1, 0.2, 0.3), (1.0, 2.0, 3.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0),
+                      (1.0, 1.0, 1.0), True, 12, 0.5, 2)
+    assert pickle.loads(pickle.dumps(entry)) == entry == Integrals.unpack(entry.pack())
+    props = entry.scaled((2.0, 2.0, 2.0))
+    assert props is not None and pickle.loads(pickle.dumps(props)) == props
     st = os.stat(__file__)
     ref = Reference("x.stl", "/m/x.stl", "U703", "warning", "msg", st)
     back = pickle.loads(pickle.dumps(ref))
     assert back == ref and back.stat == st
     solid = Solid(1.0, (0.0, 0.0, 0.5), ((1.0, 0.0, 0.0), (0.0, 2.0, 0.0), (0.0, 0.0, 3.0)), 2.0)
     assert pickle.loads(pickle.dumps(solid)) == solid
+
+
+def _fields(f: Finding) -> tuple[object, ...]:
+    return (f.code, f.level, f.message, f.file, f.line, f.origin)

@@ -9,7 +9,6 @@ loaded: checking is pure lxml, which is what makes it safe on hostile input and 
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import sys
 from collections.abc import Iterable, Mapping, Sequence
@@ -254,7 +253,7 @@ def check_file(display: str, path: str | Path,
     if xacro_file:
         # Lines of xacro's output are not lines of the file the user wrote: none, not a false
         # one (each message names its element).
-        found = [dataclasses.replace(f, line=None) for f in found]
+        found = [Finding(f.code, f.level, f.message, f.file, None, f.origin) for f in found]
     findings.extend(found)
     if physics and not any(f.level == "error" for f in findings):
         lines = {} if xacro_file else \

@@ -13,7 +13,6 @@ import math
 import os
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from lxml import etree
@@ -302,7 +301,6 @@ def _shapes_fix(shapes: tuple[float, float] | None) -> str:
             f"ixx=iyy=izz={shapes[0] / 3:.4g} with products 0")
 
 
-@dataclass(frozen=True)
 class Solid:
     """A link's collision shapes as one solid of uniform density.
 
@@ -314,13 +312,43 @@ class Solid:
         size: The largest size of any part, m (stub shapes are tiny).
     """
 
+    __slots__ = ("volume", "com", "tensor", "size")
+
     volume: float
     com: tuple[float, float, float]
     tensor: tuple[tuple[float, float, float], ...]
     size: float
 
-    def __reduce__(self) -> tuple[Any, ...]:
-        # For pickle: mypyc's compiled frozen dataclasses cannot be unpickled field by field.
+    def __init__(
+            self,
+            volume: float,
+            com: tuple[float, float, float],
+            tensor: tuple[tuple[float, float, float], ...],
+            size: float,
+    ) -> None:
+        self.volume = volume
+        self.com = com
+        self.tensor = tensor
+        self.size = size
+
+    def _key(self) -> tuple[Any, ...]:
+        return (self.volume, self.com, self.tensor, self.size)
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not Solid:
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def __repr__(self) -> str:
+        return (f"Solid(volume={self.volume!r}, "
+                f"com={self.com!r}, "
+                f"tensor={self.tensor!r}, "
+                f"size={self.size!r})")
+
+    def __reduce__(self) -> tuple[Any, ...]:  # for pickle (check's workers hand these back)
         return (Solid, (self.volume, self.com, self.tensor, self.size))
 
     def inertia(self, mass: float) -> tuple[tuple[float, float, float], ...]:

@@ -43,6 +43,7 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
     """
     from urdfkit.checks.check import check_paths, parse_codes
     from urdfkit.core.errors import ParameterError
+    from urdfkit.core.finding import Finding
     from urdfkit.sources.uris import parse_packages
 
     if fail_on not in ("error", "warning", "info"):
@@ -67,10 +68,8 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
     finally:
         if enabled:
             gc.enable()
-    import dataclasses
-
     for fr in result.files:  # a xacro or package problem speaks of flags, not parameters
-        fr.findings = [dataclasses.replace(f, message=input_flags(f.message))
+        fr.findings = [Finding(f.code, f.level, input_flags(f.message), f.file, f.line, f.origin)
                        if "`" in f.message else f for f in fr.findings]
     show.check_output(result, fmt, fail_on, show_all)
     return result.exit_code(fail_on)

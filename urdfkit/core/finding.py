@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 #: Finding levels, lowest first.
 LEVELS = ("info", "warning", "error")
 
 
-@dataclass(frozen=True)
 class Finding:
     """One problem found in a file.
 
@@ -21,18 +18,52 @@ class Finding:
         origin: Where the element was written when that is another file (xacro), else None.
     """
 
+    __slots__ = ("code", "level", "message", "file", "line", "origin")
+
     code: str
     level: str
     message: str
     file: str
-    line: int | None = None
-    origin: str | None = None
+    line: int | None
+    origin: str | None
 
-    def __reduce__(self) -> tuple[object, ...]:
-        # For pickle (check's worker processes hand findings back): a frozen dataclass
-        # compiled by mypyc (setup.py) cannot be unpickled field by field.
-        return (Finding, (self.code, self.level, self.message, self.file, self.line,
-                          self.origin))
+    def __init__(
+            self,
+            code: str,
+            level: str,
+            message: str,
+            file: str,
+            line: int | None = None,
+            origin: str | None = None,
+    ) -> None:
+        self.code = code
+        self.level = level
+        self.message = message
+        self.file = file
+        self.line = line
+        self.origin = origin
+
+    def _key(self) -> tuple[object, ...]:
+        return (self.code, self.level, self.message, self.file, self.line, self.origin)
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not Finding:
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def __repr__(self) -> str:
+        return (f"Finding(code={self.code!r}, "
+                f"level={self.level!r}, "
+                f"message={self.message!r}, "
+                f"file={self.file!r}, "
+                f"line={self.line!r}, "
+                f"origin={self.origin!r})")
+
+    def __reduce__(self) -> tuple[object, ...]:  # for pickle (check's workers hand these back)
+        return (Finding, (self.code, self.level, self.message, self.file, self.line, self.origin))
 
     def to_dict(self) -> dict[str, object]:
         """The JSON form."""

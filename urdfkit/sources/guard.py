@@ -14,7 +14,6 @@ import os
 import re
 import stat
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -427,7 +426,6 @@ def rule_inertial(root: etree._Element, r: Report) -> None:
                   "of a symmetric body)", inertia)
 
 
-@dataclass(frozen=True)
 class Reference:
     """What a ``filename`` attribute points at, and what is wrong with it, if anything.
 
@@ -440,14 +438,53 @@ class Reference:
         code, level, message: The finding, or ``code`` None when the file is fine.
     """
 
+    __slots__ = ("file", "load", "code", "level", "message", "stat")
+
     file: str | None
     load: str | None
-    code: str | None = None
-    level: str = "error"
-    message: str = ""
+    code: str | None
+    level: str
+    message: str
     #: ``os.stat`` of ``load`` when it was taken on the way (the common case), for the mesh
     #: rules not to ask again.
-    stat: os.stat_result | None = field(default=None, compare=False, repr=False)
+    stat: os.stat_result | None
+
+    def __init__(
+            self,
+            file: str | None,
+            load: str | None,
+            code: str | None = None,
+            level: str = "error",
+            message: str = "",
+            stat: os.stat_result | None = None,
+    ) -> None:
+        self.file = file
+        self.load = load
+        self.code = code
+        self.level = level
+        self.message = message
+        self.stat = stat
+
+    def _key(self) -> tuple[Any, ...]:
+        return (self.file, self.load, self.code, self.level, self.message)
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not Reference:
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def __repr__(self) -> str:
+        return (f"Reference(file={self.file!r}, "
+                f"load={self.load!r}, "
+                f"code={self.code!r}, "
+                f"level={self.level!r}, "
+                f"message={self.message!r})")
+
+    def __reduce__(self) -> tuple[Any, ...]:  # for pickle (check's workers hand these back)
+        return (Reference, (self.file, self.load, self.code, self.level, self.message, self.stat))
 
     @property
     def path(self) -> Path | None:
@@ -459,10 +496,6 @@ class Reference:
         """What PyBullet must be given."""
         return None if self.load is None else Path(self.load)
 
-    def __reduce__(self) -> tuple[Any, ...]:
-        # For pickle: mypyc's compiled frozen dataclasses cannot be unpickled field by field.
-        return (Reference, (self.file, self.load, self.code, self.level, self.message,
-                            self.stat))
 
 
 #: What ends a folder's name (os.path.join adds no separator after one).

@@ -12,7 +12,6 @@ import math
 import os
 import struct
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +31,6 @@ CONCAVE_FRACTION = 0.02
 MESH_SUFFIXES = (".stl", ".obj", ".dae")
 
 
-@dataclass(frozen=True)
 class MeshProperties:
     """A closed triangle mesh as a solid of unit density (scaled).
 
@@ -50,19 +48,64 @@ class MeshProperties:
         pieces: Convex hulls PyBullet makes of it (one per ``o``/``g`` object of an OBJ).
     """
 
+    __slots__ = ("volume", "com", "inertia", "extent", "closed", "triangles", "concavity", "pieces")
+
     volume: float
     com: tuple[float, float, float]
     inertia: tuple[tuple[float, ...], ...]
     extent: tuple[float, float, float]
     closed: bool
     triangles: int
-    concavity: float = 0.0
-    pieces: int = 1
+    concavity: float
+    pieces: int
 
-    def __reduce__(self) -> tuple[Any, ...]:
-        # For pickle: mypyc's compiled frozen dataclasses cannot be unpickled field by field.
-        return (MeshProperties, (self.volume, self.com, self.inertia, self.extent, self.closed,
-                                 self.triangles, self.concavity, self.pieces))
+    def __init__(
+            self,
+            volume: float,
+            com: tuple[float, float, float],
+            inertia: tuple[tuple[float, ...], ...],
+            extent: tuple[float, float, float],
+            closed: bool,
+            triangles: int,
+            concavity: float = 0.0,
+            pieces: int = 1,
+    ) -> None:
+        self.volume = volume
+        self.com = com
+        self.inertia = inertia
+        self.extent = extent
+        self.closed = closed
+        self.triangles = triangles
+        self.concavity = concavity
+        self.pieces = pieces
+
+    def _key(self) -> tuple[Any, ...]:
+        return (
+            self.volume, self.com, self.inertia, self.extent, self.closed, self.triangles,
+            self.concavity, self.pieces)
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not MeshProperties:
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def __repr__(self) -> str:
+        return (f"MeshProperties(volume={self.volume!r}, "
+                f"com={self.com!r}, "
+                f"inertia={self.inertia!r}, "
+                f"extent={self.extent!r}, "
+                f"closed={self.closed!r}, "
+                f"triangles={self.triangles!r}, "
+                f"concavity={self.concavity!r}, "
+                f"pieces={self.pieces!r})")
+
+    def __reduce__(self) -> tuple[Any, ...]:  # for pickle (check's workers hand these back)
+        return (MeshProperties, (
+            self.volume, self.com, self.inertia, self.extent, self.closed, self.triangles,
+            self.concavity, self.pieces))
 
     def trace_for_mass(self, mass: float) -> float | None:
         """Trace of the inertia of this solid with ``mass``, or None without a volume."""
@@ -72,7 +115,6 @@ class MeshProperties:
         return (t[0][0] + t[1][1] + t[2][2]) * mass / self.volume
 
 
-@dataclass(frozen=True)
 class Integrals:
     """A mesh's volume integrals as read, unscaled and signed (what the cache keeps).
 
@@ -85,6 +127,9 @@ class Integrals:
             unscaled).
     """
 
+    __slots__ = (
+        "volume", "first", "second", "low", "high", "closed", "triangles", "concavity", "pieces")
+
     volume: float
     first: tuple[float, float, float]
     second: tuple[float, float, float, float, float, float]
@@ -92,13 +137,59 @@ class Integrals:
     high: tuple[float, float, float]
     closed: bool
     triangles: int
-    concavity: float = 0.0
-    pieces: int = 1
+    concavity: float
+    pieces: int
 
-    def __reduce__(self) -> tuple[Any, ...]:
-        # For pickle (check's workers hand their entries back), as MeshProperties.
-        return (Integrals, (self.volume, self.first, self.second, self.low, self.high,
-                            self.closed, self.triangles, self.concavity, self.pieces))
+    def __init__(
+            self,
+            volume: float,
+            first: tuple[float, float, float],
+            second: tuple[float, float, float, float, float, float],
+            low: tuple[float, float, float],
+            high: tuple[float, float, float],
+            closed: bool,
+            triangles: int,
+            concavity: float = 0.0,
+            pieces: int = 1,
+    ) -> None:
+        self.volume = volume
+        self.first = first
+        self.second = second
+        self.low = low
+        self.high = high
+        self.closed = closed
+        self.triangles = triangles
+        self.concavity = concavity
+        self.pieces = pieces
+
+    def _key(self) -> tuple[Any, ...]:
+        return (
+            self.volume, self.first, self.second, self.low, self.high, self.closed, self.triangles,
+            self.concavity, self.pieces)
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not Integrals:
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def __repr__(self) -> str:
+        return (f"Integrals(volume={self.volume!r}, "
+                f"first={self.first!r}, "
+                f"second={self.second!r}, "
+                f"low={self.low!r}, "
+                f"high={self.high!r}, "
+                f"closed={self.closed!r}, "
+                f"triangles={self.triangles!r}, "
+                f"concavity={self.concavity!r}, "
+                f"pieces={self.pieces!r})")
+
+    def __reduce__(self) -> tuple[Any, ...]:  # for pickle (check's workers hand these back)
+        return (Integrals, (
+            self.volume, self.first, self.second, self.low, self.high, self.closed, self.triangles,
+            self.concavity, self.pieces))
 
     def pack(self) -> bytes:
         """The cache entry's bytes."""
