@@ -243,3 +243,29 @@ def test_a_refusal_of_xacro_input_names_where_the_element_was_written(tmp_path: 
     assert result.exit_code == 2
     (line,) = result.stderr.strip().splitlines()
     assert line.startswith(f"urdfkit: error: {main}: ") and f"(written at {main}:5)" in line
+
+
+def test_a_package_lookup_is_kept_only_while_settled_and_still_noted(tmp_path: Path) -> None:
+    # check walks up to "/" for each package:// mesh of every file: within one run (settled)
+    # the answer is kept, yet every answer notes the paths looked at, for the result cache;
+    # outside a run (view's reloads) a package that appears since is found.
+    from urdfkit.core import deps
+    from urdfkit.sources import uris
+
+    deep = tmp_path / "a" / "b" / "c"
+    deep.mkdir(parents=True)
+    assert uris.find_package("pkg_x", deep) is None
+    with uris.settled():
+        with deps.record() as first:
+            assert uris.find_package("pkg_x", deep) is None
+        (tmp_path / "package.xml").write_text("<package><name>pkg_x</name></package>")
+        with deps.record() as again:  # kept: the run takes the file system as settled
+            assert uris.find_package("pkg_x", deep) is None
+        assert set(again) == set(first) and str(tmp_path / "package.xml") in again
+        assert again[str(tmp_path / "package.xml")] is not None  # signed as it is now
+    assert uris.find_package("pkg_x", deep) == tmp_path  # not settled: looked up again
+    with uris.settled():
+        assert uris.find_package("pkg_x", deep) == tmp_path
+        (tmp_path / "package.xml").unlink()
+        assert uris.find_package("pkg_x", deep) == tmp_path
+    assert uris.find_package("pkg_x", deep) is None

@@ -32,6 +32,7 @@ from urdfkit.model.xmlio import (
     xacro_note,
 )
 from urdfkit.sources.guard import refuse_oversized, run_rules
+from urdfkit.sources.uris import settled
 
 if TYPE_CHECKING:
     from urdfkit.checks.resultcache import ResultCache, RunManifest
@@ -436,12 +437,13 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
         from urdfkit.sources import meshstore as meshes
 
         meshes.load_pack(given)  # before workers fork: they inherit it
-    for n, fr in zip(todo, _run_jobs(work, jobs), strict=True):
-        results[n] = fr
-        if manifest is not None and files[n][2] is None:
-            manifest.add(files[n][0], files[n][1], fr.entry)
-        if fr.meshes:
-            meshes.USED.update(fr.meshes)
+    with settled():  # package lookups made once for the run (its workers fork inside)
+        for n, fr in zip(todo, _run_jobs(work, jobs), strict=True):
+            results[n] = fr
+            if manifest is not None and files[n][2] is None:
+                manifest.add(files[n][0], files[n][1], fr.entry)
+            if fr.meshes:
+                meshes.USED.update(fr.meshes)
     if todo:
         meshes.save_pack(given)
     if manifest is not None:
