@@ -12,7 +12,6 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -45,32 +44,82 @@ ONCE_PER_RUN = frozenset({"U607"})
 _PARALLEL_MIN = 8
 
 
-@dataclass
 class FileResult:
-    """The findings of one file."""
+    """The findings of one file.
+
+    Attributes:
+        file: The file, as the user named it.
+        findings: Its findings.
+        cached: Whether the findings came from the result cache (not in the JSON).
+        entry: What the run's manifest keeps of a cacheable result: the file's stat, the
+            paths it read with their signatures, the findings as dicts
+            (:class:`urdfkit.checks.resultcache.RunManifest`).
+        meshes: The mesh cache entries a worker process used, for the run's pack (not in
+            the JSON).
+
+    Two are equal when their files and findings are.
+    """
+
+    __slots__ = ("file", "findings", "cached", "entry", "meshes")
 
     file: str
-    findings: list[Finding] = field(default_factory=list)
-    #: Whether the findings came from the result cache (not in the JSON).
-    cached: bool = field(default=False, compare=False)
-    #: What the run's manifest keeps of a cacheable result: the file's stat, the paths it
-    #: read with their signatures, the findings as dicts
-    #: (:class:`urdfkit.checks.resultcache.RunManifest`).
-    entry: tuple[tuple[int, int, int, int], dict[str, Any], list[dict[str, Any]]] | None = \
-        field(default=None, compare=False, repr=False)
-    #: The mesh cache entries a worker process used, for the run's pack (not in the JSON).
-    meshes: dict[str, Any] | None = field(default=None, compare=False, repr=False)
+    findings: list[Finding]
+    cached: bool
+    entry: tuple[tuple[int, int, int, int], dict[str, Any], list[dict[str, Any]]] | None
+    meshes: dict[str, Any] | None
+
+    def __init__(
+            self,
+            file: str,
+            findings: list[Finding] | None = None,
+            cached: bool = False,
+            entry: tuple[tuple[int, int, int, int], dict[str, Any],
+                         list[dict[str, Any]]] | None = None,
+            meshes: dict[str, Any] | None = None,
+    ) -> None:
+        self.file = file
+        self.findings = [] if findings is None else findings
+        self.cached = cached
+        self.entry = entry
+        self.meshes = meshes
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not FileResult:
+            return NotImplemented
+        return (self.file, self.findings) == (other.file, other.findings)
+
+    __hash__ = None  # type: ignore[assignment]  # mutable, as a dataclass
+
+    def __repr__(self) -> str:
+        return f"FileResult(file={self.file!r}, findings={self.findings!r}, cached={self.cached!r})"
+
+    def __reduce__(self) -> tuple[Any, ...]:  # for pickle (check's workers hand these back)
+        return (FileResult, (self.file, self.findings, self.cached, self.entry, self.meshes))
 
     def count(self, level: str) -> int:
         """How many findings of ``level``."""
         return sum(1 for f in self.findings if f.level == level)
 
 
-@dataclass
 class CheckResult:
     """The findings of a whole ``check`` run, file by file in discovery order."""
 
+    __slots__ = ("files",)
+
     files: list[FileResult]
+
+    def __init__(self, files: list[FileResult]) -> None:
+        self.files = files
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not CheckResult:
+            return NotImplemented
+        return self.files == other.files
+
+    __hash__ = None  # type: ignore[assignment]  # mutable, as a dataclass
+
+    def __repr__(self) -> str:
+        return f"CheckResult(files={self.files!r})"
 
     @property
     def findings(self) -> list[Finding]:
