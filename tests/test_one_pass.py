@@ -183,3 +183,27 @@ def test_first_keeps_lxml_namespace_rules() -> None:
     assert first(root, "{urn:a}color") is root[0]
     assert first(root, "{*}thing") is root[2]
     assert first(etree.fromstring(b'<r xmlns="urn:d"><color/></r>'), "color") is None
+
+
+@pytest.mark.parametrize("case", ["many-attributes", "namespaced", "entity-in-a-number"])
+def test_the_c_walk_keys_unusual_elements_as_the_python_walk(case: str) -> None:
+    # The C walk keys its memo by the bytes of a plain element's tag, names and numbers; an
+    # element past 32 attributes, with a namespaced attribute, or with a number that is not
+    # one text node (an entity left unresolved) is keyed as in Python. Either way the
+    # findings are the Python walk's, and a plain twin does not take the unusual one's.
+    many = " ".join(f'a{i}="{i}"' for i in range(40))
+    body = {
+        "many-attributes": f'<origin xyz="1 2" {many}/><origin xyz="1 2"/>',
+        "namespaced": '<origin xmlns:q="urn:q" q:xyz="x" xyz="1 2"/><origin xyz="1 2"/>',
+        "entity-in-a-number": '<origin xyz="&e; 0"/><origin xyz="1 0"/><origin xyz="0"/>',
+    }[case]
+    text = (f'<!DOCTYPE robot [<!ENTITY e "1">]><robot name="r"><link name="a"><visual>'
+            f'{body}<geometry><box size="1 1 1"/></geometry></visual></link></robot>')
+    parser = etree.XMLParser(resolve_entities=False, load_dtd=False, no_network=True)
+    for memo_first in (True, False):
+        root = etree.fromstring(text.encode(), parser)
+        order = (True, False) if memo_first else (False, True)
+        docs = {native: Doc(root, native=native) for native in order}
+        found = [[(code, message, el.sourceline) for code, _, message, el in
+                  docs[native].element_findings] for native in (True, False)]
+        assert found[0] == found[1] and found[0], found

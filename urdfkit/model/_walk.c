@@ -114,6 +114,113 @@ static int add_finding(Walk *w, PyObject *code, PyObject *level, PyObject *messa
     return rc;
 }
 
+/* The memo key Doc._check makes, (tag, name, [value if it holds numbers], ...): a tuple
+ * of the strings Python would see. */
+static PyObject *tuple_key(xmlNode *node, xmlAttr *attr, PyObject *tag, PyObject *numeric) {
+    PyObject *parts = PyList_New(1);
+    if (parts == NULL)
+        return NULL;
+    Py_INCREF(tag);
+    PyList_SET_ITEM(parts, 0, tag);
+    for (; attr != NULL; attr = attr->next) {
+        if (attr->type != XML_ATTRIBUTE_NODE)
+            continue;
+        PyObject *name = tag_of((xmlNode *)attr);
+        if (name == NULL || PyList_Append(parts, name) < 0) {
+            Py_XDECREF(name);
+            Py_DECREF(parts);
+            return NULL;
+        }
+        int holds_number = 0;
+        if (numeric != NULL) {
+            holds_number = PyDict_Contains(numeric, name);
+            if (holds_number < 0) {
+                Py_DECREF(name);
+                Py_DECREF(parts);
+                return NULL;
+            }
+        }
+        Py_DECREF(name);
+        if (holds_number) {
+            PyObject *value = value_of(node, attr);
+            if (value == NULL || PyList_Append(parts, value) < 0) {
+                Py_XDECREF(value);
+                Py_DECREF(parts);
+                return NULL;
+            }
+            Py_DECREF(value);
+        }
+    }
+    PyObject *key = PyList_AsTuple(parts);
+    Py_DECREF(parts);
+    return key;
+}
+
+/* The same key as bytes, for a plain element: no attribute in a namespace, at most
+ * PLAIN_MAX attributes, every number-holding value one text node. The tag, the names and
+ * those values, each ended by a NUL (which none can hold): whether a value follows a name
+ * depends only on the tag and the name, so two keys are equal exactly when the tuples are.
+ * No string is made for a value, and the key is one object. Sets *plain to 0, and returns
+ * NULL without an error, for an element that is not plain. */
+#define PLAIN_MAX 32
+static PyObject *bytes_key(xmlAttr *attr, PyObject *tag, PyObject *numeric, int *plain) {
+    const xmlChar *values[PLAIN_MAX];
+    xmlAttr *attrs[PLAIN_MAX];
+    int count = 0;
+    *plain = 0;
+    Py_ssize_t tag_len;
+    const char *tag_utf8 = PyUnicode_AsUTF8AndSize(tag, &tag_len);
+    if (tag_utf8 == NULL)
+        return NULL;
+    size_t size = (size_t)tag_len + 1;
+    for (; attr != NULL; attr = attr->next) {
+        if (attr->type != XML_ATTRIBUTE_NODE)
+            continue;
+        if (count == PLAIN_MAX || (attr->ns != NULL && attr->ns->href != NULL))
+            return NULL;
+        const xmlChar *value = NULL;
+        if (numeric != NULL) {
+            PyObject *name = name_of(attr->name);
+            if (name == NULL)
+                return NULL;
+            int holds_number = PyDict_Contains(numeric, name);
+            Py_DECREF(name);
+            if (holds_number < 0)
+                return NULL;
+            if (holds_number) {
+                xmlNode *text = attr->children;
+                if (text == NULL || text->next != NULL || text->type != XML_TEXT_NODE
+                        || text->content == NULL)
+                    return NULL;
+                value = text->content;
+                size += strlen((const char *)value) + 1;
+            }
+        }
+        size += strlen((const char *)attr->name) + 1;
+        attrs[count] = attr;
+        values[count] = value;
+        count++;
+    }
+    PyObject *key = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)size);
+    if (key == NULL)
+        return NULL;
+    char *at = PyBytes_AS_STRING(key);
+    memcpy(at, tag_utf8, (size_t)tag_len + 1);
+    at += tag_len + 1;
+    for (int i = 0; i < count; i++) {
+        size_t n = strlen((const char *)attrs[i]->name) + 1;
+        memcpy(at, attrs[i]->name, n);
+        at += n;
+        if (values[i] != NULL) {
+            n = strlen((const char *)values[i]) + 1;
+            memcpy(at, values[i], n);
+            at += n;
+        }
+    }
+    *plain = 1;
+    return key;
+}
+
 /* Doc._check: U401-U402 and U801-U802 of one element's attributes, through the memo. */
 static int check(Walk *w, xmlNode *node, PyObject *tag) {
     xmlAttr *attr = node->properties;
@@ -129,44 +236,15 @@ static int check(Walk *w, xmlNode *node, PyObject *tag) {
         if (known <= 0)
             return known;  /* an element no rule knows (or an error) */
     }
-    PyObject *parts = PyList_New(1);
-    if (parts == NULL)
-        return -1;
-    Py_INCREF(tag);
-    PyList_SET_ITEM(parts, 0, tag);
-    for (; attr != NULL; attr = attr->next) {
-        if (attr->type != XML_ATTRIBUTE_NODE)
-            continue;
-        PyObject *name = tag_of((xmlNode *)attr);
-        if (name == NULL || PyList_Append(parts, name) < 0) {
-            Py_XDECREF(name);
-            Py_DECREF(parts);
+    int plain;
+    PyObject *key = bytes_key(attr, tag, numeric, &plain);
+    if (key == NULL) {
+        if (plain || PyErr_Occurred())
             return -1;
-        }
-        int holds_number = 0;
-        if (numeric != NULL) {
-            holds_number = PyDict_Contains(numeric, name);
-            if (holds_number < 0) {
-                Py_DECREF(name);
-                Py_DECREF(parts);
-                return -1;
-            }
-        }
-        Py_DECREF(name);
-        if (holds_number) {
-            PyObject *value = value_of(node, attr);
-            if (value == NULL || PyList_Append(parts, value) < 0) {
-                Py_XDECREF(value);
-                Py_DECREF(parts);
-                return -1;
-            }
-            Py_DECREF(value);
-        }
+        key = tuple_key(node, attr, tag, numeric);
+        if (key == NULL)
+            return -1;
     }
-    PyObject *key = PyList_AsTuple(parts);
-    Py_DECREF(parts);
-    if (key == NULL)
-        return -1;
     PyObject *found = PyDict_GetItemWithError(w->verdicts, key);  /* borrowed */
     if (found != NULL) {
         Py_INCREF(found);
