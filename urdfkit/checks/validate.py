@@ -252,7 +252,7 @@ def rule_inertia(root: etree._Element, r: Report) -> None:
         trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
         eps = 10 * _DBL_EPSILON * max(1.0, trace / 2)
         a, b, c = sym_eigenvalues(tensor)
-        shapes = _shape_trace(link, mass, r)
+        shapes = _shape_trace(link, mass, r, view.collisions)
         if a < -eps:
             r.add("U603", "error", f"inertia of {label(link)} is not positive definite "
                   f"(principal moments {_moments((a, b, c))}); every principal moment must be "
@@ -361,20 +361,22 @@ class Solid:
         return sum(self.tensor[i][i] for i in range(3)) * mass / self.volume
 
 
-def link_solid(link: etree._Element, r: Report | None = None) -> Solid | None:
+def link_solid(link: etree._Element, r: Report | None = None,
+               collisions: list[etree._Element] | None = None) -> Solid | None:
     """The solid the link's collision shapes make: what ``U605`` and ``urdfkit fix`` use.
 
     Primitive shapes use spec's closed forms; STL, OBJ and COLLADA meshes (with ``scale``)
     are integrated by :mod:`urdfkit.sources.meshes` when ``r`` knows the file's folder. Each part's
     tensor is rotated into the link frame and moved to the common centre of mass (parallel
     axes). None if unknown: no collision, a capsule, plane or SDF, a mesh that cannot be read
-    or is not closed, a bad size.
+    or is not closed, a bad size. ``collisions``: the link's ``<collision>`` children, when
+    the caller has them (:class:`~urdfkit.model.index.LinkView`).
     """
     parts: list[tuple[float, tuple[float, ...], Matrix3, float]] = []
     moving: set[str] | None = None
-    for col in link:
-        if col.tag != "collision":
-            continue
+    if collisions is None:
+        collisions = [c for c in link if c.tag == "collision"]
+    for col in collisions:
         # As col.iterfind("geometry/*") and col.find("origin"), in one look at the children.
         shape = origin = None
         for c in col:
@@ -440,12 +442,13 @@ def link_solid(link: etree._Element, r: Report | None = None) -> Solid | None:
     return Solid(total, (cx, cy, cz), out, max(p[3] for p in parts))
 
 
-def _shape_trace(link: etree._Element, mass: float | None,
-                 r: Report | None = None) -> tuple[float, float] | None:
+def _shape_trace(link: etree._Element, mass: float | None, r: Report | None = None,
+                 collisions: list[etree._Element] | None = None
+                 ) -> tuple[float, float] | None:
     """Trace of the inertia of the link's collision solids for ``mass``, and their size."""
     if mass is None or mass <= 0:
         return None
-    solid = link_solid(link, r)
+    solid = link_solid(link, r, collisions)
     if solid is None:
         return None
     trace = solid.trace(mass)

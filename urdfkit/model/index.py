@@ -68,9 +68,10 @@ class LinkView:
         inertial, mass, inertia: The first ``<inertial>``, and its first ``<mass>`` and
             ``<inertia>`` (None when absent).
         parts: Its ``<visual>`` and ``<collision>`` children, in order.
+        collisions: Its ``<collision>`` children, in order.
     """
 
-    __slots__ = ("el", "name", "inertial", "mass", "inertia", "parts")
+    __slots__ = ("el", "name", "inertial", "mass", "inertia", "parts", "collisions")
 
     def __init__(self, el: El) -> None:
         self.el = el
@@ -79,10 +80,13 @@ class LinkView:
         self.mass: El = None
         self.inertia: El = None
         self.parts: list[El] = []
+        self.collisions: list[El] = []
         for c in el:
             tag = c.tag
             if tag == "visual" or tag == "collision":
                 self.parts.append(c)
+                if tag == "collision":
+                    self.collisions.append(c)
             elif tag == "inertial" and self.inertial is None:
                 self.inertial = c
                 for k in c:

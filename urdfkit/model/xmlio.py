@@ -404,7 +404,8 @@ def parse_xml(data: bytes, file: str | Path, *, tolerated: bool = False) -> etre
     if not tolerated:
         data, _ = tolerate_quirks(data)
     try:
-        lines = data.count(b"\n")
+        # Lines are counted only where there can be BIG_LINES of them (a line is a byte).
+        lines = data.count(b"\n") if len(data) >= BIG_LINES else 0
         root = etree.fromstring(data, _parser(lines))
     except etree.XMLSyntaxError as e:
         line = e.lineno if e.lineno else None

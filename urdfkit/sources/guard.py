@@ -592,8 +592,8 @@ def refuse_oversized(data: bytes, file: str) -> None:
     Raises:
         InputError: U209, the same refusal the guard gives.
     """
-    if data.count(b"<link") <= MAX_LOADABLE_LINKS:
-        return  # every <link tag is a "<link" (a count at C speed)
+    if len(data) <= 5 * MAX_LOADABLE_LINKS or data.count(b"<link") <= MAX_LOADABLE_LINKS:
+        return  # every <link tag is a "<link" (five bytes; a count at C speed)
     bound = 0
     for _ in _LINK_TAG.finditer(data):
         bound += 1
