@@ -207,3 +207,61 @@ def test_the_c_walk_keys_unusual_elements_as_the_python_walk(case: str) -> None:
         found = [[(code, message, el.sourceline) for code, _, message, el in
                   docs[native].element_findings] for native in (True, False)]
         assert found[0] == found[1] and found[0], found
+
+
+def _views(root: etree._Element) -> list[tuple[object, ...]]:
+    from urdfkit.model.index import JointView, LinkView, collision_parts
+    from urdfkit.model.spec import SHAPES
+
+    out: list[tuple[object, ...]] = []
+    for el in root.iter("link", "joint", "collision"):
+        if el.tag == "link":
+            v = LinkView(el)
+            out.append((v.inertial, v.mass, v.inertia, *v.parts, None, *v.collisions))
+        elif el.tag == "joint":
+            j = JointView(el)
+            out.append((j.parent, j.child, *j.children, None, j.limit, j.axis, j.origin,
+                        j.mimic))
+        else:
+            out.append(collision_parts(el, SHAPES))
+    return out
+
+
+PART_TAGS = ["visual", "collision", "inertial", "mass", "inertia", "geometry", "origin", "box",
+             "mesh", "sphere", "plane", "parent", "child", "limit", "axis", "mimic",
+             "{urn:x}collision", "{urn:x}box", "{urn:x}origin", "#comment"]
+
+
+@st.composite
+def part_trees(draw: st.DrawFn, tag: str = "robot", depth: int = 0) -> etree._Element:
+    """Links and joints whose children, grandchildren and great-grandchildren are drawn
+    from the names the views read, namespaced twins and comments among them."""
+    el = etree.Element(tag)
+    names = ["link", "joint", "collision"] if depth == 0 else PART_TAGS
+    for _ in range(draw(st.integers(0, 6 if depth < 2 else 3))):
+        name = draw(st.sampled_from(names))
+        if name == "#comment":
+            el.append(etree.Comment("c"))
+        elif depth < 3:
+            el.append(draw(part_trees(name, depth + 1)))
+        else:
+            etree.SubElement(el, name)
+    return el
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(root=st.one_of(trees(), part_trees()))
+def test_the_views_read_in_c_what_they_read_in_python(root: etree._Element) -> None:
+    # LinkView, JointView and collision_parts read children over libxml2's nodes where the
+    # C walk is built: the same elements (the very proxies) as lxml's iteration.
+    import pytest as _pytest
+
+    from urdfkit.model import index
+
+    native = _views(root)
+    with _pytest.MonkeyPatch.context() as mp:
+        mp.setattr(index, "_native", None)
+        python = _views(root)
+    assert len(native) == len(python)
+    for a, b in zip(native, python, strict=True):
+        assert len(a) == len(b) and all(x is y for x, y in zip(a, b, strict=True)), (a, b)

@@ -17,7 +17,7 @@ from typing import Any
 
 from lxml import etree
 
-from urdfkit.model.index import Doc, LinkView, first
+from urdfkit.model.index import Doc, LinkView, collision_parts, first
 from urdfkit.model.spec import (
     LIMITED_JOINT_TYPES,
     MAX_STATE_LINKS,
@@ -377,15 +377,7 @@ def link_solid(link: etree._Element, r: Report | None = None,
     if collisions is None:
         collisions = [c for c in link if c.tag == "collision"]
     for col in collisions:
-        # As col.iterfind("geometry/*") and col.find("origin"), in one look at the children.
-        shape = origin = None
-        for c in col:
-            tag = c.tag
-            if tag == "geometry":
-                if shape is None:
-                    shape = next((s for s in c if s.tag in SHAPES), None)
-            elif tag == "origin" and origin is None:
-                origin = c
+        shape, origin = collision_parts(col, SHAPES)
         xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
         rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
         if shape is None or xyz is None or rpy is None:

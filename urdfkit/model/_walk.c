@@ -447,9 +447,179 @@ static PyObject *py_first(PyObject *self, PyObject *const *args, Py_ssize_t narg
     Py_RETURN_NONE;
 }
 
+/* A child element with a plain name (no namespace): lxml's tag equals `name` exactly then. */
+static int named(xmlNode *c, const char *name) {
+    return c->type == XML_ELEMENT_NODE && (c->ns == NULL || c->ns->href == NULL)
+           && strcmp((const char *)c->name, name) == 0;
+}
+
+/* An element's proxy, or None for no node. */
+static PyObject *proxy(struct LxmlDocument *doc, xmlNode *node) {
+    if (node == NULL)
+        Py_RETURN_NONE;
+    return (PyObject *)elementFactory(doc, node);
+}
+
+static struct LxmlElement *element_arg(PyObject *arg, const char *who) {
+    if (!PyObject_TypeCheck(arg, element_type)) {
+        PyErr_Format(PyExc_TypeError, "%s: an lxml element", who);
+        return NULL;
+    }
+    struct LxmlElement *el = (struct LxmlElement *)arg;
+    if (el->_c_node == NULL) {
+        PyErr_Format(PyExc_ValueError, "%s: an element without a node", who);
+        return NULL;
+    }
+    return el;
+}
+
+PyDoc_STRVAR(link_parts_doc,
+"link_parts(link)\n--\n\n"
+"LinkView's reading of a <link>'s children: (inertial, mass, inertia, parts, collisions),\n"
+"the first <inertial>, its first <mass> and <inertia>, the <visual> and <collision>\n"
+"children in order, and the <collision> ones.");
+
+static PyObject *py_link_parts(PyObject *self, PyObject *arg) {
+    struct LxmlElement *el = element_arg(arg, "link_parts()");
+    if (el == NULL)
+        return NULL;
+    xmlNode *inertial = NULL, *mass = NULL, *inertia = NULL;
+    PyObject *parts = PyList_New(0), *collisions = PyList_New(0);
+    if (parts == NULL || collisions == NULL)
+        goto fail;
+    for (xmlNode *c = el->_c_node->children; c != NULL; c = c->next) {
+        int collision = named(c, "collision");
+        if (collision || named(c, "visual")) {
+            PyObject *part = proxy(el->_doc, c);
+            if (part == NULL || PyList_Append(parts, part) < 0
+                    || (collision && PyList_Append(collisions, part) < 0)) {
+                Py_XDECREF(part);
+                goto fail;
+            }
+            Py_DECREF(part);
+        } else if (inertial == NULL && named(c, "inertial")) {
+            inertial = c;
+            for (xmlNode *k = c->children; k != NULL; k = k->next) {
+                if (mass == NULL && named(k, "mass"))
+                    mass = k;
+                else if (inertia == NULL && named(k, "inertia"))
+                    inertia = k;
+            }
+        }
+    }
+    PyObject *a = proxy(el->_doc, inertial), *b = proxy(el->_doc, mass),
+             *c = proxy(el->_doc, inertia);
+    if (a == NULL || b == NULL || c == NULL) {
+        Py_XDECREF(a);
+        Py_XDECREF(b);
+        Py_XDECREF(c);
+        goto fail;
+    }
+    return Py_BuildValue("(NNNNN)", a, b, c, parts, collisions);
+fail:
+    Py_XDECREF(parts);
+    Py_XDECREF(collisions);
+    return NULL;
+}
+
+PyDoc_STRVAR(joint_parts_doc,
+"joint_parts(joint)\n--\n\n"
+"JointView's reading of a <joint>'s children: (parent, child, children, limit, axis,\n"
+"origin, mimic), the first of each and every <child>.");
+
+static PyObject *py_joint_parts(PyObject *self, PyObject *arg) {
+    static const char *slots[] = {"parent", "limit", "axis", "origin", "mimic"};
+    struct LxmlElement *el = element_arg(arg, "joint_parts()");
+    if (el == NULL)
+        return NULL;
+    xmlNode *found[5] = {NULL, NULL, NULL, NULL, NULL};
+    xmlNode *child = NULL;
+    PyObject *children = PyList_New(0);
+    if (children == NULL)
+        return NULL;
+    for (xmlNode *c = el->_c_node->children; c != NULL; c = c->next) {
+        if (named(c, "child")) {
+            PyObject *one = proxy(el->_doc, c);
+            if (one == NULL || PyList_Append(children, one) < 0) {
+                Py_XDECREF(one);
+                Py_DECREF(children);
+                return NULL;
+            }
+            Py_DECREF(one);
+            if (child == NULL)
+                child = c;
+            continue;
+        }
+        for (int i = 0; i < 5; i++) {
+            if (found[i] == NULL && named(c, slots[i])) {
+                found[i] = c;
+                break;
+            }
+        }
+    }
+    PyObject *out[6];
+    xmlNode *nodes[6] = {found[0], child, found[1], found[2], found[3], found[4]};
+    for (int i = 0; i < 6; i++) {
+        out[i] = proxy(el->_doc, nodes[i]);
+        if (out[i] == NULL) {
+            for (int j = 0; j < i; j++)
+                Py_DECREF(out[j]);
+            Py_DECREF(children);
+            return NULL;
+        }
+    }
+    return Py_BuildValue("(NNNNNNN)", out[0], out[1], children, out[2], out[3], out[4],
+                         out[5]);
+}
+
+PyDoc_STRVAR(collision_parts_doc,
+"collision_parts(collision, shapes)\n--\n\n"
+"(shape, origin) of a <collision>: the first child named in `shapes` of its <geometry>\n"
+"children (in order), and its first <origin>; None for either when absent.");
+
+static PyObject *py_collision_parts(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 2 || !PyTuple_Check(args[1])) {
+        PyErr_SetString(PyExc_TypeError, "collision_parts(collision, shapes): a tuple of names");
+        return NULL;
+    }
+    struct LxmlElement *el = element_arg(args[0], "collision_parts()");
+    if (el == NULL)
+        return NULL;
+    xmlNode *shape = NULL, *origin = NULL;
+    for (xmlNode *c = el->_c_node->children; c != NULL; c = c->next) {
+        if (shape == NULL && named(c, "geometry")) {
+            for (xmlNode *s = c->children; s != NULL && shape == NULL; s = s->next) {
+                if (s->type != XML_ELEMENT_NODE || is_namespaced(s))
+                    continue;
+                PyObject *name = name_of(s->name);
+                if (name == NULL)
+                    return NULL;
+                int known = PySequence_Contains(args[1], name);
+                Py_DECREF(name);
+                if (known < 0)
+                    return NULL;
+                if (known)
+                    shape = s;
+            }
+        } else if (origin == NULL && named(c, "origin")) {
+            origin = c;
+        }
+    }
+    PyObject *a = proxy(el->_doc, shape), *b = a == NULL ? NULL : proxy(el->_doc, origin);
+    if (b == NULL) {
+        Py_XDECREF(a);
+        return NULL;
+    }
+    return Py_BuildValue("(NN)", a, b);
+}
+
 static PyMethodDef methods[] = {
     {"walk", (PyCFunction)(void (*)(void))py_walk, METH_FASTCALL, walk_doc},
     {"first", (PyCFunction)(void (*)(void))py_first, METH_FASTCALL, first_doc},
+    {"link_parts", (PyCFunction)py_link_parts, METH_O, link_parts_doc},
+    {"joint_parts", (PyCFunction)py_joint_parts, METH_O, joint_parts_doc},
+    {"collision_parts", (PyCFunction)(void (*)(void))py_collision_parts, METH_FASTCALL,
+     collision_parts_doc},
     {NULL, NULL, 0, NULL},
 };
 

@@ -46,6 +46,27 @@ except ImportError:  # a plain-Python install, or an lxml whose C API it was not
 NATIVE_WALK = _native is not None
 
 
+def collision_parts(col: El, shapes: tuple[str, ...]) -> tuple[El, El]:
+    """(shape, origin) of a ``<collision>``, None for either when absent.
+
+    The shape is the first child of its ``<geometry>`` children (in order) whose tag is in
+    ``shapes``; the origin its first ``<origin>``. As ``col.iterfind("geometry/*")`` filtered
+    and ``col.find("origin")``, in one look at the children (over libxml2's nodes where the C
+    walk is built).
+    """
+    if _native is not None:
+        return _native.collision_parts(col, shapes)
+    shape = origin = None
+    for c in col:
+        tag = c.tag
+        if tag == "geometry":
+            if shape is None:
+                shape = next((s for s in c if s.tag in shapes), None)
+        elif tag == "origin" and origin is None:
+            origin = c
+    return shape, origin
+
+
 def first(el: El, tag: str) -> El:
     """``el.find(tag)`` for a plain tag name, filtered in C (``find`` goes through ElementPath)."""
     if _native is not None and tag.isalnum():  # a plain name ("{ns}x", "*": lxml's rules)
@@ -81,6 +102,10 @@ class LinkView:
         self.inertia: El = None
         self.parts: list[El] = []
         self.collisions: list[El] = []
+        if _native is not None:  # the same reading over libxml2's nodes, no proxy per child
+            (self.inertial, self.mass, self.inertia, self.parts,
+             self.collisions) = _native.link_parts(el)
+            return
         for c in el:
             tag = c.tag
             if tag == "visual" or tag == "collision":
@@ -120,6 +145,10 @@ class JointView:
         self.axis: El = None
         self.origin: El = None
         self.mimic: El = None
+        if _native is not None:  # the same reading over libxml2's nodes, no proxy per child
+            (self.parent, self.child, self.children, self.limit, self.axis, self.origin,
+             self.mimic) = _native.joint_parts(el)
+            return
         for c in el:
             tag = c.tag
             if tag == "child":
