@@ -33,6 +33,7 @@ COMPILED = [
     "urdfkit/model/index.py",
     "urdfkit/model/xmlio.py",
     "urdfkit/sources/guard.py",
+    "urdfkit/sources/meshdata.py",
     "urdfkit/sources/meshstore.py",
     "urdfkit/checks/validate.py",
     "urdfkit/checks/check.py",

@@ -44,7 +44,7 @@ def box_obj(size: tuple[float, float, float] = (1.0, 1.0, 1.0), *, quads: bool =
     return newline.join(lines) + newline
 
 
-def check_box(props: meshes.MeshProperties | None, size: tuple[float, float, float],
+def check_box(props: meshstore.MeshProperties | None, size: tuple[float, float, float],
               centred: bool = False) -> None:
     assert props is not None and props.closed
     volume = solid_volume("box", list(size))
@@ -72,7 +72,7 @@ def test_obj_box_matches_the_closed_form(tmp_path: Path, quads: bool, style: str
     path = tmp_path / "box.obj"
     path.write_text(box_obj((0.2, 0.5, 1.5), quads=quads, style=style, newline=newline,
                             flip=flip))
-    check_box(meshes.properties(path), (0.2, 0.5, 1.5))
+    check_box(meshstore.properties(path), (0.2, 0.5, 1.5))
 
 
 @pytest.mark.parametrize("scale", [(2.0, 0.5, 3.0), (-1.0, 1.0, 1.0), (0.001, 0.001, 0.001),
@@ -83,7 +83,7 @@ def test_scale_applied_in_closed_form_equals_a_scaled_file(tmp_path: Path,
     unit, scaled = tmp_path / "unit.obj", tmp_path / "scaled.obj"
     unit.write_text(box_obj(quads=False))
     scaled.write_text(box_obj(scale, quads=False))
-    a, b = meshes.properties(unit, scale), meshes.properties(scaled)
+    a, b = meshstore.properties(unit, scale), meshstore.properties(scaled)
     assert a is not None and b is not None
     assert a.volume == pytest.approx(b.volume) == pytest.approx(abs(math.prod(scale)))
     assert a.com == pytest.approx(b.com)
@@ -93,15 +93,15 @@ def test_scale_applied_in_closed_form_equals_a_scaled_file(tmp_path: Path,
 
 
 def test_binary_stl_cube_and_open_surface() -> None:
-    check_box(meshes.properties(FIXTURES / "unit_cube.stl"), (1.0, 1.0, 1.0), centred=True)
-    props = meshes.properties(FIXTURES / "open_triangle.stl")
+    check_box(meshstore.properties(FIXTURES / "unit_cube.stl"), (1.0, 1.0, 1.0), centred=True)
+    props = meshstore.properties(FIXTURES / "open_triangle.stl")
     assert props is not None and not props.closed and props.trace_for_mass(1.0) is None
 
 
 def test_real_meshes_agree_with_trimesh() -> None:
     trimesh = pytest.importorskip("trimesh")
     for name in ("duck_vhacd.obj", "random_urdfs/000/000.obj", "sphere_smooth.obj"):
-        ours = meshes.properties(DATA / name)
+        ours = meshstore.properties(DATA / name)
         theirs = trimesh.load(DATA / name, force="mesh", process=False)
         assert ours is not None and ours.closed, name
         assert ours.volume == pytest.approx(theirs.volume, rel=1e-9), name
@@ -125,14 +125,14 @@ def test_real_meshes_agree_with_trimesh() -> None:
 def test_broken_meshes_are_unreadable_not_a_crash(tmp_path: Path, text: str) -> None:
     path = tmp_path / "bad.obj"
     path.write_text(text)
-    assert meshes.properties(path) is None
+    assert meshstore.properties(path) is None
 
 
 def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
                                                         monkeypatch: pytest.MonkeyPatch) -> None:
     path = tmp_path / "box.obj"
     path.write_text(box_obj((1.0, 2.0, 3.0)))
-    check_box(meshes.properties(path), (1.0, 2.0, 3.0))
+    check_box(meshstore.properties(path), (1.0, 2.0, 3.0))
     entries = list((tmp_path / "cache" / "meshes-4").iterdir())
     assert len(entries) == 1
     # A new process (empty memory) reads the entry, not the mesh.
@@ -142,19 +142,19 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
         raise AssertionError("the mesh was read again")
 
     monkeypatch.setattr(meshes, "read_integrals", refuse)
-    check_box(meshes.properties(path, (2.0, 2.0, 2.0)), (2.0, 4.0, 6.0))
+    check_box(meshstore.properties(path, (2.0, 2.0, 2.0)), (2.0, 4.0, 6.0))
     monkeypatch.undo()
     monkeypatch.setenv("URDFKIT_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.setattr(meshstore, "_MEMORY", {})
     # An edit (new size and time) is a new key: the new box, never the old one's values.
     path.write_text(box_obj((3.0, 2.0, 1.0)))
     os.utime(path, ns=(1, 1))
-    check_box(meshes.properties(path), (3.0, 2.0, 1.0))
+    check_box(meshstore.properties(path), (3.0, 2.0, 1.0))
     # A damaged entry is read past and rewritten.
     for entry in (tmp_path / "cache" / "meshes-4").iterdir():
         entry.write_bytes(b"garbage")
     monkeypatch.setattr(meshstore, "_MEMORY", {})
-    check_box(meshes.properties(path), (3.0, 2.0, 1.0))
+    check_box(meshstore.properties(path), (3.0, 2.0, 1.0))
     good = [e for e in (tmp_path / "cache" / "meshes-4").iterdir()
             if e.read_bytes().startswith(b"M4")]
     assert len(good) == 1  # the current key's, rewritten (the first box's stays unused)
@@ -165,7 +165,7 @@ def test_empty_cache_dir_turns_the_cache_off(tmp_path: Path,
     monkeypatch.setenv("URDFKIT_CACHE_DIR", "")
     path = tmp_path / "box.obj"
     path.write_text(box_obj())
-    check_box(meshes.properties(path), (1.0, 1.0, 1.0))
+    check_box(meshstore.properties(path), (1.0, 1.0, 1.0))
     assert not (tmp_path / "cache").exists()
 
 
@@ -175,7 +175,7 @@ def test_unwritable_cache_is_skipped(tmp_path: Path, monkeypatch: pytest.MonkeyP
     monkeypatch.setenv("URDFKIT_CACHE_DIR", str(blocker))
     path = tmp_path / "box.obj"
     path.write_text(box_obj())
-    check_box(meshes.properties(path), (1.0, 1.0, 1.0))
+    check_box(meshstore.properties(path), (1.0, 1.0, 1.0))
 
 
 def box_dae(*, unit: float = 0.001, up: str = "Y_UP", node: str = "") -> str:
@@ -222,7 +222,7 @@ def pybullet_aabb(p, client: int, mesh: Path, workdir: Path) -> tuple:  # type: 
 def test_dae_is_placed_as_pybullet_places_it(tmp_path: Path, node: str, pb) -> None:
     path = tmp_path / "box.dae"
     path.write_text(box_dae(node=node))
-    props = meshes.properties(path)
+    props = meshstore.properties(path)
     assert props is not None and props.closed
     assert props.volume == pytest.approx(0.1 * 0.2 * 0.3)  # <unit meter="0.001">
     assert sorted(props.extent) == pytest.approx([0.1, 0.2, 0.3])
@@ -282,16 +282,16 @@ def test_a_run_s_pack_serves_the_next_run_and_follows_edits(
         raise AssertionError("the mesh was read again")
 
     monkeypatch.setattr(meshes, "read_integrals", refuse)
-    assert meshes.load_pack([str(folder)]) == 1
-    check_box(meshes.properties(folder / "box.obj"), (1.0, 2.0, 3.0))
+    assert meshstore.load_pack([str(folder)]) == 1
+    check_box(meshstore.properties(folder / "box.obj"), (1.0, 2.0, 3.0))
     monkeypatch.undo()
     monkeypatch.setenv("URDFKIT_CACHE_DIR", str(tmp_path / "cache"))
     # An edited mesh misses the pack: its new values, never the packed ones.
     (folder / "box.obj").write_text(box_obj((3.0, 2.0, 1.0)))
     os.utime(folder / "box.obj", ns=(1, 1))
     _new_process(monkeypatch)
-    meshes.load_pack([str(folder)])
-    check_box(meshes.properties(folder / "box.obj"), (3.0, 2.0, 1.0))
+    meshstore.load_pack([str(folder)])
+    check_box(meshstore.properties(folder / "box.obj"), (3.0, 2.0, 1.0))
 
 
 def test_a_damaged_pack_is_ignored_whole(tmp_path: Path,
@@ -308,7 +308,7 @@ def test_a_damaged_pack_is_ignored_whole(tmp_path: Path,
                     b"garbage"):
         pack.write_bytes(damaged)
         _new_process(monkeypatch)
-        assert meshes.load_pack([str(folder)]) == 0
+        assert meshstore.load_pack([str(folder)]) == 0
         assert meshstore._MEMORY == {}
 
 
@@ -318,13 +318,13 @@ def test_packs_are_capped(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
     monkeypatch.setattr(meshstore, "MAX_PACKS", 3)
     for n in range(6):
         _new_process(monkeypatch)
-        meshes.properties(folder / "box.obj")
-        assert meshes.save_pack([str(folder), f"run{n}"])
+        meshstore.properties(folder / "box.obj")
+        assert meshstore.save_pack([str(folder), f"run{n}"])
     assert len(list((tmp_path / "cache" / "mesh-packs-2").iterdir())) == 3
     _new_process(monkeypatch)
-    meshes.properties(folder / "box.obj")
-    assert meshes.load_pack([str(folder), "run5"]) == 1
-    assert not meshes.save_pack([str(folder), "run5"])  # the same entries: not rewritten
+    meshstore.properties(folder / "box.obj")
+    assert meshstore.load_pack([str(folder), "run5"]) == 1
+    assert not meshstore.save_pack([str(folder), "run5"])  # the same entries: not rewritten
 
 
 def test_workers_hand_their_entries_to_the_run_s_pack(
@@ -337,7 +337,7 @@ def test_workers_hand_their_entries_to_the_run_s_pack(
     _new_process(monkeypatch)
     check_paths([tmp_path / "robots"], jobs=2, cache=False)
     _new_process(monkeypatch)
-    assert meshes.load_pack([str(tmp_path / "robots")]) == 16
+    assert meshstore.load_pack([str(tmp_path / "robots")]) == 16
 
 
 @settings(max_examples=200, deadline=None)
@@ -403,7 +403,7 @@ def test_a_seam_open_by_a_rounding_step_is_closed(tmp_path: Path) -> None:
     raw = np.frombuffer(path.read_bytes()[84:], dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)),
                                                        ("a", "<u2")])["v"].reshape(-1, 3)
     assert len(np.unique(raw, axis=0)) == 9  # the crack is really in the file: 9 points, not 8
-    check_box(meshes.properties(path), (size, size, size))
+    check_box(meshstore.properties(path), (size, size, size))
 
 
 @pytest.mark.parametrize("how", ["wide crack", "missing triangle"])
@@ -411,5 +411,5 @@ def test_a_real_gap_stays_open(tmp_path: Path, how: str) -> None:
     size = 0.075
     path = _stl_box(tmp_path / "open.stl", size, crack=size * 1e-3) if how == "wide crack" \
         else _stl_box(tmp_path / "open.stl", size, drop=3)
-    props = meshes.properties(path)
+    props = meshstore.properties(path)
     assert props is not None and not props.closed

@@ -396,7 +396,7 @@ def _concave_links(resolved: Resolved, packages: Mapping[str, Path] | None) -> s
     """Links with a collision mesh PyBullet replaces by its convex hull, concave or not."""
     from urdfkit.model.spec import attr_vec
     from urdfkit.sources.guard import reference
-    from urdfkit.sources.meshes import CONCAVE_FRACTION, properties
+    from urdfkit.sources.meshstore import CONCAVE_FRACTION, properties
 
     base = resolved.source.resolve().parent
     out = set()

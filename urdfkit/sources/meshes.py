@@ -1,17 +1,18 @@
 """Mass properties of mesh files, for the mesh-aware physics checks (no trimesh needed).
 
-About half of the links of real robots collide only through meshes. :func:`properties` reads
-an STL (binary or ASCII), OBJ or COLLADA (.dae) file, placed as PyBullet places it, applies
-``<mesh scale>``, and returns the solid's volume, centre of mass and inertia per unit density
-by the signed-tetrahedron method (each triangle with the origin spans a tetrahedron; summed
-with signs, they give the closed solid's integrals). It also says whether the surface is
-closed (every edge shared by exactly two triangles), since a mesh with holes has no
-meaningful volume.
+About half of the links of real robots collide only through meshes. :func:`read_integrals`
+reads an STL (binary or ASCII), OBJ or COLLADA (.dae) file, placed as PyBullet places it, and
+integrates it by the signed-tetrahedron method (each triangle with the origin spans a
+tetrahedron; summed with signs, they give the closed solid's integrals). It also says whether
+the surface is closed (every edge shared by exactly two triangles), since a mesh with holes
+has no meaningful volume.
 
 Reading and integrating a mesh costs far more than checking the URDF that names it, so the
-integrals are kept, unscaled, in urdfkit's cache (:mod:`urdfkit.sources.cache`), keyed by the file's
-absolute path, size, modification time and inode: a second ``check`` of the same robots reads
-no mesh. Any ``scale`` is applied to the integrals in closed form.
+integrals are kept, unscaled, in urdfkit's cache (:mod:`urdfkit.sources.cache`), keyed by
+the file's absolute path, size, modification time and inode: a second ``check`` of the same
+robots reads no mesh. :func:`urdfkit.sources.meshstore.properties` is the lookup the rules
+call (memory, the cache, the run's pack, and this module on a miss); any ``<mesh scale>`` is
+applied to the integrals in closed form (:meth:`~urdfkit.sources.meshdata.Integrals.scaled`).
 """
 
 from __future__ import annotations
@@ -24,18 +25,7 @@ from typing import Any
 
 from urdfkit.core.errors import InputError
 from urdfkit.model.spec import axis_angle_matrix
-
-# The lookup, the cache entries and the pack (compiled with the check path), named here too.
-from urdfkit.sources.meshstore import (  # noqa: F401 - re-exported
-    CONCAVE_FRACTION,
-    MAX_MESH_BYTES,
-    USED,
-    Integrals,
-    MeshProperties,
-    load_pack,
-    properties,
-    save_pack,
-)
+from urdfkit.sources.meshdata import MAX_MESH_BYTES, Integrals
 
 
 def read_integrals(path: Path, suffix: str | None = None, *,
