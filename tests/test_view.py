@@ -396,11 +396,25 @@ def browser() -> Iterator[Any]:
         b.close()
 
 
-def _open_page(browser: Any, v: Viewer) -> Any:
-    page = browser.new_page(viewport={"width": 1000, "height": 700})
-    page.goto(v.url)
-    page.get_by_text("Connected").wait_for(timeout=30000)
-    return page
+@pytest.fixture
+def page_of(browser: Any) -> Iterator[Any]:
+    """Open a viewer's page, connected; every page a test opens is closed after it.
+
+    A page left open keeps drawing WebGL in software: a dozen of them starved the last
+    tests of the module of CPU on a 2-core machine (their clicks timed out in CI).
+    """
+    opened: list[Any] = []
+
+    def open_page(v: Viewer) -> Any:
+        page = browser.new_page(viewport={"width": 1000, "height": 700})
+        opened.append(page)
+        page.goto(v.url)
+        page.get_by_text("Connected").wait_for(timeout=30000)
+        return page
+
+    yield open_page
+    for page in opened:
+        page.close()
 
 
 def _pixels(page: Any, colour: str = "green", path: Path | None = None) -> int:
@@ -422,18 +436,18 @@ def _pixels(page: Any, colour: str = "green", path: Path | None = None) -> int:
     return int(((r > g + 40) & (g > b + 40)).sum())
 
 
-def test_page_connects_and_draws_the_robot(browser: Any, arm: Path, viewer_of: Any,
+def test_page_connects_and_draws_the_robot(page_of: Any, arm: Path, viewer_of: Any,
                                            tmp_path: Path) -> None:
     v = viewer_of(arm)
-    page = _open_page(browser, v)
+    page = page_of(v)
     assert _wait(lambda: _pixels(page) > 2000, 30), "no robot pixels on the page"
     assert page.get_by_text("arm", exact=False).first.is_visible()
 
 
-def test_slider_in_the_page_moves_pybullet_and_the_scene(browser: Any, arm: Path,
+def test_slider_in_the_page_moves_pybullet_and_the_scene(page_of: Any, arm: Path,
                                                          viewer_of: Any) -> None:
     v = viewer_of(arm)
-    page = _open_page(browser, v)
+    page = page_of(v)
     thumb = page.locator("[role=slider][aria-valuemin='-1.5']")
     thumb.focus()
     page.keyboard.press("End")  # to the upper limit, as a keyboard user does
@@ -446,9 +460,9 @@ def test_slider_in_the_page_moves_pybullet_and_the_scene(browser: Any, arm: Path
     assert _wait(lambda: thumb.get_attribute("aria-valuenow") == "0", 10)
 
 
-def test_collision_toggle_in_the_page(browser: Any, arm: Path, viewer_of: Any) -> None:
+def test_collision_toggle_in_the_page(page_of: Any, arm: Path, viewer_of: Any) -> None:
     v = viewer_of(arm)
-    page = _open_page(browser, v)
+    page = page_of(v)
     page.get_by_label("Collision", exact=True).check()
     assert _wait(lambda: v.visible("collision"), 10)
     page.get_by_label("Visual").uncheck()
@@ -457,13 +471,13 @@ def test_collision_toggle_in_the_page(browser: Any, arm: Path, viewer_of: Any) -
     assert _wait(lambda: _pixels(page) < 20 and _pixels(page, "orange") > 2000, 10)
 
 
-def test_finding_and_reload_error_shown_in_the_page(browser: Any, tmp_path: Path,
+def test_finding_and_reload_error_shown_in_the_page(page_of: Any, tmp_path: Path,
                                                    viewer_of: Any) -> None:
     path = tmp_path / "bad.urdf"
     path.write_text(U604)
     line = next(i for i, text in enumerate(U604.splitlines(), 1) if 'izz="0.5"' in text)
     v = viewer_of(path, inertia_from_file=True)
-    page = _open_page(browser, v)
+    page = page_of(v)
     page.get_by_text(f"{path}:{line}").wait_for(timeout=10000)
     # Red where the error is: the tinted link's pixels are in the picture.
     assert _wait(lambda: _pixels(page, "red") > 500, 20)
@@ -504,12 +518,12 @@ def test_selecting_a_link_highlights_it_and_shows_its_joint_row(tmp_path: Path,
 
 
 def test_clicking_a_finding_and_choosing_a_link_in_the_page_select_it(
-        browser: Any, tmp_path: Path, viewer_of: Any) -> None:
+        page_of: Any, tmp_path: Path, viewer_of: Any) -> None:
     path = tmp_path / "bad.urdf"
     path.write_text(U604)
     line = next(i for i, text in enumerate(U604.splitlines(), 1) if 'izz="0.5"' in text)
     v = viewer_of(path, inertia_from_file=True)
-    page = _open_page(browser, v)
+    page = page_of(v)
     # The finding's button in the page selects the link it is about, on the server.
     page.get_by_role("button", name=f"U604 line {line}: upper").click()
     assert _wait(lambda: v.selected == "upper", 10)
