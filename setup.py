@@ -28,6 +28,7 @@ from setuptools.command.build_ext import build_ext
 #: The check path, compiled by mypyc. Tests patch none of their functions (a compiled module
 #: calls its own functions directly, so a patch would not reach them).
 COMPILED = [
+    "urdfkit/core/record.py",
     "urdfkit/core/finding.py",
     "urdfkit/model/spec.py",
     "urdfkit/model/index.py",

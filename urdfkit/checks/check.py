@@ -20,6 +20,7 @@ from lxml import etree
 from urdfkit.checks.validate import ALL_RULES
 from urdfkit.core.errors import InputError, ParameterError, XacroNotExpanded
 from urdfkit.core.finding import LEVELS, Finding
+from urdfkit.core.record import Record
 from urdfkit.model.spec import PYBULLET_LINE_BYTES
 from urdfkit.model.xmlio import (
     line_of,
@@ -44,7 +45,7 @@ ONCE_PER_RUN = frozenset({"U607"})
 _PARALLEL_MIN = 8
 
 
-class FileResult:
+class FileResult(Record):
     """The findings of one file.
 
     Attributes:
@@ -61,6 +62,8 @@ class FileResult:
     """
 
     __slots__ = ("file", "findings", "cached", "entry", "meshes")
+    _FIELDS = ("file", "findings", "cached", "entry", "meshes")
+    _COMPARED = ("file", "findings")
 
     file: str
     findings: list[Finding]
@@ -83,43 +86,25 @@ class FileResult:
         self.entry = entry
         self.meshes = meshes
 
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not FileResult:
-            return NotImplemented
-        return (self.file, self.findings) == (other.file, other.findings)
-
     __hash__ = None  # type: ignore[assignment]  # mutable, as a dataclass
-
-    def __repr__(self) -> str:
-        return f"FileResult(file={self.file!r}, findings={self.findings!r}, cached={self.cached!r})"
-
-    def __reduce__(self) -> tuple[Any, ...]:  # for pickle (check's workers hand these back)
-        return (FileResult, (self.file, self.findings, self.cached, self.entry, self.meshes))
 
     def count(self, level: str) -> int:
         """How many findings of ``level``."""
         return sum(1 for f in self.findings if f.level == level)
 
 
-class CheckResult:
+class CheckResult(Record):
     """The findings of a whole ``check`` run, file by file in discovery order."""
 
     __slots__ = ("files",)
+    _FIELDS = ("files",)
 
     files: list[FileResult]
 
     def __init__(self, files: list[FileResult]) -> None:
         self.files = files
 
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not CheckResult:
-            return NotImplemented
-        return self.files == other.files
-
     __hash__ = None  # type: ignore[assignment]  # mutable, as a dataclass
-
-    def __repr__(self) -> str:
-        return f"CheckResult(files={self.files!r})"
 
     @property
     def findings(self) -> list[Finding]:

@@ -17,6 +17,7 @@ from typing import Any
 
 from lxml import etree
 
+from urdfkit.core.record import Record
 from urdfkit.model.index import Doc, LinkView, collision_parts, first
 from urdfkit.model.spec import (
     LIMITED_JOINT_TYPES,
@@ -301,7 +302,7 @@ def _shapes_fix(shapes: tuple[float, float] | None) -> str:
             f"ixx=iyy=izz={shapes[0] / 3:.4g} with products 0")
 
 
-class Solid:
+class Solid(Record):
     """A link's collision shapes as one solid of uniform density.
 
     Attributes:
@@ -313,6 +314,7 @@ class Solid:
     """
 
     __slots__ = ("volume", "com", "tensor", "size")
+    _FIELDS = ("volume", "com", "tensor", "size")
 
     volume: float
     com: tuple[float, float, float]
@@ -330,26 +332,6 @@ class Solid:
         self.com = com
         self.tensor = tensor
         self.size = size
-
-    def _key(self) -> tuple[Any, ...]:
-        return (self.volume, self.com, self.tensor, self.size)
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not Solid:
-            return NotImplemented
-        return self._key() == other._key()
-
-    def __hash__(self) -> int:
-        return hash(self._key())
-
-    def __repr__(self) -> str:
-        return (f"Solid(volume={self.volume!r}, "
-                f"com={self.com!r}, "
-                f"tensor={self.tensor!r}, "
-                f"size={self.size!r})")
-
-    def __reduce__(self) -> tuple[Any, ...]:  # for pickle (check's workers hand these back)
-        return (Solid, (self.volume, self.com, self.tensor, self.size))
 
     def inertia(self, mass: float) -> tuple[tuple[float, float, float], ...]:
         """The inertia tensor about ``com`` for a total ``mass``."""

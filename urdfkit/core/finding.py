@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from urdfkit.core.record import Record
+
 #: Finding levels, lowest first.
 LEVELS = ("info", "warning", "error")
 
 
-class Finding:
+class Finding(Record):
     """One problem found in a file.
 
     Attributes:
@@ -19,6 +21,7 @@ class Finding:
     """
 
     __slots__ = ("code", "level", "message", "file", "line", "origin")
+    _FIELDS = ("code", "level", "message", "file", "line", "origin")
 
     code: str
     level: str
@@ -42,28 +45,6 @@ class Finding:
         self.file = file
         self.line = line
         self.origin = origin
-
-    def _key(self) -> tuple[object, ...]:
-        return (self.code, self.level, self.message, self.file, self.line, self.origin)
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not Finding:
-            return NotImplemented
-        return self._key() == other._key()
-
-    def __hash__(self) -> int:
-        return hash(self._key())
-
-    def __repr__(self) -> str:
-        return (f"Finding(code={self.code!r}, "
-                f"level={self.level!r}, "
-                f"message={self.message!r}, "
-                f"file={self.file!r}, "
-                f"line={self.line!r}, "
-                f"origin={self.origin!r})")
-
-    def __reduce__(self) -> tuple[object, ...]:  # for pickle (check's workers hand these back)
-        return (Finding, (self.code, self.level, self.message, self.file, self.line, self.origin))
 
     def to_dict(self) -> dict[str, object]:
         """The JSON form."""

@@ -22,6 +22,7 @@ from lxml import etree
 from urdfkit.core import deps
 from urdfkit.core.errors import InputError, Oversized
 from urdfkit.core.finding import Finding
+from urdfkit.core.record import Record
 from urdfkit.model.index import Doc, first
 from urdfkit.model.spec import (
     CRASH_NAME_BYTES,
@@ -426,7 +427,7 @@ def rule_inertial(root: etree._Element, r: Report) -> None:
                   "of a symmetric body)", inertia)
 
 
-class Reference:
+class Reference(Record):
     """What a ``filename`` attribute points at, and what is wrong with it, if anything.
 
     Paths are kept as strings (check resolves one per mesh of every file; a Path costs ~4 us
@@ -439,6 +440,8 @@ class Reference:
     """
 
     __slots__ = ("file", "load", "code", "level", "message", "stat")
+    _FIELDS = ("file", "load", "code", "level", "message", "stat")
+    _COMPARED = ("file", "load", "code", "level", "message")
 
     file: str | None
     load: str | None
@@ -465,27 +468,6 @@ class Reference:
         self.message = message
         self.stat = stat
 
-    def _key(self) -> tuple[Any, ...]:
-        return (self.file, self.load, self.code, self.level, self.message)
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not Reference:
-            return NotImplemented
-        return self._key() == other._key()
-
-    def __hash__(self) -> int:
-        return hash(self._key())
-
-    def __repr__(self) -> str:
-        return (f"Reference(file={self.file!r}, "
-                f"load={self.load!r}, "
-                f"code={self.code!r}, "
-                f"level={self.level!r}, "
-                f"message={self.message!r})")
-
-    def __reduce__(self) -> tuple[Any, ...]:  # for pickle (check's workers hand these back)
-        return (Reference, (self.file, self.load, self.code, self.level, self.message, self.stat))
-
     @property
     def path(self) -> Path | None:
         """The file it means."""
@@ -495,7 +477,6 @@ class Reference:
     def load_path(self) -> Path | None:
         """What PyBullet must be given."""
         return None if self.load is None else Path(self.load)
-
 
 
 #: What ends a folder's name (os.path.join adds no separator after one).

@@ -9,7 +9,8 @@ check's path (setup.py).
 from __future__ import annotations
 
 import struct
-from typing import Any
+
+from urdfkit.core.record import Record
 
 #: Largest mesh file read for checks; bigger ones are skipped (checks must stay fast).
 MAX_MESH_BYTES = 16 * 1024 * 1024
@@ -19,7 +20,7 @@ CONCAVE_FRACTION = 0.02
 MESH_SUFFIXES = (".stl", ".obj", ".dae")
 
 
-class MeshProperties:
+class MeshProperties(Record):
     """A closed triangle mesh as a solid of unit density (scaled).
 
     Attributes:
@@ -37,6 +38,8 @@ class MeshProperties:
     """
 
     __slots__ = ("volume", "com", "inertia", "extent", "closed", "triangles", "concavity", "pieces")
+    _FIELDS = (
+        "volume", "com", "inertia", "extent", "closed", "triangles", "concavity", "pieces")
 
     volume: float
     com: tuple[float, float, float]
@@ -67,34 +70,6 @@ class MeshProperties:
         self.concavity = concavity
         self.pieces = pieces
 
-    def _key(self) -> tuple[Any, ...]:
-        return (
-            self.volume, self.com, self.inertia, self.extent, self.closed, self.triangles,
-            self.concavity, self.pieces)
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not MeshProperties:
-            return NotImplemented
-        return self._key() == other._key()
-
-    def __hash__(self) -> int:
-        return hash(self._key())
-
-    def __repr__(self) -> str:
-        return (f"MeshProperties(volume={self.volume!r}, "
-                f"com={self.com!r}, "
-                f"inertia={self.inertia!r}, "
-                f"extent={self.extent!r}, "
-                f"closed={self.closed!r}, "
-                f"triangles={self.triangles!r}, "
-                f"concavity={self.concavity!r}, "
-                f"pieces={self.pieces!r})")
-
-    def __reduce__(self) -> tuple[Any, ...]:  # for pickle (check's workers hand these back)
-        return (MeshProperties, (
-            self.volume, self.com, self.inertia, self.extent, self.closed, self.triangles,
-            self.concavity, self.pieces))
-
     def trace_for_mass(self, mass: float) -> float | None:
         """Trace of the inertia of this solid with ``mass``, or None without a volume."""
         if not self.closed or self.volume <= 0:
@@ -103,7 +78,7 @@ class MeshProperties:
         return (t[0][0] + t[1][1] + t[2][2]) * mass / self.volume
 
 
-class Integrals:
+class Integrals(Record):
     """A mesh's volume integrals as read, unscaled and signed (what the cache keeps).
 
     Attributes:
@@ -116,6 +91,8 @@ class Integrals:
     """
 
     __slots__ = (
+        "volume", "first", "second", "low", "high", "closed", "triangles", "concavity", "pieces")
+    _FIELDS = (
         "volume", "first", "second", "low", "high", "closed", "triangles", "concavity", "pieces")
 
     volume: float
@@ -149,35 +126,6 @@ class Integrals:
         self.triangles = triangles
         self.concavity = concavity
         self.pieces = pieces
-
-    def _key(self) -> tuple[Any, ...]:
-        return (
-            self.volume, self.first, self.second, self.low, self.high, self.closed, self.triangles,
-            self.concavity, self.pieces)
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not Integrals:
-            return NotImplemented
-        return self._key() == other._key()
-
-    def __hash__(self) -> int:
-        return hash(self._key())
-
-    def __repr__(self) -> str:
-        return (f"Integrals(volume={self.volume!r}, "
-                f"first={self.first!r}, "
-                f"second={self.second!r}, "
-                f"low={self.low!r}, "
-                f"high={self.high!r}, "
-                f"closed={self.closed!r}, "
-                f"triangles={self.triangles!r}, "
-                f"concavity={self.concavity!r}, "
-                f"pieces={self.pieces!r})")
-
-    def __reduce__(self) -> tuple[Any, ...]:  # for pickle (check's workers hand these back)
-        return (Integrals, (
-            self.volume, self.first, self.second, self.low, self.high, self.closed, self.triangles,
-            self.concavity, self.pieces))
 
     def pack(self) -> bytes:
         """The cache entry's bytes."""
