@@ -242,8 +242,8 @@ def test_a_line_pybullet_breaks_is_loaded_from_a_formatted_copy(tmp_path: Path,
 @settings(max_examples=500, deadline=None)
 @given(st.text(alphabet="ab./\\OoBbJjSsTtLlDdAaEe", max_size=12))
 def test_mesh_suffix_reads_as_splitext(fn: str) -> None:
-    # reference()'s fast path tells a mesh format by its suffix without os.path.splitext.
-    from urdfkit.model.spec import MESH_FORMATS
-    from urdfkit.sources.guard import _mesh_suffix
+    # reference()'s fast path and the mesh lookup tell a mesh format without os.path.splitext.
+    from urdfkit.model.spec import MESH_FORMATS, mesh_suffix
 
-    assert _mesh_suffix(fn) == (os.path.splitext(fn)[1].lower() in MESH_FORMATS)
+    suffix = os.path.splitext(fn)[1].lower()
+    assert mesh_suffix(fn) == (suffix if suffix in MESH_FORMATS else "")

@@ -100,6 +100,12 @@ static int is_namespaced(xmlNode *node) {
     return node->ns != NULL && node->ns->href != NULL;
 }
 
+/* A child element with a plain name (no namespace): lxml's tag equals `name` exactly then. */
+static int named(xmlNode *c, const char *name) {
+    return c->type == XML_ELEMENT_NODE && !is_namespaced(c)
+           && strcmp((const char *)c->name, name) == 0;
+}
+
 static int add_finding(Walk *w, PyObject *code, PyObject *level, PyObject *message,
                        xmlNode *node) {
     PyObject *el = (PyObject *)elementFactory(w->doc, node);
@@ -440,17 +446,10 @@ static PyObject *py_first(PyObject *self, PyObject *const *args, Py_ssize_t narg
     if (el->_c_node == NULL)
         Py_RETURN_NONE;
     for (xmlNode *c = el->_c_node->children; c != NULL; c = c->next) {
-        if (c->type == XML_ELEMENT_NODE && (c->ns == NULL || c->ns->href == NULL)
-                && strcmp((const char *)c->name, tag) == 0)
+        if (named(c, tag))
             return (PyObject *)elementFactory(el->_doc, c);
     }
     Py_RETURN_NONE;
-}
-
-/* A child element with a plain name (no namespace): lxml's tag equals `name` exactly then. */
-static int named(xmlNode *c, const char *name) {
-    return c->type == XML_ELEMENT_NODE && (c->ns == NULL || c->ns->href == NULL)
-           && strcmp((const char *)c->name, name) == 0;
 }
 
 /* An element's proxy, or None for no node. */

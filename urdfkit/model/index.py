@@ -97,28 +97,34 @@ class LinkView:
     def __init__(self, el: El) -> None:
         self.el = el
         self.name: str | None = el.get("name")
-        self.inertial: El = None
-        self.mass: El = None
-        self.inertia: El = None
-        self.parts: list[El] = []
-        self.collisions: list[El] = []
-        if _native is not None:  # the same reading over libxml2's nodes, no proxy per child
-            (self.inertial, self.mass, self.inertia, self.parts,
-             self.collisions) = _native.link_parts(el)
-            return
-        for c in el:
-            tag = c.tag
-            if tag == "visual" or tag == "collision":
-                self.parts.append(c)
-                if tag == "collision":
-                    self.collisions.append(c)
-            elif tag == "inertial" and self.inertial is None:
-                self.inertial = c
-                for k in c:
-                    if k.tag == "mass" and self.mass is None:
-                        self.mass = k
-                    elif k.tag == "inertia" and self.inertia is None:
-                        self.inertia = k
+        self.inertial: El
+        self.mass: El
+        self.inertia: El
+        self.parts: list[El]
+        self.collisions: list[El]
+        (self.inertial, self.mass, self.inertia, self.parts,
+         self.collisions) = (_link_parts if _native is None else _native.link_parts)(el)
+
+
+def _link_parts(el: El) -> tuple[El, El, El, list[El], list[El]]:
+    """``_walk.link_parts`` in Python: (inertial, mass, inertia, parts, collisions)."""
+    inertial = mass = inertia = None
+    parts: list[El] = []
+    collisions: list[El] = []
+    for c in el:
+        tag = c.tag
+        if tag == "visual" or tag == "collision":
+            parts.append(c)
+            if tag == "collision":
+                collisions.append(c)
+        elif tag == "inertial" and inertial is None:
+            inertial = c
+            for k in c:
+                if k.tag == "mass" and mass is None:
+                    mass = k
+                elif k.tag == "inertia" and inertia is None:
+                    inertia = k
+    return inertial, mass, inertia, parts, collisions
 
 
 class JointView:
@@ -138,25 +144,29 @@ class JointView:
         self.el = el
         self.name: str | None = el.get("name")
         self.type: str | None = el.get("type")
-        self.parent: El = None
-        self.child: El = None
-        self.children: list[El] = []
-        self.limit: El = None
-        self.axis: El = None
-        self.origin: El = None
-        self.mimic: El = None
-        if _native is not None:  # the same reading over libxml2's nodes, no proxy per child
-            (self.parent, self.child, self.children, self.limit, self.axis, self.origin,
-             self.mimic) = _native.joint_parts(el)
-            return
-        for c in el:
-            tag = c.tag
-            if tag == "child":
-                self.children.append(c)
-                if self.child is None:
-                    self.child = c
-            elif tag in _JOINT_SLOTS and getattr(self, tag) is None:
-                setattr(self, tag, c)
+        self.parent: El
+        self.child: El
+        self.children: list[El]
+        self.limit: El
+        self.axis: El
+        self.origin: El
+        self.mimic: El
+        (self.parent, self.child, self.children, self.limit, self.axis, self.origin,
+         self.mimic) = (_joint_parts if _native is None else _native.joint_parts)(el)
+
+
+def _joint_parts(el: El) -> tuple[El, El, list[El], El, El, El, El]:
+    """``_walk.joint_parts`` in Python: (parent, child, children, limit, axis, origin, mimic)."""
+    first: dict[str, El] = {}
+    children: list[El] = []
+    for c in el:
+        tag = c.tag
+        if tag == "child":
+            children.append(c)
+        elif tag in _JOINT_SLOTS and tag not in first:
+            first[tag] = c
+    return (first.get("parent"), children[0] if children else None, children,
+            first.get("limit"), first.get("axis"), first.get("origin"), first.get("mimic"))
 
 
 _JOINT_SLOTS = frozenset({"parent", "limit", "axis", "origin", "mimic"})

@@ -14,6 +14,7 @@ Nothing here imports lxml or PyBullet: elements are read through their ``get`` m
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Hashable, Mapping, Sequence
 from typing import Any, Protocol, TypeVar
 
@@ -92,6 +93,26 @@ def ignored_shape(el: Any) -> bool:
 #: Mesh formats PyBullet 3.2.7's URDF importer reads (any case); with any other suffix, or a
 #: missing mesh file, loadURDF fails ("Cannot load URDF file").
 MESH_FORMATS = (".stl", ".obj", ".dae")
+
+
+def mesh_suffix(name: str) -> str:
+    """``os.path.splitext(name)[1].lower()`` when it is one of :data:`MESH_FORMATS`, else "".
+
+    Without splitting (the mesh rules ask once per mesh of every file): every format is a
+    dot and three letters, and splitext gives a suffix only where something other than dots
+    stands before it in the file's name (".obj" alone has none).
+    """
+    suffix = name[-4:].lower()
+    if suffix not in MESH_FORMATS:
+        return ""
+    stem = name[:-4]
+    for sep in SEPARATORS:
+        stem = stem.rpartition(sep)[2]
+    return suffix if stem.strip(".") else ""
+
+
+#: What separates a path's parts here (and ends a folder's name).
+SEPARATORS = (os.sep, os.altsep) if os.altsep else (os.sep,)
 
 #: PyBullet's extensions to URDF, with what to tell a user who needs portable files.
 EXTENSIONS: dict[str, str] = {

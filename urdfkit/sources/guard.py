@@ -33,8 +33,10 @@ from urdfkit.model.spec import (
     MAX_NAME_BYTES,
     MAX_XML_DEPTH,
     MESH_FORMATS,
+    SEPARATORS,
     SHAPE_SIZES,
     SHAPES,
+    mesh_suffix,
     numbers,
 )
 from urdfkit.model.spec import attr_float as _num
@@ -479,24 +481,6 @@ class Reference(Record):
         return None if self.load is None else Path(self.load)
 
 
-#: What ends a folder's name (os.path.join adds no separator after one).
-_SEPARATORS = (os.sep, os.altsep) if os.altsep else (os.sep,)
-
-
-def _mesh_suffix(fn: str) -> bool:
-    """Whether ``os.path.splitext(fn)[1].lower() in MESH_FORMATS``, without splitting.
-
-    Every format is a dot and three letters; splitext gives a suffix only where something
-    other than dots stands before it in the file's name (".obj" alone has none).
-    """
-    if not fn[-4:].lower().endswith(MESH_FORMATS):
-        return False
-    stem = fn[:-4]
-    for sep in _SEPARATORS:
-        stem = stem.rpartition(sep)[2]
-    return stem.strip(".") != ""
-
-
 def reference(tag: str, fn: str, base: Path | str,
               packages: Mapping[str, Path] | None) -> Reference:
     """Resolve and judge one file reference: the one rule check and the loaders share.
@@ -510,7 +494,7 @@ def reference(tag: str, fn: str, base: Path | str,
         # The common case, a plain relative path to a regular file: one stat answers what
         # resolve_uri and not_a_file would ask (the same path, the same notes to deps).
         folder = base if isinstance(base, str) else os.fspath(base)
-        name = folder + fn if folder.endswith(_SEPARATORS) or not folder else \
+        name = folder + fn if folder.endswith(SEPARATORS) or not folder else \
             folder + os.sep + fn  # os.path.join for a relative fn, without its checks
         deps.note(name)
         try:
@@ -519,7 +503,7 @@ def reference(tag: str, fn: str, base: Path | str,
             st = None
         # A regular file's name is its last part, so fn's suffix is the path's.
         if st is not None and stat.S_ISREG(st.st_mode) and (
-                tag != "mesh" or _mesh_suffix(fn)):
+                tag != "mesh" or mesh_suffix(fn)):
             return Reference(name, name, stat=st)
     label = f"<{tag} filename={fn!r}>"
     base = Path(base)

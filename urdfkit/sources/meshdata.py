@@ -16,8 +16,6 @@ from urdfkit.core.record import Record
 MAX_MESH_BYTES = 16 * 1024 * 1024
 #: A mesh whose surface dips more than this fraction of its size inside its hull is concave.
 CONCAVE_FRACTION = 0.02
-#: The formats integrated: PyBullet's mesh formats.
-MESH_SUFFIXES = (".stl", ".obj", ".dae")
 
 
 class MeshProperties(Record):
@@ -130,8 +128,8 @@ class Integrals(Record):
     def pack(self) -> bytes:
         """The cache entry's bytes."""
         return _ENTRY + _FORMAT.pack(self.volume, *self.first, *self.second, *self.low,
-                                          *self.high, self.concavity, self.closed,
-                                          self.triangles, self.pieces)
+                                     *self.high, self.concavity, self.closed, self.triangles,
+                                     self.pieces)
 
     @classmethod
     def unpack(cls, data: bytes) -> Integrals:

@@ -15,12 +15,12 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from urdfkit.core import deps
+from urdfkit.model.spec import mesh_suffix
 from urdfkit.sources.cache import cache_dir, read_entry, write_entry
 from urdfkit.sources.meshdata import (  # noqa: F401 - named here too
     _ENTRY,
     CONCAVE_FRACTION,
     MAX_MESH_BYTES,
-    MESH_SUFFIXES,
     Integrals,
     MeshProperties,
 )
@@ -29,6 +29,7 @@ try:  # hashlib's own blake2b, without loading OpenSSL for the other digests (2.
     from _blake2 import blake2b
 except ImportError:  # pragma: no cover - a Python built without it
     from hashlib import blake2b
+
 
 def _cache_dir() -> Path | None:
     """:func:`cache_dir`, worked out once per value of the variables it reads."""
@@ -58,7 +59,7 @@ def properties(path: str | os.PathLike[str],
     when the caller has just taken it.
     """
     name = os.fspath(path)
-    suffix = _suffix(name)
+    suffix = mesh_suffix(name)
     if not suffix:
         return None
     deps.note(name)
@@ -194,19 +195,3 @@ def _integrals(path: Path, suffix: str, key: str, concavity: bool) -> Integrals 
 
 #: An absolute path starts with this (``os.path.isabs`` on POSIX, without its call).
 _ROOT = os.sep if os.sep == "/" else ("/", os.sep)
-_SEPS = (os.sep, os.altsep) if os.altsep else (os.sep,)
-
-
-def _suffix(name: str) -> str:
-    """``os.path.splitext(name)[1].lower()`` when it is a mesh format, else "".
-
-    Every format is a dot and three letters; splitext gives a suffix only where something
-    other than dots stands before it in the file's name (".obj" alone has none).
-    """
-    suffix = name[-4:].lower()
-    if suffix not in MESH_SUFFIXES:
-        return ""
-    stem = name[:-4]
-    for sep in _SEPS:
-        stem = stem.rpartition(sep)[2]
-    return suffix if stem.strip(".") else ""
