@@ -238,22 +238,48 @@ class LoadOptions:
         return flags
 
 
+class Bullet:
+    """The pybullet module with one client's id bound to every call.
+
+    ``bullet.stepSimulation()`` is ``p.stepSimulation(physicsClientId=client)``: the id is
+    bound here once (as ``pybullet_utils.bullet_client.BulletClient`` does), so no other module
+    passes ``physicsClientId``. Each function is bound on first use and then kept as a plain
+    attribute, so a lookup in a hot loop costs what ``p.name`` costs; the partial adds ~60 ns a
+    call (bench/: bind the method to a local name outside a loop that calls it per step).
+    Constants (``bullet.POSITION_CONTROL``) and ``bullet.error`` are the module's own.
+    """
+
+    def __init__(self, module: Any, client: int) -> None:
+        self._module = module
+        self.client = client
+
+    def __getattr__(self, name: str) -> Any:
+        import functools
+
+        attr = getattr(self._module, name)
+        if callable(attr) and not isinstance(attr, type):
+            attr = functools.partial(attr, physicsClientId=self.client)
+        self.__dict__[name] = attr
+        return attr
+
+
 class Session:
     """A PyBullet physics client of its own (DIRECT by default), quiet on stdout.
 
-    Several sessions can live in one process; each has its own ``client`` id, and every call
-    made through :attr:`p` must pass ``physicsClientId=session.client``.
+    Several sessions can live in one process; each has its own ``client`` id, which
+    :attr:`bullet` binds to every call.
 
     Use it as a context manager so the client is always disconnected::
 
         with Session() as s:
             body = s.load_urdf("car.urdf")
-            print(s.p.getNumJoints(body, physicsClientId=s.client))
+            print(s.bullet.getNumJoints(body))
 
     Attributes:
         gui: Whether the client is a GUI window rather than DIRECT.
         diagnostics: What PyBullet printed on stdout so far, line by line.
-        p: The pybullet module.
+        p: The pybullet module (unbound: its constants, ``p.error``).
+        bullet: The pybullet module with this client bound to every call (:class:`Bullet`).
         client: The physics client id; -1 once closed.
     """
 
@@ -276,6 +302,8 @@ class Session:
         if self.client < 0:
             raise EngineError("cannot open the PyBullet GUI: no display available "
                               "(set DISPLAY, or drop --gui)")
+        #: pybullet with this client bound: ``session.bullet.getNumJoints(body)``.
+        self.bullet = Bullet(self.p, self.client)
 
     def __enter__(self) -> Session:
         return self
