@@ -34,8 +34,8 @@ from typing import Any
 from lxml import etree
 
 from urdfkit.core.errors import InputError, ParameterError
+from urdfkit.engine.joints import JointInfo, base_link_name, joint_table, pose_joints
 from urdfkit.engine.session import LoadOptions, Session
-from urdfkit.inspect import JointInfo, base_link_name, joint_table, pose_joints
 from urdfkit.model.spec import ignored_shape
 from urdfkit.model.xmlio import children, line_of
 from urdfkit.sources.resolve import Resolved

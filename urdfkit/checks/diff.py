@@ -38,8 +38,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from urdfkit.builder import Joint, Link, Material, Robot
 from urdfkit.core.errors import ModelError, ParameterError
+from urdfkit.model.robot import Joint, Link, Material, Robot
 from urdfkit.model.spec import AXIS_JOINT_TYPES, URDF_JOINT_DOF
 
 #: Default float tolerance, absolute and relative: values this close are equal.

@@ -1,4 +1,4 @@
-"""joints, links, tree, info: what PyBullet loads, as tables or JSON (urdfkit/inspect.py)."""
+"""joints, links, tree, info: what PyBullet loads, as tables or JSON (urdfkit/engine/)."""
 
 import sys
 from typing import Annotated, Any
@@ -73,7 +73,7 @@ def joints(
     --json prints {"file", "robot", "base_link", "joints": [...]} with the 17 getJointInfo
     fields under the Quickstart Guide names (jointIndex ... parentIndex); see docs/inspect.md.
     """
-    from urdfkit.inspect import filter_joints
+    from urdfkit.engine.joints import filter_joints
 
     report = _inspect(file, package, arg, fixed_base=fixed_base, no_guard=no_guard,
                       package_path=package_path, flags=flags)

@@ -34,7 +34,7 @@ from typing import Any
 
 from urdfkit.core.errors import EngineError, InputError, MissingDependencyError, ParameterError
 from urdfkit.draw import style
-from urdfkit.inspect import JointInfo, pose_joints
+from urdfkit.engine.joints import JointInfo, pose_joints
 from urdfkit.model.spec import UP_AXES, attr_vec, rpy_to_matrix, vector
 
 #: The views, as (direction from target to camera, camera up vector). URDF: x forward, z up.

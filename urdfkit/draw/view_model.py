@@ -238,8 +238,8 @@ class Model:
     # ------------------------------------------------------------------ reading
 
     def _read(self) -> None:
+        from urdfkit.engine.joints import base_link_name, joint_table
         from urdfkit.engine.session import quiet_stdout
-        from urdfkit.inspect import base_link_name, joint_table
 
         s, body = self.session, self.body
         p, c = s.p, s.client

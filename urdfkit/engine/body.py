@@ -5,7 +5,7 @@ without ``URDF_USE_INERTIA_FROM_FILE`` PyBullet discards ``<inertia>`` and recom
 the collision shapes, and a link with no ``<inertial>`` gets 1 kg, so the two often differ.
 :func:`summary` adds counts, degrees of freedom, mass and the bounding box.
 
-Kept apart from :mod:`urdfkit.inspect` so that ``urdfkit joints``, which users run in loops,
+Kept apart from :mod:`urdfkit.engine.joints` so that ``urdfkit joints``, which users run in loops,
 does not pay for building these classes.
 """
 
@@ -18,8 +18,8 @@ from typing import Any
 
 from lxml import etree
 
+from urdfkit.engine.joints import JointInfo, base_link_name, joint_table
 from urdfkit.engine.session import Session
-from urdfkit.inspect import JointInfo, base_link_name, joint_table
 from urdfkit.model.spec import JOINT_DOF, attr_float, attr_vec
 from urdfkit.model.xmlio import children
 
@@ -59,8 +59,8 @@ def file_inertial(link: etree._Element | None) -> FileInertial | None:
     el = link.find("inertial")
     if el is None:
         return None
-    from urdfkit.builder import Inertia
     from urdfkit.core.errors import ModelError
+    from urdfkit.model.builder_elements import Inertia
 
     mass = attr_float(el.find("mass"), "value") or 0.0
     i = el.find("inertia")

@@ -16,8 +16,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from urdfkit.builder import Robot
 from urdfkit.core.errors import ParameterError
+from urdfkit.model.robot import Robot
 from urdfkit.model.templatedir import template_dir
 
 
