@@ -380,7 +380,7 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
 
     from urdfkit.engine.session import LoadOptions
 
-    p, c = session.p, session.client
+    p, bullet = session.p, session.bullet
     # Fixed base: nothing is simulated, and the robot must stay exactly where it is posed.
     opts = LoadOptions(fixed_base=True, base_orientation=UP_AXES[o.up])
     if o.collision:
@@ -389,10 +389,10 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
         opts.extra_flags = p.URDF_IGNORE_VISUAL_SHAPES
     body = session.load_urdf(resolved.load_path, opts, display=resolved.name)
     try:
-        n = p.getNumJoints(body, physicsClientId=c)
-        infos = [p.getJointInfo(body, j, physicsClientId=c) for j in range(n)]
+        n = bullet.getNumJoints(body)
+        infos = [bullet.getJointInfo(body, j) for j in range(n)]
         by_name = {i[1].decode("utf-8"): i for i in infos}
-        positions = pose_joints(p, c, body, [JointInfo.from_pybullet(i) for i in infos],
+        positions = pose_joints(bullet, body, [JointInfo.from_pybullet(i) for i in infos],
                                 o.joints, warnings, resolved.name)
         if o.collision:
             for link in range(-1, n):
@@ -400,7 +400,7 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
         lo = np.full(3, np.inf)
         hi = np.full(3, -np.inf)
         for link in range(-1, n):
-            a, b = p.getAABB(body, link, physicsClientId=c)
+            a, b = bullet.getAABB(body, link)
             a, b = np.array(a), np.array(b)
             # A link without collision shapes reports an empty or inverted box; skip it.
             if np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(b >= a):
@@ -412,7 +412,7 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
         if not o.collision:
             # getAABB only knows collision shapes; a link with visuals only (common in
             # hand-written files) would fall outside the frame. Bound its visuals too.
-            names = [p.getBodyInfo(body, physicsClientId=c)[0].decode("utf-8")]
+            names = [bullet.getBodyInfo(body)[0].decode("utf-8")]
             names += [i[12].decode("utf-8") for i in infos]
             v_lo, v_hi = _visual_bounds(resolved.root, dict(zip(names, frames, strict=True)))
             lo, hi = np.minimum(lo, v_lo), np.maximum(hi, v_hi)
@@ -422,7 +422,7 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
                 continue
             pos, rot = frames[j + 1]
             # PyBullet's axis is in the child's inertial frame: turn it into the link frame.
-            local = p.getDynamicsInfo(body, j, physicsClientId=c)[4]
+            local = bullet.getDynamicsInfo(body, j)[4]
             inertial = np.array(p.getMatrixFromQuaternion(local), dtype=float).reshape(3, 3)
             axes.append((pos, rot @ inertial @ np.array(info[13], dtype=float)))
     except p.error as e:

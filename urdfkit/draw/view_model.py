@@ -242,25 +242,25 @@ class Model:
         from urdfkit.engine.session import quiet_stdout
 
         s, body = self.session, self.body
-        p, c = s.p, s.client
+        p, bullet = s.p, s.bullet
         with quiet_stdout() as out:
             self.table = joint_table(s, body, self.resolved.root)
             names = [base_link_name(s, body)] + [j.link_name for j in self.table]
             self.links = [LinkView(i, names[i + 1]) for i in range(-1, len(self.table))]
             for link in self.links:
-                info = p.getDynamicsInfo(body, link.index, physicsClientId=c)
+                info = bullet.getDynamicsInfo(body, link.index)
                 link.mass = float(info[0])
                 link.moments = tuple(float(v) for v in info[2])  # type: ignore[assignment]
                 link.inertial_pos = tuple(float(v) for v in info[3])  # type: ignore[assignment]
                 link.inertial_quat = tuple(float(v) for v in info[4])  # type: ignore[assignment]
-            for v in p.getVisualShapeData(body, physicsClientId=c):
+            for v in bullet.getVisualShapeData(body):
                 shape = self._shape(v[2], v[3], v[4], v[5], v[6], collision=False,
                                     rgba=v[7])
                 if shape is not None:
                     self.links[v[1] + 1].visuals.append(shape)
             concave = self._concave()
             for link in self.links:
-                for v in p.getCollisionShapeData(body, link.index, physicsClientId=c):
+                for v in bullet.getCollisionShapeData(body, link.index):
                     # Relative to the inertial frame: move it into the link frame.
                     pos, quat = p.multiplyTransforms(link.inertial_pos, link.inertial_quat,
                                                      v[5], v[6])
@@ -416,38 +416,37 @@ class Model:
         Returns every movable joint's position as PyBullet now reports it.
         """
         with self.lock:
-            p, c = self.session.p, self.session.client
+            bullet = self.session.bullet
             by_name = {j.name: j for j in self.joints}
             wanted = {k: float(v) for k, v in values.items() if k in by_name}
             for name, value in wanted.items():
                 if by_name[name].mimic is None:
-                    p.resetJointState(self.body, by_name[name].index, value, physicsClientId=c)
+                    bullet.resetJointState(self.body, by_name[name].index, value)
             now = self.positions()
             for j in self.joints:  # leaders first in a chain: index order is depth order
                 if j.mimic is not None and j.mimic[0] in now:
                     value = now[j.mimic[0]] * j.mimic[1] + j.mimic[2]
-                    p.resetJointState(self.body, j.index, value, physicsClientId=c)
+                    bullet.resetJointState(self.body, j.index, value)
                     now[j.name] = value
             return self.positions()
 
     def positions(self) -> dict[str, float]:
         """Every movable joint's position, read from PyBullet (``getJointState``)."""
         with self.lock:
-            p, c = self.session.p, self.session.client
-            return {j.name: float(p.getJointState(self.body, j.index, physicsClientId=c)[0])
+            bullet = self.session.bullet
+            return {j.name: float(bullet.getJointState(self.body, j.index)[0])
                     for j in self.joints}
 
     def link_poses(self) -> list[tuple[Vec3, Quat]]:
         """World pose of every URDF link frame, base first, as PyBullet reports it."""
         with self.lock:
-            p, c = self.session.p, self.session.client
-            pos, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=c)
+            p, bullet = self.session.p, self.session.bullet
+            pos, orn = bullet.getBasePositionAndOrientation(self.body)
             base = self.links[0]
             inv = p.invertTransform(base.inertial_pos, base.inertial_quat)
             out = [p.multiplyTransforms(pos, orn, inv[0], inv[1])]
             for link in self.links[1:]:
-                state = p.getLinkState(self.body, link.index, computeForwardKinematics=1,
-                                       physicsClientId=c)
+                state = bullet.getLinkState(self.body, link.index, computeForwardKinematics=1)
                 out.append((state[4], state[5]))
             return [(tuple(float(x) for x in a), tuple(float(x) for x in b))  # type: ignore[misc]
                     for a, b in out]
@@ -455,10 +454,10 @@ class Model:
     def bounds(self) -> tuple[Vec3, Vec3]:
         """The posed robot's box (union of getAABB over links), for the camera."""
         with self.lock:
-            p, c = self.session.p, self.session.client
+            bullet = self.session.bullet
             lo, hi = [math.inf] * 3, [-math.inf] * 3
             for link in self.links:
-                a, b = p.getAABB(self.body, link.index, physicsClientId=c)
+                a, b = bullet.getAABB(self.body, link.index)
                 if all(math.isfinite(x) for x in (*a, *b)) and all(
                         b[k] >= a[k] for k in range(3)):
                     lo = [min(lo[k], a[k]) for k in range(3)]
@@ -479,14 +478,12 @@ class Model:
             if self._probe is None:
                 self._probe = self._open_probe()
             session, body, pairs = self._probe
-            p, c = session.p, session.client
+            shown, probe = self.session.bullet, session.bullet
             for j in self.joints:
-                p.resetJointState(body, j.index, p.getJointState(
-                    self.body, j.index, physicsClientId=self.session.client)[0],
-                    physicsClientId=c)
+                probe.resetJointState(body, j.index, shown.getJointState(self.body, j.index)[0])
             out = []
             for a, b in pairs:
-                points = p.getClosestPoints(body, body, 0.0, a, b, physicsClientId=c)
+                points = probe.getClosestPoints(body, body, 0.0, a, b)
                 if points:
                     out.append((self.links[a + 1].name, self.links[b + 1].name,
                                 float(min(pt[8] for pt in points))))

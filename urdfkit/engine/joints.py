@@ -28,7 +28,7 @@ from typing import Any
 
 from lxml import etree
 
-from urdfkit.engine.session import Session
+from urdfkit.engine.session import Bullet, Session
 from urdfkit.model.spec import JOINT_TYPE_FILTERS, attr_vec, pybullet_joint_type, quat_to_rpy
 from urdfkit.model.xmlio import children
 
@@ -204,7 +204,7 @@ def filter_joints(joints: Sequence[JointInfo], *, movable: bool = False,
     return out
 
 
-def pose_joints(p: Any, client: int, body: int, joints: Sequence[JointInfo],
+def pose_joints(bullet: Bullet, body: int, joints: Sequence[JointInfo],
                 values: Mapping[str, float], warnings: list[str], file: str
                 ) -> dict[str, float]:
     """Set joint positions by name with ``resetJointState``; return them by joint name.
@@ -243,6 +243,6 @@ def pose_joints(p: Any, client: int, body: int, joints: Sequence[JointInfo],
         if info.limited and not info.joint_lower_limit <= value <= info.joint_upper_limit:
             warnings.append(f"joint {name}: {value:g} is beyond its limits "
                             f"[{info.joint_lower_limit:g}, {info.joint_upper_limit:g}]")
-        p.resetJointState(body, info.joint_index, value, physicsClientId=client)
+        bullet.resetJointState(body, info.joint_index, value)
         positions[name] = value
     return positions
