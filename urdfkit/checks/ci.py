@@ -1,9 +1,8 @@
 """``urdfkit check --format sarif|junit|github``: findings in the shapes CI systems read.
 
 Each function turns a :class:`urdfkit.checks.check.CheckResult` into a document and returns it;
-:func:`urdfkit.commands.present.check_output` writes it. Nothing here prints, styles or imports
-rich:
-these formats go to files and logs, and must parse whatever the terminal.
+:func:`urdfkit.commands.present.check_formatted` writes it. Nothing here prints, styles or
+imports rich: these formats go to files and logs, and must parse whatever the terminal.
 
 - SARIF 2.1.0, for GitHub code scanning (``github/codeql-action/upload-sarif``) and other
   SARIF viewers.

@@ -276,7 +276,7 @@ def load_robot(name: str | Path, *, packages: list[str] | None = None,
     """
     from urdfkit.sources.resolve import open_input
 
-    with open_input(name, packages, xacro_args, guard=guard,
+    with open_input(name, packages=packages, xacro_args=xacro_args, guard=guard,
                     package_paths=package_paths) as resolved:
         try:
             robot = Robot.from_element(resolved.root, resolved.name, strict=False)

@@ -44,7 +44,7 @@ from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
 from urdfkit.model.spec import rpy_to_matrix, sym_eigenvalues, transpose
 from urdfkit.model.xmlio import fmt_float, fmt_vec, parse_xml, read_bytes, start_tags
-from urdfkit.sources.guard import Report, refuse_oversized
+from urdfkit.sources.guard import RuleReport, refuse_oversized
 
 #: Density (kg/m^3) that gives a link with no ``<inertial>`` its mass: water.
 DEFAULT_DENSITY = 1000.0
@@ -158,7 +158,7 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
     """
     display, source, data, text = _read_source(path, density)
     root = parse_xml(data, display).getroot()
-    report = Report(display, source.absolute().parent, packages)
+    report = RuleReport(display, source.absolute().parent, packages)
     for rule in ALL_RULES:
         rule(root, report)
     run = _Fixing(data, text, display, root, report, balance, density, packages,
@@ -214,7 +214,7 @@ class _Fixing:
     text: str
     display: str
     root: etree._Element
-    report: Report
+    report: RuleReport
     balance: bool
     density: float | None
     packages: Mapping[str, Path] | None
@@ -280,7 +280,7 @@ def _unfixed(fixed: bytes, display: str, source: Path, packages: Mapping[str, Pa
     subjects = {r.subject for r in repairs if r.subject is not None and r.code in _INERTIA_ORDER}
     if not subjects:
         return {}
-    report = Report(display, source.absolute().parent, packages)
+    report = RuleReport(display, source.absolute().parent, packages)
     tree = parse_xml(fixed, display).getroot()
     for rule in ALL_RULES:
         rule(tree, report)
@@ -351,7 +351,7 @@ class _Plan:
     """The edits to one file: spliced into its text and made on its tree, side by side."""
 
     def __init__(self, text: str, root: etree._Element, file: str, balance: bool,
-                 density: float | None, report: Report):
+                 density: float | None, report: RuleReport):
         self.text = text
         self.root = root
         self.file = file

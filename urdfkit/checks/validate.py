@@ -2,9 +2,9 @@
 
 Rules work on the lxml tree (not on a parsed model) so that every finding can carry the line
 it comes from, and so that broken files are described rather than refused at the first error.
-The rules every loader runs, and the :class:`~urdfkit.sources.guard.Report` they all write to, are
-in
-:mod:`urdfkit.sources.guard`; :data:`ALL_RULES` is the guard's rules followed by these.
+The rules every loader runs, and the :class:`~urdfkit.sources.guard.RuleReport` they all write
+to, are in :mod:`urdfkit.sources.guard`; :data:`ALL_RULES` is the guard's rules followed by
+these.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from urdfkit.model.spec import (
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.sources.guard import GUARD_RULES, Report, Rule, label
+from urdfkit.sources.guard import GUARD_RULES, Rule, RuleReport, label
 from urdfkit.sources.meshstore import CONCAVE_FRACTION, MeshProperties
 from urdfkit.sources.meshstore import properties as mesh_properties
 
@@ -46,7 +46,7 @@ from urdfkit.sources.meshstore import properties as mesh_properties
 # These are the rules PyBullet crashes on when they are broken; the guard runs exactly these.
 
 
-def rule_link_count(root: etree._Element, r: Report) -> None:
+def rule_link_count(root: etree._Element, r: RuleReport) -> None:
     """U208: 128 links or more break PyBullet's state queries."""
     n = len(r.doc(root).links)
     if n >= MAX_STATE_LINKS:
@@ -63,7 +63,7 @@ def rule_link_count(root: etree._Element, r: Report) -> None:
 _DBL_EPSILON = sys.float_info.epsilon
 
 
-def rule_elements(root: etree._Element, r: Report) -> None:
+def rule_elements(root: etree._Element, r: RuleReport) -> None:
     """U401-U402 and U801-U802: numbers and names of tags and attributes.
 
     Numbers parse, are finite and have the right length; tags and attributes are known
@@ -83,7 +83,7 @@ def _mass_of(link: LinkView) -> float | None:
     return _num(link.mass, "value")
 
 
-def rule_mass(root: etree._Element, r: Report) -> None:
+def rule_mass(root: etree._Element, r: RuleReport) -> None:
     """U601-U602, U606: mass >= 0, > 0 on links that move; warn on missing <inertial>."""
     doc = r.doc(root)
     views = {v.name: v for v in doc.links if v.name}
@@ -166,7 +166,7 @@ def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | 
     return ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))  # type: ignore[return-value]
 
 
-def rule_material_colours(root: etree._Element, r: Report) -> None:
+def rule_material_colours(root: etree._Element, r: RuleReport) -> None:
     """U710: one material name given several colours; PyBullet draws them all in one.
 
     Measured on PyBullet 3.2.7: every visual whose material has that name (``""`` included,
@@ -189,7 +189,7 @@ def rule_material_colours(root: etree._Element, r: Report) -> None:
               f"rgba {found[-1][0]}; give each colour its own name", found[1][1])
 
 
-def rule_references(root: etree._Element, r: Report) -> None:
+def rule_references(root: etree._Element, r: RuleReport) -> None:
     """U308, U706-U708: references that lead nowhere, and limits PyBullet reads differently.
 
     A ``<material name>`` used but never defined, a ``<transmission>`` naming a missing joint,
@@ -230,7 +230,7 @@ def rule_references(root: etree._Element, r: Report) -> None:
                   "it as unlimited, the URDF spec (and ROS) as 0; give both", limit)
 
 
-def rule_inertia(root: etree._Element, r: Report) -> None:
+def rule_inertia(root: etree._Element, r: RuleReport) -> None:
     """U603-U605, U607: inertia positive definite, triangle inequality, plausible for shapes.
 
     Tolerance as in Drake's ``RotationalInertia::CouldBePhysicallyValid``:
@@ -343,7 +343,7 @@ class Solid(Record):
         return sum(self.tensor[i][i] for i in range(3)) * mass / self.volume
 
 
-def link_solid(link: etree._Element, r: Report | None = None,
+def link_solid(link: etree._Element, r: RuleReport | None = None,
                collisions: list[etree._Element] | None = None) -> Solid | None:
     """The solid the link's collision shapes make: what ``U605`` and ``urdfkit fix`` use.
 
@@ -416,7 +416,7 @@ def link_solid(link: etree._Element, r: Report | None = None,
     return Solid(total, (cx, cy, cz), out, max(p[3] for p in parts))
 
 
-def _shape_trace(link: etree._Element, mass: float | None, r: Report | None = None,
+def _shape_trace(link: etree._Element, mass: float | None, r: RuleReport | None = None,
                  collisions: list[etree._Element] | None = None
                  ) -> tuple[float, float] | None:
     """Trace of the inertia of the link's collision solids for ``mass``, and their size."""
@@ -430,7 +430,7 @@ def _shape_trace(link: etree._Element, mass: float | None, r: Report | None = No
 
 
 def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
-               r: Report | None, concavity: bool = False
+               r: RuleReport | None, concavity: bool = False
                ) -> tuple[float, tuple[float, ...], Matrix3, float] | None:
     """A collision mesh as (volume, centre in the link, tensor per unit density, size).
 
@@ -465,7 +465,7 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
             matmul(matmul(rot, own), transpose(rot)), max(props.extent))
 
 
-def _properties(r: Report, path: str, scale: Sequence[float], concavity: bool = False,
+def _properties(r: RuleReport, path: str, scale: Sequence[float], concavity: bool = False,
                 st: os.stat_result | None = None) -> MeshProperties | None:
     """:func:`urdfkit.sources.meshstore.properties`, once per mesh and scale per file.
 
@@ -486,7 +486,7 @@ def _properties(r: Report, path: str, scale: Sequence[float], concavity: bool = 
 _UNSEEN: Any = object()
 
 
-def _moving(r: Report, el: etree._Element) -> set[str]:
+def _moving(r: RuleReport, el: etree._Element) -> set[str]:
     """:func:`_moving_links` of the document ``el`` belongs to, once per file."""
     moving: set[str] | None = r.memo.get("moving links")
     if moving is None:
@@ -494,7 +494,7 @@ def _moving(r: Report, el: etree._Element) -> set[str]:
     return moving
 
 
-def rule_meshes(root: etree._Element, r: Report) -> None:
+def rule_meshes(root: etree._Element, r: RuleReport) -> None:
     """U701-U705: mesh and texture files exist, are files, in formats PyBullet reads."""
     if r.folder is None:
         return
@@ -511,7 +511,7 @@ def rule_meshes(root: etree._Element, r: Report) -> None:
 UNITS_RATIO = 200.0
 
 
-def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
+def rule_mesh_shapes(root: etree._Element, r: RuleReport) -> None:
     """U613-U614: meshes in the wrong units; concave collision meshes on links that move.
 
     Units are judged against the robot's own scale: the median distance between joint
@@ -584,7 +584,7 @@ def _moving_links(doc: Doc) -> set[str]:
     return set(names) - still
 
 
-def rule_portability(root: etree._Element, r: Report) -> None:
+def rule_portability(root: etree._Element, r: RuleReport) -> None:
     """U901: PyBullet-only joint types and shapes, which other URDF tools refuse (info)."""
     doc = r.doc(root)
     for jv in doc.joints:

@@ -71,7 +71,7 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
     for fr in result.files:  # a xacro or package problem speaks of flags, not parameters
         fr.findings = [Finding(f.code, f.level, input_flags(f.message), f.file, f.line, f.origin)
                        if "`" in f.message else f for f in fr.findings]
-    show.check_output(result, fmt, fail_on, show_all)
+    show.check_formatted(result, fmt, fail_on, show_all)
     return result.exit_code(fail_on)
 
 

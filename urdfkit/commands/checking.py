@@ -19,7 +19,7 @@ from urdfkit.commands.shared import (
     PackagePathOpt,
     command,
     examples,
-    open_input,
+    open_input_and_warn,
 )
 
 
@@ -314,7 +314,8 @@ def collisions(
 
     if sum((as_json, srdf, python)) > 1:
         raise ParameterError("--json, --srdf and --python are exclusive: pick one")
-    with open_input(file, package, arg, no_guard, package_path) as resolved:
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path) as resolved:
         result = self_collisions(resolved, joints=parse_joint_positions(joints),
                                  samples=samples, seed=seed, margin=margin,
                                  packages=parse_packages(package, package_path))

@@ -71,7 +71,7 @@ def render(
         up=up)
     out = output if output is not None else f"{Path(file).name.split('.')[0] or 'robot'}.png"
     if out != "-":  # refuse before the work, not after it
-        rendering.check_output(out, force=force)
+        rendering.check_picture_path(out, force=force)
     picture = rendering.render_file(file, options, packages=package, xacro_args=arg,
                                     guard=not no_guard, package_paths=package_path)
     for w in picture.warnings:

@@ -21,7 +21,7 @@ from urdfkit.commands.shared import (
     TypeOpt,
     command,
     examples,
-    open_input,
+    open_input_and_warn,
 )
 
 
@@ -41,7 +41,8 @@ def _inspect(file: str, package: list[str] | None, arg: list[str] | None, *,
         options = LoadOptions(fixed_base=fixed_base, **parse_flags(flags))
     else:
         options = LoadOptions(fixed_base=fixed_base, inertia_from_file=inertia_from_file)
-    with open_input(file, package, arg, no_guard, package_path) as resolved:
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path) as resolved:
         report = inspect_file(resolved, options, links=links, info=info)
     report.load_flags = options.flag_names()
     return report
@@ -206,7 +207,8 @@ def tree(
     if dot or output is not None:
         _tree_dot(file, package, arg, output, force, as_json, no_guard, package_path)
         return
-    with open_input(file, package, arg, no_guard, package_path, meshes=False) as resolved:
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path, meshes=False) as resolved:
         root = kinematic_tree(resolved.root)
         robot = resolved.robot_name
     if as_json:
@@ -263,13 +265,14 @@ def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
               package_path: list[str] | None) -> None:
     """``tree --dot`` / ``tree -o graph.svg``: the kinematic graph as DOT text or a drawing."""
     from urdfkit.core.errors import ParameterError
-    from urdfkit.draw.graph import check_output, dot_graph, write_graph
+    from urdfkit.draw.graph import check_graph_path, dot_graph, write_graph
 
     if as_json:
         raise ParameterError("--json and --dot/-o are different outputs; choose one")
     if output is not None and output != "-":
-        check_output(output, force=force)
-    with open_input(file, package, arg, no_guard, package_path) as resolved:
+        check_graph_path(output, force=force)
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path) as resolved:
         text = dot_graph(resolved.root)
     if output is None or output == "-":
         sys.stdout.write(text)

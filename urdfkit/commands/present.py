@@ -421,7 +421,7 @@ def check_report(result: Any, show_all: bool = False) -> None:
     screen.print(Text(summary, style=colour), soft_wrap=True)
 
 
-def check_output(result: Any, fmt: str = "text", fail_on: str = "error",
+def check_formatted(result: Any, fmt: str = "text", fail_on: str = "error",
                  show_all: bool = False) -> None:
     """``urdfkit check --format``: text, JSON, or a CI format (:mod:`urdfkit.checks.ci`) on stdout.
 

@@ -759,14 +759,14 @@ def render_file(name: str | Path, options: RenderOptions | None = None, *,
     from urdfkit.sources.resolve import open_input
 
     _pillow()  # fail before expanding xacro when Pillow is missing
-    with open_input(name, packages, xacro_args, guard=guard,
+    with open_input(name, packages=packages, xacro_args=xacro_args, guard=guard,
                     package_paths=package_paths) as resolved:
         picture = render(resolved, options)
         picture.warnings[:0] = resolved.warnings
         return picture
 
 
-def check_output(path: str | Path, *, force: bool = False) -> Path:
+def check_picture_path(path: str | Path, *, force: bool = False) -> Path:
     """Refuse an output path early: not ``*.png``, or an existing file without ``force``.
 
     The CLI calls this before rendering, so a refused path costs nothing.
@@ -779,7 +779,7 @@ def check_output(path: str | Path, *, force: bool = False) -> Path:
 
 def write_png(rendering: Rendering, path: str | Path, *, force: bool = False) -> Path:
     """Write the picture atomically; refuses to replace a file unless ``force``."""
-    path = check_output(path, force=force)
+    path = check_picture_path(path, force=force)
     from urdfkit.core.output import atomic_write
 
     return atomic_write(path, rendering.png_bytes(), force=force)

@@ -219,7 +219,8 @@ class Model:
         with deps.record() as recorded:
             deps.note(file)
             try:
-                self.resolved = open_input(file, list(packages or []), list(xacro_args or []),
+                self.resolved = open_input(file, packages=list(packages or []),
+                                           xacro_args=list(xacro_args or []),
                                            package_paths=list(package_paths or []))
                 deps.note(self.resolved.source)
                 self.session = Session()
