@@ -30,17 +30,21 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from urdfkit.core.errors import EngineError, InputError, MissingDependencyError, ParameterError
 from urdfkit.draw import style
 from urdfkit.engine.joints import JointInfo, pose_joints
-from urdfkit.model.spec import UP_AXES, attr_vec, rpy_to_matrix, vector
+from urdfkit.model.spec import UP_AXES, UpAxis, attr_vec, rpy_to_matrix, vector
 
 #: The views, as (direction from target to camera, camera up vector). URDF: x forward, z up.
 #: ``front`` looks at the robot's face (+x), ``side`` at its right flank (-y), so the robot
 #: drives to the right of the image; ``top`` looks down with the front pointing up.
-VIEWS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
+#: A camera direction: ``--view``.
+View = Literal["iso", "front", "side", "top"]
+#: What the robot stands on in the picture: ``--ground``.
+Ground = Literal["grid", "plane", "none"]
+VIEWS: dict[View, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
     "iso": ((math.cos(math.radians(30)) * math.cos(math.radians(-40)),
              math.cos(math.radians(30)) * math.sin(math.radians(-40)),
              math.sin(math.radians(30))), (0.0, 0.0, 1.0)),
@@ -49,8 +53,8 @@ VIEWS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] 
     "top": ((0.0, 0.0, 1.0), (1.0, 0.0, 0.0)),
 }
 #: Order of the panels of ``--views all``: a 2x2 grid.
-ALL_VIEWS = ("iso", "front", "side", "top")
-GROUNDS = ("grid", "plane", "none")
+ALL_VIEWS: tuple[View, ...] = ("iso", "front", "side", "top")
+GROUNDS: tuple[Ground, ...] = ("grid", "plane", "none")
 #: The largest robot (bounding-box side, m) render frames: beyond, camera distances and grid
 #: steps overflow or lose all precision (a 1e308 m box once ended in an OverflowError).
 MAX_EXTENT = 1e5
@@ -86,15 +90,15 @@ class RenderOptions:
         up: The model's up axis (``z``, ``y`` or ``x``); it is turned onto the world's +Z.
     """
 
-    views: tuple[str, ...] = ("iso",)
+    views: tuple[View, ...] = ("iso",)
     width: int = 800
     height: int = 600
-    ground: str = "grid"
+    ground: Ground = "grid"
     joints: Mapping[str, float] = field(default_factory=dict)
     collision: bool = False
     frames: bool = False
     labels: bool | None = None
-    up: str = "z"
+    up: UpAxis = "z"
 
     def __post_init__(self) -> None:
         if self.up not in UP_AXES:
@@ -127,7 +131,7 @@ class RenderOptions:
 class Camera:
     """Where one view's camera stands (for the metadata, and to reproduce a shot)."""
 
-    view: str
+    view: View
     eye: tuple[float, float, float]
     target: tuple[float, float, float]
     up: tuple[float, float, float]
@@ -240,7 +244,7 @@ def _normalize(v: Any) -> Any:
     return v / n if n > 0 else v
 
 
-def _basis(view: str) -> tuple[Any, Any, Any]:
+def _basis(view: View) -> tuple[Any, Any, Any]:
     """(towards camera, right, up) unit vectors of a view."""
     import numpy as np
 
@@ -258,7 +262,7 @@ def _corners(lo: Any, hi: Any) -> Any:
                      for z in (lo[2], hi[2])], dtype=float)
 
 
-def frame_view(view: str, lo: Sequence[float], hi: Sequence[float], aspect: float,
+def frame_view(view: View, lo: Sequence[float], hi: Sequence[float], aspect: float,
                fov_deg: float = FOV_DEG, fill: float = FILL) -> tuple[Any, Any, Any]:
     """Place a camera so the box ``lo..hi`` fills the frame; return (eye, target, up).
 
@@ -552,7 +556,7 @@ def _add_plane(scene: _Scene) -> int:
                                     float(scene.lo[2]) - thick]))
 
 
-def _shoot(scene: _Scene, view: str, width: int, height: int, o: RenderOptions,
+def _shoot(scene: _Scene, view: View, width: int, height: int, o: RenderOptions,
            scale: int) -> tuple[Any, Camera, bool]:
     """Render one view at ``width x height`` (already supersampled) with its overlays."""
     import numpy as np

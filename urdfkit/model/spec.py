@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Hashable, Mapping, Sequence
-from typing import Any, Protocol, TypeVar
+from typing import Any, Literal, Protocol, TypeVar
 
 # --------------------------------------------------------------------------- joints
 
@@ -321,6 +321,7 @@ def attr_float(el: _HasGet | None, attr: str, default: float | None = None) -> f
 _HALF = math.sqrt(0.5)
 #: Base orientations (x, y, z, w) that stand a model up whose "up" is the given axis (many
 #: CAD-exported and graphics models are Y-up): that axis is turned onto the world's +Z.
+UpAxis = Literal["z", "y", "x"]
 UP_AXES: dict[str, tuple[float, float, float, float]] = {
     "z": (0.0, 0.0, 0.0, 1.0), "y": (_HALF, 0.0, 0.0, _HALF), "x": (0.0, -_HALF, 0.0, _HALF)}
 
