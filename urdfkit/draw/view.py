@@ -19,7 +19,7 @@ from typing import Any
 
 from urdfkit.core.errors import EngineError, MissingDependencyError, UrdfkitError
 from urdfkit.draw import view_page as page
-from urdfkit.draw.view_model import TINTS, Model, Vec3
+from urdfkit.draw.view_model import TINTS, Layer, Model, Vec3
 from urdfkit.draw.view_stream import RunDisplay, add_shapes, wxyz
 
 #: Links touching another at the current pose (self-collision pairs).
@@ -106,7 +106,7 @@ class Viewer(RunDisplay):
         self._failed: dict[str, Any] | None = None
         self._lock = threading.RLock()
         self._setting = False
-        self._nodes: dict[str, list[Any]] = {}
+        self._nodes: dict[Layer, list[Any]] = {}
         self._frames: list[Any] = []
         #: The page shows poses given from outside (a run, :meth:`show_poses`): the model's
         #: own joints no longer move the scene, even from a late slider callback.
@@ -287,7 +287,7 @@ class Viewer(RunDisplay):
                 for h in handles:
                     h.visible = bool(want[kind])
 
-    def visible(self, kind: str) -> bool:
+    def visible(self, kind: Layer) -> bool:
         """Whether a layer (visual, collision, frames, inertia) is shown."""
         handles = self._nodes.get(kind, [])
         return bool(handles) and all(h.visible for h in handles)
@@ -338,7 +338,9 @@ class Viewer(RunDisplay):
             hit = {name for a, b, _ in self.touching for name in (a, b)}
             for link, k in zip(self.model.links, range(len(self.model.links)), strict=True):
                 base = TINTS.get(link.level or "")
-                for kind, shapes in (("visual", link.visuals), ("collision", link.collisions)):
+                layers: tuple[tuple[Layer, Any], ...] = (("visual", link.visuals),
+                                                         ("collision", link.collisions))
+                for kind, shapes in layers:
                     handles = [h for h in self._nodes.get(kind, [])
                                if h.name.startswith(f"/robot/link{k}/")]
                     for h, sh in zip(handles, shapes, strict=True):
@@ -400,7 +402,7 @@ class Viewer(RunDisplay):
                         tuple(float(x) for x in frame.wxyz))
         raise KeyError(name)
 
-    def nodes(self, kind: str, link: str) -> list[Any]:
+    def nodes(self, kind: Layer, link: str) -> list[Any]:
         """The scene handles of one layer of one link (for tests and tools)."""
         index = next(i for i, lk in enumerate(self.model.links) if lk.name == link)
         prefix = f"/robot/link{index}/"

@@ -22,7 +22,7 @@ import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from urdfkit.core.errors import UrdfkitError
 from urdfkit.core.finding import Finding
@@ -42,6 +42,12 @@ Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]  # x, y, z, w as PyBullet gives them
 
 
+#: What a drawn shape was in the file (``mesh`` for a mesh, whatever PyBullet made of it).
+ShapeKind = Literal["box", "sphere", "cylinder", "capsule", "plane", "mesh"]
+#: The layers of the scene the page shows or hides: shapes, link frames, inertia boxes.
+Layer = Literal["visual", "collision", "frames", "inertia"]
+
+
 @dataclass
 class Shape:
     """One visual or collision shape, ready to draw: triangles in the shape's own frame.
@@ -57,7 +63,7 @@ class Shape:
         note: What the page should say about it (a hull of a concave mesh, a thinned mesh).
     """
 
-    kind: str
+    kind: ShapeKind
     vertices: Any
     faces: Any
     pos: Vec3
@@ -135,7 +141,7 @@ class JointControl:
     mimic: tuple[str, float, float] | None = None
 
 
-def _primitive(kind: int, dims: Sequence[float]) -> tuple[str, Any, Any] | None:
+def _primitive(kind: int, dims: Sequence[float]) -> tuple[ShapeKind, Any, Any] | None:
     import trimesh
 
     if kind == _BOX:
@@ -291,7 +297,7 @@ class Model:
                 return None
             vertices = np.asarray(mesh[0], dtype=float) * np.asarray(dims[:3], dtype=float)
             faces = np.asarray(mesh[1], dtype=np.int64)
-            kind_name = "mesh"
+            kind_name: ShapeKind = "mesh"
             if collision:  # what PyBullet collides with: the hull (urdfkit.draw.displaymesh)
                 from urdfkit.draw.displaymesh import HULL_POINTS, convex_hull
 
