@@ -2,12 +2,12 @@
 
 Three parts:
 
-- :class:`~urdfkit.draw.view_model.Model` (view_model.py) reads a loaded body into plain data:
-shapes,
-  inertial frames, movable joints, findings mapped to links. It never computes kinematics.
-- :class:`Viewer` (here) shows a Model with viser (a web server whose client ships in its
-  wheel, so it works offline), and reloads it when the file or anything it read changes; the
-  page's text is written by view_page.py.
+- :class:`~urdfkit.draw.view_model.ViewedRobot` (view_model.py) reads a loaded body into plain
+  data: shapes, inertial frames, movable joints, findings mapped to links. It never computes
+  kinematics.
+- :class:`Viewer` (here) shows a :class:`ViewedRobot` with viser (a web server whose client
+  ships in its wheel, so it works offline), and reloads it when the file or anything it read
+  changes; the page's text is written by view_page.py.
 - :class:`~urdfkit.draw.view_stream.RunStream` (view_stream.py) streams a simulated run to the page.
 """
 
@@ -19,7 +19,7 @@ from typing import Any
 
 from urdfkit.core.errors import EngineError, MissingDependencyError, UrdfkitError
 from urdfkit.draw import view_page as page
-from urdfkit.draw.view_model import TINTS, Layer, Model, Vec3
+from urdfkit.draw.view_model import TINTS, Layer, Vec3, ViewedRobot
 from urdfkit.draw.view_stream import RunDisplay, add_shapes, wxyz
 
 #: Links touching another at the current pose (self-collision pairs).
@@ -79,7 +79,7 @@ def free_port(host: str) -> int:
 
 
 class Viewer(RunDisplay):
-    """A viser server showing a :class:`Model`, reloaded when its files change.
+    """A viser server showing a :class:`ViewedRobot`, reloaded when its files change.
 
     The server never dies on a bad file: a load that fails keeps the last good robot and shows
     the error in the page (:attr:`error`).
@@ -100,7 +100,7 @@ class Viewer(RunDisplay):
             "packages": packages, "package_paths": package_paths, "xacro_args": xacro_args,
             "inertia_from_file": inertia_from_file}
         self.file = file
-        self.model = Model(file, **self._load_args)  # a bad file fails here, before serving
+        self.model = ViewedRobot(file, **self._load_args)  # a bad file fails here, before serving
         self.error: str | None = None
         self.reloads = 0
         self._failed: dict[str, Any] | None = None
@@ -112,7 +112,7 @@ class Viewer(RunDisplay):
         #: own joints no longer move the scene, even from a late slider callback.
         self.external_poses = False
         #: More robots on the page (sim --view): each model and its link frames.
-        self.extra: list[tuple[Model, list[Any]]] = []
+        self.extra: list[tuple[ViewedRobot, list[Any]]] = []
         self._gui: list[Any] = []
         self.sliders: dict[str, Any] = {}
         viser = _viser()
@@ -438,7 +438,7 @@ class Viewer(RunDisplay):
 
         kept = self.model.positions()
         try:
-            model = Model(self.file, **self._load_args)
+            model = ViewedRobot(self.file, **self._load_args)
         except Exception as e:  # noqa: BLE001 - any failure keeps the last good robot
             self.error = str(e) if isinstance(e, UrdfkitError) else \
                 f"internal error (a bug in urdfkit): {type(e).__name__}: {e}"

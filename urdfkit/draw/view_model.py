@@ -1,7 +1,7 @@
 """The robot as ``urdfkit view`` shows it: read from PyBullet into plain data.
 
-:class:`Model` reads a loaded body into plain data: every link's visual and collision shapes
-(from ``getVisualShapeData`` and ``getCollisionShapeData``, so colours follow PyBullet's
+:class:`ViewedRobot` reads a loaded body into plain data: every link's visual and collision
+shapes (from ``getVisualShapeData`` and ``getCollisionShapeData``, so colours follow PyBullet's
 material rules and collision meshes are the convex hulls PyBullet collides with), its inertial
 frame, mass and principal moments, the movable joints in PyBullet's index order, mimic joints,
 and the findings of ``check`` mapped to links. It poses the body with ``resetJointState`` and
@@ -194,7 +194,7 @@ def read_mesh(path: str | Path) -> tuple[Any, Any] | None:
     return None
 
 
-class Model:
+class ViewedRobot:
     """A file loaded in its own PyBullet session, read into what the viewer draws.
 
     Attributes:

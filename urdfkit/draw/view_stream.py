@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from urdfkit.core.errors import EngineError
-from urdfkit.draw.view_model import Layer, Model, Vec3
+from urdfkit.draw.view_model import Layer, Vec3, ViewedRobot
 
 
 def wxyz(q: Sequence[float]) -> tuple[float, float, float, float]:
@@ -45,7 +45,7 @@ class RunDisplay:
     """
 
     server: Any
-    model: Model
+    model: ViewedRobot
     status: Any
     sliders: dict[str, Any]
     reset_button: Any
@@ -53,7 +53,7 @@ class RunDisplay:
     #: own joints no longer move the scene, even from a late slider callback.
     external_poses: bool
     #: More robots on the page (sim --view): each model and its link frames.
-    extra: list[tuple[Model, list[Any]]]
+    extra: list[tuple[ViewedRobot, list[Any]]]
     _lock: threading.RLock
     _nodes: dict[Layer, list[Any]]
     _frames: list[Any]
@@ -68,7 +68,7 @@ class RunDisplay:
         For a scenario of several robots (``sim --view``): robot 0 is :attr:`model`, the
         others come here, and :meth:`show_poses` places each.
         """
-        m = Model(file, inertia_from_file=inertia_from_file)
+        m = ViewedRobot(file, inertia_from_file=inertia_from_file)
         k = len(self.extra) + 1
         scene, frames = self.server.scene, []
         with self._lock:
