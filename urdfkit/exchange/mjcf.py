@@ -142,6 +142,13 @@ def combine(parts: list[tuple[Inertial, Any]]) -> _Mass:
     """
     import numpy as np
 
+    with np.errstate(all="ignore"):  # huge values overflow: check_mass refuses the result
+        return _combine(parts)
+
+
+def _combine(parts: list[tuple[Inertial, Any]]) -> _Mass:
+    import numpy as np
+
     total = sum(i.mass for i, _ in parts)
     coms = [t[:3, :3] @ np.array(i.com) + t[:3, 3] for i, t in parts]
     if total > 0:
@@ -384,14 +391,23 @@ class _Writer:
 
         link = self.robot.links[name]
         line = link.inertial.line or link.line
+        if not (math.isfinite(m.mass) and np.isfinite(m.com).all()
+                and np.isfinite(m.tensor).all()):
+            raise InputError(f"the mass properties of link {name!r} (with the links fused into "
+                             "it) overflow a double; MuJoCo cannot use them",
+                             file=self.robot.file, line=line)
         if not moving:
             return
         if m.mass <= 0:
             raise InputError(f"U602: link {name!r} moves but has mass 0 (with the links fused "
                              "into it); MuJoCo refuses a massless moving body",
                              file=self.robot.file, line=line)
-        eig = np.linalg.eigvalsh(m.tensor)
+        with np.errstate(all="ignore"):
+            eig = np.linalg.eigvalsh(m.tensor)
         scale = max(abs(eig).max(), 1e-300)
+        if not np.isfinite(eig).all() or not math.isfinite(scale):
+            raise InputError(f"the inertia of link {name!r} overflows a double; MuJoCo cannot "
+                             "use it", file=self.robot.file, line=line)
         a, b, c = sorted(eig)
         if a < -1e-12 * scale:
             raise InputError(f"U603: inertia of link {name!r} is not positive definite (principal "
