@@ -152,5 +152,5 @@ def test_simplecar_velocity_export_drives_forward_in_mujoco(tmp_path: Path) -> N
     # a wheel of radius r at w rad/s rolls r w m/s: drive's own figure for the same car
     radius = np.mean(list(train.radius.values()))
     assert len(targets) >= 2
-    assert along > 0.5 * radius * throttle * seconds, moved
+    assert along > 0.8 * radius * throttle * seconds, moved  # measured: 2.01 m of 2.0
     assert abs(moved[1] if abs(forward[0]) > 0.5 else moved[0]) < 0.1 * along
