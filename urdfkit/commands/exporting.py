@@ -139,14 +139,14 @@ def export(
         robot = read_robot(resolved.root, resolved.name)
         for w in robot.warnings:
             show.warn(f"{resolved.name}: {w}")
-        inertials = None
-        if inertia_from_shapes:
-            from urdfkit.exchange.bullet import loaded_inertials
+        from urdfkit.exchange.bullet import loaded_inertials
 
-            inertials = loaded_inertials(resolved, inertia_from_file=False)
+        # what PyBullet simulates: its diagonalised tensors, its defaults, its recomputation
+        inertials = loaded_inertials(resolved, inertia_from_file=not inertia_from_shapes)
         e = export_mjcf(robot, ExportOptions(
             fixed_base=fixed_base, self_collision=self_collision, actuators=actuators,
-            gain=gain, ground=ground, inertials=inertials), asset_dir_for(out))
+            gain=gain, ground=ground, inertials=inertials,
+            inertia_from_shapes=inertia_from_shapes), asset_dir_for(out))
         flags = ["URDF_USE_INERTIA_FROM_FILE"] if not inertia_from_shapes else []
         flags += ["URDF_USE_SELF_COLLISION"] if self_collision else []
         write_export(e, out, force=force)

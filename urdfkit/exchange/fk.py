@@ -60,17 +60,20 @@ def link_frames(robot: Robot, q: Mapping[str, float], base: Any = None) -> dict[
     return frames
 
 
-def fused(robot: Robot) -> dict[str, tuple[str, Any]]:
+def fused(robot: Robot, split_world: bool = False) -> dict[str, tuple[str, Any]]:
     """Each link's body after fixed links are fused: (body link, the link's frame in it).
 
     A body is the root link or the child of a joint that moves; a link under a fixed joint
-    belongs to its parent's body, at the fixed joints' composed origins.
+    belongs to its parent's body, at the fixed joints' composed origins. With
+    ``split_world``, a root link named ``world`` (MuJoCo's own world body, which takes no
+    mass) keeps each fixed child as a body of its own, welded to it.
     """
     import numpy as np
 
     out: dict[str, tuple[str, Any]] = {robot.root: (robot.root, np.eye(4))}
+    split = split_world and robot.root == "world"
     for j in robot.joints:
-        if j.moves:
+        if j.moves or (split and j.parent == robot.root):
             out[j.child] = (j.child, np.eye(4))
         else:
             body, at = out[j.parent]

@@ -44,8 +44,12 @@ class ExportOptions:
         actuators: One of :data:`ACTUATORS`.
         gain: kp (position) or kv (velocity) actuators' gain; None for the default.
         ground: Add a plane and a light.
-        inertials: Link mass properties to write instead of the file's (PyBullet's own,
-            for ``inertia_from_shapes``).
+        inertials: Link mass properties to write instead of the file's: PyBullet's own
+            (:func:`urdfkit.exchange.bullet.loaded_inertials`), which the command passes. A
+            tensor with products of inertia PyBullet diagonalises with Bullet's Jacobi
+            sweeps, which leave it up to ~1e-8 relative from the file's (panda_link1: 8.2e-9).
+        inertia_from_shapes: Those are PyBullet's recomputation from the collision shapes
+            (no notes about links without ``<inertial>``).
     """
 
     fixed_base: bool = False
@@ -54,6 +58,7 @@ class ExportOptions:
     gain: float | None = None
     ground: bool = False
     inertials: dict[str, Inertial] | None = None
+    inertia_from_shapes: bool = False
 
 
 @dataclass
@@ -180,6 +185,7 @@ class _Writer:
         self.mesh_files: dict[str, str] = {}
         self.bodies: list[str] = []
         self.sites: list[str] = []
+        self.members: dict[str, list[str]] = {}
         self.root = etree.Element("mujoco", model=robot.name or "robot")
         self.compiler = etree.SubElement(self.root, "compiler", angle="radian",
                                          meshdir=asset_dir, autolimits="true")
@@ -311,10 +317,11 @@ class _Writer:
 
     def build(self) -> None:
         robot = self.robot
-        where = fused(robot)
+        where = fused(robot, split_world=True)
         members: dict[str, list[str]] = {}
         for link, (body, _) in where.items():
             members.setdefault(body, []).append(link)
+        self.members = members
         root_link = robot.links[robot.root]
         root_mass = self.inertial(root_link).mass
         self.static = self.o.fixed_base or root_mass == 0
@@ -334,28 +341,29 @@ class _Writer:
         if robot.root == "world":
             self.fill(self.world, "world", members["world"], where, inertial=False)
         for j in robot.joints:
-            if not j.moves:
-                continue
+            if where[j.child][0] != j.child:
+                continue  # fused into its parent's body
             parent_body, at = where[j.parent]
             b = self.E.SubElement(elements[parent_body], "body", name=j.child)
             elements[j.child] = b
             _place(b, at @ origin_matrix(j.xyz, j.rpy))
             self.bodies.append(j.child)
-            self.joint(b, j)
-            self.fill(b, j.child, members[j.child], where)
+            if j.moves:
+                self.joint(b, j)
+            self.fill(b, j.child, members[j.child], where, moving=j.moves)
 
     def fill(self, body: Any, name: str, links: list[str], where: dict[str, Any],
-             inertial: bool = True) -> None:
+             inertial: bool = True, moving: bool = True) -> None:
         """A body's inertial, geoms and sites, from the links fused into it."""
         robot = self.robot
         if inertial:
             parts = [(self.inertial(robot.links[n]), where[n][1]) for n in links]
             m = combine(parts)
-            moving = not (name == robot.root and self.static)
+            moving = moving and not (name == robot.root and self.static)
             self.check_mass(name, m, moving)
             el = self.E.Element("inertial", pos=nums(m.com), mass=num(m.mass))
             t = m.tensor
-            if m.mass == 0 and not moving:
+            if not moving and (m.mass == 0 or not (m.tensor.diagonal() > 0).all()):
                 el.set("diaginertia", "0 0 0")
             else:
                 el.set("fullinertia", nums((t[0, 0], t[1, 1], t[2, 2], t[0, 1], t[0, 2],
@@ -363,7 +371,14 @@ class _Writer:
             body.insert(0 if body.find("freejoint") is None else 1, el)
             for n in links:
                 link = robot.links[n]
-                if not link.inertial.given and self.o.inertials is None:
+                if link.inertial.given and not self.o.inertia_from_shapes and \
+                        self.inertial(link) is not link.inertial and \
+                        not any(self.inertial(link).tensor[k][k] for k in range(3)) and \
+                        any(link.inertial.tensor[k][k] for k in range(3)):
+                    self.note("mirrored", f"link {n!r}: its inertia breaks the triangle "
+                              "inequality; PyBullet sets it to zero, and so is it written "
+                              "(fused into a body that stays valid)", link.inertial.line)
+                if not link.inertial.given and not self.o.inertia_from_shapes:
                     self.note("default", f"link {n!r} has no <inertial>: PyBullet gives it "
                               "1 kg and unit inertia (1, 1, 1) at the link frame; written so",
                               link.line)
@@ -386,7 +401,7 @@ class _Writer:
             self.E.SubElement(body, "site", name="world")
 
     def check_mass(self, name: str, m: _Mass, moving: bool) -> None:
-        """Refuse what MuJoCo refuses, with check's code (U602, U604) and the line."""
+        """Refuse what MuJoCo refuses, with check's code (U602-U604, U608) and the line."""
         import numpy as np
 
         link = self.robot.links[name]
@@ -409,6 +424,16 @@ class _Writer:
             raise InputError(f"the inertia of link {name!r} overflows a double; MuJoCo cannot "
                              "use it", file=self.robot.file, line=line)
         a, b, c = sorted(eig)
+        if a <= 1e-15:  # mjMINVAL: MuJoCo's floor for a moving body's principal moments
+            # the cause check names: a link's own tensor PyBullet zeroed (U604)
+            for n in self.members.get(name, [name]) if not self.o.inertia_from_shapes else ():
+                given = self.robot.links[n].inertial
+                if given.given and given.mass > 0:
+                    self.triangle(n, np.array(given.tensor), given.line)
+            raise InputError(f"U608: inertia of link {name!r} (with the links fused into it) "
+                             f"has a zero principal moment ({a:.6g}, {b:.6g}, {c:.6g}); "
+                             "MuJoCo refuses it for a moving body", file=self.robot.file,
+                             line=line)
         if a < -1e-12 * scale:
             raise InputError(f"U603: inertia of link {name!r} is not positive definite (principal "
                              f"moments {a:.6g}, {b:.6g}, {c:.6g}); MuJoCo refuses it",
@@ -417,6 +442,20 @@ class _Writer:
             raise InputError(f"U604: inertia of link {name!r} violates the triangle inequality "
                              f"({a:.6g} + {b:.6g} < {c:.6g}); MuJoCo refuses it",
                              file=self.robot.file, line=line)
+
+    def triangle(self, name: str, tensor: Any, line: int | None) -> None:
+        """U604 on a link's own tensor from the file (PyBullet zeroes such a tensor)."""
+        import numpy as np
+
+        with np.errstate(all="ignore"):
+            eig = np.linalg.eigvalsh(tensor) if np.isfinite(tensor).all() else None
+        if eig is None or not np.isfinite(eig).all():
+            return
+        a, b, c = sorted(eig)
+        if a + b < c - 1e-9 * max(abs(c), 1e-300):
+            raise InputError(f"U604: inertia of link {name!r} violates the triangle inequality "
+                             f"({a:.6g} + {b:.6g} < {c:.6g}): PyBullet zeroes it and MuJoCo "
+                             "refuses it", file=self.robot.file, line=line)
 
     def joint(self, body: Any, j: Any) -> None:
         E = self.E
