@@ -132,6 +132,11 @@ def load_mjcf(path: str | Path) -> tuple[Any, Any]:
         fixed_spec = mujoco.MjSpec.from_file(str(p))
         for j in list(fixed_spec.joints):
             if j.type == mujoco.mjtJoint.mjJNT_FREE:
+                # welded where PyBullet's fixed load puts the root: at the origin (a model
+                # may spawn its root higher, as Menagerie's go2 at 0.445 m)
+                body = j.parent
+                body.pos = [0.0, 0.0, 0.0]
+                body.quat = [1.0, 0.0, 0.0, 0.0]
                 fixed_spec.delete(j)
         fixed = fixed_spec.compile()
     except (ValueError, RuntimeError) as e:
