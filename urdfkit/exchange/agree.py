@@ -123,9 +123,13 @@ def import_mujoco() -> Any:
 def load_mjcf(path: str | Path) -> tuple[Any, Any]:
     """The model as written, and the same model with its free joints removed (base fixed)."""
     mujoco = import_mujoco()
+    from urdfkit.sources.uris import not_a_file
+
     p = Path(path)
-    if not p.is_file():
-        raise InputError("no such file", file=str(path))
+    why = not_a_file(p)  # a stat only: MuJoCo would block on a FIFO
+    if why is not None:
+        raise InputError("no such file" if why == "missing" else f"is {why}, not an MJCF "
+                         "file", file=str(path))
     try:
         spec = mujoco.MjSpec.from_file(str(p))
         model = spec.compile()
