@@ -158,8 +158,7 @@ def export(
                 fixed_base, inertia_from_shapes, self_collision, 100, 0))
     if as_json:
         data = _export_dict(resolved.name, e, flags)
-        if agreement is not None:
-            data["agreement"] = agreement_dict(agreement)
+        data["agreement"] = agreement_dict(agreement) if agreement is not None else None
         show.print_json(data)
     else:
         for n in e.notes:
