@@ -154,3 +154,20 @@ def test_simplecar_velocity_export_drives_forward_in_mujoco(tmp_path: Path) -> N
     assert len(targets) >= 2
     assert along > 0.8 * radius * throttle * seconds, moved  # measured: 2.01 m of 2.0
     assert abs(moved[1] if abs(forward[0]) > 0.5 else moved[0]) < 0.1 * along
+
+
+@pytest.mark.parametrize("flag", ["--self-collision", "--inertia-from-shapes", "--fixed-base"])
+def test_each_mirrored_load_agrees_with_its_pybullet_load(flag: str, tmp_path: Path) -> None:
+    out = tmp_path / "r2d2.xml"
+    _export("r2d2.urdf", out, flag)
+    code, data = _agree("r2d2.urdf", out, flag, "--poses", "20")
+    assert code == 0, [r for r in data["rows"] if r["status"] == "fail"]
+    flags = data["load_flags"]
+    assert ("URDF_USE_SELF_COLLISION" in flags) == (flag == "--self-collision")
+    assert ("URDF_USE_INERTIA_FROM_FILE" in flags) == (flag != "--inertia-from-shapes")
+    rows = {r["check"]: r for r in data["rows"]}
+    if flag == "--self-collision":  # r2d2's parts touch: counted, not failed
+        assert rows["self-contacts at the poses"]["status"] == "info"
+        assert rows["self-contacts at the poses"]["value"] > 0
+    if flag == "--fixed-base":
+        assert rows["base"]["detail"] == "PyBullet: welded; MJCF: welded"

@@ -563,6 +563,8 @@ class _Compare:
                                     forces=[0.0] * len(pb.movable))
         for i in range(-1, len(pb.info)):
             b.changeDynamics(pb.body, i, linearDamping=0.0, angularDamping=0.0)
+            # contacts off on this side too (URDF_USE_SELF_COLLISION would collide links)
+            b.setCollisionFilterGroupMask(pb.body, i, 0, 0)
         adr = [int(m.jnt_qposadr[self.jnt[n]]) for n in pb.names]
         steps = round(self.o.seconds / self.o.time_step)
         worst, at, stop, why = 0.0, "", steps, ""
