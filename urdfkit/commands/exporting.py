@@ -147,7 +147,9 @@ def export(
             fixed_base=fixed_base, self_collision=self_collision, actuators=actuators,
             gain=gain, ground=ground, inertials=inertials,
             inertia_from_shapes=inertia_from_shapes), asset_dir_for(out))
+        # cylinders are written as true cylinders: PyBullet's with URDF_USE_IMPLICIT_CYLINDER
         flags = ["URDF_USE_INERTIA_FROM_FILE"] if not inertia_from_shapes else []
+        flags += ["URDF_USE_IMPLICIT_CYLINDER"]
         flags += ["URDF_USE_SELF_COLLISION"] if self_collision else []
         write_export(e, out, force=force)
         agreement = None

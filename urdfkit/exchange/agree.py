@@ -341,6 +341,12 @@ class _Compare:
             if int(kinds[info[2]]) == int(m.jnt_type[k]):
                 damping.append((abs(info[6] - m.dof_damping[m.jnt_dofadr[k]]), n))
         res.add("structure", "joint kinds", float(len(wrong)), 0.0, "differ", ", ".join(wrong))
+        mimic = [f"{j.name} = {j.mimic[1]:g} x {j.mimic[0]} + {j.mimic[2]:g}"
+                 for j in self.robot.movable() if j.mimic is not None and j.name in self.jnt]
+        if mimic:
+            res.add("structure", "mimic joints", float(len(mimic)), None, "known",
+                    "PyBullet ignores <mimic>; an MJCF equality means it: " + "; ".join(mimic),
+                    status="known")
         v, d = _worst(limits)
         res.add("structure", "joint limits", v, TOL_EXACT, "rad|m", d)
         v, d = _worst(damping)
