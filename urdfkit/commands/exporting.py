@@ -56,7 +56,7 @@ def agreement_dict(a: Any) -> dict[str, Any]:
                       "tolerance": r.tolerance, "unit": r.unit, "status": r.status,
                       "detail": r.detail} for r in a.rows],
             "unmatched_links": a.unmatched_links, "unmatched_joints": a.unmatched_joints,
-            "extra_joints": a.extra_joints}
+            "extra_joints": a.extra_joints, "warnings": a.warnings}
 
 
 def agreement_report(a: Any, show_all: bool = False) -> None:
@@ -70,6 +70,8 @@ def agreement_report(a: Any, show_all: bool = False) -> None:
     failed = sum(not r.ok for r in a.rows)
     title = (f"{a.file} in PyBullet vs {a.model} in MuJoCo: "
              + ("every row agrees" if not failed else f"{failed} row(s) disagree"))
+    for w in a.warnings:
+        show.warn(f"{a.model}: MuJoCo: {w}")
     show.table(title, columns, rows, show_all)
     if a.unmatched_links:
         show.note(f"{len(a.unmatched_links)} link(s) with no body or site of that name: "

@@ -42,6 +42,8 @@ TOL_FK = 1e-12             # against double-precision forward kinematics
 TOL_DYNAMICS = 1e-9        # mass matrix, inverse dynamics, relative
 TOL_SWING = 1e-9           # rad over the free swing
 LIMIT_MARGIN = 0.01        # rad: the swing is compared until a joint comes this close
+#: What MuJoCo warned while loading the last model (see :func:`load_mjcf`).
+LOAD_WARNINGS: list[str] = []
 
 
 @dataclass
@@ -96,6 +98,8 @@ class Agreement:
     unmatched_joints: list[str] = field(default_factory=list)
     extra_joints: list[str] = field(default_factory=list)
     load_flags: list[str] = field(default_factory=list)
+    #: What MuJoCo said while loading the model (its decoders' warnings).
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -130,9 +134,16 @@ def load_mjcf(path: str | Path) -> tuple[Any, Any]:
     if why is not None:
         raise InputError("no such file" if why == "missing" else f"is {why}, not an MJCF "
                          "file", file=str(path))
+    import warnings
+
     try:
-        spec = mujoco.MjSpec.from_file(str(p))
-        model = spec.compile()
+        # MuJoCo's decoders warn through Python (an OBJ's texture coordinates dropped): kept
+        # for the report, not printed
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            spec = mujoco.MjSpec.from_file(str(p))
+            model = spec.compile()
+        LOAD_WARNINGS[:] = sorted({str(w.message) for w in said})
         fixed_spec = mujoco.MjSpec.from_file(str(p))
         for j in list(fixed_spec.joints):
             if j.type == mujoco.mjtJoint.mjJNT_FREE:
@@ -142,7 +153,9 @@ def load_mjcf(path: str | Path) -> tuple[Any, Any]:
                 body.pos = [0.0, 0.0, 0.0]
                 body.quat = [1.0, 0.0, 0.0, 0.0]
                 fixed_spec.delete(j)
-        fixed = fixed_spec.compile()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the same warnings again
+            fixed = fixed_spec.compile()
     except (ValueError, RuntimeError) as e:
         first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
         raise InputError(f"MuJoCo cannot load it: {first}", file=str(path)) from None
@@ -181,8 +194,14 @@ class _Pybullet:
         self.link_index = {self.base: -1}
         for i, info in enumerate(self.info):
             self.link_index[info[12].decode("utf-8", "replace")] = i
-        self.movable = [i for i, info in enumerate(self.info) if info[2] in (0, 1)]
+        # revolute, prismatic and spherical joints (planar ones export refuses)
+        self.movable = [i for i, info in enumerate(self.info) if info[2] in (0, 1, 2)]
         self.names = [self.info[i][1].decode("utf-8", "replace") for i in self.movable]
+        #: the 1-dof joints, which the poses and the swing move (spherical ones stay at rest)
+        self.one = [i for i in self.movable if self.info[i][2] in (0, 1)]
+        self.one_names = [self.info[i][1].decode("utf-8", "replace") for i in self.one]
+        self.spherical = [n for i, n in zip(self.movable, self.names, strict=True)
+                          if self.info[i][2] == 2]
         # the floating copy's mass properties, read now: it must not fall onto the other
         self.inertials = {n: self._inertial(i) for n, i in self.link_index.items()}
         b.removeBody(self.free)
@@ -203,7 +222,7 @@ class _Pybullet:
                         tuple(map(tuple, tensor)))  # type: ignore[arg-type]
 
     def pose(self, q: dict[str, float]) -> None:
-        for i, name in zip(self.movable, self.names, strict=True):
+        for i, name in zip(self.one, self.one_names, strict=True):
             self.b.resetJointState(self.body, i, q.get(name, 0.0), 0.0)
 
     def frames(self, links: list[str]) -> dict[str, Any]:
@@ -289,7 +308,8 @@ class _Compare:
         self.o = options
         self.model, self.fixed = load_mjcf(model_path)
         self.pb = _Pybullet(session, load_path, robot.file, options)
-        self.result = Agreement(robot.file, model_path, load_flags=self.pb.flags)
+        self.result = Agreement(robot.file, model_path, load_flags=self.pb.flags,
+                                warnings=list(LOAD_WARNINGS))
         m = self.fixed
         self.jnt = {_name(m, mujoco.mjtObj.mjOBJ_JOINT, i): i for i in range(m.njnt)}
         self.body = {_name(m, mujoco.mjtObj.mjOBJ_BODY, i): i for i in range(m.nbody)}
@@ -322,7 +342,8 @@ class _Compare:
         res.add("structure", "joint order", 0.0 if not bad else 1.0, 0.0, "moved",
                 f"first out of place: {bad}" if bad else "")
         joints = {j.name: j for j in self.robot.joints}
-        kinds = {0: mj.mjtJoint.mjJNT_HINGE, 1: mj.mjtJoint.mjJNT_SLIDE}
+        kinds = {0: mj.mjtJoint.mjJNT_HINGE, 1: mj.mjtJoint.mjJNT_SLIDE,
+                 2: mj.mjtJoint.mjJNT_BALL}
         wrong, limits, damping = [], [], []
         for i, n in zip(pb.movable, pb.names, strict=True):
             if n not in self.jnt:
@@ -330,10 +351,14 @@ class _Compare:
             info, k = pb.info[i], self.jnt[n]
             if int(kinds[info[2]]) != int(m.jnt_type[k]):
                 wrong.append(n)
+            if info[2] == 2:
+                continue  # a ball joint has no limits or damping PyBullet reads
             # PyBullet limits a revolute or prismatic joint with lower <= upper, never a
             # continuous one (getJointInfo shows a continuous joint's <limit> all the same)
             pb_limited = joints[n].limited
-            if pb_limited != bool(m.jnt_limited[k]):
+            if pb_limited and joints[n].lower == joints[n].upper and not m.jnt_limited[k]:
+                pass  # locked: MuJoCo has no empty range (export holds it with an equality)
+            elif pb_limited != bool(m.jnt_limited[k]):
                 limits.append((math.inf, n))
             elif pb_limited:
                 limits.append((max(abs(info[8] - m.jnt_range[k][0]),
@@ -449,20 +474,21 @@ class _Compare:
         mass_err: list[tuple[float, str]] = []
         id_err: list[tuple[float, str]] = []
         contacts: list[str] = []
-        dyn = not res.unmatched_joints and not res.extra_joints and self.matched
+        dyn = not res.unmatched_joints and not res.extra_joints and self.matched \
+            and not pb.spherical
         dof = [int(m.jnt_dofadr[self.jnt[n]]) for n in self.matched]
         d_contact = mj.MjData(m)
         self.first_pose: dict[str, float] = {}
         tol = pybullet_frame_tolerances(robot)
         for k in range(self.o.poses):
-            q = _sample(robot, pb.names, rng)
+            q = _sample(robot, pb.one_names, rng)
             if k == 0:
                 self.first_pose = q
-            qd = _sample(robot, pb.names, rng)
-            qdd = _sample(robot, pb.names, rng)
+            qd = _sample(robot, pb.one_names, rng)
+            qdd = _sample(robot, pb.one_names, rng)
             d.qpos[:] = m.qpos0
             d.qvel[:] = 0
-            self.set_q(d, {n: q[n] for n in self.matched})
+            self.set_q(d, {n: q[n] for n in self.matched if n in q})
             mj.mj_kinematics(m, d)
             pb.pose(q)
             pb_frames = pb.frames(links)
@@ -528,6 +554,13 @@ class _Compare:
             res.add("dynamics", "mass matrix", v, TOL_DYNAMICS, "relative", n)
             v, n = _worst(id_err)
             res.add("dynamics", "inverse dynamics", v, TOL_DYNAMICS, "relative", n)
+        elif not pb.names and not res.extra_joints:
+            res.add("dynamics", "mass matrix, inverse dynamics", None, None, "",
+                    "no movable joints", status="info")
+        elif pb.spherical and not res.unmatched_joints and not res.extra_joints:
+            res.add("dynamics", "mass matrix, inverse dynamics", None, None, "",
+                    f"not compared: spherical joints ({', '.join(pb.spherical[:3])}); their "
+                    "frames are compared at rest", status="info")
         else:
             res.add("dynamics", "mass matrix, inverse dynamics", None, None, "",
                     "not compared: the joints differ")
@@ -542,8 +575,15 @@ class _Compare:
         import numpy as np
 
         mj, pb, res = self.mj, self.pb, self.result
+        if not self.pb.names and not res.extra_joints:
+            res.add("swing", "free swing", None, None, "", "no movable joints", status="info")
+            return
         if not self.matched or res.unmatched_joints or res.extra_joints:
             res.add("swing", "free swing", None, None, "", "not compared: the joints differ")
+            return
+        if self.pb.spherical:
+            res.add("swing", "free swing", None, None, "", "not compared: spherical joints",
+                    status="info")
             return
         m = self.fixed
         m.opt.timestep = self.o.time_step

@@ -186,6 +186,7 @@ class _Writer:
         self.bodies: list[str] = []
         self.sites: list[str] = []
         self.members: dict[str, list[str]] = {}
+        self.locked: list[Any] = []
         self.root = etree.Element("mujoco", model=robot.name or "robot")
         self.compiler = etree.SubElement(self.root, "compiler", angle="radian",
                                          meshdir=asset_dir, autolimits="true")
@@ -455,7 +456,8 @@ class _Writer:
         if a + b < c - 1e-9 * max(abs(c), 1e-300):
             raise InputError(f"U604: inertia of link {name!r} violates the triangle inequality "
                              f"({a:.6g} + {b:.6g} < {c:.6g}): PyBullet zeroes it and MuJoCo "
-                             "refuses it", file=self.robot.file, line=line)
+                             "refuses it (`urdfkit fix` derives one from the shapes; "
+                             "--balance balances it)", file=self.robot.file, line=line)
 
     def joint(self, body: Any, j: Any) -> None:
         E = self.E
@@ -465,8 +467,11 @@ class _Writer:
             el = E.SubElement(body, "joint", name=j.name,
                               type="slide" if j.type == "prismatic" else "hinge",
                               axis=nums(j.axis))
-            if j.limited:
+            if j.limited and j.lower < j.upper:
                 el.set("range", nums((j.lower, j.upper)))
+            elif j.limited:
+                # PyBullet locks a joint whose lower == upper; MuJoCo refuses an empty range
+                self.locked.append(j)
         if j.damping:
             el.set("damping", num(j.damping))
         if j.friction:
@@ -507,8 +512,14 @@ class _Writer:
                         el.set("ctrlrange", nums((-j.velocity, j.velocity)))
         mimics = [j for j in self.robot.movable() if j.mimic is not None]
         names = {j.name for j in self.robot.movable()}
+        eq = E.SubElement(self.root, "equality") if mimics or self.locked else None
+        for j in self.locked:
+            E.SubElement(eq, "joint", joint1=j.name, polycoef=nums((j.lower, 0, 0, 0, 0)))
+            self.note("approximated", f"joint {j.name!r} has lower == upper: PyBullet locks it "
+                      "there with a limit; MuJoCo refuses an empty range, so a joint equality "
+                      "holds it", j.line)
         if mimics:
-            eq = E.SubElement(self.root, "equality")
+            assert eq is not None
             for j in mimics:
                 assert j.mimic is not None
                 leader, mult, offset = j.mimic

@@ -272,8 +272,10 @@ def _joint(el: Any) -> Joint:
     origin = el.find("origin")
     axis = _vec3(el.find("axis"), "xyz", (1.0, 0.0, 0.0))
     limit = el.find("limit")
+    # PyBullet's defaults when <limit> leaves them out: lower 0, upper -1 (unlimited; measured)
     lower = attr_float(limit, "lower", 0.0) or 0.0
-    upper = attr_float(limit, "upper", 0.0) or 0.0
+    upper = attr_float(limit, "upper", -1.0)
+    upper = -1.0 if upper is None else upper
     if kind == "continuous":
         limited, lower, upper = False, 0.0, -1.0
     else:
