@@ -17,7 +17,10 @@ from urdfkit.cli import app
 mujoco = pytest.importorskip("mujoco")  # in the test extra: CI never skips it
 
 runner = CliRunner()
-ROBOTS = ["r2d2.urdf", "kuka_iiwa/model.urdf", "racecar/racecar.urdf", "husky/husky.urdf"]
+#: The issue's four, and the bicycle: its base's inertial frame is turned (rpy 1.57 0 0), which
+#: PyBullet's calculateInverseDynamics applies to gravity (agree hands it gravity turned back).
+ROBOTS = ["r2d2.urdf", "kuka_iiwa/model.urdf", "racecar/racecar.urdf", "husky/husky.urdf",
+          "bicycle/bike.urdf"]
 
 
 def _export(robot: str, out: Path, *args: str) -> None:
