@@ -456,8 +456,8 @@ class _Writer:
         if a + b < c - 1e-9 * max(abs(c), 1e-300):
             raise InputError(f"U604: inertia of link {name!r} violates the triangle inequality "
                              f"({a:.6g} + {b:.6g} < {c:.6g}): PyBullet zeroes it and MuJoCo "
-                             "refuses it (`urdfkit fix` derives one from the shapes; "
-                             "--balance balances it)", file=self.robot.file, line=line)
+                             "refuses it (`urdfkit fix` can derive one from the shapes)",
+                             file=self.robot.file, line=line)
 
     def joint(self, body: Any, j: Any) -> None:
         E = self.E
