@@ -220,3 +220,13 @@ def test_writer_numbers_round_trip_every_double(robot: Path, tmp_path: Path) -> 
     for x in (math.pi, 1 / 3, -2.9670597283903604, 1e-300, 0.1 + 0.2, -0.0):
         assert float(num(x)) == x
     assert num(-0.0) == "0"
+
+
+def test_a_flat_mesh_loads(tmp_path: Path) -> None:
+    """plane.urdf's plane.obj has no volume: MuJoCo refuses it unless its inertia is a shell
+    (the body's inertia is written, never taken from meshes)."""
+    out = tmp_path / "plane.xml"
+    r = runner.invoke(app, ["export", "mjcf", "plane.urdf", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    m = mujoco.MjModel.from_xml_path(str(out))
+    assert m.nmesh == 1 and m.body_mass[1] == 0  # plane.urdf's base: mass 0, welded

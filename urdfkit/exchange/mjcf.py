@@ -214,7 +214,9 @@ class _Writer:
         name = None
         if file is not None:
             name = f"mesh{len([m for m in self.meshes.values() if m])}"
-            el = self.E.SubElement(self.asset, "mesh", name=name, file=file)
+            # inertia="shell": the bodies' inertia is written, never taken from meshes, and
+            # MuJoCo refuses a flat mesh's volume (plane.urdf: "mesh volume is too small")
+            el = self.E.SubElement(self.asset, "mesh", name=name, file=file, inertia="shell")
             if tuple(shape.scale) != (1.0, 1.0, 1.0):
                 el.set("scale", nums(shape.scale))
         self.meshes[key] = name
@@ -224,7 +226,7 @@ class _Writer:
         """The file name in the assets folder of a mesh (copied or converted once)."""
         source = str(path)
         if source in self.mesh_files:
-            return self.mesh_files[source]
+            return self.mesh_files[source] or None  # "": unreadable, said once
         suffix = path.suffix.lower()
         data: bytes | Path | None = path
         out_suffix = suffix
