@@ -230,3 +230,17 @@ def test_a_flat_mesh_loads(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     m = mujoco.MjModel.from_xml_path(str(out))
     assert m.nmesh == 1 and m.body_mass[1] == 0  # plane.urdf's base: mass 0, welded
+
+
+def test_xacro_with_an_argument(tmp_path: Path) -> None:
+    """tests/data/arm.urdf.xacro: the upper arm's centre of mass sits at L/2 above the
+    shoulder, and its cylinder is L long."""
+    arm = Path(__file__).parent / "data" / "arm.urdf.xacro"
+    out = tmp_path / "arm.xml"
+    _export(arm, out, "--arg", "length:=0.8")
+    m = mujoco.MjModel.from_xml_path(str(out))
+    upper = _body(m, "upper")
+    assert m.body_ipos[upper] == pytest.approx([0, 0, 0.4], abs=1e-15)
+    cyl = [g for g in range(m.ngeom) if m.geom_bodyid[g] == upper
+           and m.geom_type[g] == mujoco.mjtGeom.mjGEOM_CYLINDER]
+    assert m.geom_size[cyl[0]][1] == pytest.approx(0.4, abs=1e-15)  # half of 0.8
