@@ -479,16 +479,13 @@ class _Compare:
             and not pb.spherical
         dof = [int(m.jnt_dofadr[self.jnt[n]]) for n in self.matched]
         d_contact = mj.MjData(m)
-        self.first_pose: dict[str, float] = {}
         tol = pybullet_frame_tolerances(robot)
         from urdfkit.model.spec import quat_to_matrix
 
         base_inertial = np.array(quat_to_matrix(pb.b.getDynamicsInfo(pb.body, -1)[4]))
         turned_back = base_inertial.T @ np.array(m.opt.gravity)
-        for k in range(self.o.poses):
+        for _ in range(self.o.poses):
             q = _sample(robot, pb.one_names, rng)
-            if k == 0:
-                self.first_pose = q
             qd = _sample(robot, pb.one_names, rng)
             qdd = _sample(robot, pb.one_names, rng)
             d.qpos[:] = m.qpos0
