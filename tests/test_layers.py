@@ -20,8 +20,8 @@ PACKAGE = Path(urdfkit.__file__).parent
 #: or below, never above. The three capabilities (checks, motion, draw) share a floor: they
 #: may use each other (a sweep checks its robot, a plot reads a drive's trajectory), without
 #: cycles between modules.
-FLOOR_FOLDERS = [["core"], ["model"], ["sources"], ["engine"], ["checks", "motion", "draw"],
-                 ["commands"]]
+FLOOR_FOLDERS = [["core"], ["model"], ["sources"], ["engine"],
+                 ["checks", "motion", "draw", "exchange"], ["commands"]]
 FLOORS: dict[str, int] = {name: n for n, names in enumerate(FLOOR_FOLDERS) for name in names}
 FOLDERS = [name for names in FLOOR_FOLDERS for name in names]
 #: The public modules at the top of the package, each on the floor of what it fronts. The last

@@ -484,3 +484,34 @@ def _solid(vertices: Any, faces: Any, starts: list[int] | None = None, *,
                      (float(high[0]), float(high[1]), float(high[2])), closed, len(faces),
                      (_concavity(vertices, faces, starts, det) if concavity else math.nan)
                      if closed else 0.0, len(starts) + 1)
+
+
+def read_triangles(path: Path) -> tuple[Any, Any] | None:
+    """A mesh's vertices and triangles (vertex indices), placed as PyBullet places them.
+
+    For converting a mesh MuJoCo cannot read (COLLADA) to one it can (``urdfkit export``):
+    the same readers as :func:`read_integrals`. None if unreadable, unsupported or empty.
+    """
+    import numpy as np
+
+    from urdfkit.model.xmlio import read_regular
+
+    suffix = path.suffix.lower()
+    try:
+        data = read_regular(path, limit=MAX_MESH_BYTES, kind="mesh")
+        if suffix == ".stl":
+            vertices, faces = _stl(data)
+        elif suffix == ".obj":
+            vertices, faces, _ = _obj(data)
+        elif suffix == ".dae":
+            vertices, faces = _dae(data, path)
+        else:
+            return None
+    except (ValueError, struct.error, IndexError, OverflowError, KeyError, InputError,
+            AttributeError, StopIteration, TypeError):
+        return None
+    if (vertices is None or faces is None or len(faces) == 0 or len(vertices) == 0
+            or faces.min() < 0 or faces.max() >= len(vertices)
+            or not np.isfinite(vertices).all()):
+        return None
+    return vertices, faces
