@@ -19,7 +19,7 @@ from urdfkit.commands.shared import (
     PackagePathOpt,
     command,
     examples,
-    open_input,
+    open_input_and_warn,
 )
 
 FixedBaseOpt = Annotated[bool, typer.Option(
@@ -137,7 +137,8 @@ def export(
         raise ParameterError(f"unknown format {kind!r}: export writes mjcf", param="kind")
     out = output or f"{Path(file).name.split('.')[0] or 'robot'}.xml"
     check_output(out, force=force, suffixes=(".xml",), what="the MJCF file")
-    with open_input(file, package, arg, no_guard, package_path) as resolved:
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path) as resolved:
         robot = read_robot(resolved.root, resolved.name)
         for w in robot.warnings:
             show.warn(f"{resolved.name}: {w}")
@@ -204,7 +205,8 @@ def agree(
     """
     from urdfkit.exchange.agree import agree as run_agree
 
-    with open_input(file, package, arg, no_guard, package_path) as resolved:
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path) as resolved:
         result = run_agree(resolved, model, _verify_options(
             fixed_base, inertia_from_shapes, self_collision, poses, seed))
     if as_json:
