@@ -42,7 +42,7 @@ from urdfkit.checks.validate import ALL_RULES, STUB_SIZE, Solid, link_solid
 from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.model.spec import rpy_to_matrix, sym_eigenvalues, transpose
+from urdfkit.model.spec import default_mass, rpy_to_matrix, sym_eigenvalues, transpose
 from urdfkit.model.xmlio import fmt_float, fmt_vec, parse_xml, read_bytes, start_tags
 from urdfkit.sources.guard import Report, refuse_oversized
 
@@ -103,7 +103,7 @@ class FixResult:
     mass_before: float = 0.0
     mass_after: float = 0.0
     #: The total mass PyBullet loads, before and after: the file's plus 1 kg for every link
-    #: without ``<inertial>`` (a frame given mass 0 loses that phantom kilogram).
+    #: without ``<inertial>`` but ``world`` (a frame given mass 0 loses that phantom kilogram).
     loaded_before: float = 0.0
     loaded_after: float = 0.0
     repairs: list[Repair] = field(default_factory=list)
@@ -256,12 +256,13 @@ class _Fixing:
 def _total_mass(root: etree._Element, loaded: bool = False) -> float:
     """The sum of a robot's finite link masses, as written.
 
-    ``loaded``: as PyBullet loads it, which gives a link with no ``<inertial>`` 1 kg.
+    ``loaded``: as PyBullet loads it, which gives a link with no ``<inertial>`` 1 kg (0 if it
+    is named ``world``).
     """
     total = 0.0
     for link in root.iterchildren("link"):
         if loaded and link.find("inertial") is None:
-            total += 1.0
+            total += default_mass(link.get("name"))
             continue
         mass = _num(link.find("inertial/mass"), "value")
         if mass is not None and math.isfinite(mass):

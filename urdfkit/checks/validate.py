@@ -24,7 +24,9 @@ from urdfkit.model.spec import (
     MAX_STATE_LINKS,
     SHAPES,
     SOLIDS,
+    WORLD_LINK,
     Matrix3,
+    default_mass,
     extension_note,
     ignored_shape,
     matmul,
@@ -77,9 +79,9 @@ def rule_elements(root: etree._Element, r: Report) -> None:
 
 
 def _mass_of(link: LinkView) -> float | None:
-    """The mass PyBullet gives a link: its <mass>, or 1 kg if there is no <inertial>."""
+    """The mass PyBullet gives a link: its <mass>, or without <inertial> 1 kg (0 for world)."""
     if link.inertial is None:
-        return 1.0
+        return default_mass(link.name)
     return _num(link.mass, "value")
 
 
@@ -100,6 +102,8 @@ def rule_mass(root: etree._Element, r: Report) -> None:
     child_names = {c.get("link") for jv in doc.joints for c in jv.children}
     for view in views.values():
         link, inertial = view.el, view.inertial
+        if inertial is None and view.name == WORLD_LINK:
+            continue  # PyBullet gives it mass 0, not 1 kg: U611 (a root) or U602 (moving) say so
         if inertial is None:
             # Never "mass 0" for the root: PyBullet fixes a mass-0 base in place (U611).
             advice = ("add <inertial> with its real mass (mass 0 would fix the robot in place)"
@@ -119,24 +123,34 @@ def rule_mass(root: etree._Element, r: Report) -> None:
     for name, j in moving:
         if name in views and _rigid_mass(name, views, fixed_children) == 0:
             r.add("U602", "error", f"{label(views[name].el)} moves (joint {j.get('name')!r} is "
-                  f"{j.get('type')}) but has mass 0; give it a mass > 0", views[name].el)
+                  f"{j.get('type')}) but has mass 0"
+                  + (" (it has no <inertial> and is named world, which PyBullet gives mass 0, "
+                     "not 1 kg)" if name == WORLD_LINK and views[name].inertial is None else "")
+                  + "; give it a mass > 0", views[name].el)
     roots = [view for name, view in views.items() if name not in child_names]
     # PyBullet judges the root link's own mass: 0 fixes the base in place, whatever its fixed
     # children weigh (a mass-0 base_footprint over a 28 kg base_link hangs in the air). A
     # root with no <inertial> gets 1 kg, so it moves (U606 says so).
-    own = _mass_of(roots[0]) if len(roots) == 1 and roots[0].inertial is not None else None
+    # A root named world without <inertial> gets mass 0 from PyBullet (measured), so it too.
+    own = _mass_of(roots[0]) if len(roots) == 1 and (
+        roots[0].inertial is not None or roots[0].name == WORLD_LINK) else None
     if own is not None and own == 0:
         base, static = roots[0].el, not moving
         carried = _rigid_mass(base.get("name", ""), views, fixed_children)
         held = (f"; its fixed links weigh {carried:g} kg, and PyBullet ignores that: it looks "
                 "at the root's own mass" if carried > 0 else "")
-        r.add("U611", "info" if static and not carried else "warning",
-              f"root {label(base)} has mass 0: PyBullet makes the base static, fixed where it "
+        why = ("has no <inertial> and is named world, which PyBullet gives mass 0 (not 1 kg)"
+               if roots[0].inertial is None else "has mass 0")
+        # A root named world is the ROS convention for "bolted to the world": as meant.
+        bolted = roots[0].inertial is None
+        r.add("U611", "info" if bolted or (static and not carried) else "warning",
+              f"root {label(base)} {why}: PyBullet makes the base static, fixed where it "
               "is loaded" + (" (right for a static object such as ground)"
                              if static and not carried else
                              "; right for an arm bolted to the world, wrong for a robot "
                              "that should fall or drive: give the root link a mass, or make "
-                             "the massive link the root") + held, base)
+                             "the massive link the root") + (held if not bolted else ""),
+              base)
 
 
 def _rigid_mass(name: str, views: dict[str, LinkView],

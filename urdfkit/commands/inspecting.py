@@ -229,6 +229,8 @@ def info(
     no_guard: NoGuardOpt = False,
 ) -> None:
     """The robot at a glance: links, joints by type, DOF, total mass, bounding box."""
+    from urdfkit.model.spec import default_mass
+
     report = _inspect(file, package, arg, fixed_base=fixed_base, info=True, no_guard=no_guard,
                       package_path=package_path, flags=flags)
     s = report.summary
@@ -241,13 +243,15 @@ def info(
     mass = f"{num(s.total_mass)} kg"
     if abs(s.total_mass - s.file_mass) > 1e-9 * max(1.0, s.file_mass):
         mass += f" (file says {num(s.file_mass)} kg"
-        if s.links_without_inertial:
-            mass += f"; {len(s.links_without_inertial)} link(s) without <inertial> get 1 kg"
+        phantom = [n for n in s.links_without_inertial if default_mass(n)]
+        if phantom:
+            mass += f"; {len(phantom)} link(s) without <inertial> get 1 kg"
         mass += ")"
     show.fields([(s.robot, "bold")], [
         ("file", str(report.path)), ("base link", s.base_link),
         ("links", str(s.links)), ("joints", f"{s.joints} ({types})"),
-        ("degrees of freedom", f"{s.dof}" + ("" if s.fixed_base else " + 6 (floating base)")),
+        ("degrees of freedom", f"{s.dof}" + (" + 6 (floating base)" if s.static_base is None
+                                             else f" (static base: {s.static_base})")),
         ("total mass", mass),
         ("bounding box", f"{nums(s.aabb_min)} .. {nums(s.aabb_max)}"),
         ("size", f"{nums(s.size)} m"),
