@@ -598,6 +598,31 @@ def _moving_links(doc: Doc) -> set[str]:
     return set(names) - still
 
 
+def rule_mimic(root: etree._Element, r: Report) -> None:
+    """U310: every ``<mimic>`` PyBullet ignores (its leader exists; U307 and U309 judge that).
+
+    PyBullet 3.2.7 reads no ``<mimic>``: the follower is an ordinary joint that moves on its
+    own, so a two-finger gripper whose second finger mimics the first opens one finger.
+    """
+    joints = {jv.name for jv in r.doc(root).joints}
+    for jv in r.doc(root).joints:
+        mimic = jv.mimic
+        leader = mimic.get("joint") if mimic is not None else None
+        if leader is None or leader not in joints or leader == jv.name:
+            continue
+        multiplier = _num(mimic, "multiplier", 1.0)
+        offset = _num(mimic, "offset", 0.0)
+        if multiplier is None or offset is None:
+            continue  # U401 says why
+        r.add("U310", "info", f"{label(jv.el)} mimics joint {leader!r} (position = "
+              f"{leader} x {multiplier:g} + {offset:g}), and PyBullet ignores <mimic>: it moves "
+              "on its own, free unless driven; drive it to that position each step"
+              + (", or tie it with p.createConstraint(body, leader link, body, its link, "
+                 f"p.JOINT_GEAR, ...) and gearRatio {-1 / multiplier:g} (measured: PyBullet's "
+                 "gear holds leader + gearRatio x follower at 0; it keeps velocities, not the "
+                 "offset)" if multiplier else ""), mimic)
+
+
 def rule_portability(root: etree._Element, r: Report) -> None:
     """U901: PyBullet-only joint types and shapes, which other URDF tools refuse (info)."""
     doc = r.doc(root)
@@ -615,7 +640,7 @@ def rule_portability(root: etree._Element, r: Report) -> None:
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
                                rule_inertia, rule_meshes, rule_mesh_shapes, rule_references,
-                               rule_material_colours, rule_portability)
+                               rule_material_colours, rule_mimic, rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -656,6 +681,7 @@ CODES: dict[str, str] = {
     "U306": "joint axis not unit length",
     "U307": "mimic refers to a missing joint",
     "U309": "mimic joints follow each other in a ring",
+    "U310": "<mimic> that PyBullet ignores (the joint moves on its own; info)",
     "U308": "revolute/prismatic <limit> without lower or upper (PyBullet: unlimited)",
     "U401": "number does not parse or is not finite",
     "U402": "vector of the wrong length",

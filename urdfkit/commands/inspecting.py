@@ -84,9 +84,11 @@ def joints(
         return
     show.diagnostics(report.diagnostics)
     num, nums = show.num, show.nums
+    mimics = any(j.mimic for j in rows)  # the column only where a joint has one
     columns = [("#", 0, "right"), ("joint", 0, "left"), ("type", 0, "left"),
                ("child link", 1, "left"), ("parent", 3, "left"), ("limits", 1, "right"),
-               ("axis", 2, "left"), ("origin xyz", 3, "left"), ("origin rpy", 3, "left"),
+               ("axis", 2, "left"), *([("mimic", 2, "left")] if mimics else []),
+               ("origin xyz", 3, "left"), ("origin rpy", 3, "left"),
                ("max force", 3, "right"), ("max vel", 3, "right"),
                ("parentFramePos", 4, "left"), ("parentFrameRpy", 4, "left"), ("q", 5, "right"),
                ("u", 5, "right"), ("damping", 6, "right"), ("friction", 6, "right"),
@@ -103,6 +105,7 @@ def joints(
             # The file's axis (the joint frame); PyBullet's jointAxis is in the child's
             # inertial frame, turned by an <inertial><origin rpy> (its own column).
             nums(j.axis_xyz if j.axis_xyz is not None else j.joint_axis) if j.movable else "",
+            *([_mimic_cell(j.mimic, num)] if mimics else []),
             nums(j.origin_xyz) if j.origin_xyz is not None else "",
             nums(j.origin_rpy) if j.origin_rpy is not None else "",
             num(j.joint_max_force),
@@ -114,6 +117,18 @@ def joints(
     show.table(f"{report.robot}: {shown} joints, base link {report.base_link}", columns, cells,
                show_all)
     _loaded_with(report)
+    if mimics:
+        show.note("mimic: the file's <mimic> (position = leader x multiplier + offset); "
+                  "PyBullet ignores it, so the joint moves on its own", stderr=False)
+
+
+def _mimic_cell(mimic: dict[str, Any] | None, num: Any) -> str:
+    """``leader x multiplier + offset`` of a joint's ``<mimic>`` ("" without one)."""
+    if not mimic:
+        return ""
+    offset = mimic["offset"]
+    return (f"{mimic['joint']} x {num(mimic['multiplier'])}"
+            + (f" {'-' if offset < 0 else '+'} {num(abs(offset))}" if offset else ""))
 
 
 @command(examples(
