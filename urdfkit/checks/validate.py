@@ -75,6 +75,8 @@ def rule_elements(root: etree._Element, r: Report) -> None:
     shapes after the first in a ``<geometry>``.
     """
     for code, level, message, el in r.doc(root).element_findings:
+        if code == "U801" and el.tag == "gazebo":
+            continue  # another tool's block, PyBullet ignores it: U803 judges its contacts
         r.add(code, level, message, el)
 
 
@@ -623,6 +625,74 @@ def rule_mimic(root: etree._Element, r: Report) -> None:
                  "offset)" if multiplier else ""), mimic)
 
 
+def rule_gazebo_contacts(root: etree._Element, r: Report) -> None:
+    """U803: Gazebo contact parameters (mu1, mu2, kp, kd) PyBullet ignores, per link.
+
+    Read by :func:`urdfkit.model.gazebo.gazebo_contacts`; judged against what PyBullet loads
+    for the link (its ``<contact>``, else lateral friction 0.5 and a rigid contact). A link
+    whose ``<contact>`` already carries the values gets nothing.
+    """
+    from urdfkit.model.gazebo import NOT_CARRIED, PYBULLET_LATERAL_FRICTION, gazebo_contacts
+
+    contacts = gazebo_contacts(root)
+    if not contacts:
+        return
+    links = {v.name: v.el for v in r.doc(root).links if v.name}
+    for name, gz in contacts.items():
+        link = links.get(name)
+        if link is None:
+            continue  # a reference to a joint or a missing link: no contact to carry
+        have = _contact_values(link)
+        want = gz.pybullet()
+        differ = {k: v for k, v in want.items()
+                  if not math.isclose(have.get(k, math.nan), v, rel_tol=1e-9)}
+        if not differ:
+            continue
+        given = ", ".join(f"{k} {v:g}" for k, v in gz.given().items())
+        parts = []
+        if "lateral_friction" in differ:
+            now = have.get("lateral_friction", PYBULLET_LATERAL_FRICTION)
+            parts.append(f"lateral friction {now:g} where Gazebo's is "
+                         f"{differ['lateral_friction']:g}")
+        if "stiffness" in differ:
+            parts.append("a rigid contact where Gazebo's is a spring of "
+                         f"{differ['stiffness']:g} N/m and {differ['damping']:g} N s/m"
+                         if "stiffness" not in have else
+                         f"contact stiffness {have['stiffness']:g} and damping "
+                         f"{have.get('damping', math.nan):g} where Gazebo's are "
+                         f"{differ['stiffness']:g} and {differ['damping']:g}")
+        notes = []
+        if gz.mu1 is not None and gz.mu2 is not None and gz.mu1 != gz.mu2:
+            notes.append(f"mu1 and mu2 differ: PyBullet has one coefficient in every direction, "
+                         f"and fix writes the smaller, {gz.lateral_friction:g}")
+        if (gz.kp is None) != (gz.kd is None):
+            notes.append(f"{'kp' if gz.kd is None else 'kd'} is not given, so stiffness and "
+                         "damping (a pair in PyBullet) are not carried")
+        if gz.not_carried:
+            notes.append("not carried: " + "; ".join(f"{k} ({NOT_CARRIED[k]})"
+                                                     for k in gz.not_carried))
+        written = ", ".join(f"{k} {v:g}" for k, v in differ.items())
+        r.add("U803", "warning", f"<gazebo reference={name!r}> gives {label(link)} {given}, "
+              f"which PyBullet ignores: it loads {' and '.join(parts)}; `urdfkit fix "
+              f"--gazebo-contacts` writes the link a <contact> with {written} (PyBullet "
+              "multiplies the two bodies' friction: on a ground of lateral friction 1, such "
+              "as plane.urdf, the contact has the link's)" + "".join(f"; {n}" for n in notes),
+              gz.element)
+
+
+def _contact_values(link: etree._Element) -> dict[str, float]:
+    """The link's ``<contact>`` values PyBullet reads: {lateral_friction, stiffness, ...}."""
+    contact = first(link, "contact")
+    out: dict[str, float] = {}
+    if contact is None:
+        return out
+    for child in contact:
+        value = _num(child, "value") if isinstance(child.tag, str) else None
+        if value is not None and child.tag not in out:
+            out[child.tag] = value
+    return out
+
+
 def rule_portability(root: etree._Element, r: Report) -> None:
     """U901: PyBullet-only joint types and shapes, which other URDF tools refuse (info)."""
     doc = r.doc(root)
@@ -640,7 +710,8 @@ def rule_portability(root: etree._Element, r: Report) -> None:
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
                                rule_inertia, rule_meshes, rule_mesh_shapes, rule_references,
-                               rule_material_colours, rule_mimic, rule_portability)
+                               rule_material_colours, rule_mimic, rule_gazebo_contacts,
+                               rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -718,6 +789,7 @@ CODES: dict[str, str] = {
     "U710": "one material name given several colours (PyBullet draws them all in the last)",
     "U801": "unknown tag",
     "U802": "unknown attribute",
+    "U803": "Gazebo contact parameters (mu1, mu2, kp, kd) PyBullet ignores (fix --gazebo-contacts)",
     "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
     "U950": "links in contact at the zero pose (check --physics: self-collision jitters)",
     "U951": "PyBullet cannot load the file (check --physics)",
