@@ -568,11 +568,12 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
                 r.add("U613", "warning", f"mesh {fn!r} of {label(link)} is {size:.3g} m across, "
                       f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
                       f"{fix}", mesh)
-            if (concave_matters and props.closed
-                    and props.concavity > CONCAVE_FRACTION * size):
+            if concave_matters and props.concavity > CONCAVE_FRACTION * size:
                 r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
                       f"concave (it is {size:.3g} m across, and parts of it stand up to "
-                      f"{props.concavity:.3g} m in front of its own faces' planes): PyBullet "
+                      f"{props.concavity:.3g} m in front of its own faces' planes"
+                      + ("" if props.closed else "; it is also open, so the depth is "
+                         "judged on the faces it has") + "): PyBullet "
                       "collides with its convex hull, so contacts happen in mid-air over the "
                       "dips; split it into convex parts (p.vhacd, or one OBJ object per part) "
                       "or use primitives", mesh)
