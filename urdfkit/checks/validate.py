@@ -723,6 +723,7 @@ CODES: dict[str, str] = {
     "U007": "xacro macro library (no links of its own): checked through its includers",
     "U008": "line longer than 8191 bytes: PyBullet breaks it and may misread the file",
     "U009": "a file not named .xacro that holds xacro: read literally ('${prefix}base')",
+    "U010": "a fragment another checked file includes (no robot alone): checked through it",
     "U001": "root element is not <robot>",
     "U002": "<robot> has no name",
     "U003": "no <link>",
