@@ -277,3 +277,18 @@ def test_a_frame_with_frames_below_gets_mass_0(tmp_path: Path) -> None:
 
     root = etree.fromstring(result.fixed)
     assert [m.get("value") for m in root.iter("mass")] == ["5", "0", "0"]
+
+
+def test_docs_u606_row_matches_the_code_and_help(broken: Path) -> None:
+    """docs/fix.md's U606 says what fix does: no mass invented without --density."""
+    docs = (Path(__file__).parent.parent / "docs" / "fix.md").read_text()
+    row = next(line for line in docs.splitlines() if line.startswith("| `U606` |"))
+    assert "only with `--density" in row and "invents no mass" in row
+    assert "(1000 kg/m^3, water)" not in row  # once the doc's default; the code has none
+    code, out, _ = _cli("fix", "--help")
+    assert "Without it fix invents no mass" in " ".join(out.replace("\u2502", " ").split())
+    left = fix_file(broken)  # no density: the shaped link 'cube' is left, said why
+    assert any(r.code == "U606" and "'cube'" in r.message for r in left.left)
+    done = fix_file(broken, density=1000.0)  # 0.1 m cube of water: 1 kg
+    cube = next(r for r in done.repairs if r.code == "U606" and "'cube'" in r.message)
+    assert "1 kg (0.001 m^3 at 1000 kg/m^3)" in cube.message
