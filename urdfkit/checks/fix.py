@@ -798,7 +798,13 @@ def _inertia_xml(t: Sequence[Sequence[float]]) -> str:
 
 
 def _attr(text: str) -> str:
-    return text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+    """``text`` as a double-quoted attribute value that parses back to ``text``.
+
+    Tabs and line breaks are written as character references: XML turns a literal one in an
+    attribute into a space (a material named ``"a&#9;b"`` would come back ``"a b"``).
+    """
+    return (text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+            .replace("\t", "&#9;").replace("\n", "&#10;").replace("\r", "&#13;"))
 
 
 def _shape(el: etree._Element) -> Any:
