@@ -107,3 +107,16 @@ def test_fix_carries_friction_and_the_cart_slides_as_it_says(pb, tmp_path: Path)
     # check on the fixed file: the contacts are carried, nothing more to say.
     findings = json.loads(_run("check", str(out), "--json")[1])["findings"]
     assert not [f for f in findings if f["code"] == "U803"]
+
+
+def test_a_link_without_collision_gets_nothing(tmp_path: Path) -> None:
+    """Unitree's imu_link: mu1 on a link that touches nothing is no finding (found on go1)."""
+    path = tmp_path / "imu.urdf"
+    path.write_text('<robot name="r"><link name="a"><collision><geometry><box size="1 1 1"/>'
+                    '</geometry></collision></link><link name="imu"/><joint name="j" '
+                    'type="fixed"><parent link="a"/><child link="imu"/></joint>'
+                    '<gazebo reference="imu"><mu1>0.2</mu1></gazebo>'
+                    '<gazebo reference="a"><mu1>0.2</mu1></gazebo></robot>')
+    found = [f for f in json.loads(_run("check", str(path), "--json")[1])["findings"]
+             if f["code"] == "U803"]
+    assert len(found) == 1 and "'a'" in found[0]["message"]

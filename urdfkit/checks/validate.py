@@ -638,11 +638,13 @@ def rule_gazebo_contacts(root: etree._Element, r: Report) -> None:
     contacts = gazebo_contacts(root)
     if not contacts:
         return
-    links = {v.name: v.el for v in r.doc(root).links if v.name}
+    # A link without <collision> touches nothing: its contact parameters do nothing in either
+    # engine (Unitree's imu_link carries mu1 0.2 from a macro that gives every link one).
+    links = {v.name: v.el for v in r.doc(root).links if v.name and v.collisions}
     for name, gz in contacts.items():
         link = links.get(name)
         if link is None:
-            continue  # a reference to a joint or a missing link: no contact to carry
+            continue  # a joint, a missing link, or one without shapes: nothing to carry
         have = _contact_values(link)
         want = gz.pybullet()
         differ = {k: v for k, v in want.items()
