@@ -165,3 +165,16 @@ def test_collisions_agrees(tmp_path: Path) -> None:
     concave = _robot(tmp_path / "l", _stl(tmp_path / "l" / "l.stl", lv, lf))
     with resolve(str(concave)) as resolved:
         assert _concave_links(resolved, None) == {"b"}
+
+
+def test_a_shell_inside_a_convex_mesh_is_no_dip(tmp_path: Path) -> None:
+    """A second closed shell inside the first (CAD exports leave inner parts in one STL, as
+    UR10's shoulder.stl): its faces' planes put the outer corners "in front", but the hull
+    (scipy: the outer cube's) is all filled, and PyBullet collides with that hull."""
+    v = np.vstack([CUBE_V * 0.3, CUBE_V * 0.1 + 0.1])
+    f = np.vstack([CUBE_F, CUBE_F + 8])
+    assert scipy_spatial.ConvexHull(v).volume == pytest.approx(0.027)
+    mesh = _stl(tmp_path / "nested.stl", v, f)
+    props = read_integrals(mesh)
+    assert props is not None and props.closed and props.concavity == 0.0
+    assert "U614" not in _codes(_robot(tmp_path, mesh))

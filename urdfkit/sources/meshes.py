@@ -388,12 +388,61 @@ def _concavity(vertices: Any, faces: Any, starts: list[int], det: Any,
         depth = _piece_depth(vertices, faces[lo:hi], det[lo:hi], closed)
         if closed and depth > 0 and hi - lo <= _WIND_TRIANGLES:
             wound = _wound(faces[lo:hi])
+            piece = faces[lo:hi] if wound is None else wound
+            a, b, c = vertices[piece.T]
+            piece_det = _det(a, b, c)
             if wound is not None:
-                a, b, c = vertices[wound.T]
-                depth = min(depth, _piece_depth(
-                    vertices, wound, _det(a, b, c)))
+                depth = min(depth, _piece_depth(vertices, wound, piece_det))
+            if depth > 0 and _hull_fill(vertices, piece, piece_det) >= CONVEX_FILL:
+                depth = 0.0  # its faces' planes say dips, its volume says none to speak of
         worst = max(worst, depth)
     return worst
+
+
+#: A closed piece filling at least this much of its convex hull is convex enough: the hull
+#: adds under 5% (GP4's convex links fill 99.8-100%, its open link_2_l 63%).
+CONVEX_FILL = 0.95
+#: Sample points and hull directions for :func:`_hull_fill`.
+_FILL_SAMPLES = 6_000
+_FILL_DIRECTIONS = 1024
+
+
+def _hull_fill(vertices: Any, faces: Any, det: Any) -> float:
+    """How much of its convex hull a closed piece fills: its volume over the hull's.
+
+    The hull is bounded by the piece's support planes along every triangle's normal, both
+    ways (so winding does not matter) and along the axes: exactly the hull for a convex
+    piece, a little more for a curved or concave one (so the fill errs low, never high for a
+    concave piece). Its volume is counted on a fixed grid of sample points in the bounding
+    box (deterministic; about 0.5% spread). Sliver normals do no harm: a support plane along
+    any direction holds the whole hull.
+    """
+    import numpy as np
+
+    used = vertices[np.flatnonzero(np.bincount(faces.ravel(), minlength=len(vertices)))]
+    low, high = used.min(axis=0), used.max(axis=0)
+    box = float(np.prod(high - low))
+    volume = abs(float(det.sum())) / 6.0
+    if not box > 0 or not volume > 0:
+        return 1.0
+    a, b, c = vertices[faces.T]
+    normal = np.cross(b - a, c - a)
+    length = np.linalg.norm(normal, axis=1)
+    order = np.argsort(-length)[:_FILL_DIRECTIONS]  # the largest triangles first
+    normal = normal[order][length[order] > 0] / length[order][length[order] > 0, None]
+    directions = np.vstack([normal, -normal, np.eye(3), -np.eye(3)])
+    support = (used @ directions.T).max(axis=0)
+    points = low + (high - low) * np.random.default_rng(0).random((_FILL_SAMPLES, 3))
+    # Axes and the largest faces first: most points outside are dropped by the first blocks.
+    directions = np.vstack([directions[-6:], directions[:-6]])
+    support = np.concatenate([support[-6:], support[:-6]])
+    for start in range(0, len(directions), 64):  # bounded temporaries, shrinking
+        block = directions[start:start + 64]
+        points = points[(points @ block.T <= support[start:start + 64]).all(axis=1)]
+        if not len(points):
+            break
+    hull = box * len(points) / _FILL_SAMPLES
+    return volume / hull if hull > 0 else 1.0
 
 
 def _det(a: Any, b: Any, c: Any) -> Any:
