@@ -18,7 +18,7 @@ from make_corpus import make_corpus  # noqa: E402
 
 #: Command -> extra arguments ({file} is replaced by the corpus file; else it comes first).
 COMMANDS: dict[str, list[str]] = {
-    "check": [], "joints": [], "links": [], "tree": [], "info": [],
+    "check": [], "joints": [], "links": [], "tree": [], "info": [], "fix": ["{file}", "--diff"],
     "drive": ["--urdf", "{file}", "--steps", "5"],
     "render": ["{file}", "--size", "64x48", "--force", "-o", "{out}"],
     "export": ["mjcf", "{file}", "--force", "-o", "{xml}"],

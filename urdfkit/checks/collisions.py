@@ -411,7 +411,6 @@ def _concave_links(resolved: Resolved, packages: Mapping[str, Path] | None) -> s
                 continue
             scale = attr_vec(mesh, "scale", 3, (1.0, 1.0, 1.0)) or (1.0, 1.0, 1.0)
             props = properties(Path(target), (scale[0], scale[1], scale[2]), concavity=True)
-            if props is not None and props.closed and \
-                    props.concavity > CONCAVE_FRACTION * max(props.extent):
+            if props is not None and props.concavity > CONCAVE_FRACTION * max(props.extent):
                 out.add(link.get("name", ""))
     return out

@@ -24,7 +24,9 @@ from urdfkit.model.spec import (
     MAX_STATE_LINKS,
     SHAPES,
     SOLIDS,
+    WORLD_LINK,
     Matrix3,
+    default_mass,
     extension_note,
     ignored_shape,
     matmul,
@@ -73,13 +75,15 @@ def rule_elements(root: etree._Element, r: RuleReport) -> None:
     shapes after the first in a ``<geometry>``.
     """
     for code, level, message, el in r.doc(root).element_findings:
+        if code == "U801" and el.tag == "gazebo":
+            continue  # another tool's block, PyBullet ignores it: U803 judges its contacts
         r.add(code, level, message, el)
 
 
 def _mass_of(link: LinkView) -> float | None:
-    """The mass PyBullet gives a link: its <mass>, or 1 kg if there is no <inertial>."""
+    """The mass PyBullet gives a link: its <mass>, or without <inertial> 1 kg (0 for world)."""
     if link.inertial is None:
-        return 1.0
+        return default_mass(link.name)
     return _num(link.mass, "value")
 
 
@@ -100,6 +104,8 @@ def rule_mass(root: etree._Element, r: RuleReport) -> None:
     child_names = {c.get("link") for jv in doc.joints for c in jv.children}
     for view in views.values():
         link, inertial = view.el, view.inertial
+        if inertial is None and view.name == WORLD_LINK:
+            continue  # PyBullet gives it mass 0, not 1 kg: U611 (a root) or U602 (moving) say so
         if inertial is None:
             # Never "mass 0" for the root: PyBullet fixes a mass-0 base in place (U611).
             advice = ("add <inertial> with its real mass (mass 0 would fix the robot in place)"
@@ -119,24 +125,34 @@ def rule_mass(root: etree._Element, r: RuleReport) -> None:
     for name, j in moving:
         if name in views and _rigid_mass(name, views, fixed_children) == 0:
             r.add("U602", "error", f"{label(views[name].el)} moves (joint {j.get('name')!r} is "
-                  f"{j.get('type')}) but has mass 0; give it a mass > 0", views[name].el)
+                  f"{j.get('type')}) but has mass 0"
+                  + (" (it has no <inertial> and is named world, which PyBullet gives mass 0, "
+                     "not 1 kg)" if name == WORLD_LINK and views[name].inertial is None else "")
+                  + "; give it a mass > 0", views[name].el)
     roots = [view for name, view in views.items() if name not in child_names]
     # PyBullet judges the root link's own mass: 0 fixes the base in place, whatever its fixed
     # children weigh (a mass-0 base_footprint over a 28 kg base_link hangs in the air). A
     # root with no <inertial> gets 1 kg, so it moves (U606 says so).
-    own = _mass_of(roots[0]) if len(roots) == 1 and roots[0].inertial is not None else None
+    # A root named world without <inertial> gets mass 0 from PyBullet (measured), so it too.
+    own = _mass_of(roots[0]) if len(roots) == 1 and (
+        roots[0].inertial is not None or roots[0].name == WORLD_LINK) else None
     if own is not None and own == 0:
         base, static = roots[0].el, not moving
         carried = _rigid_mass(base.get("name", ""), views, fixed_children)
         held = (f"; its fixed links weigh {carried:g} kg, and PyBullet ignores that: it looks "
                 "at the root's own mass" if carried > 0 else "")
-        r.add("U611", "info" if static and not carried else "warning",
-              f"root {label(base)} has mass 0: PyBullet makes the base static, fixed where it "
+        why = ("has no <inertial> and is named world, which PyBullet gives mass 0 (not 1 kg)"
+               if roots[0].inertial is None else "has mass 0")
+        # A root named world is the ROS convention for "bolted to the world": as meant.
+        bolted = roots[0].inertial is None
+        r.add("U611", "info" if bolted or (static and not carried) else "warning",
+              f"root {label(base)} {why}: PyBullet makes the base static, fixed where it "
               "is loaded" + (" (right for a static object such as ground)"
                              if static and not carried else
                              "; right for an arm bolted to the world, wrong for a robot "
                              "that should fall or drive: give the root link a mass, or make "
-                             "the massive link the root") + held, base)
+                             "the massive link the root") + (held if not bolted else ""),
+              base)
 
 
 def _rigid_mass(name: str, views: dict[str, LinkView],
@@ -552,11 +568,12 @@ def rule_mesh_shapes(root: etree._Element, r: RuleReport) -> None:
                 r.add("U613", "warning", f"mesh {fn!r} of {label(link)} is {size:.3g} m across, "
                       f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
                       f"{fix}", mesh)
-            if (concave_matters and props.closed
-                    and props.concavity > CONCAVE_FRACTION * size):
+            if concave_matters and props.concavity > CONCAVE_FRACTION * size:
                 r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
                       f"concave (it is {size:.3g} m across, and parts of it stand up to "
-                      f"{props.concavity:.3g} m in front of its own faces' planes): PyBullet "
+                      f"{props.concavity:.3g} m in front of its own faces' planes"
+                      + ("" if props.closed else "; it is also open, so the depth is "
+                         "judged on the faces it has") + "): PyBullet "
                       "collides with its convex hull, so contacts happen in mid-air over the "
                       "dips; split it into convex parts (p.vhacd, or one OBJ object per part) "
                       "or use primitives", mesh)
@@ -584,6 +601,101 @@ def _moving_links(doc: Doc) -> set[str]:
     return set(names) - still
 
 
+def rule_mimic(root: etree._Element, r: RuleReport) -> None:
+    """U310: every ``<mimic>`` PyBullet ignores (its leader exists; U307 and U309 judge that).
+
+    PyBullet 3.2.7 reads no ``<mimic>``: the follower is an ordinary joint that moves on its
+    own, so a two-finger gripper whose second finger mimics the first opens one finger.
+    """
+    joints = {jv.name for jv in r.doc(root).joints}
+    for jv in r.doc(root).joints:
+        mimic = jv.mimic
+        leader = mimic.get("joint") if mimic is not None else None
+        if leader is None or leader not in joints or leader == jv.name:
+            continue
+        multiplier = _num(mimic, "multiplier", 1.0)
+        offset = _num(mimic, "offset", 0.0)
+        if multiplier is None or offset is None:
+            continue  # U401 says why
+        r.add("U310", "info", f"{label(jv.el)} mimics joint {leader!r} (position = "
+              f"{leader} x {multiplier:g} + {offset:g}), and PyBullet ignores <mimic>: it moves "
+              "on its own, free unless driven; drive it to that position each step"
+              + (", or tie it with p.createConstraint(body, leader link, body, its link, "
+                 f"p.JOINT_GEAR, ...) and gearRatio {-1 / multiplier:g} (measured: PyBullet's "
+                 "gear holds leader + gearRatio x follower at 0; it keeps velocities, not the "
+                 "offset)" if multiplier else ""), mimic)
+
+
+def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
+    """U803: Gazebo contact parameters (mu1, mu2, kp, kd) PyBullet ignores, per link.
+
+    Read by :func:`urdfkit.model.gazebo.gazebo_contacts`; judged against what PyBullet loads
+    for the link (its ``<contact>``, else lateral friction 0.5 and a rigid contact). A link
+    whose ``<contact>`` already carries the values gets nothing.
+    """
+    from urdfkit.model.gazebo import NOT_CARRIED, PYBULLET_LATERAL_FRICTION, gazebo_contacts
+
+    contacts = gazebo_contacts(root)
+    if not contacts:
+        return
+    # A link without <collision> touches nothing: its contact parameters do nothing in either
+    # engine (Unitree's imu_link carries mu1 0.2 from a macro that gives every link one).
+    links = {v.name: v.el for v in r.doc(root).links if v.name and v.collisions}
+    for name, gz in contacts.items():
+        link = links.get(name)
+        if link is None:
+            continue  # a joint, a missing link, or one without shapes: nothing to carry
+        have = _contact_values(link)
+        want = gz.pybullet()
+        differ = {k: v for k, v in want.items()
+                  if not math.isclose(have.get(k, math.nan), v, rel_tol=1e-9)}
+        if not differ:
+            continue
+        given = ", ".join(f"{k} {v:g}" for k, v in gz.given().items())
+        parts = []
+        if "lateral_friction" in differ:
+            now = have.get("lateral_friction", PYBULLET_LATERAL_FRICTION)
+            parts.append(f"lateral friction {now:g} where Gazebo's is "
+                         f"{differ['lateral_friction']:g}")
+        if "stiffness" in differ:
+            parts.append("a rigid contact where Gazebo's is a spring of "
+                         f"{differ['stiffness']:g} N/m and {differ['damping']:g} N s/m"
+                         if "stiffness" not in have else
+                         f"contact stiffness {have['stiffness']:g} and damping "
+                         f"{have.get('damping', math.nan):g} where Gazebo's are "
+                         f"{differ['stiffness']:g} and {differ['damping']:g}")
+        notes = []
+        if gz.mu1 is not None and gz.mu2 is not None and gz.mu1 != gz.mu2:
+            notes.append(f"mu1 and mu2 differ: PyBullet has one coefficient in every direction, "
+                         f"and fix writes the smaller, {gz.lateral_friction:g}")
+        if (gz.kp is None) != (gz.kd is None):
+            notes.append(f"{'kp' if gz.kd is None else 'kd'} is not given, so stiffness and "
+                         "damping (a pair in PyBullet) are not carried")
+        if gz.not_carried:
+            notes.append("not carried: " + "; ".join(f"{k} ({NOT_CARRIED[k]})"
+                                                     for k in gz.not_carried))
+        written = ", ".join(f"{k} {v:g}" for k, v in differ.items())
+        r.add("U803", "warning", f"<gazebo reference={name!r}> gives {label(link)} {given}, "
+              f"which PyBullet ignores: it loads {' and '.join(parts)}; `urdfkit fix "
+              f"--gazebo-contacts` writes the link a <contact> with {written} (PyBullet "
+              "multiplies the two bodies' friction: on a ground of lateral friction 1, such "
+              "as plane.urdf, the contact has the link's)" + "".join(f"; {n}" for n in notes),
+              gz.element)
+
+
+def _contact_values(link: etree._Element) -> dict[str, float]:
+    """The link's ``<contact>`` values PyBullet reads: {lateral_friction, stiffness, ...}."""
+    contact = first(link, "contact")
+    out: dict[str, float] = {}
+    if contact is None:
+        return out
+    for child in contact:
+        value = _num(child, "value") if isinstance(child.tag, str) else None
+        if value is not None and child.tag not in out:
+            out[child.tag] = value
+    return out
+
+
 def rule_portability(root: etree._Element, r: RuleReport) -> None:
     """U901: PyBullet-only joint types and shapes, which other URDF tools refuse (info)."""
     doc = r.doc(root)
@@ -601,7 +713,8 @@ def rule_portability(root: etree._Element, r: RuleReport) -> None:
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
                                rule_inertia, rule_meshes, rule_mesh_shapes, rule_references,
-                               rule_material_colours, rule_portability)
+                               rule_material_colours, rule_mimic, rule_gazebo_contacts,
+                               rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -612,6 +725,7 @@ CODES: dict[str, str] = {
     "U007": "xacro macro library (no links of its own): checked through its includers",
     "U008": "line longer than 8191 bytes: PyBullet breaks it and may misread the file",
     "U009": "a file not named .xacro that holds xacro: read literally ('${prefix}base')",
+    "U010": "a fragment another checked file includes (no robot alone): checked through it",
     "U001": "root element is not <robot>",
     "U002": "<robot> has no name",
     "U003": "no <link>",
@@ -642,6 +756,7 @@ CODES: dict[str, str] = {
     "U306": "joint axis not unit length",
     "U307": "mimic refers to a missing joint",
     "U309": "mimic joints follow each other in a ring",
+    "U310": "<mimic> that PyBullet ignores (the joint moves on its own; info)",
     "U308": "revolute/prismatic <limit> without lower or upper (PyBullet: unlimited)",
     "U401": "number does not parse or is not finite",
     "U402": "vector of the wrong length",
@@ -678,6 +793,7 @@ CODES: dict[str, str] = {
     "U710": "one material name given several colours (PyBullet draws them all in the last)",
     "U801": "unknown tag",
     "U802": "unknown attribute",
+    "U803": "Gazebo contact parameters (mu1, mu2, kp, kd) PyBullet ignores (fix --gazebo-contacts)",
     "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
     "U950": "links in contact at the zero pose (check --physics: self-collision jitters)",
     "U951": "PyBullet cannot load the file (check --physics)",

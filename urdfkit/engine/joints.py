@@ -29,7 +29,13 @@ from typing import Any
 from lxml import etree
 
 from urdfkit.engine.session import Bullet, Session
-from urdfkit.model.spec import JOINT_TYPE_FILTERS, attr_vec, pybullet_joint_type, quat_to_rpy
+from urdfkit.model.spec import (
+    JOINT_TYPE_FILTERS,
+    attr_float,
+    attr_vec,
+    pybullet_joint_type,
+    quat_to_rpy,
+)
 from urdfkit.model.xmlio import children
 
 #: The 17 ``getJointInfo`` fields, in tuple order, as the Quickstart Guide names them.
@@ -91,6 +97,9 @@ class JointInfo:
     origin_xyz: Vec3 | None = None
     origin_rpy: Vec3 | None = None
     axis_xyz: Vec3 | None = None
+    #: The file's ``<mimic>`` (leader ``joint``, ``multiplier``, ``offset``; URDF's defaults 1
+    #: and 0), which PyBullet ignores; None without one.
+    mimic: dict[str, Any] | None = None
 
     @classmethod
     def from_pybullet(cls, info: Sequence[Any]) -> JointInfo:
@@ -136,7 +145,8 @@ class JointInfo:
                    limited=self.limited,
                    originXyz=None if self.origin_xyz is None else list(self.origin_xyz),
                    originRpy=None if self.origin_rpy is None else list(self.origin_rpy),
-                   axisXyz=None if self.axis_xyz is None else list(self.axis_xyz))
+                   axisXyz=None if self.axis_xyz is None else list(self.axis_xyz),
+                   mimic=self.mimic)
         return out
 
 
@@ -156,6 +166,7 @@ def joint_table(s: Session, body: int, root: etree._Element | None = None) -> li
     urdf_types: dict[str, str] = {}
     origins: dict[str, tuple[Vec3, Vec3]] = {}
     axes: dict[str, Vec3] = {}
+    mimics: dict[str, dict[str, Any]] = {}
     if root is not None:
         for el in children(root, "joint"):
             urdf_types[el.get("name", "")] = el.get("type", "")
@@ -166,6 +177,12 @@ def joint_table(s: Session, body: int, root: etree._Element | None = None) -> li
             # The file's axis, in the joint (child link) frame; URDF's default is x.
             axis = attr_vec(el.find("axis"), "xyz", 3, (1.0, 0.0, 0.0)) or (1.0, 0.0, 0.0)
             axes[el.get("name", "")] = tuple(axis)  # type: ignore[assignment]
+            mimic = el.find("mimic")
+            if mimic is not None:
+                mimics[el.get("name", "")] = {
+                    "joint": mimic.get("joint"),
+                    "multiplier": attr_float(mimic, "multiplier", 1.0),
+                    "offset": attr_float(mimic, "offset", 0.0)}
     joints = [JointInfo.from_pybullet(s.call("getJointInfo", body, i))
               for i in range(s.call("getNumJoints", body))]
     base = base_link_name(s, body)
@@ -174,6 +191,7 @@ def joint_table(s: Session, body: int, root: etree._Element | None = None) -> li
         if j.joint_name in origins:
             j.origin_xyz, j.origin_rpy = origins[j.joint_name]
             j.axis_xyz = axes[j.joint_name]
+            j.mimic = mimics.get(j.joint_name)
         j.parent_link_name = base if j.parent_index < 0 else joints[j.parent_index].link_name
     return joints
 
