@@ -22,7 +22,7 @@ from urdfkit.commands.startup import outcome, prepare
 
 #: Flags of ``check`` (no value), by option name: the keyword of :func:`run_check`.
 FLAG_OPTIONS = {"--json": "as_json", "--no-exec": "no_exec", "--all": "show_all",
-                "--physics": "physics", "--no-cache": "no_cache"}
+                "--physics": "physics", "--no-cache": "no_cache", "--strict": "strict"}
 #: Options with one value each (given once), and options that may be repeated.
 VALUE_OPTIONS = {"--format": "output_format", "--fail-on": "fail_on", "--jobs": "jobs",
                  "-j": "jobs"}
@@ -35,11 +35,15 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
               package_path: list[str] | None = None, select: list[str] | None = None,
               ignore: list[str] | None = None, jobs: int | None = None,
               arg: list[str] | None = None, no_exec: bool = False, show_all: bool = False,
-              physics: bool = False, no_cache: bool = False) -> int:
+              physics: bool = False, no_cache: bool = False, strict: bool = False) -> int:
     """Check ``paths`` and print the findings in ``output_format``; the exit code.
 
+    A folder given that holds no robot file is said (a warning): a CI run over the wrong
+    folder would otherwise pass on nothing. With ``strict`` that is a usage error instead.
+
     Raises:
-        ParameterError: a bad option value (exit code 2).
+        ParameterError: a bad option value, or (``strict``) a folder with no robot file
+            (exit code 2).
     """
     from urdfkit.checks.check import check_paths, parse_codes
     from urdfkit.core.errors import ParameterError
@@ -68,11 +72,33 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
     finally:
         if enabled:
             gc.enable()
+    for folder in empty_folders(paths, [fr.file for fr in result.files]):
+        line = (f"{folder}: no robot file in this folder (no *.urdf or *.xacro, any case, in it "
+                "or below)")
+        if strict:
+            raise ParameterError(f"{line}; --strict refuses a folder with nothing to check")
+        show.warn(line)
     for fr in result.files:  # a xacro or package problem speaks of flags, not parameters
         fr.findings = [Finding(f.code, f.level, input_flags(f.message), f.file, f.line, f.origin)
                        if "`" in f.message else f for f in fr.findings]
     show.check_output(result, fmt, fail_on, show_all)
     return result.exit_code(fail_on)
+
+
+def empty_folders(paths: list[str], checked: list[str]) -> list[str]:
+    """The folders in ``paths`` under which none of the ``checked`` files lies."""
+    import os
+
+    from urdfkit.checks.check import SUFFIXES
+
+    out = []
+    for item in paths:
+        if not os.path.isdir(item) or os.path.splitext(item)[1].lower() in SUFFIXES:
+            continue
+        prefix = os.path.join(item, "")
+        if not any(name.startswith(prefix) for name in checked):
+            out.append(item)
+    return out
 
 
 def check_format(output_format: str | None, as_json: bool) -> str:
