@@ -72,7 +72,19 @@ def rule_elements(root: etree._Element, r: Report) -> None:
     leftovers, extensions), opaque subtrees (another tool's: gazebo, transmission, ...) and
     shapes after the first in a ``<geometry>``.
     """
+    from urdfkit.model.spec import did_you_mean, nearest_attributes, nearest_tags
+
     for code, level, message, el in r.doc(root).element_findings:
+        # The verdicts are shared between elements; the nearest name is added per finding.
+        if code == "U801":
+            parent = el.getparent()
+            if parent is not None:
+                message += did_you_mean(nearest_tags(el.tag, parent.tag))
+        elif code == "U802":
+            for attr in el.keys():
+                if f"unknown attribute {attr!r};" in message:
+                    message += did_you_mean(nearest_attributes(attr, el.tag), tags=False)
+                    break
         r.add(code, level, message, el)
 
 

@@ -24,7 +24,16 @@ from lxml import etree
 
 from urdfkit.core.errors import InputError
 from urdfkit.core.finding import Finding
-from urdfkit.model.spec import FILE_SHAPES, FILE_TAGS, PYBULLET_LINE_BYTES, ignored_shape
+from urdfkit.model.spec import (
+    BUILT_CHILDREN,
+    FILE_SHAPES,
+    FILE_TAGS,
+    PYBULLET_LINE_BYTES,
+    SCHEMA,
+    did_you_mean,
+    ignored_shape,
+    nearest_tags,
+)
 from urdfkit.model.xmlio import (
     line_of,
     long_line,
@@ -194,15 +203,58 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
         return resolved
 
 
+def misspelt_tags(root: etree._Element) -> list[tuple[int | None, str]]:
+    """Unknown tags nearest a tag PyBullet builds from (``<jiont>``, ``<colision>``), said.
+
+    PyBullet skips an element it does not know without a word, so a typo in one of these
+    changes the robot it builds (a joint it never sees, a collision it drops). One walk over
+    the robot's children and theirs, two levels down: what ``check`` reports as U801.
+    """
+    out: list[tuple[int | None, str]] = []
+
+    def look(el: etree._Element, depth: int) -> None:
+        known = SCHEMA.get(el.tag)
+        built = BUILT_CHILDREN.get(el.tag)
+        if known is None or built is None:
+            return
+        for child in el:
+            tag = child.tag
+            if not isinstance(tag, str) or tag[:1] == "{":
+                continue
+            if tag not in known[1]:
+                near = [n for n in nearest_tags(tag, el.tag) if n in built]
+                if near:
+                    out.append((line_of(child), f"<{tag}> is not a URDF tag inside <{el.tag}>"
+                                f"{did_you_mean(near)} PyBullet builds the robot without it "
+                                "(U801)"))
+            elif depth < 2:
+                look(child, depth + 1)
+
+    look(root, 0)
+    return out
+
+
 def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
                   packages: Mapping[str, Path] | None, guard: bool,
                   copy: bool = False, origins: list[str | None] | None = None,
                   meshes: bool = True) -> Resolved:
-    lifted = [f"{where(f)}: {f.message} ({f.code})" if f.code in GUARD_WARNINGS else
-              f"{where(f)}: let through without the guard ({f.code}): "
-              f"{f.message.removesuffix(STRICTER)}"
-              for f in run_guard(tree, display, strict=guard, origins=origins)]
     root = tree.getroot()
+    # xacro's output lines are not the user's: its typos are said without one
+    typos = [(None if origins is not None else line, typo) for line, typo in misspelt_tags(root)]
+    try:
+        found = run_guard(tree, display, strict=guard, origins=origins)
+    except InputError as e:
+        if not typos:
+            raise
+        # "2 root links" is what a misspelt <joint> looks like to the guard: name the cause.
+        line, typo = typos[0]
+        at = "" if line is None else f"at line {line}, "
+        raise type(e)(f"{e.message}; {at}{typo}", file=e.file, line=e.line,
+                      param=e.param) from None
+    lifted = [f"{display}{'' if line is None else f':{line}'}: {typo}" for line, typo in typos]
+    lifted += [f"{where(f)}: {f.message} ({f.code})" if f.code in GUARD_WARNINGS else
+               f"{where(f)}: let through without the guard ({f.code}): "
+               f"{f.message.removesuffix(STRICTER)}" for f in found]
     # PyBullet takes paths as UTF-8 text: a file name that is not (bytes from another locale,
     # kept by Python as surrogates) is loaded from a copy with a clean name.
     needs_copy = copy or not _utf8(str(source))
