@@ -61,3 +61,72 @@ def test_fix_diff_headers_have_one_slash_before_an_absolute_path(tmp_path: Path)
     result = runner.invoke(app, ["fix", str(tmp_path / "r2d2.urdf"), "--diff"])
     head = result.stdout.splitlines()[:2]
     assert head == [f"--- a{tmp_path}/r2d2.urdf", f"+++ b{tmp_path}/r2d2.urdf"], head
+
+
+def _instance_node_dae(tmp_path: Path) -> tuple[Path, Path]:
+    """pybullet_data's cone.dae as it is, and with its node moved into <library_nodes>."""
+    import pybullet_data
+
+    text = (Path(pybullet_data.getDataPath()) / "racecar/meshes/cone.dae").read_text()
+    start = text.index('<node name="SketchUp">')
+    end = text.index("</node>", start) + len("</node>")
+    node = text[start:end].replace('<node name="SketchUp">', '<node id="N1" name="SketchUp">')
+    moved = (text[:start] + '<node name="top"><instance_node url="#N1"/></node>' + text[end:])
+    moved = moved.replace("<library_geometries>",
+                          f"<library_nodes>{node}</library_nodes><library_geometries>", 1)
+    (tmp_path / "cone.dae").write_text(text)
+    (tmp_path / "inode.dae").write_text(moved)
+    return tmp_path / "cone.dae", tmp_path / "inode.dae"
+
+
+def _one_visual(tmp_path: Path, mesh: str) -> Path:
+    path = tmp_path / f"{mesh}.urdf"
+    path.write_text(f'<robot name="r"><link name="a"><inertial><mass value="1"/><inertia ixx="1" '
+                    'iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial><visual><geometry>'
+                    f'<mesh filename="{mesh}" scale="3 3 3"/></geometry></visual>'
+                    '<collision><geometry><sphere radius="0.01"/></geometry></collision>'
+                    '</link></robot>')
+    return path
+
+
+def _pixels(pb: tuple, urdf: Path) -> int:
+    """Pixels of the robot in PyBullet's own TinyRenderer picture."""
+    import numpy as np
+
+    p, client = pb
+    body = p.loadURDF(str(urdf), physicsClientId=client)
+    view = p.computeViewMatrix([2, 2, 2], [0, 0, 0.5], [0, 0, 1])
+    proj = p.computeProjectionMatrixFOV(60, 1, 0.01, 10)
+    img = p.getCameraImage(64, 64, view, proj, renderer=p.ER_TINY_RENDERER,
+                           physicsClientId=client)
+    p.removeBody(body, physicsClientId=client)
+    return int((np.array(img[4]).reshape(64, 64) == body).sum())
+
+
+def test_a_collada_through_instance_node_is_a_finding_and_render_says_so(
+        tmp_path: Path, pb: tuple) -> None:
+    _instance_node_dae(tmp_path)
+    good, bad = _one_visual(tmp_path, "cone.dae"), _one_visual(tmp_path, "inode.dae")
+    # what the finding claims, seen in PyBullet itself: the same cone, drawn, then not
+    assert _pixels(pb, good) > 20 and _pixels(pb, bad) == 0
+    out = json.loads(runner.invoke(app, ["check", str(bad), "--json", "--no-cache"]).stdout)
+    [u715] = [f for f in out["findings"] if f["code"] == "U715"]
+    assert "2 part(s), all placed through <instance_node>" in u715["message"]
+    out = json.loads(runner.invoke(app, ["check", str(good), "--json", "--no-cache"]).stdout)
+    assert not [f for f in out["findings"] if f["code"] == "U715"]
+    result = runner.invoke(app, ["render", str(bad), "-o", str(tmp_path / "r.png"),
+                                 "--size", "64x48"])
+    assert result.exit_code == 0 and "1 of 1 visual shape(s) cannot be drawn" in result.stderr
+    result = runner.invoke(app, ["render", str(good), "-o", str(tmp_path / "g.png"),
+                                 "--size", "64x48"])
+    assert "cannot be drawn" not in result.stderr
+
+
+def test_an_empty_visual_mesh_is_a_finding(tmp_path: Path) -> None:
+    (tmp_path / "empty.stl").write_bytes(b"")
+    out = json.loads(runner.invoke(app, ["check", str(_one_visual(tmp_path, "empty.stl")),
+                                         "--json", "--no-cache"]).stdout)
+    assert [f["message"] for f in out["findings"] if f["code"] == "U715"] == [
+        "visual mesh 'empty.stl' of <link name='a'> is empty: PyBullet draws nothing of it; "
+        "the robot looks incomplete in render, view and the GUI (export it with its nodes "
+        "flattened, or as .obj/.stl)"]

@@ -763,6 +763,12 @@ def render_file(name: str | Path, options: RenderOptions | None = None, *,
                     package_paths=package_paths) as resolved:
         picture = render(resolved, options)
         picture.warnings[:0] = resolved.warnings
+        if options is None or not options.collision:
+            from urdfkit.sources.resolve import undrawn_note
+
+            note = undrawn_note(resolved)
+            if note is not None:
+                picture.warnings.append(note)
         return picture
 
 

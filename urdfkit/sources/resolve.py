@@ -33,6 +33,7 @@ from urdfkit.model.spec import (
     did_you_mean,
     ignored_shape,
     nearest_tags,
+    used_shape,
 )
 from urdfkit.model.xmlio import (
     line_of,
@@ -296,6 +297,47 @@ def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
         load_path.write_bytes(body)
         return Resolved(display, source, load_path, tree, tmp, warnings=lifted)
     return Resolved(display, source, source, tree, warnings=lifted)
+
+
+def undrawn_visuals(resolved: Resolved) -> tuple[int, list[str]]:
+    """How many visual shapes the robot has, and why each one PyBullet cannot draw is not.
+
+    For ``render`` and ``view`` to say how much of the robot is missing from the picture
+    (check's U715 says it of the file): an empty mesh file, COLLADA through ``<instance_node>``.
+    """
+    from urdfkit.sources.guard import reference
+    from urdfkit.sources.meshes import mesh_kind, undrawn_visual
+
+    total, out = 0, []
+    base = resolved.source.resolve().parent
+    for visual in resolved.root.iter("visual"):
+        total += 1
+        geometry = visual.find("geometry")
+        mesh = used_shape(geometry) if geometry is not None else None
+        fn = (mesh.get("filename") or "").strip() if mesh is not None and \
+            mesh.tag == "mesh" else ""
+        if not fn:
+            continue
+        ref = reference("mesh", fn, base, None)
+        if ref.load is None or (mesh_kind(ref.load) != ".dae" and (
+                ref.stat is None or ref.stat.st_size != 0)):
+            continue
+        why = undrawn_visual(ref.load)
+        if why is not None:
+            link = visual.getparent()
+            owner = link.get("name") if link is not None else None
+            out.append(f"{fn!r} of link {owner!r} {why}")
+    return total, out
+
+
+def undrawn_note(resolved: Resolved) -> str | None:
+    """``"2 of 7 visual shapes cannot be drawn: ..."``, or None when every one can."""
+    total, why = undrawn_visuals(resolved)
+    if not why:
+        return None
+    more = f" (and {len(why) - 1} more)" if len(why) > 1 else ""
+    return (f"{resolved.name}: {len(why)} of {total} visual shape(s) cannot be drawn, so "
+            f"the picture misses them: {why[0]}{more} (U715)")
 
 
 def open_input(name: str | Path, packages: list[str] | None = None,
