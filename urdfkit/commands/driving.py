@@ -42,7 +42,7 @@ from urdfkit.commands.shared import (
 @command(examples(
     "urdfkit drive --throttle 10 --steer 0.2",
     "urdfkit drive --urdf racecar/racecar.urdf --seconds 5 --json",
-    "urdfkit drive --urdf husky/husky.urdf --steer 0.5   # skid steer: 0.5 rad/s of yaw",
+    "urdfkit drive --urdf husky/husky.urdf --throttle 3 --steer 0.5   # skid steer: yaw rad/s",
     "urdfkit drive --steer 0.3 --trajectory run.csv --plot run.png"))
 def drive(
     throttle: ThrottleOpt = FROM_LIBRARY,
