@@ -52,8 +52,8 @@ def test_every_robot_ends_on_the_page_where_the_run_ends() -> None:
 def test_cli_sim_view_prints_json_and_serves_until_ctrl_c(tmp_path: Path,
                                                           served_run: Any) -> None:
     out = tmp_path / "rows.jsonl"
-    code, stdout, err = served_run("sim", str(TWO_CARS), "--view", "--speed", "max", "--json",
-                                   "-o", str(out))
+    code, stdout, err = served_run("sim", str(TWO_CARS), "--view", "--no-wait", "--speed",
+                                   "max", "--json", "-o", str(out))
     assert code == 0, err
     data = json.loads(stdout)
     assert data["steps"] == 720 and data["rows"] == 122

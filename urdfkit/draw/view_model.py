@@ -206,12 +206,13 @@ class Model:
     def __init__(self, file: str, *, packages: Sequence[str] | None = None,
                  package_paths: Sequence[str] | None = None,
                  xacro_args: Sequence[str] | None = None,
-                 inertia_from_file: bool = False) -> None:
+                 inertia_from_file: bool = False, display: str | None = None) -> None:
         from urdfkit.core import deps
         from urdfkit.engine.session import LoadOptions, Session
         from urdfkit.sources.resolve import open_input
 
-        self.file = file
+        #: The file as the user knows it (a template's name, not its cache path): in findings.
+        self.file = display or file
         self.notes: list[str] = []
         self.lock = threading.RLock()
         self.session: Any = None
@@ -221,6 +222,8 @@ class Model:
             try:
                 self.resolved = open_input(file, list(packages or []), list(xacro_args or []),
                                            package_paths=list(package_paths or []))
+                if display:
+                    self.resolved.name = display
                 deps.note(self.resolved.source)
                 self.session = Session()
                 options = LoadOptions(inertia_from_file=inertia_from_file)
@@ -271,6 +274,11 @@ class Model:
         self.session.diagnostics.extend(out.lines)
         self.joints = self._controls()
         self.notes.extend(self.resolved.warnings)
+        from urdfkit.sources.resolve import undrawn_note
+
+        undrawn = undrawn_note(self.resolved)
+        if undrawn is not None:
+            self.notes.append(undrawn)
 
     def _shape(self, kind: int, dims: Sequence[float], filename: bytes,
                pos: Sequence[float], quat: Sequence[float], *, collision: bool,
