@@ -487,7 +487,7 @@ def test_finding_and_reload_error_shown_in_the_page(page_of: Any, tmp_path: Path
     page = page_of(v)
     # The finding's button; clicked, its link's panel names the file and line.
     page.get_by_role("button", name=f"U604 line {line}: upper").click()
-    page.get_by_text(f"{path}:{line}").wait_for(timeout=10000)
+    page.get_by_text(f"{path}:{line}").wait_for(timeout=30000)
     # The robot's own colours first; red where the error is once the tint is asked for.
     assert _wait(lambda: _pixels(page) > 2000, 30) and _pixels(page, "red") < 20
     v.select(None)
@@ -540,7 +540,7 @@ def test_clicking_a_finding_and_choosing_a_link_in_the_page_select_it(
     # The finding's button in the page selects the link it is about, on the server.
     page.get_by_role("button", name=f"U604 line {line}: upper").click()
     assert _wait(lambda: v.selected == "upper", 10)
-    page.get_by_text("child of joint").wait_for(timeout=10000)
+    page.get_by_text("child of joint").wait_for(timeout=30000)
     # Choosing another link in the Selection dropdown moves the selection to it.
     page.get_by_label("Link", exact=True).click()
     page.get_by_role("option", name="finger", exact=True).click()

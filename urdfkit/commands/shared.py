@@ -182,7 +182,8 @@ def wait_for_page(command: str, viewer: Any, wait: bool) -> None:
         return
     show.line(f"urdfkit {command}: waiting for a page to connect to {viewer.url} before the "
               "run starts (--no-wait starts it at once)", stderr=True)
-    viewer.wait_for_page()
+    while not viewer.wait_for_page(0.5):  # short waits: Ctrl-C is taken between them
+        pass
     show.line(f"urdfkit {command}: a page connected; the run starts", stderr=True)
 
 
