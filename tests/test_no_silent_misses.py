@@ -130,3 +130,17 @@ def test_an_empty_visual_mesh_is_a_finding(tmp_path: Path) -> None:
         "visual mesh 'empty.stl' of <link name='a'> is empty: PyBullet draws nothing of it; "
         "the robot looks incomplete in render, view and the GUI (export it with its nodes "
         "flattened, or as .obj/.stl)"]
+
+
+def test_view_says_how_many_shapes_it_cannot_draw(tmp_path: Path) -> None:
+    pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
+    from urdfkit.draw import view_page
+    from urdfkit.draw.view import Viewer
+
+    _instance_node_dae(tmp_path)
+    v = Viewer(str(_one_visual(tmp_path, "inode.dae")), watch=False)
+    try:
+        said = view_page.findings(v.model)
+        assert "1 of 1 visual shape(s) cannot be drawn" in said and "(U715)" in said
+    finally:
+        v.close()

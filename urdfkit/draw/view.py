@@ -20,13 +20,9 @@ from typing import Any
 
 from urdfkit.core.errors import EngineError, MissingDependencyError, UrdfkitError
 from urdfkit.draw import view_page as page
-from urdfkit.draw.view_model import TINTS, Model, Vec3
+from urdfkit.draw.view_model import SELECTED_RGB, TINTS, TOUCHING_RGB, Model, Vec3
 from urdfkit.draw.view_stream import RunDisplay, add_shapes, wxyz
 
-#: Links touching another at the current pose (self-collision pairs).
-TOUCHING_RGB = (200, 0, 200)
-#: The selected link.
-SELECTED_RGB = (86, 180, 233)
 #: The selection dropdown's entry for no link.
 NO_LINK = "(none)"
 #: The page's vertical field of view (degrees), set so the camera's fit is computed for it.

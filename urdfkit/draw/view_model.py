@@ -29,6 +29,10 @@ from urdfkit.core.finding import Finding
 
 #: Tints of links with findings (RGB 0..255): check's error red and warning amber.
 TINTS = {"error": (220, 38, 38), "warning": (245, 158, 11)}
+#: Links touching another at the current pose (self-collision pairs).
+TOUCHING_RGB = (200, 0, 200)
+#: The selected link.
+SELECTED_RGB = (86, 180, 233)
 #: Colour of collision shapes; of those PyBullet replaces by a hull of a concave mesh.
 COLLISION_RGB = (213, 94, 0)
 CONCAVE_RGB = (204, 121, 167)

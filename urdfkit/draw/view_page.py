@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-from urdfkit.draw.view_model import COLLISION_RGB, TINTS, Model
+from urdfkit.draw.view_model import COLLISION_RGB, SELECTED_RGB, TINTS, TOUCHING_RGB, Model
 
 
 def md(text: str) -> str:
@@ -26,8 +26,6 @@ def legend() -> str:
     def swatch(rgb: tuple[int, int, int], what: str) -> str:
         hexc = "#{:02x}{:02x}{:02x}".format(*rgb)
         return f'<span style="color:{hexc}">&#9632;</span> {what}'
-
-    from urdfkit.draw.view import SELECTED_RGB, TOUCHING_RGB
 
     return "  \n".join((
         "Colours: PyBullet's own, except",
