@@ -245,3 +245,21 @@ def _wait_for(cond: Any, seconds: float) -> bool:
             return True
         time.sleep(0.2)
     return bool(cond())
+
+
+def test_the_page_names_the_template_not_its_cache_file() -> None:
+    # The built car is a file in urdfkit's cache; the findings and notes name "simplecar".
+    from urdfkit.commands.driving import _run_view
+    from urdfkit.draw import view_page
+
+    config = DriveConfig(seconds=0.1)
+    with Scenario(config) as sc:
+        assert "simplecar" in sc.car_file and sc.car_file != "simplecar"
+        stream = _run_view(sc, config, None, None, wait=False)
+        try:
+            m = stream.viewer.model
+            assert m.file == "simplecar" and m.resolved.name == "simplecar"
+            assert m.findings and all(f.file == "simplecar" for f in m.findings)
+            assert sc.car_file not in view_page.findings(m)
+        finally:
+            stream.viewer.close()

@@ -181,8 +181,13 @@ def _sim_view(s: Any, pace: float | None, port: int | None, wait: bool = True) -
 
         raise ParameterError("the scenario has no robot to show", param="view")
     first, options = bodies[0].loaded
+    # Findings name the robot as the scenario does (its urdf, or its template), not the
+    # built copy PyBullet loaded.
+    cfg = getattr(bodies[0], "config", None)
+    display = getattr(cfg, "urdf", None) or getattr(cfg, "template", None)
     viewer = Viewer(first, inertia_from_file=options.inertia_from_file, port=port,
-                    watch=False, ground=20.0, stand_on_grid=False)
+                    watch=False, ground=20.0, stand_on_grid=False,
+                    display=str(display) if display else None)
     try:
         for b in bodies[1:]:
             viewer.add_robot(b.loaded[0], inertia_from_file=b.loaded[1].inertia_from_file)
