@@ -76,3 +76,19 @@ def test_a_correct_file_gets_no_typo_warning(tmp_path: Path) -> None:
     path = _robot(tmp_path, f"<collision>{_box()}</collision>")
     result = runner.invoke(app, ["joints", str(path)])
     assert result.exit_code == 0 and "not a URDF tag" not in result.stderr
+
+
+def test_check_names_an_arg_the_xacro_does_not_declare(tmp_path: Path) -> None:
+    path = tmp_path / "arm.urdf.xacro"
+    path.write_text('<robot name="a" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                    '<xacro:arg name="prefix" default=""/>'
+                    f'<link name="$(arg prefix)base">{INERTIAL}</link></robot>')
+    result = runner.invoke(app, ["check", str(path), "--arg", "prefx:=left_", "--no-cache"])
+    assert result.exit_code == 0
+    assert "'prefx' is not an argument of this file or its includes; did you mean " \
+           "'prefix'?" in result.stderr
+    # a declared one is taken without a word; so is any in a folder walk (by design)
+    result = runner.invoke(app, ["check", str(path), "--arg", "prefix:=left_", "--no-cache"])
+    assert "not an argument" not in result.stderr
+    result = runner.invoke(app, ["check", str(tmp_path), "--arg", "prefx:=left_", "--no-cache"])
+    assert "not an argument" not in result.stderr

@@ -72,6 +72,9 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
     finally:
         if enabled:
             gc.enable()
+    if arg and not no_exec:
+        for line in unknown_args(paths, xacro_args(arg), parse_packages(package, package_path)):
+            show.warn(input_flags(line))
     for folder in empty_folders(paths, [fr.file for fr in result.files]):
         line = (f"{folder}: no robot file in this folder (no *.urdf or *.xacro, any case, in it "
                 "or below)")
@@ -83,6 +86,43 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
                        if "`" in f.message else f for f in fr.findings]
     show.check_output(result, fmt, fail_on, show_all)
     return result.exit_code(fail_on)
+
+
+def unknown_args(paths: list[str], args: dict[str, str], packages: Any) -> list[str]:
+    """``--arg`` names that none of the xacro files named on the command line declares.
+
+    ``check`` passes its ``--arg`` values to every xacro file, and a file ignores one it does
+    not declare; a misspelt name (``prefx``) would be ignored by all of them, silently. Each
+    named file is expanded strictly (once more per unknown name; folders are not searched, as
+    a tree's files declare different arguments by design), and a name every one rejects is
+    said with xacro's own message (its nearest declared name).
+    """
+    import os
+
+    from urdfkit.checks.check import _is_xacro
+    from urdfkit.core.errors import ParameterError, UrdfkitError
+    from urdfkit.sources.expand import expand_xacro
+
+    named = [p for p in paths if _is_xacro(p) and os.path.isfile(p)]
+    if not args or not named:
+        return []
+    unknown: dict[str, str] | None = None
+    for path in named:
+        left, mine = dict(args), {}
+        while left:
+            try:
+                expand_xacro(path, left, display=path, packages=packages, strict_args=True)
+                break
+            except ParameterError as e:
+                name = next((n for n in left if f"{n!r} is not an argument" in e.message), None)
+                if name is None:
+                    return []  # not about the arguments: check says what is wrong
+                mine[name] = f"{path}: {e.message}; check ignores it"
+                del left[name]
+            except UrdfkitError:
+                return []  # the file's own problem, which check reports as a finding
+        unknown = mine if unknown is None else {n: m for n, m in unknown.items() if n in mine}
+    return list((unknown or {}).values())
 
 
 def empty_folders(paths: list[str], checked: list[str]) -> list[str]:
