@@ -496,12 +496,29 @@ def undrawn_visual(path: Path | str) -> str | None:
     TinyRenderer). Cheap on the common case: a file without ``<instance_node>`` that holds an
     ``<instance_geometry>`` is not parsed.
     """
+    try:  # one answer per file version: a tree's robots share their meshes
+        st = os.stat(path)
+    except OSError:
+        return None  # missing or unreadable: U701, U704, said by the references
+    key = (os.fspath(path), st.st_size, st.st_mtime_ns, st.st_ino)
+    if key not in _UNDRAWN:
+        if len(_UNDRAWN) > 4096:
+            _UNDRAWN.clear()
+        _UNDRAWN[key] = _undrawn(path)
+    return _UNDRAWN[key]
+
+
+#: :func:`undrawn_visual`'s answers, by path and stat.
+_UNDRAWN: dict[tuple[str, int, int, int], str | None] = {}
+
+
+def _undrawn(path: Path | str) -> str | None:
     from urdfkit.model.xmlio import read_regular
 
     try:
         data = read_regular(Path(path), limit=MAX_MESH_BYTES, kind="mesh")
     except InputError:
-        return None  # missing, not regular, too big: U701, U704, said by the references
+        return None  # not regular, too big: U704, said by the references
     if not data.strip():
         return "is empty: PyBullet draws nothing of it"
     if mesh_kind(str(path)) != ".dae" or (
