@@ -177,12 +177,13 @@ def _line(text: str) -> int:
 
 
 # U008 (a line PyBullet breaks) is tested against raw PyBullet in tests/test_guard.py; U009
-# (a .urdf holding xacro) in tests/test_build_unseen.py.
+# (a .urdf holding xacro) in tests/test_build_unseen.py; U715 (a visual PyBullet draws
+# nothing of) against PyBullet's own picture in tests/test_no_silent_misses.py.
 def test_every_code_has_a_case() -> None:
     # U950 and U951 need PyBullet (check --physics): tests/test_collisions.py.
     # U010 (a fragment) needs its includer in the run: tests/test_fragments.py.
     tested = {code for code, _ in CASES} | {"U000", "U004", "U006", "U007", "U008", "U009",
-                                            "U010", "U208", "U209", "U950", "U951"}
+                                            "U010", "U208", "U209", "U715", "U950", "U951"}
     assert tested == set(CODES)
 
 

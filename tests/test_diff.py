@@ -799,3 +799,11 @@ def test_masses_whose_sum_overflows(tmp_path: Path) -> None:
     assert doc["totals"]["mass"]["old"] is None  # inf has no JSON number: null, and said so
     assert doc["totals"]["mass"]["new"] == pytest.approx(4.0)
     assert "non-finite" in err and len(err.strip().splitlines()) == 1
+
+
+def test_the_same_robot_is_counted_in_words_of_the_right_number(tmp_path: Path) -> None:
+    path = tmp_path / "two.urdf"
+    path.write_text('<robot name="t"><link name="a"/><link name="b"/><joint name="j" '
+                    'type="fixed"><parent link="a"/><child link="b"/></joint></robot>')
+    result = CliRunner().invoke(app, ["diff", str(path), str(path)])
+    assert result.exit_code == 0 and "(2 links, 1 joint;" in result.stdout, result.stdout

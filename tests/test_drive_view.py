@@ -7,6 +7,7 @@ import json
 import subprocess
 import sys
 import time
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -71,7 +72,7 @@ def test_the_run_is_paced_to_its_speed() -> None:
 
 def test_cli_streams_prints_json_and_serves_until_ctrl_c(served_run: Any) -> None:
     code, out, err = served_run("drive", "--steer", "0.2", "--seconds", "3", "--view",
-                                "--speed", "max", "--json")
+                                "--no-wait", "--speed", "max", "--json")
     assert code == 0, err  # the run finished clean: Ctrl-C only closed the page
     plain = subprocess.run([sys.executable, "-m", "urdfkit", "drive", "--steer", "0.2",
                             "--seconds", "3", "--json"], capture_output=True, text=True,
@@ -88,3 +89,177 @@ def test_cli_refuses_bad_view_options(args: list[str], says: str) -> None:
     r = subprocess.run([sys.executable, "-m", "urdfkit", "drive", *args], capture_output=True,
                        text=True, timeout=60)
     assert r.returncode == 2 and says in r.stderr and r.stderr.count("\n") == 1, r.stderr
+
+
+# --------------------------------------------------------------------------- in a browser
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+
+
+@pytest.fixture
+def chromium() -> Any:
+    """Debian's Chromium under Playwright (software WebGL); closed after the test."""
+    import os
+    import shutil
+
+    path = os.environ.get("URDFKIT_CHROMIUM") or shutil.which("chromium") or CHROMIUM
+    if not os.path.exists(path):
+        pytest.skip(f"no Chromium at {path}: apt-get install -y chromium (CI does)")
+    sync_api = pytest.importorskip("playwright.sync_api",
+                                   reason="pip install playwright (in urdfkit[test])")
+    with sync_api.sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=path, args=CHROMIUM_ARGS)
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+def _lines_until(proc: Any, text: str, seconds: float, seen: list[str]) -> bool:
+    """Take the process's stderr lines into ``seen`` until one holds ``text``.
+
+    Read by a thread into a queue (:func:`_reader`): a buffered pipe under select() can hold
+    a line select() never reports.
+    """
+    import queue
+
+    lines = _reader(proc)
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        try:
+            line = lines.get(timeout=0.2)
+        except queue.Empty:
+            continue
+        if line is None:
+            return False
+        seen.append(line)
+        if text in line:
+            return True
+    return False
+
+
+def _reader(proc: Any) -> Any:
+    """One queue of the process's stderr lines (None at its end), made on first use."""
+    import queue
+    import threading
+
+    if not hasattr(proc, "lines"):
+        proc.lines = queue.Queue()
+
+        def pump() -> None:
+            for line in iter(proc.stderr.readline, ""):
+                proc.lines.put(line)
+            proc.lines.put(None)
+
+        threading.Thread(target=pump, daemon=True).start()
+    return proc.lines
+
+
+def _car_pixels(page: Any) -> int:
+    """Pixels of the car in the canvas: its black tyres (the page is white, the grid grey)."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    box = page.locator("canvas").first.bounding_box()
+    # Software WebGL on a loaded 2-core machine: a screenshot may take a while.
+    png = page.screenshot(timeout=120000)
+    rgb = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
+    x0, y0 = int(box["x"]), int(box["y"])
+    x1, y1 = int(box["x"] + box["width"]), int(box["y"] + box["height"])
+    crop = rgb[y0 + 160:y1 - 90, x0:x1]  # below the WebGL notice, above the axes gizmo
+    return int((crop.max(axis=2) < 50).sum())
+
+
+def test_drive_view_waits_for_the_page_follows_the_car_and_replays(
+        chromium: Any, tmp_path: Path) -> None:
+    import csv
+    import re
+    import signal
+
+    run_csv = tmp_path / "run.csv"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "urdfkit", "drive", "--view", "--speed", "4", "--seconds", "8",
+         "--trajectory", str(run_csv)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        text=True)
+    seen: list[str] = []
+    page = None
+    try:
+        assert _lines_until(proc, "waiting for a page", 120, seen), "".join(seen)
+        url = re.search(r"(http://\S+)", seen[-1]).group(1)  # type: ignore[union-attr]
+        # Unwatched, it waits: at 4x real time the 8 s run would take 2 s, and after 4 s
+        # nothing has run (no line but the wait, the process alive).
+        assert not _lines_until(proc, "until Ctrl-C", 4, seen), "".join(seen)
+        assert proc.poll() is None
+        page = chromium.new_page(viewport={"width": 1000, "height": 700})
+        page.goto(url)
+        assert _lines_until(proc, "a page connected", 60, seen), "".join(seen)
+        page.get_by_text("Running").first.wait_for(timeout=30000)  # watched from the start
+        assert _lines_until(proc, "until Ctrl-C", 120, seen), "".join(seen)
+        page.get_by_text("Done").first.wait_for(timeout=30000)
+        with run_csv.open() as f:
+            rows = list(csv.DictReader(f))
+        end = rows[-1]
+        # The car, 8 m from where it started, is in the canvas at the end (the camera followed).
+        assert float(end["x"]) ** 2 + float(end["y"]) ** 2 > 4.0
+        assert _wait_for(lambda: _car_pixels(page) > 200, 20), _car_pixels(page)
+        # Replay to the midpoint: the base is where the run's own sample at 4 s has it.
+        slider = page.locator("[role=slider]").first
+        slider.focus()
+        page.keyboard.press("Home")
+        for _ in range(50):  # 100 steps over the run: 50 to the middle
+            page.keyboard.press("ArrowRight")
+        page.get_by_text("Replay").first.wait_for(timeout=10000)
+        status = page.get_by_text(re.compile(r"t = 4\.00 s")).first
+        status.wait_for(timeout=20000)
+        x, y, z = (float(v) for v in re.search(
+            r"base at x (\S+), y (\S+), z (\S+) m", status.inner_text()).groups())  # type: ignore[union-attr]
+        mid = next(r for r in rows if abs(float(r["t"]) - 4.0) < 1e-9)
+        assert (x, y, z) == pytest.approx((float(mid["x"]), float(mid["y"]), float(mid["z"])),
+                                          abs=2e-3)  # the status prints millimetres
+        # The joint readouts show the run's values at that time, not the model's zero.
+        wheel = "base_to_left_back_wheel"
+        shown = next(v for v in (t.input_value() for t in page.locator("textarea").all())
+                     if v.startswith("--joints"))
+        value = float(re.search(rf"{wheel}=(\S+?)(,|$)", shown).group(1))  # type: ignore[union-attr]
+        assert value == pytest.approx(float(mid[f"{wheel}_angle"]), rel=1e-5)  # 6 digits
+        assert value > 10  # the wheel has turned many times by then
+        assert _wait_for(lambda: _car_pixels(page) > 200, 20)  # the camera followed it back
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=30)
+        assert proc.returncode == 0
+    finally:
+        if page is not None:
+            page.close()
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+
+
+def _wait_for(cond: Any, seconds: float) -> bool:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.2)
+    return bool(cond())
+
+
+def test_the_page_names_the_template_not_its_cache_file() -> None:
+    # The built car is a file in urdfkit's cache; the findings and notes name "simplecar".
+    from urdfkit.commands.driving import _run_view
+    from urdfkit.draw import view_page
+
+    config = DriveConfig(seconds=0.1)
+    with Scenario(config) as sc:
+        assert "simplecar" in sc.car_file and sc.car_file != "simplecar"
+        stream = _run_view(sc, config, None, None, wait=False)
+        try:
+            m = stream.viewer.model
+            assert m.file == "simplecar" and m.resolved.name == "simplecar"
+            assert m.findings and all(f.file == "simplecar" for f in m.findings)
+            assert sc.car_file not in view_page.findings(m)
+        finally:
+            stream.viewer.close()

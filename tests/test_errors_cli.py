@@ -71,8 +71,9 @@ def test_a_crash_in_check_is_not_a_finding(monkeypatch: pytest.MonkeyPatch,
 
 
 @pytest.mark.parametrize(("args", "expected"), [
-    (["drive", "--throttle", "abc"], "urdfkit drive: Invalid value for '--throttle': 'abc'"),
-    (["joints"], "urdfkit joints: Missing argument 'FILE'"),
+    (["drive", "--throttle", "abc"],
+     "urdfkit: error: drive: Invalid value for '--throttle': 'abc'"),
+    (["joints"], "urdfkit: error: joints: Missing argument 'FILE'"),
     (["joints", "r2d2.urdf", "--bogus"], "No such option: --bogus"),
     (["nosuch"], "No such command 'nosuch'"),
     (["check", "--fail-on", "warn", "x.urdf"], "--fail-on expects error, warning or info"),

@@ -12,7 +12,7 @@ import pybullet as p
 import pytest
 from matplotlib.path import Path as Polygon
 
-from urdfkit.draw.render import RenderOptions, render_file
+from urdfkit.draw.render import Camera, RenderOptions, render_file
 
 BOX = """<robot name="box"><material name="red"><color rgba="0.9 0.1 0.1 1"/></material>
 <link name="b"><visual><geometry><box size="0.4 0.2 0.1"/></geometry><material name="red"/>
@@ -39,6 +39,11 @@ def _hull(points: np.ndarray) -> list[tuple[float, float]]:
     return lower[:-1] + upper[:-1]
 
 
+def _far(cam: Camera) -> float:
+    """A far plane beyond the robot (the drawing views shoot from far away, with a long lens)."""
+    return 2 * float(np.linalg.norm(np.subtract(cam.eye, cam.target))) + 100.0
+
+
 @pytest.mark.parametrize("view", ["iso", "top", "front", "side"])
 def test_a_known_box_covers_exactly_its_projected_corners(tmp_path: Path, view: str) -> None:
     path = tmp_path / "box.urdf"
@@ -49,7 +54,8 @@ def test_a_known_box_covers_exactly_its_projected_corners(tmp_path: Path, view: 
     # PyBullet's matrices (column-major) from the camera render reports: independent of how
     # render built its own.
     look = np.array(p.computeViewMatrix(cam.eye, cam.target, cam.up)).reshape(4, 4).T
-    lens = np.array(p.computeProjectionMatrixFOV(cam.fov_deg, w / h, 0.01, 100.0)).reshape(4, 4).T
+    lens = np.array(p.computeProjectionMatrixFOV(cam.fov_deg, w / h, 0.01, _far(cam))
+                    ).reshape(4, 4).T
     corners = []
     for c in itertools.product((-0.2, 0.2), (-0.1, 0.1), (-0.05, 0.05)):
         # The box as placed: its half sizes about the middle of the bounding box render reports.
@@ -112,7 +118,8 @@ def test_the_robots_share_of_the_frame_is_what_pybullet_sees(tmp_path: Path, rob
     try:
         body = p.loadURDF(load, useFixedBase=True, physicsClientId=c)
         look = p.computeViewMatrix(cam.eye, cam.target, cam.up, physicsClientId=c)
-        lens = p.computeProjectionMatrixFOV(cam.fov_deg, w / h, 0.01, 100.0, physicsClientId=c)
+        lens = p.computeProjectionMatrixFOV(cam.fov_deg, w / h, 0.01, _far(cam),
+                                            physicsClientId=c)
         seg = np.reshape(np.asarray(p.getCameraImage(
             w, h, look, lens, renderer=p.ER_TINY_RENDERER, physicsClientId=c)[4]), (h, w))
         lo, hi = p.getAABB(body, -1, physicsClientId=c)
@@ -146,3 +153,34 @@ def test_the_robots_share_of_the_frame_is_what_pybullet_sees(tmp_path: Path, rob
     perimeter = sum(float(np.hypot(*np.subtract(a, b)))
                     for a, b in zip(hull, hull[1:] + hull[:1], strict=True))
     assert (ink & ~inside).sum() <= perimeter, view
+
+
+@pytest.mark.parametrize("view", ["iso", "front", "side", "top"])
+def test_front_side_and_top_are_orthographic(tmp_path: Path, view: str) -> None:
+    """Seen through the camera render reports (PyBullet's own matrices), a 10 cm segment at
+    the back of the robot's box is drawn as long as one at its front in the three drawing
+    views (to 0.5%), and visibly shorter in iso's perspective."""
+    path = tmp_path / "box.urdf"
+    path.write_text(BOX)
+    r = render_file(path, RenderOptions(width=320, height=240, views=(view,)))
+    cam = r.cameras[0]
+    _, _, w, h = cam.panel
+    look = np.array(p.computeViewMatrix(cam.eye, cam.target, cam.up)).reshape(4, 4).T
+    lens = np.array(p.computeProjectionMatrixFOV(cam.fov_deg, w / h, 0.01, 1e9)).reshape(4, 4).T
+    lo, hi = np.array(r.aabb[0]), np.array(r.aabb[1])
+    toward = np.subtract(cam.eye, cam.target)
+    toward /= np.linalg.norm(toward)
+    across = np.cross(toward, cam.up)
+    across /= np.linalg.norm(across)
+    mid = (lo + hi) / 2
+    depth = float(np.abs(toward) @ (hi - lo)) / 2
+
+    def drawn(at: np.ndarray) -> float:
+        a, b = (lens @ look @ np.array([*(at + s * 0.05 * across), 1.0]) for s in (-1, 1))
+        return float(np.hypot(*(a[:2] / a[3] - b[:2] / b[3])) * h / 2)
+
+    near, far = drawn(mid + toward * depth), drawn(mid - toward * depth)
+    if view == "iso":
+        assert far < 0.95 * near
+    else:
+        assert abs(far - near) <= 0.005 * near, (near, far)

@@ -52,8 +52,8 @@ def test_every_robot_ends_on_the_page_where_the_run_ends() -> None:
 def test_cli_sim_view_prints_json_and_serves_until_ctrl_c(tmp_path: Path,
                                                           served_run: Any) -> None:
     out = tmp_path / "rows.jsonl"
-    code, stdout, err = served_run("sim", str(TWO_CARS), "--view", "--speed", "max", "--json",
-                                   "-o", str(out))
+    code, stdout, err = served_run("sim", str(TWO_CARS), "--view", "--no-wait", "--speed",
+                                   "max", "--json", "-o", str(out))
     assert code == 0, err
     data = json.loads(stdout)
     assert data["steps"] == 720 and data["rows"] == 122
@@ -65,3 +65,31 @@ def test_cli_sim_view_refuses_gui_and_real_time() -> None:
         r = subprocess.run([sys.executable, "-m", "urdfkit", "sim", str(TWO_CARS), "--view",
                             *extra], capture_output=True, text=True, timeout=60)
         assert r.returncode == 2 and "--view paces the run itself" in r.stderr, r.stderr
+
+
+def test_cli_sim_view_waits_for_a_page_before_the_run(tmp_path: Path) -> None:
+    # Unwatched, the run does not start: the rows file is not written while it waits (an
+    # unpaced 3 s scenario takes well under the 5 s waited here), and it says why on stderr.
+    import signal
+    import time
+
+    out = tmp_path / "rows.jsonl"
+    proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "sim", str(TWO_CARS), "--view",
+                             "--speed", "max", "-o", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        err = ""
+        deadline = time.monotonic() + 120
+        while "waiting for a page" not in err and time.monotonic() < deadline \
+                and proc.poll() is None:
+            err += proc.stderr.readline()  # type: ignore[union-attr]
+        assert "waiting for a page to connect" in err and "--no-wait" in err, err
+        time.sleep(5)
+        assert proc.poll() is None and not out.exists()
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=30)
+        assert proc.returncode == 130 and not out.exists()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()

@@ -346,3 +346,16 @@ def test_a_scenario_plot_metric_is_checked_before_the_run(tmp_path: Path) -> Non
                         str(out))
     assert code == 1 and "did you mean 'pendulum.joint_max.hinge'" in err
     assert out.exists() and not picture.exists()
+
+
+def test_every_numeric_drive_and_scenario_column_has_a_unit_on_the_plot() -> None:
+    # A sweep plot's axes say their units (rad/s, not a bare number): every metric a drive
+    # row has, and every per-robot scenario field, is known to the plot.
+    from urdfkit.draw.plot import axis_label
+    from urdfkit.sweep import DRIVE_METRICS, SIM_FIELDS
+
+    for name in (*DRIVE_METRICS, *SIM_FIELDS):
+        assert axis_label(name) != name, name
+    assert axis_label("turning_radius") == "turning_radius (m)"
+    assert axis_label("robots[0].distance") == "robots[0].distance (m)"
+    assert axis_label("robots[0].motor.kp") == "robots[0].motor.kp"  # unknown: no guess

@@ -72,9 +72,10 @@ def test_simplecar_loads_in_pybullet_with_the_tutorial_indices(pb, simplecar_urd
         assert (info[8], info[9]) == (0.0, -1.0)
     # Front wheels 0 +-0.2 0 from the hinges; rear wheels at -0.2 +-0.175 0. PyBullet reports
     # parentFramePos relative to the parent's centre of mass, and the hinge's centre of mass
-    # sits 0.1 m out along its arm, so the front wheels read 0 +-0.1 0.
-    assert p.getJointInfo(body, 1, physicsClientId=client)[14] == pytest.approx((0, 0.1, 0))
-    assert p.getJointInfo(body, 3, physicsClientId=client)[14] == pytest.approx((0, -0.1, 0))
+    # sits 0.11 m out along its arm (which starts 0.02 m out from the pivot, clear of the other
+    # hinge), so the front wheels read 0 +-0.09 0.
+    assert p.getJointInfo(body, 1, physicsClientId=client)[14] == pytest.approx((0, 0.09, 0))
+    assert p.getJointInfo(body, 3, physicsClientId=client)[14] == pytest.approx((0, -0.09, 0))
     assert p.getJointInfo(body, 4, physicsClientId=client)[14] == pytest.approx((-0.2, 0.175, 0))
     assert p.getJointInfo(body, 5, physicsClientId=client)[14] == pytest.approx((-0.2, -0.175, 0))
     # In the world, at rest, the wheel centres are where the tutorial puts them.
@@ -168,3 +169,43 @@ def test_steer_limit_parameter_reaches_pybullet(pb, tmp_path: Path) -> None:
     body = p.loadURDF(str(path), physicsClientId=client)
     info = p.getJointInfo(body, 0, physicsClientId=client)
     assert (info[8], info[9]) == pytest.approx((-math.pi / 4, math.pi / 4))
+
+
+@pytest.mark.parametrize("sets", [[], ["track=0.5", "front_track=0.5", "wheel_radius=0.12",
+                                      "body_size=0.6,0.4,0.1"]])
+def test_a_template_built_clear_of_self_contact_passes_collisions(
+        sets: list[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # The README's examples: build, then `urdfkit collisions` exits 0 (no pair in contact at
+    # the start pose) and build said nothing about contacts.
+    from typer.testing import CliRunner
+
+    from urdfkit.cli import app
+
+    monkeypatch.chdir(tmp_path)
+    runner = CliRunner()
+    args = [a for s in sets for a in ("--set", s)]
+    result = runner.invoke(app, ["build", "simplecar", *args, "-o", "car.urdf"])
+    assert result.exit_code == 0 and "start pose" not in result.stderr, result.stderr
+    result = runner.invoke(app, ["collisions", "car.urdf", "--json"])
+    assert result.exit_code == 0, result.stdout
+
+
+def test_build_names_the_pair_its_set_values_put_in_contact(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, pb: tuple) -> None:
+    from typer.testing import CliRunner
+
+    from urdfkit.cli import app
+
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(app, ["build", "simplecar", "--set", "wheel_radius=0.12",
+                                      "--set", "body_size=0.6,0.4,0.1", "-o", "car.urdf"])
+    assert result.exit_code == 0  # written (PyBullet loads it), and said
+    said = [ln for ln in result.stderr.splitlines() if "start pose" in ln]
+    assert len(said) == 2 and all("'base_link'" in ln and "25 mm" in ln for ln in said), said
+    # The depth is PyBullet's own: the body (0.4 m wide) over the front wheels, whose inner
+    # faces stand 0.2 - 0.025 = 0.175 m from the centre line: 25 mm in.
+    p, client = pb
+    body = p.loadURDF(str(tmp_path / "car.urdf"), flags=p.URDF_USE_IMPLICIT_CYLINDER,
+                      physicsClientId=client)
+    points = p.getClosestPoints(body, body, 0.0, -1, 1, physicsClientId=client)
+    assert min(pt[8] for pt in points) == pytest.approx(-0.025, abs=1e-3)

@@ -233,6 +233,7 @@ def _raw_touching(path: Path, joints: dict[str, float]) -> dict[tuple[str, str],
 
 def test_touching_pairs_follow_the_sliders(arm: Path, viewer_of: Any) -> None:
     v = viewer_of(arm)
+    v.show_touching.value = True  # off by default: the robot in its own colours
     assert v.touching == [] and _raw_touching(arm, {}) == {}
     v.set_joints({"shoulder": 1.5})  # the arm swings down onto the wheel
     raw = _raw_touching(arm, {"shoulder": 1.5, "slide": 0.085})
@@ -266,12 +267,18 @@ def test_u604_error_tints_its_link_and_names_its_line(tmp_path: Path, viewer_of:
     v = viewer_of(path, inertia_from_file=True)
     levels = {lk.name: lk.level for lk in v.model.links}
     assert levels["upper"] == "error" and levels["base"] is None
+    # By default every link keeps PyBullet's colour; the tint is asked for.
+    assert [h.color for h in v.nodes("visual", "upper")] == [(0, 229, 0)]
+    v.tint_findings.value = True
     assert [h.color for h in v.nodes("visual", "upper")] == [TINTS["error"]]
     # The file's colour, as PyBullet keeps it (float32 0.9 of 255 = 229.49...).
     assert v.nodes("visual", "base")[0].color == (0, 229, 0)
     u604 = [f for f in v.model.findings if f.code == "U604"]
     assert [f.line for f in u604] == [line]
-    assert f"{path}:{line}" in view_page.findings(v.model)
+    # Listed once: by its button (it is on a link), whose link's panel gives file:line.
+    assert f"{path}:{line}" not in view_page.findings(v.model)
+    v.select("upper")
+    assert f"{path}:{line}" in v.selected_text.content
 
 
 def test_edit_reloads_and_a_broken_file_keeps_the_last_robot(arm: Path, viewer_of: Any) -> None:
@@ -426,8 +433,8 @@ def _pixels(page: Any, colour: str = "green", path: Path | None = None) -> int:
 
     png = page.screenshot(path=str(path) if path else None)
     # Where the camera looks: below the notice, above the axes gizmo (its y axis is green),
-    # left of the control panel (whose "Connected" cloud is green too).
-    rgb = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)[160:620, :640]
+    # left of the control panel docked beside the canvas (its legend has red and amber).
+    rgb = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)[160:620, :600]
     r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
     if colour == "green":
         return int(((g > r + 60) & (g > b + 60)).sum())
@@ -478,8 +485,13 @@ def test_finding_and_reload_error_shown_in_the_page(page_of: Any, tmp_path: Path
     line = next(i for i, text in enumerate(U604.splitlines(), 1) if 'izz="0.5"' in text)
     v = viewer_of(path, inertia_from_file=True)
     page = page_of(v)
-    page.get_by_text(f"{path}:{line}").wait_for(timeout=10000)
-    # Red where the error is: the tinted link's pixels are in the picture.
+    # The finding's button; clicked, its link's panel names the file and line.
+    page.get_by_role("button", name=f"U604 line {line}: upper").click()
+    page.get_by_text(f"{path}:{line}").wait_for(timeout=30000)
+    # The robot's own colours first; red where the error is once the tint is asked for.
+    assert _wait(lambda: _pixels(page) > 2000, 30) and _pixels(page, "red") < 20
+    v.select(None)
+    page.get_by_label("Tint findings").check()
     assert _wait(lambda: _pixels(page, "red") > 500, 20)
     if os.environ.get("URDFKIT_SHOTS"):  # docs/view.png: URDFKIT_SHOTS=1 pytest -k finding
         page.locator("button.mantine-Notification-closeButton").click()
@@ -502,6 +514,7 @@ def test_selecting_a_link_highlights_it_and_shows_its_joint_row(tmp_path: Path,
     path = tmp_path / "bad.urdf"
     path.write_text(U604)
     v = viewer_of(path, inertia_from_file=True)
+    v.tint_findings.value = True
     v.select("upper")
     assert v.select_link.value == "upper"
     assert [h.color for h in v.nodes("visual", "upper")] == [SELECTED_RGB]
@@ -527,7 +540,7 @@ def test_clicking_a_finding_and_choosing_a_link_in_the_page_select_it(
     # The finding's button in the page selects the link it is about, on the server.
     page.get_by_role("button", name=f"U604 line {line}: upper").click()
     assert _wait(lambda: v.selected == "upper", 10)
-    page.get_by_text("child of joint").wait_for(timeout=10000)
+    page.get_by_text("child of joint").wait_for(timeout=30000)
     # Choosing another link in the Selection dropdown moves the selection to it.
     page.get_by_label("Link", exact=True).click()
     page.get_by_role("option", name="finger", exact=True).click()
@@ -538,9 +551,10 @@ def test_clicking_a_finding_and_choosing_a_link_in_the_page_select_it(
     import numpy as np
     from PIL import Image
 
+    page.get_by_label("Tint findings").check()
     assert _wait(lambda: _pixels(page, "red") > 500, 20)
     rgb = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
-    r, g, b = rgb[160:620, :640, 0], rgb[160:620, :640, 1], rgb[160:620, :640, 2]
+    r, g, b = rgb[160:620, :600, 0], rgb[160:620, :600, 1], rgb[160:620, :600, 2]
     ys, xs = np.nonzero((r > g + 90) & (r > b + 90) & (abs(g - b) < 40))
     k = len(ys) // 2  # a red pixel in the middle of the list, not on the silhouette's edge
     page.mouse.click(int(xs[k]), int(ys[k]) + 160)
@@ -569,3 +583,110 @@ def test_a_joint_axis_is_drawn_in_the_link_frame_whatever_the_inertial_frame(
                  .split('"')[0].split()]
     assert direction == pytest.approx(np.asarray(file_axis) / np.linalg.norm(file_axis),
                                       abs=1e-6)
+
+
+def _projected_share(camera: Any, lo: Any, hi: Any) -> tuple[float, float]:
+    """The share of the canvas's width and height the box lo..hi spans, seen by the page's
+    own camera (its position, look_at, up, vertical fov and aspect): a pinhole projection."""
+    import itertools
+
+    import numpy as np
+
+    eye, target = np.asarray(camera.position, float), np.asarray(camera.look_at, float)
+    forward = (target - eye) / np.linalg.norm(target - eye)
+    right = np.cross(forward, np.asarray(camera.up_direction, float))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    tan_v = math.tan(camera.fov / 2)
+    tan_h = tan_v * camera.aspect
+    xs, ys = [], []
+    for corner in itertools.product(*zip(lo, hi, strict=True)):
+        rel = np.asarray(corner, float) - eye
+        depth = rel @ forward
+        assert depth > 0, "a corner behind the camera"
+        xs.append(rel @ right / depth / tan_h)  # -1..1 across the canvas
+        ys.append(rel @ up / depth / tan_v)
+    assert max(map(abs, xs + ys)) <= 1.0, "the robot is not all inside the canvas"
+    return (max(xs) - min(xs)) / 2, (max(ys) - min(ys)) / 2
+
+
+def test_kuka_in_its_own_colours_with_a_legend_filling_the_view(page_of: Any,
+                                                                viewer_of: Any) -> None:
+    import io
+
+    import numpy as np
+    import pybullet as p
+    import pybullet_data
+    from PIL import Image
+
+    path = Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf"
+    v = viewer_of(path)
+    # Every link has a U612 warning (its meshes are not closed) ...
+    assert {lk.level for lk in v.model.links} == {"warning"}
+    assert {f.code for f in v.model.findings if f.level == "warning"} >= {"U612"}
+    # ... and still the links are drawn in PyBullet's own colours, as raw PyBullet has them.
+    c = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(str(path), physicsClientId=c)
+        own = {tuple(int(round(x * 255)) for x in row[7][:3])
+               for row in p.getVisualShapeData(body, physicsClientId=c)}
+    finally:
+        p.disconnect(physicsClientId=c)
+    page = page_of(v)
+    page.get_by_text("Colours: PyBullet's own").wait_for(timeout=10000)  # the legend
+    assert page.get_by_text("a link with a warning (Tint findings)").is_visible()
+    drawn = {tuple(h.color) for lk in v.model.links for h in v.nodes("visual", lk.name)}
+    assert drawn <= own and TINTS["warning"] not in drawn
+    # PyBullet's orange (1, 0.423529, 0.039215) is in the picture, and no amber tint.
+    orange = next(c for c in own if c[0] > 200 and c[2] < 40)
+
+    def near(rgb: Any, colour: tuple[int, ...], tol: int) -> int:
+        return int((np.abs(rgb - np.asarray(colour)).max(axis=2) < tol).sum())
+
+    def shot() -> Any:
+        png = page.screenshot(timeout=120000)
+        return np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)[160:620, :600]
+
+    assert _wait(lambda: near(shot(), orange, 60) > 300, 30)
+    # The camera fits the robot: seen through the page's own camera, its box spans at least
+    # half the canvas's height or width, and lies wholly inside it.
+    client = next(iter(v.server.get_clients().values()))
+    assert _wait(lambda: client.camera.update_timestamp > 0, 10)
+    lo, hi = v.model.bounds()
+    wide, high = _projected_share(client.camera, lo, hi)
+    assert max(wide, high) >= 0.5, (wide, high)
+
+
+def test_the_robot_stands_on_the_grid_and_its_frames_scale_with_it(viewer_of: Any) -> None:
+    import pybullet as p
+    import pybullet_data
+
+    path = Path(pybullet_data.getDataPath()) / "r2d2.urdf"
+    v = viewer_of(path)
+    c = p.connect(p.DIRECT)
+    try:  # r2d2's lowest point, from PyBullet's own boxes: 0.47 m below its base frame
+        body = p.loadURDF(str(path), flags=p.URDF_USE_IMPLICIT_CYLINDER, physicsClientId=c)
+        low = min(p.getAABB(body, k, physicsClientId=c)[0][2]
+                  for k in range(-1, p.getNumJoints(body, physicsClientId=c)))
+    finally:
+        p.disconnect(physicsClientId=c)
+    assert v.grid.position[2] == pytest.approx(low, abs=1e-6) and low < -0.4
+    # Link frames drawn at 15% of the robot's largest side (r2d2: ~1 m), not a fixed size.
+    lo, hi = v.model.bounds()
+    axes = v.nodes("frames", v.model.links[0].name)[0]
+    assert axes.axes_length == pytest.approx(0.15 * max(b - a for a, b in zip(lo, hi,
+                                                                          strict=True)))
+
+
+def test_collision_shapes_are_drawn_just_outside_their_visuals(arm: Path, viewer_of: Any) -> None:
+    # The arm's collision boxes are its visual boxes: drawn at the same size, both would
+    # z-fight in the collision view. Drawn 0.5% larger about their middle, they do not.
+    import numpy as np
+
+    v = viewer_of(arm)
+    (visual,) = v.nodes("visual", "upper")
+    (collision,) = v.nodes("collision", "upper")
+    span = np.ptp(np.asarray(visual.vertices), axis=0)
+    assert span == pytest.approx((0.08, 0.08, 0.5), abs=1e-6)
+    assert np.ptp(np.asarray(collision.vertices), axis=0) == pytest.approx(span * 1.005,
+                                                                           rel=1e-6)

@@ -50,7 +50,10 @@ def _click_error(e: BaseException) -> bool:
 
 def _usage_message(e: Any) -> str:
     ctx = getattr(e, "ctx", None)
-    where = f"{ctx.command_path}: " if ctx is not None else ""
+    # "urdfkit: error: drive: ...", not "urdfkit: error: urdfkit drive: ...": the program
+    # is named once, by the error line's own prefix.
+    sub = ctx.command_path.partition(" ")[2] if ctx is not None else ""
+    where = f"{sub}: " if sub else ""
     text = " ".join(e.format_message().split())  # one line, however click wrapped it
     option = getattr(e, "option_name", None)
     if option and not getattr(e, "possibilities", None) and ctx is not None:

@@ -108,7 +108,33 @@ def build(target: str, params: list[str] | None = None,
     if errors:
         raise InputError(f"the built URDF is invalid: {errors[0].message} ({errors[0].code})",
                          file=name)
-    return BuildResult(data, default, len(robot.links), len(robot.joints))
+    return BuildResult(data, default, len(robot.links), len(robot.joints),
+                       warnings=start_pose_contacts(data, target))
+
+
+def start_pose_contacts(data: bytes, template: str) -> list[str]:
+    """Link pairs of a built template in contact at its start pose, each said with its depth.
+
+    A template's ``--set`` values can put one part inside another (a wider body around the
+    front wheels): PyBullet loads it, and pushes the pair apart every step once self-collision
+    is on. Tested as ``urdfkit collisions`` tests it (one PyBullet load, ~50 ms).
+    """
+    import tempfile
+
+    from urdfkit.checks.collisions import self_collisions
+    from urdfkit.sources.resolve import resolve
+
+    with tempfile.TemporaryDirectory(prefix="urdfkit-build-") as tmp:
+        path = Path(tmp) / f"{template}.urdf"
+        path.write_bytes(data)
+        with resolve(path) as resolved:
+            resolved.name = f"template {template}"
+            found = self_collisions(resolved)
+    return [f"template {template}: links {x.link_a!r} and {x.link_b!r} "
+            f"{'interpenetrate by' if x.distance < 0 else 'touch at'} "
+            f"{abs(x.distance) * 1000:.3g} mm at the start pose (urdfkit collisions would "
+            "report them; self-collision makes them jitter): change the --set values that "
+            "place them" for x in found.pairs]
 
 
 def _build_xacro(source: Path, target: str, args: Mapping[str, str],

@@ -181,8 +181,8 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, str, str | None]]:
     for item in paths:
         path = Path(item)
         if not os.path.lexists(path):
-            raise ParameterError(f"{item}: no such file or folder")
-        if path.is_dir() and path.suffix not in SUFFIXES:
+            path = _bare_name(item)
+        if path.is_dir() and path.suffix.lower() not in SUFFIXES:
             # An entry's abspath is the walk's, then its own part of the path (no "." or ".."
             # in an entry's name, no trailing "/" on a Path's): one abspath per walk.
             top = str(path)
@@ -202,7 +202,7 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, str, str | None]]:
                         is_dir = entry.is_dir(follow_symlinks=False)
                     except OSError:
                         is_dir = False
-                    if entry.name.endswith(SUFFIXES):
+                    if entry.name.lower().endswith(SUFFIXES):
                         add(entry.path, entry.path, key=top_key + entry.path[len(top):])
                     elif is_dir:
                         subdirs.append(entry.path)
@@ -212,10 +212,24 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, str, str | None]]:
     return out
 
 
+def _bare_name(item: str | Path) -> Path:
+    """A path not found as given: looked up as every command does (pybullet_data, did you mean).
+
+    Raises:
+        ParameterError: not there either (exit code 2).
+    """
+    from urdfkit.sources.resolve import locate
+
+    try:
+        return locate(item)
+    except InputError as e:
+        raise ParameterError(f"{item}: {e.message}") from None
+
+
 def _is_xacro(name: str) -> bool:
     """Whether ``Path(name).suffix == ".xacro"``, without making the Path."""
     base = name.rpartition(os.sep)[2]
-    return base.endswith(".xacro") and len(base) > 6
+    return base[-6:].lower() == ".xacro" and len(base) > 6
 
 
 def _read(path: str, display: str, no_exec: bool = False,

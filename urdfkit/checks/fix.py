@@ -125,8 +125,10 @@ class FixResult:
         """A unified diff from the original to the fixed text."""
         a = self.original.decode("utf-8", "replace").splitlines(keepends=True)
         b = self.fixed.decode("utf-8", "replace").splitlines(keepends=True)
-        return "".join(difflib.unified_diff(a, b, f"a/{self.file}",
-                                            f"b/{new_name or self.file}"))
+        # git's a/ and b/ prefixes, before a relative path: an absolute one keeps one slash
+        old, new = self.file, new_name or self.file
+        return "".join(difflib.unified_diff(a, b, f"a/{old.lstrip('/')}",
+                                            f"b/{new.lstrip('/')}"))
 
     def to_dict(self) -> dict[str, Any]:
         """The ``--json`` form (docs/fix.md)."""
@@ -194,8 +196,10 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
 
 def _read_source(path: str | Path, density: float | None) -> tuple[str, Path, bytes, str]:
     """The file's name as shown, its path, bytes and text; refusals before any work."""
+    from urdfkit.sources.resolve import locate
+
     display = str(path)
-    source = Path(path)
+    source = locate(path)  # a bare name is found in pybullet_data, as every command finds it
     if density is not None and not (math.isfinite(density) and density > 0):
         raise ParameterError(f"`density` must be a positive number of kg/m^3, got {density!r}",
                              param="density")

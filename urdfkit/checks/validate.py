@@ -74,9 +74,21 @@ def rule_elements(root: etree._Element, r: RuleReport) -> None:
     leftovers, extensions), opaque subtrees (another tool's: gazebo, transmission, ...) and
     shapes after the first in a ``<geometry>``.
     """
+    from urdfkit.model.spec import did_you_mean, nearest_attributes, nearest_tags
+
     for code, level, message, el in r.doc(root).element_findings:
         if code == "U801" and el.tag == "gazebo":
             continue  # another tool's block, PyBullet ignores it: U803 judges its contacts
+        # The verdicts are shared between elements; the nearest name is added per finding.
+        if code == "U801":
+            parent = el.getparent()
+            if parent is not None:
+                message += did_you_mean(nearest_tags(el.tag, parent.tag))
+        elif code == "U802":
+            for attr in el.keys():
+                if f"unknown attribute {attr!r};" in message:
+                    message += did_you_mean(nearest_attributes(attr, el.tag), tags=False)
+                    break
         r.add(code, level, message, el)
 
 
@@ -522,6 +534,37 @@ def rule_meshes(root: etree._Element, r: RuleReport) -> None:
                 r.add(ref.code, ref.level, ref.message, el)
 
 
+def rule_visual_meshes(root: etree._Element, r: RuleReport) -> None:
+    """U715: a visual mesh PyBullet draws nothing or only part of.
+
+    An empty file, or COLLADA placing its parts through ``<instance_node>`` (robots exported
+    from some CAD tools): PyBullet loads the robot and draws nothing of that link, without a
+    word on stdout. Only ``.dae`` files are read (a substring search first); an empty file is
+    known from its stat.
+    """
+    if r.folder is None:
+        return
+    from urdfkit.sources.meshes import mesh_kind, undrawn_visual
+
+    for view in r.doc(root).links:
+        for part in view.parts:
+            if part.tag != "visual":
+                continue
+            mesh = used_shape(first(part, "geometry"))
+            fn = (mesh.get("filename") or "").strip() if mesh is not None and \
+                mesh.tag == "mesh" else ""
+            if not fn or (ref := r.reference("mesh", fn)).load is None:
+                continue
+            empty = ref.stat is not None and ref.stat.st_size == 0
+            if not empty and mesh_kind(ref.load) != ".dae":
+                continue
+            why = undrawn_visual(ref.load)
+            if why is not None:
+                r.add("U715", "warning", f"visual mesh {fn!r} of {label(view.el)} {why}; "
+                      "the robot looks incomplete in render, view and the GUI (export it "
+                      "with its nodes flattened, or as .obj/.stl)", mesh)
+
+
 #: A mesh this many times larger (or smaller) than the robot's typical joint spacing is in
 #: the wrong units (millimetres read as metres gives 1000x).
 UNITS_RATIO = 200.0
@@ -712,9 +755,9 @@ def rule_portability(root: etree._Element, r: RuleReport) -> None:
 
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
-                               rule_inertia, rule_meshes, rule_mesh_shapes, rule_references,
-                               rule_material_colours, rule_mimic, rule_gazebo_contacts,
-                               rule_portability)
+                               rule_inertia, rule_meshes, rule_mesh_shapes, rule_visual_meshes,
+                               rule_references, rule_material_colours, rule_mimic,
+                               rule_gazebo_contacts, rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -791,6 +834,7 @@ CODES: dict[str, str] = {
     "U708": "package:/// without a package name",
     "U709": "transmission names a missing joint",
     "U710": "one material name given several colours (PyBullet draws them all in the last)",
+    "U715": "visual mesh PyBullet draws nothing or only part of (empty, COLLADA <instance_node>)",
     "U801": "unknown tag",
     "U802": "unknown attribute",
     "U803": "Gazebo contact parameters (mu1, mu2, kp, kd) PyBullet ignores (fix --gazebo-contacts)",

@@ -56,7 +56,8 @@ def build(
         sys.stdout.flush()
         return
     path = building.write_output(out, result.data, force=force)
-    show.wrote(path, f"{result.links} links, {result.joints} joints")
+    show.wrote(path, f"{show.counted(result.links, 'link')}, "
+                     f"{show.counted(result.joints, 'joint')}")
 
 
 @command(examples("urdfkit templates", "urdfkit templates --json"))

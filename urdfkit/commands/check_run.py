@@ -26,7 +26,7 @@ if TYPE_CHECKING:
 
 #: Flags of ``check`` (no value), by option name: the keyword of :func:`run_check`.
 FLAG_OPTIONS = {"--json": "as_json", "--no-exec": "no_exec", "--all": "show_all",
-                "--physics": "physics", "--no-cache": "no_cache"}
+                "--physics": "physics", "--no-cache": "no_cache", "--strict": "strict"}
 #: Options with one value each (given once), and options that may be repeated.
 VALUE_OPTIONS = {"--format": "output_format", "--fail-on": "fail_on", "--jobs": "jobs",
                  "-j": "jobs"}
@@ -39,13 +39,18 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
               package_path: list[str] | None = None, select: list[str] | None = None,
               ignore: list[str] | None = None, jobs: int | None = None,
               arg: list[str] | None = None, no_exec: bool = False, show_all: bool = False,
-              physics: bool = False, no_cache: bool = False) -> int:
+              physics: bool = False, no_cache: bool = False, strict: bool = False) -> int:
     """Check ``paths`` and print the findings in ``output_format``; the exit code.
 
+    A folder given that holds no robot file is said (a warning): a CI run over the wrong
+    folder would otherwise pass on nothing. With ``strict`` that is a usage error instead.
+
     Raises:
-        ParameterError: a bad option value (exit code 2).
+        ParameterError: a bad option value, or (``strict``) a folder with no robot file
+            (exit code 2).
     """
     from urdfkit.checks.check import check_paths, parse_codes
+    from urdfkit.core.errors import ParameterError
     from urdfkit.core.finding import Finding
     from urdfkit.sources.uris import parse_packages
 
@@ -67,6 +72,15 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
     finally:
         if enabled:
             gc.enable()
+    if arg and not no_exec:
+        for line in unknown_args(paths, xacro_args(arg), parse_packages(package, package_path)):
+            show.warn(input_flags(line))
+    for folder in empty_folders(paths, [fr.file for fr in result.files]):
+        line = (f"{folder}: no robot file in this folder (no *.urdf or *.xacro, any case, in it "
+                "or below)")
+        if strict:
+            raise ParameterError(f"{line}; --strict refuses a folder with nothing to check")
+        show.warn(line)
     for fr in result.files:  # a xacro or package problem speaks of flags, not parameters
         fr.findings = [Finding(f.code, f.level, input_flags(f.message), f.file, f.line, f.origin)
                        if "`" in f.message else f for f in fr.findings]
@@ -85,6 +99,59 @@ def fail_on_level(fail_on: str) -> Level:
         raise ParameterError(f"`fail_on` expects error, warning or info, got {fail_on!r}"
                              f"{hint(fail_on, ('error', 'warning', 'info'))}", param="fail_on")
     return next(level for level in LEVELS if level == fail_on)
+
+
+def unknown_args(paths: list[str], args: dict[str, str], packages: Any) -> list[str]:
+    """``--arg`` names that none of the xacro files named on the command line declares.
+
+    ``check`` passes its ``--arg`` values to every xacro file, and a file ignores one it does
+    not declare; a misspelt name (``prefx``) would be ignored by all of them, silently. Each
+    named file is expanded strictly (once more per unknown name; folders are not searched, as
+    a tree's files declare different arguments by design), and a name every one rejects is
+    said with xacro's own message (its nearest declared name).
+    """
+    import os
+
+    from urdfkit.checks.check import _is_xacro
+    from urdfkit.core.errors import ParameterError, UrdfkitError
+    from urdfkit.sources.expand import expand_xacro
+
+    named = [p for p in paths if _is_xacro(p) and os.path.isfile(p)]
+    if not args or not named:
+        return []
+    unknown: dict[str, str] | None = None
+    for path in named:
+        left, mine = dict(args), {}
+        while left:
+            try:
+                expand_xacro(path, left, display=path, packages=packages, strict_args=True)
+                break
+            except ParameterError as e:
+                name = next((n for n in left if f"{n!r} is not an argument" in e.message), None)
+                if name is None:
+                    return []  # not about the arguments: check says what is wrong
+                mine[name] = f"{path}: {e.message}; check ignores it"
+                del left[name]
+            except UrdfkitError:
+                return []  # the file's own problem, which check reports as a finding
+        unknown = mine if unknown is None else {n: m for n, m in unknown.items() if n in mine}
+    return list((unknown or {}).values())
+
+
+def empty_folders(paths: list[str], checked: list[str]) -> list[str]:
+    """The folders in ``paths`` under which none of the ``checked`` files lies."""
+    import os
+
+    from urdfkit.checks.check import SUFFIXES
+
+    out = []
+    for item in paths:
+        if not os.path.isdir(item) or os.path.splitext(item)[1].lower() in SUFFIXES:
+            continue
+        prefix = os.path.join(item, "")
+        if not any(name.startswith(prefix) for name in checked):
+            out.append(item)
+    return out
 
 
 def chosen_format(output_format: str | None, as_json: bool) -> CheckFormat:

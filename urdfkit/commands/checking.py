@@ -65,6 +65,9 @@ def check(
         "--no-cache", help="Check every file afresh: do not read or write the result cache "
         "(a file's findings, reused while neither it nor anything it read changed). "
         "URDFKIT_CACHE_DIR= also turns it off.")] = False,
+    strict: Annotated[bool, typer.Option(
+        "--strict", help="Exit 2 when a folder given holds no robot file (else a warning), "
+        "so a CI run cannot pass on nothing.")] = False,
 ) -> None:
     """Check URDF files for errors PyBullet crashes on, physics mistakes and typos.
 
@@ -74,7 +77,8 @@ def check(
     from urdfkit.commands.check_run import run_check
 
     raise typer.Exit(run_check(paths, as_json, output_format, fail_on, package, package_path,
-                               select, ignore, jobs, arg, no_exec, show_all, physics, no_cache))
+                               select, ignore, jobs, arg, no_exec, show_all, physics, no_cache,
+                               strict))
 
 
 # ---- diff: two robots compared in meaning (urdfkit/diff.py)
@@ -162,10 +166,15 @@ def fix(
     input or usage.
     """
     from urdfkit.checks.fix import fix_file
+    from urdfkit.core.errors import ParameterError
     from urdfkit.core.output import check_output
+    from urdfkit.sources.resolve import locate
     from urdfkit.sources.uris import parse_packages
 
     codes = _check_fix_options(output, in_place, show_diff, as_json, select)
+    if in_place and not Path(file).expanduser().exists() and locate(file).exists():
+        raise ParameterError(f"{file}: found in pybullet_data, which --in-place would rewrite; "
+                             "write the repaired copy with -o FILE")
     backup = f"{file}.orig"
     if output not in (None, "-"):
         check_output(output, force=force)
@@ -247,6 +256,7 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
                  as_json: bool, report: Callable[[], None]) -> None:
     """Write the repaired file to stdout, in place (keeping FILE.orig) or to ``output``."""
     from urdfkit.core.output import atomic_write
+    from urdfkit.sources.resolve import locate
 
     backup = f"{file}.orig"
     if output == "-":
@@ -262,8 +272,8 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
             show.wrote(Path(file), f"original kept as {backup}")
     else:
         assert output is not None
-        if result.relative_paths and \
-                Path(output).absolute().parent.resolve() != Path(file).absolute().parent.resolve():
+        if result.relative_paths and Path(output).absolute().parent.resolve() != \
+                locate(file).absolute().parent.resolve():
             show.warn(f"{output}: {len(result.relative_paths)} mesh or texture path(s) in it are "
                       f"relative to {file}'s folder ({result.relative_paths[0]!r}, ...) and "
                       "do not resolve from where it is written: write it beside the original "

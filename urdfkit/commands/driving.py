@@ -15,6 +15,7 @@ from urdfkit.commands.shared import (
     JsonOpt,
     MaxForceOpt,
     NoGuardOpt,
+    NoWaitOpt,
     PackageOpt,
     PackagePathOpt,
     PlaneOpt,
@@ -36,13 +37,14 @@ from urdfkit.commands.shared import (
     say_streaming,
     serve_until_interrupted,
     split_joints,
+    wait_for_page,
 )
 
 
 @command(examples(
     "urdfkit drive --throttle 10 --steer 0.2",
     "urdfkit drive --urdf racecar/racecar.urdf --seconds 5 --json",
-    "urdfkit drive --urdf husky/husky.urdf --steer 0.5   # skid steer: 0.5 rad/s of yaw",
+    "urdfkit drive --urdf husky/husky.urdf --throttle 3 --steer 0.5   # skid steer: yaw rad/s",
     "urdfkit drive --steer 0.3 --trajectory run.csv --plot run.png"))
 def drive(
     throttle: ThrottleOpt = FROM_LIBRARY,
@@ -86,6 +88,7 @@ def drive(
     view: ViewOpt = False,
     speed: SpeedOpt = "1",
     port: RunPortOpt = None,
+    no_wait: NoWaitOpt = False,
 ) -> None:
     """Drive a car headless at a fixed throttle and steer, and report where it went.
 
@@ -115,7 +118,7 @@ def drive(
     with Scenario(config) as sc:
         _say_drivetrain(sc)
         said = list(sc.warnings)
-        stream = _run_view(sc, config, pace, port) if view else None
+        stream = _run_view(sc, config, pace, port, wait=not no_wait) if view else None
         result, written = _drive_run(sc, trajectory, force=force, stream=stream,
                                      quiet=as_json or view)
     if plot is not None:
@@ -241,25 +244,32 @@ def _drive_exit(result: Any, stream: Any) -> None:
         raise typer.Exit(1)
 
 
-def _run_view(sc: Any, config: Any, pace: float | None, port: int | None) -> Any:
-    """Start the page a run streams to (drive --view), and say where it is."""
+def _run_view(sc: Any, config: Any, pace: float | None, port: int | None,
+              wait: bool = True) -> Any:
+    """Start the page a run streams to (drive --view), say where it is, wait for a page."""
     import math
 
     from urdfkit.draw.view import Viewer
-    from urdfkit.draw.view_stream import RunStream
+    from urdfkit.draw.view_stream import RunStream, joint_reader
 
     total = config.total_steps * config.time_step
     reach = abs(config.throttle) * sc.drivetrain.reference_radius * total
+    # Findings name the file the user gave, or the template: never the cache path built.
+    display = config.urdf or "simplecar"
     viewer = Viewer(sc.car_file, packages=config.packages, package_paths=config.package_paths,
                     xacro_args=config.xacro_args, inertia_from_file=not config.tutorial,
-                    port=port, watch=False, ground=float(max(4, math.ceil(2 * reach + 2))))
+                    port=port, watch=False, ground=float(max(4, math.ceil(2 * reach + 2))),
+                    display=display, stand_on_grid=False)
     try:
-        stream = RunStream(viewer, sc.link_poses, pace, total)
+        session = sc.session
+        joints = joint_reader(session.p, session.client, sc.body, viewer.model.joints)
+        stream = RunStream(viewer, sc.link_poses, pace, total, joints=joints)
         stream.push()
+        say_streaming("drive", viewer, pace)
+        wait_for_page("drive", viewer, wait)
     except BaseException:
         viewer.close()
         raise
-    say_streaming("drive", viewer, pace)
     return stream
 
 

@@ -115,7 +115,8 @@ def joints(
             nums(j.parent_frame_orn), str(j.flags), nums(j.joint_axis) if j.movable else ""])
     shown = f"{len(rows)} of {len(report.joints)}" if len(rows) != len(report.joints) \
         else str(len(rows))
-    show.table(f"{report.robot}: {shown} joints, base link {report.base_link}", columns, cells,
+    noun = "joint" if shown == "1" else "joints"
+    show.table(f"{report.robot}: {shown} {noun}, base link {report.base_link}", columns, cells,
                show_all)
     _loaded_with(report)
     if mimics:
@@ -187,8 +188,8 @@ def links(
             num(link.contact_stiffness), num(link.contact_damping),
             nums(link.local_inertial_pos), nums(link.local_inertial_orn)])
     inertia = "from the file" if inertia_from_file else "recomputed by PyBullet"
-    show.table(f"{report.robot}: {len(report.links)} links, inertia {inertia}", columns, cells,
-               show_all)
+    links = show.counted(len(report.links), "link")
+    show.table(f"{report.robot}: {links}, inertia {inertia}", columns, cells, show_all)
     _loaded_with(report)
     if differs and not inertia_from_file:
         show.note("! = PyBullet's value differs from the file's; --inertia-from-file keeps the "

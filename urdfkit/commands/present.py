@@ -37,6 +37,11 @@ LEVEL_STYLE = {"error": "bold red", "warning": "yellow", "info": "cyan"}
 # --------------------------------------------------------------------------- streams
 
 
+
+def counted(n: int, noun: str) -> str:
+    """``"1 joint"``, ``"2 joints"``: a count with its noun in the right number."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
+
 def styled(stream: Any) -> bool:
     """Whether ``stream`` gets colours: a terminal, or FORCE_COLOR set (NO_COLOR wins)."""
     if os.environ.get("NO_COLOR"):
@@ -511,7 +516,8 @@ def diff_report(result: Any) -> None:
     a, b = result.a, result.b
     if result.same:
         line((b.robot, "bold"), f": {a.file} and {b.file} are the same robot "
-             f"({b.links} links, {b.joints} joints; tolerance {result.tolerance:g})")
+             f"({counted(b.links, 'link')}, {counted(b.joints, 'joint')}; "
+             f"tolerance {result.tolerance:g})")
         return
     v = diff_value
 

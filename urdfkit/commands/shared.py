@@ -144,6 +144,9 @@ ViewOpt = Annotated[bool, typer.Option(
 SpeedOpt = Annotated[str, typer.Option(
     "--speed", metavar="FACTOR|max", help="With --view: simulated seconds per wall second "
     "(max: no pacing).")]
+NoWaitOpt = Annotated[bool, typer.Option(
+    "--no-wait", help="With --view: start the run at once, not when the first page "
+    "connects (for scripts).")]
 RunPortOpt = Annotated[int | None, typer.Option(
     "--port", min=1, max=65535, help="With --view: the port to serve on.",
     show_default="a free one")]
@@ -172,6 +175,21 @@ def say_streaming(command: str, viewer: Any, pace: float | None) -> None:
     pacing = "as fast as it goes" if pace is None else \
         ("in real time" if pace == 1 else f"at {pace:g}x real time")
     show.line(f"urdfkit {command}: {viewer.url} (the run streams there {pacing})", stderr=True)
+
+
+def wait_for_page(command: str, viewer: Any, wait: bool) -> None:
+    """Hold the run until a page has connected (``wait``), saying so on stderr.
+
+    A run streamed to nobody is over before anyone sees it: by default it starts when the
+    first page connects. ``--no-wait`` (``wait`` False) starts it at once.
+    """
+    if not wait:
+        return
+    show.line(f"urdfkit {command}: waiting for a page to connect to {viewer.url} before the "
+              "run starts (--no-wait starts it at once)", stderr=True)
+    while not viewer.wait_for_page(0.5):  # short waits: Ctrl-C is taken between them
+        pass
+    show.line(f"urdfkit {command}: a page connected; the run starts", stderr=True)
 
 
 def serve_until_interrupted(viewer: Any, what: str, command: str = "drive") -> None:

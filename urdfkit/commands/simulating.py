@@ -10,6 +10,7 @@ from urdfkit.commands import present as show
 from urdfkit.commands.shared import (
     ForceOpt,
     JsonOpt,
+    NoWaitOpt,
     RunPortOpt,
     SpeedOpt,
     ViewOpt,
@@ -18,6 +19,7 @@ from urdfkit.commands.shared import (
     parse_speed,
     say_streaming,
     serve_until_interrupted,
+    wait_for_page,
 )
 
 
@@ -48,6 +50,7 @@ def sim(
     view: ViewOpt = False,
     speed: SpeedOpt = "1",
     port: RunPortOpt = None,
+    no_wait: NoWaitOpt = False,
 ) -> None:
     """Simulate a scenario of one or more robots and record their observations.
 
@@ -68,7 +71,7 @@ def sim(
     with simulation.Simulation.from_file(scenario, gui=gui) as s:
         for note in s.config.notes:
             show.warn(note)
-        stream = _sim_view(s, pace, port) if view else None
+        stream = _sim_view(s, pace, port, wait=not no_wait) if view else None
         result, written = _sim_run(s, out, force=force, real_time=real_time or gui,
                                    stream=stream)
     if stream is not None and result.interrupted:
@@ -167,7 +170,7 @@ def _sim_table(scenario: str, result: Any, summaries: list[Any], written: Any) -
         show.wrote(written, f"{result.row_count:,} rows")
 
 
-def _sim_view(s: Any, pace: float | None, port: int | None) -> Any:
+def _sim_view(s: Any, pace: float | None, port: int | None, wait: bool = True) -> Any:
     """Start the page a scenario streams to (sim --view): every robot, and say where."""
     from urdfkit.draw.view import Viewer
     from urdfkit.draw.view_stream import RunStream
@@ -178,18 +181,24 @@ def _sim_view(s: Any, pace: float | None, port: int | None) -> Any:
 
         raise ParameterError("the scenario has no robot to show", param="view")
     first, options = bodies[0].loaded
+    # Findings name the robot as the scenario does (its urdf, or its template), not the
+    # built copy PyBullet loaded.
+    cfg = getattr(bodies[0], "config", None)
+    display = getattr(cfg, "urdf", None) or getattr(cfg, "template", None)
     viewer = Viewer(first, inertia_from_file=options.inertia_from_file, port=port,
-                    watch=False, ground=20.0)
+                    watch=False, ground=20.0, stand_on_grid=False,
+                    display=str(display) if display else None)
     try:
         for b in bodies[1:]:
             viewer.add_robot(b.loaded[0], inertia_from_file=b.loaded[1].inertia_from_file)
         stream = RunStream(viewer, s.link_poses, pace, s.total_steps * s.time_step,
                            robots=True)
         stream.push()
+        say_streaming("sim", viewer, pace)
+        wait_for_page("sim", viewer, wait)
     except BaseException:
         viewer.close()
         raise
-    say_streaming("sim", viewer, pace)
     return stream
 
 

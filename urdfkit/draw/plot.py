@@ -113,6 +113,28 @@ def write_plot(result: DriveResult, path: str | Path, *, force: bool = False) ->
 SERIES = (style.PRIMARY, style.SECONDARY, style.START, style.END, style.AXIS_Z, style.AXIS_X)
 
 
+#: Units of the drive's results and settings, for a sweep plot's axes (docs/drive.md). A
+#: name not here (a scenario key, a template parameter) is labelled without one.
+UNITS = {
+    # drive rows (urdfkit.sweep.DRIVE_METRICS)
+    "final_x": "m", "final_y": "m", "final_z": "m", "final_yaw": "rad",
+    "heading_change": "rad", "yaw_rate": "rad/s", "distance": "m", "mean_speed": "m/s",
+    "turning_radius": "m", "turn_center_x": "m", "turn_center_y": "m", "expected_radius": "m",
+    "sim_time": "s", "steps": "steps", "samples": "samples", "steer_applied": "rad",
+    # scenario rows (urdfkit.sweep.SIM_FIELDS; a joint's are its own unit: rad or m)
+    "end_x": "m", "end_y": "m", "end_z": "m", "top_speed": "m/s", "heading_deg": "deg",
+    # what a drive sweep varies
+    "throttle": "rad/s", "steer": "rad, or rad/s when skid steered", "max_force": "N m",
+    "seconds": "s", "time_step": "s", "gravity": "m/s²",
+}
+
+
+def axis_label(name: str) -> str:
+    """``"turning_radius (m)"``: a sweep axis named with its unit, when known."""
+    unit = UNITS.get(name.rpartition(".")[2])
+    return f"{name} ({unit})" if unit else name
+
+
 def sweep_plot_bytes(rows: Sequence[Mapping[str, Any]], names: Sequence[str],
                      metric: str) -> bytes:
     """A sweep's ``metric`` against its first varied value, one line per value of the others.
@@ -142,8 +164,8 @@ def sweep_plot_bytes(rows: Sequence[Mapping[str, Any]], names: Sequence[str],
             text = ", ".join(f"{n} = {v}" for n, v in zip(others, label, strict=True))
             ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", linewidth=2,
                     color=hexc(SERIES[k % len(SERIES)]), label=text or None)
-        ax.set_xlabel(x_name)
-        ax.set_ylabel(metric)
+        ax.set_xlabel(axis_label(x_name))
+        ax.set_ylabel(axis_label(metric))
         ax.set_title(f"{metric} against {x_name}")
         ax.grid(True, linewidth=0.5)
         if others and ordered:

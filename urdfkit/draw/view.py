@@ -13,21 +13,24 @@ Three parts:
 
 from __future__ import annotations
 
+import math
 import threading
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 from urdfkit.core.errors import EngineError, MissingDependencyError, UrdfkitError
 from urdfkit.draw import view_page as page
-from urdfkit.draw.view_model import TINTS, Layer, Vec3, ViewedRobot
+from urdfkit.draw.view_model import SELECTED_RGB, TINTS, TOUCHING_RGB, Layer, Vec3, ViewedRobot
 from urdfkit.draw.view_stream import RunDisplay, add_shapes, wxyz
 
-#: Links touching another at the current pose (self-collision pairs).
-TOUCHING_RGB = (200, 0, 200)
-#: The selected link.
-SELECTED_RGB = (86, 180, 233)
 #: The selection dropdown's entry for no link.
 NO_LINK = "(none)"
+#: The page's vertical field of view (degrees), set so the camera's fit is computed for it.
+FOV_DEG = 45.0
+#: Share of the canvas the robot's projected bounding box may fill when the camera fits it.
+FIT = 0.85
+#: The canvas's width over its height assumed before a page says its own (reset view).
+ASPECT = 1.4
 #: How often the watcher looks at the files the robot was read from (s).
 POLL_SECONDS = 0.25
 
@@ -95,10 +98,11 @@ class Viewer(RunDisplay):
                  package_paths: Sequence[str] | None = None,
                  xacro_args: Sequence[str] | None = None, inertia_from_file: bool = False,
                  host: str = "127.0.0.1", port: int | None = None, watch: bool = True,
-                 ground: float = 4.0) -> None:
+                 ground: float = 4.0, display: str | None = None,
+                 stand_on_grid: bool = True) -> None:
         self._load_args: dict[str, Any] = {
             "packages": packages, "package_paths": package_paths, "xacro_args": xacro_args,
-            "inertia_from_file": inertia_from_file}
+            "inertia_from_file": inertia_from_file, "display": display}
         self.file = file
         self.model = ViewedRobot(file, **self._load_args)  # a bad file fails here, before serving
         self.error: str | None = None
@@ -131,8 +135,18 @@ class Viewer(RunDisplay):
         self.port = int(self.server.get_port())
         self.url = f"http://{'localhost' if host in ('127.0.0.1', '::1') else host}:{self.port}"
         self.server.scene.set_up_direction("+z")
-        self.server.scene.add_grid("/ground", width=ground, height=ground,
-                                   cell_size=0.1 if ground <= 4.0 else 0.5, section_size=1.0)
+        # A sidebar beside the canvas, not a panel floating over the scene; wide enough that
+        # joint names and the pose fields are not cut.
+        self.server.gui.configure_theme(control_width="large")
+        self.server.gui.main_panel.dock_right()
+        # The robot stands where `render` stands it: its lowest point on the grid (a run's
+        # ground is its own plane at z = 0).
+        floor = self.model.bounds()[0][2] if stand_on_grid else 0.0
+        self.grid = self.server.scene.add_grid("/ground", width=ground, height=ground,
+                                               cell_size=0.1 if ground <= 4.0 else 0.5,
+                                               section_size=1.0, position=(0.0, 0.0, floor))
+        self._connected = threading.Event()
+        self.server.on_client_connect(self._client_connected)
         self._static_gui()
         self._show_model()
         # Mimic joints to their leaders' zero pose (offsets included). Self-collisions are
@@ -155,12 +169,17 @@ class Viewer(RunDisplay):
             self.show_collision = gui.add_checkbox("Collision", False)
             self.show_frames = gui.add_checkbox("Frames and axes", False)
             self.show_inertia = gui.add_checkbox("COM and inertia boxes", False)
+            self.tint_findings = gui.add_checkbox(
+                "Tint findings", False, hint="Links with a check error in red, with a warning "
+                "in amber (else each link keeps PyBullet's own colours)")
             self.show_touching = gui.add_checkbox(
-                "Self-collisions", True, hint="Links touching at this pose, as urdfkit "
-                "collisions measures them, in magenta")
+                "Self-collisions", False, hint="Measure the links touching at this pose, as "
+                "urdfkit collisions does, list them and tint them magenta")
+            self.legend = gui.add_markdown(page.legend())
             self.touching_text = gui.add_markdown("")
         for box in (self.show_visual, self.show_collision, self.show_frames, self.show_inertia):
             box.on_update(lambda _event: self.apply_toggles())
+        self.tint_findings.on_update(lambda _event: self.recolour())
         self.show_touching.on_update(lambda _event: self.update_touching())
         self.touching: list[tuple[str, str, float]] = []
         self.selected: str | None = None
@@ -174,8 +193,9 @@ class Viewer(RunDisplay):
         with self.joints_folder:
             self.reset_button = gui.add_button("Reset to zero")
             self.reset_button.on_click(lambda _event: self.reset())
-            self.vector_text = gui.add_text("Python list", "[]", disabled=True)
-            self.joints_text = gui.add_text("--joints", "", disabled=True)
+            # Multiline: a long pose wraps instead of being cut at the field's edge.
+            self.vector_text = gui.add_text("Python list", "[]", disabled=True, multiline=True)
+            self.joints_text = gui.add_text("--joints", "", disabled=True, multiline=True)
         self.findings_folder = gui.add_folder("Findings", order=3)
         self.table_folder = gui.add_folder("Joint table", order=4, expand_by_default=False)
 
@@ -208,22 +228,23 @@ class Viewer(RunDisplay):
 
         scene, m = self.server.scene, self.model
         size = max(max(hi - lo for lo, hi in zip(*m.bounds(), strict=True)), 0.05)
+        self.frame_size = size * 0.15  # the axes a link frame is drawn with: the robot's scale
         by_index = {j.link: j for j in m.joints}
         for link, (pos, quat) in zip(m.links, m.link_poses(), strict=True):
             root = f"/robot/link{link.index + 1}"
             self._frames.append(scene.add_frame(root, show_axes=False, position=pos,
                                                 wxyz=wxyz(quat)))
-            for kind, mesh in add_shapes(scene, root, link, TINTS.get(link.level or "")):
+            for kind, mesh in add_shapes(scene, root, link, None):
                 # Clicking a link in the scene selects it (and its joint's row).
                 mesh.on_click(lambda _event, name=link.name: self.select(name))
                 self._nodes[kind].append(mesh)
             self._nodes["frames"].append(scene.add_frame(
-                f"{root}/axes", axes_length=size * 0.08, axes_radius=size * 0.004))
+                f"{root}/axes", axes_length=self.frame_size, axes_radius=size * 0.006))
             joint = by_index.get(link.index)
             if joint is not None:  # PyBullet's axis is in the inertial frame: into the link's
                 axis = np.asarray(rotate(quat_to_matrix(link.inertial_quat), joint.axis),
                                   dtype=float)
-                points = np.array([[-axis, axis]], dtype=np.float32) * size * 0.1
+                points = np.array([[-axis, axis]], dtype=np.float32) * size * 0.2
                 self._nodes["frames"].append(scene.add_line_segments(
                     f"{root}/joint_axis", points, (204, 121, 167), thickness=size * 0.006))
             self._nodes["inertia"].append(scene.add_frame(
@@ -253,7 +274,10 @@ class Viewer(RunDisplay):
                 self._gui.append(s)
 
     def _add_findings(self) -> None:
-        """The findings' text, and one button per finding on a link that selects it."""
+        """Each finding once: a button for one about a link, the text of the others.
+
+        The button selects the link, whose panel then shows the finding's text.
+        """
         gui, m = self.server.gui, self.model
         with self.findings_folder:
             self._gui.append(gui.add_markdown(page.findings(m)))
@@ -262,8 +286,8 @@ class Viewer(RunDisplay):
                 if not links:
                     continue
                 where = f"line {f.line}" if f.line is not None else f.file
-                button = gui.add_button(f"{f.code} {where}: {links[0]}",
-                                        hint=f.text[:300])
+                button = gui.add_button(f"{f.code} {where}: {links[0]}", hint=f.text[:300],
+                                        color="red" if f.level == "error" else "yellow")
                 button.on_click(lambda _event, name=links[0]: self.select(name))
                 self._gui.append(button)
 
@@ -271,12 +295,59 @@ class Viewer(RunDisplay):
         self.status.content = page.status(self.model, self.error)
 
     def _aim_camera(self) -> None:
-        lo, hi = self.model.bounds()
-        mid = [(a + b) / 2 for a, b in zip(lo, hi, strict=True)]
-        size = max(max(b - a for a, b in zip(lo, hi, strict=True)), 0.1)
+        """Fit the robot's bounds in the view: for new pages and the page's "Reset view"."""
+        eye, target, up = self.fit(*self.model.bounds(), ASPECT)
         cam = self.server.initial_camera
-        cam.look_at = tuple(mid)
-        cam.position = (mid[0] + 1.3 * size, mid[1] - 1.3 * size, mid[2] + 0.9 * size)
+        cam.fov = math.radians(FOV_DEG)
+        cam.look_at, cam.position, cam.up = target, eye, up
+
+    @staticmethod
+    def fit(lo: Vec3 | Any, hi: Vec3 | Any, aspect: float) -> tuple[Vec3, Vec3, Vec3]:
+        """Camera (eye, target, up) from render's iso direction that frames the box lo..hi.
+
+        The same fit as ``urdfkit render``'s (every corner inside :data:`FIT` of the view at
+        :data:`FOV_DEG`), so the page opens on the robot as the PNG shows it.
+        """
+        from urdfkit.draw.render import frame_view
+
+        eye, target, up = frame_view("iso", lo, hi, aspect, fov_deg=FOV_DEG, fill=FIT)
+        return (tuple(float(x) for x in eye), tuple(float(x) for x in target),  # type: ignore[return-value]
+                tuple(float(x) for x in up))
+
+    def _client_connected(self, client: Any) -> None:
+        """A page connected: fit the camera to its own canvas, and release :meth:`wait_for_page`."""
+        import time
+
+        try:
+            # The page reports its camera (and so its canvas's aspect) just after connecting.
+            end = time.monotonic() + 5.0
+            while not client.camera.update_timestamp and time.monotonic() < end:
+                time.sleep(0.02)
+            if client.camera.update_timestamp:
+                self.aim(client, self.model.bounds(), self.aspect(client))
+        finally:
+            self._connected.set()
+
+    @staticmethod
+    def aspect(client: Any) -> float:
+        """A page's canvas width over height (:data:`ASPECT` until it has said)."""
+        try:
+            return float(client.camera.aspect) or ASPECT
+        except (AttributeError, AssertionError):
+            return ASPECT
+
+    def aim(self, client: Any, bounds: tuple[Any, Any], aspect: float = ASPECT) -> None:
+        """Point one page's camera at a box (the robot, or a run's whole path)."""
+        eye, target, up = self.fit(*bounds, aspect)
+        with self.server.atomic():  # position first: setting it moves look_at along
+            client.camera.fov = math.radians(FOV_DEG)
+            client.camera.up_direction = up
+            client.camera.position = eye
+            client.camera.look_at = target
+
+    def wait_for_page(self, timeout: float | None = None) -> bool:
+        """Block until a page has connected (or ``timeout`` seconds); whether one has."""
+        return self._connected.wait(timeout)
 
     def apply_toggles(self) -> None:
         """Show or hide each layer as the Show checkboxes say."""
@@ -323,6 +394,26 @@ class Viewer(RunDisplay):
             self.joints_text.value = flags
             return now
 
+    def show_joint_values(self, values: Mapping[str, float]) -> None:
+        """Show a run's joint positions (by name) on the sliders and in the pose fields.
+
+        The robot on the page is posed by the run (:meth:`show_poses`); this keeps the
+        readouts on the same values, without moving this viewer's own PyBullet body.
+        """
+        with self._lock:
+            self._setting = True
+            try:
+                for name, value in values.items():
+                    s = self.sliders.get(name)
+                    if s is not None:
+                        s.value = min(max(float(value), float(s.min)), float(s.max))
+            finally:
+                self._setting = False
+            joints = [j for j in self.model.joints if j.name in values]
+            self.vector_text.value = repr([round(float(values[j.name]), 6) for j in joints])
+            text = ",".join(f"{j.name}={round(float(values[j.name]), 6):g}" for j in joints)
+            self.joints_text.value = f"--joints {text}" if text else ""
+
     def update_poses(self) -> None:
         """Move every link node to the pose PyBullet reports (not while a run is shown)."""
         if self.external_poses:
@@ -332,12 +423,13 @@ class Viewer(RunDisplay):
                 frame.position = pos
                 frame.wxyz = wxyz(quat)
 
-    def _recolour(self) -> None:
-        """Each link's colour: selected, else touching, else its findings' tint, else its own."""
+    def recolour(self) -> None:
+        """Each link's colour: selected, touching, its findings' tint (asked), or its own."""
         with self._lock:
             hit = {name for a, b, _ in self.touching for name in (a, b)}
+            tint = bool(self.tint_findings.value)
             for link, k in zip(self.model.links, range(len(self.model.links)), strict=True):
-                base = TINTS.get(link.level or "")
+                base = TINTS.get(link.level or "") if tint else None
                 layers: tuple[tuple[Layer, Any], ...] = (("visual", link.visuals),
                                                          ("collision", link.collisions))
                 for kind, shapes in layers:
@@ -373,7 +465,7 @@ class Viewer(RunDisplay):
                     self.select_link.value = want
             finally:
                 self._setting = False
-            self._recolour()
+            self.recolour()
             if link is None:
                 self.selected_text.content = ""
                 return
@@ -383,7 +475,7 @@ class Viewer(RunDisplay):
         """Measure the touching pairs (when shown) and colour their links magenta."""
         with self._lock:
             self.touching = self.model.touching() if self.show_touching.value else []
-            self._recolour()
+            self.recolour()
             self.touching_text.content = page.touching(self.touching)
 
     def zero(self) -> dict[str, float]:

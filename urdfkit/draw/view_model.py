@@ -29,6 +29,10 @@ from urdfkit.core.finding import Finding
 
 #: Tints of links with findings (RGB 0..255): check's error red and warning amber.
 TINTS = {"error": (220, 38, 38), "warning": (245, 158, 11)}
+#: Links touching another at the current pose (self-collision pairs).
+TOUCHING_RGB = (200, 0, 200)
+#: The selected link.
+SELECTED_RGB = (86, 180, 233)
 #: Colour of collision shapes; of those PyBullet replaces by a hull of a concave mesh.
 COLLISION_RGB = (213, 94, 0)
 CONCAVE_RGB = (204, 121, 167)
@@ -212,12 +216,13 @@ class ViewedRobot:
     def __init__(self, file: str, *, packages: Sequence[str] | None = None,
                  package_paths: Sequence[str] | None = None,
                  xacro_args: Sequence[str] | None = None,
-                 inertia_from_file: bool = False) -> None:
+                 inertia_from_file: bool = False, display: str | None = None) -> None:
         from urdfkit.core import deps
         from urdfkit.engine.session import LoadOptions, Session
         from urdfkit.sources.resolve import open_input
 
-        self.file = file
+        #: The file as the user knows it (a template's name, not its cache path): in findings.
+        self.file = display or file
         self.notes: list[str] = []
         self.lock = threading.RLock()
         self.session: Any = None
@@ -228,6 +233,8 @@ class ViewedRobot:
                 self.resolved = open_input(file, packages=list(packages or []),
                                            xacro_args=list(xacro_args or []),
                                            package_paths=list(package_paths or []))
+                if display:
+                    self.resolved.name = display
                 deps.note(self.resolved.source)
                 self.session = Session()
                 options = LoadOptions(inertia_from_file=inertia_from_file)
@@ -278,6 +285,11 @@ class ViewedRobot:
         self.session.diagnostics.extend(out.lines)
         self.joints = self._controls()
         self.notes.extend(self.resolved.warnings)
+        from urdfkit.sources.resolve import undrawn_note
+
+        undrawn = undrawn_note(self.resolved)
+        if undrawn is not None:
+            self.notes.append(undrawn)
 
     def _shape(self, kind: int, dims: Sequence[float], filename: bytes,
                pos: Sequence[float], quat: Sequence[float], *, collision: bool,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-from urdfkit.draw.view_model import TINTS, ViewedRobot
+from urdfkit.draw.view_model import COLLISION_RGB, SELECTED_RGB, TINTS, TOUCHING_RGB, ViewedRobot
 
 
 def md(text: str) -> str:
@@ -21,15 +21,35 @@ def status(m: ViewedRobot, error: str | None) -> str:
         f"{head}\n\n**Reload failed**, showing the last good robot: {md(error)}"
 
 
+def legend() -> str:
+    """What each colour the page may paint means (the robot's own colours otherwise)."""
+    def swatch(rgb: tuple[int, int, int], what: str) -> str:
+        hexc = "#{:02x}{:02x}{:02x}".format(*rgb)
+        return f'<span style="color:{hexc}">&#9632;</span> {what}'
+
+    return "  \n".join((
+        "Colours: PyBullet's own, except",
+        swatch(TINTS["error"], "a link with an error (Tint findings)"),
+        swatch(TINTS["warning"], "a link with a warning (Tint findings)"),
+        swatch(TOUCHING_RGB, "links touching (Self-collisions)"),
+        swatch(SELECTED_RGB, "the selected link"),
+        swatch(COLLISION_RGB, "collision shapes; pink: the hull of a concave mesh")))
+
+
 def findings(m: ViewedRobot) -> str:
-    """Errors and warnings with the links they are about; notes counted."""
+    """Each finding once: the file's, and those on no link (a button stands for the others)."""
     shown = [f for f in m.findings if f.level in ("error", "warning")]
-    lines = []
+    lines = [f"In `{md(m.file)}`:"] if shown else []
+    on_links = 0
     for f in shown:
+        if m.finding_links(f):
+            on_links += 1
+            continue
         where = f.file if f.line is None else f"{f.file}:{f.line}"
-        links = ", ".join(m.finding_links(f))
-        lines.append(f"- **{f.level} {f.code}** `{where}`{' (' + links + ')' if links else ''}"
-                     f": {md(f.text)}")
+        lines.append(f"- **{f.level} {f.code}** `{where}`: {md(f.text)}")
+    if on_links:
+        lines.append(f"- {on_links} on links, below: a button selects its link and shows "
+                     "the finding")
     hidden = len(m.findings) - len(shown)
     if hidden:
         lines.append(f"- and {hidden} note(s): `urdfkit check {m.file}`")

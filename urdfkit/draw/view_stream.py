@@ -20,6 +20,10 @@ def wxyz(q: Sequence[float]) -> tuple[float, float, float, float]:
 #: message. Bounded here.
 
 
+#: How much larger collision shapes are drawn than they are (see :func:`add_shapes`).
+COLLISION_INFLATE = 1.005
+
+
 def add_shapes(scene: Any, root: str, link: Any, tint: tuple[int, int, int] | None
                 ) -> list[tuple[Layer, Any]]:
     """A link's visual and collision meshes under its frame ``root``: (kind, handle) pairs."""
@@ -28,8 +32,14 @@ def add_shapes(scene: Any, root: str, link: Any, tint: tuple[int, int, int] | No
                                              ("collision", link.collisions))
     for kind, shapes in layers:
         for k, sh in enumerate(shapes):
+            vertices = sh.vertices
+            if kind == "collision" and len(vertices):
+                # A collision box on its visual box would z-fight (both drawn, the faces
+                # flicker): drawn 0.5% larger about its middle, the pair shows as one.
+                mid = (vertices.max(axis=0) + vertices.min(axis=0)) / 2
+                vertices = mid + (vertices - mid) * COLLISION_INFLATE
             out.append((kind, scene.add_mesh_simple(
-                f"{root}/{kind}{k}", sh.vertices, sh.faces, color=tint or sh.rgb,
+                f"{root}/{kind}{k}", vertices, sh.faces, color=tint or sh.rgb,
                 opacity=None if sh.opacity >= 1 else sh.opacity,
                 # No shadow pass: it doubles the first draw in software WebGL.
                 cast_shadow=False, receive_shadow=False,
@@ -60,6 +70,19 @@ class RunDisplay:
 
     def apply_toggles(self) -> None:
         """Show or hide each layer as the page's checkboxes say."""
+        raise NotImplementedError
+
+    def show_joint_values(self, values: Any) -> None:
+        """Show a run's joint positions (by name) on the page's readouts."""
+        raise NotImplementedError
+
+    def aim(self, client: Any, bounds: tuple[Any, Any], aspect: float = 1.4) -> None:
+        """Point one page's camera at a box."""
+        raise NotImplementedError
+
+    @staticmethod
+    def aspect(client: Any) -> float:
+        """A page's canvas width over height."""
         raise NotImplementedError
 
     def add_robot(self, file: str, *, inertia_from_file: bool = False) -> int:
@@ -112,6 +135,18 @@ STREAM_FPS = 30.0
 
 #: Points of a run's path kept on the page (halved by dropping every other one past this).
 PATH_POINTS = 2000
+#: Frames of a run kept for its replay (halved the same way past this).
+REPLAY_FRAMES = 4000
+#: The page's camera modes during and after a run.
+FOLLOW, WHOLE_PATH, FREE = "follow the robot", "frame the whole path", "free"
+
+
+def joint_reader(p: Any, client: int, body: int, joints: Sequence[Any]) -> Any:
+    """A function returning a run's joint positions by name (``joints``: the viewer's)."""
+    def read() -> dict[str, float]:
+        return {j.name: float(p.getJointState(body, j.index, physicsClientId=client)[0])
+                for j in joints}
+    return read
 
 
 class RunStream:
@@ -130,18 +165,38 @@ class RunStream:
         speed: Simulated seconds per wall second; None for no pacing.
         total: The run's simulated duration (for the status line).
         robots: ``poses`` gives one list per robot.
+        joints: Returns the first robot's joint positions by name (the page's readouts), or
+            None.
+
+    Each sample's poses are kept (:attr:`frames_kept`), so once the run is over the page can
+    replay it: a time slider puts the robot where the run had it at that time. The camera
+    follows the robot, frames its whole path, or is left alone (a dropdown).
     """
 
     def __init__(self, viewer: RunDisplay, poses: Any, speed: float | None,
-                 total: float, robots: bool = False) -> None:
+                 total: float, robots: bool = False, joints: Any = None) -> None:
         import time
 
         self.viewer, self.speed, self.total = viewer, speed, total
         self.poses = poses if robots else (lambda: [poses()])
+        self.joints = joints
+        #: (t, every robot's link poses, joint positions) per sample, for the replay.
+        self.frames_kept: list[tuple[float, list[Any], dict[str, float]]] = []
+        self._keep_stride = 1
+        self._kept_seen = 0
+        self.replay: Any = None
+        self._aimed_at: tuple[float, float, float] | None = None
+        gui = viewer.server.gui
+        with gui.add_folder("Run", order=0.5):
+            self.camera = gui.add_dropdown(
+                "Camera", (FOLLOW, WHOLE_PATH, FREE), initial_value=FOLLOW,
+                hint="Follow the robot, keep its whole path in view, or leave the camera be")
+        self.camera.on_update(lambda _event: self._aim_all(force=True))
         self.path: list[tuple[float, float, float]] = []
         #: Each robot's base path, sampled as frames are pushed (:meth:`tick`).
         self.paths: list[list[tuple[float, float, float]]] = []
         self.frames = 0
+        self.summary = ""
         self._clock = time.perf_counter
         self._sleep = time.sleep
         self._start = self._clock()
@@ -162,7 +217,19 @@ class RunStream:
             if len(self.path) > PATH_POINTS:
                 self.path = self.path[::2]
                 self._stride *= 2
+        self.keep(t)
         self.tick(t)
+
+    def keep(self, t: float, every: list[Any] | None = None) -> None:
+        """Keep the poses at simulated time ``t`` for the replay (thinned past REPLAY_FRAMES)."""
+        self._kept_seen += 1
+        if self._kept_seen % self._keep_stride:
+            return
+        every = self.poses() if every is None else every
+        self.frames_kept.append((t, every, self.joints() if self.joints else {}))
+        if len(self.frames_kept) > REPLAY_FRAMES:
+            self.frames_kept = self.frames_kept[::2]
+            self._keep_stride *= 2
 
     def tick(self, t: float) -> None:
         """The run is at simulated time ``t``: wait for the wall clock (paced), maybe push."""
@@ -170,6 +237,8 @@ class RunStream:
             ahead = self._start + t / self.speed - self._clock()
             if ahead > 0:
                 self._sleep(ahead)
+        if not self._seen:  # a scenario run (no drive samples): keep what each tick shows
+            self.keep(t)
         now = self._clock()
         if now - self._last >= 1.0 / STREAM_FPS:
             self._last = now
@@ -182,6 +251,8 @@ class RunStream:
         every = self.poses()
         for k, poses in enumerate(every):
             self.viewer.show_poses(poses, robot=k)
+        if self.joints is not None:
+            self.viewer.show_joint_values(self.joints())
         self.frames += 1
         paths = [self.path]
         if not self._seen:  # not fed drive samples: each robot's path from its base poses
@@ -203,7 +274,94 @@ class RunStream:
                 thickness_units="screen")
         if status is not None:
             self.viewer.status.content = status
+        self._aim_all()
+
+    def _robot_box(self, poses: Sequence[Any]) -> tuple[Any, Any]:
+        """A box around the robot's link frames, padded by the robot's size on the page."""
+        import numpy as np
+
+        pts = np.asarray([p[0] for p in poses], dtype=float)
+        lo, hi = self.viewer.model.bounds()
+        pad = max(max(b - a for a, b in zip(lo, hi, strict=True)), 0.1) / 2
+        return pts.min(axis=0) - pad, pts.max(axis=0) + pad
+
+    def _aim_all(self, force: bool = False) -> None:
+        """Move every page's camera as the Camera dropdown says (nothing when free)."""
+        import numpy as np
+
+        mode = self.camera.value
+        if mode == FREE:
+            self._aimed_at = None
+            return
+        base = tuple(float(x) for x in self.viewer.robot_pose(0)[0])
+        clients = list(self.viewer.server.get_clients().values())
+        if mode == FOLLOW and self._aimed_at is not None and not force:
+            if base == self._aimed_at:
+                return
+            for client in clients:  # keep the user's own orbit, around the robot's base
+                try:
+                    cam = client.camera
+                    orbit = np.asarray(cam.position) - np.asarray(cam.look_at)
+                    with self.viewer.server.atomic():
+                        cam.position = np.asarray(base) + orbit  # (viser moves look_at too)
+                        cam.look_at = base
+                except AssertionError:  # a page that has not reported its camera yet
+                    continue
+        else:
+            frames = self._frames_now()
+            lo, hi = self._robot_box(frames[0])
+            if mode == WHOLE_PATH:
+                for path in (self.path, *self.paths):
+                    if path:
+                        pts = np.asarray(path, dtype=float)
+                        lo, hi = np.minimum(lo, pts.min(axis=0)), np.maximum(hi, pts.max(axis=0))
+            for client in clients:
+                try:
+                    self.viewer.aim(client, (lo, hi), self.viewer.aspect(client))
+                except AssertionError:
+                    continue
+        self._aimed_at = base  # type: ignore[assignment]
+
+    def _frames_now(self) -> list[Any]:
+        """Every robot's link poses as the page shows them now."""
+        out = []
+        n = 1 + len(self.viewer.extra)
+        for k in range(n):
+            frames = self.viewer._frames if k == 0 else self.viewer.extra[k - 1][1]
+            out.append([(tuple(float(x) for x in f.position), None) for f in frames])
+        return out
 
     def finish(self, summary: str) -> None:
-        """The final pose and path, and the run's summary in the page."""
+        """The final pose and path, the run's summary, and the replay slider in the page."""
+        if not self._seen:  # a scenario run: keep its last frame for the replay too
+            self.keep(self.total)
         self.push(summary)
+        self.summary = summary
+        kept = self.frames_kept
+        if len(kept) < 2:
+            return
+        end = kept[-1][0]
+        with self.viewer.server.gui.add_folder("Replay", order=0.6):
+            self.replay = self.viewer.server.gui.add_slider(
+                "Time (s)", min=0.0, max=end, step=end / 100, initial_value=end,
+                hint="Put the robot where the run had it at this simulated time")
+        self.replay.on_update(lambda _event: self.show_time(float(self.replay.value)))
+
+    def show_time(self, t: float) -> tuple[float, list[Any]]:
+        """Show the kept frame nearest simulated time ``t``; its time and poses."""
+        import bisect
+
+        times = [f[0] for f in self.frames_kept]
+        k = bisect.bisect_left(times, t)
+        if k == len(times) or (k > 0 and t - times[k - 1] <= times[k] - t):
+            k -= 1
+        at, every, joints = self.frames_kept[k]
+        for r, poses in enumerate(every):
+            self.viewer.show_poses(poses, robot=r)
+        if joints:
+            self.viewer.show_joint_values(joints)
+        x, y, z = self.viewer.robot_pose(0)[0]
+        self.viewer.status.content = (f"**Replay**: t = {at:.2f} s of {times[-1]:.2f}; base at "
+                                      f"x {x:.3f}, y {y:.3f}, z {z:.3f} m\n\n{self.summary}")
+        self._aim_all()
+        return at, every

@@ -195,6 +195,41 @@ SCHEMA: dict[str, tuple[frozenset[str], frozenset[str]]] = {
     )
 }
 
+#: Children PyBullet builds from, by parent: a misspelt one of these changes the robot (a
+#: joint it never sees, a collision it drops), so the loaders warn of it, not check alone.
+BUILT_CHILDREN: dict[str, frozenset[str]] = {
+    "robot": frozenset(("link", "joint")),
+    "link": frozenset(("inertial", "visual", "collision")),
+    "joint": frozenset(("origin", "parent", "child", "axis", "limit", "dynamics")),
+    "inertial": frozenset(("origin", "mass", "inertia")),
+    "visual": frozenset(("origin", "geometry")), "collision": frozenset(("origin", "geometry")),
+}
+
+
+def nearest_tags(tag: str, parent: str) -> list[str]:
+    """The known children of ``<parent>`` nearest a misspelt ``<tag>`` (none when none is near)."""
+    from urdfkit.core.suggest import close
+
+    known = SCHEMA.get(parent)
+    return close(tag, known[1]) if known is not None and isinstance(tag, str) else []
+
+
+def nearest_attributes(attr: str, tag: str) -> list[str]:
+    """The known attributes of ``<tag>`` nearest a misspelt ``attr``."""
+    from urdfkit.core.suggest import close
+
+    known = SCHEMA.get(tag)
+    return close(attr, known[0]) if known is not None else []
+
+
+def did_you_mean(names: Sequence[str], tags: bool = True) -> str:
+    """``"; did you mean <collision>?"`` (``'name'`` for attributes), or ``""``."""
+    if not names:
+        return ""
+    quoted = [f"<{n}>" if tags else repr(n) for n in names]
+    return f"; did you mean {' or '.join(quoted)}?"
+
+
 # --------------------------------------------------------------------------- PyBullet's limits
 
 #: PyBullet's state queries (getJointState, getLinkState, getBasePositionAndOrientation) fail

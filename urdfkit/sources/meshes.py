@@ -18,6 +18,7 @@ applied to the integrals in closed form (:meth:`~urdfkit.sources.meshdata.Integr
 from __future__ import annotations
 
 import math
+import os
 import re
 import struct
 from pathlib import Path
@@ -664,3 +665,78 @@ def read_triangles(path: Path) -> tuple[Any, Any] | None:
             or not np.isfinite(vertices).all()):
         return None
     return vertices, faces
+
+
+def undrawn_visual(path: Path | str) -> str | None:
+    """Why PyBullet draws nothing or only part of a visual mesh file, or None.
+
+    An empty file, and a COLLADA file whose visual scene places its geometry through
+    ``<instance_node>`` (PyBullet 3.2.7 follows only ``<node>`` and ``<instance_geometry>``:
+    "cannot extract anything useful from mesh", and nothing is drawn; measured with the
+    TinyRenderer). Cheap on the common case: a file without ``<instance_node>`` that holds an
+    ``<instance_geometry>`` is not parsed.
+    """
+    try:  # one answer per file version: a tree's robots share their meshes
+        st = os.stat(path)
+    except OSError:
+        return None  # missing or unreadable: U701, U704, said by the references
+    key = (os.fspath(path), st.st_size, st.st_mtime_ns, st.st_ino)
+    if key not in _UNDRAWN:
+        if len(_UNDRAWN) > 4096:
+            _UNDRAWN.clear()
+        _UNDRAWN[key] = _undrawn(path)
+    return _UNDRAWN[key]
+
+
+#: :func:`undrawn_visual`'s answers, by path and stat.
+_UNDRAWN: dict[tuple[str, int, int, int], str | None] = {}
+
+
+def _undrawn(path: Path | str) -> str | None:
+    from urdfkit.model.xmlio import read_regular
+
+    try:
+        data = read_regular(Path(path), limit=MAX_MESH_BYTES, kind="mesh")
+    except InputError:
+        return None  # not regular, too big: U704, said by the references
+    if not data.strip():
+        return "is empty: PyBullet draws nothing of it"
+    if mesh_kind(str(path)) != ".dae" or (
+            b"instance_node" not in data and b"instance_geometry" in data):
+        return None
+    try:
+        doc = _Collada(data, Path(path))
+        scene_ref = doc.root.find("{*}scene/{*}instance_visual_scene")
+        scene = doc.ref(scene_ref.get("url")) if scene_ref is not None else None
+        drawn = total = 0
+        if scene is not None:
+            drawn = sum(_instances(doc, n, follow=False, depth=0)
+                        for n in scene.iterfind("{*}node"))
+            total = sum(_instances(doc, n, follow=True, depth=0)
+                        for n in scene.iterfind("{*}node"))
+    except (InputError, KeyError, ValueError, AttributeError):
+        return None  # not COLLADA PyBullet reads at all: not this finding's to say
+    if drawn == total and total > 0:
+        return None
+    if total == 0:
+        return "places no geometry in its visual scene: PyBullet draws nothing of it"
+    through = "placed through <instance_node>, which PyBullet does not follow"
+    if drawn == 0:
+        return f"has {total} part(s), all {through}: PyBullet draws nothing of it"
+    return f"has {total} part(s); PyBullet draws {drawn} (the rest are {through})"
+
+
+def mesh_kind(name: str) -> str:
+    """A mesh file's suffix, lower case."""
+    return os.path.splitext(name)[1].lower()
+
+
+def _instances(doc: _Collada, node: Any, *, follow: bool, depth: int) -> int:
+    """``<instance_geometry>`` under a node (through ``<instance_node>`` when ``follow``)."""
+    if depth > 64:
+        raise ValueError("nodes nested too deep")
+    n = sum(1 for _ in node.iterfind("{*}instance_geometry"))
+    kids = list(node.iterfind("{*}node"))
+    if follow:
+        kids += [doc.ref(i.get("url")) for i in node.iterfind("{*}instance_node")]
+    return n + sum(_instances(doc, k, follow=follow, depth=depth + 1) for k in kids)

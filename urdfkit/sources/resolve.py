@@ -24,7 +24,17 @@ from lxml import etree
 
 from urdfkit.core.errors import InputError
 from urdfkit.core.finding import Finding
-from urdfkit.model.spec import FILE_SHAPES, FILE_TAGS, PYBULLET_LINE_BYTES, ignored_shape
+from urdfkit.model.spec import (
+    BUILT_CHILDREN,
+    FILE_SHAPES,
+    FILE_TAGS,
+    PYBULLET_LINE_BYTES,
+    SCHEMA,
+    did_you_mean,
+    ignored_shape,
+    nearest_tags,
+    used_shape,
+)
 from urdfkit.model.xmlio import (
     line_of,
     long_line,
@@ -194,15 +204,58 @@ def resolve(name: str | Path, *, packages: Mapping[str, Path] | None = None,
         return resolved
 
 
+def misspelt_tags(root: etree._Element) -> list[tuple[int | None, str]]:
+    """Unknown tags nearest a tag PyBullet builds from (``<jiont>``, ``<colision>``), said.
+
+    PyBullet skips an element it does not know without a word, so a typo in one of these
+    changes the robot it builds (a joint it never sees, a collision it drops). One walk over
+    the robot's children and theirs, two levels down: what ``check`` reports as U801.
+    """
+    out: list[tuple[int | None, str]] = []
+
+    def look(el: etree._Element, depth: int) -> None:
+        known = SCHEMA.get(el.tag)
+        built = BUILT_CHILDREN.get(el.tag)
+        if known is None or built is None:
+            return
+        for child in el:
+            tag = child.tag
+            if not isinstance(tag, str) or tag[:1] == "{":
+                continue
+            if tag not in known[1]:
+                near = [n for n in nearest_tags(tag, el.tag) if n in built]
+                if near:
+                    out.append((line_of(child), f"<{tag}> is not a URDF tag inside <{el.tag}>"
+                                f"{did_you_mean(near)} PyBullet builds the robot without it "
+                                "(U801)"))
+            elif depth < 2:
+                look(child, depth + 1)
+
+    look(root, 0)
+    return out
+
+
 def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
                   packages: Mapping[str, Path] | None, guard: bool,
                   copy: bool = False, origins: list[str | None] | None = None,
                   meshes: bool = True) -> Resolved:
-    lifted = [f"{where(f)}: {f.message} ({f.code})" if f.code in GUARD_WARNINGS else
-              f"{where(f)}: let through without the guard ({f.code}): "
-              f"{f.message.removesuffix(STRICTER)}"
-              for f in run_guard(tree, display, strict=guard, origins=origins)]
     root = tree.getroot()
+    # xacro's output lines are not the user's: its typos are said without one
+    typos = [(None if origins is not None else line, typo) for line, typo in misspelt_tags(root)]
+    try:
+        found = run_guard(tree, display, strict=guard, origins=origins)
+    except InputError as e:
+        if not typos:
+            raise
+        # "2 root links" is what a misspelt <joint> looks like to the guard: name the cause.
+        line, typo = typos[0]
+        at = "" if line is None else f"at line {line}, "
+        raise type(e)(f"{e.message}; {at}{typo}", file=e.file, line=e.line,
+                      param=e.param) from None
+    lifted = [f"{display}{'' if line is None else f':{line}'}: {typo}" for line, typo in typos]
+    lifted += [f"{where(f)}: {f.message} ({f.code})" if f.code in GUARD_WARNINGS else
+               f"{where(f)}: let through without the guard ({f.code}): "
+               f"{f.message.removesuffix(STRICTER)}" for f in found]
     # PyBullet takes paths as UTF-8 text: a file name that is not (bytes from another locale,
     # kept by Python as surrogates) is loaded from a copy with a clean name.
     needs_copy = copy or not _utf8(str(source))
@@ -244,6 +297,47 @@ def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
         load_path.write_bytes(body)
         return Resolved(display, source, load_path, tree, tmp, warnings=lifted)
     return Resolved(display, source, source, tree, warnings=lifted)
+
+
+def undrawn_visuals(resolved: Resolved) -> tuple[int, list[str]]:
+    """How many visual shapes the robot has, and why each one PyBullet cannot draw is not.
+
+    For ``render`` and ``view`` to say how much of the robot is missing from the picture
+    (check's U715 says it of the file): an empty mesh file, COLLADA through ``<instance_node>``.
+    """
+    from urdfkit.sources.guard import reference
+    from urdfkit.sources.meshes import mesh_kind, undrawn_visual
+
+    total, out = 0, []
+    base = resolved.source.resolve().parent
+    for visual in resolved.root.iter("visual"):
+        total += 1
+        geometry = visual.find("geometry")
+        mesh = used_shape(geometry) if geometry is not None else None
+        fn = (mesh.get("filename") or "").strip() if mesh is not None and \
+            mesh.tag == "mesh" else ""
+        if not fn:
+            continue
+        ref = reference("mesh", fn, base, None)
+        if ref.load is None or (mesh_kind(ref.load) != ".dae" and (
+                ref.stat is None or ref.stat.st_size != 0)):
+            continue
+        why = undrawn_visual(ref.load)
+        if why is not None:
+            link = visual.getparent()
+            owner = link.get("name") if link is not None else None
+            out.append(f"{fn!r} of link {owner!r} {why}")
+    return total, out
+
+
+def undrawn_note(resolved: Resolved) -> str | None:
+    """``"2 of 7 visual shapes cannot be drawn: ..."``, or None when every one can."""
+    total, why = undrawn_visuals(resolved)
+    if not why:
+        return None
+    more = f" (and {len(why) - 1} more)" if len(why) > 1 else ""
+    return (f"{resolved.name}: {len(why)} of {total} visual shape(s) cannot be drawn, so "
+            f"the picture misses them: {why[0]}{more} (U715)")
 
 
 def open_input(name: str | Path, *, packages: list[str] | None = None,

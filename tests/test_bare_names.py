@@ -1,0 +1,65 @@
+"""Every command that reads a robot file finds a bare pybullet_data name the same way.
+
+The README says a bare name is looked up in pybullet_data; ``check`` and ``fix`` once said
+"no such file" where ``joints`` found it. Each command runs from an empty folder, where the
+name can only be found in pybullet_data, and must read the very file there.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from urdfkit.cli import app
+
+runner = CliRunner()
+
+
+def _data() -> Path:
+    import pybullet_data
+
+    return Path(pybullet_data.getDataPath())
+
+
+@pytest.mark.parametrize("args", [
+    ["joints", "r2d2.urdf", "--json"], ["links", "r2d2.urdf", "--json"],
+    ["tree", "r2d2.urdf"], ["info", "r2d2.urdf", "--json"], ["check", "r2d2.urdf", "--json"],
+    ["diff", "r2d2.urdf", "r2d2.urdf"], ["fix", "r2d2.urdf", "-o", "out.urdf"],
+    ["render", "r2d2.urdf", "-o", "out.png", "--size", "64x48"],
+    ["collisions", "r2d2.urdf", "--json"],
+    ["drive", "--urdf", "r2d2.urdf", "--seconds", "0.2", "--json"]])
+def test_every_command_finds_a_bare_name(args: list[str], tmp_path: Path,
+                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert not (tmp_path / "r2d2.urdf").exists()
+    result = runner.invoke(app, args)
+    assert "no such file" not in result.stderr, result.stderr
+    assert result.exit_code in (0, 1), result.stderr  # 1: findings (collisions, fix's left)
+    if args[0] == "joints":  # the file read is pybullet_data's: its 15 joints
+        import xml.etree.ElementTree as ET
+
+        want = len(ET.parse(_data() / "r2d2.urdf").getroot().findall("joint"))
+        assert len(json.loads(result.stdout)["joints"]) == want == 15
+    if args[0] == "fix":
+        assert (tmp_path / "out.urdf").read_bytes() != (_data() / "r2d2.urdf").read_bytes()
+    if args[0] == "render":
+        assert (tmp_path / "out.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_fix_in_place_refuses_to_rewrite_pybullet_data(tmp_path: Path,
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    before = (_data() / "r2d2.urdf").read_bytes()
+    result = runner.invoke(app, ["fix", "r2d2.urdf", "--in-place"])
+    assert result.exit_code == 2 and "found in pybullet_data" in result.stderr
+    assert (_data() / "r2d2.urdf").read_bytes() == before
+
+
+def test_a_misspelt_bare_name_in_check_gets_a_suggestion(tmp_path: Path,
+                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["check", "r2d3.urdf"])
+    assert result.exit_code == 2 and "did you mean 'r2d2.urdf'?" in result.stderr
