@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from urdfkit.core.record import Record
+from dataclasses import dataclass
 
 #: Finding levels, lowest first.
 LEVELS = ("info", "warning", "error")
 
 
-class Finding(Record):
+@dataclass(frozen=True, slots=True)
+class Finding:
     """One problem found in a file.
 
     Attributes:
@@ -20,31 +21,12 @@ class Finding(Record):
         origin: Where the element was written when that is another file (xacro), else None.
     """
 
-    __slots__ = ("code", "level", "message", "file", "line", "origin")
-    _FIELDS = ("code", "level", "message", "file", "line", "origin")
-
     code: str
     level: str
     message: str
     file: str
-    line: int | None
-    origin: str | None
-
-    def __init__(
-            self,
-            code: str,
-            level: str,
-            message: str,
-            file: str,
-            line: int | None = None,
-            origin: str | None = None,
-    ) -> None:
-        self.code = code
-        self.level = level
-        self.message = message
-        self.file = file
-        self.line = line
-        self.origin = origin
+    line: int | None = None
+    origin: str | None = None
 
     def to_dict(self) -> dict[str, object]:
         """The JSON form."""
