@@ -255,24 +255,31 @@ class Doc:
 
     def _check(self, el: El, tag: str) -> None:
         """U401-U402 and U801-U802 of one element's attributes."""
-        items = el.items()
-        if not items:
-            return
         # The verdict depends on the attributes' names and on the values of the numeric
         # ones only: names and file names (unique to each file) stay out of the key, or
         # every link and mesh would miss. Decodable: the tag fixes which names hold values.
         numeric = NUMERIC_BY_TAG.get(tag)
-        if numeric is None and tag not in SCHEMA:
-            return  # an element no rule knows: nothing to say of its attributes
-        parts: list[str] = [tag]
-        for attr, text in items:
-            parts.append(attr)
-            if numeric is not None and attr in numeric:
-                parts.append(text)
-        key = tuple(parts)
+        key: tuple[str, ...]
+        if numeric is None:
+            if tag not in SCHEMA:
+                return  # an element no rule knows: nothing to say of its attributes
+            names = el.keys()  # no values read: none is part of the verdict
+            if not names:
+                return
+            key = (tag, *names)
+        else:
+            items = el.items()
+            if not items:
+                return
+            parts: list[str] = [tag]
+            for attr, text in items:
+                parts.append(attr)
+                if attr in numeric:
+                    parts.append(text)
+            key = tuple(parts)
         found = _VERDICTS.get(key)
         if found is None:
-            found = _verdict(tag, items)
+            found = _verdict(tag, el.items())
             if len(_VERDICTS) >= _VERDICTS_MAX:
                 _VERDICTS.clear()
             _VERDICTS[key] = found
