@@ -124,6 +124,7 @@ def trees(draw: st.DrawFn, depth: int = 0) -> etree._Element:
     return el
 
 
+@pytest.mark.slow  # 300 drawn trees: the suite's longest property test (CI runs it)
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(root=trees())
 def test_the_walk_lists_what_lxml_lists_on_random_trees(root: etree._Element) -> None:
