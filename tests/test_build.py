@@ -47,3 +47,19 @@ def test_records_pickle_compare_and_hash() -> None:
 
 def _fields(f: Finding) -> tuple[object, ...]:
     return (f.code, f.level, f.message, f.file, f.line, f.origin)
+
+
+def test_check_results_and_targets_pickle_by_value() -> None:
+    # A worker hands back a FileResult with its findings, cache entry and mesh entries; the
+    # value is the file and its findings (what two runs must agree on), not the bookkeeping.
+    from urdfkit.checks.check import FileResult
+    from urdfkit.sources.uris import Target
+
+    f = Finding("U605", "warning", "m", "a.urdf", 3)
+    fr = FileResult("a.urdf", [f], entry=((1, 2, 3, 4), {}, [f.to_dict()]), meshes={"k": b"v"})
+    back = pickle.loads(pickle.dumps(fr))
+    assert back == fr and back.entry == fr.entry and back.meshes == fr.meshes
+    assert fr == FileResult("a.urdf", [f], cached=True) != FileResult("a.urdf", [])
+    target = Target(Path("/m/x.stl"), "pkg")
+    assert pickle.loads(pickle.dumps(target)) == target and hash(target) == hash(
+        Target(Path("/m/x.stl"), "pkg")) and target != Target(None, "pkg", "not found")
