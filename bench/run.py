@@ -148,10 +148,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def report(cases: list[Case], by_name: dict[str, Case], rounds: int) -> int:
-    import urdfkit.checks.validate as compiled_probe  # setup.py compiles it, or not
-
-    kind = "plain Python" if str(compiled_probe.__file__).endswith(".py") else "mypyc-compiled"
-    print(f"{rounds} rounds, python {sys.version.split()[0]}, urdfkit's check path {kind}\n")
+    print(f"{rounds} rounds, python {sys.version.split()[0]}\n")
     print(f"{'command':<40} {'min ms':>8} {'median ms':>10}")
     for c in cases:
         print(f"{c.name:<40} {min(c.times) * 1e3:8.1f} {statistics.median(c.times) * 1e3:10.1f}")

@@ -1,68 +1,31 @@
-"""The build: check's hot path compiled by mypyc and its walk in C (setup.py), and what
-compiling must not break.
-
-CI runs the suite twice: against a regular install (compiled, URDFKIT_CI=1) and, in its second
-environment, against a plain-Python one (URDFKIT_PURE=1). Each asserts it got what it asked for,
-so neither can silently test the other.
+"""The build is plain Python (a py3-none-any wheel), and the records check's workers hand
+back by pickle keep their value.
 """
 
 from __future__ import annotations
 
-import ast
-import importlib
 import os
 import pickle
 from pathlib import Path
 
-import pytest
-
+import urdfkit
 from urdfkit.checks.validate import Solid
 from urdfkit.core.finding import Finding
 from urdfkit.sources.guard import Reference
 from urdfkit.sources.meshstore import Integrals
 
-ROOT = Path(__file__).resolve().parents[1]
 
-
-def _compiled_modules() -> list[str]:
-    """setup.py's COMPILED list, as module names (read, not imported: importing runs setup)."""
-    tree = ast.parse((ROOT / "setup.py").read_text())
-    for node in tree.body:
-        if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", None) == "COMPILED":
-            paths = ast.literal_eval(node.value)
-            return [p.removesuffix(".py").replace("/", ".") for p in paths]
-    raise AssertionError("setup.py has no COMPILED list")
-
-
-def _is_extension(module: str) -> bool:
-    return not str(importlib.import_module(module).__file__).endswith(".py")
-
-
-def test_the_compiled_list_names_real_modules() -> None:
-    modules = _compiled_modules()
-    assert "urdfkit.model.index" in modules and "urdfkit.checks.validate" in modules
-    for m in modules:
-        assert (ROOT / (m.replace(".", "/") + ".py")).is_file(), m
-
-
-@pytest.mark.skipif(not os.environ.get("URDFKIT_CI"), reason="what CI installed")
-def test_ci_tests_the_build_it_asked_for() -> None:
-    from urdfkit.model import index
-
-    modules = _compiled_modules()
-    if os.environ.get("URDFKIT_PURE"):
-        assert not any(_is_extension(m) for m in modules)
-        assert not index.NATIVE_WALK
-    else:
-        assert all(_is_extension(m) for m in modules), \
-            [m for m in modules if not _is_extension(m)]
-        assert index.NATIVE_WALK  # the walk in C (urdfkit/model/_walk.c) was built and loads
+def test_the_package_is_plain_python() -> None:
+    # No C source and no compiled module in what is imported (the installed package in CI):
+    # the wheel is py3-none-any, and every module is the source a reader sees.
+    package = Path(urdfkit.__file__).parent
+    native = [p for p in package.rglob("*") if p.suffix in (".c", ".so", ".pyd", ".pyx")]
+    assert not native, native
 
 
 def test_records_pickle_compare_and_hash() -> None:
     # check's worker processes hand findings and mesh entries back by pickle (a pool whose
-    # results cannot be read hangs). The records are plain classes (compiled, a frozen
-    # dataclass is built through Python: 1.5 us against 0.03), compared and hashed by value.
+    # results cannot be read hangs); the records are compared and hashed by value.
     f = Finding("U605", "warning", "m", "a.urdf", 3, "b.xacro:4")
     assert pickle.loads(pickle.dumps(f)) == f
     assert hash(pickle.loads(pickle.dumps(f))) == hash(f) and len({f, Finding(*_fields(f))}) == 1
@@ -84,3 +47,19 @@ def test_records_pickle_compare_and_hash() -> None:
 
 def _fields(f: Finding) -> tuple[object, ...]:
     return (f.code, f.level, f.message, f.file, f.line, f.origin)
+
+
+def test_check_results_and_targets_pickle_by_value() -> None:
+    # A worker hands back a FileResult with its findings, cache entry and mesh entries; the
+    # value is the file and its findings (what two runs must agree on), not the bookkeeping.
+    from urdfkit.checks.check import FileResult
+    from urdfkit.sources.uris import Target
+
+    f = Finding("U605", "warning", "m", "a.urdf", 3)
+    fr = FileResult("a.urdf", [f], entry=((1, 2, 3, 4), {}, [f.to_dict()]), meshes={"k": b"v"})
+    back = pickle.loads(pickle.dumps(fr))
+    assert back == fr and back.entry == fr.entry and back.meshes == fr.meshes
+    assert fr == FileResult("a.urdf", [f], cached=True) != FileResult("a.urdf", [])
+    target = Target(Path("/m/x.stl"), "pkg")
+    assert pickle.loads(pickle.dumps(target)) == target and hash(target) == hash(
+        Target(Path("/m/x.stl"), "pkg")) and target != Target(None, "pkg", "not found")

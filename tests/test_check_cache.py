@@ -221,6 +221,7 @@ def test_damaged_entries_are_never_trusted(cache: Path, tmp_path: Path,
     assert check_paths([robot], jobs=1).to_dict()["findings"] == truth
 
 
+@pytest.mark.slow
 def test_two_checks_at_once_both_report_the_truth(cache: Path, tmp_path: Path) -> None:
     import pybullet_data
 

@@ -224,6 +224,7 @@ def test_a_start_inside_the_ground_is_reported() -> None:
     assert any(p.startswith("started inside the ground: 5") for p in r.problems)
 
 
+@pytest.mark.slow
 def test_memory_stays_flat_from_20k_to_200k_rows(tmp_path: Path) -> None:
     import subprocess
     import sys

@@ -180,6 +180,7 @@ def test_raw_pybullet_still_behaves_as_recorded(workdir: Path) -> None:
     assert mismatched == []
 
 
+@pytest.mark.slow
 def test_an_oversized_body_is_refused_before_the_tree_is_built(tmp_path: Path) -> None:
     # 280,000 links took 10 s and 720 MB to parse before the refusal; now it is a streaming
     # count with constant memory. Peak memory is the check (time is too noisy here).

@@ -65,8 +65,8 @@ def oracle_findings(root: etree._Element) -> list[tuple[str, str, etree._Element
     return out
 
 
-def assert_same_as_lxml(root: etree._Element, native: bool = True) -> None:
-    doc = Doc(root, native=native)
+def assert_same_as_lxml(root: etree._Element) -> None:
+    doc = Doc(root)
     assert [v.el for v in doc.links] == list(root.iterchildren("link"))
     assert [v.el for v in doc.joints] == list(root.iterchildren("joint"))
     assert doc.materials == list(root.iterchildren("material"))
@@ -95,15 +95,9 @@ REAL = sorted(p for p in DATA.rglob("*.urdf") if "random_urdfs" not in p.parts) 
     sorted(DATA.glob("random_urdfs/00*/*.urdf")) + sorted(FIXTURES.rglob("*.urdf"))
 
 
-#: Both walks: in C (urdfkit.model._walk, where it is built: tests/test_build.py requires it
-#: of CI's compiled install) and in Python.
-WALKS = pytest.mark.parametrize("native", [True, False], ids=["c-walk", "python-walk"])
-
-
-@WALKS
 @pytest.mark.parametrize("path", REAL, ids=lambda p: str(p.relative_to(p.parents[1])))
-def test_the_walk_lists_what_lxml_lists_on_real_files(path: Path, native: bool) -> None:
-    assert_same_as_lxml(parse_xml(read_bytes(path), path).getroot(), native)
+def test_the_walk_lists_what_lxml_lists_on_real_files(path: Path) -> None:
+    assert_same_as_lxml(parse_xml(read_bytes(path), path).getroot())
 
 
 TAGS = [*SCHEMA, *OPAQUE, "sensor", "{urn:x}thing", "plugin"]
@@ -130,40 +124,22 @@ def trees(draw: st.DrawFn, depth: int = 0) -> etree._Element:
     return el
 
 
-@WALKS
+@pytest.mark.slow  # 300 drawn trees: the suite's longest property test (CI runs it)
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(root=trees())
-def test_the_walk_lists_what_lxml_lists_on_random_trees(root: etree._Element,
-                                                       native: bool) -> None:
-    assert_same_as_lxml(root, native)
+def test_the_walk_lists_what_lxml_lists_on_random_trees(root: etree._Element) -> None:
+    assert_same_as_lxml(root)
 
 
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(trees(), st.booleans())
-def test_both_walks_name_the_same_elements(root: etree._Element, memo_first: bool) -> None:
-    # The same findings on the same element objects, whichever walk fills the shared memo.
-    order = (True, False) if memo_first else (False, True)
-    docs = {native: Doc(root, native=native) for native in order}
-    c, py = docs[True], docs[False]
-    assert [(code, level, message) for code, level, message, _ in c.element_findings] == \
-        [(code, level, message) for code, level, message, _ in py.element_findings]
-    assert all(a[3] is b[3] for a, b in zip(c.element_findings, py.element_findings,
-                                            strict=True))
-    assert c.too_deep is py.too_deep
-    assert (c.all_materials, c.geometries, c.files, c.transmissions) == \
-        (py.all_materials, py.geometries, py.files, py.transmissions)
-
-
-@WALKS
-def test_the_depth_limit_is_found_where_the_xpath_finds_it(native: bool) -> None:
+def test_the_depth_limit_is_found_where_the_xpath_finds_it() -> None:
     for extra in (0, 1, 2):
         root = etree.Element("robot")
         el = root
         for _ in range(MAX_XML_DEPTH - 1 + extra):
             el = etree.SubElement(el, "link")
         etree.SubElement(root, "link")
-        assert_same_as_lxml(root, native)
-        assert (Doc(root, native=native).too_deep is not None) == (extra > 0)
+        assert_same_as_lxml(root)
+        assert (Doc(root).too_deep is not None) == (extra > 0)
 
 
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -183,30 +159,6 @@ def test_first_keeps_lxml_namespace_rules() -> None:
     assert first(root, "{urn:a}color") is root[0]
     assert first(root, "{*}thing") is root[2]
     assert first(etree.fromstring(b'<r xmlns="urn:d"><color/></r>'), "color") is None
-
-
-@pytest.mark.parametrize("case", ["many-attributes", "namespaced", "entity-in-a-number"])
-def test_the_c_walk_keys_unusual_elements_as_the_python_walk(case: str) -> None:
-    # The C walk keys its memo by the bytes of a plain element's tag, names and numbers; an
-    # element past 32 attributes, with a namespaced attribute, or with a number that is not
-    # one text node (an entity left unresolved) is keyed as in Python. Either way the
-    # findings are the Python walk's, and a plain twin does not take the unusual one's.
-    many = " ".join(f'a{i}="{i}"' for i in range(40))
-    body = {
-        "many-attributes": f'<origin xyz="1 2" {many}/><origin xyz="1 2"/>',
-        "namespaced": '<origin xmlns:q="urn:q" q:xyz="x" xyz="1 2"/><origin xyz="1 2"/>',
-        "entity-in-a-number": '<origin xyz="&e; 0"/><origin xyz="1 0"/><origin xyz="0"/>',
-    }[case]
-    text = (f'<!DOCTYPE robot [<!ENTITY e "1">]><robot name="r"><link name="a"><visual>'
-            f'{body}<geometry><box size="1 1 1"/></geometry></visual></link></robot>')
-    parser = etree.XMLParser(resolve_entities=False, load_dtd=False, no_network=True)
-    for memo_first in (True, False):
-        root = etree.fromstring(text.encode(), parser)
-        order = (True, False) if memo_first else (False, True)
-        docs = {native: Doc(root, native=native) for native in order}
-        found = [[(code, message, el.sourceline) for code, _, message, el in
-                  docs[native].element_findings] for native in (True, False)]
-        assert found[0] == found[1] and found[0], found
 
 
 def _views(root: etree._Element) -> list[tuple[object, ...]]:
@@ -249,19 +201,33 @@ def part_trees(draw: st.DrawFn, tag: str = "robot", depth: int = 0) -> etree._El
     return el
 
 
+def _lxml_views(root: etree._Element) -> list[tuple[object, ...]]:
+    """What :func:`_views` lists, found by lxml's own ``find``, ``findall`` and ``iterfind``."""
+    from urdfkit.model.spec import SHAPES
+
+    out: list[tuple[object, ...]] = []
+    for el in root.iter("link", "joint", "collision"):
+        if el.tag == "link":
+            inertial = el.find("inertial")
+            inner = (None, None) if inertial is None else \
+                (inertial.find("mass"), inertial.find("inertia"))
+            parts = [c for c in el if c.tag in ("visual", "collision")]
+            out.append((inertial, *inner, *parts, None, *el.findall("collision")))
+        elif el.tag == "joint":
+            out.append((el.find("parent"), el.find("child"), *el.findall("child"), None,
+                        el.find("limit"), el.find("axis"), el.find("origin"), el.find("mimic")))
+        else:
+            shape = next((s for s in el.iterfind("geometry/*") if s.tag in SHAPES), None)
+            out.append((shape, el.find("origin")))
+    return out
+
+
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(root=st.one_of(trees(), part_trees()))
-def test_the_views_read_in_c_what_they_read_in_python(root: etree._Element) -> None:
-    # LinkView, JointView and collision_parts read children over libxml2's nodes where the
-    # C walk is built: the same elements (the very proxies) as lxml's iteration.
-    import pytest as _pytest
-
-    from urdfkit.model import index
-
-    native = _views(root)
-    with _pytest.MonkeyPatch.context() as mp:
-        mp.setattr(index, "_native", None)
-        python = _views(root)
-    assert len(native) == len(python)
-    for a, b in zip(native, python, strict=True):
+def test_the_views_read_what_lxml_finds(root: etree._Element) -> None:
+    # LinkView, JointView and collision_parts read each element's children in one look: the
+    # same elements (the very proxies) as lxml's find, findall and iterfind.
+    views, found = _views(root), _lxml_views(root)
+    assert len(views) == len(found)
+    for a, b in zip(views, found, strict=True):
         assert len(a) == len(b) and all(x is y for x, y in zip(a, b, strict=True)), (a, b)

@@ -186,6 +186,7 @@ def test_robots_are_measured_only_when_an_observation_is_due(tmp_path: Path,
     assert sparse == every_step[::10]
 
 
+@pytest.mark.slow
 def test_sim_out_streams_with_flat_memory(tmp_path: Path) -> None:
     import json
     import subprocess

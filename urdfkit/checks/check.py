@@ -13,6 +13,7 @@ import os
 import re
 import sys
 from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -21,7 +22,6 @@ from lxml import etree
 from urdfkit.checks.validate import ALL_RULES
 from urdfkit.core.errors import InputError, ParameterError, XacroNotExpanded
 from urdfkit.core.finding import LEVELS, Finding
-from urdfkit.core.record import Record
 from urdfkit.model.spec import PYBULLET_LINE_BYTES
 from urdfkit.model.xmlio import (
     line_of,
@@ -47,7 +47,8 @@ ONCE_PER_RUN = frozenset({"U607"})
 _PARALLEL_MIN = 8
 
 
-class FileResult(Record):
+@dataclass(slots=True)
+class FileResult:
     """The findings of one file.
 
     Attributes:
@@ -63,50 +64,23 @@ class FileResult(Record):
     Two are equal when their files and findings are.
     """
 
-    __slots__ = ("file", "findings", "cached", "entry", "meshes")
-    _FIELDS = ("file", "findings", "cached", "entry", "meshes")
-    _COMPARED = ("file", "findings")
-
     file: str
-    findings: list[Finding]
-    cached: bool
-    entry: tuple[tuple[int, int, int, int], dict[str, Any], list[dict[str, Any]]] | None
-    meshes: dict[str, Any] | None
-
-    def __init__(
-            self,
-            file: str,
-            findings: list[Finding] | None = None,
-            cached: bool = False,
-            entry: tuple[tuple[int, int, int, int], dict[str, Any],
-                         list[dict[str, Any]]] | None = None,
-            meshes: dict[str, Any] | None = None,
-    ) -> None:
-        self.file = file
-        self.findings = [] if findings is None else findings
-        self.cached = cached
-        self.entry = entry
-        self.meshes = meshes
-
-    __hash__ = None  # type: ignore[assignment]  # mutable, as a dataclass
+    findings: list[Finding] = field(default_factory=list)
+    cached: bool = field(default=False, compare=False, repr=False)
+    entry: tuple[tuple[int, int, int, int], dict[str, Any], list[dict[str, Any]]] | None = \
+        field(default=None, compare=False, repr=False)
+    meshes: dict[str, Any] | None = field(default=None, compare=False, repr=False)
 
     def count(self, level: str) -> int:
         """How many findings of ``level``."""
         return sum(1 for f in self.findings if f.level == level)
 
 
-class CheckResult(Record):
+@dataclass(slots=True)
+class CheckResult:
     """The findings of a whole ``check`` run, file by file in discovery order."""
 
-    __slots__ = ("files",)
-    _FIELDS = ("files",)
-
     files: list[FileResult]
-
-    def __init__(self, files: list[FileResult]) -> None:
-        self.files = files
-
-    __hash__ = None  # type: ignore[assignment]  # mutable, as a dataclass
 
     @property
     def findings(self) -> list[Finding]:
@@ -482,20 +456,10 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
             results[n] = FileResult(display, hit, cached=True)
         else:
             todo.append(n)
-    work = [(*files[n], pkgs, no_exec, args, physics, cache) for n in todo]
     if todo:
-        from urdfkit.sources import meshstore as meshes
-
-        meshes.load_pack(given)  # before workers fork: they inherit it
-    with settled():  # package lookups made once for the run (its workers fork inside)
-        for n, fr in zip(todo, _run_jobs(work, jobs), strict=True):
+        work = [(*files[n], pkgs, no_exec, args, physics, cache) for n in todo]
+        for n, fr in zip(todo, _check_misses(given, work, jobs, manifest), strict=True):
             results[n] = fr
-            if manifest is not None and files[n][2] is None:
-                manifest.add(files[n][0], files[n][1], fr.entry)
-            if fr.meshes:
-                meshes.USED.update(fr.meshes)
-    if todo:
-        meshes.save_pack(given)
     if manifest is not None:
         manifest.save()
     if cache and todo:
@@ -506,7 +470,34 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
             store.trim()  # new entries were written: keep the folder under its cap
     done = [fr for fr in results if fr is not None]
     _judge_fragments(done, files, packages)
-    sel, ign = tuple(select), tuple(ignore)
+    _keep_selected(done, tuple(select), tuple(ignore))
+    return CheckResult(done)
+
+
+def _check_misses(given: Sequence[str], work: list[_Job], jobs: int | None,
+                  manifest: RunManifest | None) -> list[FileResult]:
+    """Check the files the result cache did not answer; keep what the caches will need.
+
+    The run's mesh pack is loaded before workers fork (they inherit it) and saved after with
+    the entries they used; each result the manifest can keep is added to it.
+    """
+    from urdfkit.sources import meshstore as meshes
+
+    meshes.load_pack(given)
+    with settled():  # package lookups made once for the run (its workers fork inside)
+        out = _run_jobs(work, jobs)
+        for (display, path, problem, *_), fr in zip(work, out, strict=True):
+            if manifest is not None and problem is None:
+                manifest.add(display, path, fr.entry)
+            if fr.meshes:
+                meshes.USED.update(fr.meshes)
+    meshes.save_pack(given)
+    return out
+
+
+def _keep_selected(done: list[FileResult], select: tuple[str, ...],
+                   ignore: tuple[str, ...]) -> None:
+    """Keep the findings ``select`` and ``ignore`` let through, and each once-per-run one once."""
     noted = False
     for fr in done:
         kept = []
@@ -515,10 +506,9 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
                 if noted:
                     continue
                 noted = True
-            if _keep(f.code, sel, ign):
+            if _keep(f.code, select, ignore):
                 kept.append(f)
         fr.findings = kept
-    return CheckResult(done)
 
 
 #: What a file that is not a robot on its own gets: a fragment has no name, no links, or

@@ -13,11 +13,11 @@ import math
 import os
 import sys
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from lxml import etree
 
-from urdfkit.core.record import Record
 from urdfkit.model.index import Doc, LinkView, collision_parts, first
 from urdfkit.model.spec import (
     LIMITED_JOINT_TYPES,
@@ -171,9 +171,9 @@ def _rigid_mass(name: str, views: dict[str, LinkView],
                 fixed_children: dict[str, list[str]]) -> float:
     """The mass of link ``name`` with everything fixed to it: massless only if all of them are.
 
-    A module function, not one nested in rule_mass: compiled, a nested function's
-    environment holds every local of its caller and the function holds the environment, a
-    cycle that kept each file's whole document alive until the collector ran.
+    A module function, not one nested in rule_mass: a closure over the rule's locals once
+    kept each file's whole document alive in a reference cycle until the collector ran
+    (tests/test_check_memory.py fails on per-file cycles).
     """
     total, stack, seen = 0.0, [name], set()
     while stack:
@@ -330,7 +330,8 @@ def _shapes_fix(shapes: tuple[float, float] | None) -> str:
             f"ixx=iyy=izz={shapes[0] / 3:.4g} with products 0")
 
 
-class Solid(Record):
+@dataclass(frozen=True, slots=True)
+class Solid:
     """A link's collision shapes as one solid of uniform density.
 
     Attributes:
@@ -341,25 +342,10 @@ class Solid(Record):
         size: The largest size of any part, m (stub shapes are tiny).
     """
 
-    __slots__ = ("volume", "com", "tensor", "size")
-    _FIELDS = ("volume", "com", "tensor", "size")
-
     volume: float
     com: tuple[float, float, float]
     tensor: tuple[tuple[float, float, float], ...]
     size: float
-
-    def __init__(
-            self,
-            volume: float,
-            com: tuple[float, float, float],
-            tensor: tuple[tuple[float, float, float], ...],
-            size: float,
-    ) -> None:
-        self.volume = volume
-        self.com = com
-        self.tensor = tensor
-        self.size = size
 
     def inertia(self, mass: float) -> tuple[tuple[float, float, float], ...]:
         """The inertia tensor about ``com`` for a total ``mass``."""

@@ -49,11 +49,7 @@ class XacroNotExpanded(InputError):
 
 
 class Oversized(InputError):
-    """A body over MAX_LOADABLE_LINKS links, refused before parsing (finding U209).
-
-    Here, not beside the guard that raises it: a class attribute of a class that mypyc
-    compiles (setup.py) on a plain-Python base is not seen by ``getattr``.
-    """
+    """A body over MAX_LOADABLE_LINKS links, refused before parsing (finding U209)."""
 
     code = "U209"
 

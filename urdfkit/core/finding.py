@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Literal
-
-from urdfkit.core.record import Record
 
 #: A finding's level; ``check --fail-on`` takes one too.
 Level = Literal["info", "warning", "error"]
@@ -12,7 +11,8 @@ Level = Literal["info", "warning", "error"]
 LEVELS: tuple[Level, ...] = ("info", "warning", "error")
 
 
-class Finding(Record):
+@dataclass(frozen=True, slots=True)
+class Finding:
     """One problem found in a file.
 
     Attributes:
@@ -24,31 +24,12 @@ class Finding(Record):
         origin: Where the element was written when that is another file (xacro), else None.
     """
 
-    __slots__ = ("code", "level", "message", "file", "line", "origin")
-    _FIELDS = ("code", "level", "message", "file", "line", "origin")
-
     code: str
     level: str
     message: str
     file: str
-    line: int | None
-    origin: str | None
-
-    def __init__(
-            self,
-            code: str,
-            level: str,
-            message: str,
-            file: str,
-            line: int | None = None,
-            origin: str | None = None,
-    ) -> None:
-        self.code = code
-        self.level = level
-        self.message = message
-        self.file = file
-        self.line = line
-        self.origin = origin
+    line: int | None = None
+    origin: str | None = None
 
     def to_dict(self) -> dict[str, object]:
         """The JSON form."""

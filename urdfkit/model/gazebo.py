@@ -117,13 +117,8 @@ def _value(el: El) -> float | None:
     return x if math.isfinite(x) else None
 
 
-def gazebo_contacts(root: El) -> dict[str, GazeboContact]:
-    """Every link's Gazebo contact parameters, by link name (links with none left out).
-
-    Args:
-        root: The ``<robot>`` element.
-    """
-    out: dict[str, GazeboContact] = {}
+def _blocks(root: El) -> list[tuple[str, El]]:
+    """Each ``<gazebo>`` block with the link it is about: ``reference=``, or the enclosing link."""
     blocks: list[tuple[str, El]] = []
     for child in root:
         tag = _local(child.tag)
@@ -132,28 +127,42 @@ def gazebo_contacts(root: El) -> dict[str, GazeboContact]:
         elif tag == "link" and child.get("name"):
             blocks.extend((child.get("name", ""), g) for g in child
                           if _local(g.tag) == "gazebo" and not g.get("reference"))
-    for link, block in blocks:
-        found: dict[str, float] = {}
-        others: list[str] = []
-        for el in block.iter():
-            tag = _local(el.tag)
-            if el is block or not tag:
-                continue
-            parent = el.getparent()
-            if parent is block and tag in ("mu1", "mu2", "kp", "kd"):
-                name: str | None = tag
-            elif parent is not None and _local(parent.tag) == "ode" and tag in _SDF_NAMES:
-                name = _SDF_NAMES[tag]
-            else:
-                name = None
-                if tag in NOT_CARRIED and tag not in others:
-                    others.append(tag)
-            if name is not None:
-                value = _value(el)
-                if value is not None:
-                    found[name] = value
-        if not found and not others:
+    return blocks
+
+
+def _read_block(block: El) -> tuple[dict[str, float], list[str]]:
+    """A block's contact parameters ({mu1, mu2, kp, kd} it sets) and the ones none can carry."""
+    found: dict[str, float] = {}
+    others: list[str] = []
+    for el in block.iter():
+        tag = _local(el.tag)
+        if el is block or not tag:
             continue
+        parent = el.getparent()
+        if parent is block and tag in ("mu1", "mu2", "kp", "kd"):
+            name: str | None = tag
+        elif parent is not None and _local(parent.tag) == "ode" and tag in _SDF_NAMES:
+            name = _SDF_NAMES[tag]
+        else:
+            name = None
+            if tag in NOT_CARRIED and tag not in others:
+                others.append(tag)
+        if name is not None:
+            value = _value(el)
+            if value is not None:
+                found[name] = value
+    return found, others
+
+
+def gazebo_contacts(root: El) -> dict[str, GazeboContact]:
+    """Every link's Gazebo contact parameters, by link name (links with none left out).
+
+    Args:
+        root: The ``<robot>`` element.
+    """
+    out: dict[str, GazeboContact] = {}
+    for link, block in _blocks(root):
+        found, others = _read_block(block)
         contact = out.get(link)
         if contact is None:
             if not found:

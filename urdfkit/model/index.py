@@ -36,26 +36,14 @@ from urdfkit.model.spec import (
 
 El = Any  # an lxml element; this module never imports lxml
 
-_native: Any
-try:  # the walk over libxml2's nodes (_walk.c), built with the compiled check path
-    from urdfkit.model import _walk as _native
-except ImportError:  # a plain-Python install, or an lxml whose C API it was not built for
-    _native = None
-
-#: Whether :class:`Doc` walks in C (``urdfkit.model._walk``) rather than in Python.
-NATIVE_WALK = _native is not None
-
 
 def collision_parts(col: El, shapes: tuple[str, ...]) -> tuple[El, El]:
     """(shape, origin) of a ``<collision>``, None for either when absent.
 
     The shape is the first child of its ``<geometry>`` children (in order) whose tag is in
     ``shapes``; the origin its first ``<origin>``. As ``col.iterfind("geometry/*")`` filtered
-    and ``col.find("origin")``, in one look at the children (over libxml2's nodes where the C
-    walk is built).
+    and ``col.find("origin")``, in one look at the children.
     """
-    if _native is not None:
-        return _native.collision_parts(col, shapes)
     shape = origin = None
     for c in col:
         tag = c.tag
@@ -68,9 +56,7 @@ def collision_parts(col: El, shapes: tuple[str, ...]) -> tuple[El, El]:
 
 
 def first(el: El, tag: str) -> El:
-    """``el.find(tag)`` for a plain tag name, filtered in C (``find`` goes through ElementPath)."""
-    if _native is not None and tag.isalnum():  # a plain name ("{ns}x", "*": lxml's rules)
-        return _native.first(el, tag)  # without making an iterator
+    """``el.find(tag)`` for a tag name, without ``find``'s ElementPath (lxml's rules: "{ns}x")."""
     return next(el.iterchildren(tag), None)
 
 
@@ -103,11 +89,11 @@ class LinkView:
         self.parts: list[El]
         self.collisions: list[El]
         (self.inertial, self.mass, self.inertia, self.parts,
-         self.collisions) = (_link_parts if _native is None else _native.link_parts)(el)
+         self.collisions) = _link_parts(el)
 
 
 def _link_parts(el: El) -> tuple[El, El, El, list[El], list[El]]:
-    """``_walk.link_parts`` in Python: (inertial, mass, inertia, parts, collisions)."""
+    """(inertial, mass, inertia, parts, collisions) of a link, in one look at its children."""
     inertial = mass = inertia = None
     parts: list[El] = []
     collisions: list[El] = []
@@ -152,11 +138,11 @@ class JointView:
         self.origin: El
         self.mimic: El
         (self.parent, self.child, self.children, self.limit, self.axis, self.origin,
-         self.mimic) = (_joint_parts if _native is None else _native.joint_parts)(el)
+         self.mimic) = _joint_parts(el)
 
 
 def _joint_parts(el: El) -> tuple[El, El, list[El], El, El, El, El]:
-    """``_walk.joint_parts`` in Python: (parent, child, children, limit, axis, origin, mimic)."""
+    """(parent, child, children, limit, axis, origin, mimic) of a joint, in one look."""
     first: dict[str, El] = {}
     children: list[El] = []
     for c in el:
@@ -175,9 +161,6 @@ _JOINT_SLOTS = frozenset({"parent", "limit", "axis", "origin", "mimic"})
 class Doc:
     """Everything the rules read from one document, collected in one walk.
 
-    The walk is :meth:`_walk`, done in C where ``urdfkit.model._walk`` is built (``native``
-    False walks in Python, for the tests that hold the two to each other).
-
     Attributes:
         root: The root element.
         links, joints: :class:`LinkView` and :class:`JointView` of the root's children.
@@ -194,7 +177,7 @@ class Doc:
                  "geometries", "files", "transmissions", "too_deep", "element_findings",
                  "_buckets")
 
-    def __init__(self, root: El, native: bool = True) -> None:
+    def __init__(self, root: El) -> None:
         self.root = root
         self.links: list[LinkView] = []
         self.joints: list[JointView] = []
@@ -225,14 +208,7 @@ class Doc:
                     self.materials.append(child)
                 elif ctag == "deformable":
                     self.deformables += 1
-            checked = tag[0] != "{" and tag not in OPAQUE
-            if native and _native is not None:
-                # The same walk, step for step, without a proxy per element (_walk.c).
-                self.too_deep = _native.walk(
-                    root, tag, checked, self._buckets, self.element_findings, SCHEMA,
-                    NUMERIC_BY_TAG, OPAQUE, MAX_XML_DEPTH, _VERDICTS, _VERDICTS_MAX, _verdict)
-            else:
-                self._walk(root, tag, checked, 1)
+            self._walk(root, tag, tag[0] != "{" and tag not in OPAQUE, 1)
 
     def _walk(self, el: El, tag: str, checked: bool, depth: int) -> None:
         """Visit ``el``'s subtree once: collect, and check elements when ``checked``.
@@ -279,24 +255,31 @@ class Doc:
 
     def _check(self, el: El, tag: str) -> None:
         """U401-U402 and U801-U802 of one element's attributes."""
-        items = el.items()
-        if not items:
-            return
         # The verdict depends on the attributes' names and on the values of the numeric
         # ones only: names and file names (unique to each file) stay out of the key, or
         # every link and mesh would miss. Decodable: the tag fixes which names hold values.
         numeric = NUMERIC_BY_TAG.get(tag)
-        if numeric is None and tag not in SCHEMA:
-            return  # an element no rule knows: nothing to say of its attributes
-        parts: list[str] = [tag]
-        for attr, text in items:
-            parts.append(attr)
-            if numeric is not None and attr in numeric:
-                parts.append(text)
-        key = tuple(parts)
+        key: tuple[str, ...]
+        if numeric is None:
+            if tag not in SCHEMA:
+                return  # an element no rule knows: nothing to say of its attributes
+            names = el.keys()  # no values read: none is part of the verdict
+            if not names:
+                return
+            key = (tag, *names)
+        else:
+            items = el.items()
+            if not items:
+                return
+            parts: list[str] = [tag]
+            for attr, text in items:
+                parts.append(attr)
+                if attr in numeric:
+                    parts.append(text)
+            key = tuple(parts)
         found = _VERDICTS.get(key)
         if found is None:
-            found = _verdict(tag, items)
+            found = _verdict(tag, el.items())
             if len(_VERDICTS) >= _VERDICTS_MAX:
                 _VERDICTS.clear()
             _VERDICTS[key] = found

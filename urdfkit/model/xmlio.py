@@ -260,20 +260,38 @@ def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
     root = _START.search(markup)
     if root is None:
         return data, notes
-    first: dict[bytes, tuple[int, str]] = {}  # prefix: (offset, what uses it out of scope)
     if not prefixes & set(_DECLARED.findall(markup)):
-        # Declared nowhere: the first use is the first out of scope, found without a walk.
-        for prefix in sorted(prefixes):
-            p = re.escape(prefix)
-            element = re.search(rb"<" + p + rb":[^\s/>]+", markup)
-            attribute = re.search(rb"(?<=\s)" + p + rb":[A-Za-z_][\w.-]*(?=\s*=)", markup)
-            for m, shown in ((element, "<{}>"), (attribute, "{}=...")):
-                if m is not None and (prefix not in first or m.start() < first[prefix][0]):
-                    text = m.group(0).decode("utf-8", "replace").lstrip("<")
-                    first[prefix] = (m.start(), shown.format(text))
-        return _declare(data, markup, root, first, notes)
-    # Walk the tags with the declarations in scope: a prefix declared on one <gazebo> is not
-    # declared on the next one.
+        first = _first_uses(markup, prefixes)  # declared nowhere: no walk needed
+    else:
+        first = _first_uses_out_of_scope(markup)
+    return _declare(data, markup, root, first, notes)
+
+
+def _first_uses(markup: bytes, prefixes: set[bytes]) -> dict[bytes, tuple[int, str]]:
+    """{prefix: (offset, what uses it)} of the first use of each prefix declared nowhere.
+
+    With no declaration anywhere, the first use is the first out of scope: found by a search
+    per prefix, without walking the tags.
+    """
+    first: dict[bytes, tuple[int, str]] = {}
+    for prefix in sorted(prefixes):
+        p = re.escape(prefix)
+        element = re.search(rb"<" + p + rb":[^\s/>]+", markup)
+        attribute = re.search(rb"(?<=\s)" + p + rb":[A-Za-z_][\w.-]*(?=\s*=)", markup)
+        for m, shown in ((element, "<{}>"), (attribute, "{}=...")):
+            if m is not None and (prefix not in first or m.start() < first[prefix][0]):
+                text = m.group(0).decode("utf-8", "replace").lstrip("<")
+                first[prefix] = (m.start(), shown.format(text))
+    return first
+
+
+def _first_uses_out_of_scope(markup: bytes) -> dict[bytes, tuple[int, str]]:
+    """{prefix: (offset, what uses it)} of the first use of each prefix out of its scope.
+
+    Walks the tags with the declarations in scope: a prefix declared on one ``<gazebo>`` is
+    not declared on the next one.
+    """
+    first: dict[bytes, tuple[int, str]] = {}
     scopes: list[set[bytes]] = []
     in_scope: set[bytes] = {b"xml", b"xmlns"}
     for tag in _TAG.finditer(markup):
@@ -293,7 +311,7 @@ def _declare_prefixes(data: bytes, notes: list[tuple[int, str]]
         if not tag.group(4):  # not <empty/>: its declarations hold until its end tag
             scopes.append(in_scope)
             in_scope = here
-    return _declare(data, markup, root, first, notes)
+    return first
 
 
 def _declare(data: bytes, markup: bytes, root: re.Match[bytes],

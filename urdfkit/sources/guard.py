@@ -14,6 +14,7 @@ import os
 import re
 import stat
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +23,6 @@ from lxml import etree
 from urdfkit.core import deps
 from urdfkit.core.errors import InputError, Oversized
 from urdfkit.core.finding import Finding
-from urdfkit.core.record import Record
 from urdfkit.model.index import Doc, first
 from urdfkit.model.spec import (
     CRASH_NAME_BYTES,
@@ -429,7 +429,8 @@ def rule_inertial(root: etree._Element, r: RuleReport) -> None:
                   "of a symmetric body)", inertia)
 
 
-class Reference(Record):
+@dataclass(frozen=True, slots=True)
+class Reference:
     """What a ``filename`` attribute points at, and what is wrong with it, if anything.
 
     Paths are kept as strings (check resolves one per mesh of every file; a Path costs ~4 us
@@ -441,34 +442,14 @@ class Reference(Record):
         code, level, message: The finding, or ``code`` None when the file is fine.
     """
 
-    __slots__ = ("file", "load", "code", "level", "message", "stat")
-    _FIELDS = ("file", "load", "code", "level", "message", "stat")
-    _COMPARED = ("file", "load", "code", "level", "message")
-
     file: str | None
     load: str | None
-    code: str | None
-    level: str
-    message: str
+    code: str | None = None
+    level: str = "error"
+    message: str = ""
     #: ``os.stat`` of ``load`` when it was taken on the way (the common case), for the mesh
-    #: rules not to ask again.
-    stat: os.stat_result | None
-
-    def __init__(
-            self,
-            file: str | None,
-            load: str | None,
-            code: str | None = None,
-            level: str = "error",
-            message: str = "",
-            stat: os.stat_result | None = None,
-    ) -> None:
-        self.file = file
-        self.load = load
-        self.code = code
-        self.level = level
-        self.message = message
-        self.stat = stat
+    #: rules not to ask again. Not part of the reference's value.
+    stat: os.stat_result | None = field(default=None, compare=False, repr=False)
 
     @property
     def path(self) -> Path | None:

@@ -2,15 +2,13 @@
 
 :class:`Integrals` is a mesh's volume integrals as read (what the cache and a run's pack
 keep, unscaled); :class:`MeshProperties` the solid under a ``<mesh scale>``. Read by
-:mod:`urdfkit.sources.meshes`, looked up by :mod:`urdfkit.sources.meshstore`; compiled with
-check's path (setup.py).
+:mod:`urdfkit.sources.meshes`, looked up by :mod:`urdfkit.sources.meshstore`.
 """
 
 from __future__ import annotations
 
 import struct
-
-from urdfkit.core.record import Record
+from dataclasses import dataclass
 
 #: Largest mesh file read for checks; bigger ones are skipped (checks must stay fast).
 MAX_MESH_BYTES = 16 * 1024 * 1024
@@ -18,7 +16,8 @@ MAX_MESH_BYTES = 16 * 1024 * 1024
 CONCAVE_FRACTION = 0.02
 
 
-class MeshProperties(Record):
+@dataclass(frozen=True, slots=True)
+class MeshProperties:
     """A closed triangle mesh as a solid of unit density (scaled).
 
     Attributes:
@@ -35,38 +34,14 @@ class MeshProperties(Record):
         pieces: Convex hulls PyBullet makes of it (one per ``o``/``g`` object of an OBJ).
     """
 
-    __slots__ = ("volume", "com", "inertia", "extent", "closed", "triangles", "concavity", "pieces")
-    _FIELDS = (
-        "volume", "com", "inertia", "extent", "closed", "triangles", "concavity", "pieces")
-
     volume: float
     com: tuple[float, float, float]
     inertia: tuple[tuple[float, ...], ...]
     extent: tuple[float, float, float]
     closed: bool
     triangles: int
-    concavity: float
-    pieces: int
-
-    def __init__(
-            self,
-            volume: float,
-            com: tuple[float, float, float],
-            inertia: tuple[tuple[float, ...], ...],
-            extent: tuple[float, float, float],
-            closed: bool,
-            triangles: int,
-            concavity: float = 0.0,
-            pieces: int = 1,
-    ) -> None:
-        self.volume = volume
-        self.com = com
-        self.inertia = inertia
-        self.extent = extent
-        self.closed = closed
-        self.triangles = triangles
-        self.concavity = concavity
-        self.pieces = pieces
+    concavity: float = 0.0
+    pieces: int = 1
 
     def trace_for_mass(self, mass: float) -> float | None:
         """Trace of the inertia of this solid with ``mass``, or None without a volume."""
@@ -76,7 +51,8 @@ class MeshProperties(Record):
         return (t[0][0] + t[1][1] + t[2][2]) * mass / self.volume
 
 
-class Integrals(Record):
+@dataclass(frozen=True, slots=True)
+class Integrals:
     """A mesh's volume integrals as read, unscaled and signed (what the cache keeps).
 
     Attributes:
@@ -88,11 +64,6 @@ class Integrals(Record):
             unscaled).
     """
 
-    __slots__ = (
-        "volume", "first", "second", "low", "high", "closed", "triangles", "concavity", "pieces")
-    _FIELDS = (
-        "volume", "first", "second", "low", "high", "closed", "triangles", "concavity", "pieces")
-
     volume: float
     first: tuple[float, float, float]
     second: tuple[float, float, float, float, float, float]
@@ -100,30 +71,8 @@ class Integrals(Record):
     high: tuple[float, float, float]
     closed: bool
     triangles: int
-    concavity: float
-    pieces: int
-
-    def __init__(
-            self,
-            volume: float,
-            first: tuple[float, float, float],
-            second: tuple[float, float, float, float, float, float],
-            low: tuple[float, float, float],
-            high: tuple[float, float, float],
-            closed: bool,
-            triangles: int,
-            concavity: float = 0.0,
-            pieces: int = 1,
-    ) -> None:
-        self.volume = volume
-        self.first = first
-        self.second = second
-        self.low = low
-        self.high = high
-        self.closed = closed
-        self.triangles = triangles
-        self.concavity = concavity
-        self.pieces = pieces
+    concavity: float = 0.0
+    pieces: int = 1
 
     def pack(self) -> bytes:
         """The cache entry's bytes."""

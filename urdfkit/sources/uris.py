@@ -17,6 +17,7 @@ import os
 import re
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 from urdfkit.core import deps
@@ -196,6 +197,7 @@ def settled() -> Iterator[None]:
         _SETTLED.pop()
 
 
+@dataclass(frozen=True, slots=True)
 class Target:
     """Where a file reference points.
 
@@ -205,38 +207,10 @@ class Target:
         problem: Why ``path`` is None: what the user should do.
     """
 
-    __slots__ = ("path", "package", "problem")
-
     path: Path | None
-    package: str | None
-    problem: str | None
+    package: str | None = None
+    problem: str | None = None
 
-    def __init__(
-            self,
-            path: Path | None,
-            package: str | None = None,
-            problem: str | None = None,
-    ) -> None:
-        self.path = path
-        self.package = package
-        self.problem = problem
-
-    def _key(self) -> tuple[object, ...]:
-        return (self.path, self.package, self.problem)
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not Target:
-            return NotImplemented
-        return self._key() == other._key()
-
-    def __hash__(self) -> int:
-        return hash(self._key())
-
-    def __repr__(self) -> str:
-        return (f"Target(path={self.path!r}, package={self.package!r}, problem={self.problem!r})")
-
-    def __reduce__(self) -> tuple[object, ...]:  # for pickle (check's workers hand these back)
-        return (Target, (self.path, self.package, self.problem))
 
 def resolve_uri(uri: str, base: Path, packages: Mapping[str, Path] | None = None) -> Target:
     """Resolve a ``filename`` attribute written in a URDF whose folder is ``base``."""
