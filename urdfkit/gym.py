@@ -183,13 +183,13 @@ class SimpleDrivingEnv(gym.Env):
         from urdfkit.motion.drive import builtin_file
 
         s = self._session
-        p, c = s.p, s.client
-        self._p, self._client = p, c
-        p.setTimeStep(self.TIME_STEP, physicsClientId=c)
+        p = s.bullet
+        self._p = p
+        p.setTimeStep(self.TIME_STEP)
         # Sorted overlapping pairs: the solver meets contacts in the same order after every
         # reset (PyBullet's default does not, and single-step episodes then differ).
-        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=c)
-        p.setGravity(0, 0, self.GRAVITY, physicsClientId=c)
+        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
+        p.setGravity(0, 0, self.GRAVITY)
         plane, car = builtin_file("simpleplane"), builtin_file("simplecar")
         if plane is None or car is None:  # no writable cache: build into a temp folder
             import tempfile
@@ -205,12 +205,12 @@ class SimpleDrivingEnv(gym.Env):
             implicit_cylinder=implicit_cylinder), display="simplecar")
         # The goal marker: a green post, seen by the cameras, touched by nothing.
         shape = p.createVisualShape(p.GEOM_CYLINDER, radius=0.5, length=1.0,
-                                    rgbaColor=[0.0, 0.925, 0.0, 1.0], physicsClientId=c)
+                                    rgbaColor=[0.0, 0.925, 0.0, 1.0])
         self.goal_marker = p.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1,
                                              baseVisualShapeIndex=shape,
-                                             basePosition=[0.0, 0.0, 0.5], physicsClientId=c)
-        self._start = p.saveState(physicsClientId=c)
-        prime_resets(p, c, self._start, [self.car])
+                                             basePosition=[0.0, 0.0, 0.5])
+        self._start = p.saveState()
+        prime_resets(s.p, s.client, self._start, [self.car])
 
     # ---- the Gymnasium API
 
@@ -224,8 +224,8 @@ class SimpleDrivingEnv(gym.Env):
         _open(self)
         super().reset(seed=seed)
         self._ended = self._warned_end = False
-        p, c = self._p, self._client
-        restore_clean(p, c, self._start, [self.car])
+        p = self._p
+        restore_clean(self._session.p, self._session.client, self._start, [self.car])
         goal = (options or {}).get("goal")
         if goal is not None:
             gx, gy = _finite_pair(goal)
@@ -236,8 +236,7 @@ class SimpleDrivingEnv(gym.Env):
             gx = rng.uniform(5, 9) if rng.integers(2) else -rng.uniform(5, 9)
             gy = rng.uniform(5, 9) if rng.integers(2) else -rng.uniform(5, 9)
         self.goal = (float(gx), float(gy))
-        p.resetBasePositionAndOrientation(self.goal_marker, [gx, gy, 0.5], [0, 0, 0, 1],
-                                          physicsClientId=c)
+        p.resetBasePositionAndOrientation(self.goal_marker, [gx, gy, 0.5], [0, 0, 0, 1])
         self._speed = 0.0
         self._steer = None
         obs = self._observe()
@@ -257,10 +256,10 @@ class SimpleDrivingEnv(gym.Env):
         _after_end(self)
         throttle = min(max(throttle, 0.0), 1.0)
         steer = max(min(steer, 0.6), -0.6)
-        p, c, car = self._p, self._client, self.car
+        p, car = self._p, self.car
         if steer != self._steer:  # position motors persist: set on change
             p.setJointMotorControlArray(car, _HINGES, p.POSITION_CONTROL,
-                                        targetPositions=[steer, steer], physicsClientId=c)
+                                        targetPositions=[steer, steer])
             self._steer = steer
         v = self._speed
         v += self.TIME_STEP * (self.C_THROTTLE * throttle - v * (v * self.C_DRAG
@@ -269,8 +268,8 @@ class SimpleDrivingEnv(gym.Env):
         force = self.WHEEL_FORCE
         p.setJointMotorControlArray(car, _WHEELS, p.VELOCITY_CONTROL,
                                     targetVelocities=[v, v, v, v],
-                                    forces=[force, force, force, force], physicsClientId=c)
-        p.stepSimulation(physicsClientId=c)
+                                    forces=[force, force, force, force])
+        p.stepSimulation()
         obs = self._observe()
         x, y = float(obs[0]), float(obs[1])
         gx, gy = self.goal
@@ -292,9 +291,9 @@ class SimpleDrivingEnv(gym.Env):
         return obs, reward, terminated, False, {"distance": distance, "is_success": reached}
 
     def _observe(self) -> np.ndarray:
-        p, c = self._p, self._client
-        pos, (qx, qy, qz, qw) = p.getBasePositionAndOrientation(self.car, physicsClientId=c)
-        lin = p.getBaseVelocity(self.car, physicsClientId=c)[0]
+        p = self._p
+        pos, (qx, qy, qz, qw) = p.getBasePositionAndOrientation(self.car)
+        lin = p.getBaseVelocity(self.car)[0]
         # cos and sin of PyBullet's yaw, atan2(b, a), without the angle.
         a = qw * qw + qx * qx - qy * qy - qz * qz
         b = 2.0 * (qx * qy + qw * qz)
@@ -307,8 +306,8 @@ class SimpleDrivingEnv(gym.Env):
         """An ``rgb_array`` frame (height x width x 3, uint8); None in ``human`` mode."""
         if self.render_mode != "rgb_array":
             return None
-        p, c = self._p, self._client
-        pos, orn = p.getBasePositionAndOrientation(self.car, physicsClientId=c)
+        p = self._p
+        pos, orn = p.getBasePositionAndOrientation(self.car)
         if self.camera == "chase":
             # The tutorial's camera: at the car, 0.2 m up, looking along its heading.
             m = p.getMatrixFromQuaternion(orn)
@@ -316,22 +315,20 @@ class SimpleDrivingEnv(gym.Env):
             up = (m[2], m[5], m[8])
             eye = (pos[0], pos[1], 0.2)
             view = p.computeViewMatrix(eye, [e + f for e, f in zip(eye, ahead, strict=True)],
-                                       up, physicsClientId=c)
+                                       up)
             fov = 80.0
         else:
-            view = p.computeViewMatrix((0.0, -13.0, 17.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0),
-                                       physicsClientId=c)
+            view = p.computeViewMatrix((0.0, -13.0, 17.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
             fov = 60.0
-        proj = p.computeProjectionMatrixFOV(fov, self.width / self.height, 0.01, 100.0,
-                                            physicsClientId=c)
+        proj = p.computeProjectionMatrixFOV(fov, self.width / self.height, 0.01, 100.0)
         image = p.getCameraImage(self.width, self.height, view, proj,
-                                 renderer=p.ER_TINY_RENDERER, physicsClientId=c)[2]
+                                 renderer=p.ER_TINY_RENDERER)[2]
         return np.asarray(image, dtype=np.uint8).reshape(self.height, self.width, 4)[
             :, :, :3].copy()
 
     def _follow_in_gui(self, x: float, y: float) -> None:
-        p, c = self._p, self._client
-        p.resetDebugVisualizerCamera(4.0, -40.0, -35.0, [x, y, 0.0], physicsClientId=c)
+        p = self._p
+        p.resetDebugVisualizerCamera(4.0, -40.0, -35.0, [x, y, 0.0])
         wait = self._last_frame + self.TIME_STEP - time.perf_counter()
         if wait > 0:
             time.sleep(wait)

@@ -225,8 +225,8 @@ def _inspect(path: Path, display: str) -> _Robot:
         active: list[str] = []
         links: dict[str, str] = {}
         types: dict[str, int] = {}
-        for j in range(s.p.getNumJoints(body, physicsClientId=s.client)):
-            info = s.p.getJointInfo(body, j, physicsClientId=s.client)
+        for j in range(s.bullet.getNumJoints(body)):
+            info = s.bullet.getJointInfo(body, j)
             name = info[1].decode("utf-8", "replace")
             joints.append(name)
             types[name] = info[2]

@@ -31,7 +31,6 @@ def _scheduled(self: Any, b: _Body) -> _Command | None:
 
 
 def _control(self: Any, b: _Body) -> None:
-    p, client = self.session.p, self.session.client
     cmd = b.override or self._scheduled(b)
     if cmd != b.applied:
         if b.applied is not None:
@@ -44,7 +43,7 @@ def _control(self: Any, b: _Body) -> None:
 
             max_force = b.config.vehicle.max_force if b.config.vehicle else 10.0
             # Motors persist in PyBullet: set once per change of command.
-            apply_drive(p, b.body, client, b.train, cmd.throttle,
+            apply_drive(self.session.bullet, b.body, b.train, cmd.throttle,
                         clamp_steer(b.train, cmd.steer)[0], max_force)
             if b.dry_friction:  # apply_drive frees the undriven wheels
                 self._free(b, [i for i in b.train.free if i in b.dry_friction])

@@ -201,7 +201,7 @@ def _detect_train(self: Any, b: _Body) -> None:
     v = cfg.vehicle
     # Detection judges axes in the base frame, at load time: before any step.
     try:
-        b.train = detect_upright(self.session.p, b.body, self.session.client,
+        b.train = detect_upright(self.session.bullet, b.body,
                                  UP_AXES[cfg.up], wheels=v.wheels if v else None,
                                  hinges=v.hinges if v else None)
     except ParameterError as e:
