@@ -20,7 +20,7 @@ import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, Literal
 
 from urdfkit.core.errors import MissingDependencyError, ParameterError
 
@@ -33,6 +33,10 @@ except ImportError as e:  # pragma: no cover - the [gym] extra installs it
         from e
 
 from urdfkit.engine.session import LoadOptions, Session, prime_resets, restore_clean
+
+if TYPE_CHECKING:
+    from urdfkit.motion.scenario_models import Mode, Randomize, RobotConfig
+    from urdfkit.sim import Observation, SimRobot
 
 __all__ = ["SIMPLE_DRIVING_ID", "ScenarioEnv", "SimpleDrivingEnv"]
 
@@ -427,7 +431,7 @@ class ScenarioEnv(gym.Env):
         try:
             self.robot = self._pick_robot(robot)
             self._build_action_space(dict(action_bounds or {}))
-            b = self.sim.bodies[self.robot]
+            b = self.sim.robot(self.robot)
             chosen = list(fields) if fields is not None else [
                 *JOINT_FIELDS, *(BASE_FIELDS if b.config.base == "floating" else ())]
             for f in chosen:
@@ -459,7 +463,7 @@ class ScenarioEnv(gym.Env):
                 raise ParameterError(f"no robot named {robot!r}; robots: {', '.join(names)}",
                                      param="robot")
             return robot
-        driven = [n for n in names if self._controller(self.sim.bodies[n].config)]
+        driven = [n for n in names if self._controller(self.sim.robot(n).config)]
         if len(driven) == 1:
             return driven[0]
         if not driven:
@@ -469,7 +473,7 @@ class ScenarioEnv(gym.Env):
                              "which one the agent drives with robot=...", param="robot")
 
     @staticmethod
-    def _controller(cfg: Any) -> str | None:
+    def _controller(cfg: RobotConfig) -> Literal["drive", "joints"] | None:
         if cfg.drive is not None:
             return "drive"
         if cfg.joints is not None or cfg.motor is not None:
@@ -477,9 +481,9 @@ class ScenarioEnv(gym.Env):
         return None
 
     def _build_action_space(self, bounds: dict[str, tuple[float, float]]) -> None:
-        b = self.sim.bodies[self.robot]
+        b = self.sim.robot(self.robot)
         self.controller = self._controller(b.config)
-        self.modes: dict[str, str] = {}
+        self.modes: dict[str, Mode] = {}
         if self.controller == "drive":
             names, lows, highs = self._drive_action(b, bounds)
         else:
@@ -501,25 +505,26 @@ class ScenarioEnv(gym.Env):
         self.action_space = spaces.Box(np.array(lows, dtype=np.float32),
                                        np.array(highs, dtype=np.float32))
         self._low, self._high = self.action_space.low, self.action_space.high
-        self._by_mode: dict[str, list[int]] = {}
+        self._by_mode: dict[Mode, list[int]] = {}
         for k, name in enumerate(names if self.controller == "joints" else []):
             self._by_mode.setdefault(self.modes[name], []).append(k)
 
-    def _drive_action(self, b: Any, bounds: dict[str, tuple[float, float]]
+    def _drive_action(self, b: SimRobot, bounds: dict[str, tuple[float, float]]
                       ) -> tuple[list[str], list[float], list[float]]:
         """Throttle and steer, the steer's range from the drive train unless ``bounds`` says."""
         from urdfkit.motion.vehicle import clamp_steer
 
         train = b.train
+        assert train is not None
         lo, hi = train.steer_range() if train.hinges else (0.0, 0.0)
         steer = bounds.pop("steer", (lo, hi))
         throttle = bounds.pop("throttle", (-DEFAULT_THROTTLE, DEFAULT_THROTTLE))
         self._clamp = clamp_steer
         return ["throttle", "steer"], [throttle[0], steer[0]], [throttle[1], steer[1]]
 
-    def _joint_modes(self, b: Any) -> dict[str, str]:
+    def _joint_modes(self, b: SimRobot) -> dict[str, Mode]:
         """The mode each commanded joint is driven in: one per joint, or the servo's joints."""
-        modes: dict[str, str] = {}
+        modes: dict[str, Mode] = {}
         for seg in b.config.joints or []:
             for name in seg.targets:
                 mode = seg.mode if isinstance(seg.mode, str) else seg.mode[name]
@@ -534,15 +539,13 @@ class ScenarioEnv(gym.Env):
                                  param="robot")
         return modes
 
-    def _joint_bounds(self, b: Any, name: str, bounds: dict[str, tuple[float, float]]
+    def _joint_bounds(self, b: SimRobot, name: str, bounds: dict[str, tuple[float, float]]
                       ) -> tuple[float, float]:
         """A joint's action range: from ``bounds``, else its URDF limits in the measured frame."""
         if name in bounds:
             return bounds.pop(name)
-        p, client = self.sim.session.p, self.sim.session.client
         spec = b.joint(name)
-        info = p.getJointInfo(b.body, spec.index, physicsClientId=client)
-        lower, upper, effort, velocity = info[8], info[9], info[10], info[11]
+        lower, upper, effort, velocity = b.joint_limits(name)
         mode = self.modes[name]
         sign = b.directions.get(name, 1.0)
         offset = b.offsets.get(name, 0.0)
@@ -550,7 +553,7 @@ class ScenarioEnv(gym.Env):
             if lower < upper:  # measured frame: (q - offset) * direction
                 ends = sorted(((lower - offset) * sign, (upper - offset) * sign))
                 return ends[0], ends[1]
-            if spec.type == p.JOINT_REVOLUTE:
+            if spec.revolute:
                 return -math.pi, math.pi
             raise ParameterError(f"{name} has no position limits; give its range in "
                                  "action_bounds", param="action_bounds")
@@ -582,27 +585,22 @@ class ScenarioEnv(gym.Env):
         self.observation_space = spaces.Dict(boxes) if kind == "dict" else \
             spaces.Box(-np.inf, np.inf, shape=(len(names),), dtype=np.float32)
 
-    def _randomize_plan(self) -> Any:
-        b = self.sim.bodies[self.robot]
+    def _randomize_plan(self) -> Randomize | None:
+        b = self.sim.robot(self.robot)
         r = b.config.randomize
         if r is None:
             return None
-        p, client = self.sim.session.p, self.sim.session.client
         # Nominal masses, for mass_scale: the scenario's, before any episode changed them.
-        self._nominal_mass = {link: p.getDynamicsInfo(b.body, b.links[link],
-                                                      physicsClientId=client)[0]
-                              for link in r.mass_scale}
+        self._nominal_mass = {link: b.link_mass(link) for link in r.mass_scale}
         return r
 
     # ---- the Gymnasium API
 
-    def _observe(self) -> Any:
+    def _observe(self) -> Observation:
         """The robot's reported observation now (a copy)."""
-        o = self.sim.observe(self.robot)
-        assert not isinstance(o, dict)
-        return o
+        return self.sim.observation(self.robot)
 
-    def _obs(self, o: Any) -> Any:
+    def _obs(self, o: Observation) -> np.ndarray | dict[str, np.ndarray]:
         if self.observation_kind == "dict":
             return {f: np.fromiter(_values(getattr(o, f)), dtype=np.float32)
                     for f in self.fields}
@@ -628,7 +626,7 @@ class ScenarioEnv(gym.Env):
         r = self._randomize
         if r is not None:
             mine = overrides.setdefault(self.robot, {})
-            cfg = self.sim.bodies[self.robot].config
+            cfg = self.sim.robot(self.robot).config
             if r.initial_joints:
                 joints = dict(mine.get("initial_joints") or {})
                 for name, (lo, hi) in r.initial_joints.items():
@@ -640,7 +638,8 @@ class ScenarioEnv(gym.Env):
                                     for s, (lo, hi) in zip(start, r.position, strict=True)]
             if r.yaw is not None:
                 roll, pitch, yaw = mine.get("orientation_rpy", cfg.orientation_rpy or (0, 0, 0))
-                mine["orientation_rpy"] = [roll, pitch, yaw + float(rng.uniform(*r.yaw))]
+                low, high = r.yaw
+                mine["orientation_rpy"] = [roll, pitch, yaw + float(rng.uniform(low, high))]
         noise_seed = int(rng.integers(2**31 - 1))
         self.sim.reset(seed=noise_seed, overrides=overrides or None)
         if r is not None:
@@ -658,9 +657,10 @@ class ScenarioEnv(gym.Env):
         if action is None:
             return
         if self.controller == "drive":
-            b = self.sim.bodies[self.robot]
+            train = self.sim.robot(self.robot).train
+            assert train is not None
             throttle, steer = float(action[0]), float(action[1])
-            steer = self._clamp(b.train, steer)[0]
+            steer = self._clamp(train, steer)[0]
             self.sim.set_drive(self.robot, throttle=throttle, steer=steer)
             return
         for mode, ks in self._by_mode.items():
@@ -700,15 +700,12 @@ class ScenarioEnv(gym.Env):
         """An ``rgb_array`` frame looking at the robot (height x width x 3, uint8)."""
         if self.render_mode != "rgb_array":
             return None
-        p, client = self.sim.session.p, self.sim.session.client
-        b = self.sim.bodies[self.robot]
-        target = p.getBasePositionAndOrientation(b.body, physicsClientId=client)[0]
-        view = p.computeViewMatrixFromYawPitchRoll(target, 2.0, 45.0, -30.0, 0.0, 2,
-                                                   physicsClientId=client)
-        proj = p.computeProjectionMatrixFOV(60.0, self.width / self.height, 0.01, 100.0,
-                                            physicsClientId=client)
+        p = self.sim.bullet
+        target = self.sim.robot(self.robot).base_position()
+        view = p.computeViewMatrixFromYawPitchRoll(target, 2.0, 45.0, -30.0, 0.0, 2)
+        proj = p.computeProjectionMatrixFOV(60.0, self.width / self.height, 0.01, 100.0)
         image = p.getCameraImage(self.width, self.height, view, proj,
-                                 renderer=p.ER_TINY_RENDERER, physicsClientId=client)[2]
+                                 renderer=p.ER_TINY_RENDERER)[2]
         return np.asarray(image, dtype=np.uint8).reshape(self.height, self.width, 4)[
             :, :, :3].copy()
 

@@ -26,7 +26,7 @@ from urdfkit.core.errors import InputError, MissingDependencyError, ParameterErr
 from urdfkit.model.spec import MAX_STEPS
 
 if TYPE_CHECKING:
-    from urdfkit.motion.scenario_models import Robot, Scenario
+    from urdfkit.motion.scenario_models import RobotConfig, ScenarioConfig
 
 #: The observation fields that carry noise; each is a vector or a joint-keyed mapping.
 OBSERVATION_FIELDS = (
@@ -45,8 +45,9 @@ def schema() -> ModuleType:
     """The pydantic models of a scenario (:mod:`~urdfkit.motion.scenario_models`), imported lazily.
 
     Returns:
-        The module: ``Scenario`` (the document) and the models it nests, ``Physics``,
-        ``Ground``, ``Record``, ``Robot``, ``DriveSegment``, ``Vehicle``, ``JointSegment``,
+        The module: ``ScenarioConfig`` (the document) and the models it nests,
+        ``Physics``, ``Ground``, ``RecordConfig``, ``RobotConfig``, ``DriveSegment``,
+        ``Vehicle``, ``JointSegment``,
         ``Motor``, ``InitialJoint``, ``Noise``, ``LinkDynamics``, ``Randomize``.
 
     Raises:
@@ -253,7 +254,7 @@ def read_document(path: str | Path) -> dict[str, Any]:
 
 
 def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
-                   base_dir: str | Path | None = None) -> Scenario:
+                   base_dir: str | Path | None = None) -> ScenarioConfig:
     """Validate plain data into a ``Scenario`` model and run the cross-field checks.
 
     Args:
@@ -269,10 +270,10 @@ def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
     from pydantic import ValidationError
 
     try:
-        scenario = models.Scenario.model_validate(dict(data))
+        scenario = models.ScenarioConfig.model_validate(dict(data))
     except ValidationError as e:
         errors = e.errors()
-        message = _describe(errors[0], models.Scenario)
+        message = _describe(errors[0], models.ScenarioConfig)
         # Each member of a union a value fails is an error of its own: one place, one problem.
         more = len({key_path(x["loc"]) for x in errors} - {key_path(errors[0]["loc"])})
         if more:
@@ -287,7 +288,7 @@ def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
     return scenario
 
 
-def load_scenario(path: str | Path) -> Scenario:
+def load_scenario(path: str | Path) -> ScenarioConfig:
     """Read and validate a scenario file (``.json`` or ``.toml``).
 
     A simulation_and_control config (top-level ``sim``, ``robot_pybullet``, ...) is mapped
@@ -305,11 +306,11 @@ def load_scenario(path: str | Path) -> Scenario:
     return scenario
 
 
-def _fail(scenario: Scenario, path: str, message: str) -> InputError:
+def _fail(scenario: ScenarioConfig, path: str, message: str) -> InputError:
     return InputError(f"{path}: {message}", file=scenario.source)
 
 
-def _check_segments(scenario: Scenario, path: str, segments: Sequence[Any]) -> None:
+def _check_segments(scenario: ScenarioConfig, path: str, segments: Sequence[Any]) -> None:
     last = 0.0
     for i, seg in enumerate(segments):
         if seg.until <= last:
@@ -318,7 +319,8 @@ def _check_segments(scenario: Scenario, path: str, segments: Sequence[Any]) -> N
         last = seg.until
 
 
-def _check_template(scenario: Scenario, path: str, name: str, params: Mapping[str, Any]) -> None:
+def _check_template(scenario: ScenarioConfig, path: str, name: str,
+                    params: Mapping[str, Any]) -> None:
     from urdfkit.model.catalog import get_template
 
     try:
@@ -329,7 +331,7 @@ def _check_template(scenario: Scenario, path: str, name: str, params: Mapping[st
         raise _fail(scenario, where, str(e)) from None
 
 
-def _check_file(scenario: Scenario, path: str, name: str) -> None:
+def _check_file(scenario: ScenarioConfig, path: str, name: str) -> None:
     from urdfkit.sources.resolve import locate
 
     try:
@@ -347,7 +349,7 @@ def _check_file(scenario: Scenario, path: str, name: str) -> None:
 _TOO_DEEP = "nested deeper than Python's parser can follow (a config is a few levels deep)"
 
 
-def check(scenario: Scenario) -> None:
+def check(scenario: ScenarioConfig) -> None:
     """The checks pydantic's types cannot express; each error names its path.
 
     Raises:
@@ -380,7 +382,7 @@ def check(scenario: Scenario) -> None:
         _check_controllers(scenario, path, robot)
 
 
-def _check_source(scenario: Scenario, path: str, template: str | None, urdf: str | None,
+def _check_source(scenario: ScenarioConfig, path: str, template: str | None, urdf: str | None,
                   params: Mapping[str, Any]) -> None:
     """A robot or the ground comes from exactly one of a template (with its params) or a file."""
     if (template is None) == (urdf is None):
@@ -394,7 +396,7 @@ def _check_source(scenario: Scenario, path: str, template: str | None, urdf: str
         _check_file(scenario, f"{path}.urdf", urdf)
 
 
-def _check_controllers(scenario: Scenario, path: str, robot: Robot) -> None:
+def _check_controllers(scenario: ScenarioConfig, path: str, robot: RobotConfig) -> None:
     """One controller, its segments in time order, and a mode for every target."""
     if robot.drive is not None and robot.joints is not None:
         raise _fail(scenario, path, "give one controller: 'drive' or 'joints', not both")

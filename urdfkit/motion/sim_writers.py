@@ -1,6 +1,6 @@
 """Rows to files: flat columns, ``.jsonl``/``.csv`` text batch by batch, ``.parquet``.
 
-Split out of :mod:`urdfkit.sim`, which re-exports every public name here.
+Re-exported by :mod:`urdfkit.sim`.
 """
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def _pyarrow() -> Any:
     return pyarrow
 
 
-def check_output(path: str | Path, *, force: bool) -> None:
+def check_rows_output(path: str | Path, *, force: bool) -> None:
     """Refuse a bad ``--out`` before simulating: unknown format, existing file, no pyarrow."""
     from urdfkit.core.output import check_output as check
 
@@ -118,7 +118,7 @@ def write_rows(path: str | Path, rows: Sequence[Mapping[str, Any]], *, force: bo
     """Write rows in the format the suffix names, atomically; never replace without ``force``."""
     from urdfkit.core.output import atomic_write
 
-    check_output(path, force=force)
+    check_rows_output(path, force=force)
     return atomic_write(path, rows_to_bytes(rows, Path(path).suffix.lower()), force=force)
 
 

@@ -66,10 +66,10 @@ class Journal:
 
     def open(self) -> None:
         """Check the output, lock the journal, read what a previous run did, start writing."""
-        from urdfkit.sim import check_output
+        from urdfkit.motion.sim_writers import check_rows_output
 
         exists = os.path.lexists(self.path)  # a dangling symlink is there: never replaced
-        check_output(self.path, force=self.force or (self.resume and exists) or not exists)
+        check_rows_output(self.path, force=self.force or (self.resume and exists) or not exists)
         had_partial = os.path.lexists(self.partial)
         if had_partial and not self.resume and not self.force:
             raise InputError("a sweep that did not finish left its rows here: add "
@@ -195,7 +195,7 @@ class Journal:
                 except OSError as e:
                     raise _write_error(e, self.partial) from None
             rows = read_rows(self.partial, ".jsonl", notes=self.notes)
-            from urdfkit.sim import write_rows
+            from urdfkit.motion.sim_writers import write_rows
 
             path = write_rows(self.path, rows, force=True)
             self.partial.unlink()
@@ -312,7 +312,7 @@ def _csv_rows(path: Path, lines: list[str]) -> list[dict[str, Any]]:
 
 
 def _parquet_rows(path: Path, data: bytes) -> list[dict[str, Any]]:
-    from urdfkit.sim import _pyarrow
+    from urdfkit.motion.sim_writers import _pyarrow
 
     _pyarrow()
     import pyarrow as pa
