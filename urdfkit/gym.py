@@ -36,18 +36,20 @@ from urdfkit.engine.session import LoadOptions, Session, prime_resets, restore_c
 
 if TYPE_CHECKING:
     from urdfkit.motion.scenario_models import Mode, Randomize, RobotConfig
-    from urdfkit.sim import Observation, SimRobot
+    from urdfkit.sim import Observation, SimRobot, Simulation
 
 __all__ = ["SIMPLE_DRIVING_ID", "ScenarioEnv", "SimpleDrivingEnv"]
 
 SIMPLE_DRIVING_ID = "urdfkit/SimpleDriving-v0"
+#: How an environment renders: PyBullet's window, or frames as arrays.
+RenderMode = Literal["human", "rgb_array"]
 
 #: The tutorial's joint indices of simplecar (urdfkit's template keeps its joint order).
 _HINGES = (0, 2)
 _WHEELS = (1, 3, 4, 5)
 
 
-def _real(action: Any) -> None:
+def _real(action: object) -> None:
     """Refuse an action of complex numbers, text or objects before numpy casts it silently."""
     kind = np.asarray(action).dtype.kind if not isinstance(action, np.ndarray) else \
         action.dtype.kind
@@ -56,18 +58,18 @@ def _real(action: Any) -> None:
                          f"values: {_short(action)}")
 
 
-def _short(action: Any) -> str:
+def _short(action: object) -> str:
     text = repr(action)
     return text if len(text) <= 200 else text[:200] + f"... ({len(text):,} characters)"
 
 
-def _open(env: Any) -> None:
+def _open(env: gym.Env) -> None:
     """Refuse a call on a closed env with a clear error, not PyBullet's "Not connected"."""
     if getattr(env, "_closed", False):
         raise RuntimeError(f"this {type(env).__name__} is closed; make a new one")
 
 
-def _after_end(env: Any) -> None:
+def _after_end(env: SimpleDrivingEnv | ScenarioEnv) -> None:
     """Warn once per episode when ``step`` is called after it ended, as Gymnasium asks."""
     if getattr(env, "_ended", False) and not getattr(env, "_warned_end", False):
         import warnings
@@ -92,7 +94,7 @@ def _finite_pair(action: Any) -> tuple[float, float]:
 
 
 
-def _gui(render_mode: str | None) -> bool:
+def _gui(render_mode: RenderMode | None) -> bool:
     """Whether ``render_mode`` opens PyBullet's window: ``human`` where there is a display.
 
     Headless (CI, a cluster node), ``human`` runs without a window and says so once, rather
@@ -146,7 +148,8 @@ class SimpleDrivingEnv(gym.Env):
     GOAL_RADIUS = 1.0
     GOAL_BONUS = 50.0
 
-    def __init__(self, render_mode: str | None = None, *, camera: str = "chase",
+    def __init__(self, render_mode: RenderMode | None = None, *,
+                 camera: Literal["chase", "overview"] = "chase",
                  width: int = 320, height: int = 240, implicit_cylinder: bool = False):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(f"render_mode must be one of "
@@ -219,7 +222,7 @@ class SimpleDrivingEnv(gym.Env):
     # ---- the Gymnasium API
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
-              ) -> tuple[np.ndarray, dict[str, Any]]:
+              ) -> tuple[np.ndarray, dict[str, object]]:
         """Start an episode: the car at rest at the origin, a new goal.
 
         The goal is drawn as the tutorial draws it, from ``np_random``: x and y each from
@@ -249,7 +252,7 @@ class SimpleDrivingEnv(gym.Env):
             self._last_frame = time.perf_counter()
         return obs, {"distance": self._previous_distance}
 
-    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+    def step(self, action: object) -> tuple[np.ndarray, float, bool, bool, dict[str, object]]:
         """Apply (throttle, steer) for one 1/30 s physics step.
 
         Raises:
@@ -306,7 +309,7 @@ class SimpleDrivingEnv(gym.Env):
         return np.array((pos[0], pos[1], cos, sin, lin[0], lin[1], *self.goal),
                         dtype=np.float32)
 
-    def render(self) -> Any:  # an ndarray or None; gymnasium types it as a RenderFrame TypeVar
+    def render(self) -> np.ndarray | None:
         """An ``rgb_array`` frame (height x width x 3, uint8); None in ``human`` mode."""
         if self.render_mode != "rgb_array":
             return None
@@ -390,11 +393,13 @@ class ScenarioEnv(gym.Env):
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 30}
 
-    def __init__(self, scenario: Any, robot: str | None = None,
-                 reward: Callable[[Any], float] | None = None,
-                 terminated: Callable[[Any], bool] | None = None,
+    def __init__(self, scenario: str | Path | Mapping[str, object] | Simulation,
+                 robot: str | None = None,
+                 reward: Callable[[Observation], float] | None = None,
+                 terminated: Callable[[Observation], bool] | None = None,
                  max_episode_steps: int | None = None, frame_skip: int = 1,
-                 render_mode: str | None = None, *, observation: str = "flat",
+                 render_mode: RenderMode | None = None, *,
+                 observation: Literal["flat", "dict"] = "flat",
                  fields: Sequence[str] | None = None,
                  action_bounds: Mapping[str, tuple[float, float]] | None = None,
                  width: int = 320, height: int = 240):
@@ -566,17 +571,17 @@ class ScenarioEnv(gym.Env):
             else DEFAULT_TORQUE
         return -limit, limit
 
-    def _field_names(self, field: str, value: Any) -> list[str]:
+    def _field_names(self, field: str, value: dict[str, float] | list[float]) -> list[str]:
         if isinstance(value, dict):
             return [f"{field}.{k}" for k in value]
         axes = ("x", "y", "z", "w")[:len(value)]
         return [f"{field}.{a}" for a in axes]
 
-    def _build_observation_space(self, kind: str) -> None:
+    def _build_observation_space(self, kind: Literal["flat", "dict"]) -> None:
         first = self._observe()
         self.observation_kind = kind
         names: list[str] = []
-        boxes: dict[str, Any] = {}
+        boxes: dict[str, spaces.Space[np.ndarray]] = {}
         for f in self.fields:
             these = self._field_names(f, getattr(first, f))
             names.extend(these)
@@ -610,7 +615,7 @@ class ScenarioEnv(gym.Env):
         return np.array(out, dtype=np.float32)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
-              ) -> tuple[Any, dict[str, Any]]:
+              ) -> tuple[np.ndarray | dict[str, np.ndarray], dict[str, object]]:
         """Restore the scenario's start in place (``Simulation.reset``), then randomise.
 
         The noise is reseeded from ``np_random``, so ``reset(seed=s)`` and the same actions
@@ -653,7 +658,7 @@ class ScenarioEnv(gym.Env):
         obs = self._observe()
         return self._obs(obs), {}
 
-    def _apply(self, action: Any) -> None:
+    def _apply(self, action: np.ndarray | None) -> None:
         if action is None:
             return
         if self.controller == "drive":
@@ -667,7 +672,8 @@ class ScenarioEnv(gym.Env):
             self.sim.set_joint_targets(self.robot, {self.action_names[k]: float(action[k])
                                                     for k in ks}, mode=mode)
 
-    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+    def step(self, action: object
+             ) -> tuple[np.ndarray | dict[str, np.ndarray], float, bool, bool, dict[str, object]]:
         """Command the action (clipped to the space) for ``frame_skip`` physics steps.
 
         Raises:
@@ -679,7 +685,7 @@ class ScenarioEnv(gym.Env):
         if a.shape != self._low.shape:
             raise ValueError(f"expected an action of {len(self.action_names)} values "
                              f"({', '.join(self.action_names)}), got shape "
-                             f"{np.shape(action)}")
+                             f"{np.asarray(action).shape}")
         if not np.all(np.isfinite(a)):
             raise ValueError(f"the action must be finite, got {a.tolist()}")
         _after_end(self)
@@ -696,7 +702,7 @@ class ScenarioEnv(gym.Env):
         self._ended = done or truncated
         return self._obs(o), reward, done, truncated, {"t": o.t}
 
-    def render(self) -> Any:  # an ndarray or None; gymnasium types it as a RenderFrame TypeVar
+    def render(self) -> np.ndarray | None:
         """An ``rgb_array`` frame looking at the robot (height x width x 3, uint8)."""
         if self.render_mode != "rgb_array":
             return None
@@ -715,7 +721,7 @@ class ScenarioEnv(gym.Env):
         self.sim.close()
 
 
-def _values(value: Any) -> list[float]:
+def _values(value: dict[str, float] | list[float]) -> list[float]:
     return list(value.values()) if isinstance(value, dict) else list(value)
 
 

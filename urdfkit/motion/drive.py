@@ -32,10 +32,9 @@ from __future__ import annotations
 import math
 import tempfile
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 from urdfkit.core.errors import ParameterError, UrdfkitError
 from urdfkit.engine.session import LoadOptions, Session, quiet_stdout
@@ -362,14 +361,13 @@ class Scenario:
         start = c.base_position or (TUTORIAL_START if c.tutorial else (0.0, 0.0, 0.0))
         # The tutorial's load: no flags. Otherwise implicit cylinders (smooth wheels) and the
         # file's own inertia; see the module docstring.
-        flags: dict[str, Any] = {"implicit_cylinder": False} if c.tutorial else {
-            "inertia_from_file": True, "implicit_cylinder": True}
         self.flags = [] if c.tutorial else ["URDF_USE_IMPLICIT_CYLINDER",
                                             "URDF_USE_INERTIA_FROM_FILE"]
         # The car is loaded first (as the tutorial does), standing up where it starts; it is
         # turned to its spawn tilt only after its wheels are found in its own frame.
         self.body = self._load(s, c.urdf, "simplecar", LoadOptions(
-            base_position=start, base_orientation=upright, **flags), c.template_params)
+            base_position=start, base_orientation=upright, inertia_from_file=not c.tutorial,
+            implicit_cylinder=not c.tutorial), c.template_params)
         #: The car's file, for a viewer to load the same robot (the built-in one's build).
         self.car_file = self._last_file
         s.require_state_queries(self.body, car)
@@ -510,7 +508,7 @@ class Scenario:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def link_poses(self) -> list[tuple[Any, Any]]:
+    def link_poses(self) -> list[tuple[Sequence[float], Sequence[float]]]:
         """Every URDF link frame's world pose now, base first (``(xyz, xyzw)``)."""
         assert self.session is not None
         p, body = self.session.bullet, self.body
@@ -553,7 +551,7 @@ class Scenario:
 
         return sample
 
-    def simulated(self) -> dict[str, Any]:
+    def simulated(self) -> dict[str, object]:
         """What this run simulates, beyond the robot: for the summary and JSON."""
         c = self.config
         return {

@@ -7,18 +7,16 @@ its ``delay`` and ``history`` need), and the reported one of the step (delay, th
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from urdfkit.model.spec import quat_mul, quat_to_matrix, rotate_back, rpy_to_quat
 from urdfkit.motion.scenario import OBSERVATION_FIELDS
-from urdfkit.motion.sim_state import Observation
+from urdfkit.motion.sim_state import FootReading, Observation
 
 if TYPE_CHECKING:
     from urdfkit.motion.sim_robot import SimRobot
     from urdfkit.motion.sim_world import World
 
-#: A foot's reading: contact (0 or 1), normal (N), and world, local and friction vectors.
-FootReading = dict[str, int | float | list[float]]
 
 
 class Sensors:
@@ -193,7 +191,7 @@ class Sensors:
         if noise is None:
             return obs
         gauss = r.readings.rng.gauss
-        changes: dict[str, Any] = {}
+        changes: dict[str, object] = {}
         for name in (*OBSERVATION_FIELDS, "motor_torques"):
             std = getattr(noise, name)
             value = getattr(obs, name)

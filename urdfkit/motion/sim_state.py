@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 from urdfkit.motion.scenario import OBSERVATION_FIELDS
 
@@ -21,6 +21,9 @@ _ACTIVE = (_REVOLUTE, _PRISMATIC)
 
 
 # --------------------------------------------------------------------------- observations
+
+#: A foot's reading: contact (0 or 1), normal (N), and world, local and friction vectors.
+FootReading = dict[str, int | float | list[float]]
 
 
 @dataclass
@@ -73,11 +76,11 @@ class Observation:
     joint_forces: dict[str, list[float]] | None = None
     motor_torques: dict[str, float] | None = None
     link_poses: dict[str, dict[str, list[float]]] | None = None
-    feet: dict[str, dict[str, Any]] | None = None
+    feet: dict[str, FootReading] | None = None
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """The JSON row (optional fields only when recorded)."""
-        row: dict[str, Any] = {"t": self.t, "step": self.step, "robot": self.robot}
+        row: dict[str, object] = {"t": self.t, "step": self.step, "robot": self.robot}
         for name in OBSERVATION_FIELDS:
             value = getattr(self, name)
             row[name] = dict(value) if isinstance(value, dict) else list(value)
@@ -95,7 +98,7 @@ class Observation:
             row["feet"] = _copy_feet(self.feet)
         return row
 
-    def _replace(self, **changes: Any) -> Observation:
+    def _replace(self, **changes: object) -> Observation:
         data = {**self.__dict__, **changes}
         return Observation(**data)
 
@@ -118,7 +121,8 @@ class Observation:
             None if ft is None else _copy_feet(ft))
 
 
-def _copy_feet(feet: Mapping[str, Mapping[str, Any]]) -> dict[str, dict[str, Any]]:
+def _copy_feet(feet: Mapping[str, Mapping[str, int | float | list[float]]]
+               ) -> dict[str, FootReading]:
     return {k: {key: list(x) if isinstance(x, list) else x for key, x in v.items()}
             for k, v in feet.items()}
 
@@ -190,7 +194,7 @@ class RobotSummary:
     joint_min: dict[str, float] = field(default_factory=dict)
     joint_max: dict[str, float] = field(default_factory=dict)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """The JSON form."""
         return dict(self.__dict__)
 
@@ -219,7 +223,7 @@ class SimResult:
     row_count: int = 0
     summaries: list[RobotSummary] = field(default_factory=list)
 
-    def to_dicts(self) -> list[dict[str, Any]]:
+    def to_dicts(self) -> list[dict[str, object]]:
         """The reported rows as JSON-ready dicts."""
         return [r.to_dict() for r in self.rows]
 

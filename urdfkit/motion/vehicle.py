@@ -284,9 +284,9 @@ class Drivetrain:
             lo, hi = max(lo, lower), min(hi, upper)
         return lo, hi
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """The JSON form: names keyed by joint index, and the geometry driving used."""
-        def named(joints: list[int]) -> list[dict[str, Any]]:
+        def named(joints: list[int]) -> list[dict[str, object]]:
             return [{"index": j, "name": self.joint_names[j]} for j in joints]
 
         def r(x: float) -> float:
@@ -307,7 +307,7 @@ class Drivetrain:
         }
 
 
-def _is_continuous(info: tuple[Any, ...]) -> bool:
+def _is_continuous(info: tuple[Any, ...]) -> bool:  # getJointInfo's
     lower, upper = info[8], info[9]
     return info[2] == _REVOLUTE and (lower > upper or upper - lower >= 2 * math.pi - 1e-6)
 

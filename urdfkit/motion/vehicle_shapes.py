@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from urdfkit.model.spec import quat_to_matrix, rotate
 
@@ -68,7 +68,7 @@ def shape_points(p: Bullet, body: int, link: int) -> list[Vec]:
     return out
 
 
-def base_link_pose(p: Bullet, body: int) -> tuple[Any, Any]:
+def base_link_pose(p: Bullet, body: int) -> tuple[Sequence[float], Sequence[float]]:
     """The base link frame's world pose (PyBullet reports the base's inertial frame).
 
     With ``URDF_USE_INERTIA_FROM_FILE`` an ``<inertia>`` with products (ixy, ixz, iyz), or an
