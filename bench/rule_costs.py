@@ -30,7 +30,7 @@ from lxml import etree
 from urdfkit.checks.check import discover
 from urdfkit.checks.validate import ALL_RULES
 from urdfkit.model.xmlio import parse_xml, read_bytes, tolerate_quirks
-from urdfkit.sources.guard import Report
+from urdfkit.sources.guard import RuleReport
 
 
 def main() -> int:
@@ -45,7 +45,7 @@ def main() -> int:
         files = [f for f in files if ("random_urdfs" in f.parts) == (a.only == "random")]
     roots = [(f, parse_xml(read_bytes(f), f).getroot(), f.parent.absolute()) for f in files]
     for f, root, base in roots:  # warm the mesh memo, as a warm mesh cache would
-        r = Report(str(f), base, {})
+        r = RuleReport(str(f), base, {})
         for rule in ALL_RULES:
             rule(root, r)
 
@@ -77,7 +77,7 @@ def main() -> int:
         keep("the one walk (Doc) alone", time.perf_counter() - t)
         spent: dict[str, float] = defaultdict(float)
         for f, root, base in roots:
-            r = Report(str(f), base, {})
+            r = RuleReport(str(f), base, {})
             for rule in ALL_RULES:
                 t = time.perf_counter()
                 rule(root, r)

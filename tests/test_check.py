@@ -87,6 +87,9 @@ CASES = [
                  '<mimic joint="j2"/><!--HERE-->', "</joint>",
                  '<joint name="j2" type="continuous"><parent link="b"/><child link="c"/>',
                  '<mimic joint="j1"/>', "</joint>")),
+    ("U310", doc(A, B, link("c"), joint("j1", "a", "b"),
+                 '<joint name="j2" type="continuous"><parent link="a"/><child link="c"/>',
+                 '<mimic joint="j1" multiplier="-1"/><!--HERE-->', "</joint>")),
     ("U401", doc(A, B, '<joint name="j" type="fixed"><parent link="a"/><child link="b"/>',
                  '<origin xyz="0 nan 0"/><!--HERE-->', "</joint>")),
     ("U402", doc(A, B, '<joint name="j" type="fixed"><parent link="a"/><child link="b"/>',
@@ -164,6 +167,7 @@ CASES = [
     ("U801", doc(link("a", body=BOX + "\n<colision/><!--HERE-->\n"))),
     ("U802", doc(link("a", body='<collision><geometry>\n<box size="1 1 1" colour="red"/>'
                                 '<!--HERE-->\n</geometry></collision>'))),
+    ("U803", doc(A, '<gazebo reference="a"><!--HERE-->\n<mu1>0.9</mu1></gazebo>')),
     ("U901", doc(A, B, joint(jtype="spherical", inner="") + "<!--HERE-->")),
 ]
 
@@ -176,8 +180,9 @@ def _line(text: str) -> int:
 # (a .urdf holding xacro) in tests/test_build_unseen.py.
 def test_every_code_has_a_case() -> None:
     # U950 and U951 need PyBullet (check --physics): tests/test_collisions.py.
+    # U010 (a fragment) needs its includer in the run: tests/test_fragments.py.
     tested = {code for code, _ in CASES} | {"U000", "U004", "U006", "U007", "U008", "U009",
-                                            "U208", "U209", "U950", "U951"}
+                                            "U010", "U208", "U209", "U950", "U951"}
     assert tested == set(CODES)
 
 
@@ -271,7 +276,10 @@ def test_pybullet_extensions_are_not_unknown(tmp_path: Path) -> None:
                        '<capsule radius="0.1" length="0.2"/></geometry></collision>'),
         '<gazebo reference="a"><mu1>0.2</mu1><anything/></gazebo>',
         '<transmission name="t"><type>x</type></transmission>'))
-    assert not [f for f in check_file("ext.urdf", path).findings if f.code.startswith("U8")]
+    found = check_file("ext.urdf", path).findings
+    assert not [f for f in found if f.code in ("U801", "U802")]
+    # The Gazebo friction differs from the link's own <contact>: PyBullet uses the latter.
+    assert [f.code for f in found if f.code.startswith("U8")] == ["U803"]
 
 
 def test_guard_rules_are_a_subset_of_check() -> None:

@@ -119,6 +119,50 @@ def test_build_validates_the_result_before_writing(runner: CliRunner, in_tmp: Pa
     assert not (in_tmp / "tworoots.urdf").exists()
 
 
+#: A xacro whose collision mesh is missing, and one whose inertial has no <inertia>: raw
+#: p.loadURDF refuses both; and one with only an error PyBullet loads (a negative mass).
+_LINK = ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="a">{}'
+         '</link></robot>')
+_BUILDS = {
+    "mesh": _LINK.format('<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" '
+                        'iyz="0" izz="1"/></inertial><collision><geometry><mesh '
+                        'filename="meshes/gone.stl"/></geometry></collision>'),
+    "inertia": _LINK.format('<inertial><mass value="1"/></inertial>'),
+    "loads": _LINK.format('<inertial><mass value="-1"/><inertia ixx="1" ixy="0" ixz="0" '
+                          'iyy="1" iyz="0" izz="1"/></inertial>'),
+}
+
+
+@pytest.mark.parametrize("case", sorted(_BUILDS))
+def test_build_writes_only_what_pybullet_loads(runner: CliRunner, in_tmp: Path, pb,
+                                               case: str) -> None:
+    """Written means raw loadURDF takes it; refused (exit 1, nothing written) means it does not."""
+    p, c = pb
+    source = in_tmp / f"{case}.urdf.xacro"
+    source.write_text(_BUILDS[case])
+    plain = in_tmp / f"{case}_plain.urdf"  # the same robot as raw PyBullet would be handed it
+    plain.write_text(_BUILDS[case])
+    try:
+        p.loadURDF(str(plain), physicsClientId=c)
+        loads = True
+    except p.error:
+        loads = False
+    result = runner.invoke(app, ["build", source.name])
+    written = in_tmp / f"{case}.urdf"
+    if loads:
+        assert result.exit_code == 0 and "PyBullet loads it as written" in result.output
+        p.loadURDF(str(written), physicsClientId=c)  # and it does
+    else:
+        # 2: the guard's refusal (what crashes or fails PyBullet); 1: what PyBullet refuses.
+        assert result.exit_code in (1, 2), result.output
+        assert "loads it as written" not in result.output
+        if case == "mesh":
+            assert result.exit_code == 1 and "PyBullet refuses the expanded file" in \
+                result.output and "gone.stl" in result.output
+        assert not written.exists()
+    assert loads == (case == "loads")
+
+
 def test_xacro_expansion_is_time_limited(in_tmp: Path) -> None:
     from urdfkit.core.errors import InputError
     from urdfkit.sources.resolve import expand_xacro

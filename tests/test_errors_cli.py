@@ -23,7 +23,7 @@ from urdfkit.motion.drive import DriveConfig
 runner = CliRunner()
 
 COMMANDS = ["build", "templates", "joints", "links", "tree", "info", "check", "drive",
-            "render", "sim"]
+            "render", "sim", "export", "agree"]
 
 
 def invoke(*args: str, env: dict[str, str] | None = None) -> tuple[int, str, str]:

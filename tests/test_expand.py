@@ -127,6 +127,29 @@ def test_unknown_arg_names_get_a_suggestion(tmp_path: Path) -> None:
     assert b'name="a2"' in expand_xacro(path, {"wheel_radius": "2"}, timeout=20)
 
 
+def test_an_empty_arg_keeps_the_default_as_xacros_command_line(tmp_path: Path) -> None:
+    """``--arg namespace:=`` is xacro's ``namespace:=``: the file's default, not ""."""
+    import shutil
+    import subprocess
+    import sys
+
+    path = tmp_path / "ns.urdf.xacro"
+    path.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                    '<xacro:arg name="namespace" default="dflt_"/>'
+                    '<link name="$(arg namespace)base"/></robot>')
+    xacro = shutil.which("xacro", path=os.path.dirname(sys.executable)) or shutil.which("xacro")
+    assert xacro is not None  # the xacro package urdfkit depends on installs it
+    theirs = subprocess.run([xacro, str(path), "namespace:="], capture_output=True, text=True,
+                            timeout=60, check=True).stdout
+    assert 'name="dflt_base"' in theirs
+    assert b'name="dflt_base"' in expand_xacro(path, {"namespace": ""}, timeout=20)
+    out = tmp_path / "out.urdf"
+    result = runner.invoke(app, ["build", str(path), "-o", str(out), "--arg", "namespace:="])
+    assert result.exit_code == 0, result.stderr
+    assert 'name="dflt_base"' in out.read_text()
+    assert b'name="x_base"' in expand_xacro(path, {"namespace": "x_"}, timeout=20)
+
+
 # --------------------------------------------------------------------------- no exec
 
 

@@ -277,3 +277,36 @@ def test_a_frame_with_frames_below_gets_mass_0(tmp_path: Path) -> None:
 
     root = etree.fromstring(result.fixed)
     assert [m.get("value") for m in root.iter("mass")] == ["5", "0", "0"]
+
+
+def test_docs_u606_row_matches_the_code_and_help(broken: Path) -> None:
+    """docs/fix.md's U606 says what fix does: no mass invented without --density."""
+    docs = (Path(__file__).parent.parent / "docs" / "fix.md").read_text()
+    row = next(line for line in docs.splitlines() if line.startswith("| `U606` |"))
+    assert "only with `--density" in row and "invents no mass" in row
+    assert "(1000 kg/m^3, water)" not in row  # once the doc's default; the code has none
+    code, out, _ = _cli("fix", "--help")
+    assert "Without it fix invents no mass" in " ".join(out.replace("\u2502", " ").split())
+    left = fix_file(broken)  # no density: the shaped link 'cube' is left, said why
+    assert any(r.code == "U606" and "'cube'" in r.message for r in left.left)
+    done = fix_file(broken, density=1000.0)  # 0.1 m cube of water: 1 kg
+    cube = next(r for r in done.repairs if r.code == "U606" and "'cube'" in r.message)
+    assert "1 kg (0.001 m^3 at 1000 kg/m^3)" in cube.message
+
+
+@pytest.mark.parametrize("name", ["or\tange", "a\nb", "c\rd", " e "])
+def test_whitespace_in_a_material_name_is_written_back_exactly(tmp_path: Path,
+                                                               name: str) -> None:
+    """A name holding a tab or line break (a character reference in the file) is defined
+    under that very name: a literal tab in the attribute would read back as a space."""
+    from lxml import etree
+
+    ref = name.replace("\t", "&#9;").replace("\n", "&#10;").replace("\r", "&#13;")
+    path = tmp_path / "ws.urdf"
+    path.write_text(f'<robot name="r"><link name="a"><visual><geometry><box size="1 1 1"/>'
+                    f'</geometry><material name="{ref}"/></visual></link></robot>')
+    code, out, err = _cli("fix", str(path), "-o", str(tmp_path / "out.urdf"), "--json")
+    assert code in (0, 1), err
+    assert [f["code"] for f in json.loads(out)["fixes"]] == ["U706"]
+    root = etree.parse(str(tmp_path / "out.urdf")).getroot()
+    assert [m.get("name") for m in root.iter("material")] == [name, name]

@@ -18,9 +18,10 @@ from make_corpus import make_corpus  # noqa: E402
 
 #: Command -> extra arguments ({file} is replaced by the corpus file; else it comes first).
 COMMANDS: dict[str, list[str]] = {
-    "check": [], "joints": [], "links": [], "tree": [], "info": [],
+    "check": [], "joints": [], "links": [], "tree": [], "info": [], "fix": ["{file}", "--diff"],
     "drive": ["--urdf", "{file}", "--steps", "5"],
     "render": ["{file}", "--size", "64x48", "--force", "-o", "{out}"],
+    "export": ["mjcf", "{file}", "--force", "-o", "{xml}"],
 }
 PASSWD_MARK = "root:x:0:0"
 
@@ -43,7 +44,8 @@ def test_command_survives_corpus(command: str, corpus: tuple[Path, dict[str, str
     assert command in _registered(), f"`urdfkit {command}` is not registered"
     folder, expected = corpus
     files = [str(folder / name) for name in sorted(expected)]
-    extra = [a.replace("{out}", str(tmp_path / "out.png")) for a in COMMANDS[command]]
+    extra = [a.replace("{out}", str(tmp_path / "out.png"))
+             .replace("{xml}", str(tmp_path / "out.xml")) for a in COMMANDS[command]]
     log = tmp_path / "log.jsonl"
     proc = subprocess.run(
         [sys.executable, str(HERE / "run_commands.py"), str(log), command, *files, "--", *extra],

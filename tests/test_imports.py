@@ -58,7 +58,8 @@ def test_piped_joints_table_needs_no_rich(simplecar_urdf: Path) -> None:
     proc, modules = loaded_modules("joints", str(simplecar_urdf), top_level=False)
     assert "base_to_right_back_wheel" in proc.stdout and "│" not in proc.stdout
     assert "rich" not in modules
-    imported = {"urdfkit.engine.body", "urdfkit.draw.tree", "urdfkit.builder"}
+    imported = {"urdfkit.engine.body", "urdfkit.draw.tree", "urdfkit.builder",
+                "urdfkit.model.robot"}
     assert modules.isdisjoint(imported), modules
 
 

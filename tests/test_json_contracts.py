@@ -116,6 +116,9 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     runs["fix"] = ["fix", str(tmp / "broken.urdf"), "-o", str(tmp / "fixed.urdf"), "--json",
                    "--allow-mass-change"]
     runs["sweep"] = ["sweep", "drive", "--steps", "5", "--vary", "steer=0.1,0.2", "--json"]
+    # r2d2: fixed links (sites), meshes (paths), notes of every common kind
+    runs["export"] = ["export", "mjcf", "r2d2.urdf", "-o", str(tmp / "r2d2.xml"), "--json"]
+    runs["agree"] = ["agree", "r2d2.urdf", str(tmp / "r2d2.xml"), "--json", "--poses", "5"]
     out = {}
     for name, args in runs.items():
         result = CliRunner().invoke(app, args)
@@ -126,7 +129,8 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
 def test_every_json_command_is_documented() -> None:
     assert set(contracts()) == {"joints", "links", "info", "tree", "templates", "check",
-                                "drive", "render", "sim", "diff", "collisions", "fix", "sweep"}
+                                "drive", "render", "sim", "diff", "collisions", "fix", "sweep",
+                                "export", "agree"}
 
 
 @pytest.mark.parametrize("command", sorted(contracts()))

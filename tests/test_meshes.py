@@ -133,7 +133,7 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     path = tmp_path / "box.obj"
     path.write_text(box_obj((1.0, 2.0, 3.0)))
     check_box(meshstore.properties(path), (1.0, 2.0, 3.0))
-    entries = list((tmp_path / "cache" / "meshes-4").iterdir())
+    entries = list((tmp_path / "cache" / "meshes-5").iterdir())
     assert len(entries) == 1
     # A new process (empty memory) reads the entry, not the mesh.
     monkeypatch.setattr(meshstore, "_MEMORY", {})
@@ -151,12 +151,12 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     os.utime(path, ns=(1, 1))
     check_box(meshstore.properties(path), (3.0, 2.0, 1.0))
     # A damaged entry is read past and rewritten.
-    for entry in (tmp_path / "cache" / "meshes-4").iterdir():
+    for entry in (tmp_path / "cache" / "meshes-5").iterdir():
         entry.write_bytes(b"garbage")
     monkeypatch.setattr(meshstore, "_MEMORY", {})
     check_box(meshstore.properties(path), (3.0, 2.0, 1.0))
-    good = [e for e in (tmp_path / "cache" / "meshes-4").iterdir()
-            if e.read_bytes().startswith(b"M4")]
+    good = [e for e in (tmp_path / "cache" / "meshes-5").iterdir()
+            if e.read_bytes().startswith(b"M5")]
     assert len(good) == 1  # the current key's, rewritten (the first box's stays unused)
 
 
@@ -274,7 +274,7 @@ def test_a_run_s_pack_serves_the_next_run_and_follows_edits(
     packs = list((tmp_path / "cache" / "mesh-packs-2").iterdir())
     assert len(packs) == 1
     # The next run reads the pack alone: no entry file, no mesh.
-    for entry in (tmp_path / "cache" / "meshes-4").iterdir():
+    for entry in (tmp_path / "cache" / "meshes-5").iterdir():
         entry.unlink()
     _new_process(monkeypatch)
 

@@ -27,6 +27,8 @@ URDF_COMMANDS = [
     ["render", "{F}", "-o", "{D}/out.png"], ["collisions", "{F}"],
     ["fix", "{F}", "-o", "{D}/fixed.urdf"], ["diff", "{F}", "{GOOD}"], ["diff", "{GOOD}", "{F}"],
     ["drive", "--urdf", "{F}", "--steps", "5"],
+    ["export", "mjcf", "{F}", "-o", "{D}/out.xml"], ["agree", "{F}", "{D}/none.xml"],
+    ["agree", "{GOOD}", "{F}"],
     ["sweep", "drive", "--urdf", "{F}", "--steps", "5", "--vary", "throttle=1,2", "--jobs", "1"],
 ]
 SCENARIO_COMMANDS = [

@@ -217,7 +217,7 @@ class SimpleDrivingEnv(gym.Env):
                                              baseVisualShapeIndex=shape,
                                              basePosition=[0.0, 0.0, 0.5])
         self._start = p.saveState()
-        prime_resets(s.p, s.client, self._start, [self.car])
+        prime_resets(p, self._start, [self.car])
 
     # ---- the Gymnasium API
 
@@ -232,7 +232,7 @@ class SimpleDrivingEnv(gym.Env):
         super().reset(seed=seed)
         self._ended = self._warned_end = False
         p = self._p
-        restore_clean(self._session.p, self._session.client, self._start, [self.car])
+        restore_clean(p, self._start, [self.car])
         goal = (options or {}).get("goal")
         if goal is not None:
             gx, gy = _finite_pair(goal)

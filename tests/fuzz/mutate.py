@@ -19,7 +19,12 @@ from lxml import etree
 NUMERIC_VALUES = ["nan", "inf", "-inf", "1e308", "-1e308", "", "abc", "1e-320", "0", "-1",
                   "1 2", "NaN inf 0", "1e309"]
 NAME_VALUES = ["a" * 1001, "b" * 1300, "c" * 2500, "é" * 700, "ロ" * 800, "%s%n", "%x%x%x%n",
-               "name with spaces", "ü" * 300, "\u202e", "x" * 50000]
+               "name with spaces", "ü" * 300, "\u202e", "x" * 50000,
+               # whitespace XML reads back only through character references (fix once
+               # exited 3 writing a tab into a material name)
+               "tab\there", "line\nbreak", "cr\rhere", " lead and trail ", "\t"]
+#: Whitespace-bearing names for materials.
+WHITESPACE_NAMES = ["or\tange", "a\nb", "c\rd", " e ", "\t\n"]
 
 
 @dataclass
@@ -87,6 +92,20 @@ def m_robot_name(root: etree._Element, rng: random.Random) -> str:
     value = rng.choice(NAME_VALUES)
     root.set("name", value)
     return f"robot name ({len(value)} chars)"
+
+
+def m_material_name(root: etree._Element, rng: random.Random) -> str:
+    """A material name holding a tab, a line break or edge spaces (every use renamed, or a
+    visual's material renamed alone: then it is used but never defined)."""
+    materials = [el for el in root.iter("material") if el.get("name")]
+    if not materials:
+        return "no material to rename"
+    old, new = rng.choice(materials).get("name"), rng.choice(WHITESPACE_NAMES)
+    every = rng.random() < 0.5
+    for el in materials:
+        if el.get("name") == old and (every or el.getparent() is not root):
+            el.set("name", new)
+    return f"material {old!r} renamed to {new!r}" + ("" if every else " in its uses only")
 
 
 def m_joint_type(root: etree._Element, rng: random.Random) -> str:
@@ -161,7 +180,7 @@ def m_mesh(root: etree._Element, rng: random.Random) -> str:
 
 TREE_MUTATIONS: list[Callable[[etree._Element, random.Random], str]] = [
     m_number, m_number, m_number, m_link_name, m_joint_name, m_robot_name, m_joint_type,
-    m_delete, m_duplicate, m_move, m_nest, m_mesh]
+    m_delete, m_duplicate, m_move, m_nest, m_mesh, m_material_name]
 
 
 def mutate(seed_name: str, data: bytes, rng: random.Random) -> Mutant:

@@ -38,6 +38,7 @@ def commands(file: str) -> list[list[str]]:
         ["drive", "--urdf", file, "--steps", "24", "--json"], ["sim", "scenario.json", "--json"],
         ["fix", file, "-o", "fixed.urdf", "--force", "--json"], ["fix", file, "--diff"],
         ["diff", file, "fixed.urdf", "--json"], ["collisions", file, "--samples", "4", "--json"],
+        ["export", "mjcf", file, "-o", "out.xml", "--force", "--json"],
         ["sweep", "drive", "--urdf", file, "--steps", "12", "--vary", "throttle=1,2",
          "--jobs", "1", "--json"],
         ["sweep", "sim", "scenario.json", "--vary", "duration=0.02,0.04", "--jobs", "1",

@@ -90,6 +90,17 @@ def cases() -> dict[str, tuple[str | bytes, str]]:
         "long_joint_name.urdf": (robot(TWO + joint("j" * 5000, "a", "b")), "error"),
         "name_1000.urdf": (robot(link("a") + link("b" * 1000) + joint("j" * 1000, "a",
                                                                       "b" * 1000)), "ok"),
+        # Whitespace inside names, as character references (a literal tab or newline in an
+        # attribute is read as a space): fix once exited 3 defining such a material.
+        "tab_material.urdf": (robot(link("a", extra='<visual><geometry><box size="1 1 1"/>'
+                                         '</geometry><material name="or&#9;ange"/></visual>')),
+                              "ok"),
+        "newline_material.urdf": (robot(
+            '<material name="a&#10;b"><color rgba="1 0 0 1"/></material>'
+            + link("a", extra='<visual><geometry><box size="1 1 1"/></geometry>'
+                              '<material name="a&#10;b"/></visual>')), "ok"),
+        "tab_names.urdf": (robot(link("a&#9;b") + link(" c ") + joint("j&#13;k", "a&#9;b",
+                                                                      " c ")), "ok"),
         # --- size
         "chain_127.urdf": (chain(127), "ok"),
         "chain_200.urdf": (chain(200), "error"),

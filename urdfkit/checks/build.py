@@ -4,8 +4,9 @@ A template is built by urdfkit's own model, strictly. A xacro file is expanded a
 PyBullet would load it: what would crash PyBullet (the guard's refusals) is refused, with the
 file and line it was written on; every other ``check`` error (an inertia that is not positive
 definite, a mass of 0 on a moving link) is reported as a warning and the file is written, as
-PyBullet loads it. ``strict`` makes such errors refuse the build instead (exit 1, nothing
-written).
+PyBullet loads it. What PyBullet would refuse to load (a missing mesh, an ``<inertial>``
+without ``<inertia>``: :data:`PYBULLET_REFUSES`) is never written (exit 1). ``strict`` makes
+every error refuse the build (exit 1, nothing written).
 """
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from lxml import etree
 
 from urdfkit.checks.validate import ALL_RULES
 from urdfkit.core.errors import InputError, ParameterError
@@ -126,6 +129,20 @@ def _build_xacro(source: Path, target: str, args: Mapping[str, str],
     findings = run_rules(root, target, ALL_RULES, base=source.resolve().parent,
                          packages=packages, origins=origins)
     errors = [f for f in findings if f.level == "error"]
+    unloadable = _unloadable(root, source.resolve().parent, packages)
+    refused_too = [f for f in errors if f.code in PYBULLET_REFUSES]
+    if unloadable is not None or refused_too:
+        if unloadable is not None:
+            code, text = unloadable
+            # check reported it too, with where it was written (xacro's origin)
+            same = next((f for f in errors if f.code == code and f.message == text), None)
+            message, at = f"{text} ({code})", _where(same) if same else target
+        else:
+            message, at = f"{refused_too[0].message} ({refused_too[0].code})", \
+                _where(refused_too[0])
+        raise BuildFindings(f"PyBullet refuses the expanded file: {message}; nothing written "
+                            "(a mesh in another package: --package NAME=PATH or "
+                            "--package-path)", file=at)
     if strict and errors:
         f = errors[0]
         more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
@@ -137,11 +154,43 @@ def _build_xacro(source: Path, target: str, args: Mapping[str, str],
             default += ".urdf"
     else:  # a .urdf holding xacro: never the input's own name
         default = f"{source.stem}.expanded.urdf"
+    # Every error left is one PyBullet loads the file with (those it refuses are refused
+    # above, measured against raw loadURDF in tests/test_cli_build.py).
     warnings = [f"{_where(f)}: {f.message} ({f.code}); PyBullet loads it as written"
                 for f in errors]
     links = sum(1 for el in root if el.tag == "link")
     joints = sum(1 for el in root if el.tag == "joint")
     return BuildResult(to_bytes(root), default, links, joints, warnings)
+
+
+#: check's error codes for what makes ``p.loadURDF`` fail outright (docs/check.md): a
+#: ``<geometry>`` without a shape or not first, a ``<visual>``/``<collision>`` without
+#: ``<geometry>``, an ``<inertial>`` without (a whole) ``<inertia>``, a visual's material
+#: without a name, a revolute/prismatic joint without ``<limit>``. Files are judged apart
+#: (:func:`_unloadable`), as the loaders judge them.
+PYBULLET_REFUSES = frozenset({"U110", "U302", "U502", "U505", "U506", "U609", "U610"})
+
+
+def _unloadable(root: etree._Element, base: Path, packages: Mapping[str, Path] | None
+                ) -> tuple[str, str] | None:
+    """(code, message) of the first file reference PyBullet refuses the URDF for, else None.
+
+    The loaders' rule (:func:`urdfkit.sources.resolve.resolve`): a mesh or SDF that is missing,
+    not a regular file or in a format PyBullet does not read, or any reference to an unknown
+    package or a FIFO/device; a missing texture is drawn without.
+    """
+    from urdfkit.model.spec import FILE_SHAPES, FILE_TAGS, ignored_shape
+    from urdfkit.sources.guard import reference
+
+    for el in root.iter(*FILE_TAGS):
+        fn = (el.get("filename") or "").strip()
+        if not fn or ignored_shape(el):
+            continue
+        ref = reference(el.tag, fn, base, packages)
+        if ref.level == "error" and ref.code is not None and (
+                el.tag in FILE_SHAPES or ref.code in ("U702", "U704")):
+            return ref.code, ref.message
+    return None
 
 
 def write_output(path: str, data: bytes, *, force: bool) -> Path:

@@ -10,6 +10,7 @@ loaded: checking is pure lxml, which is what makes it safe on hostile input and 
 from __future__ import annotations
 
 import os
+import re
 import sys
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -27,6 +28,7 @@ from urdfkit.model.xmlio import (
     long_line,
     parse_xml,
     read_bytes,
+    read_regular,
     tolerate_quirks,
     xacro_marker,
     xacro_note,
@@ -489,6 +491,7 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
         if store is not None:
             store.trim()  # new entries were written: keep the folder under its cap
     done = [fr for fr in results if fr is not None]
+    _judge_fragments(done, files, packages)
     sel, ign = tuple(select), tuple(ignore)
     noted = False
     for fr in done:
@@ -502,6 +505,83 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
                 kept.append(f)
         fr.findings = kept
     return CheckResult(done)
+
+
+#: What a file that is not a robot on its own gets: a fragment has no name, no links, or
+#: joints to links another file defines, or more than one root.
+_NOT_A_ROBOT = frozenset({"U002", "U003", "U201", "U202", "U205", "U206"})
+#: ``<xacro:include filename="...">`` (any prefix bound to xacro; either quote).
+_INCLUDE = re.compile(rb"<\s*[A-Za-z_][\w.-]*:include\b[^>]*?\bfilename\s*=\s*"
+                      rb"(?:\"([^\"]*)\"|'([^']*)')")
+#: The substitutions an include's filename may hold that can be worked out without xacro.
+_SUBST = re.compile(r"\$\((find|optenv|env)\s+([^\s()]+)(?:\s+((?:[^()]|\([^()]*\))*))?\)")
+
+
+def _judge_fragments(done: list[FileResult], files: Sequence[tuple[str, str, str | None]],
+                     packages: Mapping[str, Path] | None) -> None:
+    """A file another checked file includes, and that is no robot alone, is a fragment (U010).
+
+    Clearpath's ``empty.urdf`` placeholders and Sawyer's ``*.gazebo.xacro`` are pieces of the
+    robot their includer builds: checked alone they have no name, no links, or joints to
+    links defined elsewhere. Their includer's check covers them; they get one note.
+    """
+    by_path = {os.path.abspath(path): n for n, (_, path, problem) in enumerate(files)
+               if problem is None}
+    if len(by_path) < 2:
+        return
+    includers: dict[int, str] = {}
+    for n, (display, path, problem) in enumerate(files):
+        if problem is not None:
+            continue
+        if any(f.code == "U000" for f in done[n].findings):
+            continue  # unreadable, or not XML: nothing to follow
+        try:  # never a FIFO or device (opened non-blocking, refused unless regular)
+            data = read_regular(path, track=False)
+        except InputError:
+            continue
+        if b"include" not in data:
+            continue
+        folder = os.path.dirname(os.path.abspath(path))
+        for m in _INCLUDE.finditer(data):
+            raw = (m.group(1) or m.group(2) or b"").decode("utf-8", "replace")
+            target = _include_target(raw, folder, packages)
+            k = by_path.get(target) if target is not None else None
+            if k is not None and k != n:
+                includers.setdefault(k, display)
+    for k, includer in includers.items():
+        fr = done[k]
+        if any(f.code in _NOT_A_ROBOT for f in fr.findings):
+            fr.findings = [Finding("U010", "info", f"a fragment, not a robot: {includer} "
+                                   "includes it (xacro:include), and its links and joints are "
+                                   "checked through that file", fr.file)]
+
+
+
+def _include_target(raw: str, folder: str, packages: Mapping[str, Path] | None) -> str | None:
+    """The absolute path an include's filename names, or None where xacro alone can say."""
+    from urdfkit.sources.uris import find_package
+
+    def sub(m: re.Match[str]) -> str:
+        kind, name, rest = m.group(1), m.group(2), (m.group(3) or "").strip()
+        if kind == "find":
+            found = (packages or {}).get(name) or find_package(name, Path(folder))
+            if found is None:
+                raise LookupError(name)
+            return str(found)
+        value = os.environ.get(name)
+        if value is None:
+            if kind == "env" or not rest:
+                raise LookupError(name)
+            return _SUBST.sub(sub, rest)
+        return value
+
+    try:
+        text = _SUBST.sub(sub, raw.strip())
+    except LookupError:
+        return None
+    if not text or "$" in text:
+        return None  # ${...} or $(arg ...): only xacro knows
+    return os.path.abspath(os.path.join(folder, text))
 
 
 def _manifest(paths: Sequence[str], packages: Mapping[str, str], no_exec: bool,

@@ -1,9 +1,8 @@
 """``urdfkit check --format sarif|junit|github``: findings in the shapes CI systems read.
 
 Each function turns a :class:`urdfkit.checks.check.CheckResult` into a document and returns it;
-:func:`urdfkit.commands.present.check_output` writes it. Nothing here prints, styles or imports
-rich:
-these formats go to files and logs, and must parse whatever the terminal.
+:func:`urdfkit.commands.present.check_formatted` writes it. Nothing here prints, styles or
+imports rich: these formats go to files and logs, and must parse whatever the terminal.
 
 - SARIF 2.1.0, for GitHub code scanning (``github/codeql-action/upload-sarif``) and other
   SARIF viewers.
@@ -20,16 +19,17 @@ from __future__ import annotations
 
 import os
 import re
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 from urdfkit import __version__
-from urdfkit.core.finding import LEVELS
+from urdfkit.core.finding import LEVELS, Level
 
 if TYPE_CHECKING:
     from urdfkit.checks.check import CheckResult
 
 #: Every ``check --format``.
-FORMATS = ("text", "json", "sarif", "junit", "github")
+CheckFormat = Literal["text", "json", "sarif", "junit", "github"]
+FORMATS: tuple[CheckFormat, ...] = ("text", "json", "sarif", "junit", "github")
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = ("https://docs.oasis-open.org/sarif/sarif/v2.1.0/errata01/os/schemas/"
@@ -165,7 +165,7 @@ def xml_safe(text: str) -> str:
     return re.sub(_NOT_XML, escape, text)
 
 
-def junit_xml(result: CheckResult, fail_on: str = "error") -> str:
+def junit_xml(result: CheckResult, fail_on: Level = "error") -> str:
     """``result`` as a JUnit XML document: one ``<testcase>`` per file checked.
 
     A file fails when it has findings at or above ``fail_on``, exactly the files that make

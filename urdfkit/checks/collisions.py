@@ -34,8 +34,8 @@ from typing import Any
 from lxml import etree
 
 from urdfkit.core.errors import InputError, ParameterError
-from urdfkit.engine.session import LoadOptions, Session
-from urdfkit.inspect import JointInfo, base_link_name, joint_table, pose_joints
+from urdfkit.engine.joints import JointInfo, base_link_name, joint_table, pose_joints
+from urdfkit.engine.session import Bullet, LoadOptions, Session
 from urdfkit.model.spec import ignored_shape
 from urdfkit.model.xmlio import children, line_of
 from urdfkit.sources.resolve import Resolved
@@ -184,7 +184,7 @@ def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = 
     read_as = _refuse_non_finite(resolved)
     _refuse_mimic_cycles(resolved)
     with Session() as s:
-        p, c = s.p, s.client
+        bullet = s.bullet
         # Without URDF_USE_SELF_COLLISION, getClosestPoints(body, body, 0, a, b) finds nothing
         # even for links 10 mm deep in each other (PyBullet 3.2.7).
         body = s.load_urdf(resolved.load_path, LoadOptions(fixed_base=True, self_collision=True),
@@ -193,9 +193,9 @@ def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = 
         table = joint_table(s, body, resolved.root)
         names = [base_link_name(s, body)] + [j.link_name for j in table]
         warnings: list[str] = list(read_as)
-        pose_joints(p, c, body, table, pinned, warnings, resolved.name)
+        pose_joints(bullet, body, table, pinned, warnings, resolved.name)
         sampler = _Sampler(table, resolved.root, pinned, warnings)
-        sampler.follow(p, c, body, sampler.start())  # mimic joints follow at the start too
+        sampler.follow(bullet, body, sampler.start())  # mimic joints follow at the start too
         shaped = [i for i in range(-1, len(table))
                   if s.call("getCollisionShapeData", body, i)]
         without = [names[i + 1] for i in range(-1, len(table)) if i not in set(shaped)]
@@ -210,11 +210,12 @@ def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = 
         rng = np.random.default_rng(seed)
         closest: dict[tuple[int, int], float] = {}
         hits: dict[tuple[int, int], int] = {}
+        closest_points = bullet.getClosestPoints  # bound once, outside the loop
         for pose in range(samples + 1):
             if pose:
-                sampler.pose(p, c, body, rng)
+                sampler.pose(bullet, body, rng)
             for a, b in tested:
-                points = p.getClosestPoints(body, body, margin, a, b, physicsClientId=c)
+                points = closest_points(body, body, margin, a, b)
                 if not points:
                     continue
                 d = min(x[8] for x in points)
@@ -373,23 +374,23 @@ class _Sampler:
         return {leader: self.pinned.get(leader, 0.0) for _, leader, _, _ in self.mimic
                 if leader not in followers}
 
-    def follow(self, p: Any, c: int, body: int, values: dict[int, float]) -> None:
+    def follow(self, bullet: Bullet, body: int, values: dict[int, float]) -> None:
         """Set each mimic joint from its leader's position in ``values``."""
         for i, leader, mult, offset in self.mimic:  # leaders first: a chain follows through
             if leader in values:
                 values[i] = mult * values[leader] + offset
-                p.resetJointState(body, i, values[i], physicsClientId=c)
+                bullet.resetJointState(body, i, values[i])
 
-    def pose(self, p: Any, c: int, body: int, rng: Any) -> None:
+    def pose(self, bullet: Bullet, body: int, rng: Any) -> None:
         values: dict[int, float] = dict(self.pinned)
         for i, low, high in self.free:
             values[i] = float(rng.uniform(low, high))
-            p.resetJointState(body, i, values[i], physicsClientId=c)
+            bullet.resetJointState(body, i, values[i])
         for i in self.spherical:
             q = rng.normal(size=4)
             q = q / (float((q * q).sum()) ** 0.5 or 1.0)  # uniform over rotations
-            p.resetJointStateMultiDof(body, i, [float(x) for x in q], physicsClientId=c)
-        self.follow(p, c, body, values)
+            bullet.resetJointStateMultiDof(body, i, [float(x) for x in q])
+        self.follow(bullet, body, values)
 
 
 def _concave_links(resolved: Resolved, packages: Mapping[str, Path] | None) -> set[str]:
@@ -410,7 +411,6 @@ def _concave_links(resolved: Resolved, packages: Mapping[str, Path] | None) -> s
                 continue
             scale = attr_vec(mesh, "scale", 3, (1.0, 1.0, 1.0)) or (1.0, 1.0, 1.0)
             props = properties(Path(target), (scale[0], scale[1], scale[2]), concavity=True)
-            if props is not None and props.closed and \
-                    props.concavity > CONCAVE_FRACTION * max(props.extent):
+            if props is not None and props.concavity > CONCAVE_FRACTION * max(props.extent):
                 out.add(link.get("name", ""))
     return out

@@ -36,11 +36,16 @@ import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
-from urdfkit.builder import Joint, Link, Material, Robot
 from urdfkit.core.errors import ModelError, ParameterError
+from urdfkit.model.robot import Joint, Link, Material, Robot
 from urdfkit.model.spec import AXIS_JOINT_TYPES, URDF_JOINT_DOF
+
+#: What a change is about: a link, a joint, or the robot itself (its name).
+ChangeKind = Literal["link", "joint", "robot"]
+#: What a robot has one of and another may not: a link or a joint.
+ElementKind = Literal["link", "joint"]
 
 #: Default float tolerance, absolute and relative: values this close are equal.
 DEFAULT_TOLERANCE = 1e-9
@@ -81,7 +86,7 @@ class Change:
         new: The second robot's value.
     """
 
-    kind: str
+    kind: ChangeKind
     name: str
     field: str
     old: Any
@@ -97,7 +102,7 @@ class Change:
 class Rename:
     """A link or joint matched by structure under a new name."""
 
-    kind: str
+    kind: ElementKind
     old: str
     new: str
 
@@ -117,7 +122,7 @@ class Element:
         type: A joint's type (None for links).
     """
 
-    kind: str
+    kind: ElementKind
     name: str
     index: int | None = None
     type: str | None = None
@@ -224,7 +229,7 @@ class DiffResult:
     def to_dict(self) -> dict[str, Any]:
         """The ``diff --json`` object (see docs/diff.md)."""
 
-        def of(kind: str) -> dict[str, Any]:
+        def of(kind: ElementKind) -> dict[str, Any]:
             return {"added": [e.to_dict() for e in self.added if e.kind == kind],
                     "removed": [e.to_dict() for e in self.removed if e.kind == kind],
                     "renamed": [r.to_dict() for r in self.renamed if r.kind == kind]}
@@ -276,7 +281,7 @@ def load_robot(name: str | Path, *, packages: list[str] | None = None,
     """
     from urdfkit.sources.resolve import open_input
 
-    with open_input(name, packages, xacro_args, guard=guard,
+    with open_input(name, packages=packages, xacro_args=xacro_args, guard=guard,
                     package_paths=package_paths) as resolved:
         try:
             robot = Robot.from_element(resolved.root, resolved.name, strict=False)
@@ -579,7 +584,7 @@ def _same_bytes(x: Path, y: Path) -> bool:
         return False
 
 
-def _compare(kind: str, name: str, old: dict[str, Any], new: dict[str, Any], close: Close,
+def _compare(kind: ChangeKind, name: str, old: dict[str, Any], new: dict[str, Any], close: Close,
              equal: Close, names: dict[str, dict[str, str]] | None = None) -> list[Change]:
     """The changes between two elements' fields, in ``new``'s order then ``old``'s.
 

@@ -18,6 +18,10 @@ its own); this module decides the repair, element by element:
   PyBullet draws for them today, so nothing changes on screen until the user picks one.
 - **``package:///path``** (U708, which ROS tools refuse) becomes ``package://NAME/path`` when
   the file lies in a folder with a ``package.xml``, else a path relative to the URDF.
+- **Gazebo contacts** (U803), only when asked (``gazebo_contacts=True``): a link's
+  ``<gazebo>`` mu1/mu2 and kp/kd become its ``<contact>`` lateral_friction, stiffness and
+  damping (:mod:`urdfkit.model.gazebo` says what maps and what cannot); values the link's
+  ``<contact>`` already has are kept.
 
 Edits are spliced into the original text: comments, element order, indentation, quotes and
 number formatting elsewhere stay byte for byte. The result is parsed again and compared,
@@ -42,9 +46,9 @@ from urdfkit.checks.validate import ALL_RULES, STUB_SIZE, Solid, link_solid
 from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.model.spec import rpy_to_matrix, sym_eigenvalues, transpose
+from urdfkit.model.spec import default_mass, rpy_to_matrix, sym_eigenvalues, transpose
 from urdfkit.model.xmlio import fmt_float, fmt_vec, parse_xml, read_bytes, start_tags
-from urdfkit.sources.guard import Report, refuse_oversized
+from urdfkit.sources.guard import RuleReport, refuse_oversized
 
 #: Density (kg/m^3) that gives a link with no ``<inertial>`` its mass: water.
 DEFAULT_DENSITY = 1000.0
@@ -54,7 +58,8 @@ SMALL_INERTIA = 1e-6
 #: What PyBullet draws a visual with an undefined material in.
 UNDEFINED_RGBA = "1 1 1 1"
 #: The codes ``fix`` repairs.
-FIXABLE = ("U601", "U602", "U603", "U604", "U605", "U606", "U608", "U609", "U610", "U706", "U708")
+FIXABLE = ("U601", "U602", "U603", "U604", "U605", "U606", "U608", "U609", "U610", "U706", "U708",
+           "U803")
 #: The inertia codes, most serious first: a link gets one inertial repair, for its worst.
 _INERTIA_ORDER = ("U606", "U602", "U601", "U609", "U610", "U603", "U604", "U605", "U608")
 
@@ -103,7 +108,7 @@ class FixResult:
     mass_before: float = 0.0
     mass_after: float = 0.0
     #: The total mass PyBullet loads, before and after: the file's plus 1 kg for every link
-    #: without ``<inertial>`` (a frame given mass 0 loses that phantom kilogram).
+    #: without ``<inertial>`` but ``world`` (a frame given mass 0 loses that phantom kilogram).
     loaded_before: float = 0.0
     loaded_after: float = 0.0
     repairs: list[Repair] = field(default_factory=list)
@@ -136,7 +141,7 @@ class FixResult:
 
 def fix_file(path: str | Path, *, balance: bool = False, density: float | None = None,
              packages: Mapping[str, Path] | None = None,
-             select: Sequence[str] = ()) -> FixResult:
+             select: Sequence[str] = (), gazebo_contacts: bool = False) -> FixResult:
     """Repair a URDF file's fixable findings; return the new text (nothing is written).
 
     Args:
@@ -151,6 +156,8 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
             ``inertial_link`` must stay massless).
         packages: ``package://`` mappings, to find meshes.
         select: Only these codes (or prefixes); empty for all of :data:`FIXABLE`.
+        gazebo_contacts: Carry Gazebo's contact parameters over to ``<contact>`` (U803);
+            without it they are left as they are, and not counted as left.
 
     Raises:
         InputError: the file cannot be read or parsed, or is xacro.
@@ -158,11 +165,11 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
     """
     display, source, data, text = _read_source(path, density)
     root = parse_xml(data, display).getroot()
-    report = Report(display, source.absolute().parent, packages)
+    report = RuleReport(display, source.absolute().parent, packages)
     for rule in ALL_RULES:
         rule(root, report)
     run = _Fixing(data, text, display, root, report, balance, density, packages,
-                  tuple(c.upper() for c in select)).run
+                  tuple(c.upper() for c in select), gazebo_contacts).run
     plan, fixed = run({})
     # A fix counts only if check then passes its rule: re-check the repaired links, and redo
     # without those still flagged (a mass of 1e308 has no inertia a float can hold).
@@ -214,11 +221,12 @@ class _Fixing:
     text: str
     display: str
     root: etree._Element
-    report: Report
+    report: RuleReport
     balance: bool
     density: float | None
     packages: Mapping[str, Path] | None
     wanted: tuple[str, ...]
+    gazebo_contacts: bool = False
 
     def run(self, skip: Mapping[str, str]) -> tuple[_Plan, bytes]:
         """Plan every repair (but those of the links in ``skip``, said why) and apply them."""
@@ -230,6 +238,8 @@ class _Fixing:
             name = el.get("name", "")
             if el.tag == "link" and name in skip:
                 plan.left.append(Repair(codes[0][0], codes[0][1], f"link {name!r}: {skip[name]}"))
+            elif el.tag == "link" and codes[0][0] == "U803":
+                plan.carry_contacts(el, codes[0][1])
             elif el.tag == "link":
                 plan.fix_link(el, codes)
             elif codes[0][0] == "U706":
@@ -247,6 +257,12 @@ class _Fixing:
                 continue
             if self.wanted and not any(f.code.startswith(w) for w in self.wanted):
                 continue
+            if f.code == "U803":
+                if self.gazebo_contacts:  # the link the <gazebo> block refers to
+                    link = _link_named(self.root, el.get("reference") or _parent_name(el))
+                    if link is not None:
+                        found.setdefault(elements[link], []).insert(0, (f.code, f.line))
+                continue
             target = el if f.code in ("U706", "U708") else _link_of(el)
             if target is not None:
                 found.setdefault(elements[target], []).append((f.code, f.line))
@@ -256,12 +272,13 @@ class _Fixing:
 def _total_mass(root: etree._Element, loaded: bool = False) -> float:
     """The sum of a robot's finite link masses, as written.
 
-    ``loaded``: as PyBullet loads it, which gives a link with no ``<inertial>`` 1 kg.
+    ``loaded``: as PyBullet loads it, which gives a link with no ``<inertial>`` 1 kg (0 if it
+    is named ``world``).
     """
     total = 0.0
     for link in root.iterchildren("link"):
         if loaded and link.find("inertial") is None:
-            total += 1.0
+            total += default_mass(link.get("name"))
             continue
         mass = _num(link.find("inertial/mass"), "value")
         if mass is not None and math.isfinite(mass):
@@ -280,7 +297,7 @@ def _unfixed(fixed: bytes, display: str, source: Path, packages: Mapping[str, Pa
     subjects = {r.subject for r in repairs if r.subject is not None and r.code in _INERTIA_ORDER}
     if not subjects:
         return {}
-    report = Report(display, source.absolute().parent, packages)
+    report = RuleReport(display, source.absolute().parent, packages)
     tree = parse_xml(fixed, display).getroot()
     for rule in ALL_RULES:
         rule(tree, report)
@@ -292,6 +309,15 @@ def _unfixed(fixed: bytes, display: str, source: Path, packages: Mapping[str, Pa
             out[name] = (f"not fixed: the derived inertial still fails {f.code} "
                          f"({f.message}); set a mass a float can carry, then run fix again")
     return out
+
+
+def _link_named(root: etree._Element, name: str | None) -> etree._Element | None:
+    return next((link for link in root.iterchildren("link") if link.get("name") == name), None)
+
+
+def _parent_name(el: etree._Element) -> str | None:
+    parent = el.getparent()
+    return parent.get("name") if parent is not None else None
 
 
 def _by_line(x: Repair) -> tuple[int, str]:
@@ -351,7 +377,7 @@ class _Plan:
     """The edits to one file: spliced into its text and made on its tree, side by side."""
 
     def __init__(self, text: str, root: etree._Element, file: str, balance: bool,
-                 density: float | None, report: Report):
+                 density: float | None, report: RuleReport):
         self.text = text
         self.root = root
         self.file = file
@@ -374,6 +400,40 @@ class _Plan:
             zip(elements, start_tags(text), strict=False))
 
     # ---- repairs
+
+    def carry_contacts(self, link: etree._Element, line: int | None) -> None:
+        """U803: write the link's Gazebo contact parameters as PyBullet's ``<contact>``."""
+        from urdfkit.model.gazebo import gazebo_contacts
+
+        name = link.get("name", "")
+        gz = gazebo_contacts(self.root).get(name)
+        if gz is None:  # pragma: no cover - the rule found them in this tree
+            return
+        contact = link.find("contact")
+        have = {c.tag for c in contact} if contact is not None else set()
+        new = {k: v for k, v in gz.pybullet().items() if k not in have}
+        kept = sorted(set(gz.pybullet()) - set(new))
+        if not new:
+            self.left.append(Repair("U803", line, f"link {name!r}: its <contact> already sets "
+                                    f"{', '.join(kept)}; left as written"))
+            return
+        xml = "".join(f'<{k} value="{fmt_float(v)}"/>' for k, v in new.items())
+        if contact is None:
+            self._insert_last_child(link, f"<contact>{xml}</contact>")
+            contact = etree.SubElement(link, "contact")
+        else:
+            self._insert_last_child(contact, xml)
+        for k, v in new.items():
+            etree.SubElement(contact, k, value=fmt_float(v))
+        said = ", ".join(f"{k} {fmt_float(v)}" for k, v in new.items())
+        source = ("the smaller of mu1 and mu2" if gz.mu1 is not None and gz.mu2 is not None
+                  and gz.mu1 != gz.mu2 else "mu1" if gz.mu1 is not None else "mu2")
+        self.repairs.append(Repair(
+            "U803", line, f"link {name!r}: wrote Gazebo's contact into <contact>: {said} "
+            f"(lateral_friction from {source}"
+            + (", stiffness and damping from kp and kd" if "stiffness" in new else "") + ")"
+            + (f"; kept its own {', '.join(kept)}" if kept else "")
+            + (f"; not carried: {', '.join(gz.not_carried)}" if gz.not_carried else "")))
 
     def fix_link(self, link: etree._Element, codes: list[tuple[str, int | None]]) -> None:
         before = len(self.repairs)
@@ -738,7 +798,13 @@ def _inertia_xml(t: Sequence[Sequence[float]]) -> str:
 
 
 def _attr(text: str) -> str:
-    return text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+    """``text`` as a double-quoted attribute value that parses back to ``text``.
+
+    Tabs and line breaks are written as character references: XML turns a literal one in an
+    attribute into a space (a material named ``"a&#9;b"`` would come back ``"a b"``).
+    """
+    return (text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+            .replace("\t", "&#9;").replace("\n", "&#10;").replace("\r", "&#13;"))
 
 
 def _shape(el: etree._Element) -> Any:

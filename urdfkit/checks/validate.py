@@ -2,9 +2,9 @@
 
 Rules work on the lxml tree (not on a parsed model) so that every finding can carry the line
 it comes from, and so that broken files are described rather than refused at the first error.
-The rules every loader runs, and the :class:`~urdfkit.sources.guard.Report` they all write to, are
-in
-:mod:`urdfkit.sources.guard`; :data:`ALL_RULES` is the guard's rules followed by these.
+The rules every loader runs, and the :class:`~urdfkit.sources.guard.RuleReport` they all write
+to, are in :mod:`urdfkit.sources.guard`; :data:`ALL_RULES` is the guard's rules followed by
+these.
 """
 
 from __future__ import annotations
@@ -24,7 +24,9 @@ from urdfkit.model.spec import (
     MAX_STATE_LINKS,
     SHAPES,
     SOLIDS,
+    WORLD_LINK,
     Matrix3,
+    default_mass,
     extension_note,
     ignored_shape,
     matmul,
@@ -38,7 +40,7 @@ from urdfkit.model.spec import (
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.sources.guard import GUARD_RULES, Report, Rule, label
+from urdfkit.sources.guard import GUARD_RULES, Rule, RuleReport, label
 from urdfkit.sources.meshstore import CONCAVE_FRACTION, MeshProperties
 from urdfkit.sources.meshstore import properties as mesh_properties
 
@@ -46,7 +48,7 @@ from urdfkit.sources.meshstore import properties as mesh_properties
 # These are the rules PyBullet crashes on when they are broken; the guard runs exactly these.
 
 
-def rule_link_count(root: etree._Element, r: Report) -> None:
+def rule_link_count(root: etree._Element, r: RuleReport) -> None:
     """U208: 128 links or more break PyBullet's state queries."""
     n = len(r.doc(root).links)
     if n >= MAX_STATE_LINKS:
@@ -63,7 +65,7 @@ def rule_link_count(root: etree._Element, r: Report) -> None:
 _DBL_EPSILON = sys.float_info.epsilon
 
 
-def rule_elements(root: etree._Element, r: Report) -> None:
+def rule_elements(root: etree._Element, r: RuleReport) -> None:
     """U401-U402 and U801-U802: numbers and names of tags and attributes.
 
     Numbers parse, are finite and have the right length; tags and attributes are known
@@ -73,17 +75,19 @@ def rule_elements(root: etree._Element, r: Report) -> None:
     shapes after the first in a ``<geometry>``.
     """
     for code, level, message, el in r.doc(root).element_findings:
+        if code == "U801" and el.tag == "gazebo":
+            continue  # another tool's block, PyBullet ignores it: U803 judges its contacts
         r.add(code, level, message, el)
 
 
 def _mass_of(link: LinkView) -> float | None:
-    """The mass PyBullet gives a link: its <mass>, or 1 kg if there is no <inertial>."""
+    """The mass PyBullet gives a link: its <mass>, or without <inertial> 1 kg (0 for world)."""
     if link.inertial is None:
-        return 1.0
+        return default_mass(link.name)
     return _num(link.mass, "value")
 
 
-def rule_mass(root: etree._Element, r: Report) -> None:
+def rule_mass(root: etree._Element, r: RuleReport) -> None:
     """U601-U602, U606: mass >= 0, > 0 on links that move; warn on missing <inertial>."""
     doc = r.doc(root)
     views = {v.name: v for v in doc.links if v.name}
@@ -100,6 +104,8 @@ def rule_mass(root: etree._Element, r: Report) -> None:
     child_names = {c.get("link") for jv in doc.joints for c in jv.children}
     for view in views.values():
         link, inertial = view.el, view.inertial
+        if inertial is None and view.name == WORLD_LINK:
+            continue  # PyBullet gives it mass 0, not 1 kg: U611 (a root) or U602 (moving) say so
         if inertial is None:
             # Never "mass 0" for the root: PyBullet fixes a mass-0 base in place (U611).
             advice = ("add <inertial> with its real mass (mass 0 would fix the robot in place)"
@@ -119,24 +125,34 @@ def rule_mass(root: etree._Element, r: Report) -> None:
     for name, j in moving:
         if name in views and _rigid_mass(name, views, fixed_children) == 0:
             r.add("U602", "error", f"{label(views[name].el)} moves (joint {j.get('name')!r} is "
-                  f"{j.get('type')}) but has mass 0; give it a mass > 0", views[name].el)
+                  f"{j.get('type')}) but has mass 0"
+                  + (" (it has no <inertial> and is named world, which PyBullet gives mass 0, "
+                     "not 1 kg)" if name == WORLD_LINK and views[name].inertial is None else "")
+                  + "; give it a mass > 0", views[name].el)
     roots = [view for name, view in views.items() if name not in child_names]
     # PyBullet judges the root link's own mass: 0 fixes the base in place, whatever its fixed
     # children weigh (a mass-0 base_footprint over a 28 kg base_link hangs in the air). A
     # root with no <inertial> gets 1 kg, so it moves (U606 says so).
-    own = _mass_of(roots[0]) if len(roots) == 1 and roots[0].inertial is not None else None
+    # A root named world without <inertial> gets mass 0 from PyBullet (measured), so it too.
+    own = _mass_of(roots[0]) if len(roots) == 1 and (
+        roots[0].inertial is not None or roots[0].name == WORLD_LINK) else None
     if own is not None and own == 0:
         base, static = roots[0].el, not moving
         carried = _rigid_mass(base.get("name", ""), views, fixed_children)
         held = (f"; its fixed links weigh {carried:g} kg, and PyBullet ignores that: it looks "
                 "at the root's own mass" if carried > 0 else "")
-        r.add("U611", "info" if static and not carried else "warning",
-              f"root {label(base)} has mass 0: PyBullet makes the base static, fixed where it "
+        why = ("has no <inertial> and is named world, which PyBullet gives mass 0 (not 1 kg)"
+               if roots[0].inertial is None else "has mass 0")
+        # A root named world is the ROS convention for "bolted to the world": as meant.
+        bolted = roots[0].inertial is None
+        r.add("U611", "info" if bolted or (static and not carried) else "warning",
+              f"root {label(base)} {why}: PyBullet makes the base static, fixed where it "
               "is loaded" + (" (right for a static object such as ground)"
                              if static and not carried else
                              "; right for an arm bolted to the world, wrong for a robot "
                              "that should fall or drive: give the root link a mass, or make "
-                             "the massive link the root") + held, base)
+                             "the massive link the root") + (held if not bolted else ""),
+              base)
 
 
 def _rigid_mass(name: str, views: dict[str, LinkView],
@@ -166,7 +182,7 @@ def _inertia_tensor(inertia: etree._Element) -> tuple[tuple[float, ...], ...] | 
     return ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))  # type: ignore[return-value]
 
 
-def rule_material_colours(root: etree._Element, r: Report) -> None:
+def rule_material_colours(root: etree._Element, r: RuleReport) -> None:
     """U710: one material name given several colours; PyBullet draws them all in one.
 
     Measured on PyBullet 3.2.7: every visual whose material has that name (``""`` included,
@@ -189,7 +205,7 @@ def rule_material_colours(root: etree._Element, r: Report) -> None:
               f"rgba {found[-1][0]}; give each colour its own name", found[1][1])
 
 
-def rule_references(root: etree._Element, r: Report) -> None:
+def rule_references(root: etree._Element, r: RuleReport) -> None:
     """U308, U706-U708: references that lead nowhere, and limits PyBullet reads differently.
 
     A ``<material name>`` used but never defined, a ``<transmission>`` naming a missing joint,
@@ -230,7 +246,7 @@ def rule_references(root: etree._Element, r: Report) -> None:
                   "it as unlimited, the URDF spec (and ROS) as 0; give both", limit)
 
 
-def rule_inertia(root: etree._Element, r: Report) -> None:
+def rule_inertia(root: etree._Element, r: RuleReport) -> None:
     """U603-U605, U607: inertia positive definite, triangle inequality, plausible for shapes.
 
     Tolerance as in Drake's ``RotationalInertia::CouldBePhysicallyValid``:
@@ -343,7 +359,7 @@ class Solid(Record):
         return sum(self.tensor[i][i] for i in range(3)) * mass / self.volume
 
 
-def link_solid(link: etree._Element, r: Report | None = None,
+def link_solid(link: etree._Element, r: RuleReport | None = None,
                collisions: list[etree._Element] | None = None) -> Solid | None:
     """The solid the link's collision shapes make: what ``U605`` and ``urdfkit fix`` use.
 
@@ -416,7 +432,7 @@ def link_solid(link: etree._Element, r: Report | None = None,
     return Solid(total, (cx, cy, cz), out, max(p[3] for p in parts))
 
 
-def _shape_trace(link: etree._Element, mass: float | None, r: Report | None = None,
+def _shape_trace(link: etree._Element, mass: float | None, r: RuleReport | None = None,
                  collisions: list[etree._Element] | None = None
                  ) -> tuple[float, float] | None:
     """Trace of the inertia of the link's collision solids for ``mass``, and their size."""
@@ -430,7 +446,7 @@ def _shape_trace(link: etree._Element, mass: float | None, r: Report | None = No
 
 
 def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
-               r: Report | None, concavity: bool = False
+               r: RuleReport | None, concavity: bool = False
                ) -> tuple[float, tuple[float, ...], Matrix3, float] | None:
     """A collision mesh as (volume, centre in the link, tensor per unit density, size).
 
@@ -465,7 +481,7 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
             matmul(matmul(rot, own), transpose(rot)), max(props.extent))
 
 
-def _properties(r: Report, path: str, scale: Sequence[float], concavity: bool = False,
+def _properties(r: RuleReport, path: str, scale: Sequence[float], concavity: bool = False,
                 st: os.stat_result | None = None) -> MeshProperties | None:
     """:func:`urdfkit.sources.meshstore.properties`, once per mesh and scale per file.
 
@@ -486,7 +502,7 @@ def _properties(r: Report, path: str, scale: Sequence[float], concavity: bool = 
 _UNSEEN: Any = object()
 
 
-def _moving(r: Report, el: etree._Element) -> set[str]:
+def _moving(r: RuleReport, el: etree._Element) -> set[str]:
     """:func:`_moving_links` of the document ``el`` belongs to, once per file."""
     moving: set[str] | None = r.memo.get("moving links")
     if moving is None:
@@ -494,7 +510,7 @@ def _moving(r: Report, el: etree._Element) -> set[str]:
     return moving
 
 
-def rule_meshes(root: etree._Element, r: Report) -> None:
+def rule_meshes(root: etree._Element, r: RuleReport) -> None:
     """U701-U705: mesh and texture files exist, are files, in formats PyBullet reads."""
     if r.folder is None:
         return
@@ -511,7 +527,7 @@ def rule_meshes(root: etree._Element, r: Report) -> None:
 UNITS_RATIO = 200.0
 
 
-def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
+def rule_mesh_shapes(root: etree._Element, r: RuleReport) -> None:
     """U613-U614: meshes in the wrong units; concave collision meshes on links that move.
 
     Units are judged against the robot's own scale: the median distance between joint
@@ -552,11 +568,12 @@ def rule_mesh_shapes(root: etree._Element, r: Report) -> None:
                 r.add("U613", "warning", f"mesh {fn!r} of {label(link)} is {size:.3g} m across, "
                       f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
                       f"{fix}", mesh)
-            if (concave_matters and props.closed
-                    and props.concavity > CONCAVE_FRACTION * size):
+            if concave_matters and props.concavity > CONCAVE_FRACTION * size:
                 r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
                       f"concave (it is {size:.3g} m across, and parts of it stand up to "
-                      f"{props.concavity:.3g} m in front of its own faces' planes): PyBullet "
+                      f"{props.concavity:.3g} m in front of its own faces' planes"
+                      + ("" if props.closed else "; it is also open, so the depth is "
+                         "judged on the faces it has") + "): PyBullet "
                       "collides with its convex hull, so contacts happen in mid-air over the "
                       "dips; split it into convex parts (p.vhacd, or one OBJ object per part) "
                       "or use primitives", mesh)
@@ -584,7 +601,102 @@ def _moving_links(doc: Doc) -> set[str]:
     return set(names) - still
 
 
-def rule_portability(root: etree._Element, r: Report) -> None:
+def rule_mimic(root: etree._Element, r: RuleReport) -> None:
+    """U310: every ``<mimic>`` PyBullet ignores (its leader exists; U307 and U309 judge that).
+
+    PyBullet 3.2.7 reads no ``<mimic>``: the follower is an ordinary joint that moves on its
+    own, so a two-finger gripper whose second finger mimics the first opens one finger.
+    """
+    joints = {jv.name for jv in r.doc(root).joints}
+    for jv in r.doc(root).joints:
+        mimic = jv.mimic
+        leader = mimic.get("joint") if mimic is not None else None
+        if leader is None or leader not in joints or leader == jv.name:
+            continue
+        multiplier = _num(mimic, "multiplier", 1.0)
+        offset = _num(mimic, "offset", 0.0)
+        if multiplier is None or offset is None:
+            continue  # U401 says why
+        r.add("U310", "info", f"{label(jv.el)} mimics joint {leader!r} (position = "
+              f"{leader} x {multiplier:g} + {offset:g}), and PyBullet ignores <mimic>: it moves "
+              "on its own, free unless driven; drive it to that position each step"
+              + (", or tie it with p.createConstraint(body, leader link, body, its link, "
+                 f"p.JOINT_GEAR, ...) and gearRatio {-1 / multiplier:g} (measured: PyBullet's "
+                 "gear holds leader + gearRatio x follower at 0; it keeps velocities, not the "
+                 "offset)" if multiplier else ""), mimic)
+
+
+def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
+    """U803: Gazebo contact parameters (mu1, mu2, kp, kd) PyBullet ignores, per link.
+
+    Read by :func:`urdfkit.model.gazebo.gazebo_contacts`; judged against what PyBullet loads
+    for the link (its ``<contact>``, else lateral friction 0.5 and a rigid contact). A link
+    whose ``<contact>`` already carries the values gets nothing.
+    """
+    from urdfkit.model.gazebo import NOT_CARRIED, PYBULLET_LATERAL_FRICTION, gazebo_contacts
+
+    contacts = gazebo_contacts(root)
+    if not contacts:
+        return
+    # A link without <collision> touches nothing: its contact parameters do nothing in either
+    # engine (Unitree's imu_link carries mu1 0.2 from a macro that gives every link one).
+    links = {v.name: v.el for v in r.doc(root).links if v.name and v.collisions}
+    for name, gz in contacts.items():
+        link = links.get(name)
+        if link is None:
+            continue  # a joint, a missing link, or one without shapes: nothing to carry
+        have = _contact_values(link)
+        want = gz.pybullet()
+        differ = {k: v for k, v in want.items()
+                  if not math.isclose(have.get(k, math.nan), v, rel_tol=1e-9)}
+        if not differ:
+            continue
+        given = ", ".join(f"{k} {v:g}" for k, v in gz.given().items())
+        parts = []
+        if "lateral_friction" in differ:
+            now = have.get("lateral_friction", PYBULLET_LATERAL_FRICTION)
+            parts.append(f"lateral friction {now:g} where Gazebo's is "
+                         f"{differ['lateral_friction']:g}")
+        if "stiffness" in differ:
+            parts.append("a rigid contact where Gazebo's is a spring of "
+                         f"{differ['stiffness']:g} N/m and {differ['damping']:g} N s/m"
+                         if "stiffness" not in have else
+                         f"contact stiffness {have['stiffness']:g} and damping "
+                         f"{have.get('damping', math.nan):g} where Gazebo's are "
+                         f"{differ['stiffness']:g} and {differ['damping']:g}")
+        notes = []
+        if gz.mu1 is not None and gz.mu2 is not None and gz.mu1 != gz.mu2:
+            notes.append(f"mu1 and mu2 differ: PyBullet has one coefficient in every direction, "
+                         f"and fix writes the smaller, {gz.lateral_friction:g}")
+        if (gz.kp is None) != (gz.kd is None):
+            notes.append(f"{'kp' if gz.kd is None else 'kd'} is not given, so stiffness and "
+                         "damping (a pair in PyBullet) are not carried")
+        if gz.not_carried:
+            notes.append("not carried: " + "; ".join(f"{k} ({NOT_CARRIED[k]})"
+                                                     for k in gz.not_carried))
+        written = ", ".join(f"{k} {v:g}" for k, v in differ.items())
+        r.add("U803", "warning", f"<gazebo reference={name!r}> gives {label(link)} {given}, "
+              f"which PyBullet ignores: it loads {' and '.join(parts)}; `urdfkit fix "
+              f"--gazebo-contacts` writes the link a <contact> with {written} (PyBullet "
+              "multiplies the two bodies' friction: on a ground of lateral friction 1, such "
+              "as plane.urdf, the contact has the link's)" + "".join(f"; {n}" for n in notes),
+              gz.element)
+
+
+def _contact_values(link: etree._Element) -> dict[str, float]:
+    """The link's ``<contact>`` values PyBullet reads: {lateral_friction, stiffness, ...}."""
+    contact = first(link, "contact")
+    out: dict[str, float] = {}
+    if contact is None:
+        return out
+    for child in contact:
+        value = _num(child, "value") if isinstance(child.tag, str) else None
+        if value is not None and child.tag not in out:
+            out[child.tag] = value
+    return out
+
+
+def rule_portability(root: etree._Element, r: RuleReport) -> None:
     """U901: PyBullet-only joint types and shapes, which other URDF tools refuse (info)."""
     doc = r.doc(root)
     for jv in doc.joints:
@@ -601,7 +713,8 @@ def rule_portability(root: etree._Element, r: Report) -> None:
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
                                rule_inertia, rule_meshes, rule_mesh_shapes, rule_references,
-                               rule_material_colours, rule_portability)
+                               rule_material_colours, rule_mimic, rule_gazebo_contacts,
+                               rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -612,6 +725,7 @@ CODES: dict[str, str] = {
     "U007": "xacro macro library (no links of its own): checked through its includers",
     "U008": "line longer than 8191 bytes: PyBullet breaks it and may misread the file",
     "U009": "a file not named .xacro that holds xacro: read literally ('${prefix}base')",
+    "U010": "a fragment another checked file includes (no robot alone): checked through it",
     "U001": "root element is not <robot>",
     "U002": "<robot> has no name",
     "U003": "no <link>",
@@ -642,6 +756,7 @@ CODES: dict[str, str] = {
     "U306": "joint axis not unit length",
     "U307": "mimic refers to a missing joint",
     "U309": "mimic joints follow each other in a ring",
+    "U310": "<mimic> that PyBullet ignores (the joint moves on its own; info)",
     "U308": "revolute/prismatic <limit> without lower or upper (PyBullet: unlimited)",
     "U401": "number does not parse or is not finite",
     "U402": "vector of the wrong length",
@@ -678,6 +793,7 @@ CODES: dict[str, str] = {
     "U710": "one material name given several colours (PyBullet draws them all in the last)",
     "U801": "unknown tag",
     "U802": "unknown attribute",
+    "U803": "Gazebo contact parameters (mu1, mu2, kp, kd) PyBullet ignores (fix --gazebo-contacts)",
     "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
     "U950": "links in contact at the zero pose (check --physics: self-collision jitters)",
     "U951": "PyBullet cannot load the file (check --physics)",

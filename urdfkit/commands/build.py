@@ -40,7 +40,8 @@ def build(
     A .xacro file (or a .urdf holding xacro) is expanded in a subprocess with a timeout:
     xacro's ${...} expressions run Python code, so only expand files you trust (see
     docs/security.md). What PyBullet loads is written: check's errors on it are warnings
-    (--strict refuses them); what would crash PyBullet is refused.
+    (--strict refuses them); what would crash PyBullet, or what it refuses to load (a
+    missing mesh), is refused, nothing written.
     """
     from urdfkit.checks import build as building
     from urdfkit.sources.uris import parse_packages

@@ -14,11 +14,15 @@ Nothing heavy is imported here, and no typer.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from urdfkit.commands import present as show
 from urdfkit.commands.flags import input_flags
 from urdfkit.commands.startup import outcome, prepare
+
+if TYPE_CHECKING:
+    from urdfkit.checks.ci import CheckFormat
+    from urdfkit.core.finding import Level
 
 #: Flags of ``check`` (no value), by option name: the keyword of :func:`run_check`.
 FLAG_OPTIONS = {"--json": "as_json", "--no-exec": "no_exec", "--all": "show_all",
@@ -42,16 +46,11 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
         ParameterError: a bad option value (exit code 2).
     """
     from urdfkit.checks.check import check_paths, parse_codes
-    from urdfkit.core.errors import ParameterError
     from urdfkit.core.finding import Finding
     from urdfkit.sources.uris import parse_packages
 
-    if fail_on not in ("error", "warning", "info"):
-        from urdfkit.core.suggest import hint
-
-        raise ParameterError(f"`fail_on` expects error, warning or info, got {fail_on!r}"
-                             f"{hint(fail_on, ('error', 'warning', 'info'))}", param="fail_on")
-    fmt = check_format(output_format, as_json)
+    level = fail_on_level(fail_on)
+    fmt = chosen_format(output_format, as_json)
     import gc
 
     # A run makes millions of short-lived objects and no reference cycles (tests/
@@ -71,12 +70,25 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
     for fr in result.files:  # a xacro or package problem speaks of flags, not parameters
         fr.findings = [Finding(f.code, f.level, input_flags(f.message), f.file, f.line, f.origin)
                        if "`" in f.message else f for f in fr.findings]
-    show.check_output(result, fmt, fail_on, show_all)
-    return result.exit_code(fail_on)
+    show.check_formatted(result, fmt, level, show_all)
+    return result.exit_code(level)
 
 
-def check_format(output_format: str | None, as_json: bool) -> str:
-    """The output format of ``--format`` and ``--json``, checked."""
+def fail_on_level(fail_on: str) -> Level:
+    """``--fail-on``, checked: the level itself."""
+    from urdfkit.core.finding import LEVELS
+
+    if fail_on not in LEVELS:
+        from urdfkit.core.errors import ParameterError
+        from urdfkit.core.suggest import hint
+
+        raise ParameterError(f"`fail_on` expects error, warning or info, got {fail_on!r}"
+                             f"{hint(fail_on, ('error', 'warning', 'info'))}", param="fail_on")
+    return next(level for level in LEVELS if level == fail_on)
+
+
+def chosen_format(output_format: str | None, as_json: bool) -> CheckFormat:
+    """The output format ``--format`` and ``--json`` choose, checked."""
     from urdfkit.checks.ci import FORMATS
     from urdfkit.core.errors import ParameterError
 
@@ -88,7 +100,8 @@ def check_format(output_format: str | None, as_json: bool) -> str:
     if as_json and output_format not in (None, "json"):
         raise ParameterError(f"`json` means `format` json; it cannot be combined with "
                              f"`format` {output_format}", param="format")
-    return "json" if as_json else output_format or "text"
+    wanted = "json" if as_json else output_format or "text"
+    return next(fmt for fmt in FORMATS if fmt == wanted)
 
 
 def xacro_args(items: list[str] | None) -> dict[str, str]:

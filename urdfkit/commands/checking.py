@@ -19,7 +19,7 @@ from urdfkit.commands.shared import (
     PackagePathOpt,
     command,
     examples,
-    open_input,
+    open_input_and_warn,
 )
 
 
@@ -145,12 +145,16 @@ def fix(
     select: Annotated[list[str] | None, typer.Option(
         "--select", metavar="CODES", help="Only these codes or prefixes (e.g. U6,U708).")]
     = None,
+    gazebo_contacts: Annotated[bool, typer.Option(
+        "--gazebo-contacts", help="Carry each link's <gazebo> mu1/mu2 and kp/kd (U803), which "
+        "PyBullet ignores, over to its <contact>: lateral_friction (the smaller of mu1 and "
+        "mu2), stiffness and damping (only as a pair).")] = False,
     as_json: JsonOpt = False,
     force: ForceOpt = False,
     package: PackageOpt = None,
     package_path: PackagePathOpt = None,
 ) -> None:
-    """Repair inertia, massless links, undefined materials and package:/// paths.
+    """Repair inertia, massless links, undefined materials, package:/// paths; Gazebo contacts.
 
     Only what it fixes changes: comments, order and formatting elsewhere stay byte for byte,
     and joints are never touched. Each fix is listed with its rule code (docs/fix.md). Exit 0:
@@ -166,7 +170,8 @@ def fix(
     if output not in (None, "-"):
         check_output(output, force=force)
     result = fix_file(file, balance=balance, density=density,
-                      packages=parse_packages(package, package_path), select=codes)
+                      packages=parse_packages(package, package_path), select=codes,
+                      gazebo_contacts=gazebo_contacts)
     _say_mass_changes(file, result, refuse=not allow_mass_change and not show_diff,
                       quiet=as_json)
     if in_place and result.changed:
@@ -314,7 +319,8 @@ def collisions(
 
     if sum((as_json, srdf, python)) > 1:
         raise ParameterError("--json, --srdf and --python are exclusive: pick one")
-    with open_input(file, package, arg, no_guard, package_path) as resolved:
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path) as resolved:
         result = self_collisions(resolved, joints=parse_joint_positions(joints),
                                  samples=samples, seed=seed, margin=margin,
                                  packages=parse_packages(package, package_path))

@@ -2,7 +2,7 @@
 
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, cast
 
 import typer
 
@@ -17,6 +17,9 @@ from urdfkit.commands.shared import (
     command,
     examples,
 )
+
+if TYPE_CHECKING:
+    from urdfkit.model.spec import UpAxis
 
 
 @command(examples(
@@ -65,13 +68,16 @@ def render(
         chosen = rendering.ALL_VIEWS
     else:
         chosen = tuple(v.strip() for v in views.split(",") if v.strip())
+    # The flags' text as RenderOptions' literals: it checks each one (the view, the ground,
+    # the up axis) and refuses any other with a "did you mean".
     options = rendering.RenderOptions(
-        views=chosen, width=width, height=height, ground=ground,
+        views=cast("tuple[rendering.View, ...]", chosen), width=width, height=height,
+        ground=cast("rendering.Ground", ground),
         joints=rendering.parse_joint_positions(joints), collision=collision, frames=frames,
-        up=up)
+        up=cast("UpAxis", up))
     out = output if output is not None else f"{Path(file).name.split('.')[0] or 'robot'}.png"
     if out != "-":  # refuse before the work, not after it
-        rendering.check_output(out, force=force)
+        rendering.check_picture_path(out, force=force)
     picture = rendering.render_file(file, options, packages=package, xacro_args=arg,
                                     guard=not no_guard, package_paths=package_path)
     for w in picture.warnings:

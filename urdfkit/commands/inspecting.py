@@ -1,4 +1,4 @@
-"""joints, links, tree, info: what PyBullet loads, as tables or JSON (urdfkit/inspect.py)."""
+"""joints, links, tree, info: what PyBullet loads, as tables or JSON (urdfkit/engine/)."""
 
 import sys
 from typing import Annotated, Any
@@ -21,7 +21,7 @@ from urdfkit.commands.shared import (
     TypeOpt,
     command,
     examples,
-    open_input,
+    open_input_and_warn,
 )
 
 
@@ -41,7 +41,8 @@ def _inspect(file: str, package: list[str] | None, arg: list[str] | None, *,
         options = LoadOptions(fixed_base=fixed_base, **parse_flags(flags))
     else:
         options = LoadOptions(fixed_base=fixed_base, inertia_from_file=inertia_from_file)
-    with open_input(file, package, arg, no_guard, package_path) as resolved:
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path) as resolved:
         report = inspect_file(resolved, options, links=links, info=info)
     report.load_flags = options.flag_names()
     return report
@@ -73,7 +74,7 @@ def joints(
     --json prints {"file", "robot", "base_link", "joints": [...]} with the 17 getJointInfo
     fields under the Quickstart Guide names (jointIndex ... parentIndex); see docs/inspect.md.
     """
-    from urdfkit.inspect import filter_joints
+    from urdfkit.engine.joints import filter_joints
 
     report = _inspect(file, package, arg, fixed_base=fixed_base, no_guard=no_guard,
                       package_path=package_path, flags=flags)
@@ -84,9 +85,11 @@ def joints(
         return
     show.diagnostics(report.diagnostics)
     num, nums = show.num, show.nums
+    mimics = any(j.mimic for j in rows)  # the column only where a joint has one
     columns = [("#", 0, "right"), ("joint", 0, "left"), ("type", 0, "left"),
                ("child link", 1, "left"), ("parent", 3, "left"), ("limits", 1, "right"),
-               ("axis", 2, "left"), ("origin xyz", 3, "left"), ("origin rpy", 3, "left"),
+               ("axis", 2, "left"), *([("mimic", 2, "left")] if mimics else []),
+               ("origin xyz", 3, "left"), ("origin rpy", 3, "left"),
                ("max force", 3, "right"), ("max vel", 3, "right"),
                ("parentFramePos", 4, "left"), ("parentFrameRpy", 4, "left"), ("q", 5, "right"),
                ("u", 5, "right"), ("damping", 6, "right"), ("friction", 6, "right"),
@@ -103,6 +106,7 @@ def joints(
             # The file's axis (the joint frame); PyBullet's jointAxis is in the child's
             # inertial frame, turned by an <inertial><origin rpy> (its own column).
             nums(j.axis_xyz if j.axis_xyz is not None else j.joint_axis) if j.movable else "",
+            *([_mimic_cell(j.mimic, num)] if mimics else []),
             nums(j.origin_xyz) if j.origin_xyz is not None else "",
             nums(j.origin_rpy) if j.origin_rpy is not None else "",
             num(j.joint_max_force),
@@ -114,6 +118,18 @@ def joints(
     show.table(f"{report.robot}: {shown} joints, base link {report.base_link}", columns, cells,
                show_all)
     _loaded_with(report)
+    if mimics:
+        show.note("mimic: the file's <mimic> (position = leader x multiplier + offset); "
+                  "PyBullet ignores it, so the joint moves on its own", stderr=False)
+
+
+def _mimic_cell(mimic: dict[str, Any] | None, num: Any) -> str:
+    """``leader x multiplier + offset`` of a joint's ``<mimic>`` ("" without one)."""
+    if not mimic:
+        return ""
+    offset = mimic["offset"]
+    return (f"{mimic['joint']} x {num(mimic['multiplier'])}"
+            + (f" {'-' if offset < 0 else '+'} {num(abs(offset))}" if offset else ""))
 
 
 @command(examples(
@@ -206,7 +222,8 @@ def tree(
     if dot or output is not None:
         _tree_dot(file, package, arg, output, force, as_json, no_guard, package_path)
         return
-    with open_input(file, package, arg, no_guard, package_path, meshes=False) as resolved:
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path, meshes=False) as resolved:
         root = kinematic_tree(resolved.root)
         robot = resolved.robot_name
     if as_json:
@@ -229,6 +246,8 @@ def info(
     no_guard: NoGuardOpt = False,
 ) -> None:
     """The robot at a glance: links, joints by type, DOF, total mass, bounding box."""
+    from urdfkit.model.spec import default_mass
+
     report = _inspect(file, package, arg, fixed_base=fixed_base, info=True, no_guard=no_guard,
                       package_path=package_path, flags=flags)
     s = report.summary
@@ -241,13 +260,15 @@ def info(
     mass = f"{num(s.total_mass)} kg"
     if abs(s.total_mass - s.file_mass) > 1e-9 * max(1.0, s.file_mass):
         mass += f" (file says {num(s.file_mass)} kg"
-        if s.links_without_inertial:
-            mass += f"; {len(s.links_without_inertial)} link(s) without <inertial> get 1 kg"
+        phantom = [n for n in s.links_without_inertial if default_mass(n)]
+        if phantom:
+            mass += f"; {len(phantom)} link(s) without <inertial> get 1 kg"
         mass += ")"
     show.fields([(s.robot, "bold")], [
         ("file", str(report.path)), ("base link", s.base_link),
         ("links", str(s.links)), ("joints", f"{s.joints} ({types})"),
-        ("degrees of freedom", f"{s.dof}" + ("" if s.fixed_base else " + 6 (floating base)")),
+        ("degrees of freedom", f"{s.dof}" + (" + 6 (floating base)" if s.static_base is None
+                                             else f" (static base: {s.static_base})")),
         ("total mass", mass),
         ("bounding box", f"{nums(s.aabb_min)} .. {nums(s.aabb_max)}"),
         ("size", f"{nums(s.size)} m"),
@@ -263,13 +284,14 @@ def _tree_dot(file: str, package: list[str] | None, arg: list[str] | None,
               package_path: list[str] | None) -> None:
     """``tree --dot`` / ``tree -o graph.svg``: the kinematic graph as DOT text or a drawing."""
     from urdfkit.core.errors import ParameterError
-    from urdfkit.draw.graph import check_output, dot_graph, write_graph
+    from urdfkit.draw.graph import check_graph_path, dot_graph, write_graph
 
     if as_json:
         raise ParameterError("--json and --dot/-o are different outputs; choose one")
     if output is not None and output != "-":
-        check_output(output, force=force)
-    with open_input(file, package, arg, no_guard, package_path) as resolved:
+        check_graph_path(output, force=force)
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path) as resolved:
         text = dot_graph(resolved.root)
     if output is None or output == "-":
         sys.stdout.write(text)

@@ -19,7 +19,11 @@ import os
 import re
 import sys
 from collections.abc import Callable, Iterable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from urdfkit.checks.ci import CheckFormat
+    from urdfkit.core.finding import Level
 
 Part = str | tuple[str, str]
 """A piece of a line: plain text, or ``(text, rich style)``."""
@@ -421,8 +425,8 @@ def check_report(result: Any, show_all: bool = False) -> None:
     screen.print(Text(summary, style=colour), soft_wrap=True)
 
 
-def check_output(result: Any, fmt: str = "text", fail_on: str = "error",
-                 show_all: bool = False) -> None:
+def check_formatted(result: Any, fmt: CheckFormat = "text", fail_on: Level = "error",
+                    show_all: bool = False) -> None:
     """``urdfkit check --format``: text, JSON, or a CI format (:mod:`urdfkit.checks.ci`) on stdout.
 
     The CI formats are written whole and unstyled, terminal or not: they are for files and

@@ -89,13 +89,18 @@ FileArg = Annotated[str, typer.Argument(
     help="A .urdf or .xacro file; a bare name is also looked up in pybullet_data.")]
 
 
-def open_input(file: str, package: list[str] | None, arg: list[str] | None, no_guard: bool,
-               package_path: list[str] | None = None, meshes: bool = True) -> Any:
-    """The robot file resolved (xacro expanded, packages found, guarded), warnings said."""
-    from urdfkit.sources.resolve import open_input as resolve_input
+def open_input_and_warn(file: str, *, packages: list[str] | None,
+                        xacro_args: list[str] | None, guard: bool,
+                        package_paths: list[str] | None = None, meshes: bool = True) -> Any:
+    """:func:`urdfkit.sources.resolve.open_input`, and its warnings said on stderr.
 
-    resolved = resolve_input(file, package, arg, guard=not no_guard,
-                             package_paths=package_path, meshes=meshes)
+    Takes the library's keyword-only options under the library's names: a command passes
+    ``guard=not no_guard``, so no flag means its opposite on the way down.
+    """
+    from urdfkit.sources.resolve import open_input
+
+    resolved = open_input(file, packages=packages, xacro_args=xacro_args, guard=guard,
+                          package_paths=package_paths, meshes=meshes)
     for w in resolved.warnings:
         show.warn(input_flags(w))
     return resolved

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+from typing import Literal
+
 from urdfkit.core.record import Record
 
+#: A finding's level; ``check --fail-on`` takes one too.
+Level = Literal["info", "warning", "error"]
 #: Finding levels, lowest first.
-LEVELS = ("info", "warning", "error")
+LEVELS: tuple[Level, ...] = ("info", "warning", "error")
 
 
 class Finding(Record):

@@ -20,8 +20,7 @@ from pathlib import Path
 from lxml import etree
 
 from urdfkit.core.errors import MissingDependencyError, OutputError
-from urdfkit.core.output import atomic_write
-from urdfkit.core.output import check_output as _check_output
+from urdfkit.core.output import atomic_write, check_output
 from urdfkit.draw import style
 from urdfkit.model.xmlio import fmt_float, fmt_vec
 
@@ -122,15 +121,15 @@ def render_dot(dot: str, fmt: str, timeout: float = DOT_TIMEOUT) -> bytes:
     return proc.stdout
 
 
-def check_output(path: str | Path, *, force: bool = False) -> Path:
+def check_graph_path(path: str | Path, *, force: bool = False) -> Path:
     """Refuse an output path early: unknown suffix, or an existing file without ``force``."""
-    return _check_output(path, force=force, suffixes=DOT_SUFFIXES + RENDERED_SUFFIXES,
-                         what="the graph")
+    return check_output(path, force=force, suffixes=DOT_SUFFIXES + RENDERED_SUFFIXES,
+                        what="the graph")
 
 
 def write_graph(dot: str, path: str | Path, *, force: bool = False) -> Path:
     """Write DOT text (``.dot``/``.gv``) or a picture rendered by ``dot`` (``.svg`` ...)."""
-    path = check_output(path, force=force)
+    path = check_graph_path(path, force=force)
     suffix = path.suffix.lower()
     data = dot.encode("utf-8") if suffix in DOT_SUFFIXES else render_dot(dot, suffix[1:])
     return atomic_write(path, data, force=force)

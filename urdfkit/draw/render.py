@@ -30,17 +30,21 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from urdfkit.core.errors import EngineError, InputError, MissingDependencyError, ParameterError
 from urdfkit.draw import style
-from urdfkit.inspect import JointInfo, pose_joints
-from urdfkit.model.spec import UP_AXES, attr_vec, rpy_to_matrix, vector
+from urdfkit.engine.joints import JointInfo, pose_joints
+from urdfkit.model.spec import UP_AXES, UpAxis, attr_vec, rpy_to_matrix, vector
 
 #: The views, as (direction from target to camera, camera up vector). URDF: x forward, z up.
 #: ``front`` looks at the robot's face (+x), ``side`` at its right flank (-y), so the robot
 #: drives to the right of the image; ``top`` looks down with the front pointing up.
-VIEWS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
+#: A camera direction: ``--view``.
+View = Literal["iso", "front", "side", "top"]
+#: What the robot stands on in the picture: ``--ground``.
+Ground = Literal["grid", "plane", "none"]
+VIEWS: dict[View, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
     "iso": ((math.cos(math.radians(30)) * math.cos(math.radians(-40)),
              math.cos(math.radians(30)) * math.sin(math.radians(-40)),
              math.sin(math.radians(30))), (0.0, 0.0, 1.0)),
@@ -49,8 +53,8 @@ VIEWS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] 
     "top": ((0.0, 0.0, 1.0), (1.0, 0.0, 0.0)),
 }
 #: Order of the panels of ``--views all``: a 2x2 grid.
-ALL_VIEWS = ("iso", "front", "side", "top")
-GROUNDS = ("grid", "plane", "none")
+ALL_VIEWS: tuple[View, ...] = ("iso", "front", "side", "top")
+GROUNDS: tuple[Ground, ...] = ("grid", "plane", "none")
 #: The largest robot (bounding-box side, m) render frames: beyond, camera distances and grid
 #: steps overflow or lose all precision (a 1e308 m box once ended in an OverflowError).
 MAX_EXTENT = 1e5
@@ -86,15 +90,15 @@ class RenderOptions:
         up: The model's up axis (``z``, ``y`` or ``x``); it is turned onto the world's +Z.
     """
 
-    views: tuple[str, ...] = ("iso",)
+    views: tuple[View, ...] = ("iso",)
     width: int = 800
     height: int = 600
-    ground: str = "grid"
+    ground: Ground = "grid"
     joints: Mapping[str, float] = field(default_factory=dict)
     collision: bool = False
     frames: bool = False
     labels: bool | None = None
-    up: str = "z"
+    up: UpAxis = "z"
 
     def __post_init__(self) -> None:
         if self.up not in UP_AXES:
@@ -127,7 +131,7 @@ class RenderOptions:
 class Camera:
     """Where one view's camera stands (for the metadata, and to reproduce a shot)."""
 
-    view: str
+    view: View
     eye: tuple[float, float, float]
     target: tuple[float, float, float]
     up: tuple[float, float, float]
@@ -240,7 +244,7 @@ def _normalize(v: Any) -> Any:
     return v / n if n > 0 else v
 
 
-def _basis(view: str) -> tuple[Any, Any, Any]:
+def _basis(view: View) -> tuple[Any, Any, Any]:
     """(towards camera, right, up) unit vectors of a view."""
     import numpy as np
 
@@ -258,7 +262,7 @@ def _corners(lo: Any, hi: Any) -> Any:
                      for z in (lo[2], hi[2])], dtype=float)
 
 
-def frame_view(view: str, lo: Sequence[float], hi: Sequence[float], aspect: float,
+def frame_view(view: View, lo: Sequence[float], hi: Sequence[float], aspect: float,
                fov_deg: float = FOV_DEG, fill: float = FILL) -> tuple[Any, Any, Any]:
     """Place a camera so the box ``lo..hi`` fills the frame; return (eye, target, up).
 
@@ -380,7 +384,7 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
 
     from urdfkit.engine.session import LoadOptions
 
-    p, c = session.p, session.client
+    p, bullet = session.p, session.bullet
     # Fixed base: nothing is simulated, and the robot must stay exactly where it is posed.
     opts = LoadOptions(fixed_base=True, base_orientation=UP_AXES[o.up])
     if o.collision:
@@ -389,10 +393,10 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
         opts.extra_flags = p.URDF_IGNORE_VISUAL_SHAPES
     body = session.load_urdf(resolved.load_path, opts, display=resolved.name)
     try:
-        n = p.getNumJoints(body, physicsClientId=c)
-        infos = [p.getJointInfo(body, j, physicsClientId=c) for j in range(n)]
+        n = bullet.getNumJoints(body)
+        infos = [bullet.getJointInfo(body, j) for j in range(n)]
         by_name = {i[1].decode("utf-8"): i for i in infos}
-        positions = pose_joints(p, c, body, [JointInfo.from_pybullet(i) for i in infos],
+        positions = pose_joints(bullet, body, [JointInfo.from_pybullet(i) for i in infos],
                                 o.joints, warnings, resolved.name)
         if o.collision:
             for link in range(-1, n):
@@ -400,7 +404,7 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
         lo = np.full(3, np.inf)
         hi = np.full(3, -np.inf)
         for link in range(-1, n):
-            a, b = p.getAABB(body, link, physicsClientId=c)
+            a, b = bullet.getAABB(body, link)
             a, b = np.array(a), np.array(b)
             # A link without collision shapes reports an empty or inverted box; skip it.
             if np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(b >= a):
@@ -412,7 +416,7 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
         if not o.collision:
             # getAABB only knows collision shapes; a link with visuals only (common in
             # hand-written files) would fall outside the frame. Bound its visuals too.
-            names = [p.getBodyInfo(body, physicsClientId=c)[0].decode("utf-8")]
+            names = [bullet.getBodyInfo(body)[0].decode("utf-8")]
             names += [i[12].decode("utf-8") for i in infos]
             v_lo, v_hi = _visual_bounds(resolved.root, dict(zip(names, frames, strict=True)))
             lo, hi = np.minimum(lo, v_lo), np.maximum(hi, v_hi)
@@ -422,7 +426,7 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
                 continue
             pos, rot = frames[j + 1]
             # PyBullet's axis is in the child's inertial frame: turn it into the link frame.
-            local = p.getDynamicsInfo(body, j, physicsClientId=c)[4]
+            local = bullet.getDynamicsInfo(body, j)[4]
             inertial = np.array(p.getMatrixFromQuaternion(local), dtype=float).reshape(3, 3)
             axes.append((pos, rot @ inertial @ np.array(info[13], dtype=float)))
     except p.error as e:
@@ -552,7 +556,7 @@ def _add_plane(scene: _Scene) -> int:
                                     float(scene.lo[2]) - thick]))
 
 
-def _shoot(scene: _Scene, view: str, width: int, height: int, o: RenderOptions,
+def _shoot(scene: _Scene, view: View, width: int, height: int, o: RenderOptions,
            scale: int) -> tuple[Any, Camera, bool]:
     """Render one view at ``width x height`` (already supersampled) with its overlays."""
     import numpy as np
@@ -759,14 +763,14 @@ def render_file(name: str | Path, options: RenderOptions | None = None, *,
     from urdfkit.sources.resolve import open_input
 
     _pillow()  # fail before expanding xacro when Pillow is missing
-    with open_input(name, packages, xacro_args, guard=guard,
+    with open_input(name, packages=packages, xacro_args=xacro_args, guard=guard,
                     package_paths=package_paths) as resolved:
         picture = render(resolved, options)
         picture.warnings[:0] = resolved.warnings
         return picture
 
 
-def check_output(path: str | Path, *, force: bool = False) -> Path:
+def check_picture_path(path: str | Path, *, force: bool = False) -> Path:
     """Refuse an output path early: not ``*.png``, or an existing file without ``force``.
 
     The CLI calls this before rendering, so a refused path costs nothing.
@@ -779,7 +783,7 @@ def check_output(path: str | Path, *, force: bool = False) -> Path:
 
 def write_png(rendering: Rendering, path: str | Path, *, force: bool = False) -> Path:
     """Write the picture atomically; refuses to replace a file unless ``force``."""
-    path = check_output(path, force=force)
+    path = check_picture_path(path, force=force)
     from urdfkit.core.output import atomic_write
 
     return atomic_write(path, rendering.png_bytes(), force=force)

@@ -2,12 +2,12 @@
 
 Three parts:
 
-- :class:`~urdfkit.draw.view_model.Model` (view_model.py) reads a loaded body into plain data:
-shapes,
-  inertial frames, movable joints, findings mapped to links. It never computes kinematics.
-- :class:`Viewer` (here) shows a Model with viser (a web server whose client ships in its
-  wheel, so it works offline), and reloads it when the file or anything it read changes; the
-  page's text is written by view_page.py.
+- :class:`~urdfkit.draw.view_model.ViewedRobot` (view_model.py) reads a loaded body into plain
+  data: shapes, inertial frames, movable joints, findings mapped to links. It never computes
+  kinematics.
+- :class:`Viewer` (here) shows a :class:`ViewedRobot` with viser (a web server whose client
+  ships in its wheel, so it works offline), and reloads it when the file or anything it read
+  changes; the page's text is written by view_page.py.
 - :class:`~urdfkit.draw.view_stream.RunStream` (view_stream.py) streams a simulated run to the page.
 """
 
@@ -19,7 +19,7 @@ from typing import Any
 
 from urdfkit.core.errors import EngineError, MissingDependencyError, UrdfkitError
 from urdfkit.draw import view_page as page
-from urdfkit.draw.view_model import TINTS, Model, Vec3
+from urdfkit.draw.view_model import TINTS, Layer, Vec3, ViewedRobot
 from urdfkit.draw.view_stream import RunDisplay, add_shapes, wxyz
 
 #: Links touching another at the current pose (self-collision pairs).
@@ -79,7 +79,7 @@ def free_port(host: str) -> int:
 
 
 class Viewer(RunDisplay):
-    """A viser server showing a :class:`Model`, reloaded when its files change.
+    """A viser server showing a :class:`ViewedRobot`, reloaded when its files change.
 
     The server never dies on a bad file: a load that fails keeps the last good robot and shows
     the error in the page (:attr:`error`).
@@ -100,19 +100,19 @@ class Viewer(RunDisplay):
             "packages": packages, "package_paths": package_paths, "xacro_args": xacro_args,
             "inertia_from_file": inertia_from_file}
         self.file = file
-        self.model = Model(file, **self._load_args)  # a bad file fails here, before serving
+        self.model = ViewedRobot(file, **self._load_args)  # a bad file fails here, before serving
         self.error: str | None = None
         self.reloads = 0
         self._failed: dict[str, Any] | None = None
         self._lock = threading.RLock()
         self._setting = False
-        self._nodes: dict[str, list[Any]] = {}
+        self._nodes: dict[Layer, list[Any]] = {}
         self._frames: list[Any] = []
         #: The page shows poses given from outside (a run, :meth:`show_poses`): the model's
         #: own joints no longer move the scene, even from a late slider callback.
         self.external_poses = False
         #: More robots on the page (sim --view): each model and its link frames.
-        self.extra: list[tuple[Model, list[Any]]] = []
+        self.extra: list[tuple[ViewedRobot, list[Any]]] = []
         self._gui: list[Any] = []
         self.sliders: dict[str, Any] = {}
         viser = _viser()
@@ -287,7 +287,7 @@ class Viewer(RunDisplay):
                 for h in handles:
                     h.visible = bool(want[kind])
 
-    def visible(self, kind: str) -> bool:
+    def visible(self, kind: Layer) -> bool:
         """Whether a layer (visual, collision, frames, inertia) is shown."""
         handles = self._nodes.get(kind, [])
         return bool(handles) and all(h.visible for h in handles)
@@ -338,7 +338,9 @@ class Viewer(RunDisplay):
             hit = {name for a, b, _ in self.touching for name in (a, b)}
             for link, k in zip(self.model.links, range(len(self.model.links)), strict=True):
                 base = TINTS.get(link.level or "")
-                for kind, shapes in (("visual", link.visuals), ("collision", link.collisions)):
+                layers: tuple[tuple[Layer, Any], ...] = (("visual", link.visuals),
+                                                         ("collision", link.collisions))
+                for kind, shapes in layers:
                     handles = [h for h in self._nodes.get(kind, [])
                                if h.name.startswith(f"/robot/link{k}/")]
                     for h, sh in zip(handles, shapes, strict=True):
@@ -400,7 +402,7 @@ class Viewer(RunDisplay):
                         tuple(float(x) for x in frame.wxyz))
         raise KeyError(name)
 
-    def nodes(self, kind: str, link: str) -> list[Any]:
+    def nodes(self, kind: Layer, link: str) -> list[Any]:
         """The scene handles of one layer of one link (for tests and tools)."""
         index = next(i for i, lk in enumerate(self.model.links) if lk.name == link)
         prefix = f"/robot/link{index}/"
@@ -436,7 +438,7 @@ class Viewer(RunDisplay):
 
         kept = self.model.positions()
         try:
-            model = Model(self.file, **self._load_args)
+            model = ViewedRobot(self.file, **self._load_args)
         except Exception as e:  # noqa: BLE001 - any failure keeps the last good robot
             self.error = str(e) if isinstance(e, UrdfkitError) else \
                 f"internal error (a bug in urdfkit): {type(e).__name__}: {e}"

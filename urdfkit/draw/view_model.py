@@ -1,7 +1,7 @@
 """The robot as ``urdfkit view`` shows it: read from PyBullet into plain data.
 
-:class:`Model` reads a loaded body into plain data: every link's visual and collision shapes
-(from ``getVisualShapeData`` and ``getCollisionShapeData``, so colours follow PyBullet's
+:class:`ViewedRobot` reads a loaded body into plain data: every link's visual and collision
+shapes (from ``getVisualShapeData`` and ``getCollisionShapeData``, so colours follow PyBullet's
 material rules and collision meshes are the convex hulls PyBullet collides with), its inertial
 frame, mass and principal moments, the movable joints in PyBullet's index order, mimic joints,
 and the findings of ``check`` mapped to links. It poses the body with ``resetJointState`` and
@@ -22,7 +22,7 @@ import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from urdfkit.core.errors import UrdfkitError
 from urdfkit.core.finding import Finding
@@ -42,6 +42,12 @@ Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]  # x, y, z, w as PyBullet gives them
 
 
+#: What a drawn shape was in the file (``mesh`` for a mesh, whatever PyBullet made of it).
+ShapeKind = Literal["box", "sphere", "cylinder", "capsule", "plane", "mesh"]
+#: The layers of the scene the page shows or hides: shapes, link frames, inertia boxes.
+Layer = Literal["visual", "collision", "frames", "inertia"]
+
+
 @dataclass
 class Shape:
     """One visual or collision shape, ready to draw: triangles in the shape's own frame.
@@ -57,7 +63,7 @@ class Shape:
         note: What the page should say about it (a hull of a concave mesh, a thinned mesh).
     """
 
-    kind: str
+    kind: ShapeKind
     vertices: Any
     faces: Any
     pos: Vec3
@@ -135,7 +141,7 @@ class JointControl:
     mimic: tuple[str, float, float] | None = None
 
 
-def _primitive(kind: int, dims: Sequence[float]) -> tuple[str, Any, Any] | None:
+def _primitive(kind: int, dims: Sequence[float]) -> tuple[ShapeKind, Any, Any] | None:
     import trimesh
 
     if kind == _BOX:
@@ -188,7 +194,7 @@ def read_mesh(path: str | Path) -> tuple[Any, Any] | None:
     return None
 
 
-class Model:
+class ViewedRobot:
     """A file loaded in its own PyBullet session, read into what the viewer draws.
 
     Attributes:
@@ -219,7 +225,8 @@ class Model:
         with deps.record() as recorded:
             deps.note(file)
             try:
-                self.resolved = open_input(file, list(packages or []), list(xacro_args or []),
+                self.resolved = open_input(file, packages=list(packages or []),
+                                           xacro_args=list(xacro_args or []),
                                            package_paths=list(package_paths or []))
                 deps.note(self.resolved.source)
                 self.session = Session()
@@ -238,29 +245,29 @@ class Model:
     # ------------------------------------------------------------------ reading
 
     def _read(self) -> None:
+        from urdfkit.engine.joints import base_link_name, joint_table
         from urdfkit.engine.session import quiet_stdout
-        from urdfkit.inspect import base_link_name, joint_table
 
         s, body = self.session, self.body
-        p, c = s.p, s.client
+        p, bullet = s.p, s.bullet
         with quiet_stdout() as out:
             self.table = joint_table(s, body, self.resolved.root)
             names = [base_link_name(s, body)] + [j.link_name for j in self.table]
             self.links = [LinkView(i, names[i + 1]) for i in range(-1, len(self.table))]
             for link in self.links:
-                info = p.getDynamicsInfo(body, link.index, physicsClientId=c)
+                info = bullet.getDynamicsInfo(body, link.index)
                 link.mass = float(info[0])
                 link.moments = tuple(float(v) for v in info[2])  # type: ignore[assignment]
                 link.inertial_pos = tuple(float(v) for v in info[3])  # type: ignore[assignment]
                 link.inertial_quat = tuple(float(v) for v in info[4])  # type: ignore[assignment]
-            for v in p.getVisualShapeData(body, physicsClientId=c):
+            for v in bullet.getVisualShapeData(body):
                 shape = self._shape(v[2], v[3], v[4], v[5], v[6], collision=False,
                                     rgba=v[7])
                 if shape is not None:
                     self.links[v[1] + 1].visuals.append(shape)
             concave = self._concave()
             for link in self.links:
-                for v in p.getCollisionShapeData(body, link.index, physicsClientId=c):
+                for v in bullet.getCollisionShapeData(body, link.index):
                     # Relative to the inertial frame: move it into the link frame.
                     pos, quat = p.multiplyTransforms(link.inertial_pos, link.inertial_quat,
                                                      v[5], v[6])
@@ -290,7 +297,7 @@ class Model:
                 return None
             vertices = np.asarray(mesh[0], dtype=float) * np.asarray(dims[:3], dtype=float)
             faces = np.asarray(mesh[1], dtype=np.int64)
-            kind_name = "mesh"
+            kind_name: ShapeKind = "mesh"
             if collision:  # what PyBullet collides with: the hull (urdfkit.draw.displaymesh)
                 from urdfkit.draw.displaymesh import HULL_POINTS, convex_hull
 
@@ -416,38 +423,37 @@ class Model:
         Returns every movable joint's position as PyBullet now reports it.
         """
         with self.lock:
-            p, c = self.session.p, self.session.client
+            bullet = self.session.bullet
             by_name = {j.name: j for j in self.joints}
             wanted = {k: float(v) for k, v in values.items() if k in by_name}
             for name, value in wanted.items():
                 if by_name[name].mimic is None:
-                    p.resetJointState(self.body, by_name[name].index, value, physicsClientId=c)
+                    bullet.resetJointState(self.body, by_name[name].index, value)
             now = self.positions()
             for j in self.joints:  # leaders first in a chain: index order is depth order
                 if j.mimic is not None and j.mimic[0] in now:
                     value = now[j.mimic[0]] * j.mimic[1] + j.mimic[2]
-                    p.resetJointState(self.body, j.index, value, physicsClientId=c)
+                    bullet.resetJointState(self.body, j.index, value)
                     now[j.name] = value
             return self.positions()
 
     def positions(self) -> dict[str, float]:
         """Every movable joint's position, read from PyBullet (``getJointState``)."""
         with self.lock:
-            p, c = self.session.p, self.session.client
-            return {j.name: float(p.getJointState(self.body, j.index, physicsClientId=c)[0])
+            bullet = self.session.bullet
+            return {j.name: float(bullet.getJointState(self.body, j.index)[0])
                     for j in self.joints}
 
     def link_poses(self) -> list[tuple[Vec3, Quat]]:
         """World pose of every URDF link frame, base first, as PyBullet reports it."""
         with self.lock:
-            p, c = self.session.p, self.session.client
-            pos, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=c)
+            p, bullet = self.session.p, self.session.bullet
+            pos, orn = bullet.getBasePositionAndOrientation(self.body)
             base = self.links[0]
             inv = p.invertTransform(base.inertial_pos, base.inertial_quat)
             out = [p.multiplyTransforms(pos, orn, inv[0], inv[1])]
             for link in self.links[1:]:
-                state = p.getLinkState(self.body, link.index, computeForwardKinematics=1,
-                                       physicsClientId=c)
+                state = bullet.getLinkState(self.body, link.index, computeForwardKinematics=1)
                 out.append((state[4], state[5]))
             return [(tuple(float(x) for x in a), tuple(float(x) for x in b))  # type: ignore[misc]
                     for a, b in out]
@@ -455,10 +461,10 @@ class Model:
     def bounds(self) -> tuple[Vec3, Vec3]:
         """The posed robot's box (union of getAABB over links), for the camera."""
         with self.lock:
-            p, c = self.session.p, self.session.client
+            bullet = self.session.bullet
             lo, hi = [math.inf] * 3, [-math.inf] * 3
             for link in self.links:
-                a, b = p.getAABB(self.body, link.index, physicsClientId=c)
+                a, b = bullet.getAABB(self.body, link.index)
                 if all(math.isfinite(x) for x in (*a, *b)) and all(
                         b[k] >= a[k] for k in range(3)):
                     lo = [min(lo[k], a[k]) for k in range(3)]
@@ -479,14 +485,12 @@ class Model:
             if self._probe is None:
                 self._probe = self._open_probe()
             session, body, pairs = self._probe
-            p, c = session.p, session.client
+            shown, probe = self.session.bullet, session.bullet
             for j in self.joints:
-                p.resetJointState(body, j.index, p.getJointState(
-                    self.body, j.index, physicsClientId=self.session.client)[0],
-                    physicsClientId=c)
+                probe.resetJointState(body, j.index, shown.getJointState(self.body, j.index)[0])
             out = []
             for a, b in pairs:
-                points = p.getClosestPoints(body, body, 0.0, a, b, physicsClientId=c)
+                points = probe.getClosestPoints(body, body, 0.0, a, b)
                 if points:
                     out.append((self.links[a + 1].name, self.links[b + 1].name,
                                 float(min(pt[8] for pt in points))))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-from urdfkit.draw.view_model import TINTS, Model
+from urdfkit.draw.view_model import TINTS, ViewedRobot
 
 
 def md(text: str) -> str:
@@ -13,7 +13,7 @@ def md(text: str) -> str:
     return re.sub(r"([\\`*_|<>\[\]])", r"\\\1", text)
 
 
-def status(m: Model, error: str | None) -> str:
+def status(m: ViewedRobot, error: str | None) -> str:
     """The head line: the robot, its size, and the last reload's error if any."""
     head = f"**{md(m.resolved.robot_name or m.file)}**: {len(m.links)} links, " \
            f"{len(m.joints)} movable joints"
@@ -21,7 +21,7 @@ def status(m: Model, error: str | None) -> str:
         f"{head}\n\n**Reload failed**, showing the last good robot: {md(error)}"
 
 
-def findings(m: Model) -> str:
+def findings(m: ViewedRobot) -> str:
     """Errors and warnings with the links they are about; notes counted."""
     shown = [f for f in m.findings if f.level in ("error", "warning")]
     lines = []
@@ -37,7 +37,7 @@ def findings(m: Model) -> str:
     return "\n".join(lines) or "No errors or warnings."
 
 
-def joint_table(m: Model) -> str:
+def joint_table(m: ViewedRobot) -> str:
     """PyBullet's joint table: index, name, type, child link, limits."""
     rows = ["| # | joint | type | child | limits |", "|---|---|---|---|---|"]
     for j in m.table:
@@ -47,7 +47,7 @@ def joint_table(m: Model) -> str:
     return "\n".join(rows)
 
 
-def selection(m: Model, link: str) -> str:
+def selection(m: ViewedRobot, link: str) -> str:
     """A selected link: its joint's row, its mass, and the findings about it."""
     row = next((j for j in m.table if j.link_name == link), None)
     lines = [f"**{md(link)}**: " + (

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from urdfkit.core.errors import EngineError
-from urdfkit.draw.view_model import Model, Vec3
+from urdfkit.draw.view_model import Layer, Vec3, ViewedRobot
 
 
 def wxyz(q: Sequence[float]) -> tuple[float, float, float, float]:
@@ -21,10 +21,12 @@ def wxyz(q: Sequence[float]) -> tuple[float, float, float, float]:
 
 
 def add_shapes(scene: Any, root: str, link: Any, tint: tuple[int, int, int] | None
-                ) -> list[tuple[str, Any]]:
+                ) -> list[tuple[Layer, Any]]:
     """A link's visual and collision meshes under its frame ``root``: (kind, handle) pairs."""
-    out = []
-    for kind, shapes in (("visual", link.visuals), ("collision", link.collisions)):
+    out: list[tuple[Layer, Any]] = []
+    layers: tuple[tuple[Layer, Any], ...] = (("visual", link.visuals),
+                                             ("collision", link.collisions))
+    for kind, shapes in layers:
         for k, sh in enumerate(shapes):
             out.append((kind, scene.add_mesh_simple(
                 f"{root}/{kind}{k}", sh.vertices, sh.faces, color=tint or sh.rgb,
@@ -43,7 +45,7 @@ class RunDisplay:
     """
 
     server: Any
-    model: Model
+    model: ViewedRobot
     status: Any
     sliders: dict[str, Any]
     reset_button: Any
@@ -51,9 +53,9 @@ class RunDisplay:
     #: own joints no longer move the scene, even from a late slider callback.
     external_poses: bool
     #: More robots on the page (sim --view): each model and its link frames.
-    extra: list[tuple[Model, list[Any]]]
+    extra: list[tuple[ViewedRobot, list[Any]]]
     _lock: threading.RLock
-    _nodes: dict[str, list[Any]]
+    _nodes: dict[Layer, list[Any]]
     _frames: list[Any]
 
     def apply_toggles(self) -> None:
@@ -66,7 +68,7 @@ class RunDisplay:
         For a scenario of several robots (``sim --view``): robot 0 is :attr:`model`, the
         others come here, and :meth:`show_poses` places each.
         """
-        m = Model(file, inertia_from_file=inertia_from_file)
+        m = ViewedRobot(file, inertia_from_file=inertia_from_file)
         k = len(self.extra) + 1
         scene, frames = self.server.scene, []
         with self._lock:

@@ -5,7 +5,7 @@ without ``URDF_USE_INERTIA_FROM_FILE`` PyBullet discards ``<inertia>`` and recom
 the collision shapes, and a link with no ``<inertial>`` gets 1 kg, so the two often differ.
 :func:`summary` adds counts, degrees of freedom, mass and the bounding box.
 
-Kept apart from :mod:`urdfkit.inspect` so that ``urdfkit joints``, which users run in loops,
+Kept apart from :mod:`urdfkit.engine.joints` so that ``urdfkit joints``, which users run in loops,
 does not pay for building these classes.
 """
 
@@ -18,8 +18,8 @@ from typing import Any
 
 from lxml import etree
 
+from urdfkit.engine.joints import JointInfo, base_link_name, joint_table
 from urdfkit.engine.session import Session
-from urdfkit.inspect import JointInfo, base_link_name, joint_table
 from urdfkit.model.spec import JOINT_DOF, attr_float, attr_vec
 from urdfkit.model.xmlio import children
 
@@ -59,8 +59,8 @@ def file_inertial(link: etree._Element | None) -> FileInertial | None:
     el = link.find("inertial")
     if el is None:
         return None
-    from urdfkit.builder import Inertia
     from urdfkit.core.errors import ModelError
+    from urdfkit.model.builder_elements import Inertia
 
     mass = attr_float(el.find("mass"), "value") or 0.0
     i = el.find("inertia")
@@ -185,6 +185,10 @@ class Summary:
     links_without_inertial: list[str]
     aabb_min: Vec3
     aabb_max: Vec3
+    #: Why the base does not move, or None: loaded with useFixedBase, or a root PyBullet
+    #: gives mass 0 (written so, or a ``world`` link without ``<inertial>``), which it makes
+    #: static. ``fixed_base`` is True in every one of these cases.
+    static_base: str | None = None
 
     @property
     def size(self) -> Vec3:
@@ -196,7 +200,8 @@ class Summary:
         return {
             "robot": self.robot, "base_link": self.base_link, "links": self.links,
             "joints": self.joints, "joint_types": self.joint_types, "dof": self.dof,
-            "fixed_base": self.fixed_base, "total_mass": self.total_mass,
+            "fixed_base": self.fixed_base, "static_base": self.static_base,
+            "total_mass": self.total_mass,
             "file_mass": self.file_mass, "links_without_inertial": self.links_without_inertial,
             "aabb": {"min": list(self.aabb_min), "max": list(self.aabb_max),
                      "size": list(self.size)},
@@ -217,10 +222,17 @@ def summary(s: Session, body: int, root: etree._Element, fixed_base: bool = Fals
         a, b = s.call("getAABB", body, index)
         lo = [min(x, y) for x, y in zip(lo, a, strict=False)]
         hi = [max(x, y) for x, y in zip(hi, b, strict=False)]
+    base = links[0]
+    # PyBullet makes a base of mass 0 static (measured): it stays where it is loaded.
+    static = ("loaded with useFixedBase" if fixed_base else None if base.mass != 0 else
+              f"the root link {base.link_name!r} has no <inertial>, and PyBullet gives a link "
+              "named world mass 0" if base.file is None else
+              f"the root link {base.link_name!r} has mass 0")
     return Summary(
         robot=root.get("name", ""), base_link=base_link_name(s, body), links=len(links),
         joints=len(joints), joint_types=dict(sorted(types.items())),
-        dof=sum(JOINT_DOF.get(j.joint_type, 0) for j in joints), fixed_base=fixed_base,
+        dof=sum(JOINT_DOF.get(j.joint_type, 0) for j in joints),
+        fixed_base=static is not None, static_base=static,
         total_mass=sum(link.mass for link in links),
         file_mass=sum(link.file.mass for link in links if link.file),
         links_without_inertial=[link.link_name for link in links if link.file is None],

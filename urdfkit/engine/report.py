@@ -1,9 +1,8 @@
 """One file loaded and read into a :class:`Report`: what ``joints``, ``links`` and ``info`` show.
 
-Sits above :mod:`urdfkit.inspect` (the joint table) and :mod:`urdfkit.engine.body` (links and
-summary):
-both are plain readers of a loaded body, and this module is the one that loads it. ``body`` is
-imported only when links or the summary are asked for.
+Sits above :mod:`urdfkit.engine.joints` (the joint table) and :mod:`urdfkit.engine.body`
+(links and summary): both are plain readers of a loaded body, and this module is the one that
+loads it. ``body`` is imported only when links or the summary are asked for.
 """
 
 from __future__ import annotations
@@ -14,8 +13,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from urdfkit.engine.joints import JointInfo, base_link_name, joint_table
 from urdfkit.engine.session import LoadOptions, Session, quiet_stdout
-from urdfkit.inspect import JointInfo, base_link_name, joint_table
 from urdfkit.sources.resolve import Resolved
 
 if TYPE_CHECKING:

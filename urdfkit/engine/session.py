@@ -17,7 +17,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, overload
 
 from urdfkit.core.errors import EngineError
 from urdfkit.model.spec import MAX_STATE_LINKS
@@ -321,13 +321,16 @@ class Session:
                     pass
             self.diagnostics.extend(out.lines)
             self.client = -1
+            # Calls after close fail as on any closed client, and never reach a later client
+            # that PyBullet gives the same id.
+            self.bullet = Bullet(self.p, -1)
 
     def call(self, fn: str, *args: Any, **kwargs: Any) -> Any:
         """Call ``p.<fn>`` on this client with stdout captured into :attr:`diagnostics`."""
         out = None
         try:
             with quiet_stdout() as out:
-                return getattr(self.p, fn)(*args, physicsClientId=self.client, **kwargs)
+                return getattr(self.bullet, fn)(*args, **kwargs)
         finally:
             # Only after the with block has exited does ``out`` hold the captured text.
             if out is not None:
@@ -377,14 +380,18 @@ class Session:
         ``getBasePositionAndOrientation``, ``getJointState`` and ``getLinkState`` raise on
         such bodies (MAX_DEGREE_OF_FREEDOM), so simulating commands check before they start.
         """
-        links = self.p.getNumJoints(body, physicsClientId=self.client) + 1
+        links = self.bullet.getNumJoints(body) + 1
         if links >= MAX_STATE_LINKS:
             raise EngineError(f"{links} links: PyBullet cannot report the state of bodies with "
                               f"{MAX_STATE_LINKS} links or more; split the model",
                               file=display)
 
 
-def restore_clean(p: Any, client: int, state: int, bodies: Sequence[int]) -> None:
+@overload
+def restore_clean(bullet: Bullet, state: int, bodies: Sequence[int], /) -> None: ...
+@overload
+def restore_clean(p: Any, client: int, state: int, bodies: Sequence[int], /) -> None: ...
+def restore_clean(*args: Any) -> None:
     """``restoreState`` and nothing carried over: the way to an in-place reset.
 
     restoreState puts positions and velocities back but leaves the contact manifolds of the
@@ -392,23 +399,42 @@ def restore_clean(p: Any, client: int, state: int, bodies: Sequence[int]) -> Non
     before (measured on 3.2.7: a car's path differed by 0.2 m). Moving the bodies apart and
     running collision detection drops those manifolds; a second restore puts the bodies back.
     After :func:`prime_resets`, every reset continues exactly as a fresh load does.
+
+    Takes the session's :class:`Bullet`; the older ``(p, client, state, bodies)`` form is kept
+    for callers that still hold the module and the id.
     """
-    p.restoreState(state, physicsClientId=client)
+    bullet, state, bodies = _bound(args)
+    bullet.restoreState(state)
     for k, body in enumerate(bodies):
-        p.resetBasePositionAndOrientation(body, [1.0e4 * (k + 1), 0.0, 1.0e4], [0, 0, 0, 1],
-                                          physicsClientId=client)
-    p.performCollisionDetection(physicsClientId=client)
-    p.restoreState(state, physicsClientId=client)
+        bullet.resetBasePositionAndOrientation(body, [1.0e4 * (k + 1), 0.0, 1.0e4],
+                                               [0, 0, 0, 1])
+    bullet.performCollisionDetection()
+    bullet.restoreState(state)
 
 
-def prime_resets(p: Any, client: int, state: int, bodies: Sequence[int]) -> None:
+@overload
+def prime_resets(bullet: Bullet, state: int, bodies: Sequence[int], /) -> None: ...
+@overload
+def prime_resets(p: Any, client: int, state: int, bodies: Sequence[int], /) -> None: ...
+def prime_resets(*args: Any) -> None:
     """Bring a new world to the state every :func:`restore_clean` reset leaves, at ``state``.
 
     The engine's contact bookkeeping after a reset differs from a fresh world's until it has
     been through one step and one reset; doing that here makes the first episode like all
-    later ones (tested bitwise against reloading every file).
+    later ones (tested bitwise against reloading every file). Takes the same arguments as
+    :func:`restore_clean`.
     """
-    p.stepSimulation(physicsClientId=client)
-    restore_clean(p, client, state, bodies)
-    p.stepSimulation(physicsClientId=client)
-    restore_clean(p, client, state, bodies)
+    bullet, state, bodies = _bound(args)
+    bullet.stepSimulation()
+    restore_clean(bullet, state, bodies)
+    bullet.stepSimulation()
+    restore_clean(bullet, state, bodies)
+
+
+def _bound(args: tuple[Any, ...]) -> tuple[Bullet, int, Sequence[int]]:
+    """``(bullet, state, bodies)`` from either form :func:`restore_clean` takes."""
+    if len(args) == 4:  # (p, client, state, bodies)
+        p, client, state, bodies = args
+        return Bullet(p, client), state, bodies
+    bullet, state, bodies = args
+    return bullet, state, bodies

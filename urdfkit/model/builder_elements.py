@@ -1,9 +1,9 @@
 """The model's elements: one class per URDF tag, each value checked where it is set.
 
-:mod:`urdfkit.builder` is the public face (it re-exports every class here) and holds
-:class:`~urdfkit.builder.Robot` with the XML reading and writing; this module holds what a
-robot is made of: :class:`Link`, :class:`Joint`, :class:`Inertial`, the shapes, and the
-checks on their values.
+:mod:`urdfkit.builder` is the public face (it re-exports every class here);
+:mod:`urdfkit.model.robot` holds :class:`~urdfkit.builder.Robot` with the XML reading and
+writing; this module holds what a robot is made of: :class:`Link`, :class:`Joint`,
+:class:`Inertial`, the shapes, and the checks on their values.
 """
 
 from __future__ import annotations

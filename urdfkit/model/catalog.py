@@ -14,11 +14,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
-from urdfkit.builder import Robot
 from urdfkit.core.errors import ParameterError
+from urdfkit.model.robot import Robot
 from urdfkit.model.templatedir import template_dir
+
+#: A template parameter's type: one number, or three.
+ParamKind = Literal["float", "vec3"]
 
 
 @dataclass(frozen=True)
@@ -37,7 +40,7 @@ class Param:
     """
 
     name: str
-    kind: str
+    kind: ParamKind
     default: Any
     help: str
     minimum: float | None = 0.0

@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Hashable, Mapping, Sequence
-from typing import Any, Protocol, TypeVar
+from typing import Any, Literal, Protocol, TypeVar
 
 # --------------------------------------------------------------------------- joints
 
@@ -230,6 +230,18 @@ CRASH_PERCENT_TAGS = frozenset({"link"})
 #: Past it a duration or time step is a typo (``1e308``, ``1e-300``), refused before it runs.
 MAX_STEPS = 100_000_000
 
+#: The link name PyBullet 3.2.7 treats apart: a link so named with no ``<inertial>`` gets mass 0
+#: (not the 1 kg every other such link gets), so a ``world`` root makes the base static and a
+#: ``world`` child is massless. Measured: case matters (``World`` gets 1 kg), and a ``world``
+#: link with an ``<inertial>`` keeps its mass.
+WORLD_LINK = "world"
+
+
+def default_mass(link_name: str | None) -> float:
+    """The mass PyBullet gives a link that has no ``<inertial>``: 0 for ``world``, else 1 kg."""
+    return 0.0 if link_name == WORLD_LINK else 1.0
+
+
 # --------------------------------------------------------------------------- numbers
 
 
@@ -321,6 +333,7 @@ def attr_float(el: _HasGet | None, attr: str, default: float | None = None) -> f
 _HALF = math.sqrt(0.5)
 #: Base orientations (x, y, z, w) that stand a model up whose "up" is the given axis (many
 #: CAD-exported and graphics models are Y-up): that axis is turned onto the world's +Z.
+UpAxis = Literal["z", "y", "x"]
 UP_AXES: dict[str, tuple[float, float, float, float]] = {
     "z": (0.0, 0.0, 0.0, 1.0), "y": (_HALF, 0.0, 0.0, _HALF), "x": (0.0, -_HALF, 0.0, _HALF)}
 

@@ -338,7 +338,7 @@ class Scenario:
         from urdfkit.sources.resolve import open_input
 
         self._last_file = name
-        with open_input(name, self.config.packages, self.config.xacro_args,
+        with open_input(name, packages=self.config.packages, xacro_args=self.config.xacro_args,
                         guard=self.config.guard, package_paths=self.config.package_paths) as res:
             self.warnings.extend(res.warnings)
             if self._phantom is None:  # the car, loaded first: links PyBullet gives 1 kg

@@ -116,14 +116,12 @@ class World:
 
         restoreState is ~100x cheaper than a new Simulation.
         """
-        s = self.session
         self._start_state = self.bullet.saveState()
-        prime_resets(s.p, s.client, self._start_state, [r.body for r in self.robots.values()])
+        prime_resets(self.bullet, self._start_state, [r.body for r in self.robots.values()])
 
     def restore(self) -> None:
         """Back to the saved start, contacts and all; time starts over."""
-        s = self.session
-        restore_clean(s.p, s.client, self._start_state, [r.body for r in self.robots.values()])
+        restore_clean(self.bullet, self._start_state, [r.body for r in self.robots.values()])
         self.step_count = 0
 
     def set_time_step(self, time_step: float) -> None:

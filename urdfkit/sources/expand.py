@@ -110,7 +110,10 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
         index = packages if isinstance(packages, PackageIndex) else PackageIndex(packages)
         cmd = [sys.executable, "-m", "urdfkit.sources._xacro_worker", str(out), str(err),
                f"{limit:g}", str(XACRO_MEMORY), json.dumps(index.to_json()), str(source_path)]
-        cmd += [f"{k}:={v}" for k, v in (args or {}).items()]
+        # As xacro's command line: ``name:=`` with nothing after it keeps the file's default
+        # (xacro 2.1.1 `xacro f.xacro namespace:=` gives the default, not ""), so an empty
+        # value is not passed.
+        cmd += [f"{k}:={v}" for k, v in (args or {}).items() if v != ""]
         if not strict_args:
             cmd.append("--lenient-args")
         with open(os.devnull, "rb") as stdin, open(err, "ab") as log:

@@ -4,7 +4,7 @@
 child with two parents, cycles, duplicate names, ``%`` in names, ...) and what is not URDF at
 all, and raises the first error as an :class:`~urdfkit.core.errors.InputError`. Every command that
 loads a file calls it. The rest of ``check``'s rules live in :mod:`urdfkit.checks.validate`, which
-builds on the :class:`Report` and the runner here.
+builds on the :class:`RuleReport` and the runner here.
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ from urdfkit.model.xmlio import line_of
 from urdfkit.sources.uris import not_a_file, pybullet_data_path, resolve_uri
 
 
-class Report:
+class RuleReport:
     """Collects findings for one file.
 
     Attributes:
@@ -107,7 +107,7 @@ class Report:
         return [f for f in self.findings if f.level == "error"]
 
 
-Rule = Callable[[etree._Element, Report], None]
+Rule = Callable[[etree._Element, RuleReport], None]
 
 
 def label(el: etree._Element) -> str:
@@ -129,7 +129,7 @@ LIFTABLE_CODES = frozenset({"U107", "U108"})
 STRICTER = " (PyBullet 3.2.7 loads this, but the guard refuses it; `guard=False` lifts it)"
 
 
-def rule_document(root: etree._Element, r: Report) -> None:
+def rule_document(root: etree._Element, r: RuleReport) -> None:
     """U001-U003: root is <robot>, has a name, and has links."""
     if root.tag != "robot":
         r.add("U001", "error", f"root element is <{root.tag}>, expected <robot>", root)
@@ -148,7 +148,7 @@ def rule_document(root: etree._Element, r: Report) -> None:
                if soft else ""), root)
 
 
-def _check_name(el: etree._Element, r: Report) -> str | None:
+def _check_name(el: etree._Element, r: RuleReport) -> str | None:
     name = el.get("name")
     if name is None or not name.strip():
         r.add("U101", "error", f"<{el.tag}> has no name; give it a unique name=\"...\"", el)
@@ -158,7 +158,7 @@ def _check_name(el: etree._Element, r: Report) -> str | None:
     return name
 
 
-def _check_percent(el: etree._Element, name: str, r: Report) -> None:
+def _check_percent(el: etree._Element, name: str, r: RuleReport) -> None:
     if "%" not in name:
         return
     # PyBullet passes some names into printf as the format string: "%s" reads garbage, "%n"
@@ -172,7 +172,7 @@ def _check_percent(el: etree._Element, name: str, r: Report) -> None:
               "printf format; rename it" + STRICTER, el)
 
 
-def _check_length(el: etree._Element, name: str, r: Report) -> None:
+def _check_length(el: etree._Element, name: str, r: RuleReport) -> None:
     size = len(name.encode("utf-8", "surrogatepass"))
     if size <= MAX_NAME_BYTES:
         return
@@ -187,7 +187,7 @@ def _check_length(el: etree._Element, name: str, r: Report) -> None:
               "fixed-size buffers are not much larger" + STRICTER, el)
 
 
-def rule_names(root: etree._Element, r: Report) -> None:
+def rule_names(root: etree._Element, r: RuleReport) -> None:
     """U101-U108: links, joints and materials are named, uniquely, without '%', not too long."""
     if root.tag != "robot":
         return
@@ -240,7 +240,7 @@ def rule_names(root: etree._Element, r: Report) -> None:
             _check_name(el, r)
 
 
-def rule_tree(root: etree._Element, r: Report) -> None:
+def rule_tree(root: etree._Element, r: RuleReport) -> None:
     """U201-U207: joints reference links; exactly one root; single parents; no cycles."""
     if root.tag != "robot":
         return
@@ -305,7 +305,7 @@ def rule_tree(root: etree._Element, r: Report) -> None:
               f"{', '.join(map(repr, cyclic[:5]))}; joints must form a tree", j)
 
 
-def rule_joints(root: etree._Element, r: Report) -> None:
+def rule_joints(root: etree._Element, r: RuleReport) -> None:
     """U301-U307, U309: joint type, limits, axis; a mimic's leader exists and leads somewhere."""
     views = r.doc(root).joints
     joints = {v.name for v in views}
@@ -364,7 +364,7 @@ def rule_joints(root: etree._Element, r: Report) -> None:
                   leaders[start][1])
 
 
-def rule_geometry(root: etree._Element, r: Report) -> None:
+def rule_geometry(root: etree._Element, r: RuleReport) -> None:
     """U501-U506: one shape per <geometry>, first; positive sizes; meshes have a filename."""
     doc = r.doc(root)
     for view in doc.links:
@@ -411,7 +411,7 @@ def rule_geometry(root: etree._Element, r: Report) -> None:
             r.add("U503", "error", f"<{shape.tag}> has no filename", shape)
 
 
-def rule_inertial(root: etree._Element, r: Report) -> None:
+def rule_inertial(root: etree._Element, r: RuleReport) -> None:
     """U609-U610: <inertial> has an <inertia> with all six components (PyBullet refuses less)."""
     for view in r.doc(root).links:
         link, inertial, inertia = view.el, view.inertial, view.inertia
@@ -535,7 +535,7 @@ def _too_many_links(n: int) -> str:
             "model")
 
 
-def rule_link_limit(root: etree._Element, r: Report) -> None:
+def rule_link_limit(root: etree._Element, r: RuleReport) -> None:
     """U209: refuse bodies so large that loading and stepping them takes minutes."""
     n = len(r.doc(root).links)
     if n > MAX_LOADABLE_LINKS:
@@ -615,7 +615,7 @@ def run_rules(root: etree._Element, file: str, rules: tuple[Rule, ...], *,
     :class:`urdfkit.sources.expand.Expanded`) give each finding the file and line its element was
     written on.
     """
-    report = Report(file, base, packages, origin_map(root, origins))
+    report = RuleReport(file, base, packages, origin_map(root, origins))
     for rule in rules:
         rule(root, report)
     return report.findings

@@ -183,6 +183,6 @@ class Integrals(Record):
 
 
 #: Cache entries start with this; a new layout is a new prefix and a new folder.
-_ENTRY = b"M4"
+_ENTRY = b"M5"
 #: Integrals' cache entry layout, after the prefix.
 _FORMAT = struct.Struct("<17d?II")

@@ -42,7 +42,7 @@ def _cache_dir() -> Path | None:
 
 _CACHE_DIRS: dict[tuple[str | None, ...], Path | None] = {}
 
-_FOLDER = "meshes-4"
+_FOLDER = "meshes-5"
 _MEMORY: dict[str, Integrals | None] = {}
 _MISSING = object()
 

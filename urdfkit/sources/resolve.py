@@ -246,10 +246,15 @@ def _resolve_tree(source: Path, display: str, tree: etree._ElementTree,
     return Resolved(display, source, source, tree, warnings=lifted)
 
 
-def open_input(name: str | Path, packages: list[str] | None = None,
+def open_input(name: str | Path, *, packages: list[str] | None = None,
                xacro_args: list[str] | None = None, guard: bool = True,
                package_paths: list[str] | None = None, meshes: bool = True) -> Resolved:
-    """:func:`resolve` with the raw ``--package NAME=PATH`` and ``--arg k:=v`` option lists."""
+    """:func:`resolve` with the raw ``--package NAME=PATH`` and ``--arg k:=v`` option lists.
+
+    The options are keyword-only, so no call can pass ``guard`` where ``packages`` goes; the
+    command line's flags reach here through
+    :func:`urdfkit.commands.shared.open_input_and_warn`.
+    """
     args: dict[str, str] = {}
     if xacro_args:
         # Only now: catalog pulls in the builder model (~15 ms), which plain loads never need.

@@ -1,0 +1,216 @@
+"""export, agree: a URDF written for MuJoCo, and proof that it agrees (urdfkit/exchange/)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from urdfkit.commands import present as show
+from urdfkit.commands.shared import (
+    AllOpt,
+    ArgOpt,
+    FileArg,
+    ForceOpt,
+    JsonOpt,
+    NoGuardOpt,
+    PackageOpt,
+    PackagePathOpt,
+    command,
+    examples,
+    open_input_and_warn,
+)
+
+FixedBaseOpt = Annotated[bool, typer.Option(
+    "--fixed-base", help="Weld the root link to the world, as loadURDF's useFixedBase "
+    "(default: a free joint, as loadURDF; a root of mass 0 is welded, as PyBullet fixes it).")]
+ShapesOpt = Annotated[bool, typer.Option(
+    "--inertia-from-shapes", help="Mirror PyBullet's load without URDF_USE_INERTIA_FROM_FILE: "
+    "inertia recomputed from the collision shapes (default: the file's, with the flag).")]
+SelfCollisionOpt = Annotated[bool, typer.Option(
+    "--self-collision", help="Let the robot's links collide, as URDF_USE_SELF_COLLISION "
+    "(parent-child pairs excluded).")]
+
+
+def _verify_options(fixed_base: bool, shapes: bool, self_collision: bool, poses: int,
+                    seed: int) -> Any:
+    from urdfkit.exchange.agree import AgreeOptions
+
+    return AgreeOptions(fixed_base=fixed_base, inertia_from_file=not shapes,
+                        self_collision=self_collision, poses=poses, seed=seed)
+
+
+def _figure(x: float | None) -> str:
+    if x is None:
+        return "-"
+    if x == 0:
+        return "0"
+    return f"{x:.2g}"
+
+
+def agreement_dict(a: Any) -> dict[str, Any]:
+    """``agree --json``: the rows with their tolerances, what was not matched, ok."""
+    return {"file": a.file, "model": a.model, "ok": a.ok, "load_flags": a.load_flags,
+            "rows": [{"group": r.group, "check": r.what, "value": r.value,
+                      "tolerance": r.tolerance, "unit": r.unit, "status": r.status,
+                      "detail": r.detail} for r in a.rows],
+            "unmatched_links": a.unmatched_links, "unmatched_joints": a.unmatched_joints,
+            "extra_joints": a.extra_joints, "warnings": a.warnings}
+
+
+def agreement_report(a: Any, show_all: bool = False) -> None:
+    """``agree``'s table: one row per comparison, the tolerance beside each figure."""
+    rows = [[r.group, r.what, _figure(r.value), _figure(r.tolerance), r.unit,
+             {"pass": "ok", "fail": "FAIL"}.get(r.status, r.status), r.detail]
+            for r in a.rows]
+    columns: list[show.Column] = [("group", 1, "left"), ("check", 0, "left"),
+                                  ("worst", 0, "right"), ("tolerance", 0, "right"),
+                                  ("unit", 2, "left"), ("", 0, "left"), ("where", 1, "left")]
+    failed = sum(not r.ok for r in a.rows)
+    title = (f"{a.file} in PyBullet vs {a.model} in MuJoCo: "
+             + ("every row agrees" if not failed else f"{failed} row(s) disagree"))
+    for w in a.warnings:
+        show.warn(f"{a.model}: MuJoCo: {w}")
+    show.table(title, columns, rows, show_all)
+    if a.unmatched_links:
+        show.note(f"{len(a.unmatched_links)} link(s) with no body or site of that name: "
+                  + ", ".join(a.unmatched_links), stderr=False)
+    show.note("PyBullet loaded with " + (" | ".join(a.load_flags) or "no flags")
+              + "; its link damping and velocity motors off for the swing", stderr=False)
+
+
+def _export_dict(file: str, e: Any, flags: list[str]) -> dict[str, Any]:
+    return {"file": file, "paths": e.paths, "bodies": e.bodies, "sites": e.sites,
+            "mirrored_flags": flags,
+            "notes": [{"kind": n.kind, "message": n.message, "line": n.line} for n in e.notes]}
+
+
+@command(examples(
+    "urdfkit export mjcf kuka_iiwa/model.urdf -o iiwa.xml",
+    "urdfkit export mjcf robot.urdf.xacro -a prefix:=left_ -o robot.xml --actuators position",
+    "urdfkit export mjcf simplecar.urdf -o car.xml --ground --actuators velocity --verify",
+    "python -m mujoco.viewer --mjcf car.xml"))
+def export(
+    kind: Annotated[str, typer.Argument(metavar="mjcf", help="The format: mjcf (MuJoCo).")],
+    file: FileArg,
+    output: Annotated[str | None, typer.Option(
+        "--output", "-o", metavar="FILE.xml", help="Where to write; the meshes go to "
+        "FILE_assets/ beside it.", show_default="the robot file's name, .xml")] = None,
+    fixed_base: FixedBaseOpt = False,
+    inertia_from_shapes: ShapesOpt = False,
+    self_collision: SelfCollisionOpt = False,
+    actuators: Annotated[str, typer.Option(
+        "--actuators", metavar="motor|position|velocity|none",
+        help="One actuator per movable joint that mimics none: motor (ctrlrange from the "
+        "effort limit), position or velocity servos (forcerange from it), or none.")]
+    = "motor",
+    gain: Annotated[float | None, typer.Option(
+        "--gain", help="kp of position servos (N m/rad) or kv of velocity servos (N m s/rad).",
+        show_default="100 / 1")] = None,
+    ground: Annotated[bool, typer.Option(
+        "--ground", help="Add a ground plane and a light, so the file simulates as it is.")]
+    = False,
+    verify: Annotated[bool, typer.Option(
+        "--verify", help="Then run `urdfkit agree` on what was written (exit 1 if it "
+        "disagrees).")] = False,
+    as_json: JsonOpt = False,
+    force: ForceOpt = False,
+    package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
+    arg: ArgOpt = None,
+    no_guard: NoGuardOpt = False,
+) -> None:
+    """Write the robot PyBullet simulates as a standalone MuJoCo model (MJCF + meshes).
+
+    Same joints, limits, damping, masses and full inertia as PyBullet loads with
+    URDF_USE_INERTIA_FROM_FILE; fixed links fused into their parent body, each kept as a site
+    of its name; meshes copied (COLLADA converted) into FILE_assets/. What is dropped or
+    approximated is listed on stderr (or in --json). See docs/export.md.
+    """
+    from urdfkit.core.errors import ParameterError
+    from urdfkit.core.output import check_output
+    from urdfkit.exchange.mjcf import ExportOptions, asset_dir_for, export_mjcf, write_export
+    from urdfkit.exchange.robot import read_robot
+
+    if kind.lower() != "mjcf":
+        raise ParameterError(f"unknown format {kind!r}: export writes mjcf", param="kind")
+    out = output or f"{Path(file).name.split('.')[0] or 'robot'}.xml"
+    check_output(out, force=force, suffixes=(".xml",), what="the MJCF file")
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path) as resolved:
+        robot = read_robot(resolved.root, resolved.name)
+        for w in robot.warnings:
+            show.warn(f"{resolved.name}: {w}")
+        from urdfkit.exchange.bullet import loaded_inertials
+
+        # what PyBullet simulates: its diagonalised tensors, its defaults, its recomputation
+        inertials = loaded_inertials(resolved, inertia_from_file=not inertia_from_shapes)
+        e = export_mjcf(robot, ExportOptions(
+            fixed_base=fixed_base, self_collision=self_collision, actuators=actuators,
+            gain=gain, ground=ground, inertials=inertials,
+            inertia_from_shapes=inertia_from_shapes), asset_dir_for(out))
+        # cylinders are written as true cylinders: PyBullet's with URDF_USE_IMPLICIT_CYLINDER
+        flags = ["URDF_USE_INERTIA_FROM_FILE"] if not inertia_from_shapes else []
+        flags += ["URDF_USE_IMPLICIT_CYLINDER"]
+        flags += ["URDF_USE_SELF_COLLISION"] if self_collision else []
+        write_export(e, out, force=force)
+        agreement = None
+        if verify:
+            from urdfkit.exchange.agree import agree as run_agree
+
+            agreement = run_agree(resolved, out, _verify_options(
+                fixed_base, inertia_from_shapes, self_collision, 100, 0))
+    if as_json:
+        data = _export_dict(resolved.name, e, flags)
+        data["agreement"] = agreement_dict(agreement) if agreement is not None else None
+        show.print_json(data)
+    else:
+        for n in e.notes:
+            where = f"{resolved.name}:{n.line}: " if n.line else f"{resolved.name}: "
+            show.note(f"{where}{n.kind}: {n.message}")
+        show.wrote(out, f"{len(e.bodies)} bodies, {len(e.sites)} sites, "
+                   f"{len(e.paths) - 1} mesh file(s); mirrors loadURDF with "
+                   + (" | ".join(flags) or "no flags")
+                   + (" and useFixedBase" if fixed_base else ""))
+        if agreement is not None:
+            agreement_report(agreement)
+    raise typer.Exit(1 if agreement is not None and not agreement.ok else 0)
+
+
+@command(examples(
+    "urdfkit agree kuka_iiwa/model.urdf iiwa.xml",
+    "urdfkit agree panda.urdf mujoco_menagerie/franka_emika_panda/panda.xml --json"))
+def agree(
+    file: FileArg,
+    model: Annotated[str, typer.Argument(metavar="MODEL.xml", help="The MJCF to compare.")],
+    fixed_base: FixedBaseOpt = False,
+    inertia_from_shapes: ShapesOpt = False,
+    self_collision: SelfCollisionOpt = False,
+    poses: Annotated[int, typer.Option("--poses", min=1, help="Seeded random poses.")] = 100,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the poses.")] = 0,
+    as_json: JsonOpt = False,
+    show_all: AllOpt = False,
+    package: PackageOpt = None,
+    package_path: PackagePathOpt = None,
+    arg: ArgOpt = None,
+    no_guard: NoGuardOpt = False,
+) -> None:
+    """Does a MuJoCo model agree with the URDF PyBullet loads? Both engines, compared.
+
+    Links are matched to bodies or sites and joints to joints by name; structure, link frames
+    at seeded poses, mass matrix, inverse dynamics and a 1 s free swing are compared, each
+    with its tolerance. Exit 0: every row holds; 1: rows disagree (named); 2: bad input.
+    Needs urdfkit[mujoco]. See docs/export.md.
+    """
+    from urdfkit.exchange.agree import agree as run_agree
+
+    with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
+                             package_paths=package_path) as resolved:
+        result = run_agree(resolved, model, _verify_options(
+            fixed_base, inertia_from_shapes, self_collision, poses, seed))
+    if as_json:
+        show.print_json(agreement_dict(result))
+    else:
+        agreement_report(result, show_all)
+    raise typer.Exit(0 if result.ok else 1)

@@ -1,0 +1,1 @@
+"""Other engines' formats: the MJCF writer, its agreement with PyBullet, exact kinematics."""

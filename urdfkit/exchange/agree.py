@@ -1,0 +1,670 @@
+"""Does an MJCF agree with the URDF PyBullet loads? Both engines loaded and compared.
+
+The URDF goes into PyBullet (the flags ``export`` mirrors), the MJCF into MuJoCo; links are
+matched to bodies or sites and joints to joints by name, and each comparison is one
+:class:`Row` with its worst figure and its tolerance beside it:
+
+- structure: joint names, order, kinds, limits, damping (1e-12); total and per-body mass
+  (1e-12 relative) and inertia about the centre of mass (1e-9 relative), bodies welded
+  together (fixed links fused; MuJoCo's own welded bodies) compared as one;
+- kinematics: every matched link frame at seeded poses, against PyBullet's ``getLinkState``
+  (float32 inside: 1e-6) and against :mod:`urdfkit.exchange.fk` (1e-12);
+- dynamics: the joint-space mass matrix and inverse-dynamics torques at those poses (1e-9
+  relative), base fixed on both sides (the joint block of the floating model);
+- a free swing under gravity, MuJoCo set to PyBullet's integration (Euler, implicit damping
+  off, contacts off) and PyBullet's motors and link damping off, base fixed (a free-falling
+  floating robot does not swing), compared until a joint comes within 0.01 rad of a limit:
+  the engines' limit models differ (PyBullet's a hard constraint, MuJoCo's a soft one);
+- self-contacts at the poses: none unless self-collision was asked for.
+
+The MJCF need not be ours: anything matched by name is compared, and what cannot be matched
+is listed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from urdfkit.core.errors import InputError, MissingDependencyError
+from urdfkit.exchange.fk import fused, link_frames
+from urdfkit.exchange.mjcf import combine
+from urdfkit.exchange.robot import Inertial, Robot
+
+#: Tolerances (docs/export.md explains each).
+TOL_EXACT = 1e-12          # joint limits, damping (absolute); masses (relative)
+TOL_COM = 1e-12            # centres of mass, m
+TOL_INERTIA = 1e-9         # inertia tensors, relative to the largest moment
+TOL_PYBULLET_FRAME = 1e-6  # getLinkState: float32 inside
+TOL_FK = 1e-12             # against double-precision forward kinematics
+TOL_DYNAMICS = 1e-9        # mass matrix, inverse dynamics, relative
+TOL_SWING = 1e-9           # rad over the free swing
+LIMIT_MARGIN = 0.01        # rad: the swing is compared until a joint comes this close
+#: What MuJoCo warned while loading the last model (see :func:`load_mjcf`).
+LOAD_WARNINGS: list[str] = []
+
+
+@dataclass
+class Row:
+    """One comparison: its worst figure, the tolerance, and what the figure is about."""
+
+    group: str
+    what: str
+    value: float | None
+    tolerance: float | None
+    unit: str
+    status: str          # pass, fail, info, known
+    detail: str = ""
+
+    @property
+    def ok(self) -> bool:
+        """Whether the row holds (info and known differences do not fail)."""
+        return self.status != "fail"
+
+
+@dataclass
+class AgreeOptions:
+    """How to compare.
+
+    Attributes:
+        fixed_base: The export welded the base (``useFixedBase``).
+        inertia_from_file: PyBullet loads with URDF_USE_INERTIA_FROM_FILE (export's default).
+        self_collision: Self-collision was asked for (contacts at the poses are allowed).
+        poses: How many seeded poses.
+        seed: The poses' seed.
+        seconds: The free swing's length.
+        time_step: Its step.
+    """
+
+    fixed_base: bool = False
+    inertia_from_file: bool = True
+    self_collision: bool = False
+    poses: int = 100
+    seed: int = 0
+    seconds: float = 1.0
+    time_step: float = 1e-3
+
+
+@dataclass
+class Agreement:
+    """Every row, and what could not be matched."""
+
+    file: str
+    model: str
+    rows: list[Row] = field(default_factory=list)
+    unmatched_links: list[str] = field(default_factory=list)
+    unmatched_joints: list[str] = field(default_factory=list)
+    extra_joints: list[str] = field(default_factory=list)
+    load_flags: list[str] = field(default_factory=list)
+    #: What MuJoCo said while loading the model (its decoders' warnings).
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        """Whether every row holds."""
+        return all(r.ok for r in self.rows)
+
+    def add(self, group: str, what: str, value: float | None, tolerance: float | None,
+            unit: str, detail: str = "", status: str | None = None) -> None:
+        """A row; its status from the figure and the tolerance unless given."""
+        if status is None:
+            status = "pass" if value is not None and tolerance is not None and \
+                value <= tolerance else "fail"
+        self.rows.append(Row(group, what, value, tolerance, unit, status, detail))
+
+
+def import_mujoco() -> Any:
+    """mujoco, or an error saying how to install it."""
+    try:
+        import mujoco
+    except ImportError as e:
+        raise MissingDependencyError("agree needs MuJoCo: pip install 'urdfkit[mujoco]'") from e
+    return mujoco
+
+
+def load_mjcf(path: str | Path) -> tuple[Any, Any]:
+    """The model as written, and the same model with its free joints removed (base fixed)."""
+    mujoco = import_mujoco()
+    from urdfkit.sources.uris import not_a_file
+
+    p = Path(path)
+    why = not_a_file(p)  # a stat only: MuJoCo would block on a FIFO
+    if why is not None:
+        raise InputError("no such file" if why == "missing" else f"is {why}, not an MJCF "
+                         "file", file=str(path))
+    import warnings
+
+    try:
+        # MuJoCo's decoders warn through Python (an OBJ's texture coordinates dropped): kept
+        # for the report, not printed
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            spec = mujoco.MjSpec.from_file(str(p))
+            model = spec.compile()
+        LOAD_WARNINGS[:] = sorted({str(w.message) for w in said})
+        fixed_spec = mujoco.MjSpec.from_file(str(p))
+        for j in list(fixed_spec.joints):
+            if j.type == mujoco.mjtJoint.mjJNT_FREE:
+                # welded where PyBullet's fixed load puts the root: at the origin (a model
+                # may spawn its root higher, as Menagerie's go2 at 0.445 m)
+                body = j.parent
+                body.pos = [0.0, 0.0, 0.0]
+                body.quat = [1.0, 0.0, 0.0, 0.0]
+                fixed_spec.delete(j)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the same warnings again
+            fixed = fixed_spec.compile()
+    except (ValueError, RuntimeError) as e:
+        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        raise InputError(f"MuJoCo cannot load it: {first}", file=str(path)) from None
+    return model, fixed
+
+
+def _worst(items: list[tuple[float, str]]) -> tuple[float, str]:
+    return max(items, key=lambda x: x[0]) if items else (0.0, "")
+
+
+def _name(m: Any, kind: Any, i: int) -> str:
+    import mujoco
+
+    return mujoco.mj_id2name(m, kind, i) or ""
+
+
+class _Pybullet:
+    """The URDF in PyBullet: a floating load for masses, a fixed one for the rest."""
+
+    def __init__(self, session: Any, path: str, display: str, options: AgreeOptions) -> None:
+        from urdfkit.engine.session import LoadOptions
+
+        load = LoadOptions(fixed_base=True, inertia_from_file=options.inertia_from_file,
+                           self_collision=options.self_collision)
+        self.flags = load.flag_names()
+        self.b = session.bullet
+        self.gravity = (0.0, 0.0, -9.81)
+        self.free = session.load_urdf(path, LoadOptions(
+            inertia_from_file=options.inertia_from_file,
+            self_collision=options.self_collision), display)
+        self.body = session.load_urdf(path, load, display)
+        b = self.b
+        n = b.getNumJoints(self.body)
+        self.info = [b.getJointInfo(self.body, i) for i in range(n)]
+        self.base = b.getBodyInfo(self.body)[0].decode("utf-8", "replace")
+        self.link_index = {self.base: -1}
+        for i, info in enumerate(self.info):
+            self.link_index[info[12].decode("utf-8", "replace")] = i
+        # revolute, prismatic and spherical joints (planar ones export refuses)
+        self.movable = [i for i, info in enumerate(self.info) if info[2] in (0, 1, 2)]
+        self.names = [self.info[i][1].decode("utf-8", "replace") for i in self.movable]
+        #: the 1-dof joints, which the poses and the swing move (spherical ones stay at rest)
+        self.one = [i for i in self.movable if self.info[i][2] in (0, 1)]
+        self.one_names = [self.info[i][1].decode("utf-8", "replace") for i in self.one]
+        self.spherical = [n for i, n in zip(self.movable, self.names, strict=True)
+                          if self.info[i][2] == 2]
+        # the floating copy's mass properties, read now: it must not fall onto the other
+        self.inertials = {n: self._inertial(i) for n, i in self.link_index.items()}
+        b.removeBody(self.free)
+
+    def inertial(self, link: str) -> Inertial:
+        """A link's mass properties as PyBullet loaded them (floating load), link frame."""
+        return self.inertials[link]
+
+    def _inertial(self, index: int) -> Inertial:
+        import numpy as np
+
+        from urdfkit.model.spec import quat_to_matrix
+
+        d = self.b.getDynamicsInfo(self.free, index)
+        r = np.array(quat_to_matrix(d[4]))
+        tensor = r @ np.diag(d[2]) @ r.T
+        return Inertial(float(d[0]), tuple(d[3]),
+                        tuple(map(tuple, tensor)))  # type: ignore[arg-type]
+
+    def pose(self, q: dict[str, float]) -> None:
+        for i, name in zip(self.one, self.one_names, strict=True):
+            self.b.resetJointState(self.body, i, q.get(name, 0.0), 0.0)
+
+    def frames(self, links: list[str]) -> dict[str, Any]:
+        import numpy as np
+
+        from urdfkit.model.spec import quat_to_matrix
+
+        out = {}
+        idx = [self.link_index[n] for n in links if self.link_index[n] >= 0]
+        states = self.b.getLinkStates(self.body, idx, computeForwardKinematics=1) if idx else []
+        by_index = dict(zip(idx, states or [], strict=True))
+        for n in links:
+            i = self.link_index[n]
+            t = np.eye(4)
+            if i < 0:
+                pos, orn = self.b.getBasePositionAndOrientation(self.body)
+                d = self.b.getDynamicsInfo(self.body, -1)
+                inv_p, inv_o = self.b.invertTransform(d[3], d[4])
+                pos, orn = self.b.multiplyTransforms(pos, orn, inv_p, inv_o)
+            else:
+                pos, orn = by_index[i][4], by_index[i][5]
+            t[:3, :3] = quat_to_matrix(orn)
+            t[:3, 3] = pos
+            out[n] = t
+        return out
+
+
+def pybullet_frame_tolerances(robot: Robot) -> dict[str, float]:
+    """Each link frame's tolerance against PyBullet's ``getLinkState``: float32 inside.
+
+    A float32 rounding is 2^-24 relative; each transform on the way from the root rounds a
+    few times (4 roundings a step, 2^-22), and a joint angle q is itself held to |q| 2^-24,
+    which its sine and cosine carry. So a frame's error is bounded by
+    2^-22 x sum over its chain of (1 + the joint's largest |q|), never below the issue's 1e-6
+    (go2's FL_calf, whose joints reach 1.05, 3.49 and 2.72 rad, measured 1.0e-6, gets
+    2.5e-6; kuka_iiwa's frames, measured 7.6e-7 at worst, mostly 1e-6).
+    """
+    acc = {robot.root: 0.0}
+    for j in robot.joints:
+        reach = 0.0
+        if j.moves:
+            reach = max(abs(j.lower), abs(j.upper)) if j.limited else \
+                (1.0 if j.type == "prismatic" else math.pi)
+        acc[j.child] = acc[j.parent] + 1.0 + reach
+    return {n: max(TOL_PYBULLET_FRAME, 2.0 ** -22 * a) for n, a in acc.items()}
+
+
+def _sample(robot: Robot, names: list[str], rng: Any) -> dict[str, float]:
+    q = {}
+    joints = {j.name: j for j in robot.joints}
+    for n in names:
+        j = joints[n]
+        if j.limited:
+            q[n] = float(rng.uniform(j.lower, j.upper))
+        elif j.type == "prismatic":
+            q[n] = float(rng.uniform(-1.0, 1.0))
+        else:
+            q[n] = float(rng.uniform(-math.pi, math.pi))
+    return q
+
+
+def _full_mass_matrix(mj: Any, m: Any, d: Any, out: Any) -> None:
+    """``mj_fullM``: (m, d, dst) since MuJoCo 3.3's sparse M; (m, dst, qM) before."""
+    try:
+        mj.mj_fullM(m, d, out)
+    except TypeError:
+        mj.mj_fullM(m, out, d.qM)
+
+
+def _frame_error(a: Any, b: Any) -> tuple[float, float]:
+    import numpy as np
+
+    return float(np.abs(a[:3, 3] - b[:3, 3]).max()), float(np.abs(a[:3, :3] - b[:3, :3]).max())
+
+
+class _Compare:
+    def __init__(self, robot: Robot, model_path: str, session: Any,
+                 load_path: str, options: AgreeOptions) -> None:
+        import mujoco
+
+        self.mj = mujoco
+        self.robot = robot
+        self.o = options
+        self.model, self.fixed = load_mjcf(model_path)
+        self.pb = _Pybullet(session, load_path, robot.file, options)
+        self.result = Agreement(robot.file, model_path, load_flags=self.pb.flags,
+                                warnings=list(LOAD_WARNINGS))
+        m = self.fixed
+        self.jnt = {_name(m, mujoco.mjtObj.mjOBJ_JOINT, i): i for i in range(m.njnt)}
+        self.body = {_name(m, mujoco.mjtObj.mjOBJ_BODY, i): i for i in range(m.nbody)}
+        self.site = {_name(m, mujoco.mjtObj.mjOBJ_SITE, i): i for i in range(m.nsite)}
+        self.body.pop("world", None)
+        self.matched = [n for n in self.pb.names if n in self.jnt]
+        # PyBullet's world has no gravity until set: MuJoCo's, for inverse dynamics and swing
+        self.pb.b.setGravity(*map(float, self.fixed.opt.gravity))
+
+    # ------------------------------------------------------------------ structure
+
+    def structure(self) -> None:
+        mj, m, pb, res = self.mj, self.fixed, self.pb, self.result
+        free = [i for i in range(self.model.njnt)
+                if self.model.jnt_type[i] == mj.mjtJoint.mjJNT_FREE]
+        moving_root = not self.o.fixed_base and self.robot.links[self.robot.root].inertial.mass \
+            != 0 and self.robot.root != "world"
+        want = "free joint" if moving_root else "welded"
+        got = "free joint" if free else "welded"
+        res.add("structure", "base", None, None, "", f"PyBullet: {want}; MJCF: {got}",
+                "pass" if want == got else "fail")
+        mj_names = [n for n in self.jnt if m.jnt_type[self.jnt[n]] != mj.mjtJoint.mjJNT_FREE]
+        res.unmatched_joints = [n for n in pb.names if n not in self.jnt]
+        res.extra_joints = [n for n in mj_names if n not in pb.names]
+        missing = res.unmatched_joints + [f"+{n}" for n in res.extra_joints]
+        res.add("structure", "joint names", float(len(missing)), 0.0, "unmatched",
+                ", ".join(missing[:6]) + (" ..." if len(missing) > 6 else ""))
+        order = [n for n in mj_names if n in pb.names]
+        bad = next((a for a, b in zip(order, self.matched, strict=True) if a != b), "")
+        res.add("structure", "joint order", 0.0 if not bad else 1.0, 0.0, "moved",
+                f"first out of place: {bad}" if bad else "")
+        joints = {j.name: j for j in self.robot.joints}
+        kinds = {0: mj.mjtJoint.mjJNT_HINGE, 1: mj.mjtJoint.mjJNT_SLIDE,
+                 2: mj.mjtJoint.mjJNT_BALL}
+        wrong, limits, damping = [], [], []
+        for i, n in zip(pb.movable, pb.names, strict=True):
+            if n not in self.jnt:
+                continue
+            info, k = pb.info[i], self.jnt[n]
+            if int(kinds[info[2]]) != int(m.jnt_type[k]):
+                wrong.append(n)
+            if info[2] == 2:
+                continue  # a ball joint has no limits or damping PyBullet reads
+            # PyBullet limits a revolute or prismatic joint with lower <= upper, never a
+            # continuous one (getJointInfo shows a continuous joint's <limit> all the same)
+            pb_limited = joints[n].limited
+            if pb_limited and joints[n].lower == joints[n].upper and not m.jnt_limited[k]:
+                pass  # locked: MuJoCo has no empty range (export holds it with an equality)
+            elif pb_limited != bool(m.jnt_limited[k]):
+                limits.append((math.inf, n))
+            elif pb_limited:
+                limits.append((max(abs(info[8] - m.jnt_range[k][0]),
+                                   abs(info[9] - m.jnt_range[k][1])), n))
+            if int(kinds[info[2]]) == int(m.jnt_type[k]):
+                damping.append((abs(info[6] - m.dof_damping[m.jnt_dofadr[k]]), n))
+        res.add("structure", "joint kinds", float(len(wrong)), 0.0, "differ", ", ".join(wrong))
+        mimic = [f"{j.name} = {j.mimic[1]:g} x {j.mimic[0]} + {j.mimic[2]:g}"
+                 for j in self.robot.movable() if j.mimic is not None and j.name in self.jnt]
+        if mimic:
+            res.add("structure", "mimic joints", float(len(mimic)), None, "known",
+                    "PyBullet ignores <mimic>; an MJCF equality means it: " + "; ".join(mimic),
+                    status="known")
+        v, d = _worst(limits)
+        res.add("structure", "joint limits", v, TOL_EXACT, "rad|m", d)
+        v, d = _worst(damping)
+        res.add("structure", "joint damping", v, TOL_EXACT, "N m s/rad", d)
+        self.masses()
+
+    def masses(self) -> None:
+        """Mass, centre of mass and inertia, welded groups compared at the zero pose."""
+        import numpy as np
+
+        mj, m, res = self.mj, self.fixed, self.result
+        robot = self.robot
+        where = fused(robot)
+        zero = link_frames(robot, {})
+        # PyBullet: each body group (fixed links fused), in the world at the zero pose
+        groups: dict[str, list[tuple[Inertial, Any]]] = {}
+        for link, (body, _) in where.items():
+            if link in self.pb.link_index:
+                groups.setdefault(body, []).append((self.pb.inertial(link), zero[link]))
+        # MuJoCo: bodies grouped by the body they are welded to, at qpos0 = 0
+        d = mj.MjData(m)
+        d.qpos[:] = 0
+        mj.mj_kinematics(m, d)
+        mj.mj_comPos(m, d)
+        weld: dict[str, list[tuple[Inertial, Any]]] = {}
+        for b in range(1, m.nbody):
+            w = int(m.body_weldid[b])
+            key = _name(m, mj.mjtObj.mjOBJ_BODY, w) if w else robot.root
+            t = np.eye(4)
+            t[:3, :3] = d.ximat[b].reshape(3, 3)
+            t[:3, 3] = d.xipos[b]
+            own = Inertial(float(m.body_mass[b]), (0.0, 0.0, 0.0),
+                           tuple(map(tuple, np.diag(m.body_inertia[b]))))  # type: ignore[arg-type]
+            weld.setdefault(key, []).append((own, t))
+        total_pb = sum(i.mass for parts in groups.values() for i, _ in parts)
+        total_mj = float(m.body_mass[1:].sum())
+        res.add("structure", "total mass", abs(total_pb - total_mj) / max(total_pb, 1e-300),
+                TOL_EXACT, "relative", f"PyBullet {total_pb!r} kg, MuJoCo {total_mj!r} kg")
+        mass: list[tuple[float, str]] = []
+        com: list[tuple[float, str]] = []
+        inertia: list[tuple[float, str]] = []
+        missing: list[str] = []
+        for body, parts in groups.items():
+            if body not in weld:
+                if not (body == robot.root == "world" and combine(parts).mass == 0):
+                    missing.append(body)  # (a massless `world` is MuJoCo's world body)
+                continue
+            ours, theirs = combine(parts), combine(weld[body])
+            mass.append((abs(ours.mass - theirs.mass) / max(ours.mass, theirs.mass, 1e-300),
+                         body))
+            if ours.mass > 0:
+                com.append((float(np.abs(ours.com - theirs.com).max()), body))
+                scale = max(float(np.abs(ours.tensor).max()), 1e-300)
+                inertia.append((float(np.abs(ours.tensor - theirs.tensor).max()) / scale, body))
+        if missing:
+            res.add("structure", "bodies", float(len(missing)), 0.0, "unmatched",
+                    ", ".join(missing))
+        v, dd = _worst(mass)
+        res.add("structure", "body masses", v, TOL_EXACT, "relative", dd)
+        v, dd = _worst(com)
+        res.add("structure", "centres of mass", v, TOL_COM, "m", dd)
+        v, dd = _worst(inertia)
+        res.add("structure", "inertia tensors", v, TOL_INERTIA, "relative", dd)
+
+    # ------------------------------------------------------------------ poses
+
+    def mj_frame(self, d: Any, name: str) -> Any:
+        import numpy as np
+
+        t = np.eye(4)
+        if name in self.body:
+            i = self.body[name]
+            t[:3, :3] = d.xmat[i].reshape(3, 3)
+            t[:3, 3] = d.xpos[i]
+        else:
+            i = self.site[name]
+            t[:3, :3] = d.site_xmat[i].reshape(3, 3)
+            t[:3, 3] = d.site_xpos[i]
+        return t
+
+    def set_q(self, d: Any, q: dict[str, float], qd: dict[str, float] | None = None) -> None:
+        m = self.fixed
+        for n, v in q.items():
+            k = self.jnt[n]
+            d.qpos[m.jnt_qposadr[k]] = v
+            if qd is not None:
+                d.qvel[m.jnt_dofadr[k]] = qd[n]
+
+    def poses(self) -> None:
+        import numpy as np
+
+        mj, m, pb, res, robot = self.mj, self.fixed, self.pb, self.result, self.robot
+        links = [n for n in pb.link_index if n in self.body or n in self.site]
+        res.unmatched_links = [n for n in pb.link_index if n not in links and n != "world"]
+        rng = np.random.default_rng(self.o.seed)
+        d = mj.MjData(m)
+        pb_pos: list[tuple[float, str]] = []
+        pb_rot: list[tuple[float, str]] = []
+        fk_pos: list[tuple[float, str]] = []
+        fk_rot: list[tuple[float, str]] = []
+        mass_err: list[tuple[float, str]] = []
+        id_err: list[tuple[float, str]] = []
+        contacts: list[str] = []
+        dyn = not res.unmatched_joints and not res.extra_joints and self.matched \
+            and not pb.spherical
+        dof = [int(m.jnt_dofadr[self.jnt[n]]) for n in self.matched]
+        d_contact = mj.MjData(m)
+        tol = pybullet_frame_tolerances(robot)
+        from urdfkit.model.spec import quat_to_matrix
+
+        base_inertial = np.array(quat_to_matrix(pb.b.getDynamicsInfo(pb.body, -1)[4]))
+        turned_back = base_inertial.T @ np.array(m.opt.gravity)
+        for _ in range(self.o.poses):
+            q = _sample(robot, pb.one_names, rng)
+            qd = _sample(robot, pb.one_names, rng)
+            qdd = _sample(robot, pb.one_names, rng)
+            d.qpos[:] = m.qpos0
+            d.qvel[:] = 0
+            self.set_q(d, {n: q[n] for n in self.matched if n in q})
+            mj.mj_kinematics(m, d)
+            pb.pose(q)
+            pb_frames = pb.frames(links)
+            exact = link_frames(robot, q)
+            for n in links:
+                f = self.mj_frame(d, n)
+                a, b = _frame_error(f, pb_frames[n])
+                pb_pos.append((a / tol[n], n))
+                pb_rot.append((b / tol[n], n))
+                a, b = _frame_error(f, exact[n])
+                fk_pos.append((a, n))
+                fk_rot.append((b, n))
+            if dyn:
+                self.set_q(d, {n: q[n] for n in self.matched}, qd)
+                mj.mj_kinematics(m, d)
+                mj.mj_comPos(m, d)
+                mj.mj_crb(m, d)
+                full = np.zeros((m.nv, m.nv))
+                _full_mass_matrix(mj, m, d, full)
+                mm = full[np.ix_(dof, dof)]
+                qs = [q[n] for n in pb.names]
+                pm = np.array(pb.b.calculateMassMatrix(pb.body, qs))
+                scale = max(float(np.abs(pm).max()), 1e-300)
+                e = np.abs(pm - mm) / scale
+                mass_err.append((float(e.max()), pb.names[int(np.unravel_index(
+                    e.argmax(), e.shape)[0])]))
+                d.qacc[:] = 0
+                for n, i in zip(self.matched, dof, strict=True):
+                    d.qacc[i] = qdd[n]
+                mj.mj_comVel(m, d)
+                out = np.zeros(m.nv)
+                mj.mj_rne(m, d, 1, out)
+                tau_mj = out[dof]
+                # PyBullet's calculateInverseDynamics turns gravity by the base's inertial
+                # orientation (measured: bicycle/bike.urdf, base inertial rpy 1.57 0 0,
+                # 0.656 N m where MuJoCo and the swing say 0.0525): handed gravity turned
+                # back, it answers for the world's
+                pb.b.setGravity(*map(float, turned_back))
+                tau_pb = np.array(pb.b.calculateInverseDynamics(
+                    pb.body, qs, [qd[n] for n in pb.names], [qdd[n] for n in pb.names]))
+                pb.b.setGravity(*map(float, m.opt.gravity))
+                scale = max(float(np.abs(tau_pb).max()), 1e-300)
+                e = np.abs(tau_pb - tau_mj) / scale
+                id_err.append((float(e.max()), pb.names[int(e.argmax())]))
+            d_contact.qpos[:] = d.qpos
+            mj.mj_forward(m, d_contact)
+            for c in d_contact.contact[:d_contact.ncon]:
+                b1, b2 = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
+                if b1 and b2:
+                    contacts.append(f"{_name(m, mj.mjtObj.mjOBJ_BODY, b1)}/"
+                                    f"{_name(m, mj.mjtObj.mjOBJ_BODY, b2)}")
+        if not links:
+            res.add("kinematics", "link frames", None, None, "", "not compared: no link has "
+                    "a body or site of its name")
+        for what, items, fixed in (("frames vs PyBullet: position", pb_pos, None),
+                                   ("frames vs PyBullet: rotation", pb_rot, None),
+                                   ("frames vs exact FK: position", fk_pos, TOL_FK),
+                                   ("frames vs exact FK: rotation", fk_rot, TOL_FK)):
+            if not links:
+                break
+            v, n = _worst(items)
+            limit = fixed if fixed is not None else tol[n]
+            if fixed is None:
+                v *= limit  # the worst error relative to its own frame's tolerance
+            res.add("kinematics", what, v, limit, "m" if "position" in what else "matrix",
+                    f"{n} ({len(links)} frames x {self.o.poses} poses)")
+        if dyn:
+            v, n = _worst(mass_err)
+            res.add("dynamics", "mass matrix", v, TOL_DYNAMICS, "relative", n)
+            v, n = _worst(id_err)
+            res.add("dynamics", "inverse dynamics", v, TOL_DYNAMICS, "relative", n)
+        elif not pb.names and not res.extra_joints:
+            res.add("dynamics", "mass matrix, inverse dynamics", None, None, "",
+                    "no movable joints", status="info")
+        elif pb.spherical and not res.unmatched_joints and not res.extra_joints:
+            res.add("dynamics", "mass matrix, inverse dynamics", None, None, "",
+                    f"not compared: spherical joints ({', '.join(pb.spherical[:3])}); their "
+                    "frames are compared at rest", status="info")
+        else:
+            res.add("dynamics", "mass matrix, inverse dynamics", None, None, "",
+                    "not compared: the joints differ")
+        pairs = sorted(set(contacts))
+        res.add("contacts", "self-contacts at the poses", float(len(contacts)), 0.0, "contacts",
+                ", ".join(pairs[:4]) + (" ..." if len(pairs) > 4 else ""),
+                status="info" if self.o.self_collision else None)
+
+    # ------------------------------------------------------------------ swing
+
+    def swing(self) -> None:
+        import numpy as np
+
+        mj, pb, res = self.mj, self.pb, self.result
+        if not self.pb.names and not res.extra_joints:
+            res.add("swing", "free swing", None, None, "", "no movable joints", status="info")
+            return
+        if not self.matched or res.unmatched_joints or res.extra_joints:
+            res.add("swing", "free swing", None, None, "", "not compared: the joints differ")
+            return
+        if self.pb.spherical:
+            res.add("swing", "free swing", None, None, "", "not compared: spherical joints",
+                    status="info")
+            return
+        m = self.fixed
+        m.opt.timestep = self.o.time_step
+        m.opt.integrator = mj.mjtIntegrator.mjINT_EULER
+        m.opt.disableflags |= (mj.mjtDisableBit.mjDSBL_CONTACT | mj.mjtDisableBit.mjDSBL_EULERDAMP
+                               | mj.mjtDisableBit.mjDSBL_EQUALITY
+                               | mj.mjtDisableBit.mjDSBL_ACTUATION)
+        d = mj.MjData(m)
+        # the start: each limited joint in the middle half of its range, seeded
+        rng = np.random.default_rng(self.o.seed + 1)
+        joints = {j.name: j for j in self.robot.joints}
+        q0 = {}
+        for n in pb.names:
+            j = joints[n]
+            mid, half = ((j.lower + j.upper) / 2, (j.upper - j.lower) / 4) if j.limited \
+                else (0.0, 1.0)
+            q0[n] = float(rng.uniform(mid - half, mid + half))
+        self.set_q(d, {n: q0[n] for n in self.matched})
+        b = pb.b
+        b.setTimeStep(self.o.time_step)
+        pb.pose(q0)
+        b.setJointMotorControlArray(pb.body, pb.movable, b.VELOCITY_CONTROL,
+                                    forces=[0.0] * len(pb.movable))
+        for i in range(-1, len(pb.info)):
+            b.changeDynamics(pb.body, i, linearDamping=0.0, angularDamping=0.0)
+            # contacts off on this side too (URDF_USE_SELF_COLLISION would collide links)
+            b.setCollisionFilterGroupMask(pb.body, i, 0, 0)
+        adr = [int(m.jnt_qposadr[self.jnt[n]]) for n in pb.names]
+        steps = round(self.o.seconds / self.o.time_step)
+        worst, at, stop, why = 0.0, "", steps, ""
+        for step in range(steps):
+            mj.mj_step(m, d)
+            b.stepSimulation()
+            qp = [s[0] for s in b.getJointStates(pb.body, pb.movable)]
+            near = ""
+            for n, a, v in zip(pb.names, adr, qp, strict=True):
+                j = joints[n]
+                e = abs(d.qpos[a] - v)
+                if e > worst:
+                    worst, at = e, n
+                if j.limited and min(v - j.lower, j.upper - v, d.qpos[a] - j.lower,
+                                     j.upper - d.qpos[a]) < LIMIT_MARGIN:
+                    near = n
+            if near:
+                stop, why = step + 1, f"; stopped at {(step + 1) * self.o.time_step:g} s: " \
+                    f"{near} within {LIMIT_MARGIN} rad of a limit"
+                break
+        mimic = [j.name for j in self.robot.movable() if j.mimic is not None]
+        known = f"; mimic joints free on both sides ({', '.join(mimic)}): PyBullet ignores " \
+            "<mimic>" if mimic else ""
+        res.add("swing", f"free swing {stop * self.o.time_step:g} s, dt {self.o.time_step:g}",
+                worst, TOL_SWING, "rad", f"{at}{why}{known}")
+
+
+def agree(resolved: Any, model_path: str | Path, options: AgreeOptions | None = None
+          ) -> Agreement:
+    """Compare ``model_path`` (MJCF) with the resolved URDF as PyBullet loads it.
+
+    Raises:
+        InputError: MuJoCo cannot load the MJCF.
+        MissingDependencyError: MuJoCo is not installed.
+    """
+    from urdfkit.engine.session import Session
+    from urdfkit.exchange.robot import read_robot
+
+    o = options or AgreeOptions()
+    robot = read_robot(resolved.root, resolved.name)
+    import_mujoco()
+    with Session() as session:
+        c = _Compare(robot, str(model_path), session, str(resolved.load_path), o)
+        c.structure()
+        c.poses()
+        c.swing()
+        return c.result
+
+
