@@ -262,7 +262,7 @@ def _run_view(sc: Any, config: Any, pace: float | None, port: int | None,
                     display=display, stand_on_grid=False)
     try:
         session = sc.session
-        joints = joint_reader(session.p, session.client, sc.body, viewer.model.joints)
+        joints = joint_reader(session.bullet, sc.body, viewer.model.joints)
         stream = RunStream(viewer, sc.link_poses, pace, total, joints=joints)
         stream.push()
         say_streaming("drive", viewer, pace)

@@ -183,8 +183,7 @@ def _sim_view(s: Any, pace: float | None, port: int | None, wait: bool = True) -
     first, options = bodies[0].loaded
     # Findings name the robot as the scenario does (its urdf, or its template), not the
     # built copy PyBullet loaded.
-    cfg = getattr(bodies[0], "config", None)
-    display = getattr(cfg, "urdf", None) or getattr(cfg, "template", None)
+    display = bodies[0].config.urdf or bodies[0].config.template
     viewer = Viewer(first, inertia_from_file=options.inertia_from_file, port=port,
                     watch=False, ground=20.0, stand_on_grid=False,
                     display=str(display) if display else None)

@@ -141,11 +141,13 @@ REPLAY_FRAMES = 4000
 FOLLOW, WHOLE_PATH, FREE = "follow the robot", "frame the whole path", "free"
 
 
-def joint_reader(p: Any, client: int, body: int, joints: Sequence[Any]) -> Any:
-    """A function returning a run's joint positions by name (``joints``: the viewer's)."""
+def joint_reader(bullet: Any, body: int, joints: Sequence[Any]) -> Any:
+    """A function returning a run's joint positions by name (``joints``: the viewer's).
+
+    ``bullet`` is the run's session's bound pybullet (:class:`~urdfkit.engine.session.Bullet`).
+    """
     def read() -> dict[str, float]:
-        return {j.name: float(p.getJointState(body, j.index, physicsClientId=client)[0])
-                for j in joints}
+        return {j.name: float(bullet.getJointState(body, j.index)[0]) for j in joints}
     return read
 
 
