@@ -89,8 +89,11 @@ def test_spaces_are_the_tutorials():
 
 def test_in_place_reset_is_exact_whatever_came_before_and_follows_reloading():
     # An episode after a reset in place is bitwise the same after any history; and it is the
-    # tutorial's own episode (resetSimulation, load plane, car and goal again) to 1e-4 for
-    # the first second, before chaos amplifies float-level differences in contact order.
+    # tutorial's own episode (resetSimulation, load plane, car and goal again) to float level
+    # at first, then within chaos's growth of those differences in contact order. Measured
+    # with the simplecar whose hinge arms clear each other: 1.5e-11 after one step, 8.9e-7 by
+    # step 9, 1.5e-4 at step 24 (the arms' changed inertia moved the old 1e-4 over 30 steps).
+    # A reset that kept anything of the last episode differs by far more from the first step.
     import pybullet as p
 
     ours = SimpleDrivingEnv()
@@ -101,7 +104,8 @@ def test_in_place_reset_is_exact_whatever_came_before_and_follows_reloading():
             _rollout(ours, seed=1, steps=warm, action_seed=2)
             assert np.array_equal(_rollout(ours, seed=5, steps=200), first)
         reloaded = _rollout(theirs, seed=5, steps=30)
-        assert np.abs(first[:31] - reloaded).max() < 1e-4
+        assert np.abs(first[:10] - reloaded[:10]).max() < 1e-6
+        assert np.abs(first[:31] - reloaded).max() < 1e-3
     finally:
         ours.close()
         theirs.close()
