@@ -44,9 +44,9 @@ def steps_cost(env, n: int) -> tuple[float, int]:
 
 def bodies(env) -> int:
     """How many bodies the env's world holds (a car, a goal and a plane after a reset)."""
-    p = env._p if hasattr(env, "_p") else env.p
-    client = env._client if hasattr(env, "_client") else env.client
-    return p.getNumBodies(physicsClientId=client)
+    if hasattr(env, "_p"):  # urdfkit's: pybullet bound to its client
+        return env._p.getNumBodies()
+    return env.p.getNumBodies(physicsClientId=env.client)  # the tutorial's
 
 
 def resets_cost(env, n: int) -> float:

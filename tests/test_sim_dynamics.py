@@ -170,14 +170,16 @@ def test_robots_are_measured_only_when_an_observation_is_due(tmp_path: Path,
     spec = {**scenario(pendulum(tmp_path), q0=1.0), "duration": 0.5}
     with Simulation({**spec, "record": {"every": 1}}) as sim:
         every_step = [r.to_dict() for r in sim.run().rows]
-    calls = []
-    original = Simulation._measure
+    from urdfkit.motion.sim_sensors import Sensors
 
-    def counted(self: Simulation, b: Any) -> Any:
-        calls.append(self.step_count)
+    calls = []
+    original = Sensors.measure
+
+    def counted(self: Sensors, b: Any) -> Any:
+        calls.append(self.world.step_count)
         return original(self, b)
 
-    monkeypatch.setattr(Simulation, "_measure", counted)
+    monkeypatch.setattr(Sensors, "measure", counted)
     with Simulation({**spec, "record": {"every": 10}}) as sim:
         sparse = [r.to_dict() for r in sim.run().rows]
     # 120 steps: the start and 12 rows, not 121 measurements.
@@ -219,7 +221,7 @@ def test_sim_out_streams_with_flat_memory(tmp_path: Path) -> None:
 
 def test_parquet_streams_in_row_groups(tmp_path: Path) -> None:
     pq = pytest.importorskip("pyarrow.parquet")
-    from urdfkit import sim as simulation
+    from urdfkit.motion import simulation
 
     spec = {**scenario(pendulum(tmp_path)), "duration": 50 / 240}
     with Simulation(spec) as a, Simulation(spec) as b:

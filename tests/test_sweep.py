@@ -10,9 +10,9 @@ from typing import Any
 import pytest
 from typer.testing import CliRunner
 
-from urdfkit import sweep
 from urdfkit.cli import app
 from urdfkit.core.errors import InputError, MissingDependencyError, ParameterError
+from urdfkit.motion import sweep_plan as sweep
 from urdfkit.motion.drive import DriveConfig, drive
 from urdfkit.sim import Simulation
 

@@ -20,7 +20,7 @@ import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, Literal
 
 from urdfkit.core.errors import MissingDependencyError, ParameterError
 
@@ -34,16 +34,22 @@ except ImportError as e:  # pragma: no cover - the [gym] extra installs it
 
 from urdfkit.engine.session import LoadOptions, Session, prime_resets, restore_clean
 
+if TYPE_CHECKING:
+    from urdfkit.motion.scenario_models import Mode, Randomize, RobotConfig
+    from urdfkit.sim import Observation, SimRobot, Simulation
+
 __all__ = ["SIMPLE_DRIVING_ID", "ScenarioEnv", "SimpleDrivingEnv"]
 
 SIMPLE_DRIVING_ID = "urdfkit/SimpleDriving-v0"
+#: How an environment renders: PyBullet's window, or frames as arrays.
+RenderMode = Literal["human", "rgb_array"]
 
 #: The tutorial's joint indices of simplecar (urdfkit's template keeps its joint order).
 _HINGES = (0, 2)
 _WHEELS = (1, 3, 4, 5)
 
 
-def _real(action: Any) -> None:
+def _real(action: object) -> None:
     """Refuse an action of complex numbers, text or objects before numpy casts it silently."""
     kind = np.asarray(action).dtype.kind if not isinstance(action, np.ndarray) else \
         action.dtype.kind
@@ -52,18 +58,18 @@ def _real(action: Any) -> None:
                          f"values: {_short(action)}")
 
 
-def _short(action: Any) -> str:
+def _short(action: object) -> str:
     text = repr(action)
     return text if len(text) <= 200 else text[:200] + f"... ({len(text):,} characters)"
 
 
-def _open(env: Any) -> None:
+def _open(env: gym.Env) -> None:
     """Refuse a call on a closed env with a clear error, not PyBullet's "Not connected"."""
     if getattr(env, "_closed", False):
         raise RuntimeError(f"this {type(env).__name__} is closed; make a new one")
 
 
-def _after_end(env: Any) -> None:
+def _after_end(env: SimpleDrivingEnv | ScenarioEnv) -> None:
     """Warn once per episode when ``step`` is called after it ended, as Gymnasium asks."""
     if getattr(env, "_ended", False) and not getattr(env, "_warned_end", False):
         import warnings
@@ -88,7 +94,7 @@ def _finite_pair(action: Any) -> tuple[float, float]:
 
 
 
-def _gui(render_mode: str | None) -> bool:
+def _gui(render_mode: RenderMode | None) -> bool:
     """Whether ``render_mode`` opens PyBullet's window: ``human`` where there is a display.
 
     Headless (CI, a cluster node), ``human`` runs without a window and says so once, rather
@@ -142,7 +148,8 @@ class SimpleDrivingEnv(gym.Env):
     GOAL_RADIUS = 1.0
     GOAL_BONUS = 50.0
 
-    def __init__(self, render_mode: str | None = None, *, camera: str = "chase",
+    def __init__(self, render_mode: RenderMode | None = None, *,
+                 camera: Literal["chase", "overview"] = "chase",
                  width: int = 320, height: int = 240, implicit_cylinder: bool = False):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(f"render_mode must be one of "
@@ -183,13 +190,13 @@ class SimpleDrivingEnv(gym.Env):
         from urdfkit.motion.drive import builtin_file
 
         s = self._session
-        p, c = s.p, s.client
-        self._p, self._client = p, c
-        p.setTimeStep(self.TIME_STEP, physicsClientId=c)
+        p = s.bullet
+        self._p = p
+        p.setTimeStep(self.TIME_STEP)
         # Sorted overlapping pairs: the solver meets contacts in the same order after every
         # reset (PyBullet's default does not, and single-step episodes then differ).
-        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=c)
-        p.setGravity(0, 0, self.GRAVITY, physicsClientId=c)
+        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
+        p.setGravity(0, 0, self.GRAVITY)
         plane, car = builtin_file("simpleplane"), builtin_file("simplecar")
         if plane is None or car is None:  # no writable cache: build into a temp folder
             import tempfile
@@ -205,17 +212,17 @@ class SimpleDrivingEnv(gym.Env):
             implicit_cylinder=implicit_cylinder), display="simplecar")
         # The goal marker: a green post, seen by the cameras, touched by nothing.
         shape = p.createVisualShape(p.GEOM_CYLINDER, radius=0.5, length=1.0,
-                                    rgbaColor=[0.0, 0.925, 0.0, 1.0], physicsClientId=c)
+                                    rgbaColor=[0.0, 0.925, 0.0, 1.0])
         self.goal_marker = p.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1,
                                              baseVisualShapeIndex=shape,
-                                             basePosition=[0.0, 0.0, 0.5], physicsClientId=c)
-        self._start = p.saveState(physicsClientId=c)
-        prime_resets(p, c, self._start, [self.car])
+                                             basePosition=[0.0, 0.0, 0.5])
+        self._start = p.saveState()
+        prime_resets(s.p, s.client, self._start, [self.car])
 
     # ---- the Gymnasium API
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
-              ) -> tuple[np.ndarray, dict[str, Any]]:
+              ) -> tuple[np.ndarray, dict[str, object]]:
         """Start an episode: the car at rest at the origin, a new goal.
 
         The goal is drawn as the tutorial draws it, from ``np_random``: x and y each from
@@ -224,8 +231,8 @@ class SimpleDrivingEnv(gym.Env):
         _open(self)
         super().reset(seed=seed)
         self._ended = self._warned_end = False
-        p, c = self._p, self._client
-        restore_clean(p, c, self._start, [self.car])
+        p = self._p
+        restore_clean(self._session.p, self._session.client, self._start, [self.car])
         goal = (options or {}).get("goal")
         if goal is not None:
             gx, gy = _finite_pair(goal)
@@ -236,8 +243,7 @@ class SimpleDrivingEnv(gym.Env):
             gx = rng.uniform(5, 9) if rng.integers(2) else -rng.uniform(5, 9)
             gy = rng.uniform(5, 9) if rng.integers(2) else -rng.uniform(5, 9)
         self.goal = (float(gx), float(gy))
-        p.resetBasePositionAndOrientation(self.goal_marker, [gx, gy, 0.5], [0, 0, 0, 1],
-                                          physicsClientId=c)
+        p.resetBasePositionAndOrientation(self.goal_marker, [gx, gy, 0.5], [0, 0, 0, 1])
         self._speed = 0.0
         self._steer = None
         obs = self._observe()
@@ -246,7 +252,7 @@ class SimpleDrivingEnv(gym.Env):
             self._last_frame = time.perf_counter()
         return obs, {"distance": self._previous_distance}
 
-    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+    def step(self, action: object) -> tuple[np.ndarray, float, bool, bool, dict[str, object]]:
         """Apply (throttle, steer) for one 1/30 s physics step.
 
         Raises:
@@ -257,10 +263,10 @@ class SimpleDrivingEnv(gym.Env):
         _after_end(self)
         throttle = min(max(throttle, 0.0), 1.0)
         steer = max(min(steer, 0.6), -0.6)
-        p, c, car = self._p, self._client, self.car
+        p, car = self._p, self.car
         if steer != self._steer:  # position motors persist: set on change
             p.setJointMotorControlArray(car, _HINGES, p.POSITION_CONTROL,
-                                        targetPositions=[steer, steer], physicsClientId=c)
+                                        targetPositions=[steer, steer])
             self._steer = steer
         v = self._speed
         v += self.TIME_STEP * (self.C_THROTTLE * throttle - v * (v * self.C_DRAG
@@ -269,8 +275,8 @@ class SimpleDrivingEnv(gym.Env):
         force = self.WHEEL_FORCE
         p.setJointMotorControlArray(car, _WHEELS, p.VELOCITY_CONTROL,
                                     targetVelocities=[v, v, v, v],
-                                    forces=[force, force, force, force], physicsClientId=c)
-        p.stepSimulation(physicsClientId=c)
+                                    forces=[force, force, force, force])
+        p.stepSimulation()
         obs = self._observe()
         x, y = float(obs[0]), float(obs[1])
         gx, gy = self.goal
@@ -292,9 +298,9 @@ class SimpleDrivingEnv(gym.Env):
         return obs, reward, terminated, False, {"distance": distance, "is_success": reached}
 
     def _observe(self) -> np.ndarray:
-        p, c = self._p, self._client
-        pos, (qx, qy, qz, qw) = p.getBasePositionAndOrientation(self.car, physicsClientId=c)
-        lin = p.getBaseVelocity(self.car, physicsClientId=c)[0]
+        p = self._p
+        pos, (qx, qy, qz, qw) = p.getBasePositionAndOrientation(self.car)
+        lin = p.getBaseVelocity(self.car)[0]
         # cos and sin of PyBullet's yaw, atan2(b, a), without the angle.
         a = qw * qw + qx * qx - qy * qy - qz * qz
         b = 2.0 * (qx * qy + qw * qz)
@@ -303,12 +309,12 @@ class SimpleDrivingEnv(gym.Env):
         return np.array((pos[0], pos[1], cos, sin, lin[0], lin[1], *self.goal),
                         dtype=np.float32)
 
-    def render(self) -> Any:  # an ndarray or None; gymnasium types it as a RenderFrame TypeVar
+    def render(self) -> np.ndarray | None:
         """An ``rgb_array`` frame (height x width x 3, uint8); None in ``human`` mode."""
         if self.render_mode != "rgb_array":
             return None
-        p, c = self._p, self._client
-        pos, orn = p.getBasePositionAndOrientation(self.car, physicsClientId=c)
+        p = self._p
+        pos, orn = p.getBasePositionAndOrientation(self.car)
         if self.camera == "chase":
             # The tutorial's camera: at the car, 0.2 m up, looking along its heading.
             m = p.getMatrixFromQuaternion(orn)
@@ -316,22 +322,20 @@ class SimpleDrivingEnv(gym.Env):
             up = (m[2], m[5], m[8])
             eye = (pos[0], pos[1], 0.2)
             view = p.computeViewMatrix(eye, [e + f for e, f in zip(eye, ahead, strict=True)],
-                                       up, physicsClientId=c)
+                                       up)
             fov = 80.0
         else:
-            view = p.computeViewMatrix((0.0, -13.0, 17.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0),
-                                       physicsClientId=c)
+            view = p.computeViewMatrix((0.0, -13.0, 17.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
             fov = 60.0
-        proj = p.computeProjectionMatrixFOV(fov, self.width / self.height, 0.01, 100.0,
-                                            physicsClientId=c)
+        proj = p.computeProjectionMatrixFOV(fov, self.width / self.height, 0.01, 100.0)
         image = p.getCameraImage(self.width, self.height, view, proj,
-                                 renderer=p.ER_TINY_RENDERER, physicsClientId=c)[2]
+                                 renderer=p.ER_TINY_RENDERER)[2]
         return np.asarray(image, dtype=np.uint8).reshape(self.height, self.width, 4)[
             :, :, :3].copy()
 
     def _follow_in_gui(self, x: float, y: float) -> None:
-        p, c = self._p, self._client
-        p.resetDebugVisualizerCamera(4.0, -40.0, -35.0, [x, y, 0.0], physicsClientId=c)
+        p = self._p
+        p.resetDebugVisualizerCamera(4.0, -40.0, -35.0, [x, y, 0.0])
         wait = self._last_frame + self.TIME_STEP - time.perf_counter()
         if wait > 0:
             time.sleep(wait)
@@ -389,11 +393,13 @@ class ScenarioEnv(gym.Env):
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 30}
 
-    def __init__(self, scenario: Any, robot: str | None = None,
-                 reward: Callable[[Any], float] | None = None,
-                 terminated: Callable[[Any], bool] | None = None,
+    def __init__(self, scenario: str | Path | Mapping[str, object] | Simulation,
+                 robot: str | None = None,
+                 reward: Callable[[Observation], float] | None = None,
+                 terminated: Callable[[Observation], bool] | None = None,
                  max_episode_steps: int | None = None, frame_skip: int = 1,
-                 render_mode: str | None = None, *, observation: str = "flat",
+                 render_mode: RenderMode | None = None, *,
+                 observation: Literal["flat", "dict"] = "flat",
                  fields: Sequence[str] | None = None,
                  action_bounds: Mapping[str, tuple[float, float]] | None = None,
                  width: int = 320, height: int = 240):
@@ -430,7 +436,7 @@ class ScenarioEnv(gym.Env):
         try:
             self.robot = self._pick_robot(robot)
             self._build_action_space(dict(action_bounds or {}))
-            b = self.sim.bodies[self.robot]
+            b = self.sim.robot(self.robot)
             chosen = list(fields) if fields is not None else [
                 *JOINT_FIELDS, *(BASE_FIELDS if b.config.base == "floating" else ())]
             for f in chosen:
@@ -462,7 +468,7 @@ class ScenarioEnv(gym.Env):
                 raise ParameterError(f"no robot named {robot!r}; robots: {', '.join(names)}",
                                      param="robot")
             return robot
-        driven = [n for n in names if self._controller(self.sim.bodies[n].config)]
+        driven = [n for n in names if self._controller(self.sim.robot(n).config)]
         if len(driven) == 1:
             return driven[0]
         if not driven:
@@ -472,7 +478,7 @@ class ScenarioEnv(gym.Env):
                              "which one the agent drives with robot=...", param="robot")
 
     @staticmethod
-    def _controller(cfg: Any) -> str | None:
+    def _controller(cfg: RobotConfig) -> Literal["drive", "joints"] | None:
         if cfg.drive is not None:
             return "drive"
         if cfg.joints is not None or cfg.motor is not None:
@@ -480,9 +486,9 @@ class ScenarioEnv(gym.Env):
         return None
 
     def _build_action_space(self, bounds: dict[str, tuple[float, float]]) -> None:
-        b = self.sim.bodies[self.robot]
+        b = self.sim.robot(self.robot)
         self.controller = self._controller(b.config)
-        self.modes: dict[str, str] = {}
+        self.modes: dict[str, Mode] = {}
         if self.controller == "drive":
             names, lows, highs = self._drive_action(b, bounds)
         else:
@@ -504,25 +510,26 @@ class ScenarioEnv(gym.Env):
         self.action_space = spaces.Box(np.array(lows, dtype=np.float32),
                                        np.array(highs, dtype=np.float32))
         self._low, self._high = self.action_space.low, self.action_space.high
-        self._by_mode: dict[str, list[int]] = {}
+        self._by_mode: dict[Mode, list[int]] = {}
         for k, name in enumerate(names if self.controller == "joints" else []):
             self._by_mode.setdefault(self.modes[name], []).append(k)
 
-    def _drive_action(self, b: Any, bounds: dict[str, tuple[float, float]]
+    def _drive_action(self, b: SimRobot, bounds: dict[str, tuple[float, float]]
                       ) -> tuple[list[str], list[float], list[float]]:
         """Throttle and steer, the steer's range from the drive train unless ``bounds`` says."""
         from urdfkit.motion.vehicle import clamp_steer
 
         train = b.train
+        assert train is not None
         lo, hi = train.steer_range() if train.hinges else (0.0, 0.0)
         steer = bounds.pop("steer", (lo, hi))
         throttle = bounds.pop("throttle", (-DEFAULT_THROTTLE, DEFAULT_THROTTLE))
         self._clamp = clamp_steer
         return ["throttle", "steer"], [throttle[0], steer[0]], [throttle[1], steer[1]]
 
-    def _joint_modes(self, b: Any) -> dict[str, str]:
+    def _joint_modes(self, b: SimRobot) -> dict[str, Mode]:
         """The mode each commanded joint is driven in: one per joint, or the servo's joints."""
-        modes: dict[str, str] = {}
+        modes: dict[str, Mode] = {}
         for seg in b.config.joints or []:
             for name in seg.targets:
                 mode = seg.mode if isinstance(seg.mode, str) else seg.mode[name]
@@ -537,15 +544,13 @@ class ScenarioEnv(gym.Env):
                                  param="robot")
         return modes
 
-    def _joint_bounds(self, b: Any, name: str, bounds: dict[str, tuple[float, float]]
+    def _joint_bounds(self, b: SimRobot, name: str, bounds: dict[str, tuple[float, float]]
                       ) -> tuple[float, float]:
         """A joint's action range: from ``bounds``, else its URDF limits in the measured frame."""
         if name in bounds:
             return bounds.pop(name)
-        p, client = self.sim.session.p, self.sim.session.client
         spec = b.joint(name)
-        info = p.getJointInfo(b.body, spec.index, physicsClientId=client)
-        lower, upper, effort, velocity = info[8], info[9], info[10], info[11]
+        lower, upper, effort, velocity = b.joint_limits(name)
         mode = self.modes[name]
         sign = b.directions.get(name, 1.0)
         offset = b.offsets.get(name, 0.0)
@@ -553,7 +558,7 @@ class ScenarioEnv(gym.Env):
             if lower < upper:  # measured frame: (q - offset) * direction
                 ends = sorted(((lower - offset) * sign, (upper - offset) * sign))
                 return ends[0], ends[1]
-            if spec.type == p.JOINT_REVOLUTE:
+            if spec.revolute:
                 return -math.pi, math.pi
             raise ParameterError(f"{name} has no position limits; give its range in "
                                  "action_bounds", param="action_bounds")
@@ -566,17 +571,17 @@ class ScenarioEnv(gym.Env):
             else DEFAULT_TORQUE
         return -limit, limit
 
-    def _field_names(self, field: str, value: Any) -> list[str]:
+    def _field_names(self, field: str, value: dict[str, float] | list[float]) -> list[str]:
         if isinstance(value, dict):
             return [f"{field}.{k}" for k in value]
         axes = ("x", "y", "z", "w")[:len(value)]
         return [f"{field}.{a}" for a in axes]
 
-    def _build_observation_space(self, kind: str) -> None:
+    def _build_observation_space(self, kind: Literal["flat", "dict"]) -> None:
         first = self._observe()
         self.observation_kind = kind
         names: list[str] = []
-        boxes: dict[str, Any] = {}
+        boxes: dict[str, spaces.Space[np.ndarray]] = {}
         for f in self.fields:
             these = self._field_names(f, getattr(first, f))
             names.extend(these)
@@ -585,27 +590,22 @@ class ScenarioEnv(gym.Env):
         self.observation_space = spaces.Dict(boxes) if kind == "dict" else \
             spaces.Box(-np.inf, np.inf, shape=(len(names),), dtype=np.float32)
 
-    def _randomize_plan(self) -> Any:
-        b = self.sim.bodies[self.robot]
+    def _randomize_plan(self) -> Randomize | None:
+        b = self.sim.robot(self.robot)
         r = b.config.randomize
         if r is None:
             return None
-        p, client = self.sim.session.p, self.sim.session.client
         # Nominal masses, for mass_scale: the scenario's, before any episode changed them.
-        self._nominal_mass = {link: p.getDynamicsInfo(b.body, b.links[link],
-                                                      physicsClientId=client)[0]
-                              for link in r.mass_scale}
+        self._nominal_mass = {link: b.link_mass(link) for link in r.mass_scale}
         return r
 
     # ---- the Gymnasium API
 
-    def _observe(self) -> Any:
+    def _observe(self) -> Observation:
         """The robot's reported observation now (a copy)."""
-        o = self.sim.observe(self.robot)
-        assert not isinstance(o, dict)
-        return o
+        return self.sim.observation(self.robot)
 
-    def _obs(self, o: Any) -> Any:
+    def _obs(self, o: Observation) -> np.ndarray | dict[str, np.ndarray]:
         if self.observation_kind == "dict":
             return {f: np.fromiter(_values(getattr(o, f)), dtype=np.float32)
                     for f in self.fields}
@@ -615,7 +615,7 @@ class ScenarioEnv(gym.Env):
         return np.array(out, dtype=np.float32)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
-              ) -> tuple[Any, dict[str, Any]]:
+              ) -> tuple[np.ndarray | dict[str, np.ndarray], dict[str, object]]:
         """Restore the scenario's start in place (``Simulation.reset``), then randomise.
 
         The noise is reseeded from ``np_random``, so ``reset(seed=s)`` and the same actions
@@ -631,7 +631,7 @@ class ScenarioEnv(gym.Env):
         r = self._randomize
         if r is not None:
             mine = overrides.setdefault(self.robot, {})
-            cfg = self.sim.bodies[self.robot].config
+            cfg = self.sim.robot(self.robot).config
             if r.initial_joints:
                 joints = dict(mine.get("initial_joints") or {})
                 for name, (lo, hi) in r.initial_joints.items():
@@ -643,7 +643,8 @@ class ScenarioEnv(gym.Env):
                                     for s, (lo, hi) in zip(start, r.position, strict=True)]
             if r.yaw is not None:
                 roll, pitch, yaw = mine.get("orientation_rpy", cfg.orientation_rpy or (0, 0, 0))
-                mine["orientation_rpy"] = [roll, pitch, yaw + float(rng.uniform(*r.yaw))]
+                low, high = r.yaw
+                mine["orientation_rpy"] = [roll, pitch, yaw + float(rng.uniform(low, high))]
         noise_seed = int(rng.integers(2**31 - 1))
         self.sim.reset(seed=noise_seed, overrides=overrides or None)
         if r is not None:
@@ -657,20 +658,22 @@ class ScenarioEnv(gym.Env):
         obs = self._observe()
         return self._obs(obs), {}
 
-    def _apply(self, action: Any) -> None:
+    def _apply(self, action: np.ndarray | None) -> None:
         if action is None:
             return
         if self.controller == "drive":
-            b = self.sim.bodies[self.robot]
+            train = self.sim.robot(self.robot).train
+            assert train is not None
             throttle, steer = float(action[0]), float(action[1])
-            steer = self._clamp(b.train, steer)[0]
+            steer = self._clamp(train, steer)[0]
             self.sim.set_drive(self.robot, throttle=throttle, steer=steer)
             return
         for mode, ks in self._by_mode.items():
             self.sim.set_joint_targets(self.robot, {self.action_names[k]: float(action[k])
                                                     for k in ks}, mode=mode)
 
-    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+    def step(self, action: object
+             ) -> tuple[np.ndarray | dict[str, np.ndarray], float, bool, bool, dict[str, object]]:
         """Command the action (clipped to the space) for ``frame_skip`` physics steps.
 
         Raises:
@@ -682,7 +685,7 @@ class ScenarioEnv(gym.Env):
         if a.shape != self._low.shape:
             raise ValueError(f"expected an action of {len(self.action_names)} values "
                              f"({', '.join(self.action_names)}), got shape "
-                             f"{np.shape(action)}")
+                             f"{np.asarray(action).shape}")
         if not np.all(np.isfinite(a)):
             raise ValueError(f"the action must be finite, got {a.tolist()}")
         _after_end(self)
@@ -699,19 +702,16 @@ class ScenarioEnv(gym.Env):
         self._ended = done or truncated
         return self._obs(o), reward, done, truncated, {"t": o.t}
 
-    def render(self) -> Any:  # an ndarray or None; gymnasium types it as a RenderFrame TypeVar
+    def render(self) -> np.ndarray | None:
         """An ``rgb_array`` frame looking at the robot (height x width x 3, uint8)."""
         if self.render_mode != "rgb_array":
             return None
-        p, client = self.sim.session.p, self.sim.session.client
-        b = self.sim.bodies[self.robot]
-        target = p.getBasePositionAndOrientation(b.body, physicsClientId=client)[0]
-        view = p.computeViewMatrixFromYawPitchRoll(target, 2.0, 45.0, -30.0, 0.0, 2,
-                                                   physicsClientId=client)
-        proj = p.computeProjectionMatrixFOV(60.0, self.width / self.height, 0.01, 100.0,
-                                            physicsClientId=client)
+        p = self.sim.bullet
+        target = self.sim.robot(self.robot).base_position()
+        view = p.computeViewMatrixFromYawPitchRoll(target, 2.0, 45.0, -30.0, 0.0, 2)
+        proj = p.computeProjectionMatrixFOV(60.0, self.width / self.height, 0.01, 100.0)
         image = p.getCameraImage(self.width, self.height, view, proj,
-                                 renderer=p.ER_TINY_RENDERER, physicsClientId=client)[2]
+                                 renderer=p.ER_TINY_RENDERER)[2]
         return np.asarray(image, dtype=np.uint8).reshape(self.height, self.width, 4)[
             :, :, :3].copy()
 
@@ -721,7 +721,7 @@ class ScenarioEnv(gym.Env):
         self.sim.close()
 
 
-def _values(value: Any) -> list[float]:
+def _values(value: dict[str, float] | list[float]) -> list[float]:
     return list(value.values()) if isinstance(value, dict) else list(value)
 
 

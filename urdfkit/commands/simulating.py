@@ -64,7 +64,7 @@ def sim(
     pace = _check_sim_options(scenario, config, gui=gui, real_time=real_time, view=view,
                               speed=speed)
     if out is not None:
-        simulation.check_output(out, force=force)  # fail before the run, not after it
+        simulation.check_rows_output(out, force=force)  # fail before the run, not after it
     with simulation.Simulation.from_file(scenario, gui=gui) as s:
         for note in s.config.notes:
             show.warn(note)

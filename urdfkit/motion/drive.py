@@ -32,10 +32,9 @@ from __future__ import annotations
 import math
 import tempfile
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 from urdfkit.core.errors import ParameterError, UrdfkitError
 from urdfkit.engine.session import LoadOptions, Session, quiet_stdout
@@ -353,33 +352,32 @@ class Scenario:
     def _open(self) -> None:
         c = self.config
         self.session = s = Session(gui=c.gui)
-        p, client = s.p, s.client
-        p.setGravity(0, 0, c.gravity, physicsClientId=client)
-        p.setTimeStep(c.time_step, physicsClientId=client)
+        p = s.bullet
+        p.setGravity(0, 0, c.gravity)
+        p.setTimeStep(c.time_step)
         car = c.urdf or "simplecar"
         upright = UP_AXES[c.up]
         spawn = quat_mul(p.getQuaternionFromEuler(c.base_rpy), upright)
         start = c.base_position or (TUTORIAL_START if c.tutorial else (0.0, 0.0, 0.0))
         # The tutorial's load: no flags. Otherwise implicit cylinders (smooth wheels) and the
         # file's own inertia; see the module docstring.
-        flags: dict[str, Any] = {"implicit_cylinder": False} if c.tutorial else {
-            "inertia_from_file": True, "implicit_cylinder": True}
         self.flags = [] if c.tutorial else ["URDF_USE_IMPLICIT_CYLINDER",
                                             "URDF_USE_INERTIA_FROM_FILE"]
         # The car is loaded first (as the tutorial does), standing up where it starts; it is
         # turned to its spawn tilt only after its wheels are found in its own frame.
         self.body = self._load(s, c.urdf, "simplecar", LoadOptions(
-            base_position=start, base_orientation=upright, **flags), c.template_params)
+            base_position=start, base_orientation=upright, inertia_from_file=not c.tutorial,
+            implicit_cylinder=not c.tutorial), c.template_params)
         #: The car's file, for a viewer to load the same robot (the built-in one's build).
         self.car_file = self._last_file
         s.require_state_queries(self.body, car)
         try:
-            self.drivetrain = train = detect_upright(p, self.body, client, upright, c.wheels,
+            self.drivetrain = train = detect_upright(p, self.body, upright, c.wheels,
                                                      c.hinges, c.drivetrain)
         except DrivetrainError as e:
             raise DrivetrainError(e.message, file=car, param=e.param) from None
         if spawn != upright:  # the link frame, as loadURDF placed it
-            set_base_link_pose(p, self.body, client, start, spawn)
+            set_base_link_pose(p, self.body, start, spawn)
         # The tutorial loads its plane as it is (a mass-0 box: static either way).
         self.plane = self._load(s, c.plane, "simpleplane", LoadOptions(
             fixed_base=not c.tutorial, implicit_cylinder=not c.tutorial), self._ground_params())
@@ -407,9 +405,9 @@ class Scenario:
         if not self._phantom:
             return
         assert self.session is not None
-        p, client = self.session.p, self.session.client
-        total = sum(p.getDynamicsInfo(self.body, k, physicsClientId=client)[0]
-                    for k in range(-1, p.getNumJoints(self.body, physicsClientId=client)))
+        p = self.session.bullet
+        total = sum(p.getDynamicsInfo(self.body, k)[0]
+                    for k in range(-1, p.getNumJoints(self.body)))
         made_up = float(len(self._phantom))
         if total > 0 and made_up >= 0.1 * total:
             names = ", ".join(self._phantom[:5]) + (", ..." if len(self._phantom) > 5 else "")
@@ -426,14 +424,14 @@ class Scenario:
         it was loaded. Casters always roll free; ``limp`` frees the rest too.
         """
         assert self.session is not None
-        p, client, train = self.session.p, self.session.client, self.drivetrain
+        p, train = self.session.bullet, self.drivetrain
         casters = set(train.casters)
         candidates = [j for j in train.passive if j not in casters]
         self.held: dict[int, tuple[float, float]] = {}  # joint: (angle, force)
         self.limp: list[int] = list(candidates) if self.config.limp else []
         if self.config.limp or not candidates:
             return
-        states = p.getJointStates(self.body, candidates, physicsClientId=client)
+        states = p.getJointStates(self.body, candidates)
         weak = []
         for j, st in zip(candidates, states, strict=True):
             force = train.efforts.get(j, 0.0)
@@ -458,8 +456,8 @@ class Scenario:
     def _ground(self) -> tuple[float | None, tuple[float, float, float, float] | None]:
         """The ground's top z and its x-y extent (None where unbounded, as a GEOM_PLANE)."""
         assert self.session is not None
-        p, client = self.session.p, self.session.client
-        lo, hi = p.getAABB(self.plane, -1, physicsClientId=client)
+        p = self.session.bullet
+        lo, hi = p.getAABB(self.plane, -1)
         top = hi[2] if abs(hi[2]) < 1e6 else None
         bounds = (lo[0], hi[0], lo[1], hi[1]) if max(map(abs, (*lo[:2], *hi[:2]))) < 1e6 \
             else None
@@ -468,23 +466,23 @@ class Scenario:
     def _rest_on_ground(self, start: tuple[float, float, float]) -> None:
         """Lower or raise the car until its lowest point is 1 mm above the ground's top."""
         assert self.session is not None
-        p, client = self.session.p, self.session.client
-        lowest = lowest_point(p, self.body, client)  # the shapes' own, not the AABB's
+        p = self.session.bullet
+        lowest = lowest_point(p, self.body)  # the shapes' own, not the AABB's
         top = self.ground_top if self.ground_top is not None else 0.0
-        pos, orn = base_link_pose(p, self.body, client)
-        set_base_link_pose(p, self.body, client,
+        pos, orn = base_link_pose(p, self.body)
+        set_base_link_pose(p, self.body,
                            (pos[0], pos[1], pos[2] + top + 0.001 - lowest), orn)
 
     def _check_start(self) -> None:
         """A static base, or a start inside the ground, make the run meaningless: say so."""
         assert self.session is not None
-        p, client = self.session.p, self.session.client
+        p = self.session.bullet
         self.problems = []
-        self.static_base = p.getDynamicsInfo(self.body, -1, physicsClientId=client)[0] == 0
+        self.static_base = p.getDynamicsInfo(self.body, -1)[0] == 0
         if self.static_base:
             self.problems.append("static base: the root link has mass 0, so PyBullet fixes it "
                                  "where it is loaded and the car cannot move; give it a mass")
-        points = p.getClosestPoints(self.body, self.plane, 0.0, physicsClientId=client)
+        points = p.getClosestPoints(self.body, self.plane, 0.0)
         depth = min((pt[8] for pt in points), default=0.0)
         if depth < -0.005:
             if self.config.tutorial:  # the tutorial's own start: reproduced, and said
@@ -510,33 +508,33 @@ class Scenario:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def link_poses(self) -> list[tuple[Any, Any]]:
+    def link_poses(self) -> list[tuple[Sequence[float], Sequence[float]]]:
         """Every URDF link frame's world pose now, base first (``(xyz, xyzw)``)."""
         assert self.session is not None
-        p, body, client = self.session.p, self.body, self.session.client
-        out = [base_link_pose(p, body, client)]
-        for j in range(p.getNumJoints(body, physicsClientId=client)):
-            st = p.getLinkState(body, j, computeForwardKinematics=True, physicsClientId=client)
+        p, body = self.session.bullet, self.body
+        out = [base_link_pose(p, body)]
+        for j in range(p.getNumJoints(body)):
+            st = p.getLinkState(body, j, computeForwardKinematics=True)
             out.append((st[4], st[5]))
         return out
 
     def _sampler(self) -> Callable[[float], tuple[float, ...]]:
         assert self.session is not None
-        p, body, client = self.session.p, self.body, self.session.client
+        p, body = self.session.bullet, self.body
         joints = self.drivetrain.wheels + self.drivetrain.hinges
         pose, velocity = p.getBasePositionAndOrientation, p.getBaseVelocity
         euler, states = p.getEulerFromQuaternion, p.getJointStates
         # The base link frame's pose and velocity, not the inertial frame's PyBullet reports:
         # with inertia products or an <inertial><origin> they differ (a yaw of -0.16 rad at
         # rest). The local inertial pose is fixed for the run: inverted once.
-        local = p.getDynamicsInfo(body, -1, physicsClientId=client)
+        local = p.getDynamicsInfo(body, -1)
         inv_pos, inv_orn = p.invertTransform(local[3], local[4])
         compose = p.multiplyTransforms
         offset = any(abs(x) > 0 for x in inv_pos) or any(abs(x) > 0 for x in inv_orn[:3])
 
         def sample(t: float) -> tuple[float, ...]:
-            com, com_orn = pose(body, physicsClientId=client)
-            lin, ang = velocity(body, physicsClientId=client)
+            com, com_orn = pose(body)
+            lin, ang = velocity(body)
             if offset:
                 pos, orn = compose(com, com_orn, inv_pos, inv_orn)
                 r = (pos[0] - com[0], pos[1] - com[1], pos[2] - com[2])
@@ -547,13 +545,13 @@ class Scenario:
                 pos, orn = com, com_orn
             row = [t, *pos, *euler(orn), *lin]
             if joints:
-                for st in states(body, joints, physicsClientId=client):
+                for st in states(body, joints):
                     row += (st[0], st[1])
             return tuple(row)
 
         return sample
 
-    def simulated(self) -> dict[str, Any]:
+    def simulated(self) -> dict[str, object]:
         """What this run simulates, beyond the robot: for the summary and JSON."""
         c = self.config
         return {
@@ -584,15 +582,15 @@ class Scenario:
         """
         assert self.session is not None
         c, s, train = self.config, self.session, self.drivetrain
-        p, body, client = s.p, self.body, s.client
-        disable_default_motors(p, body, client, [j for j in train.passive if j not in self.held])
+        p, body = s.bullet, self.body
+        disable_default_motors(p, body, [j for j in train.passive if j not in self.held])
         if self.held:
             held = list(self.held)
             p.setJointMotorControlArray(
                 body, held, p.POSITION_CONTROL,
                 targetPositions=[self.held[j][0] for j in held],
-                forces=[self.held[j][1] for j in held], physicsClientId=client)
-        apply_drive(p, body, client, train, c.throttle, self.steer, c.max_force)
+                forces=[self.held[j][1] for j in held])
+        apply_drive(p, body, train, c.throttle, self.steer, c.max_force)
         total, period, dt = c.total_steps, c.sample_period, c.time_step
         take = self._sampler()
         stats = Stats(SETTLED_FRACTION * total * dt)
@@ -622,10 +620,10 @@ class Scenario:
                     if gui is not None:
                         n = gui.steps(n)
                     else:
-                        # The hot loop: nothing but the physics step (positional client id is
-                        # a little cheaper than the keyword).
+                        # The hot loop: nothing but the physics step (bound to the client
+                        # once, above).
                         for _ in range(n):
-                            step(client)
+                            step()
                     done += n
                     if done % period == 0 or done == total:
                         sample(done * dt)
@@ -723,28 +721,26 @@ class _GuiControls:
 
     def __init__(self, sc: Scenario):
         assert sc.session is not None
-        self.sc, self.p, self.client = sc, sc.session.p, sc.session.client
+        self.sc, self.p = sc, sc.session.bullet
         lo, hi = sc.drivetrain.steer_range()
         lo, hi = max(lo, -1.0), min(hi, 1.0)
         top = max(20.0, abs(sc.config.throttle))
-        self.steer_id = self.p.addUserDebugParameter("Steering", lo, hi, sc.steer,
-                                                     physicsClientId=self.client)
+        self.steer_id = self.p.addUserDebugParameter("Steering", lo, hi, sc.steer)
         self.throttle_id = self.p.addUserDebugParameter("Throttle", -top, top,
-                                                        sc.config.throttle,
-                                                        physicsClientId=self.client)
+                                                        sc.config.throttle)
         self.last = (sc.config.throttle, sc.steer)
         self.next_tick = time.perf_counter()
 
     def steps(self, n: int) -> int:
-        p, client, dt = self.p, self.client, self.sc.config.time_step
+        p, dt = self.p, self.sc.config.time_step
         for _ in range(n):
-            now = (p.readUserDebugParameter(self.throttle_id, physicsClientId=client),
-                   p.readUserDebugParameter(self.steer_id, physicsClientId=client))
+            now = (p.readUserDebugParameter(self.throttle_id),
+                   p.readUserDebugParameter(self.steer_id))
             if now != self.last:
                 self.last = now
-                apply_drive(p, self.sc.body, client, self.sc.drivetrain, now[0], now[1],
+                apply_drive(p, self.sc.body, self.sc.drivetrain, now[0], now[1],
                             self.sc.config.max_force)
-            p.stepSimulation(physicsClientId=client)
+            p.stepSimulation()
             self.next_tick += dt
             delay = self.next_tick - time.perf_counter()
             if delay > 0:

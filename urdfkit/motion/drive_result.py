@@ -139,12 +139,12 @@ class DriveResult:
     warnings: list[str] = field(default_factory=list)
     expected_radius: float | None = None
     radius_note: str | None = None
-    simulated: dict[str, Any] = field(default_factory=dict)
+    simulated: dict[str, object] = field(default_factory=dict)
     samples: int = 0
     problems: list[str] = field(default_factory=list)
     yaw_rate: float | None = None
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:  # the JSON document
         """The JSON form (the trajectory goes to its own file, not here)."""
         def r(x: float | None) -> float | None:
             return None if x is None else round(x, 6)
@@ -250,7 +250,8 @@ class Monitor:
         duration: The run's simulated length (s).
     """
 
-    def __init__(self, train: Drivetrain, columns: list[str], bounds: Any, top: float | None,
+    def __init__(self, train: Drivetrain, columns: list[str],
+                 bounds: tuple[float, float, float, float] | None, top: float | None,
                  static_base: bool, duration: float) -> None:
         self.problems: list[str] = []
         self.seen: set[str] = set()

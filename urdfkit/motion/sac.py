@@ -75,7 +75,7 @@ NOISE_KEYS: dict[str, tuple[str, ...]] = {
 }
 
 
-def is_config(data: Any) -> bool:
+def is_config(data: object) -> bool:
     """Whether a document is a simulation_and_control config (a section of theirs on top).
 
     No native scenario key is one of their section names.
@@ -93,7 +93,7 @@ class Imported:
             SimInterface drops: one line each, naming the key.
     """
 
-    scenario: dict[str, Any]
+    scenario: dict[str, Any]  # the JSON document: a native scenario's tables
     notes: list[str] = field(default_factory=list)
 
 
@@ -111,7 +111,7 @@ class _Robot:
 class _Reader:
     """The document, with errors that name the key (``robot_pybullet.base_type[1]``)."""
 
-    def __init__(self, data: Mapping[str, Any], source: str | None):
+    def __init__(self, data: Mapping[str, object], source: str | None):
         self.data = data
         self.source = source
         self.notes: list[str] = []
@@ -120,7 +120,7 @@ class _Reader:
         return InputError(f"{where}: {message} (a simulation_and_control config)",
                           file=self.source)
 
-    def section(self, name: str, known: Sequence[str]) -> Mapping[str, Any]:
+    def section(self, name: str, known: Sequence[str]) -> Mapping[str, object]:
         value = self.data.get(name, {})
         if not isinstance(value, Mapping):
             raise self.fail(name, "expected an object")
@@ -130,8 +130,8 @@ class _Reader:
                                   "effect there, nor here")
         return value
 
-    def per_robot(self, section: Mapping[str, Any], where: str, key: str, count: int,
-                  default: Any = None) -> list[Any]:
+    def per_robot(self, section: Mapping[str, object], where: str, key: str, count: int,
+                  default: object = None) -> list[object]:
         """The key's list, one entry per robot (a missing key: ``default`` for each)."""
         if key not in section:
             if default is None:
@@ -145,26 +145,26 @@ class _Reader:
         return value
 
 
-def _number(reader: _Reader, where: str, value: Any) -> float:
+def _number(reader: _Reader, where: str, value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or \
             not math.isfinite(value):
         raise reader.fail(where, f"expected a finite number, got {value!r}")
     return float(value)
 
 
-def _flag(reader: _Reader, where: str, value: Any) -> bool:
+def _flag(reader: _Reader, where: str, value: object) -> bool:
     if isinstance(value, bool) or value in (0, 1):
         return bool(value)
     raise reader.fail(where, f"expected true/false (or 0/1), got {value!r}")
 
 
-def _vector(reader: _Reader, where: str, value: Any, size: int) -> list[float]:
+def _vector(reader: _Reader, where: str, value: object, size: int) -> list[float]:
     if not isinstance(value, list) or len(value) != size:
         raise reader.fail(where, f"expected {size} numbers, got {value!r}")
     return [_number(reader, f"{where}[{k}]", v) for k, v in enumerate(value)]
 
 
-def _per_joint(reader: _Reader, where: str, value: Any, names: Sequence[str], *,
+def _per_joint(reader: _Reader, where: str, value: object, names: Sequence[str], *,
                one_ok: bool, non_negative: bool = False) -> float | dict[str, float]:
     """A scalar, or a list over the motors (a 1-list too when ``one_ok``, as adjust_value)."""
     if isinstance(value, list):
@@ -185,7 +185,7 @@ def _per_joint(reader: _Reader, where: str, value: Any, names: Sequence[str], *,
     return number
 
 
-def _resolve_urdf(reader: _Reader, where: str, name: Any, base: Path) -> Path:
+def _resolve_urdf(reader: _Reader, where: str, name: object, base: Path) -> Path:
     """Where SimInterface finds ``urdf_path``: ``<configs>/../models/<name>``.
 
     SimInterface reads its configs from ``<root>/configs`` and URDFs from ``<root>/models``.
@@ -225,8 +225,8 @@ def _inspect(path: Path, display: str) -> _Robot:
         active: list[str] = []
         links: dict[str, str] = {}
         types: dict[str, int] = {}
-        for j in range(s.p.getNumJoints(body, physicsClientId=s.client)):
-            info = s.p.getJointInfo(body, j, physicsClientId=s.client)
+        for j in range(s.bullet.getNumJoints(body)):
+            info = s.bullet.getJointInfo(body, j)
             name = info[1].decode("utf-8", "replace")
             joints.append(name)
             types[name] = info[2]
@@ -236,7 +236,7 @@ def _inspect(path: Path, display: str) -> _Robot:
         return _Robot(path, joints, active, links, types)
 
 
-def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imported:
+def convert(data: Mapping[str, object], *, source: str | Path | None = None) -> Imported:
     """Map a simulation_and_control config onto a native scenario document.
 
     Args:
@@ -274,7 +274,7 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
         reader.notes.append("robot_pin: the Pinocchio model is not simulated; Simulation's "
                             "mass_matrix, gravity_torques, coriolis_and_gravity and jacobian "
                             "give PyBullet's own")
-    scenario: dict[str, Any] = {
+    scenario: dict[str, object] = {
         # SimInterface's engine settings; contacts in the engine's own order, not sorted.
         "physics": {"time_step": time_step, "gravity": [0.0, 0.0, -9.81],
                     "solver_iterations": 30, "cone_friction": False,
@@ -291,7 +291,7 @@ def convert(data: Mapping[str, Any], *, source: str | Path | None = None) -> Imp
     return Imported(scenario, reader.notes)
 
 
-def _time_step(reader: _Reader, sim: Mapping[str, Any], env: Mapping[str, Any]) -> float:
+def _time_step(reader: _Reader, sim: Mapping[str, object], env: Mapping[str, object]) -> float:
     """``sim.time_step``, after refusing an ``env_script_name`` (code urdfkit never runs)."""
     script = env.get("env_script_name", "")
     if script:
@@ -307,7 +307,7 @@ def _time_step(reader: _Reader, sim: Mapping[str, Any], env: Mapping[str, Any]) 
     return time_step
 
 
-def _load_robots(reader: _Reader, rp: Mapping[str, Any], base: Path) -> list[_Robot]:
+def _load_robots(reader: _Reader, rp: Mapping[str, object], base: Path) -> list[_Robot]:
     """Each ``urdf_path``, found as SimInterface finds it and loaded to read its joints."""
     paths = rp.get("urdf_path")
     if not isinstance(paths, list) or not paths:
@@ -338,7 +338,7 @@ def _load_robots(reader: _Reader, rp: Mapping[str, Any], base: Path) -> list[_Ro
 class _Converter:
     """The per-robot part of :func:`convert`: one native robot document per config robot."""
 
-    def __init__(self, reader: _Reader, sim: Mapping[str, Any], rp: Mapping[str, Any],
+    def __init__(self, reader: _Reader, sim: Mapping[str, object], rp: Mapping[str, object],
                  count: int) -> None:
         self.reader, self.sim, self.rp, self.count = reader, sim, rp, count
         self.notes = reader.notes
@@ -351,13 +351,13 @@ class _Converter:
         self.link_poses: list[str] = []
         self.used_names: set[str] = set()
 
-    def get(self, key: str, default: Any = None) -> list[Any]:
+    def get(self, key: str, default: object = None) -> list[object]:
         """A ``robot_pybullet`` key, one value per robot."""
         return self.reader.per_robot(self.rp, "robot_pybullet", key, self.count, default)
 
-    def record(self) -> dict[str, Any]:
+    def record(self) -> dict[str, object]:
         """What the scenario records: torques, and the feet, forces and poses met."""
-        record: dict[str, Any] = {"motor_torques": True}
+        record: dict[str, object] = {"motor_torques": True}
         if self.feet_record:
             record["feet"] = self.feet_record
         if self.joint_forces:
@@ -366,7 +366,7 @@ class _Converter:
             record["link_poses"] = self.link_poses
         return record
 
-    def robot(self, i: int, robot: _Robot) -> dict[str, Any]:
+    def robot(self, i: int, robot: _Robot) -> dict[str, object]:
         """The native document of robot ``i``."""
         w = f"robot_pybullet.{{}}[{i}]"
         doc = self._body(i, robot, w)
@@ -387,10 +387,10 @@ class _Converter:
             doc["delay"] = steps
         return doc
 
-    def _body(self, i: int, robot: _Robot, w: str) -> dict[str, Any]:
+    def _body(self, i: int, robot: _Robot, w: str) -> dict[str, object]:
         """Name, file, base type, self-collision, start pose and base velocity."""
         reader, get = self.reader, self.get
-        doc: dict[str, Any] = {}
+        doc: dict[str, object] = {}
         stem = robot.path.stem or f"robot{i}"
         name = stem if stem not in self.used_names else f"{stem}_{i}"
         self.used_names.add(name)
@@ -421,7 +421,7 @@ class _Converter:
             doc.update(_base_velocity(reader, self.rp, self.notes))
         return doc
 
-    def _motors(self, doc: dict[str, Any], i: int, names: list[str], w: str) -> None:
+    def _motors(self, doc: dict[str, object], i: int, names: list[str], w: str) -> None:
         """Offsets, directions, initial joints (in the measured frame) and the servo."""
         reader, get, n = self.reader, self.get, len(names)
         offsets = get("motor_offset", [])[i]
@@ -453,10 +453,10 @@ class _Converter:
                                        strict=True)}
         doc["motor"] = self._servo(i, names, w, any(offset) or any(d < 0 for d in direction))
 
-    def _servo(self, i: int, names: list[str], w: str, adjusted: bool) -> dict[str, Any]:
+    def _servo(self, i: int, names: list[str], w: str, adjusted: bool) -> dict[str, object]:
         """The servo: gains through the mass matrix, friction and spring if enabled."""
         reader, get = self.reader, self.get
-        motor: dict[str, Any] = {
+        motor: dict[str, object] = {
             "kp": _per_joint(reader, w.format("servo_pos_gains"), get("servo_pos_gains")[i],
                              names, one_ok=False, non_negative=True),
             "kd": _per_joint(reader, w.format("servo_vel_gains"), get("servo_vel_gains")[i],
@@ -484,7 +484,7 @@ class _Converter:
                                   "either (the native motor.inertia applies one)")
         return motor
 
-    def _feet(self, doc: dict[str, Any], i: int, robot: _Robot, w: str) -> None:
+    def _feet(self, doc: dict[str, object], i: int, robot: _Robot, w: str) -> None:
         """Foot friction and restitution, and the feet recorded under their labels."""
         reader, get = self.reader, self.get
         feet = self.feet_names[i]
@@ -493,7 +493,7 @@ class _Converter:
         friction = _number(reader, w.format("foot_friction"), get("foot_friction", 1.0)[i])
         restitution = _number(reader, w.format("foot_restitution"),
                               get("foot_restitution", 0.0)[i])
-        dynamics: dict[str, Any] = {}
+        dynamics: dict[str, object] = {}
         for link in feet:
             if link not in robot.links:
                 self.notes.append(f"sim.feet_contact_names[{i}]: {robot.path.name} has no "
@@ -501,8 +501,8 @@ class _Converter:
                                   "does urdfkit")
                 continue
             dynamics[link] = {"lateral_friction": friction, "restitution": restitution}
-            label = next((lab for lab in FOOT_LABELS if isinstance(self.labels[lab][i], list)
-                          and link in self.labels[lab][i]), link)
+            label = next((lab for lab in FOOT_LABELS if _listed(link, self.labels[lab][i])),
+                         link)
             if self.count > 1:
                 label = f"{doc['name']}.{label}"
             self.feet_record[label] = link
@@ -547,7 +547,12 @@ class _Converter:
             self.link_poses.append(link)
 
 
-def _base_velocity(reader: _Reader, rp: Mapping[str, Any], notes: list[str]) -> dict[str, Any]:
+def _listed(link: str, names: object) -> bool:
+    return isinstance(names, list) and link in names
+
+
+def _base_velocity(reader: _Reader, rp: Mapping[str, object], notes: list[str]
+                   ) -> dict[str, object]:
     """SimInterface's initial base velocity: one 3-vector pair shared by floating robots.
 
     It reads ``init_link_base_vel`` and ``init_link_base_ang_vel`` without a robot index
@@ -556,7 +561,8 @@ def _base_velocity(reader: _Reader, rp: Mapping[str, Any], notes: list[str]) -> 
     lin, ang = rp.get("init_link_base_vel", []), rp.get("init_link_base_ang_vel", [])
     if not lin or not ang:
         return {}
-    if any(isinstance(v, list) for v in (*lin, *ang)):
+    if isinstance(lin, list) and isinstance(ang, list) and \
+            any(isinstance(v, list) for v in (*lin, *ang)):
         notes.append("robot_pybullet.init_link_base_vel: a list per robot; SimInterface "
                      "passes the whole list to resetBaseVelocity, which ignores it (the robot "
                      "starts at rest); so does urdfkit. Give one 3-vector to set it")
@@ -566,18 +572,18 @@ def _base_velocity(reader: _Reader, rp: Mapping[str, Any], notes: list[str]) -> 
                                              ang, 3)}
 
 
-def _noise(reader: _Reader, where: str, value: Any, names: Sequence[str]) -> dict[str, Any]:
+def _noise(reader: _Reader, where: str, value: object, names: Sequence[str]) -> dict[str, object]:
     """robot_noise -> native noise (SimInterface draws N(0, value): standard deviations)."""
     if not isinstance(value, Mapping):
         raise reader.fail(where, "expected an object of *_cov values")
-    out: dict[str, Any] = {}
+    out: dict[str, object] = {}
     for key, std in value.items():
         if key not in NOISE_KEYS:
             raise reader.fail(f"{where}.{key}", f"not a noise key SimInterface reads; known "
                                                 f"keys: {', '.join(NOISE_KEYS)}")
         fields = NOISE_KEYS[key]
         if fields[0].startswith("motor"):
-            native: Any = _per_joint(reader, f"{where}.{key}", std, names, one_ok=True,
+            native: object = _per_joint(reader, f"{where}.{key}", std, names, one_ok=True,
                                      non_negative=True)
         elif isinstance(std, list) and len(std) != 1:
             native = _vector(reader, f"{where}.{key}", std, 3)
@@ -593,7 +599,7 @@ def _noise(reader: _Reader, where: str, value: Any, names: Sequence[str]) -> dic
     return out
 
 
-def _damping(robots: Sequence[_Robot], docs: list[dict[str, Any]], notes: list[str]) -> None:
+def _damping(robots: Sequence[_Robot], docs: list[dict[str, object]], notes: list[str]) -> None:
     """The link damping SimInterface ends up with, robot by robot.
 
     SimInterface means to zero PyBullet's default link damping (0.04) but passes each joint

@@ -20,13 +20,20 @@ import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING, Annotated, Any, Union, get_args, get_origin
+from typing import TYPE_CHECKING, Annotated, Union, get_args, get_origin
 
 from urdfkit.core.errors import InputError, MissingDependencyError, ParameterError
 from urdfkit.model.spec import MAX_STEPS
 
 if TYPE_CHECKING:
-    from urdfkit.motion.scenario_models import Robot, Scenario
+    from pydantic_core import ErrorDetails
+
+    from urdfkit.motion.scenario_models import (
+        DriveSegment,
+        JointSegment,
+        RobotConfig,
+        ScenarioConfig,
+    )
 
 #: The observation fields that carry noise; each is a vector or a joint-keyed mapping.
 OBSERVATION_FIELDS = (
@@ -45,8 +52,9 @@ def schema() -> ModuleType:
     """The pydantic models of a scenario (:mod:`~urdfkit.motion.scenario_models`), imported lazily.
 
     Returns:
-        The module: ``Scenario`` (the document) and the models it nests, ``Physics``,
-        ``Ground``, ``Record``, ``Robot``, ``DriveSegment``, ``Vehicle``, ``JointSegment``,
+        The module: ``ScenarioConfig`` (the document) and the models it nests,
+        ``Physics``, ``Ground``, ``RecordConfig``, ``RobotConfig``, ``DriveSegment``,
+        ``Vehicle``, ``JointSegment``,
         ``Motor``, ``InitialJoint``, ``Noise``, ``LinkDynamics``, ``Randomize``.
 
     Raises:
@@ -75,7 +83,7 @@ def format_path(loc: Sequence[str | int]) -> str:
     return out or "(top level)"
 
 
-def _peel(tp: Any) -> Any:
+def _peel(tp: object) -> object:
     """Strip Annotated and Optional down to the type that holds the next level."""
     while True:
         origin = get_origin(tp)
@@ -88,9 +96,9 @@ def _peel(tp: Any) -> Any:
             return tp
 
 
-def _known_keys(root: Any, loc: Sequence[str | int]) -> list[str]:
+def _known_keys(root: object, loc: Sequence[str | int]) -> list[str]:
     """The keys the model at ``loc`` accepts (to suggest them after an unknown key)."""
-    tp: Any = root
+    tp: object = root
     for part in loc:
         tp = _peel(tp)
         fields = getattr(tp, "model_fields", None)
@@ -106,11 +114,11 @@ def _known_keys(root: Any, loc: Sequence[str | int]) -> list[str]:
     return list(fields) if isinstance(fields, dict) else []
 
 
-def _known_size(root: Any, loc: Sequence[str | int]) -> int | None:
+def _known_size(root: object, loc: Sequence[str | int]) -> int | None:
     """The fixed length of the vector field at ``loc`` (3 for a position), if it has one."""
     if not loc or not isinstance(loc[-1], str):
         return None
-    parent: Any = root
+    parent: object = root
     for part in loc[:-1]:
         parent = _peel(parent)
         fields = getattr(parent, "model_fields", None)
@@ -149,7 +157,7 @@ def key_path(loc: Sequence[str | int]) -> tuple[str | int, ...]:
         "[" in p or p.startswith(_TAG_PREFIXES) or p in _TAG_NAMES))
 
 
-def _describe(error: Mapping[str, Any], root: Any) -> str:
+def _describe(error: ErrorDetails, root: object) -> str:
     """One pydantic error as ``path: what was expected``."""
     kind = error["type"]
     loc = key_path(error["loc"])
@@ -196,8 +204,8 @@ def _describe(error: Mapping[str, Any], root: Any) -> str:
 # --------------------------------------------------------------------------- loading
 
 
-def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    out: dict[str, Any] = {}
+def _no_duplicates(pairs: list[tuple[str, object]]) -> dict[str, object]:
+    out: dict[str, object] = {}
     for key, value in pairs:
         if key in out:
             raise ValueError(f"duplicate key {key!r}")
@@ -205,7 +213,7 @@ def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def read_document(path: str | Path) -> dict[str, Any]:
+def read_document(path: str | Path) -> dict[str, object]:
     """Read a scenario file's JSON or TOML into plain data (not yet validated).
 
     Raises:
@@ -252,8 +260,8 @@ def read_document(path: str | Path) -> dict[str, Any]:
     return data
 
 
-def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
-                   base_dir: str | Path | None = None) -> Scenario:
+def parse_scenario(data: Mapping[str, object], *, source: str | Path | None = None,
+                   base_dir: str | Path | None = None) -> ScenarioConfig:
     """Validate plain data into a ``Scenario`` model and run the cross-field checks.
 
     Args:
@@ -269,10 +277,10 @@ def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
     from pydantic import ValidationError
 
     try:
-        scenario = models.Scenario.model_validate(dict(data))
+        scenario = models.ScenarioConfig.model_validate(dict(data))
     except ValidationError as e:
         errors = e.errors()
-        message = _describe(errors[0], models.Scenario)
+        message = _describe(errors[0], models.ScenarioConfig)
         # Each member of a union a value fails is an error of its own: one place, one problem.
         more = len({key_path(x["loc"]) for x in errors} - {key_path(errors[0]["loc"])})
         if more:
@@ -287,7 +295,7 @@ def parse_scenario(data: Mapping[str, Any], *, source: str | Path | None = None,
     return scenario
 
 
-def load_scenario(path: str | Path) -> Scenario:
+def load_scenario(path: str | Path) -> ScenarioConfig:
     """Read and validate a scenario file (``.json`` or ``.toml``).
 
     A simulation_and_control config (top-level ``sim``, ``robot_pybullet``, ...) is mapped
@@ -305,11 +313,12 @@ def load_scenario(path: str | Path) -> Scenario:
     return scenario
 
 
-def _fail(scenario: Scenario, path: str, message: str) -> InputError:
+def _fail(scenario: ScenarioConfig, path: str, message: str) -> InputError:
     return InputError(f"{path}: {message}", file=scenario.source)
 
 
-def _check_segments(scenario: Scenario, path: str, segments: Sequence[Any]) -> None:
+def _check_segments(scenario: ScenarioConfig, path: str,
+                    segments: Sequence[DriveSegment | JointSegment]) -> None:
     last = 0.0
     for i, seg in enumerate(segments):
         if seg.until <= last:
@@ -318,7 +327,8 @@ def _check_segments(scenario: Scenario, path: str, segments: Sequence[Any]) -> N
         last = seg.until
 
 
-def _check_template(scenario: Scenario, path: str, name: str, params: Mapping[str, Any]) -> None:
+def _check_template(scenario: ScenarioConfig, path: str, name: str,
+                    params: Mapping[str, object]) -> None:
     from urdfkit.model.catalog import get_template
 
     try:
@@ -329,7 +339,7 @@ def _check_template(scenario: Scenario, path: str, name: str, params: Mapping[st
         raise _fail(scenario, where, str(e)) from None
 
 
-def _check_file(scenario: Scenario, path: str, name: str) -> None:
+def _check_file(scenario: ScenarioConfig, path: str, name: str) -> None:
     from urdfkit.sources.resolve import locate
 
     try:
@@ -347,7 +357,7 @@ def _check_file(scenario: Scenario, path: str, name: str) -> None:
 _TOO_DEEP = "nested deeper than Python's parser can follow (a config is a few levels deep)"
 
 
-def check(scenario: Scenario) -> None:
+def check(scenario: ScenarioConfig) -> None:
     """The checks pydantic's types cannot express; each error names its path.
 
     Raises:
@@ -380,8 +390,8 @@ def check(scenario: Scenario) -> None:
         _check_controllers(scenario, path, robot)
 
 
-def _check_source(scenario: Scenario, path: str, template: str | None, urdf: str | None,
-                  params: Mapping[str, Any]) -> None:
+def _check_source(scenario: ScenarioConfig, path: str, template: str | None, urdf: str | None,
+                  params: Mapping[str, object]) -> None:
     """A robot or the ground comes from exactly one of a template (with its params) or a file."""
     if (template is None) == (urdf is None):
         raise _fail(scenario, path, "give either 'template' or 'urdf'")
@@ -394,7 +404,7 @@ def _check_source(scenario: Scenario, path: str, template: str | None, urdf: str
         _check_file(scenario, f"{path}.urdf", urdf)
 
 
-def _check_controllers(scenario: Scenario, path: str, robot: Robot) -> None:
+def _check_controllers(scenario: ScenarioConfig, path: str, robot: RobotConfig) -> None:
     """One controller, its segments in time order, and a mode for every target."""
     if robot.drive is not None and robot.joints is not None:
         raise _fail(scenario, path, "give one controller: 'drive' or 'joints', not both")

@@ -15,7 +15,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator  # noqa: TID253
 
 
-class Model(BaseModel):
+class ConfigModel(BaseModel):
     """Every model: strict types, no unknown keys, no NaN or infinity."""
 
     # strict: "3" is not a number and 1 is not true; a typo must not pass silently.
@@ -28,7 +28,7 @@ positive = Annotated[float, Field(gt=0)]
 non_negative = Annotated[float, Field(ge=0)]
 
 
-class Physics(Model):
+class Physics(ConfigModel):
     """The engine: time step, gravity, solver, damping (``physics``)."""
 
     time_step: Annotated[float, Field(gt=0, le=1)] = 1.0 / 240.0
@@ -43,7 +43,7 @@ class Physics(Model):
     deterministic_pairs: bool = True
 
 
-class Ground(Model):
+class Ground(ConfigModel):
     """What the robots stand on: a template or a URDF (``ground``; a bare string is either)."""
 
     template: str | None = None
@@ -62,7 +62,7 @@ class Ground(Model):
         return data
 
 
-class Record(Model):
+class RecordConfig(ConfigModel):
     """What is recorded every ``every`` steps besides the base (``record``)."""
 
     every: Annotated[int, Field(ge=1)] = 1
@@ -74,7 +74,7 @@ class Record(Model):
     feet: list[str] | dict[str, str] = Field(default_factory=list)
 
 
-class LinkDynamics(Model):
+class LinkDynamics(ConfigModel):
     """A link's contact and friction settings (``link_dynamics``)."""
 
     lateral_friction: non_negative | None = None
@@ -83,7 +83,7 @@ class LinkDynamics(Model):
     spinning_friction: non_negative | None = None
 
 
-class DriveSegment(Model):
+class DriveSegment(ConfigModel):
     """Throttle and steer until a time (``drive``)."""
 
     until: positive
@@ -91,7 +91,7 @@ class DriveSegment(Model):
     steer: float = 0.0
 
 
-class Vehicle(Model):
+class Vehicle(ConfigModel):
     """Which joints drive and steer, and the wheel force (``vehicle``)."""
 
     wheels: list[str] | None = None
@@ -102,7 +102,7 @@ class Vehicle(Model):
 Mode = Literal["position", "velocity", "torque"]
 
 
-class JointSegment(Model):
+class JointSegment(ConfigModel):
     """Joint targets until a time, by position, velocity or torque (``joints``)."""
 
     until: positive
@@ -114,7 +114,7 @@ class JointSegment(Model):
     max_force: positive | None = None
 
 
-class Motor(Model):
+class Motor(ConfigModel):
     """The servo model between targets and torques (``motor``)."""
 
     # One gain for every joint, or joint name -> gain (joints not named get 0).
@@ -137,7 +137,7 @@ class Motor(Model):
     measured_state: bool = False
 
 
-class InitialJoint(Model):
+class InitialJoint(ConfigModel):
     """A joint's start (``initial_joints``; a bare number is a position)."""
 
     position: float = 0.0
@@ -158,7 +158,7 @@ per_joint = non_negative | dict[str, non_negative]
 per_axis = non_negative | Annotated[list[non_negative], Field(min_length=3, max_length=3)]
 
 
-class Noise(Model):
+class Noise(ConfigModel):
     """Standard deviations of the noise on what the robot reports (``noise``)."""
 
     # Standard deviations: one for every joint, or joint name -> value (others 0) ...
@@ -178,7 +178,7 @@ class Noise(Model):
 span = Annotated[list[float], Field(min_length=2, max_length=2)]
 
 
-class Randomize(Model):
+class Randomize(ConfigModel):
     """What a ScenarioEnv reset draws anew, uniformly in [low, high] (``randomize``)."""
 
     # Drawn anew at every ScenarioEnv reset, uniformly in [low, high]:
@@ -208,7 +208,7 @@ class Randomize(Model):
         return self
 
 
-class Robot(Model):
+class RobotConfig(ConfigModel):
     """One robot: its file, pose, controller, servo, sensors (``robots[i]``)."""
 
     name: Annotated[str, Field(min_length=1)] | None = None
@@ -249,15 +249,15 @@ class Robot(Model):
     randomize: Randomize | None = None
 
 
-class Scenario(Model):
+class ScenarioConfig(ConfigModel):
     """A whole scenario document."""
 
     physics: Physics = Field(default_factory=Physics)
     ground: Ground | None = None
     duration: positive = 1.0
     seed: int = 0
-    record: Record = Field(default_factory=Record)
-    robots: Annotated[list[Robot], Field(min_length=1)]
+    record: RecordConfig = Field(default_factory=RecordConfig)
+    robots: Annotated[list[RobotConfig], Field(min_length=1)]
 
     _source: str | None = PrivateAttr(default=None)
     _base_dir: Path = PrivateAttr(default_factory=Path.cwd)

@@ -1,9 +1,5 @@
 """Dynamics: mass matrix, inverse and forward dynamics, Jacobians on shadow models.
 
-Methods of :class:`urdfkit.sim.Simulation`, split out of :mod:`urdfkit.sim`: each function
-takes the simulation as ``self`` and is bound as a method of ``Simulation`` (a class
-attribute), so a call costs what a method defined in the class costs.
-
 PyBullet builds the model its calculateMassMatrix, calculateInverseDynamics and
 calculateJacobian use once, at the first call, and never updates it: a mass changed later is
 ignored (measured on 3.2.7). So the dynamics run on a copy of the robot in a client of its
@@ -12,170 +8,208 @@ own (a *shadow*, :class:`Shadows`), rebuilt after every ``set_mass``/``set_inert
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
 from urdfkit.core.errors import ParameterError
-from urdfkit.engine.session import Session
-from urdfkit.motion.sim_state import _FIXED, JointSpec, _Body
+from urdfkit.engine.session import LoadOptions, Session
+from urdfkit.motion.sim_state import _FIXED, JointSpec
 
-
-def dynamics_joints(self: Any, robot: str) -> list[str]:
-    """The joints the dynamics quantities are ordered by (PyBullet's order).
-
-    The movable joints; a floating base adds 6 base coordinates before them in
-    :meth:`mass_matrix`.
-    """
-    return [j.name for j in self._dynamics_joints(self._body(robot))]
-
-
-def _dynamics_joints(self: Any, b: _Body) -> list[JointSpec]:
-    movable = [j for j in b.joints if j.type != _FIXED]
-    odd = [j.name for j in movable if not j.active]
-    if odd:
-        raise ParameterError(f"{b.name}: the dynamics need 1-DOF joints; {odd[0]!r} is not",
-                             param="robot")
-    return movable
-
-
-def _physical_state(self: Any, b: _Body) -> tuple[list[float], list[float]]:
-    p, client = self.session.p, self.session.client
-    states = p.getJointStates(b.body, [j.index for j in self._dynamics_joints(b)],
-                              physicsClientId=client)
-    return [float(st[0]) for st in states], [float(st[1]) for st in states]
-
-
-def _fixed(self: Any, b: _Body, what: str) -> None:
-    p, client = self.session.p, self.session.client
-    moving_base = b.config.base != "fixed" and \
-        p.getDynamicsInfo(b.body, -1, physicsClientId=client)[0] > 0
-    if moving_base:
-        raise ParameterError(f"{b.name}: {what} needs a fixed base (PyBullet's "
-                             "calculateInverseDynamics does not take a floating one); "
-                             "use base = \"fixed\"", param="robot")
-
-
-def _model(self: Any, b: _Body) -> tuple[Any, int, int]:
-    """``(p, client, body)`` of the robot's dynamics model, as the robot is now.
-
-    PyBullet builds the model its calculateMassMatrix, calculateInverseDynamics and
-    calculateJacobian use once, at the first call, and never updates it: a mass changed
-    later is ignored (measured on 3.2.7). So the dynamics run on a copy of the robot in a
-    client of their own, rebuilt after every ``set_mass``/``set_inertia``.
-    """
-    assert b.loaded is not None
-    return self._shadows.model(b.name, b.loaded, self.config.physics.gravity, b.changes)
-
-
-def _changed(self: Any, b: _Body, link: int, values: dict[str, Any]) -> None:
-    """Remember a change to a robot's mass properties; its dynamics model is stale."""
-    for key, value in values.items():
-        b.changes[(link, key)] = value
-    self._shadows.stale(b.name)
-
-
-def mass_matrix(self: Any, robot: str) -> Any:
-    """The joint-space mass matrix M(q) now (numpy, PyBullet's calculateMassMatrix).
-
-    Physical joint coordinates, in :meth:`dynamics_joints` order; a floating base puts its
-    6 coordinates first, as PyBullet does.
-    """
+if TYPE_CHECKING:
     import numpy as np
 
-    b = self._body(robot)
-    q, _ = self._physical_state(b)
-    p, client, body = self._model(b)
-    return np.array(p.calculateMassMatrix(body, q, physicsClientId=client))
+    from urdfkit.engine.session import Bullet
+    from urdfkit.motion.sim_robot import MassValue, SimRobot
+    from urdfkit.motion.sim_world import World
 
 
-def coriolis_and_gravity(self: Any, robot: str) -> Any:
-    """C(q, qd) qd + g(q) now: the torques that hold the current motion (numpy)."""
-    import numpy as np
+class Dynamics:
+    """The dynamics quantities of a world's robots, each on its robot's shadow model."""
 
-    b = self._body(robot)
-    self._fixed(b, "coriolis_and_gravity")
-    q, qd = self._physical_state(b)
-    p, client, body = self._model(b)
-    return np.array(p.calculateInverseDynamics(body, q, qd, [0.0] * len(q),
-                                               physicsClientId=client))
+    def __init__(self, world: World) -> None:
+        self.world = world
+        self.shadows = Shadows()
 
+    def close(self) -> None:
+        """Disconnect every shadow client (safe to call twice)."""
+        self.shadows.close()
 
-def gravity_torques(self: Any, robot: str) -> Any:
-    """g(q) now: the torques that hold the robot still against gravity (numpy)."""
-    import numpy as np
+    def joints(self, robot: SimRobot) -> list[JointSpec]:
+        """The joints the dynamics quantities are ordered by: the movable ones, 1-DOF."""
+        movable = [j for j in robot.joints if j.type != _FIXED]
+        odd = [j.name for j in movable if not j.active]
+        if odd:
+            raise ParameterError(f"{robot.name}: the dynamics need 1-DOF joints; {odd[0]!r} "
+                                 "is not", param="robot")
+        return movable
 
-    b = self._body(robot)
-    self._fixed(b, "gravity_torques")
-    q, _ = self._physical_state(b)
-    p, client, body = self._model(b)
-    zero = [0.0] * len(q)
-    return np.array(p.calculateInverseDynamics(body, q, zero, zero,
-                                               physicsClientId=client))
+    def physical_state(self, robot: SimRobot) -> tuple[list[float], list[float]]:
+        """The joints' positions and velocities now, physical (no offsets or directions)."""
+        states = self.world.bullet.getJointStates(robot.body,
+                                                  [j.index for j in self.joints(robot)])
+        return [float(st[0]) for st in states], [float(st[1]) for st in states]
 
+    def _fixed(self, robot: SimRobot, what: str) -> None:
+        moving_base = robot.config.base != "fixed" and \
+            self.world.bullet.getDynamicsInfo(robot.body, -1)[0] > 0
+        if moving_base:
+            raise ParameterError(f"{robot.name}: {what} needs a fixed base (PyBullet's "
+                                 "calculateInverseDynamics does not take a floating one); "
+                                 "use base = \"fixed\"", param="robot")
 
-def forward_dynamics(self: Any, robot: str, tau: Sequence[float]) -> Any:
-    """The joint accelerations ``tau`` would cause now, without contacts (numpy).
+    def model(self, robot: SimRobot) -> tuple[Bullet, int]:
+        """``(bullet, body)`` of the robot's dynamics model, as the robot is now."""
+        return self.shadows.model(robot.name, robot.loaded, self.world.config.physics.gravity,
+                                  robot.changes, robot.mass_version)
 
-    qdd = M^-1 (tau - C qd - g).
-    """
-    import numpy as np
+    def mass_matrix(self, robot: SimRobot) -> np.ndarray:
+        """The joint-space mass matrix M(q) now (PyBullet's calculateMassMatrix).
 
-    b = self._body(robot)
-    torque = np.asarray(tau, dtype=float)
-    n = len(self._dynamics_joints(b))
-    if torque.shape != (n,):
-        raise ParameterError(f"`tau` needs {n} torques, one per dynamics joint of "
-                             f"{robot}, got {torque.shape}", param="tau")
-    return np.linalg.solve(self.mass_matrix(robot), torque - self.coriolis_and_gravity(robot))
+        Physical joint coordinates, in :meth:`joints` order; a floating base puts its 6
+        coordinates first, as PyBullet does.
+        """
+        import numpy as np
 
+        q, _ = self.physical_state(robot)
+        p, body = self.model(robot)
+        return np.array(p.calculateMassMatrix(body, q))
 
-def jacobian(self: Any, robot: str, link: str, point: Sequence[float] = (0.0, 0.0, 0.0)
-             ) -> Any:
-    """The 6 x n Jacobian (linear rows, then angular) of a point of a link now (numpy).
+    def coriolis_and_gravity(self, robot: SimRobot) -> np.ndarray:
+        """C(q, qd) qd + g(q) now: the torques that hold the current motion."""
+        import numpy as np
 
-    ``point`` is in the link's URDF frame (the joint frame): PyBullet 3.2.7's
-    calculateJacobian takes it so, whatever its docs say of the centre of mass (measured:
-    the point (0, 0, 0) of a pendulum's bob link is on the hinge, J = 0).
-    """
-    import numpy as np
+        self._fixed(robot, "coriolis_and_gravity")
+        q, qd = self.physical_state(robot)
+        p, body = self.model(robot)
+        return np.array(p.calculateInverseDynamics(body, q, qd, [0.0] * len(q)))
 
-    b = self._body(robot)
-    index = b.links.get(link)
-    if index is None or index == -1:
-        raise ParameterError(f"`link`: {robot} has no moving link named {link!r}",
-                             param="link")
-    q, qd = self._physical_state(b)
-    p, client, body = self._model(b)
-    lin, ang = p.calculateJacobian(body, index, list(point), q, qd, [0.0] * len(q),
-                                   physicsClientId=client)
-    return np.vstack([np.array(lin), np.array(ang)])
+    def gravity_torques(self, robot: SimRobot) -> np.ndarray:
+        """g(q) now: the torques that hold the robot still against gravity."""
+        import numpy as np
+
+        self._fixed(robot, "gravity_torques")
+        q, _ = self.physical_state(robot)
+        p, body = self.model(robot)
+        zero = [0.0] * len(q)
+        return np.array(p.calculateInverseDynamics(body, q, zero, zero))
+
+    def forward_dynamics(self, robot: SimRobot, tau: Sequence[float]) -> np.ndarray:
+        """The joint accelerations ``tau`` would cause now, without contacts.
+
+        qdd = M^-1 (tau - C qd - g).
+        """
+        import numpy as np
+
+        torque = np.asarray(tau, dtype=float)
+        n = len(self.joints(robot))
+        if torque.shape != (n,):
+            raise ParameterError(f"`tau` needs {n} torques, one per dynamics joint of "
+                                 f"{robot.name}, got {torque.shape}", param="tau")
+        out: np.ndarray = np.linalg.solve(self.mass_matrix(robot),
+                                          torque - self.coriolis_and_gravity(robot))
+        return out
+
+    def jacobian(self, robot: SimRobot, link: str, point: Sequence[float]) -> np.ndarray:
+        """The 6 x n Jacobian (linear rows, then angular) of a point of a link now.
+
+        ``point`` is in the link's URDF frame (the joint frame): PyBullet 3.2.7's
+        calculateJacobian takes it so, whatever its docs say of the centre of mass (measured:
+        the point (0, 0, 0) of a pendulum's bob link is on the hinge, J = 0).
+        """
+        import numpy as np
+
+        index = robot.links.get(link)
+        if index is None or index == -1:
+            raise ParameterError(f"`link`: {robot.name} has no moving link named {link!r}",
+                                 param="link")
+        q, qd = self.physical_state(robot)
+        p, body = self.model(robot)
+        lin, ang = p.calculateJacobian(body, index, list(point), q, qd, [0.0] * len(q))
+        return np.vstack([np.array(lin), np.array(ang)])
+
+    def times_mass_matrix(self, robot: SimRobot, vector: list[float]) -> list[float]:
+        """``D M D v`` for the servo joints: M(q) at the true state, in the measured frame.
+
+        With ``mass_matrix_angles = "measured"`` (simulation_and_control's servo): ``M v``
+        with M from calculateMassMatrix given the measured angles ``(q - offset) * direction``
+        as if they were joint angles, and no ``D``; the same as ``D M D v`` when every offset
+        is 0 and every direction 1.
+        """
+        dyn = self.joints(robot)
+        q, _ = self.physical_state(robot)
+        motor = robot.config.motor
+        measured = motor is not None and motor.mass_matrix_angles == "measured"
+        if measured:
+            q = [(x - robot.offsets.get(j.name, 0.0)) * robot.directions.get(j.name, 1.0)
+                 for x, j in zip(q, dyn, strict=True)]
+        p, body = self.model(robot)
+        matrix = p.calculateMassMatrix(body, q)
+        skip = len(matrix) - len(dyn)  # a floating base's 6 coordinates come first
+        where = {j.name: skip + k for k, j in enumerate(dyn)}
+        rows = [where[spec.name] for spec in robot.servo]
+        if measured and rows == list(range(skip, skip + len(rows))):
+            return self._as_numpy_does(robot, q, matrix, skip, len(rows), vector)
+        signs = [1.0 if measured else robot.directions.get(spec.name, 1.0)
+                 for spec in robot.servo]
+        return [signs[i] * math.fsum(matrix[r][c] * signs[k] * vector[k]
+                                     for k, c in enumerate(rows))
+                for i, r in enumerate(rows)]
+
+    def _as_numpy_does(self, robot: SimRobot, q: list[float], matrix: list[list[float]],
+                       skip: int, n: int, vector: list[float]) -> list[float]:
+        """``M v`` as simulation_and_control computes it, to the last bit.
+
+        A floating base's matrix at the base's true pose (flags=1 takes position and
+        quaternion first; the quaternion's 4th row and column are zero and dropped), and
+        numpy's matrix product (whose rounding differs from an exact sum by an ulp or two).
+        """
+        import numpy as np
+
+        p, body = self.model(robot)
+        if skip:
+            pos, orn = self.world.bullet.getBasePositionAndOrientation(robot.body)
+            full = np.asarray(p.calculateMassMatrix(body, [*pos, *orn, *q], flags=1))
+            full = np.delete(np.delete(full, 6, 0), 6, 1)
+        else:
+            full = np.asarray(matrix)
+        block = full[skip:, skip:][:n, :n]
+        return [float(x) for x in block @ np.asarray(vector, dtype=float)]
 
 
 class Shadows:
-    """One shadow client per robot, built at the first dynamics query, dropped when stale."""
+    """One shadow client per robot, built at the first dynamics query, rebuilt when stale."""
 
     def __init__(self) -> None:
-        self.models: dict[str, tuple[Session, int]] = {}
+        self.models: dict[str, tuple[Session, int, int]] = {}
 
-    def model(self, name: str, loaded: tuple[str, Any], gravity: Sequence[float],
-              changes: Mapping[tuple[int, str], Any]) -> tuple[Any, int, int]:
-        """``(p, client, body)`` of the robot's model: its URDF as loaded, its changes since."""
-        if name not in self.models:
+    def model(self, name: str, loaded: tuple[str, LoadOptions], gravity: Sequence[float],
+              changes: Mapping[tuple[int, str], MassValue], version: int
+              ) -> tuple[Bullet, int]:
+        """``(bullet, body)`` of the robot's model: its URDF as loaded, its changes since.
+
+        ``version`` counts the robot's mass changes: a model built at an older one is
+        closed and built again.
+        """
+        shadow = self.models.get(name)
+        if shadow is not None and shadow[2] != version:
+            self.stale(name)
+            shadow = None
+        if shadow is None:
             s = Session()
             try:
-                s.p.setGravity(*gravity, physicsClientId=s.client)
+                s.bullet.setGravity(*gravity)
                 body = s.load_urdf(loaded[0], loaded[1], display=name)
                 for (link, key), value in changes.items():
-                    s.p.changeDynamics(body, link, physicsClientId=s.client, **{key: value})
+                    s.bullet.changeDynamics(body, link, **{key: value})
             except BaseException:
                 s.close()
                 raise
-            self.models[name] = (s, body)
-        s, body = self.models[name]
-        return s.p, s.client, body
+            shadow = self.models[name] = (s, body, version)
+        return shadow[0].bullet, shadow[1]
 
     def stale(self, name: str) -> None:
-        """The robot's mass properties changed: close its model, rebuilt when next asked."""
+        """Close a robot's model: it is built again when next asked."""
         shadow = self.models.pop(name, None)
         if shadow is not None:
             shadow[0].close()

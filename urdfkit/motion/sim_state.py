@@ -1,20 +1,19 @@
 """The plain data of a simulation: observations, joints, commands, each robot's state, results.
 
-Split out of :mod:`urdfkit.sim`, which re-exports the public names.
+The public ones are re-exported by :mod:`urdfkit.sim`.
 """
 
 from __future__ import annotations
 
-import functools
 import math
-import random
-from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Literal
 
-from urdfkit.engine.session import LoadOptions
 from urdfkit.motion.scenario import OBSERVATION_FIELDS
+
+if TYPE_CHECKING:
+    from urdfkit.motion.scenario_models import Mode
 
 _REVOLUTE, _PRISMATIC, _FIXED = 0, 1, 4  # p.JOINT_* values
 #: Joint types with one degree of freedom: what getJointState can report.
@@ -22,6 +21,9 @@ _ACTIVE = (_REVOLUTE, _PRISMATIC)
 
 
 # --------------------------------------------------------------------------- observations
+
+#: A foot's reading: contact (0 or 1), normal (N), and world, local and friction vectors.
+FootReading = dict[str, int | float | list[float]]
 
 
 @dataclass
@@ -74,11 +76,11 @@ class Observation:
     joint_forces: dict[str, list[float]] | None = None
     motor_torques: dict[str, float] | None = None
     link_poses: dict[str, dict[str, list[float]]] | None = None
-    feet: dict[str, dict[str, Any]] | None = None
+    feet: dict[str, FootReading] | None = None
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """The JSON row (optional fields only when recorded)."""
-        row: dict[str, Any] = {"t": self.t, "step": self.step, "robot": self.robot}
+        row: dict[str, object] = {"t": self.t, "step": self.step, "robot": self.robot}
         for name in OBSERVATION_FIELDS:
             value = getattr(self, name)
             row[name] = dict(value) if isinstance(value, dict) else list(value)
@@ -96,7 +98,7 @@ class Observation:
             row["feet"] = _copy_feet(self.feet)
         return row
 
-    def _replace(self, **changes: Any) -> Observation:
+    def _replace(self, **changes: object) -> Observation:
         data = {**self.__dict__, **changes}
         return Observation(**data)
 
@@ -119,7 +121,8 @@ class Observation:
             None if ft is None else _copy_feet(ft))
 
 
-def _copy_feet(feet: Mapping[str, Mapping[str, Any]]) -> dict[str, dict[str, Any]]:
+def _copy_feet(feet: Mapping[str, Mapping[str, int | float | list[float]]]
+               ) -> dict[str, FootReading]:
     return {k: {key: list(x) if isinstance(x, list) else x for key, x in v.items()}
             for k, v in feet.items()}
 
@@ -142,20 +145,29 @@ class JointSpec:
         """Whether the joint has one degree of freedom we measure and drive."""
         return self.type in _ACTIVE
 
+    @property
+    def revolute(self) -> bool:
+        """Whether the joint turns (revolute or continuous; PyBullet's JOINT_REVOLUTE)."""
+        return self.type == _REVOLUTE
+
+
+#: What a command drives: a car's wheels and hinges, or joints by target.
+CommandKind = Literal["drive", "joints"]
+
 
 @dataclass
-class _Command:
+class Command:
     """A controller command: a drive (throttle, steer) or joint targets."""
 
-    kind: str  # "drive" or "joints"
+    kind: CommandKind
     throttle: float = 0.0
     steer: float = 0.0
-    mode: str | dict[str, str] = "position"  # one for all targets, or per joint
+    mode: Mode | dict[str, Mode] = "position"  # one for all targets, or per joint
     targets: dict[str, float] = field(default_factory=dict)
     max_force: float | None = None
     velocities: dict[str, float] = field(default_factory=dict)
 
-    def mode_of(self, joint: str) -> str:
+    def mode_of(self, joint: str) -> Mode:
         """The control mode of one target joint."""
         return self.mode if isinstance(self.mode, str) else self.mode.get(joint, "position")
 
@@ -165,59 +177,6 @@ class _Command:
         if isinstance(self.mode, str):
             return self.mode == "torque" and self.kind == "joints"
         return "torque" in self.mode.values()
-
-
-@dataclass
-class _Body:
-    """A loaded robot and the state the simulation keeps for it."""
-
-    name: str
-    path: str  # "robots[i]", for messages
-    config: Any
-    body: int
-    joints: list[JointSpec]
-    active: list[JointSpec]
-    links: dict[str, int]
-    offsets: dict[str, float]
-    directions: dict[str, float]
-    rng: random.Random
-    history: deque[Observation]
-    train: Any = None
-    servo: list[JointSpec] = field(default_factory=list)
-    contact_links: dict[str, int] = field(default_factory=dict)
-    force_joints: dict[str, int] = field(default_factory=dict)
-    pose_links: list[str] = field(default_factory=list)
-    # The active joints' physical velocities when last taken, and the step they were taken at.
-    previous_velocities: list[float] | None = None
-    previous_step: int = -1
-    applied: _Command | None = None
-    override: _Command | None = None
-    reported: tuple[int, Observation] | None = None
-    loaded: tuple[str, LoadOptions] | None = None  # the file PyBullet loaded, and how
-    # set_* changes to mass properties, (link, changeDynamics key) -> the latest value, in the
-    # order first made (mass before the inertia it rescales): bounded however often it is set.
-    changes: dict[tuple[int, str], Any] = field(default_factory=dict)
-    feet: dict[str, int] = field(default_factory=dict)  # label -> link index
-    kp: float | dict[str, float] = 0.0  # the servo's gains (set_motor_gains changes them)
-    kd: float | dict[str, float] = 0.0
-    reports: deque[Observation] | None = None  # the last N reported, with history N > 1
-    # Torques given in TORQUE_CONTROL for the coming step (physical frame): PyBullet reports
-    # 0 as a torque-controlled joint's applied torque.
-    torques: dict[str, float] = field(default_factory=dict)
-    dry_friction: dict[int, float] = field(default_factory=dict)  # joint index -> N m or N
-
-    @functools.cached_property
-    def frame(self) -> tuple[list[int], list[str], list[float], list[float]]:
-        """The active joints' indices, names, directions and offsets, in order (fixed)."""
-        return ([j.index for j in self.active], [j.name for j in self.active],
-                [self.directions.get(j.name, 1.0) for j in self.active],
-                [self.offsets.get(j.name, 0.0) for j in self.active])
-
-    def joint(self, name: str) -> JointSpec:
-        for j in self.joints:
-            if j.name == name:
-                return j
-        raise KeyError(name)
 
 
 @dataclass
@@ -235,7 +194,7 @@ class RobotSummary:
     joint_min: dict[str, float] = field(default_factory=dict)
     joint_max: dict[str, float] = field(default_factory=dict)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """The JSON form."""
         return dict(self.__dict__)
 
@@ -264,7 +223,7 @@ class SimResult:
     row_count: int = 0
     summaries: list[RobotSummary] = field(default_factory=list)
 
-    def to_dicts(self) -> list[dict[str, Any]]:
+    def to_dicts(self) -> list[dict[str, object]]:
         """The reported rows as JSON-ready dicts."""
         return [r.to_dict() for r in self.rows]
 

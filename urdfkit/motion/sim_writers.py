@@ -1,6 +1,6 @@
 """Rows to files: flat columns, ``.jsonl``/``.csv`` text batch by batch, ``.parquet``.
 
-Split out of :mod:`urdfkit.sim`, which re-exports every public name here.
+Re-exported by :mod:`urdfkit.sim`.
 """
 
 from __future__ import annotations
@@ -10,9 +10,12 @@ import io
 import json
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import MissingDependencyError, OutputError
+
+if TYPE_CHECKING:
+    from urdfkit.core.output import StreamingFile
 
 OUTPUT_FORMATS = (".jsonl", ".csv", ".parquet")
 #: Column suffixes of flattened vectors, by length (position, quaternion, wrench).
@@ -22,11 +25,11 @@ _AXES = {3: ("x", "y", "z"), 4: ("x", "y", "z", "w"), 6: ("fx", "fy", "fz", "mx"
 # --------------------------------------------------------------------------- writers
 
 
-def flatten(row: Mapping[str, Any]) -> dict[str, Any]:
+def flatten(row: Mapping[str, object]) -> dict[str, object]:
     """A nested row as flat columns: ``motor_angles.hinge``, ``base_position.x``."""
-    out: dict[str, Any] = {}
+    out: dict[str, object] = {}
 
-    def put(prefix: str, value: Any) -> None:
+    def put(prefix: str, value: object) -> None:
         if isinstance(value, Mapping):
             for k, v in value.items():
                 put(f"{prefix}.{k}", v)
@@ -42,14 +45,14 @@ def flatten(row: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:
+def _columns(rows: Iterable[Mapping[str, object]]) -> list[str]:
     seen: dict[str, None] = {}
     for row in rows:
         seen.update(dict.fromkeys(row))
     return list(seen)
 
 
-def _pyarrow() -> Any:
+def _pyarrow() -> Any:  # pyarrow: untyped
     try:
         import pyarrow
         import pyarrow.parquet
@@ -59,7 +62,7 @@ def _pyarrow() -> Any:
     return pyarrow
 
 
-def check_output(path: str | Path, *, force: bool) -> None:
+def check_rows_output(path: str | Path, *, force: bool) -> None:
     """Refuse a bad ``--out`` before simulating: unknown format, existing file, no pyarrow."""
     from urdfkit.core.output import check_output as check
 
@@ -81,7 +84,7 @@ class RowText:
         self.fmt = fmt
         self.columns: list[str] | None = None
 
-    def encode(self, rows: Sequence[Mapping[str, Any]]) -> bytes:
+    def encode(self, rows: Sequence[Mapping[str, object]]) -> bytes:
         """The text of ``rows`` (with the CSV header before the first batch)."""
         if self.fmt == ".jsonl":
             return "".join(json.dumps(r, allow_nan=False) + "\n" for r in rows).encode("utf-8")
@@ -99,7 +102,7 @@ class RowText:
         return text.getvalue().encode("utf-8", "backslashreplace")
 
 
-def rows_to_bytes(rows: Sequence[Mapping[str, Any]], fmt: str) -> bytes:
+def rows_to_bytes(rows: Sequence[Mapping[str, object]], fmt: str) -> bytes:
     """Serialise rows as ``.jsonl`` (nested), ``.csv`` or ``.parquet`` (flattened)."""
     if fmt in (".jsonl", ".csv"):
         return RowText(fmt).encode(rows)
@@ -114,18 +117,18 @@ def rows_to_bytes(rows: Sequence[Mapping[str, Any]], fmt: str) -> bytes:
     raise OutputError(f"unknown output format {fmt!r}; use {', '.join(OUTPUT_FORMATS)}")
 
 
-def write_rows(path: str | Path, rows: Sequence[Mapping[str, Any]], *, force: bool) -> Path:
+def write_rows(path: str | Path, rows: Sequence[Mapping[str, object]], *, force: bool) -> Path:
     """Write rows in the format the suffix names, atomically; never replace without ``force``."""
     from urdfkit.core.output import atomic_write
 
-    check_output(path, force=force)
+    check_rows_output(path, force=force)
     return atomic_write(path, rows_to_bytes(rows, Path(path).suffix.lower()), force=force)
 
 
 class _ByteSink:
     """The file-like face pyarrow writes through, onto a StreamingFile."""
 
-    def __init__(self, out: Any):
+    def __init__(self, out: StreamingFile):
         self.out = out
         self.closed = False
         self.position = 0

@@ -11,12 +11,11 @@ import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from urdfkit.core.errors import InputError, OutputError
 
 
-def parse_value(text: str) -> Any:
+def parse_value(text: str) -> bool | int | float | str:
     """A value as typed: a number where it reads as one, true/false, else the text."""
     t = text.strip()
     if t.lower() in ("true", "false"):
@@ -51,8 +50,8 @@ class Journal:
     names: list[str]
     resume: bool = False
     force: bool = False
-    done: list[dict[str, Any]] = field(default_factory=list)
-    assignments: Sequence[dict[str, Any]] = field(default_factory=list)
+    done: list[dict[str, object]] = field(default_factory=list)
+    assignments: Sequence[dict[str, object]] = field(default_factory=list)
     #: What the caller should tell the user (rows dropped, and why).
     notes: list[str] = field(default_factory=list)
     _fd: int | None = None
@@ -66,10 +65,10 @@ class Journal:
 
     def open(self) -> None:
         """Check the output, lock the journal, read what a previous run did, start writing."""
-        from urdfkit.sim import check_output
+        from urdfkit.motion.sim_writers import check_rows_output
 
         exists = os.path.lexists(self.path)  # a dangling symlink is there: never replaced
-        check_output(self.path, force=self.force or (self.resume and exists) or not exists)
+        check_rows_output(self.path, force=self.force or (self.resume and exists) or not exists)
         had_partial = os.path.lexists(self.partial)
         if had_partial and not self.resume and not self.force:
             raise InputError("a sweep that did not finish left its rows here: add "
@@ -128,14 +127,14 @@ class Journal:
                 pass
             self._fd = None
 
-    def _same_sweep(self, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    def _same_sweep(self, rows: list[dict[str, object]]) -> list[dict[str, object]]:
         """The rows to keep: each must be a point of this sweep; failed ones run again.
 
         Raises:
             InputError: a row that is not the same point of this sweep (another grid, other
                 names): resuming would mix two sweeps in one file.
         """
-        kept: dict[int, dict[str, Any]] = {}
+        kept: dict[int, dict[str, object]] = {}
         for row in rows:
             point = row.get("point")
             if isinstance(point, float) and point.is_integer():
@@ -152,7 +151,7 @@ class Journal:
                 kept[point] = row  # a point that failed runs again, and its new row replaces
         return [kept[p] for p in sorted(kept)]
 
-    def _write(self, row: Mapping[str, Any]) -> None:
+    def _write(self, row: Mapping[str, object]) -> None:
         import json
 
         assert self._fd is not None, "open() the journal first"
@@ -164,7 +163,7 @@ class Journal:
         except OSError as e:
             raise _write_error(e, self.partial) from None
 
-    def add(self, row: Mapping[str, Any]) -> None:
+    def add(self, row: Mapping[str, object]) -> None:
         """Record a finished point.
 
         A metric that is not finite (a robot whose file holds NaN blew up) is recorded as
@@ -180,7 +179,7 @@ class Journal:
                                   "simulation blew up): written as null")
         self._write(row)
 
-    def finished(self, values: Mapping[str, Any]) -> bool:
+    def finished(self, values: Mapping[str, object]) -> bool:
         """Whether a point with these values has a row without an error (for ``skip``)."""
         if self._keys is None:
             self._keys = {_key(r, self.names) for r in self.done if not r.get("error")}
@@ -195,7 +194,7 @@ class Journal:
                 except OSError as e:
                     raise _write_error(e, self.partial) from None
             rows = read_rows(self.partial, ".jsonl", notes=self.notes)
-            from urdfkit.sim import write_rows
+            from urdfkit.motion.sim_writers import write_rows
 
             path = write_rows(self.path, rows, force=True)
             self.partial.unlink()
@@ -218,7 +217,7 @@ def clip(text: str, most: int = 200) -> str:
     return text if len(text) <= most else f"{text[:most]}... ({len(text):,} characters)"
 
 
-def _key(row: Mapping[str, Any], names: Sequence[str]) -> tuple[str, ...]:
+def _key(row: Mapping[str, object], names: Sequence[str]) -> tuple[str, ...]:
     """The varied values of a row, comparable across formats (CSV gives text back)."""
     out = []
     for n in names:
@@ -235,11 +234,11 @@ MAX_ROWS_BYTES = 1 << 30
 
 
 def read_rows(path: Path, fmt: str | None = None, *,
-              notes: list[str] | None = None) -> list[dict[str, Any]]:
+              notes: list[str] | None = None) -> list[dict[str, object]]:
     """The rows of a sweep's output (``.csv``, ``.jsonl``, ``.parquet``) or journal.
 
     A last row cut short (the file does not end its line: a crash or a full disk) is dropped,
-    with a note in ``notes``; its point runs again. Any other row that does not read is
+    with a note in ``notes``; its point runs again. object other row that does not read is
     damage, and refused with its line.
 
     Raises:
@@ -268,7 +267,7 @@ def read_rows(path: Path, fmt: str | None = None, *,
     return _csv_rows(path, lines)
 
 
-def _jsonl_rows(path: Path, lines: list[str]) -> list[dict[str, Any]]:
+def _jsonl_rows(path: Path, lines: list[str]) -> list[dict[str, object]]:
     import json
 
     rows = []
@@ -287,7 +286,7 @@ def _jsonl_rows(path: Path, lines: list[str]) -> list[dict[str, Any]]:
     return rows
 
 
-def _csv_rows(path: Path, lines: list[str]) -> list[dict[str, Any]]:
+def _csv_rows(path: Path, lines: list[str]) -> list[dict[str, object]]:
     import csv
 
     reader = csv.reader(lines)
@@ -311,8 +310,8 @@ def _csv_rows(path: Path, lines: list[str]) -> list[dict[str, Any]]:
     return rows
 
 
-def _parquet_rows(path: Path, data: bytes) -> list[dict[str, Any]]:
-    from urdfkit.sim import _pyarrow
+def _parquet_rows(path: Path, data: bytes) -> list[dict[str, object]]:
+    from urdfkit.motion.sim_writers import _pyarrow
 
     _pyarrow()
     import pyarrow as pa
@@ -325,7 +324,7 @@ def _parquet_rows(path: Path, data: bytes) -> list[dict[str, Any]]:
                          file=path) from None
 
 
-def _csv_value(text: str | None) -> Any:
+def _csv_value(text: str | None) -> object:
     if text is None or text == "":
         return None
     return parse_value(text)

@@ -12,10 +12,9 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Any
 
-from urdfkit import sweep as sweeping
 from urdfkit.core.errors import ParameterError, UrdfkitError
+from urdfkit.motion import sweep_plan as sweeping
 
 #: The drive options a drive sweep holds fixed for every point, in the order messages list them.
 FIXED_DRIVE = ("throttle", "steer", "drivetrain", "seconds", "steps", "time_step", "max_force",
@@ -25,7 +24,7 @@ FIXED_DRIVE = ("throttle", "steer", "drivetrain", "seconds", "steps", "time_step
 VALUED_DRIVE = ("throttle", "steer", "drivetrain", "time_step", "up")
 
 
-def drive_defaults() -> dict[str, Any]:
+def drive_defaults() -> dict[str, object]:
     """DriveConfig's defaults of :data:`VALUED_DRIVE`: an option equal to one was not given."""
     from urdfkit.motion.drive import DriveConfig
 
@@ -44,7 +43,7 @@ class SweepRequest:
     kind: str
     vary: Sequence[str] | None
     scenario: str | None = None
-    drive: Mapping[str, Any] = field(default_factory=dict)
+    drive: Mapping[str, object] = field(default_factory=dict)
     zip_: bool = False
     jobs: int | None = None
     backend: str = "local"
@@ -63,7 +62,7 @@ class SweepOutcome:
 
     kind: str
     plan: sweeping.Plan
-    rows: list[dict[str, Any]]
+    rows: list[dict[str, object]]
     total: int
     ran: int = 0
     failed: int = 0
@@ -75,7 +74,7 @@ class SweepOutcome:
     plot_error: UrdfkitError | None = None
     notes: list[str] = field(default_factory=list)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """The ``--json`` object."""
         return {"kind": self.kind, "points": self.total, "ran": self.ran,
                 "skipped": self.skipped, "failed": self.failed,
@@ -84,12 +83,12 @@ class SweepOutcome:
                 "interrupted": self.interrupted, "rows": self.rows}
 
 
-def _given(drive: Mapping[str, Any]) -> dict[str, bool]:
+def _given(drive: Mapping[str, object]) -> dict[str, bool]:
     defaults = drive_defaults()
     return {name: drive.get(name) != defaults.get(name) for name in FIXED_DRIVE}
 
 
-def _sim_base(request: SweepRequest) -> Any:
+def _sim_base(request: SweepRequest) -> object:
     if request.scenario is None:
         raise ParameterError("sweep sim needs the scenario file: urdfkit sweep sim "
                              "scenario.toml --vary PATH=VALUES", param="kind")
@@ -101,7 +100,7 @@ def _sim_base(request: SweepRequest) -> Any:
     return request.scenario
 
 
-def _drive_base(request: SweepRequest) -> dict[str, Any]:
+def _drive_base(request: SweepRequest) -> dict[str, object]:
     if request.scenario is not None:
         raise ParameterError(f"sweep drive takes no scenario file (got {request.scenario!r}); "
                              "drive options are flags", param="kind")
@@ -112,11 +111,16 @@ def _drive_base(request: SweepRequest) -> dict[str, Any]:
     if drive.get("template_params"):
         from urdfkit.model.catalog import parse_assignments
 
-        params = parse_assignments(drive["template_params"], "template_params")
+        params = parse_assignments(_strings(drive["template_params"]), "template_params")
     drive["template_params"] = params
     # Not given: DriveConfig's default (seconds and max_force are None until then).
     return {name: value for name, value in drive.items()
             if name in FIXED_DRIVE and not (value is None and name in ("seconds", "max_force"))}
+
+
+def _strings(value: object) -> list[str]:
+    """A list of ``KEY=VALUE`` strings as given (none: empty)."""
+    return [str(v) for v in value] if isinstance(value, (list, tuple)) else []
 
 
 def _check_vary_against_fixed(request: SweepRequest) -> None:
@@ -124,7 +128,7 @@ def _check_vary_against_fixed(request: SweepRequest) -> None:
     given = {name: given for name, given in _given(request.drive).items()
              if name not in ("template_params", "xacro_args", "packages", "package_paths")}
     set_names = {item.replace(":=", "=").partition("=")[0].strip()
-                 for item in request.drive.get("template_params") or []}
+                 for item in _strings(request.drive.get("template_params"))}
     for item in request.vary or []:
         name = item.partition("=")[0].strip()
         if given.get(name) or name in set_names:
@@ -134,7 +138,7 @@ def _check_vary_against_fixed(request: SweepRequest) -> None:
                                  param=how)
 
 
-def check_request(request: SweepRequest) -> Any:
+def check_request(request: SweepRequest) -> object:
     """Refuse conflicting options, before anything is planned; return the sweep's base."""
     if request.kind == "sim":
         base = _sim_base(request)
@@ -200,7 +204,7 @@ class SweepRun:
         """
         r, journal = self.request, self.journal
         keep = r.out is None or r.plot is not None or r.keep_rows
-        rows: list[dict[str, Any]] = list(journal.done) if journal is not None and keep else []
+        rows: list[dict[str, object]] = list(journal.done) if journal is not None and keep else []
         skip = journal.finished if journal is not None and r.resume else None
         total = len(self.plan.assignments)
         count = total - sum(1 for a in self.plan.assignments if skip is not None and skip(a))

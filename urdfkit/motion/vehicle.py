@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import ParameterError
 from urdfkit.model.spec import quat_to_matrix, rotate
@@ -54,6 +54,9 @@ from urdfkit.motion.vehicle_shapes import (
     vsub,
     vunit,
 )
+
+if TYPE_CHECKING:
+    from urdfkit.engine.session import Bullet
 
 #: |axis . up| below this is "horizontal" (about 11 degrees of tilt allowed).
 HORIZONTAL_TOLERANCE = 0.2
@@ -281,9 +284,9 @@ class Drivetrain:
             lo, hi = max(lo, lower), min(hi, upper)
         return lo, hi
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """The JSON form: names keyed by joint index, and the geometry driving used."""
-        def named(joints: list[int]) -> list[dict[str, Any]]:
+        def named(joints: list[int]) -> list[dict[str, object]]:
             return [{"index": j, "name": self.joint_names[j]} for j in joints]
 
         def r(x: float) -> float:
@@ -304,7 +307,7 @@ class Drivetrain:
         }
 
 
-def _is_continuous(info: tuple[Any, ...]) -> bool:
+def _is_continuous(info: tuple[Any, ...]) -> bool:  # getJointInfo's
     lower, upper = info[8], info[9]
     return info[2] == _REVOLUTE and (lower > upper or upper - lower >= 2 * math.pi - 1e-6)
 
@@ -337,7 +340,7 @@ def _pick(spec: Sequence[str | int], names: dict[int, str], movable: list[int],
     return out
 
 
-def detect_drivetrain(p: Any, body: int, client: int,
+def detect_drivetrain(p: Bullet, body: int,
                       wheels: Sequence[str | int] | None = None,
                       hinges: Sequence[str | int] | None = None,
                       mode: str = "differential") -> Drivetrain:
@@ -348,9 +351,8 @@ def detect_drivetrain(p: Any, body: int, client: int,
     "vertical" and "touches the ground" are judged in the base frame.
 
     Args:
-        p: The pybullet module.
+        p: The pybullet module bound to the body's client (``Session.bullet``).
         body: The body id.
-        client: The physics client id.
         wheels: Joint names or indices to drive instead of the detected wheels.
         hinges: Joint names or indices to steer instead of the detected hinges.
         mode: The drivetrain (see :data:`DRIVETRAINS`).
@@ -361,7 +363,7 @@ def detect_drivetrain(p: Any, body: int, client: int,
     if mode not in DRIVETRAINS:
         raise DrivetrainError(f"`drivetrain` must be one of {', '.join(DRIVETRAINS)}, got "
                               f"{mode!r}", param="drivetrain")
-    scan = _Scan(p, body, client)
+    scan = _Scan(p, body)
     names, movable, infos = scan.names, scan.movable, scan.infos
     wheel_list = _pick(wheels, names, movable, "wheels") if wheels is not None \
         else _find_wheels(scan)
@@ -384,7 +386,7 @@ def detect_drivetrain(p: Any, body: int, client: int,
     in_base = (vdot(forward, scan.base_x), vdot(forward, scan.base_y))
     n = scan.n
     link_names = {k: infos[k][12].decode("utf-8", "replace") for k in range(n)}
-    link_names[-1] = p.getBodyInfo(body, physicsClientId=client)[0].decode("utf-8", "replace")
+    link_names[-1] = p.getBodyInfo(body)[0].decode("utf-8", "replace")
     efforts = {j: float(infos[j][10]) for j in movable}
     return Drivetrain(wheel_list, hinge_list, passive, names, hinge_limits, wheel_signs,
                       hinge_signs, mode, radius, contact, carried_by, pivot, in_base,
@@ -395,14 +397,13 @@ def detect_drivetrain(p: Any, body: int, client: int,
 class _Scan:
     """What detection reads of a body once: joints, their world axes and origins, shapes."""
 
-    def __init__(self, p: Any, body: int, client: int) -> None:
-        self.n = n = p.getNumJoints(body, physicsClientId=client)
-        self.infos = infos = [p.getJointInfo(body, j, physicsClientId=client) for j in range(n)]
+    def __init__(self, p: Bullet, body: int) -> None:
+        self.n = n = p.getNumJoints(body)
+        self.infos = infos = [p.getJointInfo(body, j) for j in range(n)]
         self.names = {j: info[1].decode("utf-8", "replace") for j, info in enumerate(infos)}
         self.movable = movable = [j for j, info in enumerate(infos)
                                   if info[2] in (_REVOLUTE, _PRISMATIC)]
-        states = {j: p.getLinkState(body, j, computeForwardKinematics=True,
-                                    physicsClientId=client) for j in movable}
+        states = {j: p.getLinkState(body, j, computeForwardKinematics=True) for j in movable}
         self.origin = {j: tuple(states[j][4]) for j in movable}
         # getJointInfo's axis is in the child's inertial frame (measured: with inertia products
         # and URDF_USE_INERTIA_FROM_FILE a PR2 caster's vertical axis read 32 degrees off in the
@@ -410,16 +411,16 @@ class _Scan:
         # frame.
         self.axes = {j: vunit(rotate(quat_to_matrix(states[j][1]), infos[j][13]))
                      for j in movable}
-        base_pos, base_orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
-        dyn = p.getDynamicsInfo(body, -1, physicsClientId=client)
+        base_pos, base_orn = p.getBasePositionAndOrientation(body)
+        dyn = p.getDynamicsInfo(body, -1)
         inv_pos, inv_orn = p.invertTransform(dyn[3], dyn[4])
         self.base_link, base_link_orn = p.multiplyTransforms(base_pos, base_orn, inv_pos,
                                                              inv_orn)
         base_rot = quat_to_matrix(base_link_orn)
         self.base_x = rotate(base_rot, (1.0, 0.0, 0.0))
         self.base_y = rotate(base_rot, (0.0, 1.0, 0.0))
-        self.link_points = {link: shape_points(p, body, link, client) for link in range(-1, n)}
-        self.lowest = lowest_point(p, body, client, self.link_points)
+        self.link_points = {link: shape_points(p, body, link) for link in range(-1, n)}
+        self.lowest = lowest_point(p, body, self.link_points)
         self._shapes: dict[int, tuple[float, float, Vec] | None] = {}
         self.forward: Vec = (1.0, 0.0, 0.0)
         self.left: Vec = (0.0, 1.0, 0.0)
@@ -589,7 +590,7 @@ def _forward(wheel_axes: list[Vec], base_x: Vec, base_y: Vec) -> Vec:
     return roll if vdot(roll, flat_y) > 0 else (-roll[0], -roll[1], 0.0)
 
 
-def detect_upright(p: Any, body: int, client: int, upright: Sequence[float],
+def detect_upright(p: Bullet, body: int, upright: Sequence[float],
                    wheels: Sequence[str | int] | None = None,
                    hinges: Sequence[str | int] | None = None,
                    mode: str = "differential") -> Drivetrain:
@@ -598,18 +599,18 @@ def detect_upright(p: Any, body: int, client: int, upright: Sequence[float],
     A body spawned tilted (or upside down) is stood up where it is for detection, so its
     wheels are judged in its own frame, then put back exactly as it was.
     """
-    pos, orn = base_link_pose(p, body, client)  # the link frame is the one to stand up
+    pos, orn = base_link_pose(p, body)  # the link frame is the one to stand up
     turned = any(abs(a - b) > 1e-12 for a, b in zip(orn, upright, strict=True))
     if turned:
-        set_base_link_pose(p, body, client, pos, list(upright))
+        set_base_link_pose(p, body, pos, list(upright))
     try:
-        return detect_drivetrain(p, body, client, wheels, hinges, mode)
+        return detect_drivetrain(p, body, wheels, hinges, mode)
     finally:
         if turned:
-            set_base_link_pose(p, body, client, pos, orn)
+            set_base_link_pose(p, body, pos, orn)
 
 
-def disable_default_motors(p: Any, body: int, client: int, joints: Sequence[int]) -> None:
+def disable_default_motors(p: Bullet, body: int, joints: Sequence[int]) -> None:
     """Switch off PyBullet's default velocity motors on ``joints``.
 
     PyBullet gives every revolute and prismatic joint a velocity motor with target 0 at load
@@ -620,18 +621,17 @@ def disable_default_motors(p: Any, body: int, client: int, joints: Sequence[int]
         return
     p.setJointMotorControlArray(body, list(joints), p.VELOCITY_CONTROL,
                                 targetVelocities=[0.0] * len(joints),
-                                forces=[0.0] * len(joints), physicsClientId=client)
+                                forces=[0.0] * len(joints))
 
 
-def apply_drive(p: Any, body: int, client: int, train: Drivetrain, throttle: float,
+def apply_drive(p: Bullet, body: int, train: Drivetrain, throttle: float,
                 steer: float, max_force: float | None, steer_force: float = STEER_FORCE
                 ) -> None:
     """Set the wheel and hinge motors once; PyBullet keeps them until they are changed.
 
     Args:
-        p: The pybullet module.
+        p: The pybullet module bound to the body's client (``Session.bullet``).
         body: The body id.
-        client: The physics client id.
         train: What :func:`detect_drivetrain` found.
         throttle: Wheel angular velocity, rad/s (positive = forward): see
             :meth:`Drivetrain.wheel_speeds`.
@@ -647,15 +647,15 @@ def apply_drive(p: Any, body: int, client: int, train: Drivetrain, throttle: flo
         p.setJointMotorControlArray(
             body, driven, p.VELOCITY_CONTROL,
             targetVelocities=[speeds[w] * train.wheel_signs.get(w, 1.0) for w in driven],
-            forces=[force] * len(driven), physicsClientId=client)
-    disable_default_motors(p, body, client, train.free)
+            forces=[force] * len(driven))
+    disable_default_motors(p, body, train.free)
     if train.hinges:
         angles = train.hinge_angles(steer) if train.mode != "locked" else \
             dict.fromkeys(train.hinges, steer)
         p.setJointMotorControlArray(
             body, train.hinges, p.POSITION_CONTROL,
             targetPositions=[angles[h] * train.hinge_signs.get(h, 1.0) for h in train.hinges],
-            forces=[steer_force] * len(train.hinges), physicsClientId=client)
+            forces=[steer_force] * len(train.hinges))
 
 
 def clamp_steer(train: Drivetrain, steer: float) -> tuple[float, str | None]:

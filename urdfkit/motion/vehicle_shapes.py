@@ -8,9 +8,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
 from urdfkit.model.spec import quat_to_matrix, rotate
+
+if TYPE_CHECKING:
+    from urdfkit.engine.session import Bullet
 
 Vec = tuple[float, float, float]
 
@@ -19,26 +22,25 @@ ROUND_SECTORS = 12
 _SPHERE, _BOX, _CYLINDER, _MESH, _CAPSULE = 2, 3, 4, 5, 7  # p.GEOM_*
 
 
-def shape_points(p: Any, body: int, link: int, client: int) -> list[Vec]:
+def shape_points(p: Bullet, body: int, link: int) -> list[Vec]:
     """Points outlining a link's collision shapes, in world coordinates.
 
     Meshes (and cylinders PyBullet turned into meshes) give their vertices; implicit
     cylinders, capsules, spheres and boxes are outlined from their dimensions.
     """
     if link < 0:  # the base: getBasePositionAndOrientation is its inertial (COM) frame
-        pos_, orn_ = p.getBasePositionAndOrientation(body, physicsClientId=client)
+        pos_, orn_ = p.getBasePositionAndOrientation(body)
         com_pos, com_rot = tuple(pos_), quat_to_matrix(orn_)
     else:
-        st = p.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=client)
+        st = p.getLinkState(body, link, computeForwardKinematics=True)
         com_pos, com_rot = st[0], quat_to_matrix(st[1])
     out: list[Vec] = []
-    for k, shape in enumerate(p.getCollisionShapeData(body, link, physicsClientId=client)):
+    for k, shape in enumerate(p.getCollisionShapeData(body, link)):
         kind, dims, pos, orn = shape[2], shape[3], shape[5], shape[6]
         local: list[Vec] = []
         if kind == _MESH:
             try:
-                count, verts = p.getMeshData(body, link, collisionShapeIndex=k,
-                                             physicsClientId=client)
+                count, verts = p.getMeshData(body, link, collisionShapeIndex=k)
             except p.error:
                 count, verts = 0, []
             if count:  # already in the link's inertial frame
@@ -66,31 +68,31 @@ def shape_points(p: Any, body: int, link: int, client: int) -> list[Vec]:
     return out
 
 
-def base_link_pose(p: Any, body: int, client: int) -> tuple[Any, Any]:
+def base_link_pose(p: Bullet, body: int) -> tuple[Sequence[float], Sequence[float]]:
     """The base link frame's world pose (PyBullet reports the base's inertial frame).
 
     With ``URDF_USE_INERTIA_FROM_FILE`` an ``<inertia>`` with products (ixy, ixz, iyz), or an
     ``<inertial><origin>``, puts the inertial frame elsewhere than the link frame: its pose is
     not the robot's.
     """
-    pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
-    local = p.getDynamicsInfo(body, -1, physicsClientId=client)
+    pos, orn = p.getBasePositionAndOrientation(body)
+    local = p.getDynamicsInfo(body, -1)
     inv_pos, inv_orn = p.invertTransform(local[3], local[4])
     return p.multiplyTransforms(pos, orn, inv_pos, inv_orn)
 
 
-def set_base_link_pose(p: Any, body: int, client: int, pos: Sequence[float],
+def set_base_link_pose(p: Bullet, body: int, pos: Sequence[float],
                        orn: Sequence[float]) -> None:
     """Place the base link frame.
 
     ``resetBasePositionAndOrientation`` places the inertial frame; ``loadURDF`` the link frame.
     """
-    local = p.getDynamicsInfo(body, -1, physicsClientId=client)
+    local = p.getDynamicsInfo(body, -1)
     com_pos, com_orn = p.multiplyTransforms(pos, orn, local[3], local[4])
-    p.resetBasePositionAndOrientation(body, com_pos, com_orn, physicsClientId=client)
+    p.resetBasePositionAndOrientation(body, com_pos, com_orn)
 
 
-def lowest_point(p: Any, body: int, client: int,
+def lowest_point(p: Bullet, body: int,
                  points: dict[int, list[Vec]] | None = None) -> float:
     """The lowest z of the body's collision shapes, from the shapes themselves.
 
@@ -100,14 +102,14 @@ def lowest_point(p: Any, body: int, client: int,
     without collision shapes does not count; a body with none falls back to the AABB.
     ``points`` (link index to :func:`shape_points`) saves measuring them again.
     """
-    n = p.getNumJoints(body, physicsClientId=client)
+    n = p.getNumJoints(body)
     if points is None:
-        points = {link: shape_points(p, body, link, client) for link in range(-1, n)}
+        points = {link: shape_points(p, body, link) for link in range(-1, n)}
     zs = [pt[2] for pts in points.values() for pt in pts]
     finite = [z for z in zs if math.isfinite(z)]
     if finite:
         return min(finite)
-    return min(p.getAABB(body, link, physicsClientId=client)[0][2] for link in range(-1, n))
+    return min(p.getAABB(body, link)[0][2] for link in range(-1, n))
 
 
 def _fibonacci_sphere(n: int) -> list[Vec]:

@@ -1,0 +1,548 @@
+"""Config-driven simulation: a scenario in, per-step observations out.
+
+:class:`Simulation` is a facade over typed parts that meet through small interfaces
+(docs/architecture.md draws them):
+
+- :class:`~urdfkit.motion.sim_world.World`: the session, the ground, the robots as loaded,
+  time, save and restore;
+- :class:`~urdfkit.motion.sim_robot.SimRobot`, one per body: joints, frames, the command in
+  force, setters, link poses (the handle :meth:`Simulation.robot` gives);
+- :class:`~urdfkit.motion.sim_control.Controller`: applies a robot's command every step
+  (PyBullet's motors, or the servo model);
+- :class:`~urdfkit.motion.sim_sensors.Sensors`: measuring, noise, delay, history;
+- :class:`~urdfkit.motion.sim_dynamics.Dynamics`: mass matrix, inverse and forward dynamics,
+  Jacobians, on shadow models;
+- :class:`~urdfkit.motion.sim_record.Recorder`: the run loop and the sinks rows go to.
+
+:mod:`urdfkit.sim` re-exports the public names.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from urdfkit.core.errors import ParameterError
+from urdfkit.motion.scenario import load_scenario, parse_scenario
+from urdfkit.motion.sim_control import Controller, MotorControl, ServoControl
+from urdfkit.motion.sim_dynamics import Dynamics
+from urdfkit.motion.sim_episode import reset_plan
+from urdfkit.motion.sim_record import Recorder, Sink, world_total_steps
+from urdfkit.motion.sim_robot import SimRobot
+from urdfkit.motion.sim_sensors import Sensors
+from urdfkit.motion.sim_state import Command, Observation, RobotSummary, SimResult
+from urdfkit.motion.sim_world import World, robot_seed
+from urdfkit.motion.sim_writers import (
+    RowText,
+    _ByteSink,
+    _columns,
+    _pyarrow,
+    check_rows_output,
+    flatten,
+)
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from urdfkit.engine.session import Bullet, Session
+    from urdfkit.motion.scenario_models import Mode, ScenarioConfig
+
+
+class Simulation:
+    """A scenario running in its own PyBullet client.
+
+    Args:
+        config: A validated scenario (:func:`urdfkit.motion.scenario.load_scenario`) or the plain
+            dict of one, which is validated here.
+        base_dir: Where relative ``urdf`` paths of a dict ``config`` are resolved.
+        gui: Open PyBullet's GUI window to watch the run (needs a display).
+
+    Raises:
+        InputError: the scenario is invalid, or names a joint or link a robot lacks.
+        EngineError: PyBullet refused a file.
+    """
+
+    def __init__(self, config: ScenarioConfig | Mapping[str, object], *,
+                 base_dir: str | Path | None = None, gui: bool = False):
+        if isinstance(config, Mapping):
+            config = parse_scenario(config, base_dir=base_dir)
+        self.config = config
+        self.world = World(config, gui=gui)
+        self.sensors = Sensors(self.world)
+        self.dynamics = Dynamics(self.world)
+        self.recorder = Recorder(self.world, self.sensors, self.step)
+        motors = MotorControl(self.world.bullet)
+        servo = ServoControl(self.world.bullet, self.sensors, self.dynamics)
+        #: What applies each robot's command every step: the servo model, or PyBullet's motors.
+        self.controllers: dict[str, Controller] = {}
+        try:
+            self.world.setup()
+            for r in self.world.robots.values():
+                self.controllers[r.name] = servo if r.servo else motors
+            self.sensors.start()
+            self.world.save()
+        except BaseException:
+            self.close()
+            raise
+
+    @classmethod
+    def from_file(cls, path: str | Path, *, gui: bool = False) -> Simulation:
+        """Load and validate a ``.json`` or ``.toml`` scenario and set it up.
+
+        A simulation_and_control config is imported (:mod:`urdfkit.motion.sac`); what the import
+        had to say is in ``simulation.config.notes``.
+        """
+        return cls(load_scenario(path), gui=gui)
+
+    # ---- lifecycle
+
+    def __enter__(self) -> Simulation:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Disconnect the client and remove temp files (safe to call twice)."""
+        self.dynamics.close()
+        self.world.close()
+
+    # ---- the world
+
+    @property
+    def session(self) -> Session:
+        """The PyBullet client of this simulation alone."""
+        return self.world.session
+
+    @property
+    def bullet(self) -> Bullet:
+        """PyBullet bound to this simulation's client (``sim.bullet.getNumBodies()``)."""
+        return self.world.bullet
+
+    @property
+    def bodies(self) -> dict[str, SimRobot]:
+        """The robots by name, in scenario order."""
+        return self.world.robots
+
+    @property
+    def ground(self) -> int | None:
+        """The ground's body id (None: no ground)."""
+        return self.world.ground
+
+    @property
+    def step_count(self) -> int:
+        """Physics steps since the start (or the last reset)."""
+        return self.world.step_count
+
+    @property
+    def time_step(self) -> float:
+        """The physics time step, s."""
+        return self.world.time_step
+
+    @property
+    def t(self) -> float:
+        """Simulated time, s."""
+        return self.world.t
+
+    @property
+    def total_steps(self) -> int:
+        """Steps in the scenario's ``duration``."""
+        return world_total_steps(self.world)
+
+    @property
+    def robots(self) -> list[str]:
+        """Robot names, in scenario order."""
+        return list(self.world.robots)
+
+    def robot_names(self) -> list[str]:
+        """Robot names, in scenario order."""
+        return list(self.world.robots)
+
+    def robot(self, name: str) -> SimRobot:
+        """The handle of robot ``name``: its joints, links, frames, setters, config."""
+        try:
+            return self.world.robots[name]
+        except KeyError:
+            raise ParameterError(f"no robot named {name!r}; robots: "
+                                 f"{', '.join(self.world.robots)}") from None
+
+    # ---- control
+
+    def set_drive(self, robot: str, throttle: float, steer: float = 0.0) -> None:
+        """Drive ``robot`` with this throttle and steer until :meth:`clear_command`.
+
+        Overrides the scenario's ``drive`` segments (for an RL policy, say).
+        """
+        r = self.robot(robot)
+        if r.train is None:
+            raise ParameterError(f"robot {robot!r} has no drive controller; give it 'drive' "
+                                 "segments in the scenario")
+        r.override = Command("drive", throttle=throttle, steer=steer)
+
+    def set_joint_targets(self, robot: str, targets: Mapping[str, float],
+                          mode: Mode = "position", max_force: float | None = None) -> None:
+        """Command joints of ``robot`` (measured frame) until :meth:`clear_command`.
+
+        Args:
+            robot: The robot's name.
+            targets: Joint name to position, velocity or torque.
+            mode: ``position``, ``velocity`` or ``torque``.
+            max_force: Motor force limit for position and velocity modes (default: the
+                joint's effort limit).
+        """
+        r = self.robot(robot)
+        if mode not in ("position", "velocity", "torque"):
+            raise ParameterError(f"mode must be position, velocity or torque, got {mode!r}")
+        for name in targets:
+            if not any(j.name == name and j.active for j in r.joints):
+                raise ParameterError(f"robot {robot!r} has no active joint named {name!r}")
+        r.override = Command("joints", mode=mode, targets=dict(targets), max_force=max_force)
+
+    def clear_command(self, robot: str) -> None:
+        """Return ``robot`` to the scenario's own controller."""
+        self.robot(robot).override = None
+
+    # ---- stepping and observing
+
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` physics steps, applying every robot's controller before each.
+
+        Robots are measured only when an observation is due: every step for a robot with a
+        ``delay`` or a ``history`` (what they report comes from it), and otherwise when asked
+        (``observe``, a recorded row); the step before a recorded row keeps the joint
+        velocities, so the row's accelerations are over one step, as before.
+        """
+        world, sensors = self.world, self.sensors
+        step = world.bullet.stepSimulation
+        every = self.config.record.every
+        robots = list(world.robots.values())
+        delayed = [r for r in robots if r.config.delay > 0 or r.readings.reports is not None]
+        lazy = [r for r in robots if r not in delayed and r.active]
+        # Robots with nothing to command (no schedule, override, servo or standing command)
+        # cost nothing per step.
+        controlled = [(r, self.controllers[r.name]) for r in robots
+                      if r.override is not None or r.applied is not None or r.servo
+                      or r.config.drive or r.config.joints]
+        for _ in range(n):
+            t = world.step_count * world.time_step
+            for r, controller in controlled:
+                controller.control(r, t)
+            step()
+            world.step_count += 1
+            for r in delayed:
+                r.readings.history.append(sensors.measure(r))
+                if r.readings.reports is not None:
+                    sensors.report(r)
+            # The step before a row (unless a row is taken now, which keeps them anyway).
+            if lazy and (world.step_count + 1) % every == 0 and world.step_count % every:
+                for r in lazy:
+                    sensors.keep_velocities(r)
+
+    def observe(self, robot: str | None = None, *, ideal: bool = False
+                ) -> Observation | dict[str, Observation]:
+        """The observation now: as reported (delay, then noise) or ``ideal``.
+
+        For the first ``delay`` steps a delayed robot reports its initial state. Asking twice
+        at the same step returns the same noisy values. What is returned is a copy: changing
+        it changes no later observation.
+
+        Args:
+            robot: One robot's name; default: all, as a dict keyed by name.
+            ideal: The true values, without noise or delay.
+        """
+        if robot is None:
+            return {name: self.sensors.observe(r, ideal=ideal)
+                    for name, r in self.world.robots.items()}
+        return self.sensors.observe(self.robot(robot), ideal=ideal)
+
+    def observation(self, robot: str, *, ideal: bool = False) -> Observation:
+        """:meth:`observe` of one robot (typed as one observation)."""
+        return self.sensors.observe(self.robot(robot), ideal=ideal)
+
+    def history(self, robot: str, *, ideal: bool = False) -> list[Observation]:
+        """The robot's last ``history`` observations, one per physics step, oldest first.
+
+        Reported ones (delay, noise) unless ``ideal``. Fewer at the start of a run; copies.
+        """
+        return self.sensors.history(self.robot(robot), ideal=ideal)
+
+    # ---- episodes
+
+    def reset(self, seed: int | None = None,
+              overrides: Mapping[str, Mapping[str, object]] | None = None) -> None:
+        """Go back to the starting state in place, deterministically.
+
+        Positions, velocities and contacts come back through PyBullet's saveState and
+        restoreState; time, observation history, delays, commands and noise generators
+        (reseeded with ``seed``, default the scenario's) start over, so the same seed and the
+        same actions give the same observations. Changes made with the ``set_*`` methods
+        stay: they change the robot, not its state.
+
+        Args:
+            seed: Reseeds the noise; default: the scenario's ``seed``.
+            overrides: Per robot name, a different start for this episode, with the
+                scenario's keys and meanings: ``initial_joints`` (joint -> position, or ->
+                ``{"position", "velocity"}``; measured frame), ``position`` and
+                ``orientation_rpy`` or ``orientation_quat`` (in the robot's ``pose_frame``),
+                ``base_velocity`` and ``base_angular_velocity``. What is not given is the
+                scenario's start.
+
+        Raises:
+            ParameterError: an unknown robot, key or joint, or a value of the wrong shape;
+                nothing is reset then.
+        """
+        import random
+
+        plans = {self.robot(robot).name: reset_plan(self.robot(robot), changes)
+                 for robot, changes in (overrides or {}).items()}
+        self.world.restore()
+        base_seed = self.config.seed if seed is None else seed
+        for i, r in enumerate(self.world.robots.values()):
+            r.readings.restart(random.Random(robot_seed(base_seed, i)))
+            r.applied = r.override = None
+            r.free()
+            r.torques.clear()
+            for call in plans.get(r.name, ()):
+                call()
+            r.readings.history.append(self.sensors.measure(r))
+
+    # ---- state and kinematics (SimInterface's, in Python's manners)
+
+    def joint_positions(self, robot: str) -> dict[str, float]:
+        """True joint positions now (measured frame: offsets and directions applied)."""
+        return dict(self.sensors.fresh(self.robot(robot)).motor_angles)
+
+    def joint_velocities(self, robot: str) -> dict[str, float]:
+        """True joint velocities now (measured frame)."""
+        return dict(self.sensors.fresh(self.robot(robot)).motor_velocities)
+
+    def motor_torques(self, robot: str) -> dict[str, float]:
+        """The torque each joint's motor applied in the last step, in the joint's own frame.
+
+        As simulation_and_control's ``GetMotorTorques``: the torque applied at the joint (the
+        motor's torque times its ``motor_direction``), not in the measured frame the angles
+        are reported in, and never delayed. PyBullet's applied motor torque for position and
+        velocity motors; for the servo model and torque commands, the torque it applied.
+        """
+        r = self.robot(robot)
+        states = self.world.bullet.getJointStates(r.body, [j.index for j in r.active])
+        # PyBullet reports 0 for a torque-controlled joint: the torque given is the answer.
+        return {j.name: r.torques.get(j.name, st[3])
+                for j, st in zip(r.active, states, strict=True)}
+
+    def link_pose(self, robot: str, link: str) -> tuple[list[float], list[float]]:
+        """World position and orientation (x, y, z, w) of a link's URDF frame."""
+        return self.robot(robot).link_pose(link)
+
+    def link_poses(self) -> list[list[tuple[list[float], list[float]]]]:
+        """Every robot's URDF link frames' world poses now, base first (``(xyz, xyzw)``).
+
+        Robots in the scenario's order; the base's pose is its link frame, not the inertial
+        frame ``getBasePositionAndOrientation`` reports.
+        """
+        return self.world.link_poses()
+
+    # ---- dynamics on shadow models (urdfkit/motion/sim_dynamics.py)
+
+    def dynamics_joints(self, robot: str) -> list[str]:
+        """The joints the dynamics quantities are ordered by (PyBullet's order).
+
+        The movable joints; a floating base adds 6 base coordinates before them in
+        :meth:`mass_matrix`.
+        """
+        return [j.name for j in self.dynamics.joints(self.robot(robot))]
+
+    def mass_matrix(self, robot: str) -> np.ndarray:
+        """The joint-space mass matrix M(q) now (numpy, PyBullet's calculateMassMatrix).
+
+        Physical joint coordinates, in :meth:`dynamics_joints` order; a floating base puts its
+        6 coordinates first, as PyBullet does.
+        """
+        return self.dynamics.mass_matrix(self.robot(robot))
+
+    def coriolis_and_gravity(self, robot: str) -> np.ndarray:
+        """C(q, qd) qd + g(q) now: the torques that hold the current motion (numpy)."""
+        return self.dynamics.coriolis_and_gravity(self.robot(robot))
+
+    def gravity_torques(self, robot: str) -> np.ndarray:
+        """g(q) now: the torques that hold the robot still against gravity (numpy)."""
+        return self.dynamics.gravity_torques(self.robot(robot))
+
+    def forward_dynamics(self, robot: str, tau: Sequence[float]) -> np.ndarray:
+        """The joint accelerations ``tau`` would cause now, without contacts (numpy).
+
+        qdd = M^-1 (tau - C qd - g).
+        """
+        return self.dynamics.forward_dynamics(self.robot(robot), tau)
+
+    def jacobian(self, robot: str, link: str, point: Sequence[float] = (0.0, 0.0, 0.0)
+                 ) -> np.ndarray:
+        """The 6 x n Jacobian (linear rows, then angular) of a point of a link now (numpy).
+
+        ``point`` is in the link's URDF frame (the joint frame): PyBullet 3.2.7's
+        calculateJacobian takes it so, whatever its docs say of the centre of mass (measured:
+        the point (0, 0, 0) of a pendulum's bob link is on the hinge, J = 0).
+        """
+        return self.dynamics.jacobian(self.robot(robot), link, point)
+
+    # ---- setters: a robot's physical parameters (urdfkit/motion/sim_robot.py)
+
+    def set_mass(self, robot: str, link: str, mass: float) -> None:
+        """A link's mass, kg; its inertia scales with it (the same body, heavier).
+
+        PyBullet's changeDynamics(mass=...) alone throws the inertia away and recomputes it
+        from the collision shapes (a link without any gets ~1e-6): not what "heavier" means.
+        """
+        self.robot(robot).set_mass(link, mass)
+
+    def set_inertia(self, robot: str, link: str, diagonal: Sequence[float]) -> None:
+        """A link's principal moments of inertia, kg m^2 (in its inertial frame)."""
+        self.robot(robot).set_inertia(link, diagonal)
+
+    def set_friction(self, robot: str, link: str | None, lateral: float) -> None:
+        """Lateral friction of a link (every link when ``link`` is None).
+
+        Robot ``"ground"`` is the floor.
+        """
+        self._change(robot, link, lateralFriction=float(lateral))
+
+    def set_restitution(self, robot: str, link: str | None, restitution: float) -> None:
+        """Restitution (bounciness) of a link, or of the floor with robot ``"ground"``."""
+        self._change(robot, link, restitution=float(restitution))
+
+    def _change(self, target: str, link: str | None, **values: float) -> None:
+        if target == "ground":
+            self.world.change_ground(**values)
+        else:
+            self.robot(target).change(link, **values)
+
+    def set_joint_damping(self, robot: str, joint: str, damping: float) -> None:
+        """PyBullet's joint damping of one joint (N m s/rad)."""
+        self.robot(robot).set_joint_damping(joint, damping)
+
+    def set_joint_friction(self, robot: str, joint: str, friction: float) -> None:
+        """A joint's dry (Coulomb) friction, N m (N for a prismatic joint); 0 removes it.
+
+        The joint holds against up to ``friction`` of torque and is slowed by that much when
+        it moves (PyBullet's joint motor at velocity 0 with that force limit). While a
+        PyBullet position or velocity command drives the joint (a ``joints`` segment without
+        a ``motor`` table, or a car's wheels and hinges), that command owns the motor; the
+        friction comes back when it ends. It stays across ``reset()``.
+        """
+        self.robot(robot).set_joint_friction(joint, friction)
+
+    def set_link_damping(self, robot: str, linear: float, angular: float) -> None:
+        """Every link's linear and angular velocity damping (PyBullet's default is 0.04)."""
+        self._change(robot, None, linearDamping=float(linear), angularDamping=float(angular))
+
+    def set_motor_gains(self, robot: str, kp: float | Mapping[str, float] | None = None,
+                        kd: float | Mapping[str, float] | None = None) -> None:
+        """The servo's position and velocity gains: one for every joint, or per joint name.
+
+        A gain not given keeps its value. Needs the robot's ``motor`` table (the servo).
+        """
+        self.robot(robot).set_motor_gains(kp, kd)
+
+    def set_time_step(self, time_step: float) -> None:
+        """The physics time step, s (times already recorded keep theirs)."""
+        self.world.set_time_step(time_step)
+
+    # ---- recording (urdfkit/motion/sim_record.py)
+
+    def run(self, duration: float | None = None, sink: Sink | None = None, *,
+            keep: bool = True, real_time: bool = False) -> SimResult:
+        """Step to ``duration`` (default: the scenario's), recording every ``record.every``.
+
+        Rows are taken at every step that is a multiple of ``record.every``, the starting
+        state included when the run starts at step 0. ``sink`` gets each batch of rows (one
+        per robot) as it is recorded, to stream them to disk; with ``keep=False`` the result
+        then holds no rows, only their count and the per-robot summary, so a run's memory
+        does not grow with its length. Ctrl-C ends the run early with ``interrupted`` set;
+        the rows so far are kept, as they are when the GUI window is closed. ``real_time``
+        paces the steps to the wall clock (to watch the run in the GUI).
+        """
+        return self.recorder.run(duration, sink, keep=keep, real_time=real_time)
+
+
+# --------------------------------------------------------------------------- summary and files
+
+
+def summarize(result: SimResult) -> list[RobotSummary]:
+    """Per robot: where it started and ended, how far and fast it went, its final joints."""
+    return list(result.summaries)
+
+
+def run_to_file(simulation: Simulation, path: str | Path, *, force: bool = False,
+                duration: float | None = None, real_time: bool = False,
+                also: Callable[[list[Observation]], None] | None = None
+                ) -> tuple[SimResult, Path]:
+    """Run ``simulation``, writing its rows to ``path`` as they are recorded.
+
+    Every format streams: ``.jsonl`` and ``.csv`` row by row, ``.parquet`` in row groups of
+    :data:`PARQUET_ROWS`. The result keeps no rows (their count and the summary only), so
+    memory does not grow with the run. On Ctrl-C (SIGTERM, SIGHUP in the CLI) the file holds
+    every complete row so far (a parquet file gets its footer). Nothing is replaced without
+    ``force``. ``also`` gets every batch too, after it is written.
+    """
+    from urdfkit.core.output import StreamingFile
+
+    check_rows_output(path, force=force)
+    fmt = Path(path).suffix.lower()
+    if fmt == ".parquet":
+        return _run_to_parquet(simulation, path, force=force, duration=duration,
+                               real_time=real_time, also=also)
+    text = RowText(fmt)
+    with StreamingFile(path, force=force, keep_on_interrupt=True) as out:
+        def write(batch: list[Observation]) -> None:
+            out.write(text.encode([r.to_dict() for r in batch]))
+            if also is not None:
+                also(batch)
+
+        result = simulation.run(duration, sink=write, keep=False, real_time=real_time)
+    return result, out.path
+
+
+#: Rows per parquet row group when streaming.
+PARQUET_ROWS = 4096
+
+
+def _run_to_parquet(simulation: Simulation, path: str | Path, *, force: bool,
+                    duration: float | None, real_time: bool,
+                    also: Callable[[list[Observation]], None] | None = None
+                    ) -> tuple[SimResult, Path]:
+    from urdfkit.core.output import StreamingFile
+
+    pa = _pyarrow()
+    import pyarrow.parquet as pq
+
+    buffer: list[dict[str, object]] = []
+    columns: list[str] = []
+    writer: pq.ParquetWriter | None = None
+    with StreamingFile(path, force=force, keep_on_interrupt=True) as out:
+        sink = _ByteSink(out)
+
+        def flush() -> None:
+            nonlocal writer
+            table = pa.table({c: [r.get(c) for r in buffer] for c in columns})
+            if writer is None:
+                writer = pq.ParquetWriter(pa.PythonFile(sink, mode="w"), table.schema)
+            writer.write_table(table)
+            buffer.clear()
+
+        def take(batch: list[Observation]) -> None:
+            flat = [flatten(r.to_dict()) for r in batch]
+            if not columns:
+                columns.extend(_columns(flat))
+            buffer.extend(flat)
+            if len(buffer) >= PARQUET_ROWS:
+                flush()
+            if also is not None:
+                also(batch)
+
+        result = simulation.run(duration, sink=take, keep=False, real_time=real_time)
+        if buffer or writer is None:
+            flush()
+        assert writer is not None
+        writer.close()  # the footer: a complete file, interrupted or not
+    return result, out.path
