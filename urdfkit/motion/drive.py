@@ -67,8 +67,6 @@ SAMPLES_PER_SECOND = 10
 PYBULLET_LINK_DAMPING = 0.04
 #: The tutorial's start: the car's base 0.1 m up, loaded before the plane.
 TUTORIAL_START = (0.0, 0.0, 0.1)
-#: The built-in ground is at least this size (m), and larger when the run needs it.
-MIN_GROUND = 20.0
 
 BASE_COLUMNS = ("t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz")
 
@@ -445,13 +443,16 @@ class Scenario:
                                  f"{', '.join(weak[:8])}{', ...' if len(weak) > 8 else ''}")
 
     def _ground_params(self) -> dict[str, str] | None:
-        """The built-in ground's size: at least 20 m, and room for the whole run."""
-        c, train = self.config, self.drivetrain
-        if c.plane is not None or c.tutorial:
+        """The built-in ground: an infinite plane, or the tutorial's own box.
+
+        A box ground loaded with URDF_USE_IMPLICIT_CYLINDER makes wheeled robots veer (MiR100
+        at steer 0: 0.375 m forward and 0.277 rad of yaw in 3 s); PyBullet's plane shape does
+        not (6.18 m, 0.003 rad), and needs no size.
+        """
+        c = self.config
+        if c.plane is not None:
             return None
-        reach = abs(c.throttle) * train.reference_radius * c.total_steps * c.time_step
-        size = max(MIN_GROUND, math.ceil(2 * (reach + 5.0)))
-        return None if size == MIN_GROUND else {"size": str(size)}
+        return {"shape": "box"} if c.tutorial else None
 
     def _ground(self) -> tuple[float | None, tuple[float, float, float, float] | None]:
         """The ground's top z and its x-y extent (None where unbounded, as a GEOM_PLANE)."""
