@@ -480,7 +480,15 @@ class Scenario:
         p = self.session.bullet
         self.problems = []
         self.static_base = p.getDynamicsInfo(self.body, -1)[0] == 0
-        if self.static_base:
+        root = p.getBodyInfo(self.body)[0].decode("utf-8", "replace")
+        if self.static_base and root == "world":
+            # PyBullet gives a link named `world` without <inertial> mass 0, not 1 kg
+            # (measured on 3.2.7: with a mass of its own it falls like any other).
+            self.problems.append("static base: the root link is named `world`, and PyBullet "
+                                 "gives a `world` link without <inertial> mass 0, which fixes it "
+                                 "where it is loaded: the car cannot move; drop the `world` link "
+                                 "and its joint (build without the world frame) to drive it")
+        elif self.static_base:
             self.problems.append("static base: the root link has mass 0, so PyBullet fixes it "
                                  "where it is loaded and the car cannot move; give it a mass")
         points = p.getClosestPoints(self.body, self.plane, 0.0)
