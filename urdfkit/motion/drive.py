@@ -35,6 +35,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from urdfkit.core.errors import ParameterError, UrdfkitError
 from urdfkit.engine.session import LoadOptions, Session, quiet_stdout
@@ -59,6 +60,9 @@ from urdfkit.motion.vehicle import (
 )
 from urdfkit.motion.vehicle_shapes import base_link_pose, lowest_point, set_base_link_pose
 from urdfkit.sources.cache import cache_dir, write_entry
+
+if TYPE_CHECKING:
+    from urdfkit.model.gazebo import GazeboContact
 
 #: Default simulated samples per second in the trajectory (and for the statistics): enough
 #: for a smooth path and a good circle fit, cheap enough to cost nothing next to the physics.
@@ -124,6 +128,9 @@ class DriveConfig:
         limp: Let the passive joints (neither wheels, hinges nor casters: an arm on a mobile
             base) go limp; by default each is held at its start angle by a position motor
             with the URDF's effort as its force.
+        gazebo_contacts: Apply the file's ``<gazebo reference>`` contact parameters at load
+            (PyBullet ignores them): lateral friction from mu1/mu2 (the smaller), contact
+            stiffness and damping from kp/kd (both given); see :mod:`urdfkit.model.gazebo`.
     """
 
     urdf: str | None = None
@@ -151,6 +158,7 @@ class DriveConfig:
     package_paths: list[str] | None = None
     up: str = "z"
     limp: bool = False
+    gazebo_contacts: bool = False
 
     def check(self) -> None:
         """Refuse values that would make the run meaningless (exit 2 in the CLI)."""
@@ -308,6 +316,9 @@ class Scenario:
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
         self._last_file = ""
         self._phantom: list[str] | None = None
+        self._gazebo: dict[str, GazeboContact] = {}
+        #: The Gazebo contacts applied at load: {link: {lateralFriction, ...}}.
+        self.gazebo_applied: dict[str, dict[str, float]] = {}
         self.session: Session | None = None
         try:
             self._open()
@@ -345,6 +356,9 @@ class Scenario:
                 children = {c.get("link") for c in res.root.iterfind("joint/child")}
                 self._phantom = [el.get("name", "") for el in res.root.iterchildren("link")
                                  if el.find("inertial") is None and el.get("name") in children]
+                from urdfkit.motion.gazebo_load import contacts_to_apply
+
+                self._gazebo = contacts_to_apply(res.root)
             return s.load_urdf(res.load_path, options, display=res.name)
 
     def _open(self) -> None:
@@ -376,6 +390,8 @@ class Scenario:
             raise DrivetrainError(e.message, file=car, param=e.param) from None
         if spawn != upright:  # the link frame, as loadURDF placed it
             set_base_link_pose(p, self.body, start, spawn)
+        if c.gazebo_contacts:
+            self._apply_gazebo()
         # The tutorial loads its plane as it is (a mass-0 box: static either way).
         self.plane = self._load(s, c.plane, "simpleplane", LoadOptions(
             fixed_base=not c.tutorial, implicit_cylinder=not c.tutorial), self._ground_params())
@@ -392,6 +408,34 @@ class Scenario:
         for j in train.wheels + train.hinges:
             name = train.joint_names[j]
             self.columns += [f"{name}_angle", f"{name}_speed"]
+
+    def _apply_gazebo(self) -> None:
+        """Carry the file's Gazebo contact parameters over with changeDynamics."""
+        from urdfkit.motion.gazebo_load import apply_gazebo_contacts
+
+        assert self.session is not None
+        self.gazebo_applied = apply_gazebo_contacts(self.session.bullet, self.body,
+                                                    self._gazebo)
+
+    def gazebo_differences(self) -> list[str]:
+        """The file's Gazebo friction where PyBullet uses another, as a user reads it."""
+        if not self._gazebo or self.session is None:
+            return []
+        from urdfkit.motion.gazebo_load import link_indices
+
+        p = self.session.bullet
+        index = link_indices(p, self.body)
+        out = []
+        for name, g in self._gazebo.items():
+            mu = g.lateral_friction
+            if mu is None or name not in index:
+                continue
+            used = p.getDynamicsInfo(self.body, index[name])[1]
+            if abs(used - mu) > 1e-9 * max(1.0, mu):
+                given = " ".join(f"{k} {v:g}" for k, v in g.given().items()
+                                 if k in ("mu1", "mu2"))
+                out.append(f"{name} {given}, PyBullet uses {used:g}")
+        return out
 
     def _warn_phantom_mass(self) -> None:
         """Say when PyBullet's 1 kg for each link without <inertial> is much of the robot.
@@ -576,6 +620,7 @@ class Scenario:
             "link_damping": {"linear": PYBULLET_LINK_DAMPING,
                              "angular": PYBULLET_LINK_DAMPING, "note": "PyBullet's default"},
             "tutorial": c.tutorial,
+            "gazebo_contacts": self.gazebo_applied,
         }
 
     def run(self, progress: ProgressFn | None = None,
@@ -668,6 +713,14 @@ class Scenario:
             if share < 0.9:
                 (problems if share < 0.1 else warnings).append(
                     _yaw_shortfall(self, rate, share, sim_time))
+        slipping = [m for m in problems + warnings
+                    if m.startswith(("wheels slipping", "stuck", "skid steering turns",
+                                     "differential steering turns"))]
+        differ = self.gazebo_differences() if slipping else []
+        if differ:
+            shown = "; ".join(differ[:4]) + ("; ..." if len(differ) > 4 else "")
+            warnings.append(f"the file's <gazebo> gives {shown}: --gazebo-contacts applies "
+                            f"{'them' if len(differ) > 1 else 'it'}")
         last = stats.last
         assert last is not None
         expected = train.expected_radius(c.throttle, self.steer)
