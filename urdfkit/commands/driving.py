@@ -87,6 +87,9 @@ def drive(
         "--gazebo-contacts", help="Apply the file's <gazebo reference> contact parameters, "
         "which PyBullet ignores: lateral friction from mu1/mu2 (the smaller), contact "
         "stiffness and damping from kp/kd.")] = False,
+    no_mimic: Annotated[bool, typer.Option(
+        "--no-mimic", help="Raw PyBullet, which ignores <mimic>: by default each follower is "
+        "geared to its leader (multiplier x leader + offset).")] = False,
     view: ViewOpt = False,
     speed: SpeedOpt = "1",
     port: RunPortOpt = None,
@@ -116,7 +119,7 @@ def drive(
         steer=steer, drivetrain=drivetrain, tutorial=tutorial, keep_trajectory=plot is not None,
         wheels=split_joints(wheels), hinges=split_joints(hinges), sample_every=sample_every,
         gui=gui, guard=not no_guard, package_paths=package_path, up=up, limp=limp,
-        gazebo_contacts=gazebo_contacts, **given)
+        gazebo_contacts=gazebo_contacts, mimic=not no_mimic, **given)
     with Scenario(config) as sc:
         _say_drivetrain(sc)
         said = list(sc.warnings)

@@ -63,6 +63,7 @@ from urdfkit.sources.cache import cache_dir, write_entry
 
 if TYPE_CHECKING:
     from urdfkit.model.gazebo import GazeboContact
+    from urdfkit.motion.mimic import Mimic
 
 #: Default simulated samples per second in the trajectory (and for the statistics): enough
 #: for a smooth path and a good circle fit, cheap enough to cost nothing next to the physics.
@@ -131,6 +132,8 @@ class DriveConfig:
         gazebo_contacts: Apply the file's ``<gazebo reference>`` contact parameters at load
             (PyBullet ignores them): lateral friction from mu1/mu2 (the smaller), contact
             stiffness and damping from kp/kd (both given); see :mod:`urdfkit.model.gazebo`.
+        mimic: Honour ``<mimic>`` (a gear constraint per follower, :mod:`urdfkit.motion.mimic`);
+            False: raw PyBullet, which ignores it.
     """
 
     urdf: str | None = None
@@ -159,6 +162,7 @@ class DriveConfig:
     up: str = "z"
     limp: bool = False
     gazebo_contacts: bool = False
+    mimic: bool = True
 
     def check(self) -> None:
         """Refuse values that would make the run meaningless (exit 2 in the CLI)."""
@@ -317,6 +321,9 @@ class Scenario:
         self._last_file = ""
         self._phantom: list[str] | None = None
         self._gazebo: dict[str, GazeboContact] = {}
+        self._mimics: list[Mimic] = []
+        #: Mimic followers geared to their leaders: {joint name: constraint id}.
+        self.mimic_followers: dict[str, int] = {}
         #: The Gazebo contacts applied at load: {link: {lateralFriction, ...}}.
         self.gazebo_applied: dict[str, dict[str, float]] = {}
         self.session: Session | None = None
@@ -357,8 +364,10 @@ class Scenario:
                 self._phantom = [el.get("name", "") for el in res.root.iterchildren("link")
                                  if el.find("inertial") is None and el.get("name") in children]
                 from urdfkit.motion.gazebo_load import contacts_to_apply
+                from urdfkit.motion.mimic import mimic_relations
 
                 self._gazebo = contacts_to_apply(res.root)
+                self._mimics = mimic_relations(res.root)
             return s.load_urdf(res.load_path, options, display=res.name)
 
     def _open(self) -> None:
@@ -392,6 +401,10 @@ class Scenario:
             set_base_link_pose(p, self.body, start, spawn)
         if c.gazebo_contacts:
             self._apply_gazebo()
+        if c.mimic and self._mimics:
+            from urdfkit.motion.mimic import couple_mimics
+
+            self.mimic_followers = couple_mimics(p, self.body, self._mimics)
         # The tutorial loads its plane as it is (a mass-0 box: static either way).
         self.plane = self._load(s, c.plane, "simpleplane", LoadOptions(
             fixed_base=not c.tutorial, implicit_cylinder=not c.tutorial), self._ground_params())
@@ -468,7 +481,9 @@ class Scenario:
         assert self.session is not None
         p, train = self.session.bullet, self.drivetrain
         casters = set(train.casters)
-        candidates = [j for j in train.passive if j not in casters]
+        geared = set(self.mimic_followers)  # moved by their leaders' gears, not held
+        candidates = [j for j in train.passive if j not in casters
+                      and train.joint_names[j] not in geared]
         self.held: dict[int, tuple[float, float]] = {}  # joint: (angle, force)
         self.limp: list[int] = list(candidates) if self.config.limp else []
         if self.config.limp or not candidates:
@@ -621,6 +636,7 @@ class Scenario:
                              "angular": PYBULLET_LINK_DAMPING, "note": "PyBullet's default"},
             "tutorial": c.tutorial,
             "gazebo_contacts": self.gazebo_applied,
+            "mimic": sorted(self.mimic_followers),
         }
 
     def run(self, progress: ProgressFn | None = None,

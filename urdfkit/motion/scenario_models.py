@@ -229,6 +229,8 @@ class RobotConfig(ConfigModel):
     # Apply the file's <gazebo reference> mu1/mu2/kp/kd (PyBullet ignores them) at load;
     # link_dynamics overrides them.
     gazebo_contacts: bool = False
+    # Honour <mimic> (a gear constraint per follower); false: raw PyBullet, which ignores it.
+    mimic: bool = True
     inertia_from_file: bool = True
     implicit_cylinder: bool = True
     self_collision: bool = False
