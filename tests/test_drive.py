@@ -171,9 +171,10 @@ def test_skid_steer_turns_by_speed_difference_and_says_when_it_cannot() -> None:
     weak = drive(DriveConfig(urdf="husky/husky.urdf", steer=0.3, seconds=6,
                              keep_trajectory=False))
     assert weak.drivetrain.steering == "skid"
-    # Measured before said: ten times the force (100 N m) does turn it, so the advice is given.
+    # Measured before said: ten times the force (100 N m) does turn it, so the advice is given,
+    # with the option as the command line spells it.
     advice = [p for p in weak.problems if p.startswith("skid steering turns at")]
-    assert len(advice) == 1 and advice[0].endswith("raise `max_force`"), weak.problems
+    assert len(advice) == 1 and advice[0].endswith("run with --max-force 100"), weak.problems
     strong = drive(DriveConfig(urdf="husky/husky.urdf", steer=0.3, seconds=6, max_force=500,
                                keep_trajectory=False))
     assert strong.heading_change > 0.5 and strong.problems == []

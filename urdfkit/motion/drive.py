@@ -756,38 +756,64 @@ class Scenario:
 
 
 def _yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> str:
-    """Why the base turns slower than commanded, and whether more wheel force helps.
+    """Why the base turns slower than commanded, and advice that was tried before it is said.
 
-    Measured, not guessed: the same drive (same duration, so the same settled half) is
-    run again with ten times the wheel force. Only when that turns clearly faster (1.5x)
-    is the user told to raise ``max_force``; otherwise the wheels are slipping sideways,
-    which more torque cannot cure (husky turns at 0.132 rad/s of 0.3 at 500 N m and at
-    10,000 alike). Runs over :data:`PROBE_LIMIT` s are not repeated.
+    The same drive (same duration, so the same settled half) is run again over what a user
+    would reach: ten and a hundred times the wheel force (capped at PyBullet's default), then,
+    if no force helps, up to three times the yaw rate (capped where the inner wheels would
+    stop: 2 v / track). Advice is given only when its run turns clearly faster (1.5x); it
+    names the option as the command line spells it. At most three re-runs, only when this
+    warning is printed; runs over :data:`PROBE_LIMIT` s are not repeated.
     """
     c, train = sc.config, sc.drivetrain
     kind = "skid steering" if train.steering == "skid" else "differential steering"
     said = f"{kind} turns at {rate:.3g} rad/s, {share:.0%} of the {sc.steer:g} commanded"
     force = PYBULLET_DEFAULT_FORCE if c.max_force is None else c.max_force
-    if force >= PYBULLET_DEFAULT_FORCE:
-        return f"{said}, at PyBullet's default wheel force: the wheels slip sideways"
-    higher = min(force * 10.0, PYBULLET_DEFAULT_FORCE) if force > 0 else 10.0
     if not 0 < sim_time <= PROBE_LIMIT:
         return (f"{said}; not measured at more force (the run is over {PROBE_LIMIT:g} s): "
                 "the wheels slip sideways, or the motors are too weak")
-    probe_cfg = replace(c, max_force=higher, keep_trajectory=False, gui=False, steps=None,
-                        seconds=sim_time)
-    try:
-        with Scenario(probe_cfg, probe=True) as sc:
-            probe = sc.run().yaw_rate
-    except UrdfkitError:
-        probe = None
-    if probe is not None and abs(probe) > 1.5 * abs(rate) and \
-            abs(probe - rate) > 0.05 * abs(sc.steer):
-        return (f"{said}; at {higher:g} N m it turns at {probe:.3g} rad/s "
-                f"({probe / sc.steer:.0%}): raise `max_force`")
-    at = "" if probe is None else f" (at {higher:g} N m: {probe:.3g} rad/s)"
-    return (f"{said}; more wheel force does not help{at}: the wheels slip sideways, "
-            "so command more yaw rate for more turn")
+
+    def probe(**changes: float | None) -> float | None:
+        cfg = replace(c, keep_trajectory=False, gui=False, steps=None, seconds=sim_time,
+                      **changes)  # type: ignore[arg-type]
+        try:
+            with Scenario(cfg, probe=True) as run:
+                return run.run().yaw_rate
+        except UrdfkitError:
+            return None
+
+    def better(r: float | None) -> bool:
+        return r is not None and abs(r) > 1.5 * abs(rate) and \
+            abs(r - rate) > 0.05 * abs(sc.steer)
+
+    def shown(r: float | None) -> str:
+        return "failed" if r is None else f"{r:.3g} rad/s"
+
+    tried: list[str] = []
+    for factor in (10.0, 100.0):
+        higher = min(force * factor, PYBULLET_DEFAULT_FORCE) if force > 0 else factor
+        if higher <= force or (tried and tried[-1].startswith(f"--max-force {higher:g}:")):
+            break
+        r = probe(max_force=higher)
+        if better(r):
+            assert r is not None
+            return (f"{said}; with --max-force {higher:g} it turns at {r:.3g} rad/s "
+                    f"({r / sc.steer:.0%}): run with --max-force {higher:g}")
+        tried.append(f"--max-force {higher:g}: {shown(r)}")
+    widest = 2.0 * abs(c.throttle) * train.reference_radius / train.track \
+        if train.track > 0 else math.inf
+    more = math.copysign(min(3.0 * abs(sc.steer), widest), sc.steer)
+    if abs(more) > 1.2 * abs(sc.steer):
+        r = probe(steer=more)
+        if better(r):
+            assert r is not None
+            first = f"more wheel force does not help ({'; '.join(tried)})" if tried \
+                else "at PyBullet's default wheel force"
+            return (f"{said}; {first}: the wheels slip sideways, and --steer {more:.3g} "
+                    f"turns at {r:.3g} rad/s: command more yaw rate (--steer {more:.3g})")
+        tried.append(f"--steer {more:.3g}: {shown(r)}")
+    return (f"{said}; neither more force nor more yaw rate turns it faster "
+            f"({'; '.join(tried)}): the wheels slip sideways")
 
 
 class _GuiControls:
