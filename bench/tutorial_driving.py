@@ -45,7 +45,8 @@ class TutorialDrivingEnv(gym.Env):
         self._tmp = tempfile.TemporaryDirectory(prefix="tutorial-driving-")
         folder = Path(self._tmp.name)
         self.car_file = str(build_template("simplecar").write(folder / "simplecar.urdf"))
-        self.plane_file = str(build_template("simpleplane").write(folder / "simpleplane.urdf"))
+        self.plane_file = str(build_template("simpleplane", {"shape": "box"}).write(  # the box
+            folder / "simpleplane.urdf"))
         self.goal_file = str(folder / "simplegoal.urdf")
         Path(self.goal_file).write_text(GOAL_URDF)
         self.action_space = gym.spaces.Box(np.array([0, -0.6], dtype=np.float32),

@@ -114,7 +114,7 @@ def test_tutorial_mode_lands_within_a_centimetre_of_the_tutorials_own_loop(
 
     car, plane = tmp_path / "simplecar.urdf", tmp_path / "simpleplane.urdf"
     build_template("simplecar").write(car)
-    build_template("simpleplane").write(plane)
+    build_template("simpleplane", {"shape": "box"}).write(plane)  # the tutorial's own ground
     loop = (
         "import pybullet as p\n"
         "p.connect(p.DIRECT)\n"
@@ -171,9 +171,10 @@ def test_skid_steer_turns_by_speed_difference_and_says_when_it_cannot() -> None:
     weak = drive(DriveConfig(urdf="husky/husky.urdf", steer=0.3, seconds=6,
                              keep_trajectory=False))
     assert weak.drivetrain.steering == "skid"
-    # Measured before said: ten times the force (100 N m) does turn it, so the advice is given.
+    # Measured before said: ten times the force (100 N m) does turn it, so the advice is given,
+    # with the option as the command line spells it.
     advice = [p for p in weak.problems if p.startswith("skid steering turns at")]
-    assert len(advice) == 1 and advice[0].endswith("raise `max_force`"), weak.problems
+    assert len(advice) == 1 and advice[0].endswith("run with --max-force 100"), weak.problems
     strong = drive(DriveConfig(urdf="husky/husky.urdf", steer=0.3, seconds=6, max_force=500,
                                keep_trajectory=False))
     assert strong.heading_change > 0.5 and strong.problems == []
@@ -198,7 +199,8 @@ def test_forward_is_where_the_wheels_roll() -> None:
 
 def test_leaving_the_ground_and_a_static_base_are_reported(tmp_path: Path) -> None:
     plane = tmp_path / "plane.urdf"
-    build_template("simpleplane").write(plane)  # 20 x 20 m: a 20 s run leaves it
+    # The tutorial's 20 x 20 m box: a 20 s run leaves it.
+    build_template("simpleplane", {"shape": "box"}).write(plane)
     result = CliRunner().invoke(app, ["drive", "--plane", str(plane), "--seconds", "20",
                                       "--json"])
     assert result.exit_code == 1  # a physically suspect run is a finding
@@ -210,7 +212,7 @@ def test_leaving_the_ground_and_a_static_base_are_reported(tmp_path: Path) -> No
     assert 10.0 <= left_at <= 11.5, problems[0]
     assert any(p.startswith("fell:") for p in problems)
     assert any(p.startswith("flipped over at t = ") for p in problems)  # it tumbles off
-    # The built-in ground grows with the run instead.
+    # The built-in ground is an infinite plane instead.
     assert drive(DriveConfig(seconds=30, keep_trajectory=False)).problems == []
     static = tmp_path / "static.urdf"
     static.write_text(build_template("simplecar").to_bytes().decode().replace(

@@ -160,15 +160,17 @@ def test_yaw_shortfall_warnings_show_in_text_and_their_advice_is_measured() -> N
     weak = _cli("--urdf", "husky/husky.urdf", "--steer", "0.3", "--seconds", "6")
     assert weak.returncode == 1
     said = [ln for ln in weak.stderr.splitlines() if "skid steering turns at" in ln]
-    assert len(said) == 1 and said[0].endswith("raise `max_force`"), weak.stderr
-    assert f"at 100 N m it turns at {_yaw_rate(100, 6):.3g} rad/s" in said[0]
-    # 1000 N m: ten times more turns no faster (the wheels slip), so no advice to raise it.
+    assert len(said) == 1 and said[0].endswith("run with --max-force 100"), weak.stderr
+    assert f"with --max-force 100 it turns at {_yaw_rate(100, 6):.3g} rad/s" in said[0]
+    # 1000 N m: ten and a hundred times more turn no faster (the wheels slip), nor does more
+    # yaw rate, so nothing is advised.
     strong = _cli("--urdf", "husky/husky.urdf", "--steer", "0.3", "--seconds", "6",
                   "--max-force", "1000")
     said = [ln for ln in strong.stderr.splitlines() if "skid steering turns at" in ln]
-    assert len(said) == 1 and "raise" not in said[0], strong.stderr
+    assert len(said) == 1 and "run with" not in said[0], strong.stderr
     quoted = _yaw_rate(10000, 6)
-    assert f"more wheel force does not help (at 10000 N m: {quoted:.3g} rad/s)" in said[0]
+    assert "neither more force nor more yaw rate turns it faster" in said[0]
+    assert f"--max-force 10000: {quoted:.3g} rad/s" in said[0]
     assert abs(quoted) < 1.5 * abs(_yaw_rate(1000, 6))
     # JSON carries the same warning.
     data = json.loads(_cli("--urdf", "husky/husky.urdf", "--steer", "0.3", "--seconds", "6",

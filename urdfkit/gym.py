@@ -47,6 +47,8 @@ RenderMode = Literal["human", "rgb_array"]
 #: The tutorial's joint indices of simplecar (urdfkit's template keeps its joint order).
 _HINGES = (0, 2)
 _WHEELS = (1, 3, 4, 5)
+#: simpleplane as the tutorial has it: a 20 x 20 x 0.01 m box (the template's default is a plane).
+TUTORIAL_GROUND = {"shape": "box"}
 
 
 def _real(action: object) -> None:
@@ -197,14 +199,16 @@ class SimpleDrivingEnv(gym.Env):
         # reset (PyBullet's default does not, and single-step episodes then differ).
         p.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
         p.setGravity(0, 0, self.GRAVITY)
-        plane, car = builtin_file("simpleplane"), builtin_file("simplecar")
+        # The tutorial's own ground, a box (drive's default ground is an infinite plane).
+        plane, car = builtin_file("simpleplane", TUTORIAL_GROUND), builtin_file("simplecar")
         if plane is None or car is None:  # no writable cache: build into a temp folder
             import tempfile
 
             from urdfkit.model.catalog import build_template
 
             self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-gym-")
-            plane = build_template("simpleplane").write(Path(self._tmp.name) / "plane.urdf")
+            plane = build_template("simpleplane", TUTORIAL_GROUND).write(
+                Path(self._tmp.name) / "plane.urdf")
             car = build_template("simplecar").write(Path(self._tmp.name) / "car.urdf")
         s.load_urdf(plane, LoadOptions(fixed_base=True), display="simpleplane")
         self.car = s.load_urdf(car, LoadOptions(

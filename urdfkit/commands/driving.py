@@ -85,6 +85,13 @@ def drive(
     limp: Annotated[bool, typer.Option(
         "--limp", help="Let joints that are neither wheels, hinges nor casters go limp "
         "instead of holding their start angle (with the URDF's effort).")] = False,
+    gazebo_contacts: Annotated[bool, typer.Option(
+        "--gazebo-contacts", help="Apply the file's <gazebo reference> contact parameters, "
+        "which PyBullet ignores: lateral friction from mu1/mu2 (the smaller), contact "
+        "stiffness and damping from kp/kd.")] = False,
+    no_mimic: Annotated[bool, typer.Option(
+        "--no-mimic", help="Raw PyBullet, which ignores <mimic>: by default each follower is "
+        "geared to its leader (multiplier x leader + offset).")] = False,
     view: ViewOpt = False,
     speed: SpeedOpt = "1",
     port: RunPortOpt = None,
@@ -114,7 +121,8 @@ def drive(
         packages=package, xacro_args=arg, steps=steps, time_step=time_step, throttle=throttle,
         steer=steer, drivetrain=drivetrain, tutorial=tutorial, keep_trajectory=plot is not None,
         wheels=split_joints(wheels), hinges=split_joints(hinges), sample_every=sample_every,
-        gui=gui, guard=not no_guard, package_paths=package_path, up=up, limp=limp, **given)
+        gui=gui, guard=not no_guard, package_paths=package_path, up=up, limp=limp,
+        gazebo_contacts=gazebo_contacts, mimic=not no_mimic, **given)
     with Scenario(config) as sc:
         _say_drivetrain(sc)
         said = list(sc.warnings)
@@ -190,6 +198,10 @@ def _say_drivetrain(sc: Any) -> None:
     show.note(f"{sc.model}: wheels {names(t.wheels)}; hinges {names(t.hinges)}; "
               f"casters {', '.join(casters) or 'none'}; held {names(list(sc.held))}; "
               f"limp {names(sc.limp)}; drivetrain {t.mode} ({t.steering} steering)")
+    if sc.gazebo_applied:
+        show.note("Gazebo contacts applied: " + "; ".join(
+            f"{k} " + ", ".join(f"{n} {v:g}" for n, v in vals.items())
+            for k, vals in sc.gazebo_applied.items()))
     for w in sc.warnings:
         show.warn(w)
 

@@ -20,8 +20,8 @@ from urdfkit.core.errors import ParameterError
 from urdfkit.model.robot import Robot
 from urdfkit.model.templatedir import template_dir
 
-#: A template parameter's type: one number, or three.
-ParamKind = Literal["float", "vec3"]
+#: A template parameter's type: one number, three, or one word of ``choices``.
+ParamKind = Literal["float", "vec3", "choice"]
 
 
 @dataclass(frozen=True)
@@ -30,13 +30,14 @@ class Param:
 
     Attributes:
         name: The key users pass with ``--set name=value``.
-        kind: ``"float"`` or ``"vec3"`` (three numbers).
+        kind: ``"float"``, ``"vec3"`` (three numbers) or ``"choice"`` (one of ``choices``).
         default: The value when none is given.
         help: One line for ``urdfkit templates``.
         minimum: Values must be above this (or equal, if ``inclusive``).
         maximum: Values must be at most this.
         inclusive: Whether ``minimum`` itself is allowed.
         to_args: Maps the value to xacro ``arg`` names; by default ``{name: value}``.
+        choices: The words a ``"choice"`` parameter takes.
     """
 
     name: str
@@ -47,9 +48,16 @@ class Param:
     maximum: float | None = None
     inclusive: bool = False
     to_args: Callable[[Any], dict[str, float]] | None = None
+    choices: tuple[str, ...] = ()
 
     def parse(self, raw: Any) -> Any:
         """Turn a string or number into this parameter's type, checking its range."""
+        if self.kind == "choice":
+            word = str(raw).strip() if isinstance(raw, str) else raw
+            if word not in self.choices:
+                raise ParameterError(f"parameter '{self.name}' expects one of "
+                                     f"{', '.join(self.choices)}, got {raw!r}")
+            return word
         if self.kind == "vec3":
             items = raw.replace(",", " ").split() if isinstance(raw, str) else raw
             try:
@@ -84,7 +92,7 @@ class Param:
             raise ParameterError(f"parameter '{self.name}' must be <= {self.maximum:g}, "
                                  f"got {raw!r}")
 
-    def args(self, value: Any) -> dict[str, float]:
+    def args(self, value: Any) -> dict[str, Any]:
         """The xacro arguments this value sets."""
         if self.to_args is not None:
             return self.to_args(value)
@@ -94,6 +102,8 @@ class Param:
         """Format a value for people."""
         if isinstance(value, tuple):
             return " ".join(f"{v:g}" for v in value)
+        if isinstance(value, str):
+            return value
         return f"{value:g}"
 
 
@@ -130,7 +140,7 @@ class Template:
         args: dict[str, str] = {}
         for p in self.params:
             for k, v in p.args(resolved[p.name]).items():
-                args[k] = repr(float(v))
+                args[k] = v if isinstance(v, str) else repr(float(v))
         return args
 
     def source(self) -> str:
@@ -167,10 +177,14 @@ TEMPLATES: dict[str, Template] = {
         ),
         Template(
             "simpleplane", "simpleplane.urdf.xacro",
-            "The tutorial's ground: a static 20 x 20 m box with high friction.",
+            "A static ground with high friction: an infinite plane (the default) or the "
+            "tutorial's 20 x 20 m box.",
             (
-                Param("size", "float", 20.0, "Side length of the square plane (m)"),
-                Param("thickness", "float", 0.01, "Thickness of the plane (m)"),
+                Param("shape", "choice", "plane", "plane: PyBullet's infinite plane, its top at "
+                      "z = 0 (wheels roll straight); box: the tutorial's box (size, thickness)",
+                      minimum=None, choices=("plane", "box")),
+                Param("size", "float", 20.0, "Side length of the square drawn (m); the box's too"),
+                Param("thickness", "float", 0.01, "Thickness of the box (m)"),
                 Param("lateral_friction", "float", 4.0, "Ground lateral friction coefficient",
                       inclusive=True),
             ),

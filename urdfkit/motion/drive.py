@@ -35,6 +35,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from urdfkit.core.errors import ParameterError, UrdfkitError
 from urdfkit.engine.session import LoadOptions, Session, quiet_stdout
@@ -60,6 +61,10 @@ from urdfkit.motion.vehicle import (
 from urdfkit.motion.vehicle_shapes import base_link_pose, lowest_point, set_base_link_pose
 from urdfkit.sources.cache import cache_dir, write_entry
 
+if TYPE_CHECKING:
+    from urdfkit.model.gazebo import GazeboContact
+    from urdfkit.motion.mimic import Mimic
+
 #: Default simulated samples per second in the trajectory (and for the statistics): enough
 #: for a smooth path and a good circle fit, cheap enough to cost nothing next to the physics.
 SAMPLES_PER_SECOND = 10
@@ -67,8 +72,6 @@ SAMPLES_PER_SECOND = 10
 PYBULLET_LINK_DAMPING = 0.04
 #: The tutorial's start: the car's base 0.1 m up, loaded before the plane.
 TUTORIAL_START = (0.0, 0.0, 0.1)
-#: The built-in ground is at least this size (m), and larger when the run needs it.
-MIN_GROUND = 20.0
 
 BASE_COLUMNS = ("t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz")
 
@@ -126,6 +129,11 @@ class DriveConfig:
         limp: Let the passive joints (neither wheels, hinges nor casters: an arm on a mobile
             base) go limp; by default each is held at its start angle by a position motor
             with the URDF's effort as its force.
+        gazebo_contacts: Apply the file's ``<gazebo reference>`` contact parameters at load
+            (PyBullet ignores them): lateral friction from mu1/mu2 (the smaller), contact
+            stiffness and damping from kp/kd (both given); see :mod:`urdfkit.model.gazebo`.
+        mimic: Honour ``<mimic>`` (a gear constraint per follower, :mod:`urdfkit.motion.mimic`);
+            False: raw PyBullet, which ignores it.
     """
 
     urdf: str | None = None
@@ -153,6 +161,8 @@ class DriveConfig:
     package_paths: list[str] | None = None
     up: str = "z"
     limp: bool = False
+    gazebo_contacts: bool = False
+    mimic: bool = True
 
     def check(self) -> None:
         """Refuse values that would make the run meaningless (exit 2 in the CLI)."""
@@ -310,6 +320,12 @@ class Scenario:
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
         self._last_file = ""
         self._phantom: list[str] | None = None
+        self._gazebo: dict[str, GazeboContact] = {}
+        self._mimics: list[Mimic] = []
+        #: Mimic followers geared to their leaders: {joint name: constraint id}.
+        self.mimic_followers: dict[str, int] = {}
+        #: The Gazebo contacts applied at load: {link: {lateralFriction, ...}}.
+        self.gazebo_applied: dict[str, dict[str, float]] = {}
         self.session: Session | None = None
         try:
             self._open()
@@ -347,6 +363,11 @@ class Scenario:
                 children = {c.get("link") for c in res.root.iterfind("joint/child")}
                 self._phantom = [el.get("name", "") for el in res.root.iterchildren("link")
                                  if el.find("inertial") is None and el.get("name") in children]
+                from urdfkit.motion.gazebo_load import contacts_to_apply
+                from urdfkit.motion.mimic import mimic_relations
+
+                self._gazebo = contacts_to_apply(res.root)
+                self._mimics = mimic_relations(res.root)
             return s.load_urdf(res.load_path, options, display=res.name)
 
     def _open(self) -> None:
@@ -378,6 +399,12 @@ class Scenario:
             raise DrivetrainError(e.message, file=car, param=e.param) from None
         if spawn != upright:  # the link frame, as loadURDF placed it
             set_base_link_pose(p, self.body, start, spawn)
+        if c.gazebo_contacts:
+            self._apply_gazebo()
+        if c.mimic and self._mimics:
+            from urdfkit.motion.mimic import couple_mimics
+
+            self.mimic_followers = couple_mimics(p, self.body, self._mimics)
         # The tutorial loads its plane as it is (a mass-0 box: static either way).
         self.plane = self._load(s, c.plane, "simpleplane", LoadOptions(
             fixed_base=not c.tutorial, implicit_cylinder=not c.tutorial), self._ground_params())
@@ -394,6 +421,34 @@ class Scenario:
         for j in train.wheels + train.hinges:
             name = train.joint_names[j]
             self.columns += [f"{name}_angle", f"{name}_speed"]
+
+    def _apply_gazebo(self) -> None:
+        """Carry the file's Gazebo contact parameters over with changeDynamics."""
+        from urdfkit.motion.gazebo_load import apply_gazebo_contacts
+
+        assert self.session is not None
+        self.gazebo_applied = apply_gazebo_contacts(self.session.bullet, self.body,
+                                                    self._gazebo)
+
+    def gazebo_differences(self) -> list[str]:
+        """The file's Gazebo friction where PyBullet uses another, as a user reads it."""
+        if not self._gazebo or self.session is None:
+            return []
+        from urdfkit.motion.gazebo_load import link_indices
+
+        p = self.session.bullet
+        index = link_indices(p, self.body)
+        out = []
+        for name, g in self._gazebo.items():
+            mu = g.lateral_friction
+            if mu is None or name not in index:
+                continue
+            used = p.getDynamicsInfo(self.body, index[name])[1]
+            if abs(used - mu) > 1e-9 * max(1.0, mu):
+                given = " ".join(f"{k} {v:g}" for k, v in g.given().items()
+                                 if k in ("mu1", "mu2"))
+                out.append(f"{name} {given}, PyBullet uses {used:g}")
+        return out
 
     def _warn_phantom_mass(self) -> None:
         """Say when PyBullet's 1 kg for each link without <inertial> is much of the robot.
@@ -426,7 +481,9 @@ class Scenario:
         assert self.session is not None
         p, train = self.session.bullet, self.drivetrain
         casters = set(train.casters)
-        candidates = [j for j in train.passive if j not in casters]
+        geared = set(self.mimic_followers)  # moved by their leaders' gears, not held
+        candidates = [j for j in train.passive if j not in casters
+                      and train.joint_names[j] not in geared]
         self.held: dict[int, tuple[float, float]] = {}  # joint: (angle, force)
         self.limp: list[int] = list(candidates) if self.config.limp else []
         if self.config.limp or not candidates:
@@ -445,13 +502,16 @@ class Scenario:
                                  f"{', '.join(weak[:8])}{', ...' if len(weak) > 8 else ''}")
 
     def _ground_params(self) -> dict[str, str] | None:
-        """The built-in ground's size: at least 20 m, and room for the whole run."""
-        c, train = self.config, self.drivetrain
-        if c.plane is not None or c.tutorial:
+        """The built-in ground: an infinite plane, or the tutorial's own box.
+
+        A box ground loaded with URDF_USE_IMPLICIT_CYLINDER makes wheeled robots veer (MiR100
+        at steer 0: 0.375 m forward and 0.277 rad of yaw in 3 s); PyBullet's plane shape does
+        not (6.18 m, 0.003 rad), and needs no size.
+        """
+        c = self.config
+        if c.plane is not None:
             return None
-        reach = abs(c.throttle) * train.reference_radius * c.total_steps * c.time_step
-        size = max(MIN_GROUND, math.ceil(2 * (reach + 5.0)))
-        return None if size == MIN_GROUND else {"size": str(size)}
+        return {"shape": "box"} if c.tutorial else None
 
     def _ground(self) -> tuple[float | None, tuple[float, float, float, float] | None]:
         """The ground's top z and its x-y extent (None where unbounded, as a GEOM_PLANE)."""
@@ -479,7 +539,15 @@ class Scenario:
         p = self.session.bullet
         self.problems = []
         self.static_base = p.getDynamicsInfo(self.body, -1)[0] == 0
-        if self.static_base:
+        root = p.getBodyInfo(self.body)[0].decode("utf-8", "replace")
+        if self.static_base and root == "world":
+            # PyBullet gives a link named `world` without <inertial> mass 0, not 1 kg
+            # (measured on 3.2.7: with a mass of its own it falls like any other).
+            self.problems.append("static base: the root link is named `world`, and PyBullet "
+                                 "gives a `world` link without <inertial> mass 0, which fixes it "
+                                 "where it is loaded: the car cannot move; drop the `world` link "
+                                 "and its joint (build without the world frame) to drive it")
+        elif self.static_base:
             self.problems.append("static base: the root link has mass 0, so PyBullet fixes it "
                                  "where it is loaded and the car cannot move; give it a mass")
         points = p.getClosestPoints(self.body, self.plane, 0.0)
@@ -567,6 +635,8 @@ class Scenario:
             "link_damping": {"linear": PYBULLET_LINK_DAMPING,
                              "angular": PYBULLET_LINK_DAMPING, "note": "PyBullet's default"},
             "tutorial": c.tutorial,
+            "gazebo_contacts": self.gazebo_applied,
+            "mimic": sorted(self.mimic_followers),
         }
 
     def run(self, progress: ProgressFn | None = None,
@@ -659,6 +729,14 @@ class Scenario:
             if share < 0.9:
                 (problems if share < 0.1 else warnings).append(
                     _yaw_shortfall(self, rate, share, sim_time))
+        slipping = [m for m in problems + warnings
+                    if m.startswith(("wheels slipping", "stuck", "skid steering turns",
+                                     "differential steering turns"))]
+        differ = self.gazebo_differences() if slipping else []
+        if differ:
+            shown = "; ".join(differ[:4]) + ("; ..." if len(differ) > 4 else "")
+            warnings.append(f"the file's <gazebo> gives {shown}: --gazebo-contacts applies "
+                            f"{'them' if len(differ) > 1 else 'it'}")
         last = stats.last
         assert last is not None
         expected = train.expected_radius(c.throttle, self.steer)
@@ -678,38 +756,64 @@ class Scenario:
 
 
 def _yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> str:
-    """Why the base turns slower than commanded, and whether more wheel force helps.
+    """Why the base turns slower than commanded, and advice that was tried before it is said.
 
-    Measured, not guessed: the same drive (same duration, so the same settled half) is
-    run again with ten times the wheel force. Only when that turns clearly faster (1.5x)
-    is the user told to raise ``max_force``; otherwise the wheels are slipping sideways,
-    which more torque cannot cure (husky turns at 0.132 rad/s of 0.3 at 500 N m and at
-    10,000 alike). Runs over :data:`PROBE_LIMIT` s are not repeated.
+    The same drive (same duration, so the same settled half) is run again over what a user
+    would reach: ten and a hundred times the wheel force (capped at PyBullet's default), then,
+    if no force helps, up to three times the yaw rate (capped where the inner wheels would
+    stop: 2 v / track). Advice is given only when its run turns clearly faster (1.5x); it
+    names the option as the command line spells it. At most three re-runs, only when this
+    warning is printed; runs over :data:`PROBE_LIMIT` s are not repeated.
     """
     c, train = sc.config, sc.drivetrain
     kind = "skid steering" if train.steering == "skid" else "differential steering"
     said = f"{kind} turns at {rate:.3g} rad/s, {share:.0%} of the {sc.steer:g} commanded"
     force = PYBULLET_DEFAULT_FORCE if c.max_force is None else c.max_force
-    if force >= PYBULLET_DEFAULT_FORCE:
-        return f"{said}, at PyBullet's default wheel force: the wheels slip sideways"
-    higher = min(force * 10.0, PYBULLET_DEFAULT_FORCE) if force > 0 else 10.0
     if not 0 < sim_time <= PROBE_LIMIT:
         return (f"{said}; not measured at more force (the run is over {PROBE_LIMIT:g} s): "
                 "the wheels slip sideways, or the motors are too weak")
-    probe_cfg = replace(c, max_force=higher, keep_trajectory=False, gui=False, steps=None,
-                        seconds=sim_time)
-    try:
-        with Scenario(probe_cfg, probe=True) as sc:
-            probe = sc.run().yaw_rate
-    except UrdfkitError:
-        probe = None
-    if probe is not None and abs(probe) > 1.5 * abs(rate) and \
-            abs(probe - rate) > 0.05 * abs(sc.steer):
-        return (f"{said}; at {higher:g} N m it turns at {probe:.3g} rad/s "
-                f"({probe / sc.steer:.0%}): raise `max_force`")
-    at = "" if probe is None else f" (at {higher:g} N m: {probe:.3g} rad/s)"
-    return (f"{said}; more wheel force does not help{at}: the wheels slip sideways, "
-            "so command more yaw rate for more turn")
+
+    def probe(**changes: float | None) -> float | None:
+        cfg = replace(c, keep_trajectory=False, gui=False, steps=None, seconds=sim_time,
+                      **changes)  # type: ignore[arg-type]
+        try:
+            with Scenario(cfg, probe=True) as run:
+                return run.run().yaw_rate
+        except UrdfkitError:
+            return None
+
+    def better(r: float | None) -> bool:
+        return r is not None and abs(r) > 1.5 * abs(rate) and \
+            abs(r - rate) > 0.05 * abs(sc.steer)
+
+    def shown(r: float | None) -> str:
+        return "failed" if r is None else f"{r:.3g} rad/s"
+
+    tried: list[str] = []
+    for factor in (10.0, 100.0):
+        higher = min(force * factor, PYBULLET_DEFAULT_FORCE) if force > 0 else factor
+        if higher <= force or (tried and tried[-1].startswith(f"--max-force {higher:g}:")):
+            break
+        r = probe(max_force=higher)
+        if better(r):
+            assert r is not None
+            return (f"{said}; with --max-force {higher:g} it turns at {r:.3g} rad/s "
+                    f"({r / sc.steer:.0%}): run with --max-force {higher:g}")
+        tried.append(f"--max-force {higher:g}: {shown(r)}")
+    widest = 2.0 * abs(c.throttle) * train.reference_radius / train.track \
+        if train.track > 0 else math.inf
+    more = math.copysign(min(3.0 * abs(sc.steer), widest), sc.steer)
+    if abs(more) > 1.2 * abs(sc.steer):
+        r = probe(steer=more)
+        if better(r):
+            assert r is not None
+            first = f"more wheel force does not help ({'; '.join(tried)})" if tried \
+                else "at PyBullet's default wheel force"
+            return (f"{said}; {first}: the wheels slip sideways, and --steer {more:.3g} "
+                    f"turns at {r:.3g} rad/s: command more yaw rate (--steer {more:.3g})")
+        tried.append(f"--steer {more:.3g}: {shown(r)}")
+    return (f"{said}; neither more force nor more yaw rate turns it faster "
+            f"({'; '.join(tried)}): the wheels slip sideways")
 
 
 class _GuiControls:

@@ -226,6 +226,11 @@ class RobotConfig(ConfigModel):
     base_velocity: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     base_angular_velocity: vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     link_dynamics: dict[str, LinkDynamics] = Field(default_factory=dict)
+    # Apply the file's <gazebo reference> mu1/mu2/kp/kd (PyBullet ignores them) at load;
+    # link_dynamics overrides them.
+    gazebo_contacts: bool = False
+    # Honour <mimic> (a gear constraint per follower); false: raw PyBullet, which ignores it.
+    mimic: bool = True
     inertia_from_file: bool = True
     implicit_cylinder: bool = True
     self_collision: bool = False

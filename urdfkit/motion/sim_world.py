@@ -209,6 +209,14 @@ class World:
             # The pose is the base's centre of mass, as resetBasePositionAndOrientation takes it.
             p.resetBasePositionAndOrientation(body, cfg.position, orientation)
         loaded = (str(self._resolved[-1].load_path), options)
+        if cfg.gazebo_contacts:  # before link_dynamics, which overrides them
+            from urdfkit.motion.gazebo_load import apply_gazebo_contacts, contacts_to_apply
+
+            apply_gazebo_contacts(p, body, contacts_to_apply(self._resolved[-1].root))
+        if cfg.mimic:  # PyBullet ignores <mimic>: a gear constraint per follower
+            from urdfkit.motion.mimic import couple_mimics, mimic_relations
+
+            couple_mimics(p, body, mimic_relations(self._resolved[-1].root))
         try:
             # getBasePositionAndOrientation, getJointStates... all fail on 128+ link bodies.
             self.session.require_state_queries(body, str(cfg.name))

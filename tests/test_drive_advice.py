@@ -1,0 +1,48 @@
+"""drive's yaw advice is tried before it is said (issue 41, item 4), over the range a user
+would reach (force up to 100x, more yaw rate), and names options as the command line does.
+
+stiff_skid.urdf needs a hundred times drive's 10 N m to turn; the advice's setting is run
+again here, independently, and must turn."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from urdfkit.motion.drive import DriveConfig, drive
+
+SKID = str(Path(__file__).parent / "fixtures" / "robots" / "stiff_skid.urdf")
+
+
+def test_advice_reaches_a_hundred_times_the_force_and_is_right() -> None:
+    weak = drive(DriveConfig(urdf=SKID, steer=0.3, seconds=4, keep_trajectory=False))
+    said = [w for w in weak.warnings if w.startswith("skid steering turns at")]
+    assert len(said) == 1, weak.warnings
+    assert weak.yaw_rate is not None and abs(weak.yaw_rate) < 0.01
+    # The option as the command line spells it, at 100x the 10 N m default.
+    assert said[0].endswith("run with --max-force 1000"), said[0]
+    assert "max_force" not in said[0]
+    quoted = float(re.search(r"with --max-force 1000 it turns at (\S+) rad/s", said[0])[1])
+    advised = drive(DriveConfig(urdf=SKID, steer=0.3, seconds=4, keep_trajectory=False,
+                                max_force=1000))
+    assert advised.yaw_rate is not None and advised.yaw_rate > 0.05  # it does turn
+    assert advised.yaw_rate == float(f"{quoted:.3g}") or \
+        abs(advised.yaw_rate - quoted) < 5e-4 * max(1.0, abs(quoted))
+    # and ten times (100 N m) would not have been enough: the advice did not stop there.
+    ten = drive(DriveConfig(urdf=SKID, steer=0.3, seconds=4, keep_trajectory=False,
+                            max_force=100))
+    assert ten.yaw_rate is not None and abs(ten.yaw_rate) < 0.01
+
+
+def test_more_yaw_rate_is_not_advised_when_it_does_not_turn_more() -> None:
+    # husky at 1000 N m slips sideways: neither 10x force nor 3x the yaw rate turns it faster
+    # (--steer 0.9 turns slower), so nothing is advised.
+    r = drive(DriveConfig(urdf="husky/husky.urdf", steer=0.3, seconds=6, max_force=1000,
+                          keep_trajectory=False))
+    said = [w for w in r.warnings if w.startswith("skid steering turns at")]
+    assert len(said) == 1 and "neither more force nor more yaw rate" in said[0], said
+    slower = drive(DriveConfig(urdf="husky/husky.urdf", steer=0.9, seconds=6, max_force=1000,
+                               keep_trajectory=False))
+    assert r.yaw_rate is not None and slower.yaw_rate is not None
+    assert abs(slower.yaw_rate) < 1.5 * abs(r.yaw_rate)
+    assert "--steer 0.9: " in said[0]
