@@ -212,7 +212,7 @@ def test_leaving_the_ground_and_a_static_base_are_reported(tmp_path: Path) -> No
     assert 10.0 <= left_at <= 11.5, problems[0]
     assert any(p.startswith("fell:") for p in problems)
     assert any(p.startswith("flipped over at t = ") for p in problems)  # it tumbles off
-    # The built-in ground is an infinite plane instead.
+    # The built-in ground grows with the run instead.
     assert drive(DriveConfig(seconds=30, keep_trajectory=False)).problems == []
     static = tmp_path / "static.urdf"
     static.write_text(build_template("simplecar").to_bytes().decode().replace(

@@ -199,7 +199,7 @@ class SimpleDrivingEnv(gym.Env):
         # reset (PyBullet's default does not, and single-step episodes then differ).
         p.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
         p.setGravity(0, 0, self.GRAVITY)
-        # The tutorial's own ground, a box (drive's default ground is an infinite plane).
+        # The tutorial's own ground, a box centred on its origin (drive's default is the slab).
         plane, car = builtin_file("simpleplane", TUTORIAL_GROUND), builtin_file("simplecar")
         if plane is None or car is None:  # no writable cache: build into a temp folder
             import tempfile

@@ -177,12 +177,13 @@ TEMPLATES: dict[str, Template] = {
         ),
         Template(
             "simpleplane", "simpleplane.urdf.xacro",
-            "A static ground with high friction: an infinite plane (the default) or the "
-            "tutorial's 20 x 20 m box.",
+            "A static ground with high friction: a slab whose top is z = 0 (the default), "
+            "PyBullet's infinite plane, or the tutorial's 20 x 20 m box.",
             (
-                Param("shape", "choice", "plane", "plane: PyBullet's infinite plane, its top at "
-                      "z = 0 (wheels roll straight); box: the tutorial's box (size, thickness)",
-                      minimum=None, choices=("plane", "box")),
+                Param("shape", "choice", "slab", "slab: a box whose top face is z = 0 (wheels "
+                      "roll straight); plane: PyBullet's infinite plane at z = 0; box: the "
+                      "tutorial's box centred on its origin", minimum=None,
+                      choices=("slab", "plane", "box")),
                 Param("size", "float", 20.0, "Side length of the square drawn (m); the box's too"),
                 Param("thickness", "float", 0.01, "Thickness of the box (m)"),
                 Param("lateral_friction", "float", 4.0, "Ground lateral friction coefficient",

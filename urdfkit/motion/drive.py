@@ -72,6 +72,8 @@ SAMPLES_PER_SECOND = 10
 PYBULLET_LINK_DAMPING = 0.04
 #: The tutorial's start: the car's base 0.1 m up, loaded before the plane.
 TUTORIAL_START = (0.0, 0.0, 0.1)
+#: The built-in ground is at least this size (m), and larger when the run needs it.
+MIN_GROUND = 20.0
 
 BASE_COLUMNS = ("t", "x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz")
 
@@ -502,16 +504,22 @@ class Scenario:
                                  f"{', '.join(weak[:8])}{', ...' if len(weak) > 8 else ''}")
 
     def _ground_params(self) -> dict[str, str] | None:
-        """The built-in ground: an infinite plane, or the tutorial's own box.
+        """The built-in ground: a slab with room for the whole run, or the tutorial's own box.
 
-        A box ground loaded with URDF_USE_IMPLICIT_CYLINDER makes wheeled robots veer (MiR100
-        at steer 0: 0.375 m forward and 0.277 rad of yaw in 3 s); PyBullet's plane shape does
-        not (6.18 m, 0.003 rad), and needs no size.
+        The slab's top is z = 0 and its collision box lies below the link origin. Measured on
+        PyBullet 3.2.7 with implicit-cylinder wheels: on the tutorial's box, centred on its
+        origin, MiR100 veers at steer 0 (0.375 m forward, 0.277 rad of yaw in 3 s); on the slab
+        it does not (1.81 m, 5 mm sideways), nor does a six-cylinder base that circles on
+        PyBullet's infinite plane (tests/test_drive_ground.py).
         """
-        c = self.config
+        c, train = self.config, self.drivetrain
         if c.plane is not None:
             return None
-        return {"shape": "box"} if c.tutorial else None
+        if c.tutorial:
+            return {"shape": "box"}
+        reach = abs(c.throttle) * train.reference_radius * c.total_steps * c.time_step
+        size = max(MIN_GROUND, math.ceil(2 * (reach + 5.0)))
+        return None if size == MIN_GROUND else {"size": str(size)}
 
     def _ground(self) -> tuple[float | None, tuple[float, float, float, float] | None]:
         """The ground's top z and its x-y extent (None where unbounded, as a GEOM_PLANE)."""
