@@ -4,8 +4,9 @@ The tutorial's box (centred on its link origin) makes MiR100 veer at steer 0 wit
 loaded as implicit cylinders; the fixture mir_like.urdf is MiR100 with its mesh collisions
 replaced by boxes, and veers the same way on that box. PyBullet's infinite plane fixes MiR but
 lets six_cylinders.urdf (six wheels of one radius) circle; the slab (a box whose collision lies
-below its link origin) drives both straight. Expectations are physics (rolling without slip: v = omega r; a
-differential base turning at omega: R = v / omega) and PyBullet's own shape queries.
+below its link origin) drives both straight. Expectations are physics (rolling without slip:
+v = omega r; a differential base turning at omega: R = v / omega) and PyBullet's own shape
+queries.
 """
 
 from __future__ import annotations
