@@ -132,7 +132,7 @@ def test_simplecar_velocity_export_drives_forward_in_mujoco(tmp_path: Path) -> N
     throttle = DriveConfig().throttle
     with Session() as s:
         body = s.load_urdf(car, LoadOptions())
-        train = detect_drivetrain(s.p, body, s.client)
+        train = detect_drivetrain(s.bullet, body)
         speeds = train.wheel_speeds(throttle, 0.0)
         targets = {train.joint_names[w]: speeds[w] * train.wheel_signs.get(w, 1.0)
                    for w in train.wheels if w in speeds}

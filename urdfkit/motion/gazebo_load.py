@@ -7,12 +7,17 @@ of mu1 and mu2, contact stiffness and damping from kp and kd when both are given
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 from urdfkit.model.gazebo import GazeboContact, gazebo_contacts
 
+if TYPE_CHECKING:
+    from lxml import etree
 
-def link_indices(p: Any, body: int) -> dict[str, int]:
+    from urdfkit.engine.session import Bullet
+
+
+def link_indices(p: Bullet, body: int) -> dict[str, int]:
     """Every link's PyBullet index by name (the root -1)."""
     out = {p.getBodyInfo(body)[0].decode("utf-8", "replace"): -1}
     for j in range(p.getNumJoints(body)):
@@ -20,12 +25,12 @@ def link_indices(p: Any, body: int) -> dict[str, int]:
     return out
 
 
-def contacts_to_apply(root: Any) -> dict[str, GazeboContact]:
+def contacts_to_apply(root: etree._Element) -> dict[str, GazeboContact]:
     """The links whose <gazebo> gives something PyBullet can take."""
     return {k: g for k, g in gazebo_contacts(root).items() if g.pybullet()}
 
 
-def apply_gazebo_contacts(p: Any, body: int,
+def apply_gazebo_contacts(p: Bullet, body: int,
                           contacts: dict[str, GazeboContact]) -> dict[str, dict[str, float]]:
     """Set each link's dynamics as its Gazebo block says; {link: the values set}."""
     index, applied = link_indices(p, body), {}

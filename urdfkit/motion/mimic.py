@@ -19,7 +19,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from lxml import etree
+
+    from urdfkit.engine.session import Bullet
 
 #: The gear's force when the follower's URDF gives no effort (N or N m).
 DEFAULT_MIMIC_FORCE = 1000.0
@@ -45,7 +50,7 @@ def _number(text: str | None, default: float) -> float:
     return x if math.isfinite(x) else default
 
 
-def mimic_relations(root: Any) -> list[Mimic]:
+def mimic_relations(root: etree._Element) -> list[Mimic]:
     """Every joint's ``<mimic>`` in an lxml URDF root (multiplier 0 skipped: nothing to gear)."""
     out = []
     for joint in root.iterchildren("joint"):
@@ -60,7 +65,7 @@ def mimic_relations(root: Any) -> list[Mimic]:
     return out
 
 
-def couple_mimics(p: Any, body: int, mimics: list[Mimic]) -> dict[str, int]:
+def couple_mimics(p: Bullet, body: int, mimics: list[Mimic]) -> dict[str, int]:
     """A gear constraint per follower; {follower: constraint id}.
 
     Followers are put on the relation first; joints PyBullet did not load (fixed, unknown)
