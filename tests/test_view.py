@@ -23,6 +23,10 @@ from typing import Any
 
 import pytest
 
+#: One worker runs every page and server test (pytest-xdist --dist loadgroup): two Chromiums
+#: drawing WebGL in software on 2 cores starve each other.
+pytestmark = pytest.mark.xdist_group("browser")
+
 pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
 
 from urdfkit.draw import view_page  # noqa: E402
