@@ -269,3 +269,22 @@ def test_a_package_lookup_is_kept_only_while_settled_and_still_noted(tmp_path: P
         (tmp_path / "package.xml").unlink()
         assert uris.find_package("pkg_x", deep) == tmp_path
     assert uris.find_package("pkg_x", deep) is None
+
+
+def test_package_path_follows_symlinked_packages_and_survives_a_loop(
+        workspaces: tuple[Path, Path], tmp_path: Path) -> None:
+    """A workspace whose src/ links its packages in (as ROSbot's did in the real-package
+    trials): catkin_pkg and rospack follow the links, and so does --package-path."""
+    arm, macros_ws = workspaces
+    linked = tmp_path / "linked_ws" / "src"
+    linked.mkdir(parents=True)
+    (linked / "common_macros").symlink_to(macros_ws / "nested" / "common_macros",
+                                          target_is_directory=True)
+    (linked / "loop").symlink_to(tmp_path / "linked_ws", target_is_directory=True)
+    env = {"ROS_PACKAGE_PATH": "", "AMENT_PREFIX_PATH": ""}
+    doc = joints([str(arm), "--package-path", str(tmp_path / "linked_ws")], env)
+    names = [j["jointName"] for j in doc["joints"]]  # type: ignore[union-attr]
+    assert names == ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"]
+    index = PackageIndex({}, [str(tmp_path / "linked_ws")], env=False)
+    assert index["common_macros"] == linked / "common_macros"
+    assert list(index) == ["common_macros"]  # the loop is entered once, nothing found twice
