@@ -825,6 +825,7 @@ CODES: dict[str, str] = {
     "U708": "package:/// without a package name",
     "U709": "transmission names a missing joint",
     "U710": "one material name given several colours (PyBullet draws them all in the last)",
+    "U711": "package:// found only through a package.xml, which raw PyBullet does not read",
     "U715": "visual mesh PyBullet draws nothing or only part of (empty, COLLADA <instance_node>)",
     "U801": "unknown tag",
     "U802": "unknown attribute",
