@@ -120,3 +120,53 @@ def test_a_link_without_collision_gets_nothing(tmp_path: Path) -> None:
     found = [f for f in json.loads(_run("check", str(path), "--json")[1])["findings"]
              if f["code"] == "U803"]
     assert len(found) == 1 and "'a'" in found[0]["message"]
+
+
+ONE_WAY = Path(__file__).parent / "fixtures" / "robots" / "one_way_grip.urdf"
+
+
+def _roll(pb, path: Path, seconds: float = 2.0, omega: float = 5.0) -> tuple[float, list[float]]:
+    """Raw PyBullet: all four wheels at omega on plane.urdf; the base's travel in x and each
+    wheel's lateral friction."""
+    import pybullet_data
+
+    p, c = pb
+    p.resetSimulation(physicsClientId=c)
+    p.setGravity(0, 0, -G, physicsClientId=c)
+    p.loadURDF(str(Path(pybullet_data.getDataPath()) / "plane.urdf"), physicsClientId=c)
+    body = p.loadURDF(str(path), [0, 0, 0.07], flags=p.URDF_USE_IMPLICIT_CYLINDER,
+                      physicsClientId=c)
+    n = p.getNumJoints(body, physicsClientId=c)
+    for _ in range(120):  # settle
+        p.stepSimulation(physicsClientId=c)
+    x0 = p.getBasePositionAndOrientation(body, physicsClientId=c)[0][0]
+    for i in range(n):
+        p.setJointMotorControl2(body, i, p.VELOCITY_CONTROL, targetVelocity=omega, force=1.5,
+                                physicsClientId=c)
+    for _ in range(int(240 * seconds)):
+        p.stepSimulation(physicsClientId=c)
+    x1 = p.getBasePositionAndOrientation(body, physicsClientId=c)[0][0]
+    return x1 - x0, [p.getDynamicsInfo(body, i, physicsClientId=c)[1] for i in range(n)]
+
+
+def test_one_way_grip_is_carried_as_the_larger_so_the_robot_drives(pb, tmp_path: Path) -> None:
+    """ROSbot 2R's wheels (mu 1 along fdir1, mu2 0 across): the smaller, 0, stops the robot."""
+    out = tmp_path / "fixed.urdf"
+    code, text = _run("fix", str(ONE_WAY), "--gazebo-contacts", "-o", str(out), "--json")
+    assert code == 0, text
+    fixes = json.loads(text)["fixes"]
+    assert len(fixes) == 4 and all("the larger of mu1 and mu2" in f["message"] for f in fixes)
+    moved, friction = _roll(pb, out)
+    assert friction == [1.0] * 4
+    # omega r t = 5 x 0.0425 x 2 = 0.425 m; a skid steer rolling straight keeps most of it.
+    assert moved > 0.8 * 5.0 * 0.0425 * 2.0
+    # What the old rule wrote, lateral_friction 0 on every wheel: raw PyBullet does not move.
+    zero = tmp_path / "zero.urdf"
+    zero.write_text(out.read_text().replace('<lateral_friction value="1"/>',
+                                            '<lateral_friction value="0"/>'))
+    stuck, friction0 = _roll(pb, zero)
+    assert friction0 == [0.0] * 4 and abs(stuck) < 0.01
+    # check says which value fix writes, and why.
+    findings = json.loads(_run("check", str(ONE_WAY), "--json")[1])["findings"]
+    notes = [f["message"] for f in findings if f["code"] == "U803"]
+    assert len(notes) == 4 and all("fix writes the larger, 1" in m for m in notes)

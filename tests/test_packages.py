@@ -269,3 +269,56 @@ def test_a_package_lookup_is_kept_only_while_settled_and_still_noted(tmp_path: P
         (tmp_path / "package.xml").unlink()
         assert uris.find_package("pkg_x", deep) == tmp_path
     assert uris.find_package("pkg_x", deep) is None
+
+
+def test_package_path_follows_symlinked_packages_and_survives_a_loop(
+        workspaces: tuple[Path, Path], tmp_path: Path) -> None:
+    """A workspace whose src/ links its packages in (as ROSbot's did in the real-package
+    trials): catkin_pkg and rospack follow the links, and so does --package-path."""
+    arm, macros_ws = workspaces
+    linked = tmp_path / "linked_ws" / "src"
+    linked.mkdir(parents=True)
+    (linked / "common_macros").symlink_to(macros_ws / "nested" / "common_macros",
+                                          target_is_directory=True)
+    (linked / "loop").symlink_to(tmp_path / "linked_ws", target_is_directory=True)
+    env = {"ROS_PACKAGE_PATH": "", "AMENT_PREFIX_PATH": ""}
+    doc = joints([str(arm), "--package-path", str(tmp_path / "linked_ws")], env)
+    names = [j["jointName"] for j in doc["joints"]]  # type: ignore[union-attr]
+    assert names == ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"]
+    index = PackageIndex({}, [str(tmp_path / "linked_ws")], env=False)
+    assert index["common_macros"] == linked / "common_macros"
+    assert list(index) == ["common_macros"]  # the loop is entered once, nothing found twice
+
+
+def test_a_package_found_only_through_package_xml_is_said_where_raw_pybullet_refuses(
+        pb, tmp_path: Path) -> None:
+    """poppy_ergo_jr_description unpacked as poppy-project+poppy_ergo_jr_description: urdfkit
+    found its meshes through package.xml and loaded it; raw p.loadURDF refused it."""
+    from urdfkit.engine.session import quiet_stdout
+
+    p, c = pb
+    repo = tmp_path / "owner+arm_like_description"  # the package at a repository's root
+    shutil.copytree(PACKAGES / "arm_like_description", repo)
+    robot = repo / "urdf" / "arm.urdf"
+    robot.write_text(
+        '<robot name="arm"><link name="base"><visual><geometry>'
+        '<mesh filename="package://arm_like_description/meshes/segment.stl"/>'
+        '</geometry></visual></link></robot>')
+    with quiet_stdout(), pytest.raises(p.error):
+        p.loadURDF(str(robot), physicsClientId=c)
+    result = runner.invoke(app, ["check", str(robot), "--json"],
+                           env={"ROS_PACKAGE_PATH": "", "AMENT_PREFIX_PATH": ""})
+    codes = [f["code"] for f in json.loads(result.stdout)["findings"]]
+    assert "U711" in codes
+    assert joints([str(robot)])["joints"] == []  # urdfkit still loads it
+    # Given the package on the command line, the user has said where it is: no U711.
+    given = runner.invoke(app, ["check", str(robot), "--json", "--package-path", str(tmp_path)])
+    assert "U711" not in [f["code"] for f in json.loads(given.stdout)["findings"]]
+    # Under its own name raw PyBullet finds the mesh, and check says nothing of it.
+    named = tmp_path / "ws" / "arm_like_description"
+    shutil.copytree(repo, named)
+    with quiet_stdout():
+        p.loadURDF(str(named / "urdf" / "arm.urdf"), physicsClientId=c)
+    result = runner.invoke(app, ["check", str(named / "urdf" / "arm.urdf"), "--json"],
+                           env={"ROS_PACKAGE_PATH": "", "AMENT_PREFIX_PATH": ""})
+    assert "U711" not in [f["code"] for f in json.loads(result.stdout)["findings"]]

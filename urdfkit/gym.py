@@ -313,7 +313,7 @@ class SimpleDrivingEnv(gym.Env):
         return np.array((pos[0], pos[1], cos, sin, lin[0], lin[1], *self.goal),
                         dtype=np.float32)
 
-    def render(self) -> np.ndarray | None:
+    def render(self) -> np.ndarray | None:  # type: ignore[override, unused-ignore]
         """An ``rgb_array`` frame (height x width x 3, uint8); None in ``human`` mode."""
         if self.render_mode != "rgb_array":
             return None
@@ -706,7 +706,7 @@ class ScenarioEnv(gym.Env):
         self._ended = done or truncated
         return self._obs(o), reward, done, truncated, {"t": o.t}
 
-    def render(self) -> np.ndarray | None:
+    def render(self) -> np.ndarray | None:  # type: ignore[override, unused-ignore]
         """An ``rgb_array`` frame looking at the robot (height x width x 3, uint8)."""
         if self.render_mode != "rgb_array":
             return None

@@ -430,7 +430,9 @@ class _Plan:
         for k, v in new.items():
             etree.SubElement(contact, k, value=fmt_float(v))
         said = ", ".join(f"{k} {fmt_float(v)}" for k, v in new.items())
-        source = ("the smaller of mu1 and mu2" if gz.mu1 is not None and gz.mu2 is not None
+        source = ("the larger of mu1 and mu2 (the other is 0, which would leave no grip)"
+                  if gz.grip_only_one_way else
+                  "the smaller of mu1 and mu2" if gz.mu1 is not None and gz.mu2 is not None
                   and gz.mu1 != gz.mu2 else "mu1" if gz.mu1 is not None else "mu2")
         self.repairs.append(Repair(
             "U803", line, f"link {name!r}: wrote Gazebo's contact into <contact>: {said} "

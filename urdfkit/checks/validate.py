@@ -694,7 +694,12 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
                          f"{have.get('damping', math.nan):g} where Gazebo's are "
                          f"{differ['stiffness']:g} and {differ['damping']:g}")
         notes = []
-        if gz.mu1 is not None and gz.mu2 is not None and gz.mu1 != gz.mu2:
+        if gz.grip_only_one_way:
+            notes.append(f"mu1 and mu2 differ and one is 0 (grip one way, none across): "
+                         f"PyBullet has one coefficient in every direction, and 0 would leave "
+                         f"the link no grip at all, so fix writes the larger, "
+                         f"{gz.lateral_friction:g}, which grips across too")
+        elif gz.mu1 is not None and gz.mu2 is not None and gz.mu1 != gz.mu2:
             notes.append(f"mu1 and mu2 differ: PyBullet has one coefficient in every direction, "
                          f"and fix writes the smaller, {gz.lateral_friction:g}")
         if (gz.kp is None) != (gz.kd is None):
@@ -820,6 +825,7 @@ CODES: dict[str, str] = {
     "U708": "package:/// without a package name",
     "U709": "transmission names a missing joint",
     "U710": "one material name given several colours (PyBullet draws them all in the last)",
+    "U711": "package:// found only through a package.xml, which raw PyBullet does not read",
     "U715": "visual mesh PyBullet draws nothing or only part of (empty, COLLADA <instance_node>)",
     "U801": "unknown tag",
     "U802": "unknown attribute",

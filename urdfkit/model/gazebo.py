@@ -16,7 +16,11 @@ What carries over to PyBullet's ``<contact>`` (:meth:`GazeboContact.pybullet`):
 
 - **Friction.** PyBullet has one lateral coefficient in every direction; Gazebo's ODE has
   ``mu1`` along ``fdir1`` and ``mu2`` across it. Equal, that one number; different, the
-  smaller, so the link never grips harder than Gazebo lets it in any direction. PyBullet
+  smaller, so the link never grips harder than Gazebo lets it in any direction; but never a
+  smaller 0 beside a larger one (ROSbot 2R's wheels: ``mu 1`` along a 45 degree ``fdir1``,
+  ``mu2 0`` across it): PyBullet's one coefficient at 0 takes away the grip Gazebo gives in
+  ``fdir1`` too, and the robot cannot move (measured: 0.844 m in 4 s as built, 0 m with 0
+  written), so the larger is written, and check and fix say so. PyBullet
   multiplies the two bodies' coefficients of a contact (Gazebo takes the smaller of the two):
   on a ground of lateral friction 1 (pybullet_data's plane.urdf) the link's own coefficient
   is the contact's, as on Gazebo's ground of mu 100.
@@ -81,9 +85,21 @@ class GazeboContact:
 
     @property
     def lateral_friction(self) -> float | None:
-        """PyBullet's one coefficient for mu1 and mu2: the smaller when they differ."""
+        """PyBullet's one coefficient for mu1 and mu2: the smaller when they differ.
+
+        The larger when the smaller is 0: a coefficient of 0 in every direction is no grip
+        where Gazebo grips (:attr:`grip_only_one_way`).
+        """
         given = [m for m in (self.mu1, self.mu2) if m is not None]
-        return min(given) if given else None
+        if not given:
+            return None
+        return max(given) if self.grip_only_one_way else min(given)
+
+    @property
+    def grip_only_one_way(self) -> bool:
+        """mu1 and mu2 are both given, one 0 and the other not (a wheel that only rolls)."""
+        return (self.mu1 is not None and self.mu2 is not None
+                and min(self.mu1, self.mu2) == 0 < max(self.mu1, self.mu2))
 
     def pybullet(self) -> dict[str, float]:
         """The ``<contact>`` children that carry these over: {tag: value}."""

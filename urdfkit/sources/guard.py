@@ -507,7 +507,41 @@ def reference(tag: str, fn: str, base: Path | str,
     if tag == "mesh" and path.suffix.lower() not in MESH_FORMATS:
         return Reference(str(path), None, "U705", "error", f"{label}: PyBullet reads "
                          f"{', '.join(MESH_FORMATS)} meshes, not {path.suffix or 'this file'}")
+    unseen = _only_through_package_xml(fn, base, target.package, packages)
+    if unseen is not None:
+        return Reference(str(path), str(path), "U711", "warning", f"{label}: found through "
+                         f"the package.xml of {unseen}, a folder not named "
+                         f"{target.package!r}; PyBullet knows no package.xml (it looks for "
+                         f"{target.package}/... in the file's folder and those above), so a raw "
+                         "p.loadURDF of this file refuses it: name the package's folder "
+                         f"{target.package!r}, or load through urdfkit")
     return Reference(str(path), str(path))
+
+
+def _only_through_package_xml(fn: str, base: Path, package: str | None,
+                              packages: Mapping[str, Path] | None) -> Path | None:
+    """The package folder a ``package://`` reference was found in by its package.xml alone.
+
+    None when PyBullet's own search finds the file too, or when the user mapped the package
+    (``--package``, ``--package-path``, ROS_PACKAGE_PATH: urdfkit's loaders use the map, and
+    a user who gave it knows). Measured on poppy_ergo_jr_description unpacked under another
+    folder name: urdfkit loaded it, raw PyBullet said "Cannot load URDF file."
+    """
+    if package is None or not fn.startswith("package://"):
+        return None
+    try:
+        if packages is not None and package in packages:
+            return None
+    except OSError:
+        return None
+    from urdfkit.sources.uris import find_package, pybullet_search
+
+    folder = find_package(package, base)
+    if folder is None or folder.name == package:
+        return None  # PyBullet finds NAME/rest from the folder above
+    if pybullet_search(fn[len("package://"):], base) is not None:
+        return None
+    return folder
 
 
 def _too_many_links(n: int) -> str:

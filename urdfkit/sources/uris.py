@@ -95,12 +95,24 @@ class PackageIndex(Mapping[str, Path]):
         self._found: dict[str, Path] | None = None
 
     def _scan(self) -> dict[str, Path]:
+        """Every package under the search folders, following symlinked folders.
+
+        A workspace often links its packages into ``src/`` (``ln -s ~/repos/pkg src/``);
+        catkin's package search (catkin_pkg, ``os.walk(followlinks=True)``) and rospack
+        follow such links, so this does too. Each real folder is entered once, so a link
+        back up the tree ends the walk there instead of looping.
+        """
         if self._found is None:
             found: dict[str, Path] = {}
+            seen: set[str] = set()
             for root in self.search:
                 stack = [root]
                 while stack:
                     folder = stack.pop()
+                    real = os.path.realpath(folder)
+                    if real in seen:
+                        continue
+                    seen.add(real)
                     name = package_xml_name(folder)
                     if name is not None:
                         found.setdefault(name, Path(folder))
@@ -109,7 +121,7 @@ class PackageIndex(Mapping[str, Path]):
                         with os.scandir(folder) as it:
                             subdirs = sorted(e.path for e in it if e.name not in _SKIP_DIRS
                                              and not e.name.startswith(".")
-                                             and e.is_dir(follow_symlinks=False))
+                                             and e.is_dir(follow_symlinks=True))
                     except OSError:
                         continue
                     stack.extend(reversed(subdirs))
