@@ -35,6 +35,18 @@ def read_integrals(path: Path, suffix: str | None = None, *,
 
     ``concavity`` False leaves the concavity depth NaN.
     """
+    mesh = _read_mesh(path, suffix)
+    if mesh is None:
+        return None
+    vertices, faces, starts = mesh
+    return _solid(vertices, faces, starts, concavity=concavity)
+
+
+def _read_mesh(path: Path, suffix: str | None = None) -> tuple[Any, Any, list[int]] | None:
+    """A mesh's vertices, triangles and (OBJ) piece starts, as PyBullet places them.
+
+    None if unreadable, unsupported, empty or out of range.
+    """
     import numpy as np
 
     from urdfkit.model.xmlio import read_regular
@@ -61,7 +73,7 @@ def read_integrals(path: Path, suffix: str | None = None, *,
             or faces.min() < 0 or faces.max() >= len(vertices)
             or not np.isfinite(vertices).all()):
         return None
-    return _solid(vertices, faces, starts, concavity=concavity)
+    return vertices, faces, starts
 
 
 def _stl(data: bytes) -> tuple[Any, Any]:
@@ -642,29 +654,8 @@ def read_triangles(path: Path) -> tuple[Any, Any] | None:
     For converting a mesh MuJoCo cannot read (COLLADA) to one it can (``urdfkit export``):
     the same readers as :func:`read_integrals`. None if unreadable, unsupported or empty.
     """
-    import numpy as np
-
-    from urdfkit.model.xmlio import read_regular
-
-    suffix = path.suffix.lower()
-    try:
-        data = read_regular(path, limit=MAX_MESH_BYTES, kind="mesh")
-        if suffix == ".stl":
-            vertices, faces = _stl(data)
-        elif suffix == ".obj":
-            vertices, faces, _ = _obj(data)
-        elif suffix == ".dae":
-            vertices, faces = _dae(data, path)
-        else:
-            return None
-    except (ValueError, struct.error, IndexError, OverflowError, KeyError, InputError,
-            AttributeError, StopIteration, TypeError):
-        return None
-    if (vertices is None or faces is None or len(faces) == 0 or len(vertices) == 0
-            or faces.min() < 0 or faces.max() >= len(vertices)
-            or not np.isfinite(vertices).all()):
-        return None
-    return vertices, faces
+    mesh = _read_mesh(path)
+    return None if mesh is None else (mesh[0], mesh[1])
 
 
 def undrawn_visual(path: Path | str) -> str | None:
