@@ -96,6 +96,7 @@ def _plant(source: str) -> tuple[str, int, str]:
     raise AssertionError("nothing to plant a typo in")
 
 
+@pytest.mark.slow  # a whole mypy run per part (16 s): CI's slow step runs it
 def test_mypy_catches_a_misspelt_attribute_in_every_part(tmp_path: Path) -> None:
     """One typo per part (``self.world`` read as ``self.worldx``...), one mypy run: all caught."""
     api = pytest.importorskip("mypy.api")
