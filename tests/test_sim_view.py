@@ -97,3 +97,30 @@ def test_cli_sim_view_waits_for_a_page_before_the_run(tmp_path: Path) -> None:
         if proc.poll() is None:
             proc.kill()
             proc.communicate()
+
+
+def test_sim_view_readouts_show_the_first_robots_joints_as_the_run_leaves_them() -> None:
+    """sim --view's sliders read the run's joints (the first robot's), held to raw PyBullet."""
+    from urdfkit.commands.simulating import _sim_view
+
+    doc = {"physics": {"time_step": 1 / 240}, "ground": "simpleplane", "duration": 1.0,
+           "robots": [{"name": "north", "template": "simplecar",
+                       "drive": [{"until": 1.0, "throttle": 10, "steer": 0.3}]}]}
+    with Simulation(doc) as s:
+        stream = _sim_view(s, None, None, wait=False)
+        viewer = stream.viewer
+        try:
+            s.run(sink=lambda _batch: stream.tick(s.t))
+            stream.finish("done")
+            body = next(iter(s.bodies.values())).body
+            bullet = s.bullet
+            raw = {bullet.getJointInfo(body, j)[1].decode(): bullet.getJointState(body, j)[0]
+                   for j in range(bullet.getNumJoints(body))}
+            shown = {name: float(sl.value) for name, sl in viewer.sliders.items()}
+        finally:
+            viewer.close()
+    # The car's wheels turned (10 rad/s for 1 s): the readouts are not the load pose.
+    assert any(abs(v) > 1.0 for v in shown.values())
+    for name, value in shown.items():
+        lo, hi = float(viewer.sliders[name].min), float(viewer.sliders[name].max)
+        assert value == pytest.approx(min(max(raw[name], lo), hi), abs=1e-6), name

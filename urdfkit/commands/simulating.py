@@ -173,7 +173,7 @@ def _sim_table(scenario: str, result: Any, summaries: list[Any], written: Any) -
 def _sim_view(s: Any, pace: float | None, port: int | None, wait: bool = True) -> Any:
     """Start the page a scenario streams to (sim --view): every robot, and say where."""
     from urdfkit.draw.view import Viewer
-    from urdfkit.draw.view_stream import RunStream
+    from urdfkit.draw.view_stream import RunStream, joint_reader
 
     bodies = [b for b in s.bodies.values() if b.loaded is not None]
     if not bodies:
@@ -190,8 +190,10 @@ def _sim_view(s: Any, pace: float | None, port: int | None, wait: bool = True) -
     try:
         for b in bodies[1:]:
             viewer.add_robot(b.loaded[0], inertia_from_file=b.loaded[1].inertia_from_file)
+        # The joint readouts show the first robot's run, as the page's sliders stand for it.
+        joints = joint_reader(s.bullet, bodies[0].body, viewer.model.joints)
         stream = RunStream(viewer, s.link_poses, pace, s.total_steps * s.time_step,
-                           robots=True)
+                           robots=True, joints=joints)
         stream.push()
         say_streaming("sim", viewer, pace)
         wait_for_page("sim", viewer, wait)
