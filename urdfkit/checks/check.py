@@ -529,9 +529,11 @@ def _judge_fragments(done: list[FileResult], files: Sequence[tuple[str, str, str
     robot their includer builds: checked alone they have no name, no links, or joints to
     links defined elsewhere. Their includer's check covers them; they get one note.
     """
+    # Only a file that is no robot alone can be one: most runs have none, and then no file is
+    # read a second time (a warm re-run reads none at all otherwise).
     by_path = {os.path.abspath(path): n for n, (_, path, problem) in enumerate(files)
-               if problem is None}
-    if len(by_path) < 2:
+               if problem is None and any(f.code in _NOT_A_ROBOT for f in done[n].findings)}
+    if not by_path or len(files) < 2:
         return
     includers: dict[int, str] = {}
     for n, (display, path, problem) in enumerate(files):
