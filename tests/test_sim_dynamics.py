@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from urdfkit.core.errors import InputError, ParameterError
+from urdfkit.core.errors import EngineError, InputError, ParameterError
 from urdfkit.sim import Simulation
 
 M, L, INERTIA = 2.0, 0.5, 0.01  # bob mass (kg), rod length (m), inertia about its centre
@@ -340,3 +340,101 @@ def test_a_servo_on_the_measured_state_feels_the_delay(tmp_path: Path) -> None:
 
     late = servo_run(tmp_path, {**motor, "measured_state": True}, 1.0, segment=step, delay=12)
     assert overshoot(late) > 2 * overshoot(true)  # 50 ms late, the PD loop overshoots more
+
+
+# KUKA KR210's link_2 inertia: PyBullet loads and simulates it, but its inverse-dynamics model
+# (calculateMassMatrix, calculateInverseDynamics, calculateJacobian) refuses it.
+ID_ASYMMETRIC = Path(__file__).parent / "fixtures" / "robots" / "id_asymmetric.urdf"
+
+
+def scaled_servo(urdf: Path | str, **motor: Any) -> dict[str, Any]:
+    """One fixed-base robot under a servo whose friction and spring go through M(q)."""
+    return {"duration": 0.05, "robots": [{
+        "name": "kr", "urdf": str(urdf), "base": "fixed",
+        "motor": {"kp": 10.0, "kd": 1.0, "viscous_friction": 0.5,
+                  "scale_by_mass_matrix": True, **motor}}]}
+
+
+def test_sim_refuses_a_mass_matrix_servo_pybullet_cannot_compute(tmp_path: Path, pb) -> None:
+    """It exited 3 with PyBullet's "invalid inertia tensor" on stdout, at the first step."""
+    import json
+    import subprocess
+    import sys
+
+    from urdfkit.engine.session import quiet_stdout
+
+    p, c = pb
+    with quiet_stdout():  # the premise: raw PyBullet refuses this robot's mass matrix
+        body = p.loadURDF(str(ID_ASYMMETRIC), useFixedBase=True,
+                          flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=c)
+        with pytest.raises(SystemError):
+            p.calculateMassMatrix(body, [0.0], physicsClientId=c)
+    path = tmp_path / "kr210.json"
+    path.write_text(json.dumps(scaled_servo(ID_ASYMMETRIC)))
+    for flags in ([], ["--json"]):
+        proc = subprocess.run([sys.executable, "-m", "urdfkit", "sim", str(path), *flags],
+                              capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2, proc.stderr
+        assert proc.stdout == ""  # no "b3Error ... invalid inertia tensor" chatter
+        lines = proc.stderr.splitlines()
+        assert len(lines) == 1 and len(lines[0]) < 500, proc.stderr
+        assert lines[0].startswith(f"urdfkit: error: {path}: robots[0].motor."
+                                   "scale_by_mass_matrix: PyBullet cannot compute the mass "
+                                   "matrix of robot 'kr': ")
+        assert "inertia of link 'link_1' asymmetric" in lines[0]
+        assert "Traceback" not in proc.stderr
+
+
+def test_the_api_raises_typed_errors_where_pybullet_refuses_the_dynamics(
+        capfd: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(InputError, match=r"robots\[0\]\.motor\.scale_by_mass_matrix: PyBullet "
+                                         r"cannot compute the mass matrix of robot 'kr'"):
+        Simulation(scaled_servo(ID_ASYMMETRIC))
+    # Without friction or a spring the servo never takes M: the scenario runs.
+    with Simulation(scaled_servo(ID_ASYMMETRIC, viscous_friction=0.0)) as sim:
+        sim.run()
+    # Asked directly, each dynamics quantity is an EngineError (not pybullet.error) saying why.
+    doc = {"robots": [{"name": "kr", "urdf": str(ID_ASYMMETRIC), "base": "fixed"}]}
+    with Simulation(doc) as sim:
+        for ask, what in ((sim.mass_matrix, "the mass matrix"),
+                          (sim.gravity_torques, "the inverse dynamics"),
+                          (lambda r: sim.jacobian(r, "link_1"), "Jacobians"),
+                          (sim.mass_matrix, "the mass matrix")):  # again: the same answer
+            with pytest.raises(EngineError, match=f"cannot compute {what} of robot 'kr': its "
+                                                  "inverse-dynamics model finds the inertia "
+                                                  "of link 'link_1' asymmetric by 7.1e-15"):
+                ask("kr")
+        sim.step()  # the robot itself still simulates
+    assert capfd.readouterr().out == ""  # PyBullet's refusal never reached fd 1
+
+
+def test_a_mass_matrix_servo_applies_pybullets_own_mass_matrix(pb) -> None:
+    """KUKA iiwa, which PyBullet accepts: the servo's torque is M(q) e, M from raw PyBullet."""
+    import os
+
+    import pybullet_data
+
+    b, k = 0.7, 3.0
+    q0 = [0.3, -0.6, 0.9, 1.2, -0.4, 0.5, 0.2]
+    qd0 = [0.5, -0.3, 0.8, 0.2, -0.6, 0.4, 1.0]
+    names = [f"lbr_iiwa_joint_{i}" for i in range(1, 8)]
+    doc = {"physics": {"gravity": [0, 0, 0]}, "robots": [{
+        "name": "iiwa", "urdf": "kuka_iiwa/model.urdf", "base": "fixed",
+        "initial_joints": {n: {"position": q, "velocity": v}
+                           for n, q, v in zip(names, q0, qd0, strict=True)},
+        "motor": {"viscous_friction": b, "stiffness": k, "scale_by_mass_matrix": True,
+                  "max_torque": "unlimited"}}]}
+    p, c = pb
+    body = p.loadURDF(os.path.join(pybullet_data.getDataPath(), "kuka_iiwa/model.urdf"),
+                      useFixedBase=True, flags=p.URDF_USE_INERTIA_FROM_FILE,
+                      physicsClientId=c)
+    raw = np.array(p.calculateMassMatrix(body, q0, physicsClientId=c))
+    assert abs(raw[0, 1]) > 1e-3  # coupled joints: M is not diagonal
+    e = -b * np.array(qd0) - k * np.array(q0)
+    with Simulation(doc) as sim:
+        assert sim.mass_matrix("iiwa") == pytest.approx(raw, rel=1e-12, abs=1e-15)
+        sim.step()
+        applied = sim.motor_torques("iiwa")
+    assert [applied[n] for n in names] == pytest.approx(raw @ e, rel=1e-9, abs=1e-12)
+    # ... which is not the unscaled law's e
+    assert not np.allclose([applied[n] for n in names], e, rtol=0.1)

@@ -438,3 +438,74 @@ def _bound(args: tuple[Any, ...]) -> tuple[Bullet, int, Sequence[int]]:
         return Bullet(p, client), state, bodies
     bullet, state, bodies = args
     return bullet, state, bodies
+
+
+#: What each of PyBullet's inverse-dynamics calls computes, for messages.
+DYNAMICS_CALLS = {"calculateMassMatrix": "the mass matrix",
+                  "calculateInverseDynamics": "the inverse dynamics",
+                  "calculateJacobian": "Jacobians"}
+
+
+def dynamics_call(bullet: Bullet, fn: str, body: int, *args: Any, **kwargs: Any) -> Any:
+    """One of PyBullet's inverse-dynamics calls (:data:`DYNAMICS_CALLS`), quiet on stdout.
+
+    The three share one model of the body, which PyBullet builds at the first of them and
+    which can fail on a body that loads and simulates: KUKA KR210's link_2 inertia
+    (tests/fixtures/robots/id_asymmetric.urdf) makes each raise SystemError and print
+    "invalid inertia tensor" on fd 1 (measured on 3.2.7, fixed base or floating, the file's
+    inertia or PyBullet's). Quieting costs 21 us over the bare call's 3 us (KUKA iiwa's mass
+    matrix, measured), so callers need it only for the first call on a body: later ones meet
+    the same model, built or refused.
+
+    Raises:
+        EngineError: PyBullet refused; the message is why, as a clause for the caller's
+            sentence ("its inverse-dynamics model finds the inertia of link 'link_1' ...").
+    """
+    out: Captured | None = None
+    try:
+        with quiet_stdout() as out:
+            return getattr(bullet, fn)(body, *args, **kwargs)
+    except (SystemError, bullet.error) as e:
+        # SystemError from PyBullet wraps its own error: say that one's text.
+        said = str(e.__cause__ or e.__context__ or e)
+    assert out is not None  # filled once the with block has exited
+    raise EngineError(dynamics_refusal(bullet, body, out.lines, fn, said)) from None
+
+
+def dynamics_refusal(bullet: Bullet, body: int, lines: Sequence[str], fn: str,
+                     said: str) -> str:
+    """Why PyBullet's ``fn`` failed on ``body``, from what it printed (``lines``) and raised.
+
+    PyBullet's inverse-dynamics model wants each link's inertia tensor exactly symmetric. A
+    URDF's always is (six numbers), but PyBullet keeps the principal moments and axes and
+    rebuilds the tensor from them, and for some products of inertia the rebuilt tensor
+    differs from its transpose in the last bit (KR210's link_2: 7e-15 of 33.8). It prints
+    that once, at the first call, naming the link as "body N": the tree's body 0 is the base,
+    body N link N - 1 (measured: a fixed joint between counts, fixed base or floating).
+    """
+    import re
+
+    for line in lines:
+        m = re.search(r"invalid inertia tensor for body (\d+) (I\(\d,\d\))!=(I\(\d,\d\))\. "
+                      r"\S+=\s*(\S+)", line)
+        if m is None:
+            continue
+        index = int(m.group(1)) - 1
+        try:
+            name = (bullet.getBodyInfo(body)[0] if index == -1
+                    else bullet.getJointInfo(body, index)[12]).decode("utf-8", "replace")
+            link = f"link {name[:80]!r}"
+        except bullet.error:
+            link = f"its body {index + 1}"
+        try:
+            gap = f"by {abs(float(m.group(4))):.2g} ({m.group(2)} - {m.group(3)})"
+        except ValueError:
+            gap = f"({m.group(2)} != {m.group(3)})"
+        return (f"its inverse-dynamics model finds the inertia of {link} asymmetric {gap} "
+                "once rebuilt from the principal axes PyBullet stores; a PyBullet rounding "
+                "limit, not an error in the file")
+    printed = [ln for ln in lines if not ln.startswith(("b3Error", "b3Warning"))]
+    detail = "; ".join([said, *printed[-2:]])
+    if len(detail) > 200:
+        detail = detail[:197] + "..."
+    return f"PyBullet's {fn} failed ({detail})"

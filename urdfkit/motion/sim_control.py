@@ -118,6 +118,14 @@ class ServoControl:
         self.sensors = sensors
         self.dynamics = dynamics
 
+    @staticmethod
+    def needs_mass_matrix(robot: SimRobot) -> bool:
+        """Whether the law takes the mass matrix: scaled friction or a scaled spring."""
+        m = robot.config.motor
+        return m is not None and m.scale_by_mass_matrix and any(
+            _per_joint(m.viscous_friction, spec.name) or _per_joint(m.stiffness, spec.name)
+            for spec in robot.servo)
+
     def control(self, robot: SimRobot, t: float) -> None:
         """The servo's torques for this step, under the command in force."""
         cmd = robot.command(t)

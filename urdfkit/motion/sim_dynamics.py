@@ -4,16 +4,22 @@ PyBullet builds the model its calculateMassMatrix, calculateInverseDynamics and
 calculateJacobian use once, at the first call, and never updates it: a mass changed later is
 ignored (measured on 3.2.7). So the dynamics run on a copy of the robot in a client of its
 own (a *shadow*, :class:`Shadows`), rebuilt after every ``set_mass``/``set_inertia``.
+
+PyBullet can refuse to build that model for a robot it loads and simulates (KUKA KR210's
+link_2 inertia; :func:`urdfkit.engine.session.dynamics_refusal` says why). Its calls then
+raise SystemError and print on fd 1: the first call on each shadow runs quiet and, when
+PyBullet refuses, every call on that shadow raises :class:`EngineError` saying why.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
-from urdfkit.core.errors import ParameterError
-from urdfkit.engine.session import LoadOptions, Session
+from urdfkit.core.errors import EngineError, ParameterError
+from urdfkit.engine.session import DYNAMICS_CALLS, LoadOptions, Session, dynamics_call
 from urdfkit.motion.sim_state import _FIXED, JointSpec
 
 if TYPE_CHECKING:
@@ -60,8 +66,38 @@ class Dynamics:
 
     def model(self, robot: SimRobot) -> tuple[Bullet, int]:
         """``(bullet, body)`` of the robot's dynamics model, as the robot is now."""
+        shadow = self._shadow(robot)
+        return shadow.session.bullet, shadow.body
+
+    def _shadow(self, robot: SimRobot) -> Shadow:
         return self.shadows.model(robot.name, robot.loaded, self.world.config.physics.gravity,
                                   robot.changes, robot.mass_version)
+
+    def call(self, robot: SimRobot, fn: str, *args: Any, **kwargs: Any) -> Any:
+        """PyBullet's ``fn`` (one of DYNAMICS_CALLS) on the robot's model, given ``args``.
+
+        Raises:
+            EngineError: PyBullet cannot build its inverse-dynamics model of the robot, or
+                the call failed; the message names the robot and says why.
+        """
+        shadow = self._shadow(robot)
+        p, body = shadow.session.bullet, shadow.body
+        cannot = f"PyBullet cannot compute {DYNAMICS_CALLS[fn]} of robot {robot.name!r}"
+        if shadow.refused is not None:
+            raise EngineError(f"{cannot}: {shadow.refused}")
+        if not shadow.proven:  # the call that builds PyBullet's model: it may print
+            try:
+                out = dynamics_call(p, fn, body, *args, **kwargs)
+            except EngineError as e:
+                shadow.refused = e.message
+                raise EngineError(f"{cannot}: {e.message}") from None
+            shadow.proven = True
+            return out
+        try:
+            return getattr(p, fn)(body, *args, **kwargs)
+        except (SystemError, p.error) as e:
+            raise EngineError(f"{cannot}: PyBullet's {fn} failed "
+                              f"({e.__cause__ or e.__context__ or e})") from None
 
     def mass_matrix(self, robot: SimRobot) -> np.ndarray:
         """The joint-space mass matrix M(q) now (PyBullet's calculateMassMatrix).
@@ -72,8 +108,7 @@ class Dynamics:
         import numpy as np
 
         q, _ = self.physical_state(robot)
-        p, body = self.model(robot)
-        return np.array(p.calculateMassMatrix(body, q))
+        return np.array(self.call(robot, "calculateMassMatrix", q))
 
     def coriolis_and_gravity(self, robot: SimRobot) -> np.ndarray:
         """C(q, qd) qd + g(q) now: the torques that hold the current motion."""
@@ -81,8 +116,7 @@ class Dynamics:
 
         self._fixed(robot, "coriolis_and_gravity")
         q, qd = self.physical_state(robot)
-        p, body = self.model(robot)
-        return np.array(p.calculateInverseDynamics(body, q, qd, [0.0] * len(q)))
+        return np.array(self.call(robot, "calculateInverseDynamics", q, qd, [0.0] * len(q)))
 
     def gravity_torques(self, robot: SimRobot) -> np.ndarray:
         """g(q) now: the torques that hold the robot still against gravity."""
@@ -90,9 +124,8 @@ class Dynamics:
 
         self._fixed(robot, "gravity_torques")
         q, _ = self.physical_state(robot)
-        p, body = self.model(robot)
         zero = [0.0] * len(q)
-        return np.array(p.calculateInverseDynamics(body, q, zero, zero))
+        return np.array(self.call(robot, "calculateInverseDynamics", q, zero, zero))
 
     def forward_dynamics(self, robot: SimRobot, tau: Sequence[float]) -> np.ndarray:
         """The joint accelerations ``tau`` would cause now, without contacts.
@@ -124,8 +157,8 @@ class Dynamics:
             raise ParameterError(f"`link`: {robot.name} has no moving link named {link!r}",
                                  param="link")
         q, qd = self.physical_state(robot)
-        p, body = self.model(robot)
-        lin, ang = p.calculateJacobian(body, index, list(point), q, qd, [0.0] * len(q))
+        lin, ang = self.call(robot, "calculateJacobian", index, list(point), q, qd,
+                             [0.0] * len(q))
         return np.vstack([np.array(lin), np.array(ang)])
 
     def times_mass_matrix(self, robot: SimRobot, vector: list[float]) -> list[float]:
@@ -143,8 +176,7 @@ class Dynamics:
         if measured:
             q = [(x - robot.offsets.get(j.name, 0.0)) * robot.directions.get(j.name, 1.0)
                  for x, j in zip(q, dyn, strict=True)]
-        p, body = self.model(robot)
-        matrix = p.calculateMassMatrix(body, q)
+        matrix = self.call(robot, "calculateMassMatrix", q)
         skip = len(matrix) - len(dyn)  # a floating base's 6 coordinates come first
         where = {j.name: skip + k for k, j in enumerate(dyn)}
         rows = [where[spec.name] for spec in robot.servo]
@@ -166,10 +198,10 @@ class Dynamics:
         """
         import numpy as np
 
-        p, body = self.model(robot)
         if skip:
             pos, orn = self.world.bullet.getBasePositionAndOrientation(robot.body)
-            full = np.asarray(p.calculateMassMatrix(body, [*pos, *orn, *q], flags=1))
+            full = np.asarray(self.call(robot, "calculateMassMatrix", [*pos, *orn, *q],
+                                        flags=1))
             full = np.delete(np.delete(full, 6, 0), 6, 1)
         else:
             full = np.asarray(matrix)
@@ -177,22 +209,40 @@ class Dynamics:
         return [float(x) for x in block @ np.asarray(vector, dtype=float)]
 
 
+@dataclass
+class Shadow:
+    """One robot's dynamics model: its client, its body, and what PyBullet made of it.
+
+    Attributes:
+        session: The shadow's own PyBullet client.
+        body: The robot's body id in it.
+        version: The robot's mass-change count it was built at.
+        proven: PyBullet has built its inverse-dynamics model of the body (a call worked).
+        refused: Why PyBullet refused to (None: not refused, or not tried yet).
+    """
+
+    session: Session
+    body: int
+    version: int
+    proven: bool = False
+    refused: str | None = None
+
+
 class Shadows:
     """One shadow client per robot, built at the first dynamics query, rebuilt when stale."""
 
     def __init__(self) -> None:
-        self.models: dict[str, tuple[Session, int, int]] = {}
+        self.models: dict[str, Shadow] = {}
 
     def model(self, name: str, loaded: tuple[str, LoadOptions], gravity: Sequence[float],
-              changes: Mapping[tuple[int, str], MassValue], version: int
-              ) -> tuple[Bullet, int]:
-        """``(bullet, body)`` of the robot's model: its URDF as loaded, its changes since.
+              changes: Mapping[tuple[int, str], MassValue], version: int) -> Shadow:
+        """The robot's model: its URDF as loaded, its changes since.
 
         ``version`` counts the robot's mass changes: a model built at an older one is
         closed and built again.
         """
         shadow = self.models.get(name)
-        if shadow is not None and shadow[2] != version:
+        if shadow is not None and shadow.version != version:
             self.stale(name)
             shadow = None
         if shadow is None:
@@ -205,17 +255,17 @@ class Shadows:
             except BaseException:
                 s.close()
                 raise
-            shadow = self.models[name] = (s, body, version)
-        return shadow[0].bullet, shadow[1]
+            shadow = self.models[name] = Shadow(s, body, version)
+        return shadow
 
     def stale(self, name: str) -> None:
         """Close a robot's model: it is built again when next asked."""
         shadow = self.models.pop(name, None)
         if shadow is not None:
-            shadow[0].close()
+            shadow.session.close()
 
     def close(self) -> None:
         """Disconnect every shadow client (safe to call twice)."""
         for shadow in self.models.values():
-            shadow[0].close()
+            shadow.session.close()
         self.models.clear()

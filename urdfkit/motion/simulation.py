@@ -23,7 +23,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from urdfkit.core.errors import ParameterError
+from urdfkit.core.errors import EngineError, ParameterError
 from urdfkit.motion.scenario import load_scenario, parse_scenario
 from urdfkit.motion.sim_control import Controller, MotorControl, ServoControl
 from urdfkit.motion.sim_dynamics import Dynamics
@@ -59,7 +59,8 @@ class Simulation:
         gui: Open PyBullet's GUI window to watch the run (needs a display).
 
     Raises:
-        InputError: the scenario is invalid, or names a joint or link a robot lacks.
+        InputError: the scenario is invalid, or names a joint or link a robot lacks, or
+            scales its servo by the mass matrix of a robot PyBullet cannot compute it for.
         EngineError: PyBullet refused a file.
     """
 
@@ -80,11 +81,28 @@ class Simulation:
             self.world.setup()
             for r in self.world.robots.values():
                 self.controllers[r.name] = servo if r.servo else motors
+                if r.servo and servo.needs_mass_matrix(r):
+                    self._require_mass_matrix(r)
             self.sensors.start()
             self.world.save()
         except BaseException:
             self.close()
             raise
+
+    def _require_mass_matrix(self, r: SimRobot) -> None:
+        """Refuse, before any step, a servo scaled by a mass matrix PyBullet cannot give.
+
+        PyBullet refuses some models it simulates (the inertia of KUKA KR210's link_2): the
+        run would fail at its first step, so the scenario is refused at load, naming why.
+        So is a robot with a joint of more than one degree of freedom, which the mass matrix
+        is not ordered by.
+        """
+        try:
+            self.dynamics.mass_matrix(r)
+        except (EngineError, ParameterError) as e:
+            raise self.world.error(f"{r.path}.motor.scale_by_mass_matrix",
+                                   f"{e.message}; set scale_by_mass_matrix = false (or "
+                                   "viscous_friction and stiffness to 0)") from None
 
     @classmethod
     def from_file(cls, path: str | Path, *, gui: bool = False) -> Simulation:
