@@ -8,7 +8,7 @@ from pathlib import Path
 def template_dir() -> Path:
     """The folder of the built-in templates.
 
-    Installed, it is the package ``urdfkit.templates``: pyproject.toml maps the top-level
+    Installed, it is the package ``urdfkit.templates``: pyproject.toml puts the top-level
     ``templates/`` folder there, and ``tests/test_packaging.py`` checks the wheel carries it.
     Run from a source checkout (``python -m urdfkit`` in the repository) that package does not
     exist, and the top-level folder beside the package is the same files.
