@@ -36,7 +36,6 @@ from urdfkit.model.spec import (
     solid_volume,
     sym_eigenvalues,
     transpose,
-    used_shape,
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
@@ -274,27 +273,25 @@ def rule_inertia(root: etree._Element, r: RuleReport) -> None:
                   "from the collision shapes unless loaded with URDF_USE_INERTIA_FROM_FILE "
                   "(urdfkit: --inertia-from-file)", inertia)
             noted = True
-        tensor = _inertia_tensor(inertia)
-        mass = _num(view.mass, "value")
-        if tensor is None:
+        principal = _principal(inertia)
+        if principal is None:
             continue
-        trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
-        eps = 10 * _DBL_EPSILON * max(1.0, trace / 2)
-        a, b, c = sym_eigenvalues(tensor)
+        trace, eps, a, b, c, moments = principal
+        mass = _num(view.mass, "value")
         shapes = _shape_trace(link, mass, r, view.collisions)
         if a < -eps:
             r.add("U603", "error", f"inertia of {label(link)} is not positive definite "
-                  f"(principal moments {_moments((a, b, c))}); every principal moment must be "
+                  f"(principal moments {moments}); every principal moment must be "
                   f"> 0{_shapes_fix(shapes)}", inertia)
             continue
         if mass is not None and mass > 0 and a <= eps:
             r.add("U608", "warning", f"inertia of {label(link)} is singular (principal moments "
-                  f"{_moments((a, b, c))}): a point or a thin rod, not a solid; with "
+                  f"{moments}): a point or a thin rod, not a solid; with "
                   f"URDF_USE_INERTIA_FROM_FILE the solver may blow up{_shapes_fix(shapes)}",
                   inertia)
         if a + b < c - eps:
             r.add("U604", "error", f"inertia of {label(link)} violates the triangle inequality: "
-                  f"principal moments {_moments((a, b, c))} (the two smaller sum to less than "
+                  f"principal moments {moments} (the two smaller sum to less than "
                   f"the largest); no rigid body has it: lower the largest to at most "
                   f"{a + b:.4g}{_shapes_fix(shapes)}", inertia)
             continue
@@ -311,6 +308,36 @@ def rule_inertia(root: etree._Element, r: RuleReport) -> None:
 
 #: Collision shapes smaller than this (m, largest size) are placeholders, not the body.
 STUB_SIZE = 0.01
+
+
+def _principal(inertia: etree._Element
+               ) -> tuple[float, float, float, float, float, str] | None:
+    """(trace, tolerance, principal moments a <= b <= c, the moments as a message writes them).
+
+    None if a component is missing or malformed. Kept per process by the element's
+    attributes, which are all it depends on (bounded): files repeat their inertia values
+    (pybullet_data's thousand random objects all have ``ixx="1" ... izz="0"``).
+    """
+    key = tuple(inertia.items())
+    found: Any = _PRINCIPAL.get(key, _UNSEEN)
+    if found is _UNSEEN:
+        tensor = _inertia_tensor(inertia)
+        if tensor is None:
+            found = None
+        else:
+            trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
+            a, b, c = sym_eigenvalues(tensor)
+            found = (trace, 10 * _DBL_EPSILON * max(1.0, trace / 2), a, b, c,
+                     _moments((a, b, c)))
+        if len(_PRINCIPAL) >= _PRINCIPAL_MAX:
+            _PRINCIPAL.clear()
+        _PRINCIPAL[key] = found
+    return found
+
+
+_PRINCIPAL: dict[tuple[tuple[str, str], ...],
+                 tuple[float, float, float, float, float, str] | None] = {}
+_PRINCIPAL_MAX = 4096
 
 
 def _moments(values: Sequence[float]) -> str:
@@ -368,17 +395,35 @@ def link_solid(link: etree._Element, r: RuleReport | None = None,
     or is not closed, a bad size. ``collisions``: the link's ``<collision>`` children, when
     the caller has them (:class:`~urdfkit.model.index.LinkView`).
     """
+    found = _solid(link, r, collisions)
+    return None if found is None else Solid(*found)
+
+
+_ZERO3: tuple[float, ...] = (0.0, 0.0, 0.0)
+
+
+def _solid(link: etree._Element, r: RuleReport | None,
+           collisions: list[etree._Element] | None
+           ) -> tuple[float, tuple[float, float, float], Matrix3, float] | None:
+    """:func:`link_solid`'s fields (volume, com, tensor, size), without making the record."""
     parts: list[tuple[float, tuple[float, ...], Matrix3, float]] = []
     moving: set[str] | None = None
     if collisions is None:
         collisions = [c for c in link if c.tag == "collision"]
     for col in collisions:
         shape, origin = collision_parts(col, SHAPES)
-        xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
-        rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
-        if shape is None or xyz is None or rpy is None:
+        if shape is None:
             return None
-        rot = None if rpy == (0.0, 0.0, 0.0) else rpy_to_matrix(rpy)  # None: no rotation
+        xyz: tuple[float, ...] | None
+        rpy: tuple[float, ...] | None
+        if origin is None:
+            xyz = rpy = _ZERO3
+        else:
+            xyz = _vec(origin, "xyz", 3, _ZERO3)
+            rpy = _vec(origin, "rpy", 3, _ZERO3)
+            if xyz is None or rpy is None:
+                return None
+        rot = None if rpy == _ZERO3 else rpy_to_matrix(rpy)  # None: no rotation
         if shape.tag == "mesh":
             # The mesh-shape rule will want a moving link's concavity: read it in one go.
             if r is not None and moving is None:
@@ -403,12 +448,27 @@ def link_solid(link: etree._Element, r: RuleReport | None = None,
         diag = ((d[0], 0.0, 0.0), (0.0, d[1], 0.0), (0.0, 0.0, d[2]))
         parts.append((volume, xyz, diag if rot is None else
                       matmul(matmul(rot, diag), transpose(rot)), size))
-    total = sum(p[0] for p in parts)
-    if not parts or not 0 < total < math.inf:
-        return None
-    cx = sum(v * c[0] for v, c, _, _ in parts) / total
-    cy = sum(v * c[1] for v, c, _, _ in parts) / total
-    cz = sum(v * c[2] for v, c, _, _ in parts) / total
+    return _combine(parts)
+
+
+def _combine(parts: list[tuple[float, tuple[float, ...], Matrix3, float]]
+             ) -> tuple[float, tuple[float, float, float], Matrix3, float] | None:
+    """Parts (volume, centre, tensor per unit density, size) as one solid's fields."""
+    if len(parts) == 1:  # the common case: sum() of one term is 0.0 plus the term
+        volume, centre, _, _ = parts[0]
+        total = 0.0 + volume
+        if not 0 < total < math.inf:
+            return None
+        cx = (0.0 + volume * centre[0]) / total
+        cy = (0.0 + volume * centre[1]) / total
+        cz = (0.0 + volume * centre[2]) / total
+    else:
+        total = sum(p[0] for p in parts)
+        if not parts or not 0 < total < math.inf:
+            return None
+        cx = sum(v * c[0] for v, c, _, _ in parts) / total
+        cy = sum(v * c[1] for v, c, _, _ in parts) / total
+        cz = sum(v * c[2] for v, c, _, _ in parts) / total
     # Parallel axes: each part's tensor moved from its centre to the common one.
     xx = xy = xz = yx = yy = yz = zx = zy = zz = 0.0
     for volume, centre, t, _ in parts:
@@ -424,10 +484,10 @@ def link_solid(link: etree._Element, r: RuleReport | None = None,
         zx += t20 + volume * (0.0 - dz * dx)
         zy += t21 + volume * (0.0 - dz * dy)
         zz += t22 + volume * (d2 - dz * dz)
-    out = ((xx, xy, xz), (yx, yy, yz), (zx, zy, zz))
     if not all(map(math.isfinite, (xx, xy, xz, yx, yy, yz, zx, zy, zz))):
         return None
-    return Solid(total, (cx, cy, cz), out, max(p[3] for p in parts))
+    return (total, (cx, cy, cz), ((xx, xy, xz), (yx, yy, yz), (zx, zy, zz)),
+            parts[0][3] if len(parts) == 1 else max(p[3] for p in parts))
 
 
 def _shape_trace(link: etree._Element, mass: float | None, r: RuleReport | None = None,
@@ -436,11 +496,12 @@ def _shape_trace(link: etree._Element, mass: float | None, r: RuleReport | None 
     """Trace of the inertia of the link's collision solids for ``mass``, and their size."""
     if mass is None or mass <= 0:
         return None
-    solid = link_solid(link, r, collisions)
+    solid = _solid(link, r, collisions)
     if solid is None:
         return None
-    trace = solid.trace(mass)
-    return (trace, solid.size) if math.isfinite(trace) else None
+    volume, _, tensor, size = solid
+    trace = sum((tensor[0][0], tensor[1][1], tensor[2][2])) * mass / volume  # Solid.trace
+    return (trace, size) if math.isfinite(trace) else None
 
 
 def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
@@ -530,25 +591,23 @@ def rule_visual_meshes(root: etree._Element, r: RuleReport) -> None:
     """
     if r.folder is None:
         return
-    from urdfkit.sources.meshes import mesh_kind, undrawn_visual
+    for view, part, _, mesh in r.parts(root):
+        if part.tag != "visual" or mesh is None or mesh.tag != "mesh":
+            continue
+        fn = (mesh.get("filename") or "").strip()
+        if not fn or (ref := r.reference("mesh", fn)).load is None:
+            continue
+        empty = ref.stat is not None and ref.stat.st_size == 0
+        # meshes.mesh_kind(ref.load), without importing the mesh readers for every check run
+        if not empty and os.path.splitext(ref.load)[1].lower() != ".dae":
+            continue
+        from urdfkit.sources.meshes import undrawn_visual
 
-    for view in r.doc(root).links:
-        for part in view.parts:
-            if part.tag != "visual":
-                continue
-            mesh = used_shape(first(part, "geometry"))
-            fn = (mesh.get("filename") or "").strip() if mesh is not None and \
-                mesh.tag == "mesh" else ""
-            if not fn or (ref := r.reference("mesh", fn)).load is None:
-                continue
-            empty = ref.stat is not None and ref.stat.st_size == 0
-            if not empty and mesh_kind(ref.load) != ".dae":
-                continue
-            why = undrawn_visual(ref.load)
-            if why is not None:
-                r.add("U715", "warning", f"visual mesh {fn!r} of {label(view.el)} {why}; "
-                      "the robot looks incomplete in render, view and the GUI (export it "
-                      "with its nodes flattened, or as .obj/.stl)", mesh)
+        why = undrawn_visual(ref.load)
+        if why is not None:
+            r.add("U715", "warning", f"visual mesh {fn!r} of {label(view.el)} {why}; "
+                  "the robot looks incomplete in render, view and the GUI (export it "
+                  "with its nodes flattened, or as .obj/.stl)", mesh)
 
 
 #: A mesh this many times larger (or smaller) than the robot's typical joint spacing is in
@@ -572,40 +631,40 @@ def rule_mesh_shapes(root: etree._Element, r: RuleReport) -> None:
                      if (xyz := _vec(jv.origin, "xyz", 3)) is not None and any(xyz))
     spacing = offsets[len(offsets) // 2] if len(offsets) >= 2 else None
     moving = _moving(r, root)
-    for view in doc.links:
+    if not spacing and not moving:
+        return  # neither finding can be made of any mesh
+    for view, part, _, mesh in r.parts(root):
         link = view.el
-        for part in view.parts:
-            concave_matters = part.tag == "collision" and link.get("name") in moving
-            if not spacing and not concave_matters:
-                continue  # neither finding can be made of this mesh
-            mesh = used_shape(first(part, "geometry"))
-            fn = (mesh.get("filename") or "").strip() if mesh is not None and \
-                mesh.tag == "mesh" else ""
-            if not fn or (ref := r.reference("mesh", fn)).load is None:
-                continue
-            scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
-            props = _properties(r, ref.load, scale, concave_matters, ref.stat) \
-                if scale else None
-            if props is None:
-                continue
-            size = max(props.extent)
-            if spacing and size > 0 and not 1 / UNITS_RATIO <= size / spacing <= UNITS_RATIO:
-                ratio = size / spacing
-                fix = ("probably in millimetres: add scale=\"0.001 0.001 0.001\"" if ratio > 1
-                       else "probably scaled twice, or in metres where millimetres were meant: "
-                       "check its scale")
-                r.add("U613", "warning", f"mesh {fn!r} of {label(link)} is {size:.3g} m across, "
-                      f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
-                      f"{fix}", mesh)
-            if concave_matters and props.concavity > CONCAVE_FRACTION * size:
-                r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
-                      f"concave (it is {size:.3g} m across, and parts of it stand up to "
-                      f"{props.concavity:.3g} m in front of its own faces' planes"
-                      + ("" if props.closed else "; it is also open, so the depth is "
-                         "judged on the faces it has") + "): PyBullet "
-                      "collides with its convex hull, so contacts happen in mid-air over the "
-                      "dips; split it into convex parts (p.vhacd, or one OBJ object per part) "
-                      "or use primitives", mesh)
+        concave_matters = part.tag == "collision" and view.name in moving
+        if not spacing and not concave_matters:
+            continue  # neither finding can be made of this mesh
+        fn = (mesh.get("filename") or "").strip() if mesh is not None and \
+            mesh.tag == "mesh" else ""
+        if not fn or (ref := r.reference("mesh", fn)).load is None:
+            continue
+        scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
+        props = _properties(r, ref.load, scale, concave_matters, ref.stat) \
+            if scale else None
+        if props is None:
+            continue
+        size = max(props.extent)
+        if spacing and size > 0 and not 1 / UNITS_RATIO <= size / spacing <= UNITS_RATIO:
+            ratio = size / spacing
+            fix = ("probably in millimetres: add scale=\"0.001 0.001 0.001\"" if ratio > 1
+                   else "probably scaled twice, or in metres where millimetres were meant: "
+                   "check its scale")
+            r.add("U613", "warning", f"mesh {fn!r} of {label(link)} is {size:.3g} m across, "
+                  f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
+                  f"{fix}", mesh)
+        if concave_matters and props.concavity > CONCAVE_FRACTION * size:
+            r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
+                  f"concave (it is {size:.3g} m across, and parts of it stand up to "
+                  f"{props.concavity:.3g} m in front of its own faces' planes"
+                  + ("" if props.closed else "; it is also open, so the depth is "
+                     "judged on the faces it has") + "): PyBullet "
+                  "collides with its convex hull, so contacts happen in mid-air over the "
+                  "dips; split it into convex parts (p.vhacd, or one OBJ object per part) "
+                  "or use primitives", mesh)
 
 
 def _moving_links(doc: Doc) -> set[str]:

@@ -23,7 +23,7 @@ from lxml import etree
 from urdfkit.core import deps
 from urdfkit.core.errors import InputError, Oversized
 from urdfkit.core.finding import Finding
-from urdfkit.model.index import Doc, first
+from urdfkit.model.index import Doc, LinkView
 from urdfkit.model.spec import (
     CRASH_NAME_BYTES,
     CRASH_PERCENT_TAGS,
@@ -38,6 +38,7 @@ from urdfkit.model.spec import (
     SHAPES,
     mesh_suffix,
     numbers,
+    used_shape,
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
@@ -68,6 +69,7 @@ class RuleReport:
         self.elements: list[etree._Element | None] = []
         self._references: dict[tuple[str, str], Reference] = {}
         self._doc: Doc | None = None
+        self._parts: tuple[Doc, list[Part]] | None = None
         #: Results rules share within this file (a mesh's properties at a scale).
         self.memo: dict[object, Any] = {}
 
@@ -82,6 +84,27 @@ class RuleReport:
         if doc is None or doc.root is not root:
             doc = self._doc = Doc(root)
         return doc
+
+    def parts(self, root: etree._Element) -> list[Part]:
+        """Every link's ``<visual>`` and ``<collision>``, in order, with what rules read of it.
+
+        Each is (link view, the element, its first ``<geometry>``, the shape PyBullet builds
+        it from: :func:`~urdfkit.model.spec.used_shape`), None where absent. Worked out once
+        per file: the geometry and mesh rules all ask.
+        """
+        doc = self.doc(root)
+        if self._parts is None or self._parts[0] is not doc:
+            found: list[Part] = []
+            for view in doc.links:
+                for part in view.parts:
+                    geometry = None
+                    for c in part:  # first(part, "geometry"), without an iterator object
+                        if c.tag == "geometry":
+                            geometry = c
+                            break
+                    found.append((view, part, geometry, used_shape(geometry)))
+            self._parts = (doc, found)
+        return self._parts[1]
 
     def reference(self, tag: str, fn: str) -> Reference:
         """:func:`reference` from this file's folder, judged once per file (several rules ask)."""
@@ -108,6 +131,8 @@ class RuleReport:
 
 
 Rule = Callable[[etree._Element, RuleReport], None]
+#: A ``<visual>`` or ``<collision>`` as :meth:`RuleReport.parts` gives it.
+Part = tuple[LinkView, etree._Element, etree._Element | None, etree._Element | None]
 
 
 def label(el: etree._Element) -> str:
@@ -366,13 +391,11 @@ def rule_joints(root: etree._Element, r: RuleReport) -> None:
 
 def rule_geometry(root: etree._Element, r: RuleReport) -> None:
     """U501-U506: one shape per <geometry>, first; positive sizes; meshes have a filename."""
-    doc = r.doc(root)
-    for view in doc.links:
-        for part in view.parts:
-            if first(part, "geometry") is None:
-                r.add("U506", "error", f"<{part.tag}> of {label(view.el)} has no <geometry>, "
-                      "which PyBullet refuses; add one or remove the element", part)
-    for geom in doc.geometries:
+    for view, part, geometry, _ in r.parts(root):
+        if geometry is None:
+            r.add("U506", "error", f"<{part.tag}> of {label(view.el)} has no <geometry>, "
+                  "which PyBullet refuses; add one or remove the element", part)
+    for geom in r.doc(root).geometries:
         elements = [c for c in geom if isinstance(c.tag, str)]
         shapes = [c for c in elements if c.tag in SHAPES]
         if shapes and elements[0].tag not in SHAPES:
