@@ -201,11 +201,16 @@ def rule_material_colours(root: etree._Element, r: RuleReport) -> None:
     """
     colours: dict[str, list[tuple[str, etree._Element]]] = {}
     for m in r.doc(root).all_materials:
-        name, color = m.get("name"), first(m, "color")
-        if name is None or color is None or color.get("rgba") is None:
+        name = m.get("name")
+        if name is None:
+            continue
+        color = _child(m, "color")
+        if color is None or color.get("rgba") is None:
             continue
         colours.setdefault(name, []).append((" ".join(color.get("rgba", "").split()), color))
     for name, found in colours.items():
+        if len(found) < 2:
+            continue  # one colour given
         distinct = list(dict.fromkeys(c for c, _ in found))
         if len(distinct) < 2:
             continue
@@ -224,12 +229,14 @@ def rule_references(root: etree._Element, r: RuleReport) -> None:
     prismatic ``<limit>`` without lower/upper (PyBullet: unlimited; the URDF spec: 0..0).
     """
     doc = r.doc(root)
-    defined = {m.get("name") for m in doc.all_materials
-               if first(m, "color") is not None or first(m, "texture") is not None}
-    for m in doc.all_materials:
+    # (material, whether it has a <color> or <texture> child), each looked at once
+    given = [(m, _defines_colour(m)) for m in doc.all_materials]
+    defined = {m.get("name") for m, has in given if has}
+    for m, has in given:
+        if has:
+            continue
         parent = m.getparent()
         if (parent is not None and parent.tag == "visual" and m.get("name")
-                and first(m, "color") is None and first(m, "texture") is None
                 and m.get("name") not in defined):
             r.add("U706", "warning", f"<material name={m.get('name')!r}> is used but never "
                   "defined with a <color> or <texture>; PyBullet draws the default colour", m)
@@ -255,6 +262,22 @@ def rule_references(root: etree._Element, r: RuleReport) -> None:
             missing = " and ".join(a for a in ("lower", "upper") if limit.get(a) is None)
             r.add("U308", "warning", f"<limit> of {label(j)} has no {missing}: PyBullet reads "
                   "it as unlimited, the URDF spec (and ROS) as 0; give both", limit)
+
+
+def _defines_colour(material: etree._Element) -> bool:
+    """Whether a ``<material>`` has a ``<color>`` or ``<texture>`` child."""
+    for c in material:  # first(m, "color") or first(m, "texture"), in one look
+        if c.tag == "color" or c.tag == "texture":
+            return True
+    return False
+
+
+def _child(el: etree._Element, tag: str) -> etree._Element | None:
+    """``first(el, tag)``: the first child named ``tag``, by a loop (no iterator object)."""
+    for c in el:
+        if c.tag == tag:
+            return c
+    return None
 
 
 def rule_inertia(root: etree._Element, r: RuleReport) -> None:
@@ -721,6 +744,8 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
     for the link (its ``<contact>``, else lateral friction 0.5 and a rigid contact). A link
     whose ``<contact>`` already carries the values gets nothing.
     """
+    if not _has_gazebo(root):
+        return  # most files: nothing to read, and no Gazebo reader to load
     from urdfkit.model.gazebo import NOT_CARRIED, PYBULLET_LATERAL_FRICTION, gazebo_contacts
 
     contacts = gazebo_contacts(root)
@@ -774,6 +799,26 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
               "multiplies the two bodies' friction: on a ground of lateral friction 1, such "
               "as plane.urdf, the contact has the link's)" + "".join(f"; {n}" for n in notes),
               gz.element)
+
+
+def _has_gazebo(root: etree._Element) -> bool:
+    """Whether a ``<gazebo>`` may stand where gazebo_contacts looks for one.
+
+    That is: among the root's children, or among the children of a root's ``<link>``, in any
+    namespace. A look at tag names only, so a superset: ``<mygazebo>`` says True too.
+    """
+    for child in root:
+        tag = child.tag
+        if not isinstance(tag, str):
+            continue
+        if tag.endswith("gazebo"):
+            return True
+        if tag.endswith("link"):
+            for g in child:
+                gtag = g.tag
+                if isinstance(gtag, str) and gtag.endswith("gazebo"):
+                    return True
+    return False
 
 
 def _contact_values(link: etree._Element) -> dict[str, float]:

@@ -396,30 +396,12 @@ def rule_geometry(root: etree._Element, r: RuleReport) -> None:
             r.add("U506", "error", f"<{part.tag}> of {label(view.el)} has no <geometry>, "
                   "which PyBullet refuses; add one or remove the element", part)
     for geom in r.doc(root).geometries:
-        elements = [c for c in geom if isinstance(c.tag, str)]
-        shapes = [c for c in elements if c.tag in SHAPES]
-        if shapes and elements[0].tag not in SHAPES:
-            r.add("U505", "error", f"<{elements[0].tag}> comes before the shape in <geometry>; "
-                  "PyBullet reads the first element as the shape and refuses the file",
-                  elements[0])
-        for c in elements:
-            if c.tag == "origin":
-                r.add("U504", "warning", "<origin> inside <geometry> is ignored by PyBullet; put "
-                      "it in the enclosing <visual> or <collision>", c)
-        if len(shapes) != 1:
-            owner = geom.getparent()
-            what = f"<{owner.tag}> of {label(owner.getparent())}" if owner is not None \
-                and owner.getparent() is not None else "<geometry>"
-            if not shapes:
-                r.add("U502", "error", f"<geometry> in {what} holds no shape, which PyBullet "
-                      f"refuses; it needs one of {', '.join(SHAPES[:4])}", geom)
+        # The common case, one child and a shape, has nothing for _sole_shape to say.
+        shape = geom[0] if len(geom) == 1 else None
+        if shape is None or shape.tag not in SHAPES:
+            shape = _sole_shape(geom, r)
+            if shape is None:
                 continue
-            # Measured (PyBullet 3.2.7): the file loads, visual and collision alike built from
-            # the first shape; the others are ignored.
-            r.add("U507", "warning", f"<geometry> in {what} holds {len(shapes)} shapes "
-                  f"({', '.join(f'<{c.tag}>' for c in shapes)}); PyBullet uses the first, "
-                  f"<{shapes[0].tag}>, and ignores the rest: keep one", shapes[1])
-        shape = shapes[0]  # PyBullet reads none after the first (measured)
         for attr in SHAPE_SIZES.get(shape.tag, ()):
             text = shape.get(attr)
             if text is None:
@@ -432,6 +414,34 @@ def rule_geometry(root: etree._Element, r: RuleReport) -> None:
                       shape)
         if shape.tag in ("mesh", "cdf") and not (shape.get("filename") or "").strip():
             r.add("U503", "error", f"<{shape.tag}> has no filename", shape)
+
+
+def _sole_shape(geom: etree._Element, r: RuleReport) -> etree._Element | None:
+    """U502, U504, U505, U507 of a ``<geometry>``; its first shape, None if it has none."""
+    elements = [c for c in geom if isinstance(c.tag, str)]
+    shapes = [c for c in elements if c.tag in SHAPES]
+    if shapes and elements[0].tag not in SHAPES:
+        r.add("U505", "error", f"<{elements[0].tag}> comes before the shape in <geometry>; "
+              "PyBullet reads the first element as the shape and refuses the file",
+              elements[0])
+    for c in elements:
+        if c.tag == "origin":
+            r.add("U504", "warning", "<origin> inside <geometry> is ignored by PyBullet; put "
+                  "it in the enclosing <visual> or <collision>", c)
+    if len(shapes) != 1:
+        owner = geom.getparent()
+        what = f"<{owner.tag}> of {label(owner.getparent())}" if owner is not None \
+            and owner.getparent() is not None else "<geometry>"
+        if not shapes:
+            r.add("U502", "error", f"<geometry> in {what} holds no shape, which PyBullet "
+                  f"refuses; it needs one of {', '.join(SHAPES[:4])}", geom)
+            return None
+        # Measured (PyBullet 3.2.7): the file loads, visual and collision alike built from
+        # the first shape; the others are ignored.
+        r.add("U507", "warning", f"<geometry> in {what} holds {len(shapes)} shapes "
+              f"({', '.join(f'<{c.tag}>' for c in shapes)}); PyBullet uses the first, "
+              f"<{shapes[0].tag}>, and ignores the rest: keep one", shapes[1])
+    return shapes[0]  # PyBullet reads none after the first (measured)
 
 
 def rule_inertial(root: etree._Element, r: RuleReport) -> None:
