@@ -199,8 +199,11 @@ def rule_material_colours(root: etree._Element, r: RuleReport) -> None:
     Measured on PyBullet 3.2.7: every visual whose material has that name (``""`` included,
     at the top level or inline) is drawn in the colour written last in the file.
     """
+    materials = r.doc(root).all_materials
+    if len(materials) < 2:
+        return  # no name can be given two colours
     colours: dict[str, list[tuple[str, etree._Element]]] = {}
-    for m in r.doc(root).all_materials:
+    for m in materials:
         name = m.get("name")
         if name is None:
             continue
@@ -622,7 +625,9 @@ def rule_visual_meshes(root: etree._Element, r: RuleReport) -> None:
             continue
         empty = ref.stat is not None and ref.stat.st_size == 0
         # meshes.mesh_kind(ref.load), without importing the mesh readers for every check run
-        if not empty and os.path.splitext(ref.load)[1].lower() != ".dae":
+        # (and without splitting names that cannot end in .dae)
+        if not empty and (ref.load[-4:].lower() != ".dae"
+                          or os.path.splitext(ref.load)[1].lower() != ".dae"):
             continue
         from urdfkit.sources.meshes import undrawn_visual
 
@@ -702,6 +707,8 @@ def _moving_links(doc: Doc) -> set[str]:
             (child.get("link", ""), jv.type == "fixed"))
         children.add(child.get("link", ""))
     names = [view.name if view.name is not None else "" for view in doc.links]
+    if not below:  # no joint: only the first link stays with the root
+        return set(names) - set(names[:1])
     roots = [n for n in names if n not in children]
     still, stack = set(), roots[:1]
     while stack:

@@ -42,7 +42,7 @@ from urdfkit.model.spec import (
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.model.xmlio import line_of
+from urdfkit.model.xmlio import BIG_LINES, line_of
 from urdfkit.sources.uris import not_a_file, pybullet_data_path, resolve_uri
 
 
@@ -119,7 +119,9 @@ class RuleReport:
             line: int | None = None) -> None:
         """Record a finding; its line comes from ``el`` unless given."""
         if line is None and el is not None:
-            line = line_of(el)
+            line = el.sourceline  # line_of(el), whose lookup only lines past 65,535 need
+            if line is not None and line >= BIG_LINES:
+                line = line_of(el)
         origin = self.origins.get(el) if self.origins is not None and el is not None else None
         self.findings.append(Finding(code, level, message, self.file, line, origin))
         self.elements.append(el)
@@ -198,6 +200,8 @@ def _check_percent(el: etree._Element, name: str, r: RuleReport) -> None:
 
 
 def _check_length(el: etree._Element, name: str, r: RuleReport) -> None:
+    if len(name) * 4 <= MAX_NAME_BYTES:
+        return  # no character is more than 4 bytes of UTF-8
     size = len(name.encode("utf-8", "surrogatepass"))
     if size <= MAX_NAME_BYTES:
         return
@@ -455,11 +459,16 @@ def rule_inertial(root: etree._Element, r: RuleReport) -> None:
                   "PyBullet refuses; add <inertia ixx=... iyy=... izz=... ixy ixz iyz>",
                   inertial)
             continue
+        if _INERTIA_ATTRIBUTES.issubset(inertia.keys()):
+            continue  # all six there (keys() names an attribute get() finds as get does)
         missing = [a for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz") if inertia.get(a) is None]
         if missing:
             r.add("U610", "error", f"<inertia> of {label(link)} has no {', '.join(missing)}, "
                   "which PyBullet refuses; give all six components (0 for products of inertia "
                   "of a symmetric body)", inertia)
+
+
+_INERTIA_ATTRIBUTES = frozenset(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
 
 
 @dataclass(frozen=True, slots=True)
