@@ -318,7 +318,14 @@ def rule_tree(root: etree._Element, r: RuleReport) -> None:
     elif not roots:
         r.add("U206", "error", "no root link: every link is some joint's child, so the joints "
               "form a cycle", root)
-    # Anything not reachable from a root sits on a cycle.
+    if parent_of:  # with no parent anywhere, every link is a root and none is on a cycle
+        _report_cycle(r, links, roots, parent_of, children)
+
+
+def _report_cycle(r: RuleReport, links: dict[str, etree._Element], roots: list[str],
+                  parent_of: dict[str, tuple[str, etree._Element]],
+                  children: dict[str, list[str]]) -> None:
+    """U207: links not reachable from a root sit on a cycle."""
     reachable: set[str] = set()
     stack = list(roots)
     while stack:
