@@ -73,9 +73,12 @@ def rule_elements(root: etree._Element, r: RuleReport) -> None:
     leftovers, extensions), opaque subtrees (another tool's: gazebo, transmission, ...) and
     shapes after the first in a ``<geometry>``.
     """
+    found = r.doc(root).element_findings
+    if not found:
+        return  # most files (and no import statement run for them)
     from urdfkit.model.spec import did_you_mean, nearest_attributes, nearest_tags
 
-    for code, level, message, el in r.doc(root).element_findings:
+    for code, level, message, el in found:
         if code == "U801" and el.tag == "gazebo":
             continue  # another tool's block, PyBullet ignores it: U803 judges its contacts
         # The verdicts are shared between elements; the nearest name is added per finding.
