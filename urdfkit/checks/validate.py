@@ -20,6 +20,7 @@ from lxml import etree
 
 from urdfkit.model.index import Doc, LinkView, collision_parts, first
 from urdfkit.model.spec import (
+    EXTENSIONS,
     LIMITED_JOINT_TYPES,
     MAX_STATE_LINKS,
     SHAPES,
@@ -853,9 +854,14 @@ def rule_portability(root: etree._Element, r: RuleReport) -> None:
             r.add("U901", "info", f"{label(jv.el)}: {note}", jv.el)
     for geom in doc.geometries:
         for shape in geom:
-            note = extension_note("shape", shape.tag) if isinstance(shape.tag, str) else None
+            note = _SHAPE_NOTES.get(shape.tag)  # a comment's tag is a function: no note
             if note:
                 r.add("U901", "info", note, shape)
+
+
+#: extension_note("shape", tag) by tag, one lookup a shape.
+_SHAPE_NOTES = {key.partition(":")[2]: note for key, note in EXTENSIONS.items()
+                if key.startswith("shape:")}
 
 
 #: Every rule ``urdfkit check`` runs, in order.

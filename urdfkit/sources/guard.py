@@ -258,14 +258,15 @@ def rule_names(root: etree._Element, r: RuleReport) -> None:
             continue
         # Only a link's visual: PyBullet ignores <gazebo> and what is in it (a Gazebo
         # <visual><material><ambient> has no name and loads; found on linorobot2).
-        if el.get("name") is None and visual is not None and visual.tag == "visual" and \
+        name = el.get("name")
+        if name is None and visual is not None and visual.tag == "visual" and \
                 visual.getparent() is not None and visual.getparent().tag == "link":
             # Measured: PyBullet refuses the whole file ("Could not parse visual element");
             # name="" loads.
             r.add("U110", "error", "<material> of a <visual> has no name attribute: PyBullet "
                   "refuses the file (\"Could not parse visual element\"); give it one "
                   "(name=\"\" is enough)", el)
-        elif el.get("name") and "%" in el.get("name", ""):
+        elif name and "%" in name:
             _check_name(el, r)
 
 
