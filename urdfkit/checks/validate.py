@@ -247,16 +247,23 @@ def rule_references(root: etree._Element, r: RuleReport) -> None:
                 and m.get("name") not in defined):
             r.add("U706", "warning", f"<material name={m.get('name')!r}> is used but never "
                   "defined with a <color> or <texture>; PyBullet draws the default colour", m)
-    for t in doc.files:
-        if t.tag == "texture" and not (t.get("filename") or "").strip():
-            r.add("U707", "warning", "<texture> without a filename; remove it or name the "
-                  "image", t)
+    # One look at each filename; all U707 first, then all U708, as two passes gave them.
+    empty, rooted = [], []
     for el in doc.files:
-        if (el.get("filename") or "").strip().startswith("package:///"):
-            r.add("U708", "info", f"<{el.tag} filename={el.get('filename')!r}>: package:/// "
-                  "has no package name; PyBullet and urdfkit look the path up beside the file "
-                  "and in every folder above, ROS tools refuse it", el)
-    joints = {jv.name for jv in doc.joints}
+        fn = (el.get("filename") or "").strip()
+        if not fn:
+            if el.tag == "texture":
+                empty.append(el)
+        elif fn.startswith("package:///"):
+            rooted.append(el)
+    for t in empty:
+        r.add("U707", "warning", "<texture> without a filename; remove it or name the "
+              "image", t)
+    for el in rooted:
+        r.add("U708", "info", f"<{el.tag} filename={el.get('filename')!r}>: package:/// "
+              "has no package name; PyBullet and urdfkit look the path up beside the file "
+              "and in every folder above, ROS tools refuse it", el)
+    joints = {jv.name for jv in doc.joints} if doc.transmissions else set()
     for t in doc.transmissions:
         for j in t.iter("joint"):
             if j.get("name") and j.get("name") not in joints:
