@@ -20,6 +20,7 @@ from lxml import etree
 
 from urdfkit.model.index import Doc, LinkView, collision_parts, first
 from urdfkit.model.spec import (
+    EXTENSIONS,
     LIMITED_JOINT_TYPES,
     MAX_STATE_LINKS,
     SHAPES,
@@ -36,7 +37,6 @@ from urdfkit.model.spec import (
     solid_volume,
     sym_eigenvalues,
     transpose,
-    used_shape,
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
@@ -74,9 +74,12 @@ def rule_elements(root: etree._Element, r: RuleReport) -> None:
     leftovers, extensions), opaque subtrees (another tool's: gazebo, transmission, ...) and
     shapes after the first in a ``<geometry>``.
     """
+    found = r.doc(root).element_findings
+    if not found:
+        return  # most files (and no import statement run for them)
     from urdfkit.model.spec import did_you_mean, nearest_attributes, nearest_tags
 
-    for code, level, message, el in r.doc(root).element_findings:
+    for code, level, message, el in found:
         if code == "U801" and el.tag == "gazebo":
             continue  # another tool's block, PyBullet ignores it: U803 judges its contacts
         # The verdicts are shared between elements; the nearest name is added per finding.
@@ -200,13 +203,21 @@ def rule_material_colours(root: etree._Element, r: RuleReport) -> None:
     Measured on PyBullet 3.2.7: every visual whose material has that name (``""`` included,
     at the top level or inline) is drawn in the colour written last in the file.
     """
+    materials = r.doc(root).all_materials
+    if len(materials) < 2:
+        return  # no name can be given two colours
     colours: dict[str, list[tuple[str, etree._Element]]] = {}
-    for m in r.doc(root).all_materials:
-        name, color = m.get("name"), first(m, "color")
-        if name is None or color is None or color.get("rgba") is None:
+    for m in materials:
+        name = m.get("name")
+        if name is None:
+            continue
+        color = _child(m, "color")
+        if color is None or color.get("rgba") is None:
             continue
         colours.setdefault(name, []).append((" ".join(color.get("rgba", "").split()), color))
     for name, found in colours.items():
+        if len(found) < 2:
+            continue  # one colour given
         distinct = list(dict.fromkeys(c for c, _ in found))
         if len(distinct) < 2:
             continue
@@ -225,25 +236,34 @@ def rule_references(root: etree._Element, r: RuleReport) -> None:
     prismatic ``<limit>`` without lower/upper (PyBullet: unlimited; the URDF spec: 0..0).
     """
     doc = r.doc(root)
-    defined = {m.get("name") for m in doc.all_materials
-               if first(m, "color") is not None or first(m, "texture") is not None}
-    for m in doc.all_materials:
+    # (material, whether it has a <color> or <texture> child), each looked at once
+    given = [(m, _defines_colour(m)) for m in doc.all_materials]
+    defined = {m.get("name") for m, has in given if has}
+    for m, has in given:
+        if has:
+            continue
         parent = m.getparent()
         if (parent is not None and parent.tag == "visual" and m.get("name")
-                and first(m, "color") is None and first(m, "texture") is None
                 and m.get("name") not in defined):
             r.add("U706", "warning", f"<material name={m.get('name')!r}> is used but never "
                   "defined with a <color> or <texture>; PyBullet draws the default colour", m)
-    for t in doc.files:
-        if t.tag == "texture" and not (t.get("filename") or "").strip():
-            r.add("U707", "warning", "<texture> without a filename; remove it or name the "
-                  "image", t)
+    # One look at each filename; all U707 first, then all U708, as two passes gave them.
+    empty, rooted = [], []
     for el in doc.files:
-        if (el.get("filename") or "").strip().startswith("package:///"):
-            r.add("U708", "info", f"<{el.tag} filename={el.get('filename')!r}>: package:/// "
-                  "has no package name; PyBullet and urdfkit look the path up beside the file "
-                  "and in every folder above, ROS tools refuse it", el)
-    joints = {jv.name for jv in doc.joints}
+        fn = (el.get("filename") or "").strip()
+        if not fn:
+            if el.tag == "texture":
+                empty.append(el)
+        elif fn.startswith("package:///"):
+            rooted.append(el)
+    for t in empty:
+        r.add("U707", "warning", "<texture> without a filename; remove it or name the "
+              "image", t)
+    for el in rooted:
+        r.add("U708", "info", f"<{el.tag} filename={el.get('filename')!r}>: package:/// "
+              "has no package name; PyBullet and urdfkit look the path up beside the file "
+              "and in every folder above, ROS tools refuse it", el)
+    joints = {jv.name for jv in doc.joints} if doc.transmissions else set()
     for t in doc.transmissions:
         for j in t.iter("joint"):
             if j.get("name") and j.get("name") not in joints:
@@ -256,6 +276,22 @@ def rule_references(root: etree._Element, r: RuleReport) -> None:
             missing = " and ".join(a for a in ("lower", "upper") if limit.get(a) is None)
             r.add("U308", "warning", f"<limit> of {label(j)} has no {missing}: PyBullet reads "
                   "it as unlimited, the URDF spec (and ROS) as 0; give both", limit)
+
+
+def _defines_colour(material: etree._Element) -> bool:
+    """Whether a ``<material>`` has a ``<color>`` or ``<texture>`` child."""
+    for c in material:  # first(m, "color") or first(m, "texture"), in one look
+        if c.tag == "color" or c.tag == "texture":
+            return True
+    return False
+
+
+def _child(el: etree._Element, tag: str) -> etree._Element | None:
+    """``first(el, tag)``: the first child named ``tag``, by a loop (no iterator object)."""
+    for c in el:
+        if c.tag == tag:
+            return c
+    return None
 
 
 def rule_inertia(root: etree._Element, r: RuleReport) -> None:
@@ -274,27 +310,25 @@ def rule_inertia(root: etree._Element, r: RuleReport) -> None:
                   "from the collision shapes unless loaded with URDF_USE_INERTIA_FROM_FILE "
                   "(urdfkit: --inertia-from-file)", inertia)
             noted = True
-        tensor = _inertia_tensor(inertia)
-        mass = _num(view.mass, "value")
-        if tensor is None:
+        principal = _principal(inertia)
+        if principal is None:
             continue
-        trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
-        eps = 10 * _DBL_EPSILON * max(1.0, trace / 2)
-        a, b, c = sym_eigenvalues(tensor)
+        trace, eps, a, b, c, moments = principal
+        mass = _num(view.mass, "value")
         shapes = _shape_trace(link, mass, r, view.collisions)
         if a < -eps:
             r.add("U603", "error", f"inertia of {label(link)} is not positive definite "
-                  f"(principal moments {_moments((a, b, c))}); every principal moment must be "
+                  f"(principal moments {moments}); every principal moment must be "
                   f"> 0{_shapes_fix(shapes)}", inertia)
             continue
         if mass is not None and mass > 0 and a <= eps:
             r.add("U608", "warning", f"inertia of {label(link)} is singular (principal moments "
-                  f"{_moments((a, b, c))}): a point or a thin rod, not a solid; with "
+                  f"{moments}): a point or a thin rod, not a solid; with "
                   f"URDF_USE_INERTIA_FROM_FILE the solver may blow up{_shapes_fix(shapes)}",
                   inertia)
         if a + b < c - eps:
             r.add("U604", "error", f"inertia of {label(link)} violates the triangle inequality: "
-                  f"principal moments {_moments((a, b, c))} (the two smaller sum to less than "
+                  f"principal moments {moments} (the two smaller sum to less than "
                   f"the largest); no rigid body has it: lower the largest to at most "
                   f"{a + b:.4g}{_shapes_fix(shapes)}", inertia)
             continue
@@ -311,6 +345,36 @@ def rule_inertia(root: etree._Element, r: RuleReport) -> None:
 
 #: Collision shapes smaller than this (m, largest size) are placeholders, not the body.
 STUB_SIZE = 0.01
+
+
+def _principal(inertia: etree._Element
+               ) -> tuple[float, float, float, float, float, str] | None:
+    """(trace, tolerance, principal moments a <= b <= c, the moments as a message writes them).
+
+    None if a component is missing or malformed. Kept per process by the element's
+    attributes, which are all it depends on (bounded): files repeat their inertia values
+    (pybullet_data's thousand random objects all have ``ixx="1" ... izz="0"``).
+    """
+    key = tuple(inertia.items())
+    found: Any = _PRINCIPAL.get(key, _UNSEEN)
+    if found is _UNSEEN:
+        tensor = _inertia_tensor(inertia)
+        if tensor is None:
+            found = None
+        else:
+            trace = tensor[0][0] + tensor[1][1] + tensor[2][2]
+            a, b, c = sym_eigenvalues(tensor)
+            found = (trace, 10 * _DBL_EPSILON * max(1.0, trace / 2), a, b, c,
+                     _moments((a, b, c)))
+        if len(_PRINCIPAL) >= _PRINCIPAL_MAX:
+            _PRINCIPAL.clear()
+        _PRINCIPAL[key] = found
+    return found
+
+
+_PRINCIPAL: dict[tuple[tuple[str, str], ...],
+                 tuple[float, float, float, float, float, str] | None] = {}
+_PRINCIPAL_MAX = 4096
 
 
 def _moments(values: Sequence[float]) -> str:
@@ -368,17 +432,35 @@ def link_solid(link: etree._Element, r: RuleReport | None = None,
     or is not closed, a bad size. ``collisions``: the link's ``<collision>`` children, when
     the caller has them (:class:`~urdfkit.model.index.LinkView`).
     """
+    found = _solid(link, r, collisions)
+    return None if found is None else Solid(*found)
+
+
+_ZERO3: tuple[float, ...] = (0.0, 0.0, 0.0)
+
+
+def _solid(link: etree._Element, r: RuleReport | None,
+           collisions: list[etree._Element] | None
+           ) -> tuple[float, tuple[float, float, float], Matrix3, float] | None:
+    """:func:`link_solid`'s fields (volume, com, tensor, size), without making the record."""
     parts: list[tuple[float, tuple[float, ...], Matrix3, float]] = []
     moving: set[str] | None = None
     if collisions is None:
         collisions = [c for c in link if c.tag == "collision"]
     for col in collisions:
         shape, origin = collision_parts(col, SHAPES)
-        xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
-        rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
-        if shape is None or xyz is None or rpy is None:
+        if shape is None:
             return None
-        rot = None if rpy == (0.0, 0.0, 0.0) else rpy_to_matrix(rpy)  # None: no rotation
+        xyz: tuple[float, ...] | None
+        rpy: tuple[float, ...] | None
+        if origin is None:
+            xyz = rpy = _ZERO3
+        else:
+            xyz = _vec(origin, "xyz", 3, _ZERO3)
+            rpy = _vec(origin, "rpy", 3, _ZERO3)
+            if xyz is None or rpy is None:
+                return None
+        rot = None if rpy == _ZERO3 else rpy_to_matrix(rpy)  # None: no rotation
         if shape.tag == "mesh":
             # The mesh-shape rule will want a moving link's concavity: read it in one go.
             if r is not None and moving is None:
@@ -403,12 +485,27 @@ def link_solid(link: etree._Element, r: RuleReport | None = None,
         diag = ((d[0], 0.0, 0.0), (0.0, d[1], 0.0), (0.0, 0.0, d[2]))
         parts.append((volume, xyz, diag if rot is None else
                       matmul(matmul(rot, diag), transpose(rot)), size))
-    total = sum(p[0] for p in parts)
-    if not parts or not 0 < total < math.inf:
-        return None
-    cx = sum(v * c[0] for v, c, _, _ in parts) / total
-    cy = sum(v * c[1] for v, c, _, _ in parts) / total
-    cz = sum(v * c[2] for v, c, _, _ in parts) / total
+    return _combine(parts)
+
+
+def _combine(parts: list[tuple[float, tuple[float, ...], Matrix3, float]]
+             ) -> tuple[float, tuple[float, float, float], Matrix3, float] | None:
+    """Parts (volume, centre, tensor per unit density, size) as one solid's fields."""
+    if len(parts) == 1:  # the common case: sum() of one term is 0.0 plus the term
+        volume, centre, _, _ = parts[0]
+        total = 0.0 + volume
+        if not 0 < total < math.inf:
+            return None
+        cx = (0.0 + volume * centre[0]) / total
+        cy = (0.0 + volume * centre[1]) / total
+        cz = (0.0 + volume * centre[2]) / total
+    else:
+        total = sum(p[0] for p in parts)
+        if not parts or not 0 < total < math.inf:
+            return None
+        cx = sum(v * c[0] for v, c, _, _ in parts) / total
+        cy = sum(v * c[1] for v, c, _, _ in parts) / total
+        cz = sum(v * c[2] for v, c, _, _ in parts) / total
     # Parallel axes: each part's tensor moved from its centre to the common one.
     xx = xy = xz = yx = yy = yz = zx = zy = zz = 0.0
     for volume, centre, t, _ in parts:
@@ -424,10 +521,10 @@ def link_solid(link: etree._Element, r: RuleReport | None = None,
         zx += t20 + volume * (0.0 - dz * dx)
         zy += t21 + volume * (0.0 - dz * dy)
         zz += t22 + volume * (d2 - dz * dz)
-    out = ((xx, xy, xz), (yx, yy, yz), (zx, zy, zz))
     if not all(map(math.isfinite, (xx, xy, xz, yx, yy, yz, zx, zy, zz))):
         return None
-    return Solid(total, (cx, cy, cz), out, max(p[3] for p in parts))
+    return (total, (cx, cy, cz), ((xx, xy, xz), (yx, yy, yz), (zx, zy, zz)),
+            parts[0][3] if len(parts) == 1 else max(p[3] for p in parts))
 
 
 def _shape_trace(link: etree._Element, mass: float | None, r: RuleReport | None = None,
@@ -436,11 +533,12 @@ def _shape_trace(link: etree._Element, mass: float | None, r: RuleReport | None 
     """Trace of the inertia of the link's collision solids for ``mass``, and their size."""
     if mass is None or mass <= 0:
         return None
-    solid = link_solid(link, r, collisions)
+    solid = _solid(link, r, collisions)
     if solid is None:
         return None
-    trace = solid.trace(mass)
-    return (trace, solid.size) if math.isfinite(trace) else None
+    volume, _, tensor, size = solid
+    trace = sum((tensor[0][0], tensor[1][1], tensor[2][2])) * mass / volume  # Solid.trace
+    return (trace, size) if math.isfinite(trace) else None
 
 
 def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
@@ -530,25 +628,25 @@ def rule_visual_meshes(root: etree._Element, r: RuleReport) -> None:
     """
     if r.folder is None:
         return
-    from urdfkit.sources.meshes import mesh_kind, undrawn_visual
+    for view, part, _, mesh in r.parts(root):
+        if part.tag != "visual" or mesh is None or mesh.tag != "mesh":
+            continue
+        fn = (mesh.get("filename") or "").strip()
+        if not fn or (ref := r.reference("mesh", fn)).load is None:
+            continue
+        empty = ref.stat is not None and ref.stat.st_size == 0
+        # meshes.mesh_kind(ref.load), without importing the mesh readers for every check run
+        # (and without splitting names that cannot end in .dae)
+        if not empty and (ref.load[-4:].lower() != ".dae"
+                          or os.path.splitext(ref.load)[1].lower() != ".dae"):
+            continue
+        from urdfkit.sources.meshes import undrawn_visual
 
-    for view in r.doc(root).links:
-        for part in view.parts:
-            if part.tag != "visual":
-                continue
-            mesh = used_shape(first(part, "geometry"))
-            fn = (mesh.get("filename") or "").strip() if mesh is not None and \
-                mesh.tag == "mesh" else ""
-            if not fn or (ref := r.reference("mesh", fn)).load is None:
-                continue
-            empty = ref.stat is not None and ref.stat.st_size == 0
-            if not empty and mesh_kind(ref.load) != ".dae":
-                continue
-            why = undrawn_visual(ref.load)
-            if why is not None:
-                r.add("U715", "warning", f"visual mesh {fn!r} of {label(view.el)} {why}; "
-                      "the robot looks incomplete in render, view and the GUI (export it "
-                      "with its nodes flattened, or as .obj/.stl)", mesh)
+        why = undrawn_visual(ref.load)
+        if why is not None:
+            r.add("U715", "warning", f"visual mesh {fn!r} of {label(view.el)} {why}; "
+                  "the robot looks incomplete in render, view and the GUI (export it "
+                  "with its nodes flattened, or as .obj/.stl)", mesh)
 
 
 #: A mesh this many times larger (or smaller) than the robot's typical joint spacing is in
@@ -572,40 +670,40 @@ def rule_mesh_shapes(root: etree._Element, r: RuleReport) -> None:
                      if (xyz := _vec(jv.origin, "xyz", 3)) is not None and any(xyz))
     spacing = offsets[len(offsets) // 2] if len(offsets) >= 2 else None
     moving = _moving(r, root)
-    for view in doc.links:
+    if not spacing and not moving:
+        return  # neither finding can be made of any mesh
+    for view, part, _, mesh in r.parts(root):
         link = view.el
-        for part in view.parts:
-            concave_matters = part.tag == "collision" and link.get("name") in moving
-            if not spacing and not concave_matters:
-                continue  # neither finding can be made of this mesh
-            mesh = used_shape(first(part, "geometry"))
-            fn = (mesh.get("filename") or "").strip() if mesh is not None and \
-                mesh.tag == "mesh" else ""
-            if not fn or (ref := r.reference("mesh", fn)).load is None:
-                continue
-            scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
-            props = _properties(r, ref.load, scale, concave_matters, ref.stat) \
-                if scale else None
-            if props is None:
-                continue
-            size = max(props.extent)
-            if spacing and size > 0 and not 1 / UNITS_RATIO <= size / spacing <= UNITS_RATIO:
-                ratio = size / spacing
-                fix = ("probably in millimetres: add scale=\"0.001 0.001 0.001\"" if ratio > 1
-                       else "probably scaled twice, or in metres where millimetres were meant: "
-                       "check its scale")
-                r.add("U613", "warning", f"mesh {fn!r} of {label(link)} is {size:.3g} m across, "
-                      f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
-                      f"{fix}", mesh)
-            if concave_matters and props.concavity > CONCAVE_FRACTION * size:
-                r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
-                      f"concave (it is {size:.3g} m across, and parts of it stand up to "
-                      f"{props.concavity:.3g} m in front of its own faces' planes"
-                      + ("" if props.closed else "; it is also open, so the depth is "
-                         "judged on the faces it has") + "): PyBullet "
-                      "collides with its convex hull, so contacts happen in mid-air over the "
-                      "dips; split it into convex parts (p.vhacd, or one OBJ object per part) "
-                      "or use primitives", mesh)
+        concave_matters = part.tag == "collision" and view.name in moving
+        if not spacing and not concave_matters:
+            continue  # neither finding can be made of this mesh
+        fn = (mesh.get("filename") or "").strip() if mesh is not None and \
+            mesh.tag == "mesh" else ""
+        if not fn or (ref := r.reference("mesh", fn)).load is None:
+            continue
+        scale = _vec(mesh, "scale", 3, (1.0, 1.0, 1.0))
+        props = _properties(r, ref.load, scale, concave_matters, ref.stat) \
+            if scale else None
+        if props is None:
+            continue
+        size = max(props.extent)
+        if spacing and size > 0 and not 1 / UNITS_RATIO <= size / spacing <= UNITS_RATIO:
+            ratio = size / spacing
+            fix = ("probably in millimetres: add scale=\"0.001 0.001 0.001\"" if ratio > 1
+                   else "probably scaled twice, or in metres where millimetres were meant: "
+                   "check its scale")
+            r.add("U613", "warning", f"mesh {fn!r} of {label(link)} is {size:.3g} m across, "
+                  f"{ratio:.3g} times the robot's typical joint spacing ({spacing:.3g} m): "
+                  f"{fix}", mesh)
+        if concave_matters and props.concavity > CONCAVE_FRACTION * size:
+            r.add("U614", "warning", f"collision mesh {fn!r} of moving {label(link)} is "
+                  f"concave (it is {size:.3g} m across, and parts of it stand up to "
+                  f"{props.concavity:.3g} m in front of its own faces' planes"
+                  + ("" if props.closed else "; it is also open, so the depth is "
+                     "judged on the faces it has") + "): PyBullet "
+                  "collides with its convex hull, so contacts happen in mid-air over the "
+                  "dips; split it into convex parts (p.vhacd, or one OBJ object per part) "
+                  "or use primitives", mesh)
 
 
 def _moving_links(doc: Doc) -> set[str]:
@@ -620,6 +718,8 @@ def _moving_links(doc: Doc) -> set[str]:
             (child.get("link", ""), jv.type == "fixed"))
         children.add(child.get("link", ""))
     names = [view.name if view.name is not None else "" for view in doc.links]
+    if not below:  # no joint: only the first link stays with the root
+        return set(names) - set(names[:1])
     roots = [n for n in names if n not in children]
     still, stack = set(), roots[:1]
     while stack:
@@ -662,6 +762,8 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
     for the link (its ``<contact>``, else lateral friction 0.5 and a rigid contact). A link
     whose ``<contact>`` already carries the values gets nothing.
     """
+    if not _has_gazebo(root):
+        return  # most files: nothing to read, and no Gazebo reader to load
     from urdfkit.model.gazebo import NOT_CARRIED, PYBULLET_LATERAL_FRICTION, gazebo_contacts
 
     contacts = gazebo_contacts(root)
@@ -717,6 +819,26 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
               gz.element)
 
 
+def _has_gazebo(root: etree._Element) -> bool:
+    """Whether a ``<gazebo>`` may stand where gazebo_contacts looks for one.
+
+    That is: among the root's children, or among the children of a root's ``<link>``, in any
+    namespace. A look at tag names only, so a superset: ``<mygazebo>`` says True too.
+    """
+    for child in root:
+        tag = child.tag
+        if not isinstance(tag, str):
+            continue
+        if tag.endswith("gazebo"):
+            return True
+        if tag.endswith("link"):
+            for g in child:
+                gtag = g.tag
+                if isinstance(gtag, str) and gtag.endswith("gazebo"):
+                    return True
+    return False
+
+
 def _contact_values(link: etree._Element) -> dict[str, float]:
     """The link's ``<contact>`` values PyBullet reads: {lateral_friction, stiffness, ...}."""
     contact = first(link, "contact")
@@ -739,9 +861,14 @@ def rule_portability(root: etree._Element, r: RuleReport) -> None:
             r.add("U901", "info", f"{label(jv.el)}: {note}", jv.el)
     for geom in doc.geometries:
         for shape in geom:
-            note = extension_note("shape", shape.tag) if isinstance(shape.tag, str) else None
+            note = _SHAPE_NOTES.get(shape.tag)  # a comment's tag is a function: no note
             if note:
                 r.add("U901", "info", note, shape)
+
+
+#: extension_note("shape", tag) by tag, one lookup a shape.
+_SHAPE_NOTES = {key.partition(":")[2]: note for key, note in EXTENSIONS.items()
+                if key.startswith("shape:")}
 
 
 #: Every rule ``urdfkit check`` runs, in order.

@@ -81,7 +81,10 @@ def used_shape(geometry: Any) -> Any:
     """
     if geometry is None:
         return None
-    return next((c for c in geometry if isinstance(c.tag, str)), None)
+    for c in geometry:  # a loop, not next() over a generator: check asks per shape of a file
+        if isinstance(c.tag, str):
+            return c
+    return None
 
 
 def ignored_shape(el: Any) -> bool:

@@ -23,7 +23,7 @@ from lxml import etree
 from urdfkit.core import deps
 from urdfkit.core.errors import InputError, Oversized
 from urdfkit.core.finding import Finding
-from urdfkit.model.index import Doc, first
+from urdfkit.model.index import Doc, LinkView
 from urdfkit.model.spec import (
     CRASH_NAME_BYTES,
     CRASH_PERCENT_TAGS,
@@ -38,10 +38,11 @@ from urdfkit.model.spec import (
     SHAPES,
     mesh_suffix,
     numbers,
+    used_shape,
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.model.xmlio import line_of
+from urdfkit.model.xmlio import BIG_LINES, line_of
 from urdfkit.sources.uris import not_a_file, pybullet_data_path, resolve_uri
 
 
@@ -68,6 +69,7 @@ class RuleReport:
         self.elements: list[etree._Element | None] = []
         self._references: dict[tuple[str, str], Reference] = {}
         self._doc: Doc | None = None
+        self._parts: tuple[Doc, list[Part]] | None = None
         #: Results rules share within this file (a mesh's properties at a scale).
         self.memo: dict[object, Any] = {}
 
@@ -83,6 +85,27 @@ class RuleReport:
             doc = self._doc = Doc(root)
         return doc
 
+    def parts(self, root: etree._Element) -> list[Part]:
+        """Every link's ``<visual>`` and ``<collision>``, in order, with what rules read of it.
+
+        Each is (link view, the element, its first ``<geometry>``, the shape PyBullet builds
+        it from: :func:`~urdfkit.model.spec.used_shape`), None where absent. Worked out once
+        per file: the geometry and mesh rules all ask.
+        """
+        doc = self.doc(root)
+        if self._parts is None or self._parts[0] is not doc:
+            found: list[Part] = []
+            for view in doc.links:
+                for part in view.parts:
+                    geometry = None
+                    for c in part:  # first(part, "geometry"), without an iterator object
+                        if c.tag == "geometry":
+                            geometry = c
+                            break
+                    found.append((view, part, geometry, used_shape(geometry)))
+            self._parts = (doc, found)
+        return self._parts[1]
+
     def reference(self, tag: str, fn: str) -> Reference:
         """:func:`reference` from this file's folder, judged once per file (several rules ask)."""
         assert self.folder is not None
@@ -96,7 +119,9 @@ class RuleReport:
             line: int | None = None) -> None:
         """Record a finding; its line comes from ``el`` unless given."""
         if line is None and el is not None:
-            line = line_of(el)
+            line = el.sourceline  # line_of(el), whose lookup only lines past 65,535 need
+            if line is not None and line >= BIG_LINES:
+                line = line_of(el)
         origin = self.origins.get(el) if self.origins is not None and el is not None else None
         self.findings.append(Finding(code, level, message, self.file, line, origin))
         self.elements.append(el)
@@ -108,6 +133,8 @@ class RuleReport:
 
 
 Rule = Callable[[etree._Element, RuleReport], None]
+#: A ``<visual>`` or ``<collision>`` as :meth:`RuleReport.parts` gives it.
+Part = tuple[LinkView, etree._Element, etree._Element | None, etree._Element | None]
 
 
 def label(el: etree._Element) -> str:
@@ -173,6 +200,8 @@ def _check_percent(el: etree._Element, name: str, r: RuleReport) -> None:
 
 
 def _check_length(el: etree._Element, name: str, r: RuleReport) -> None:
+    if len(name) * 4 <= MAX_NAME_BYTES:
+        return  # no character is more than 4 bytes of UTF-8
     size = len(name.encode("utf-8", "surrogatepass"))
     if size <= MAX_NAME_BYTES:
         return
@@ -229,14 +258,15 @@ def rule_names(root: etree._Element, r: RuleReport) -> None:
             continue
         # Only a link's visual: PyBullet ignores <gazebo> and what is in it (a Gazebo
         # <visual><material><ambient> has no name and loads; found on linorobot2).
-        if el.get("name") is None and visual is not None and visual.tag == "visual" and \
+        name = el.get("name")
+        if name is None and visual is not None and visual.tag == "visual" and \
                 visual.getparent() is not None and visual.getparent().tag == "link":
             # Measured: PyBullet refuses the whole file ("Could not parse visual element");
             # name="" loads.
             r.add("U110", "error", "<material> of a <visual> has no name attribute: PyBullet "
                   "refuses the file (\"Could not parse visual element\"); give it one "
                   "(name=\"\" is enough)", el)
-        elif el.get("name") and "%" in el.get("name", ""):
+        elif name and "%" in name:
             _check_name(el, r)
 
 
@@ -289,7 +319,14 @@ def rule_tree(root: etree._Element, r: RuleReport) -> None:
     elif not roots:
         r.add("U206", "error", "no root link: every link is some joint's child, so the joints "
               "form a cycle", root)
-    # Anything not reachable from a root sits on a cycle.
+    if parent_of:  # with no parent anywhere, every link is a root and none is on a cycle
+        _report_cycle(r, links, roots, parent_of, children)
+
+
+def _report_cycle(r: RuleReport, links: dict[str, etree._Element], roots: list[str],
+                  parent_of: dict[str, tuple[str, etree._Element]],
+                  children: dict[str, list[str]]) -> None:
+    """U207: links not reachable from a root sit on a cycle."""
     reachable: set[str] = set()
     stack = list(roots)
     while stack:
@@ -366,37 +403,17 @@ def rule_joints(root: etree._Element, r: RuleReport) -> None:
 
 def rule_geometry(root: etree._Element, r: RuleReport) -> None:
     """U501-U506: one shape per <geometry>, first; positive sizes; meshes have a filename."""
-    doc = r.doc(root)
-    for view in doc.links:
-        for part in view.parts:
-            if first(part, "geometry") is None:
-                r.add("U506", "error", f"<{part.tag}> of {label(view.el)} has no <geometry>, "
-                      "which PyBullet refuses; add one or remove the element", part)
-    for geom in doc.geometries:
-        elements = [c for c in geom if isinstance(c.tag, str)]
-        shapes = [c for c in elements if c.tag in SHAPES]
-        if shapes and elements[0].tag not in SHAPES:
-            r.add("U505", "error", f"<{elements[0].tag}> comes before the shape in <geometry>; "
-                  "PyBullet reads the first element as the shape and refuses the file",
-                  elements[0])
-        for c in elements:
-            if c.tag == "origin":
-                r.add("U504", "warning", "<origin> inside <geometry> is ignored by PyBullet; put "
-                      "it in the enclosing <visual> or <collision>", c)
-        if len(shapes) != 1:
-            owner = geom.getparent()
-            what = f"<{owner.tag}> of {label(owner.getparent())}" if owner is not None \
-                and owner.getparent() is not None else "<geometry>"
-            if not shapes:
-                r.add("U502", "error", f"<geometry> in {what} holds no shape, which PyBullet "
-                      f"refuses; it needs one of {', '.join(SHAPES[:4])}", geom)
+    for view, part, geometry, _ in r.parts(root):
+        if geometry is None:
+            r.add("U506", "error", f"<{part.tag}> of {label(view.el)} has no <geometry>, "
+                  "which PyBullet refuses; add one or remove the element", part)
+    for geom in r.doc(root).geometries:
+        # The common case, one child and a shape, has nothing for _sole_shape to say.
+        shape = geom[0] if len(geom) == 1 else None
+        if shape is None or shape.tag not in SHAPES:
+            shape = _sole_shape(geom, r)
+            if shape is None:
                 continue
-            # Measured (PyBullet 3.2.7): the file loads, visual and collision alike built from
-            # the first shape; the others are ignored.
-            r.add("U507", "warning", f"<geometry> in {what} holds {len(shapes)} shapes "
-                  f"({', '.join(f'<{c.tag}>' for c in shapes)}); PyBullet uses the first, "
-                  f"<{shapes[0].tag}>, and ignores the rest: keep one", shapes[1])
-        shape = shapes[0]  # PyBullet reads none after the first (measured)
         for attr in SHAPE_SIZES.get(shape.tag, ()):
             text = shape.get(attr)
             if text is None:
@@ -411,6 +428,34 @@ def rule_geometry(root: etree._Element, r: RuleReport) -> None:
             r.add("U503", "error", f"<{shape.tag}> has no filename", shape)
 
 
+def _sole_shape(geom: etree._Element, r: RuleReport) -> etree._Element | None:
+    """U502, U504, U505, U507 of a ``<geometry>``; its first shape, None if it has none."""
+    elements = [c for c in geom if isinstance(c.tag, str)]
+    shapes = [c for c in elements if c.tag in SHAPES]
+    if shapes and elements[0].tag not in SHAPES:
+        r.add("U505", "error", f"<{elements[0].tag}> comes before the shape in <geometry>; "
+              "PyBullet reads the first element as the shape and refuses the file",
+              elements[0])
+    for c in elements:
+        if c.tag == "origin":
+            r.add("U504", "warning", "<origin> inside <geometry> is ignored by PyBullet; put "
+                  "it in the enclosing <visual> or <collision>", c)
+    if len(shapes) != 1:
+        owner = geom.getparent()
+        what = f"<{owner.tag}> of {label(owner.getparent())}" if owner is not None \
+            and owner.getparent() is not None else "<geometry>"
+        if not shapes:
+            r.add("U502", "error", f"<geometry> in {what} holds no shape, which PyBullet "
+                  f"refuses; it needs one of {', '.join(SHAPES[:4])}", geom)
+            return None
+        # Measured (PyBullet 3.2.7): the file loads, visual and collision alike built from
+        # the first shape; the others are ignored.
+        r.add("U507", "warning", f"<geometry> in {what} holds {len(shapes)} shapes "
+              f"({', '.join(f'<{c.tag}>' for c in shapes)}); PyBullet uses the first, "
+              f"<{shapes[0].tag}>, and ignores the rest: keep one", shapes[1])
+    return shapes[0]  # PyBullet reads none after the first (measured)
+
+
 def rule_inertial(root: etree._Element, r: RuleReport) -> None:
     """U609-U610: <inertial> has an <inertia> with all six components (PyBullet refuses less)."""
     for view in r.doc(root).links:
@@ -422,11 +467,16 @@ def rule_inertial(root: etree._Element, r: RuleReport) -> None:
                   "PyBullet refuses; add <inertia ixx=... iyy=... izz=... ixy ixz iyz>",
                   inertial)
             continue
+        if _INERTIA_ATTRIBUTES.issubset(inertia.keys()):
+            continue  # all six there (keys() names an attribute get() finds as get does)
         missing = [a for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz") if inertia.get(a) is None]
         if missing:
             r.add("U610", "error", f"<inertia> of {label(link)} has no {', '.join(missing)}, "
                   "which PyBullet refuses; give all six components (0 for products of inertia "
                   "of a symmetric body)", inertia)
+
+
+_INERTIA_ATTRIBUTES = frozenset(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
 
 
 @dataclass(frozen=True, slots=True)
