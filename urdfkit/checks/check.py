@@ -13,7 +13,6 @@ import os
 import re
 import sys
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -47,7 +46,6 @@ ONCE_PER_RUN = frozenset({"U607"})
 _PARALLEL_MIN = 8
 
 
-@dataclass(slots=True)
 class FileResult:
     """The findings of one file.
 
@@ -60,27 +58,61 @@ class FileResult:
             (:class:`urdfkit.checks.resultcache.RunManifest`).
         meshes: The mesh cache entries a worker process used, for the run's pack (not in
             the JSON).
+        includes: Whether the bytes checked (the file's own, not xacro's output) mention
+            ``include``; None when unknown (a cached result, xacro): what
+            :func:`_judge_fragments` would otherwise read the file again to learn.
 
-    Two are equal when their files and findings are.
+    Two are equal when their files and findings are. (Plain classes, here and in
+    :class:`CheckResult`: each dataclass costs ~0.7 ms at import on every run.)
     """
 
-    file: str
-    findings: list[Finding] = field(default_factory=list)
-    cached: bool = field(default=False, compare=False, repr=False)
-    entry: tuple[tuple[int, int, int, int], dict[str, Any], list[dict[str, Any]]] | None = \
-        field(default=None, compare=False, repr=False)
-    meshes: dict[str, Any] | None = field(default=None, compare=False, repr=False)
+    __slots__ = ("file", "findings", "cached", "entry", "meshes", "includes")
+
+    def __init__(self, file: str, findings: list[Finding] | None = None, cached: bool = False,
+                 entry: tuple[tuple[int, int, int, int], dict[str, Any],
+                              list[dict[str, Any]]] | None = None,
+                 meshes: dict[str, Any] | None = None) -> None:
+        self.file = file
+        self.findings: list[Finding] = [] if findings is None else findings
+        self.cached = cached
+        self.entry = entry
+        self.meshes = meshes
+        self.includes: bool | None = None
+
+    def __eq__(self, other: object) -> bool:
+        if other.__class__ is not FileResult:
+            return NotImplemented
+        assert isinstance(other, FileResult)
+        return (self.file, self.findings) == (other.file, other.findings)
+
+    __hash__ = None  # type: ignore[assignment]  # mutable
+
+    def __repr__(self) -> str:
+        return f"FileResult(file={self.file!r}, findings={self.findings!r})"
 
     def count(self, level: str) -> int:
         """How many findings of ``level``."""
         return sum(1 for f in self.findings if f.level == level)
 
 
-@dataclass(slots=True)
 class CheckResult:
     """The findings of a whole ``check`` run, file by file in discovery order."""
 
-    files: list[FileResult]
+    __slots__ = ("files",)
+
+    def __init__(self, files: list[FileResult]) -> None:
+        self.files = files
+
+    def __eq__(self, other: object) -> bool:
+        if other.__class__ is not CheckResult:
+            return NotImplemented
+        assert isinstance(other, CheckResult)
+        return self.files == other.files
+
+    __hash__ = None  # type: ignore[assignment]  # mutable
+
+    def __repr__(self) -> str:
+        return f"CheckResult(files={self.files!r})"
 
     @property
     def findings(self) -> list[Finding]:
@@ -252,6 +284,8 @@ def check_file(display: str, path: str | Path,
         result.findings.append(Finding("U000", "error", f"cannot check: {e}", display))
         return result
     findings = result.findings
+    if not xacro_file:
+        result.includes = b"include" in data
     for line, note in quirks:
         findings.append(Finding("U004", "warning", note, display, line))
     if not xacro_file:
@@ -541,6 +575,8 @@ def _judge_fragments(done: list[FileResult], files: Sequence[tuple[str, str, str
             continue
         if any(f.code == "U000" for f in done[n].findings):
             continue  # unreadable, or not XML: nothing to follow
+        if done[n].includes is False:
+            continue  # its bytes were searched when it was checked
         try:  # never a FIFO or device (opened non-blocking, refused unless regular)
             data = read_regular(path, track=False)
         except InputError:
