@@ -13,6 +13,7 @@ import os
 import re
 import sys
 from collections.abc import Iterable, Mapping, Sequence
+from operator import attrgetter
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -198,24 +199,29 @@ def discover(paths: Iterable[str | Path]) -> list[tuple[str, str, str | None]]:
                 folder = stack.pop()
                 try:
                     with os.scandir(folder) as it:
-                        entries = sorted(it, key=lambda e: e.name)
+                        entries = sorted(it, key=_entry_name)
                 except OSError as e:
                     add(folder, folder, f"cannot list this folder: {e.strerror}")
                     continue
                 subdirs = []
                 for entry in entries:
+                    if entry.name.lower().endswith(SUFFIXES):
+                        add(entry.path, entry.path, key=top_key + entry.path[len(top):])
+                        continue
                     try:
                         is_dir = entry.is_dir(follow_symlinks=False)
                     except OSError:
                         is_dir = False
-                    if entry.name.lower().endswith(SUFFIXES):
-                        add(entry.path, entry.path, key=top_key + entry.path[len(top):])
-                    elif is_dir:
+                    if is_dir:
                         subdirs.append(entry.path)
                 stack.extend(reversed(subdirs))
         else:
             add(str(item), str(path))
     return out
+
+
+#: A folder entry's name, the key its folder's entries are sorted by (C, no lambda call).
+_entry_name = attrgetter("name")
 
 
 def _bare_name(item: str | Path) -> Path:

@@ -56,11 +56,14 @@ def collision_parts(col: El, shapes: tuple[str, ...]) -> tuple[El, El]:
 
 
 def first(el: El, tag: str) -> El:
-    """``el.find(tag)`` for a tag name ("x" or "{ns}x"), without ``find``'s ElementPath.
+    """``el.find(tag)`` for a tag name, without ``find``'s ElementPath (lxml's rules: "{ns}x").
 
-    A loop over the children: about half the cost of ``next(el.iterchildren(tag))``, whose
-    tag matcher is built anew on each call (the rules ask ~12 times a file).
+    A plain name is a loop over the children: about half the cost of
+    ``next(el.iterchildren(tag))``, whose tag matcher is built anew on each call (the rules
+    ask ~12 times a file). A namespaced one ("{*}x" included) is lxml's.
     """
+    if tag[0] == "{":
+        return next(el.iterchildren(tag), None)
     for child in el:
         if child.tag == tag:
             return child

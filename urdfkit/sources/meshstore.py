@@ -1,8 +1,8 @@
 """Mesh mass properties as check asks for them: the lookup, the cache entries, a run's pack.
 
-Compiled with the check path (setup.py): ``check`` asks once per mesh of every file, and a
-warm run answers every one of them from memory or the run's pack, so this lookup is the
-mesh rules' whole cost then. Reading and integrating a mesh, on a miss, is
+Loaded with the check path: ``check`` asks once per mesh of every file, and a warm run
+answers every one of them from memory or the run's pack, so this lookup is the mesh rules'
+whole cost then. Reading and integrating a mesh, on a miss, is
 :mod:`urdfkit.sources.meshes` (imported only then: it loads numpy and its patterns).
 """
 
