@@ -49,7 +49,10 @@ def collision_parts(col: El, shapes: tuple[str, ...]) -> tuple[El, El]:
         tag = c.tag
         if tag == "geometry":
             if shape is None:
-                shape = next((s for s in c if s.tag in shapes), None)
+                for s in c:
+                    if s.tag in shapes:
+                        shape = s
+                        break
         elif tag == "origin" and origin is None:
             origin = c
     return shape, origin

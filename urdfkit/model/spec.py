@@ -81,7 +81,10 @@ def used_shape(geometry: Any) -> Any:
     """
     if geometry is None:
         return None
-    return next((c for c in geometry if isinstance(c.tag, str)), None)
+    for child in geometry:  # a loop, not next(generator): asked ~8 times a file
+        if isinstance(child.tag, str):
+            return child
+    return None
 
 
 def ignored_shape(el: Any) -> bool:
