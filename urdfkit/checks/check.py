@@ -583,12 +583,10 @@ def _judge_fragments(done: list[FileResult], files: Sequence[tuple[str, str, str
         return
     includers: dict[int, str] = {}
     for n, (display, path, problem) in enumerate(files):
-        if problem is not None:
-            continue
+        if problem is not None or done[n].includes is False:
+            continue  # not a file; or its bytes, searched when it was checked, include nothing
         if any(f.code == "U000" for f in done[n].findings):
             continue  # unreadable, or not XML: nothing to follow
-        if done[n].includes is False:
-            continue  # its bytes were searched when it was checked
         try:  # never a FIFO or device (opened non-blocking, refused unless regular)
             data = read_regular(path, track=False)
         except InputError:
