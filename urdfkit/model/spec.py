@@ -81,9 +81,9 @@ def used_shape(geometry: Any) -> Any:
     """
     if geometry is None:
         return None
-    for child in geometry:  # a loop, not next(generator): asked ~8 times a file
-        if isinstance(child.tag, str):
-            return child
+    for c in geometry:  # a loop, not next() over a generator: check asks per shape of a file
+        if isinstance(c.tag, str):
+            return c
     return None
 
 
