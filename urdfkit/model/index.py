@@ -289,7 +289,10 @@ class Doc:
         if form is None:
             return  # an element no rule knows: nothing to say of its attributes
         if form is _NAMES:  # no values read: none is part of the verdict
-            key: tuple[Any, ...] = (tag, *el.keys())
+            names = el.keys()
+            if not names:
+                return  # <geometry>, <inertial>, <contact>: nothing to judge
+            key: tuple[Any, ...] = (tag, *names)
         elif form is _VALUES:  # every known attribute is a number: all of it is the key
             key = (tag, *el.items())
         else:  # names, then the numeric attributes' values (None when absent)
