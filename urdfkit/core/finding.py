@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Literal
 
 #: A finding's level; ``check --fail-on`` takes one too.
@@ -11,9 +10,8 @@ Level = Literal["info", "warning", "error"]
 LEVELS: tuple[Level, ...] = ("info", "warning", "error")
 
 
-@dataclass(frozen=True, slots=True)
 class Finding:
-    """One problem found in a file.
+    """One problem found in a file: a value (compared and hashed by its fields), read-only.
 
     Attributes:
         code: A stable identifier such as ``U201``, for ``--select`` and ``--ignore``.
@@ -22,14 +20,53 @@ class Finding:
         file: The file, as the user named it.
         line: The 1-based line, where known.
         origin: Where the element was written when that is another file (xacro), else None.
+
+    A plain class, not a dataclass: ``check`` loads this on every run, and making a frozen
+    dataclass at import costs ~0.7 ms (measured: ~4.5M instructions, a plain class ~0.1M).
     """
 
+    __slots__ = ("code", "level", "message", "file", "line", "origin")
     code: str
     level: str
     message: str
     file: str
-    line: int | None = None
-    origin: str | None = None
+    line: int | None
+    origin: str | None
+
+    def __init__(self, code: str, level: str, message: str, file: str,
+                 line: int | None = None, origin: str | None = None) -> None:
+        _set = object.__setattr__
+        _set(self, "code", code)
+        _set(self, "level", level)
+        _set(self, "message", message)
+        _set(self, "file", file)
+        _set(self, "line", line)
+        _set(self, "origin", origin)
+
+    def _key(self) -> tuple[str, str, str, str, int | None, str | None]:
+        return (self.code, self.level, self.message, self.file, self.line, self.origin)
+
+    def __eq__(self, other: object) -> bool:
+        if other.__class__ is not Finding:
+            return NotImplemented
+        assert isinstance(other, Finding)
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise AttributeError(f"cannot assign to field {name!r}: a Finding is read-only")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"cannot delete field {name!r}: a Finding is read-only")
+
+    def __reduce__(self) -> tuple[type[Finding], tuple[object, ...]]:
+        return (Finding, self._key())
+
+    def __repr__(self) -> str:
+        return (f"Finding(code={self.code!r}, level={self.level!r}, message={self.message!r}, "
+                f"file={self.file!r}, line={self.line!r}, origin={self.origin!r})")
 
     def to_dict(self) -> dict[str, object]:
         """The JSON form."""

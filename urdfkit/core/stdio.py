@@ -10,6 +10,7 @@ other. Re-entrant: the thread inside a redirection may print (into it).
 
 from __future__ import annotations
 
-import threading
+# The lock threading.RLock() makes, without importing threading (~0.5 ms of every run).
+from _thread import RLock
 
-LOCK = threading.RLock()
+LOCK = RLock()

@@ -136,6 +136,8 @@ def _value(el: El) -> float | None:
 def _blocks(root: El) -> list[tuple[str, El]]:
     """Each ``<gazebo>`` block with the link it is about: ``reference=``, or the enclosing link."""
     blocks: list[tuple[str, El]] = []
+    if next(root.iter("{*}gazebo"), None) is None:  # in C; most files have none
+        return blocks
     for child in root:
         tag = _local(child.tag)
         if tag == "gazebo" and child.get("reference"):

@@ -49,15 +49,28 @@ def collision_parts(col: El, shapes: tuple[str, ...]) -> tuple[El, El]:
         tag = c.tag
         if tag == "geometry":
             if shape is None:
-                shape = next((s for s in c if s.tag in shapes), None)
+                for s in c:
+                    if s.tag in shapes:
+                        shape = s
+                        break
         elif tag == "origin" and origin is None:
             origin = c
     return shape, origin
 
 
 def first(el: El, tag: str) -> El:
-    """``el.find(tag)`` for a tag name, without ``find``'s ElementPath (lxml's rules: "{ns}x")."""
-    return next(el.iterchildren(tag), None)
+    """``el.find(tag)`` for a tag name, without ``find``'s ElementPath (lxml's rules: "{ns}x").
+
+    A plain name is a loop over the children: about half the cost of
+    ``next(el.iterchildren(tag))``, whose tag matcher is built anew on each call (the rules
+    ask ~12 times a file). A namespaced one ("{*}x" included) is lxml's.
+    """
+    if tag[0] == "{":
+        return next(el.iterchildren(tag), None)
+    for child in el:
+        if child.tag == tag:
+            return child
+    return None
 
 
 #: NUMERIC by tag: {tag: {attribute: how many numbers}}, one lookup per element.
@@ -208,83 +221,108 @@ class Doc:
                     self.materials.append(child)
                 elif ctag == "deformable":
                     self.deformables += 1
-            self._walk(root, tag, tag[0] != "{" and tag not in OPAQUE, 1)
+            if tag[0] == "{" or tag in _OPAQUE:
+                self._measure(root, 1)
+            else:
+                self._walk(root, tag, 1)
 
-    def _walk(self, el: El, tag: str, checked: bool, depth: int) -> None:
-        """Visit ``el``'s subtree once: collect, and check elements when ``checked``.
+    def _walk(self, el: El, tag: str, depth: int) -> None:
+        """Check ``el`` and its subtree, in document order.
 
         The element checks skip what ``rule_elements`` always skipped: comments, namespaced
         elements (xacro leftovers, extensions) and opaque subtrees (another tool's), and a
-        shape after the first in a ``<geometry>`` (PyBullet never reads it). Collection
-        goes everywhere ``root.iter`` goes.
+        shape after the first in a ``<geometry>`` (PyBullet never reads it); those subtrees
+        are only measured for depth (:meth:`_measure`).
         """
-        allowed = None
-        if checked:
-            self._check(el, tag)
-            known = SCHEMA.get(tag)
-            if known is not None:
-                allowed = known[1]
+        self._check(el, tag)
+        known = SCHEMA.get(tag)
+        allowed = known[1] if known is not None else None
+        first = used_shape(el) if tag == "geometry" else None
         if depth == MAX_XML_DEPTH and self.too_deep is None:
             self.too_deep = next((c for c in el if isinstance(c.tag, str)), None)
-        buckets = self._buckets
-        first = used_shape(el) if checked and tag == "geometry" else None
         depth += 1
+        buckets = self._buckets
         for child in el:
             ctag = child.tag
-            if not isinstance(ctag, str):
+            if ctag.__class__ is not str:
                 continue  # comments, processing instructions, entities
             bucket = buckets.get(ctag)
             if bucket is not None:
                 bucket.append(child)
-            if not checked or ctag[0] == "{":
-                if len(child):  # nothing to check, but more to collect
-                    self._walk(child, ctag, False, depth)
+            if ctag[0] == "{":
+                if len(child):  # nothing to check, but maybe too deep
+                    self._measure(child, depth)
                 continue
             if allowed is not None and ctag not in allowed:
                 self.element_findings.append((
                     "U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
                     "ignores it", child))
             # A shape after the first in a <geometry> is never read (U507).
-            if ctag in OPAQUE or (first is not None and child is not first):
+            if ctag in _OPAQUE or (first is not None and child is not first):
                 if len(child):
-                    self._walk(child, ctag, False, depth)
+                    self._measure(child, depth)
             elif len(child):
-                self._walk(child, ctag, True, depth)
+                self._walk(child, ctag, depth)
             else:  # a leaf: its attributes are all there is to check
                 self._check(child, ctag)
+
+    def _measure(self, el: El, depth: int) -> None:
+        """Collect from an unchecked subtree, and find its first element too deep."""
+        if depth == MAX_XML_DEPTH and self.too_deep is None:
+            self.too_deep = next((c for c in el if isinstance(c.tag, str)), None)
+        buckets = self._buckets
+        for child in el:
+            ctag = child.tag
+            if ctag.__class__ is str:
+                bucket = buckets.get(ctag)
+                if bucket is not None:
+                    bucket.append(child)
+                if len(child):
+                    self._measure(child, depth + 1)
 
     def _check(self, el: El, tag: str) -> None:
         """U401-U402 and U801-U802 of one element's attributes."""
         # The verdict depends on the attributes' names and on the values of the numeric
         # ones only: names and file names (unique to each file) stay out of the key, or
-        # every link and mesh would miss. Decodable: the tag fixes which names hold values.
-        numeric = NUMERIC_BY_TAG.get(tag)
-        key: tuple[str, ...]
-        if numeric is None:
-            if tag not in SCHEMA:
-                return  # an element no rule knows: nothing to say of its attributes
-            names = el.keys()  # no values read: none is part of the verdict
+        # every link and mesh would miss. Decodable: the tag fixes the key's form.
+        form = _KEY_FORMS.get(tag)
+        if form is None:
+            return  # an element no rule knows: nothing to say of its attributes
+        if form is _NAMES:  # no values read: none is part of the verdict
+            names = el.keys()
             if not names:
-                return
-            key = (tag, *names)
-        else:
-            items = el.items()
-            if not items:
-                return
-            parts: list[str] = [tag]
-            for attr, text in items:
-                parts.append(attr)
-                if attr in numeric:
-                    parts.append(text)
-            key = tuple(parts)
+                return  # <geometry>, <inertial>, <contact>: nothing to judge
+            key: tuple[Any, ...] = (tag, *names)
+        elif form is _VALUES:  # every known attribute is a number: all of it is the key
+            key = (tag, *el.items())
+        else:  # names, then the numeric attributes' values (None when absent)
+            key = (tag, *el.keys(), *map(el.get, form))
         found = _VERDICTS.get(key)
         if found is None:
             found = _verdict(tag, el.items())
             if len(_VERDICTS) >= _VERDICTS_MAX:
                 _VERDICTS.clear()
             _VERDICTS[key] = found
-        for code, level, message in found:
-            self.element_findings.append((code, level, message, el))
+        if found:
+            self.element_findings.extend([(*f, el) for f in found])
+
+
+_OPAQUE = frozenset(OPAQUE)
+#: The tags Doc collects from the whole document (no namespace: as ``root.iter(tag)``).
+_COLLECTED = ("material", "geometry", "transmission", *FILE_TAGS)
+#: How :meth:`Doc._check` keys its memo for each tag it judges: by the attributes' names
+#: (_NAMES: no numeric attribute), by names and values (_VALUES: every known attribute is
+#: numeric; an unknown one's value only makes the key longer), or by names and the values
+#: of the numeric attributes named (a tuple: ``<mesh filename= scale=>``).
+_NAMES: tuple[str, ...] = ("<names>",)
+_VALUES: tuple[str, ...] = ("<values>",)
+_KEY_FORMS: dict[str, tuple[str, ...]] = {}
+for _tag, (_attrs, _kids) in SCHEMA.items():
+    _numeric = tuple(sorted(NUMERIC_BY_TAG.get(_tag, ())))
+    _KEY_FORMS[_tag] = (_NAMES if not _numeric else _VALUES if set(_numeric) >= _attrs
+                        else _numeric)
+for _tag, _num in NUMERIC_BY_TAG.items():
+    _KEY_FORMS.setdefault(_tag, tuple(sorted(_num)))
 
 
 #: The element rules' verdict on a tag with its attributes, for the whole process: real files

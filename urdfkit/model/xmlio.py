@@ -12,7 +12,7 @@ import math
 import os
 import re
 import stat
-import threading
+from _thread import _local as thread_local  # threading.local, without threading (~0.5 ms)
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -45,7 +45,7 @@ def _parser(lines: int = 0) -> etree.XMLParser:
 
 
 #: lxml parsers are not shared between threads (the viewer parses in its own).
-_PARSERS = threading.local()
+_PARSERS = thread_local()
 
 
 def _new_parser(big: bool) -> etree.XMLParser:

@@ -1,8 +1,8 @@
 """Mesh mass properties as check asks for them: the lookup, the cache entries, a run's pack.
 
-Compiled with the check path (setup.py): ``check`` asks once per mesh of every file, and a
-warm run answers every one of them from memory or the run's pack, so this lookup is the
-mesh rules' whole cost then. Reading and integrating a mesh, on a miss, is
+Loaded with the check path: ``check`` asks once per mesh of every file, and a warm run
+answers every one of them from memory or the run's pack, so this lookup is the mesh rules'
+whole cost then. Reading and integrating a mesh, on a miss, is
 :mod:`urdfkit.sources.meshes` (imported only then: it loads numpy and its patterns).
 """
 
@@ -92,6 +92,10 @@ def properties(path: str | os.PathLike[str],
 
 _PACKS = "mesh-packs-2"
 _PACK_MAGIC = b"MP2\n"
+#: Each pack entry: its key's length, its entry's length; then the two.
+_PACK_HEAD = struct.Struct("<IH")
+#: The entry of a path that is no mesh (unreadable, unsupported or empty).
+_NO_MESH = _ENTRY + b"-"
 #: Packs kept; the oldest beyond this are removed when a new one is written.
 MAX_PACKS = 64
 #: The entries this process used (its own, and its workers' once merged), by key.
@@ -119,15 +123,17 @@ def load_pack(paths: Sequence[str]) -> int:
     if blake2b(body, digest_size=16).digest() != check:
         return 0  # damaged: trust none of it
     found: dict[str, Integrals | None] = {}
-    at = 0
+    at, end = 0, len(body)
+    head, unpack = _PACK_HEAD.unpack_from, Integrals.unpack
     try:
-        while at < len(body):
-            klen, elen = struct.unpack_from("<IH", body, at)
+        while at < end:
+            klen, elen = head(body, at)
             at += 6
             key = body[at:at + klen].decode("utf-8", "surrogateescape")
-            entry = body[at + klen:at + klen + elen]
-            at += klen + elen
-            found[key] = None if entry == _ENTRY + b"-" else Integrals.unpack(entry)
+            at += klen
+            entry = body[at:at + elen]
+            at += elen
+            found[key] = None if entry == _NO_MESH else unpack(entry)
     except (ValueError, struct.error):
         return 0
     for key, value in found.items():
@@ -150,8 +156,8 @@ def save_pack(paths: Sequence[str]) -> bool:
     parts = []
     for key, value in USED.items():
         k = key.encode("utf-8", "surrogateescape")
-        e = value.pack() if value is not None else _ENTRY + b"-"
-        parts.append(struct.pack("<IH", len(k), len(e)) + k + e)
+        e = value.pack() if value is not None else _NO_MESH
+        parts.append(_PACK_HEAD.pack(len(k), len(e)) + k + e)
     body = b"".join(parts)
     if not write_entry(path, _PACK_MAGIC + body + blake2b(body, digest_size=16).digest()):
         return False

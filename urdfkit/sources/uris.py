@@ -17,8 +17,8 @@ import os
 import re
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 from urdfkit.core import deps
 from urdfkit.core.errors import ParameterError
@@ -209,8 +209,7 @@ def settled() -> Iterator[None]:
         _SETTLED.pop()
 
 
-@dataclass(frozen=True, slots=True)
-class Target:
+class Target(NamedTuple):
     """Where a file reference points.
 
     Attributes:
