@@ -14,6 +14,7 @@ import os
 import re
 import stat
 from collections.abc import Callable, Mapping, Sequence
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -558,7 +559,7 @@ def reference(tag: str, fn: str, base: Path | str,
                 tag != "mesh" or mesh_suffix(fn)):
             return Reference(name, name, stat=st)
     label = f"<{tag} filename={fn!r}>"
-    base = Path(base)
+    base = base if isinstance(base, Path) else _folder_path(base)
     target = resolve_uri(fn, base, packages)
     if target.path is None:
         return Reference(None, None, "U702", "error", f"{label}: {target.problem}")
@@ -587,6 +588,16 @@ def reference(tag: str, fn: str, base: Path | str,
                          "p.loadURDF of this file refuses it: name the package's folder "
                          f"{target.package!r}, or load through urdfkit")
     return Reference(str(path), str(path))
+
+
+@lru_cache(maxsize=256)
+def _folder_path(folder: str) -> Path:
+    """``Path(folder)``, made once per folder (bounded).
+
+    Each ``package://`` reference of a file asks (~3 us a Path), and a file's references
+    share its folder.
+    """
+    return Path(folder)
 
 
 def _only_through_package_xml(fn: str, base: Path, package: str | None,
