@@ -14,7 +14,7 @@ import os
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 from lxml import etree
 
@@ -566,8 +566,8 @@ def _mesh_part(shape: etree._Element, xyz: Sequence[float], rot: Matrix3 | None,
         return None
     if props.volume <= 0:
         return None
-    t = props.inertia
-    own = ((t[0][0], t[0][1], t[0][2]), (t[1][0], t[1][1], t[1][2]), (t[2][0], t[2][1], t[2][2]))
+    # MeshProperties.scaled makes the tensor as three rows of three: no copy needed.
+    own = cast(Matrix3, props.inertia)
     com = props.com
     if rot is None:
         return (props.volume, (xyz[0] + com[0], xyz[1] + com[1], xyz[2] + com[2]), own,
