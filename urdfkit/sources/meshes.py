@@ -406,7 +406,7 @@ def _concavity(vertices: Any, faces: Any, starts: list[int], det: Any,
             piece_det = _det(a, b, c)
             if wound is not None:
                 depth = min(depth, _piece_depth(vertices, wound, piece_det))
-            if depth > 0 and _hull_fill(vertices, piece, piece_det) >= CONVEX_FILL:
+            if depth > 0 and _fills_hull(vertices, piece, piece_det, CONVEX_FILL):
                 depth = 0.0  # its faces' planes say dips, its volume says none to speak of
         worst = max(worst, depth)
     return worst
@@ -415,13 +415,13 @@ def _concavity(vertices: Any, faces: Any, starts: list[int], det: Any,
 #: A closed piece filling at least this much of its convex hull is convex enough: the hull
 #: adds under 5% (GP4's convex links fill 99.8-100%, its open link_2_l 63%).
 CONVEX_FILL = 0.95
-#: Sample points and hull directions for :func:`_hull_fill`.
+#: Sample points and hull directions for :func:`_fills_hull`.
 _FILL_SAMPLES = 6_000
 _FILL_DIRECTIONS = 1024
 
 
-def _hull_fill(vertices: Any, faces: Any, det: Any) -> float:
-    """How much of its convex hull a closed piece fills: its volume over the hull's.
+def _fills_hull(vertices: Any, faces: Any, det: Any, fill: float) -> bool:
+    """Whether a closed piece fills at least ``fill`` of its convex hull (volume over hull).
 
     The hull is bounded by the piece's support planes along every triangle's normal, both
     ways (so winding does not matter) and along the axes: exactly the hull for a convex
@@ -429,6 +429,10 @@ def _hull_fill(vertices: Any, faces: Any, det: Any) -> float:
     concave piece). Its volume is counted on a fixed grid of sample points in the bounding
     box (deterministic; about 0.5% spread). Sliver normals do no harm: a support plane along
     any direction holds the whole hull.
+
+    Each block of planes only drops points, so the fill it implies only grows: once it reaches
+    ``fill`` the answer is yes, and the remaining blocks (most of the cost for a convex piece,
+    whose inside points survive them all) are skipped. The verdict is the full count's.
     """
     import numpy as np
 
@@ -437,7 +441,7 @@ def _hull_fill(vertices: Any, faces: Any, det: Any) -> float:
     box = float(np.prod(high - low))
     volume = abs(float(det.sum())) / 6.0
     if not box > 0 or not volume > 0:
-        return 1.0
+        return True
     a, b, c = vertices[faces.T]
     normal = np.cross(b - a, c - a)
     length = np.linalg.norm(normal, axis=1)
@@ -452,10 +456,9 @@ def _hull_fill(vertices: Any, faces: Any, det: Any) -> float:
     for start in range(0, len(directions), 64):  # bounded temporaries, shrinking
         block = directions[start:start + 64]
         points = points[(points @ block.T <= support[start:start + 64]).all(axis=1)]
-        if not len(points):
-            break
-    hull = box * len(points) / _FILL_SAMPLES
-    return volume / hull if hull > 0 else 1.0
+        if not len(points) or volume >= fill * box * len(points) / _FILL_SAMPLES:
+            return True  # no point left: a hull of no counted volume, filled
+    return volume >= fill * box * len(points) / _FILL_SAMPLES
 
 
 def _det(a: Any, b: Any, c: Any) -> Any:
