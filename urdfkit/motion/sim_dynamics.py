@@ -73,7 +73,7 @@ class Dynamics:
         return self.shadows.model(robot.name, robot.loaded, self.world.config.physics.gravity,
                                   robot.changes, robot.mass_version)
 
-    def call(self, robot: SimRobot, fn: str, *args: Any, **kwargs: Any) -> Any:
+    def call(self, robot: SimRobot, fn: str, *args: object, **kwargs: object) -> Any:
         """PyBullet's ``fn`` (one of DYNAMICS_CALLS) on the robot's model, given ``args``.
 
         Raises:

@@ -10,7 +10,8 @@ import io
 import json
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from types import ModuleType
+from typing import TYPE_CHECKING
 
 from urdfkit.core.errors import MissingDependencyError, OutputError
 
@@ -52,7 +53,7 @@ def _columns(rows: Iterable[Mapping[str, object]]) -> list[str]:
     return list(seen)
 
 
-def _pyarrow() -> Any:  # pyarrow: untyped
+def _pyarrow() -> ModuleType:  # pyarrow: untyped (a module's attributes read as Any)
     try:
         import pyarrow
         import pyarrow.parquet
