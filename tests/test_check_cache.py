@@ -109,6 +109,24 @@ def test_the_file_itself_and_its_mesh_invalidate_only_their_file(cache: Path,
     assert _cached(check_paths([tmp_path], jobs=1)) == {"a.urdf": True, "b.urdf": False}
 
 
+def test_a_mesh_answered_from_memory_is_still_a_dependency(cache: Path,
+                                                           tmp_path: Path) -> None:
+    # The mesh's integrals come from memory (a run without the result cache read them), so
+    # no mesh reader runs while the entry is recorded: the reference's own note of the path
+    # is what must record it (the mesh lookup relies on it and does not note it again).
+    (tmp_path / "m").mkdir()
+    _stl(tmp_path / "m" / "a.stl", 0.1)
+    robot = tmp_path / "a.urdf"
+    robot.write_text(ARM.format(mesh="m/a.stl"))
+    check_paths([tmp_path], jobs=1, cache=False)
+    before = _codes(check_paths([tmp_path], jobs=1), "a.urdf")
+    assert _cached(check_paths([tmp_path], jobs=1)) == {"a.urdf": True}
+    _stl(tmp_path / "m" / "a.stl", 100.0)
+    warm = check_paths([tmp_path], jobs=1)
+    assert _cached(warm) == {"a.urdf": False}
+    assert _codes(warm, "a.urdf") != before
+
+
 def test_a_missing_mesh_that_appears_invalidates_the_file(cache: Path, tmp_path: Path) -> None:
     robot = tmp_path / "r.urdf"
     robot.write_text(ARM.format(mesh="later.stl"))

@@ -43,6 +43,7 @@ from urdfkit.model.spec import attr_vec as _vec
 from urdfkit.sources.guard import GUARD_RULES, Rule, RuleReport, label
 from urdfkit.sources.meshstore import CONCAVE_FRACTION, MeshProperties
 from urdfkit.sources.meshstore import properties as mesh_properties
+from urdfkit.sources.meshstore import stated as stated_properties
 
 # --------------------------------------------------------------------------- structural rules
 # These are the rules PyBullet crashes on when they are broken; the guard runs exactly these.
@@ -589,8 +590,12 @@ def _properties(r: RuleReport, path: str, scale: Sequence[float], concavity: boo
     memo = r.memo
     found: Any = memo.get(key, _UNSEEN)  # Any: the marker is not a MeshProperties
     if found is _UNSEEN or (concavity and found is not None and math.isnan(found.concavity)):
-        props = memo[key] = mesh_properties(path, (scale[0], scale[1], scale[2]),
-                                            concavity=concavity, stat=st)
+        # A reference carries a stat only from guard.reference's plain-path branch, which has
+        # noted ``path`` to deps and, for a "mesh" reference (the only kind asked here),
+        # found a mesh suffix on it: meshstore.stated skips those two steps.
+        three = (scale[0], scale[1], scale[2])
+        props = memo[key] = (mesh_properties(path, three, concavity=concavity) if st is None
+                             else stated_properties(path, st, three, concavity=concavity))
         return props
     return found
 

@@ -492,8 +492,10 @@ class Reference:
         load: What PyBullet must be given, or None when it cannot be loaded.
         code, level, message: The finding, or ``code`` None when the file is fine.
         stat: ``os.stat`` of ``load`` when it was taken on the way (the common case), for the
-            mesh rules not to ask again. Not part of the reference's value (equality, hash,
-            repr).
+            mesh rules not to ask again. Only a plain relative path's reference carries it,
+            and then ``load`` is a regular file already noted to :mod:`urdfkit.core.deps`
+            and, for a "mesh", named with a mesh suffix (:func:`meshstore.stated` relies on
+            both). Not part of the reference's value (equality, hash, repr).
     """
 
     __slots__ = ("file", "load", "code", "level", "message", "stat")

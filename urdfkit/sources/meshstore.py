@@ -49,26 +49,34 @@ _MISSING = object()
 
 def properties(path: str | os.PathLike[str],
                scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *,
-               concavity: bool = False,
-               stat: os.stat_result | None = None) -> MeshProperties | None:
+               concavity: bool = False) -> MeshProperties | None:
     """Mass properties of an STL or OBJ mesh, or None if unreadable, unsupported or empty.
 
     The concavity depth costs as much as the rest together and only the concave-mesh rules
     read it, so it is worked out when ``concavity`` asks for it, once per mesh (the cache
-    entry is then rewritten with it); otherwise it may be NaN. ``stat``: ``os.stat(path)``
-    when the caller has just taken it.
+    entry is then rewritten with it); otherwise it may be NaN.
     """
     name = os.fspath(path)
-    suffix = mesh_suffix(name)
-    if not suffix:
+    if not mesh_suffix(name):
         return None
     deps.note(name)
-    st = stat
-    if st is None:
-        try:
-            st = os.stat(name)
-        except (OSError, ValueError):
-            return None
+    try:
+        st = os.stat(name)
+    except (OSError, ValueError):
+        return None
+    return stated(name, st, scale, concavity=concavity)
+
+
+def stated(name: str, st: os.stat_result,
+           scale: tuple[float, float, float] = (1.0, 1.0, 1.0), *,
+           concavity: bool = False) -> MeshProperties | None:
+    """:func:`properties` of a mesh whose caller has already taken its first steps.
+
+    For a :class:`urdfkit.sources.guard.Reference` that carries a ``stat`` (check asks once
+    per mesh of every file): ``st`` is ``os.stat(name)``, and the reference has already
+    noted ``name`` to :mod:`urdfkit.core.deps` (under the same recording: a file's rules run
+    within one call) and found a mesh suffix on it, so neither is done again here.
+    """
     if st.st_size > MAX_MESH_BYTES:
         return None
     # An absolute name is its own key (normalizing it would cost more than the rare second
@@ -78,7 +86,7 @@ def properties(path: str | os.PathLike[str],
     found = _MEMORY.get(key, _MISSING)
     if found is _MISSING or (concavity and isinstance(found, Integrals)
                              and math.isnan(found.concavity)):
-        found = _MEMORY[key] = _integrals(Path(name), suffix, key, concavity)
+        found = _MEMORY[key] = _integrals(Path(name), mesh_suffix(name), key, concavity)
     assert found is None or isinstance(found, Integrals)
     USED[key] = found
     return found.scaled(scale) if found is not None else None

@@ -245,13 +245,14 @@ def resolve_uri(uri: str, base: Path, packages: Mapping[str, Path] | None = None
             return Target(None, pkg, f"package {pkg!r} not found near the file (nor "
                           f"{stripped!r} in its folder or any above, where PyBullet looks); "
                           f"map it with `packages` ({pkg}=PATH)")
-        if not _is_file(found / rest):
+        path = found / rest
+        if not _is_file(path):
             # The package's folder lacks it (package.xml at a repository's root, meshes under
             # share/NAME/): PyBullet, which knows no packages, may still find it above.
             found_at = pybullet_search(stripped, base)
             if found_at is not None:
                 return Target(found_at, pkg)
-        return Target(found / rest, pkg)
+        return Target(path, pkg)
     if uri.startswith("model://"):  # Gazebo's; PyBullet drops the prefix and searches
         stripped = uri[len("model://"):]
         return Target(pybullet_search(stripped, base) or base / stripped)
