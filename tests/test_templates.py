@@ -38,13 +38,13 @@ def test_templates_ship_as_package_data(name: str) -> None:
 @pytest.mark.parametrize("name", sorted(TEMPLATES))
 def test_python_defaults_match_the_xacro_defaults(name: str) -> None:
     # Plain `xacro file.urdf.xacro` must give the same robot as `urdfkit build name`.
-    from importlib import resources
-
     import xacro
 
+    from urdfkit.model.templatedir import template_dir
+
     t = get_template(name)
-    with resources.as_file(resources.files("urdfkit.templates") / t.file) as path:
-        plain = xacro.process_file(str(path)).toxml()
+    # The installed package's folder, or the checkout's templates/ (an editable install).
+    plain = xacro.process_file(str(template_dir() / t.file)).toxml()
     robot = Robot.from_string(plain)
     robot.complete_inertia()
     assert robot == build_template(name)
