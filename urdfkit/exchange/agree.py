@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from urdfkit.core.errors import InputError, MissingDependencyError
+from urdfkit.core.errors import EngineError, InputError, MissingDependencyError
 from urdfkit.exchange.fk import fused, link_frames
 from urdfkit.exchange.mjcf import combine
 from urdfkit.exchange.robot import Inertial, Robot
@@ -63,16 +63,6 @@ class Row:
         """Whether the row holds (info and known differences do not fail)."""
         return self.status != "fail"
 
-
-#: Why PyBullet's calculateMassMatrix and calculateInverseDynamics can fail on a model that
-#: loads and simulates: its inverse-dynamics tree wants each link's inertia exactly symmetric,
-#: and the tensor it rebuilds from the principal moments and axes it stores differs from its
-#: transpose in the last bit for some products of inertia (KUKA KR210's link_2: 1.4e-14;
-#: tests/fixtures/robots/id_asymmetric.urdf). It raises SystemError, printing "invalid inertia
-#: tensor" on fd 1.
-_PYBULLET_ID_REFUSES = ("its inverse-dynamics model finds a link's inertia, rebuilt from the "
-                        "principal axes PyBullet stores, not exactly symmetric; a PyBullet "
-                        "limit, not the MJCF's")
 
 
 @dataclass
@@ -476,31 +466,30 @@ class _Compare:
                          turned_back: Any) -> tuple[tuple[float, str], tuple[float, str]] | str:
         """The worst relative mass-matrix and inverse-dynamics errors at one pose.
 
-        Each with its joint; or the name of the PyBullet call that failed on this model
-        (see _PYBULLET_ID_REFUSES).
+        Each with its joint; or, when PyBullet cannot build its inverse-dynamics model of this
+        robot (:func:`urdfkit.engine.session.dynamics_call`), the call that failed and why.
         """
         import numpy as np
 
-        from urdfkit.engine.session import quiet_stdout
+        from urdfkit.engine.session import dynamics_call
 
         mj, m, pb = self.mj, self.fixed, self.pb
         qs = [q[n] for n in pb.names]
         try:
-            with quiet_stdout():  # PyBullet prints its refusal on fd 1
-                pm = np.array(pb.b.calculateMassMatrix(pb.body, qs))
-        except (SystemError, pb.b.error):
-            return "calculateMassMatrix"
+            pm = np.array(dynamics_call(pb.b, "calculateMassMatrix", pb.body, qs))
+        except EngineError as refusal:
+            return f"calculateMassMatrix fails on this model ({refusal.message})"
         # PyBullet's calculateInverseDynamics turns gravity by the base's inertial
         # orientation (measured: bicycle/bike.urdf, base inertial rpy 1.57 0 0,
         # 0.656 N m where MuJoCo and the swing say 0.0525): handed gravity turned
         # back, it answers for the world's
         pb.b.setGravity(*map(float, turned_back))
         try:
-            with quiet_stdout():
-                tau_pb = np.array(pb.b.calculateInverseDynamics(
-                    pb.body, qs, [qd[n] for n in pb.names], [qdd[n] for n in pb.names]))
-        except (SystemError, pb.b.error):
-            return "calculateInverseDynamics"
+            tau_pb = np.array(dynamics_call(
+                pb.b, "calculateInverseDynamics", pb.body, qs, [qd[n] for n in pb.names],
+                [qdd[n] for n in pb.names]))
+        except EngineError as refusal:
+            return f"calculateInverseDynamics fails on this model ({refusal.message})"
         finally:
             pb.b.setGravity(*map(float, m.opt.gravity))
         self.set_q(d, {n: q[n] for n in self.matched}, qd)
@@ -599,8 +588,7 @@ class _Compare:
                     f"{n} ({len(links)} frames x {self.o.poses} poses)")
         if dyn and refused is not None:
             res.add("dynamics", "mass matrix, inverse dynamics", None, None, "",
-                    f"not compared: raw PyBullet's {refused} fails on this model "
-                    f"({_PYBULLET_ID_REFUSES})", status="known")
+                    f"not compared: raw PyBullet's {refused}", status="known")
         elif dyn:
             v, n = _worst(mass_err)
             res.add("dynamics", "mass matrix", v, TOL_DYNAMICS, "relative", n)

@@ -82,22 +82,21 @@ class Dynamics:
         """
         shadow = self._shadow(robot)
         p, body = shadow.session.bullet, shadow.body
-        cannot = f"PyBullet cannot compute {DYNAMICS_CALLS[fn]} of robot {robot.name!r}"
-        if shadow.refused is not None:
-            raise EngineError(f"{cannot}: {shadow.refused}")
-        if not shadow.proven:  # the call that builds PyBullet's model: it may print
+        if shadow.proven:  # the motor's every-step path: the bare call
             try:
-                out = dynamics_call(p, fn, body, *args, **kwargs)
-            except EngineError as e:
-                shadow.refused = e.message
-                raise EngineError(f"{cannot}: {e.message}") from None
-            shadow.proven = True
-            return out
-        try:
-            return getattr(p, fn)(body, *args, **kwargs)
-        except (SystemError, p.error) as e:
-            raise EngineError(f"{cannot}: PyBullet's {fn} failed "
-                              f"({e.__cause__ or e.__context__ or e})") from None
+                return getattr(p, fn)(body, *args, **kwargs)
+            except (SystemError, p.error) as e:
+                raise EngineError(f"{_cannot(robot, fn)}: PyBullet's {fn} failed "
+                                  f"({e.__cause__ or e.__context__ or e})") from None
+        if shadow.refused is not None:
+            raise EngineError(f"{_cannot(robot, fn)}: {shadow.refused}")
+        try:  # the call that builds PyBullet's model: it may print
+            out = dynamics_call(p, fn, body, *args, **kwargs)
+        except EngineError as e:
+            shadow.refused = e.message
+            raise EngineError(f"{_cannot(robot, fn)}: {e.message}") from None
+        shadow.proven = True
+        return out
 
     def mass_matrix(self, robot: SimRobot) -> np.ndarray:
         """The joint-space mass matrix M(q) now (PyBullet's calculateMassMatrix).
@@ -269,3 +268,8 @@ class Shadows:
         for shadow in self.models.values():
             shadow.session.close()
         self.models.clear()
+
+
+def _cannot(robot: SimRobot, fn: str) -> str:
+    """The start of a refusal's message (made only when there is one)."""
+    return f"PyBullet cannot compute {DYNAMICS_CALLS[fn]} of robot {robot.name!r}"
