@@ -207,3 +207,71 @@ def test_python_m_urdfkit_works_from_a_source_checkout(tmp_path: Path) -> None:
                          timeout=60, cwd=root)
     assert out.returncode == 0, out.stderr
     assert (tmp_path / "car.urdf").read_bytes() == (GOLDEN / "simplecar.urdf").read_bytes()
+
+
+_TETRA_STL = """solid t
+facet normal 0 0 -1
+ outer loop
+  vertex 0 0 0
+  vertex 0 0.1 0
+  vertex 0.1 0 0
+ endloop
+endfacet
+facet normal 0 -1 0
+ outer loop
+  vertex 0 0 0
+  vertex 0.1 0 0
+  vertex 0 0 0.1
+ endloop
+endfacet
+facet normal -1 0 0
+ outer loop
+  vertex 0 0 0
+  vertex 0 0 0.1
+  vertex 0 0.1 0
+ endloop
+endfacet
+facet normal 1 1 1
+ outer loop
+  vertex 0.1 0 0
+  vertex 0 0.1 0
+  vertex 0 0 0.1
+ endloop
+endfacet
+endsolid t
+"""
+
+
+def _raw_loads(path: Path) -> bool:
+    """Whether raw PyBullet loads ``path`` (run in a child: its C text goes to fd 1)."""
+    code = ("import sys, pybullet as p\nc = p.connect(p.DIRECT)\n"
+            "try:\n    p.loadURDF(sys.argv[1])\nexcept p.error:\n    sys.exit(1)\n")
+    return subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
+                          timeout=60).returncode == 0
+
+
+def test_build_warns_when_raw_pybullet_cannot_reach_a_nested_package(tmp_path: Path) -> None:
+    # As turtlebot4 includes create3_sim's irobot_create_common/irobot_create_description: a
+    # package one folder deeper than its name, found by its package.xml only.
+    pkg = tmp_path / "ws" / "group" / "mypkg"
+    (pkg / "meshes").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>mypkg</name></package>")
+    (pkg / "meshes" / "t.stl").write_text(_TETRA_STL)
+    src = tmp_path / "src" / "robot.urdf.xacro"
+    src.parent.mkdir()
+    src.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="a">'
+                   '<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0"'
+                   ' izz="1"/></inertial><collision><geometry>'
+                   '<mesh filename="package://mypkg/meshes/t.stl"/></geometry></collision>'
+                   '</link></robot>')
+    outside, inside = tmp_path / "out" / "r.urdf", tmp_path / "ws" / "group" / "r.urdf"
+    outside.parent.mkdir()
+    for out in (outside, inside):
+        done = subprocess.run([sys.executable, "-m", "urdfkit", "build", str(src), "-o",
+                               str(out), "--package-path", str(tmp_path / "ws")],
+                              capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+        warned = "raw p.loadURDF will not find 1 package:// file(s)" in done.stderr
+        # The warning says exactly what raw PyBullet then does with the written file.
+        assert warned == (out == outside) == (not _raw_loads(out)), (out, done.stderr)
+        assert ("package://mypkg/meshes/t.stl" in done.stderr) == warned

@@ -219,6 +219,36 @@ def _unloadable(root: etree._Element, base: Path, packages: Mapping[str, Path] |
     return None
 
 
+def unreachable_packages(data: bytes, out: Path) -> str | None:
+    """A warning when raw PyBullet cannot find the written file's ``package://`` files.
+
+    urdfkit finds packages by their package.xml (``--package-path``, ROS_PACKAGE_PATH);
+    PyBullet drops ``package://`` and looks for ``NAME/rest`` in the file's folder and each
+    folder above it. A package nested in a workspace (create3_sim's
+    irobot_create_common/irobot_create_description, which turtlebot4 includes) is then out
+    of its reach wherever the file is written outside it: ``p.loadURDF`` says "Cannot load
+    URDF file." None when every such file is found from ``out``'s folder.
+    """
+    from urdfkit.sources.uris import pybullet_search
+
+    folder = out.resolve().parent
+    lost: dict[str, None] = {}
+    parser = etree.XMLParser(resolve_entities=False, no_network=True)
+    for el in etree.fromstring(data, parser).iter("mesh", "texture"):
+        fn = (el.get("filename") or "").strip()
+        if fn.startswith("package://") and \
+                pybullet_search(fn[len("package://"):], folder) is None:
+            lost[fn] = None
+    if not lost:
+        return None
+    names = list(lost)
+    shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+    return (f"{out}: raw p.loadURDF will not find {len(names)} package:// file(s) from "
+            f"{folder} ({shown}): PyBullet looks for NAME/... in the file's folder and those "
+            "above it, and knows no package.xml; load it through urdfkit (--package-path), or "
+            "write it inside the folder that holds those packages")
+
+
 def write_output(path: str, data: bytes, *, force: bool) -> Path:
     """Write atomically, never replacing a file without ``force``."""
     return atomic_write(path, data, force=force)

@@ -1,6 +1,7 @@
 """The build and templates commands: a URDF from a template or a xacro file."""
 
 import sys
+from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -55,6 +56,9 @@ def build(
         sys.stdout.buffer.write(result.data)
         sys.stdout.flush()
         return
+    lost = building.unreachable_packages(result.data, Path(out))
+    if lost is not None:
+        show.warn(lost)
     path = building.write_output(out, result.data, force=force)
     show.wrote(path, f"{show.counted(result.links, 'link')}, "
                      f"{show.counted(result.joints, 'joint')}")
