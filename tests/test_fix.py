@@ -310,3 +310,39 @@ def test_whitespace_in_a_material_name_is_written_back_exactly(tmp_path: Path,
     assert [f["code"] for f in json.loads(out)["fixes"]] == ["U706"]
     root = etree.parse(str(tmp_path / "out.urdf")).getroot()
     assert [m.get("name") for m in root.iter("material")] == [name, name]
+
+
+def _raw_loads(path: Path) -> bool:
+    """Whether raw PyBullet loads ``path`` (in a child: its C text goes to fd 1)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, pybullet as p\nc = p.connect(p.DIRECT)\n"
+            "try:\n    p.loadURDF(sys.argv[1])\nexcept p.error:\n    sys.exit(1)\n")
+    return subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
+                          timeout=60).returncode == 0
+
+
+def test_fix_warns_when_raw_pybullet_cannot_reach_a_nested_package(tmp_path: Path) -> None:
+    # A package one folder deeper than its name (turtlebot4 on create3_sim's
+    # irobot_create_common/irobot_create_description), found by its package.xml only: the
+    # repaired copy written outside the workspace is out of raw PyBullet's reach.
+    pkg = tmp_path / "ws" / "group" / "mypkg"
+    (pkg / "meshes").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>mypkg</name></package>")
+    shutil.copy(MESHES / "unit_cube.stl", pkg / "meshes" / "cube.stl")
+    src = tmp_path / "ws" / "group" / "robot.urdf"
+    src.write_text('<robot name="r"><link name="a"><inertial><mass value="1"/>'
+                   '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="3"/></inertial>'
+                   '<collision><geometry><mesh filename="package://mypkg/meshes/cube.stl"/>'
+                   '</geometry></collision></link></robot>')
+    assert _raw_loads(src)
+    outside, inside = tmp_path / "out" / "r.urdf", tmp_path / "ws" / "group" / "fixed.urdf"
+    outside.parent.mkdir()
+    for out in (outside, inside):
+        result = CliRunner().invoke(app, ["fix", str(src), "-o", str(out)])
+        assert result.exit_code == 0, result.output
+        assert 'izz="3"' not in out.read_text()  # the U604 inertia was repaired
+        warned = "raw p.loadURDF will not find 1 package:// file(s)" in result.output
+        # The warning says exactly what raw PyBullet then does with the written file.
+        assert warned == (out == outside) == (not _raw_loads(out)), (out, result.output)

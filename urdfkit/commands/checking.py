@@ -278,6 +278,11 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
                       f"relative to {file}'s folder ({result.relative_paths[0]!r}, ...) and "
                       "do not resolve from where it is written: write it beside the original "
                       "(or --in-place), or copy what it names")
+        from urdfkit.checks.build import unreachable_packages
+
+        lost = unreachable_packages(result.fixed, Path(output))
+        if lost is not None:
+            show.warn(lost)
         path = atomic_write(output, result.fixed, force=force)
         report()
         if not as_json:
