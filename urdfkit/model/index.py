@@ -233,6 +233,11 @@ class Doc:
         elements (xacro leftovers, extensions) and opaque subtrees (another tool's), and a
         shape after the first in a ``<geometry>`` (PyBullet never reads it); those subtrees
         are only measured for depth (:meth:`_measure`).
+
+        Most children are known tags that no list collects (origin, mass, inertia, link,
+        visual...): one lookup (:data:`_PLAIN`) gives such a child's memo key form, and a
+        leaf among them is judged here, without a call. Any other child takes
+        :meth:`_other`, the general road.
         """
         self._check(el, tag)
         known = SCHEMA.get(tag)
@@ -241,30 +246,66 @@ class Doc:
         if depth == MAX_XML_DEPTH and self.too_deep is None:
             self.too_deep = next((c for c in el if isinstance(c.tag, str)), None)
         depth += 1
-        buckets = self._buckets
         for child in el:
             ctag = child.tag
-            if ctag.__class__ is not str:
-                continue  # comments, processing instructions, entities
-            bucket = buckets.get(ctag)
-            if bucket is not None:
-                bucket.append(child)
-            if ctag[0] == "{":
-                if len(child):  # nothing to check, but maybe too deep
-                    self._measure(child, depth)
+            form = _PLAIN.get(ctag)  # a comment's tag (a function) is no key: None
+            if form is None:
+                if ctag.__class__ is str:
+                    self._other(child, ctag, tag, allowed, first, depth)
                 continue
             if allowed is not None and ctag not in allowed:
                 self.element_findings.append((
                     "U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
                     "ignores it", child))
-            # A shape after the first in a <geometry> is never read (U507).
-            if ctag in _OPAQUE or (first is not None and child is not first):
+            if first is not None and child is not first:  # never read (U507)
                 if len(child):
                     self._measure(child, depth)
-            elif len(child):
+                continue
+            if len(child):
                 self._walk(child, ctag, depth)
-            else:  # a leaf: its attributes are all there is to check
-                self._check(child, ctag)
+                continue
+            # A leaf: its attributes are all there is to check (as _check, inlined).
+            if form is _NAMES:
+                names = child.keys()
+                if not names:
+                    continue
+                key: tuple[Any, ...] = (ctag, *names)
+            elif form is _VALUES:
+                key = (ctag, *child.items())
+            else:
+                key = (ctag, *child.keys(), *map(child.get, form))
+            found = _VERDICTS.get(key)
+            if found is None:
+                found = _remember(key, ctag, child.items())
+            if found:
+                self.element_findings.extend([(*f, child) for f in found])
+
+    def _other(self, child: El, ctag: str, tag: str, allowed: frozenset[str] | None,
+               first: El, depth: int) -> None:
+        """:meth:`_walk`'s road for a child outside :data:`_PLAIN` (``depth``: the child's).
+
+        Collected tags (material, geometry, mesh...), namespaced and opaque elements,
+        unknown tags.
+        """
+        bucket = self._buckets.get(ctag)
+        if bucket is not None:
+            bucket.append(child)
+        if ctag[0] == "{":
+            if len(child):  # nothing to check, but maybe too deep
+                self._measure(child, depth)
+            return
+        if allowed is not None and ctag not in allowed:
+            self.element_findings.append((
+                "U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
+                "ignores it", child))
+        # A shape after the first in a <geometry> is never read (U507).
+        if ctag in _OPAQUE or (first is not None and child is not first):
+            if len(child):
+                self._measure(child, depth)
+        elif len(child):
+            self._walk(child, ctag, depth)
+        else:  # a leaf: its attributes are all there is to check
+            self._check(child, ctag)
 
     def _measure(self, el: El, depth: int) -> None:
         """Collect from an unchecked subtree, and find its first element too deep."""
@@ -299,10 +340,7 @@ class Doc:
             key = (tag, *el.keys(), *map(el.get, form))
         found = _VERDICTS.get(key)
         if found is None:
-            found = _verdict(tag, el.items())
-            if len(_VERDICTS) >= _VERDICTS_MAX:
-                _VERDICTS.clear()
-            _VERDICTS[key] = found
+            found = _remember(key, tag, el.items())
         if found:
             self.element_findings.extend([(*f, el) for f in found])
 
@@ -323,12 +361,26 @@ for _tag, (_attrs, _kids) in SCHEMA.items():
                         else _numeric)
 for _tag, _num in NUMERIC_BY_TAG.items():
     _KEY_FORMS.setdefault(_tag, tuple(sorted(_num)))
+#: The key forms of the tags :meth:`Doc._walk` handles on its short road: known, and neither
+#: collected (:data:`_COLLECTED`) nor opaque.
+_PLAIN: dict[object, tuple[str, ...]] = {
+    t: form for t, form in _KEY_FORMS.items() if t not in _COLLECTED and t not in _OPAQUE}
 
 
 #: The element rules' verdict on a tag with its attributes, for the whole process: real files
 #: repeat ``<origin rpy="0 0 0" xyz="0 0 0"/>`` thousands of times. Emptied past _VERDICTS_MAX.
 _VERDICTS: dict[tuple[str, ...], tuple[tuple[str, str, str], ...]] = {}
 _VERDICTS_MAX = 65536
+
+
+def _remember(key: tuple[Any, ...], tag: str, items: list[tuple[str, str]]
+              ) -> tuple[tuple[str, str, str], ...]:
+    """:func:`_verdict` of an element, kept in :data:`_VERDICTS` under ``key``."""
+    found = _verdict(tag, items)
+    if len(_VERDICTS) >= _VERDICTS_MAX:
+        _VERDICTS.clear()
+    _VERDICTS[key] = found
+    return found
 
 
 def _verdict(tag: str, items: list[tuple[str, str]]) -> tuple[tuple[str, str, str], ...]:
