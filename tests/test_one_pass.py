@@ -89,6 +89,19 @@ def assert_same_as_lxml(root: etree._Element) -> None:
         assert jv.children == jv.el.findall("child")
     got = [(code, message, el) for code, _, message, el in doc.element_findings]
     assert got == oracle_findings(root)
+    assert doc.gazebo is may_hold_gazebo(root)
+
+
+def may_hold_gazebo(root: etree._Element) -> bool:
+    """Where gazebo_contacts looks: a tag ending in gazebo among the root's children, or among
+    the children of a root's child whose tag ends in link (as rule_gazebo_contacts' own look
+    was written before the walk gave it)."""
+    def ends(el: etree._Element, suffix: str) -> bool:
+        return isinstance(el.tag, str) and el.tag.endswith(suffix)
+
+    return any(ends(child, "gazebo") or (ends(child, "link") and any(ends(g, "gazebo")
+                                                                     for g in child))
+               for child in root)
 
 
 REAL = sorted(p for p in DATA.rglob("*.urdf") if "random_urdfs" not in p.parts) + \
@@ -100,7 +113,7 @@ def test_the_walk_lists_what_lxml_lists_on_real_files(path: Path) -> None:
     assert_same_as_lxml(parse_xml(read_bytes(path), path).getroot())
 
 
-TAGS = [*SCHEMA, *OPAQUE, "sensor", "{urn:x}thing", "plugin"]
+TAGS = [*SCHEMA, *OPAQUE, "sensor", "{urn:x}thing", "plugin", "{urn:x}gazebo", "{urn:x}link"]
 ATTRS = sorted({a for attrs, _ in SCHEMA.values() for a in attrs} | {"bogus", "{urn:x}a"})
 VALUES = ["0", "1", "0 0 0", " 1  2\t3 ", "1 2", "nan", "-inf", "1e999", "x", "", "1_0",
           "0.5 0.5 0.5 1", "base"]
@@ -231,3 +244,18 @@ def test_the_views_read_what_lxml_finds(root: etree._Element) -> None:
     assert len(views) == len(found)
     for a, b in zip(views, found, strict=True):
         assert len(a) == len(b) and all(x is y for x, y in zip(a, b, strict=True)), (a, b)
+
+
+@pytest.mark.parametrize("text, held", [
+    (b"<robot><link name='a'><gazebo/></link></robot>", True),
+    (b"<robot><link name='a'><visual/></link><x:gazebo xmlns:x='urn:x'/></robot>", True),
+    (b"<robot><x:link xmlns:x='urn:x'><x:gazebo/></x:link></robot>", True),
+    (b"<robot><link name='a'><visual><gazebo/></visual></link></robot>", False),
+    (b"<robot><joint name='j'><gazebo/></joint><!-- gazebo --></robot>", False),
+])
+def test_the_walk_says_where_a_gazebo_block_may_stand(text: bytes, held: bool) -> None:
+    # rule_gazebo_contacts reads <gazebo> only where gazebo_contacts looks: the root's
+    # children and its links' children (a <gazebo> deeper is never read).
+    root = etree.fromstring(text)
+    assert may_hold_gazebo(root) is held
+    assert_same_as_lxml(root)

@@ -767,7 +767,7 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
     for the link (its ``<contact>``, else lateral friction 0.5 and a rigid contact). A link
     whose ``<contact>`` already carries the values gets nothing.
     """
-    if not _has_gazebo(root):
+    if not r.doc(root).gazebo:
         return  # most files: nothing to read, and no Gazebo reader to load
     from urdfkit.model.gazebo import NOT_CARRIED, PYBULLET_LATERAL_FRICTION, gazebo_contacts
 
@@ -822,26 +822,6 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
               "multiplies the two bodies' friction: on a ground of lateral friction 1, such "
               "as plane.urdf, the contact has the link's)" + "".join(f"; {n}" for n in notes),
               gz.element)
-
-
-def _has_gazebo(root: etree._Element) -> bool:
-    """Whether a ``<gazebo>`` may stand where gazebo_contacts looks for one.
-
-    That is: among the root's children, or among the children of a root's ``<link>``, in any
-    namespace. A look at tag names only, so a superset: ``<mygazebo>`` says True too.
-    """
-    for child in root:
-        tag = child.tag
-        if not isinstance(tag, str):
-            continue
-        if tag.endswith("gazebo"):
-            return True
-        if tag.endswith("link"):
-            for g in child:
-                gtag = g.tag
-                if isinstance(gtag, str) and gtag.endswith("gazebo"):
-                    return True
-    return False
 
 
 def _contact_values(link: etree._Element) -> dict[str, float]:

@@ -89,9 +89,10 @@ class LinkView:
             ``<inertia>`` (None when absent).
         parts: Its ``<visual>`` and ``<collision>`` children, in order.
         collisions: Its ``<collision>`` children, in order.
+        gazebo: Whether a child's tag ends in ``gazebo`` (any namespace or prefix).
     """
 
-    __slots__ = ("el", "name", "inertial", "mass", "inertia", "parts", "collisions")
+    __slots__ = ("el", "name", "inertial", "mass", "inertia", "parts", "collisions", "gazebo")
 
     def __init__(self, el: El) -> None:
         self.el = el
@@ -101,15 +102,17 @@ class LinkView:
         self.inertia: El
         self.parts: list[El]
         self.collisions: list[El]
+        self.gazebo: bool
         (self.inertial, self.mass, self.inertia, self.parts,
-         self.collisions) = _link_parts(el)
+         self.collisions, self.gazebo) = _link_parts(el)
 
 
-def _link_parts(el: El) -> tuple[El, El, El, list[El], list[El]]:
-    """(inertial, mass, inertia, parts, collisions) of a link, in one look at its children."""
+def _link_parts(el: El) -> tuple[El, El, El, list[El], list[El], bool]:
+    """(inertial, mass, inertia, parts, collisions, gazebo) of a link, in one look."""
     inertial = mass = inertia = None
     parts: list[El] = []
     collisions: list[El] = []
+    gazebo = False
     for c in el:
         tag = c.tag
         if tag == "visual" or tag == "collision":
@@ -123,7 +126,9 @@ def _link_parts(el: El) -> tuple[El, El, El, list[El], list[El]]:
                     mass = k
                 elif k.tag == "inertia" and inertia is None:
                     inertia = k
-    return inertial, mass, inertia, parts, collisions
+        elif tag.__class__ is str and tag.endswith("gazebo"):
+            gazebo = True
+    return inertial, mass, inertia, parts, collisions, gazebo
 
 
 class JointView:
@@ -171,6 +176,15 @@ def _joint_parts(el: El) -> tuple[El, El, list[El], El, El, El, El]:
 _JOINT_SLOTS = frozenset({"parent", "limit", "axis", "origin", "mimic"})
 
 
+def _gazebo_child(el: El) -> bool:
+    """Whether a child of ``el`` has a tag ending in ``gazebo``."""
+    for c in el:
+        tag = c.tag
+        if tag.__class__ is str and tag.endswith("gazebo"):
+            return True
+    return False
+
+
 class Doc:
     """Everything the rules read from one document, collected in one walk.
 
@@ -179,6 +193,10 @@ class Doc:
         links, joints: :class:`LinkView` and :class:`JointView` of the root's children.
         materials: The root's ``<material>`` children.
         deformables: How many ``<deformable>`` children the root has.
+        gazebo: Whether a ``<gazebo>`` may stand where
+            :func:`urdfkit.model.gazebo.gazebo_contacts` looks for one: a tag ending in
+            ``gazebo`` (any namespace or prefix: a superset) among the root's children, or
+            among the children of a root's child whose tag ends in ``link``.
         all_materials, geometries, files, transmissions: Every ``<material>``,
             ``<geometry>``, ``<mesh>``/``<cdf>``/``<texture>`` and ``<transmission>`` in
             the document, in document order (as ``root.iter(tag)``).
@@ -186,7 +204,7 @@ class Doc:
         element_findings: ``(code, level, message, element)`` of the element rules.
     """
 
-    __slots__ = ("root", "links", "joints", "materials", "deformables", "all_materials",
+    __slots__ = ("root", "links", "joints", "materials", "deformables", "gazebo", "all_materials",
                  "geometries", "files", "transmissions", "too_deep", "element_findings",
                  "_buckets")
 
@@ -196,6 +214,7 @@ class Doc:
         self.joints: list[JointView] = []
         self.materials: list[El] = []
         self.deformables = 0
+        self.gazebo = False
         self.all_materials: list[El] = []
         self.geometries: list[El] = []
         self.files: list[El] = []
@@ -214,13 +233,18 @@ class Doc:
             for child in root:  # the root's own children are also the top-level lists
                 ctag = child.tag
                 if ctag == "link":
-                    self.links.append(LinkView(child))
+                    view = LinkView(child)
+                    self.links.append(view)
+                    self.gazebo = self.gazebo or view.gazebo
                 elif ctag == "joint":
                     self.joints.append(JointView(child))
                 elif ctag == "material":
                     self.materials.append(child)
                 elif ctag == "deformable":
                     self.deformables += 1
+                elif ctag.__class__ is str and not self.gazebo:
+                    self.gazebo = ctag.endswith("gazebo") or (
+                        ctag.endswith("link") and _gazebo_child(child))
             if tag[0] == "{" or tag in _OPAQUE:
                 self._measure(root, 1)
             else:
