@@ -19,7 +19,15 @@ from hypothesis import strategies as st
 from lxml import etree
 
 from urdfkit.model.index import Doc
-from urdfkit.model.spec import FILE_TAGS, MAX_XML_DEPTH, NUMERIC, OPAQUE, SCHEMA, used_shape
+from urdfkit.model.spec import (
+    FILE_TAGS,
+    MAX_XML_DEPTH,
+    NUMERIC,
+    OPAQUE,
+    SCHEMA,
+    ignored_shape,
+    used_shape,
+)
 from urdfkit.model.xmlio import parse_xml, read_bytes
 
 DATA = Path(pybullet_data.getDataPath())
@@ -75,6 +83,7 @@ def assert_same_as_lxml(root: etree._Element) -> None:
     assert doc.geometries == list(root.iter("geometry"))
     assert doc.files == list(root.iter(*FILE_TAGS))
     assert doc.transmissions == list(root.iter("transmission"))
+    assert doc.unread == {el for el in doc.files if ignored_shape(el)}
     deep = etree.XPath("/*" * (MAX_XML_DEPTH + 1))(root)
     assert doc.too_deep is (deep[0] if deep else None)
     for view in doc.links:
@@ -258,4 +267,22 @@ def test_the_walk_says_where_a_gazebo_block_may_stand(text: bytes, held: bool) -
     # children and its links' children (a <gazebo> deeper is never read).
     root = etree.fromstring(text)
     assert may_hold_gazebo(root) is held
+    assert_same_as_lxml(root)
+
+
+@pytest.mark.parametrize("text, unread", [
+    (b"<robot><link name='a'><visual><geometry><box size='1 1 1'/><mesh filename='m.stl'/>"
+     b"</geometry></visual></link></robot>", 1),
+    (b"<robot><link name='a'><visual><geometry><mesh filename='m.stl'/><box/></geometry>"
+     b"</visual></link></robot>", 0),
+    (b"<robot><gazebo><geometry><box/><mesh filename='m.stl'/></geometry></gazebo></robot>", 1),
+    (b"<robot><gazebo><geometry><mesh filename='m.stl'/></geometry></gazebo></robot>", 0),
+    (b"<robot><x:a xmlns:x='urn:x'><geometry><!-- c --><cdf filename='c'/><mesh "
+     b"filename='m.stl'/></geometry></x:a></robot>", 1),
+])
+def test_the_walk_knows_which_files_pybullet_never_reads(text: bytes, unread: int) -> None:
+    # A mesh after the first element of a <geometry> is never opened (rule_meshes skips
+    # it), in the walked tree and in the subtrees the walk only measures alike.
+    root = etree.fromstring(text)
+    assert len(Doc(root).unread) == unread
     assert_same_as_lxml(root)

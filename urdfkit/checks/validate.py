@@ -29,7 +29,6 @@ from urdfkit.model.spec import (
     Matrix3,
     default_mass,
     extension_note,
-    ignored_shape,
     matmul,
     rotate,
     rpy_to_matrix,
@@ -615,9 +614,10 @@ def rule_meshes(root: etree._Element, r: RuleReport) -> None:
     """U701-U705: mesh and texture files exist, are files, in formats PyBullet reads."""
     if r.folder is None:
         return
-    for el in r.doc(root).files:
+    doc = r.doc(root)
+    for el in doc.files:
         fn = (el.get("filename") or "").strip()
-        if fn and not ignored_shape(el):  # a mesh after the first shape is never opened
+        if fn and el not in doc.unread:  # a mesh after the first shape is never opened
             ref = r.reference(el.tag, fn)
             if ref.code is not None:
                 r.add(ref.code, ref.level, ref.message, el)

@@ -200,12 +200,15 @@ class Doc:
         all_materials, geometries, files, transmissions: Every ``<material>``,
             ``<geometry>``, ``<mesh>``/``<cdf>``/``<texture>`` and ``<transmission>`` in
             the document, in document order (as ``root.iter(tag)``).
+        unread: The elements of ``files`` that stand in a ``<geometry>`` after its first
+            element, which PyBullet never reads (:func:`~urdfkit.model.spec.ignored_shape`).
         too_deep: The first element nested deeper than PyBullet reads, or None.
         element_findings: ``(code, level, message, element)`` of the element rules.
     """
 
     __slots__ = ("root", "links", "joints", "materials", "deformables", "gazebo", "all_materials",
-                 "geometries", "files", "transmissions", "too_deep", "element_findings",
+                 "geometries", "files", "transmissions", "unread", "too_deep",
+                 "element_findings",
                  "_buckets")
 
     def __init__(self, root: El) -> None:
@@ -219,6 +222,7 @@ class Doc:
         self.geometries: list[El] = []
         self.files: list[El] = []
         self.transmissions: list[El] = []
+        self.unread: set[El] = set()
         self.too_deep: El = None
         self.element_findings: list[tuple[str, str, str, El]] = []
         #: Where each collected tag's elements go.
@@ -257,13 +261,18 @@ class Doc:
         elements (xacro leftovers, extensions) and opaque subtrees (another tool's), and a
         shape after the first in a ``<geometry>`` (PyBullet never reads it); those subtrees
         are only measured for depth (:meth:`_measure`).
-
-        Most children are known tags that no list collects (origin, mass, inertia, link,
-        visual...): one lookup (:data:`_PLAIN`) gives such a child's memo key form, and a
-        leaf among them is judged here, without a call. Any other child takes
-        :meth:`_other`, the general road.
         """
         self._check(el, tag)
+        self._children(el, tag, depth)
+
+    def _children(self, el: El, tag: str, depth: int) -> None:
+        """:meth:`_walk` below ``el``, which is checked already.
+
+        Most children are known tags that no list collects (origin, mass, inertia, link,
+        visual...): one lookup (:data:`_PLAIN`) gives such a child's memo key form, and it
+        is judged here, as :meth:`_check` would, without a call. Any other child takes
+        :meth:`_other`, the general road.
+        """
         known = SCHEMA.get(tag)
         allowed = known[1] if known is not None else None
         first = used_shape(el) if tag == "geometry" else None
@@ -285,24 +294,21 @@ class Doc:
                 if len(child):
                     self._measure(child, depth)
                 continue
-            if len(child):
-                self._walk(child, ctag, depth)
-                continue
-            # A leaf: its attributes are all there is to check (as _check, inlined).
             if form is _NAMES:
                 names = child.keys()
-                if not names:
-                    continue
-                key: tuple[Any, ...] = (ctag, *names)
+                key: tuple[Any, ...] | None = (ctag, *names) if names else None
             elif form is _VALUES:
                 key = (ctag, *child.items())
             else:
                 key = (ctag, *child.keys(), *map(child.get, form))
-            found = _VERDICTS.get(key)
-            if found is None:
-                found = _remember(key, ctag, child.items())
-            if found:
-                self.element_findings.extend([(*f, child) for f in found])
+            if key is not None:
+                found = _VERDICTS.get(key)
+                if found is None:
+                    found = _remember(key, ctag, child.items())
+                if found:
+                    self.element_findings.extend([(*f, child) for f in found])
+            if len(child):
+                self._children(child, ctag, depth)
 
     def _other(self, child: El, ctag: str, tag: str, allowed: frozenset[str] | None,
                first: El, depth: int) -> None:
@@ -314,6 +320,8 @@ class Doc:
         bucket = self._buckets.get(ctag)
         if bucket is not None:
             bucket.append(child)
+            if bucket is self.files and first is not None and child is not first:
+                self.unread.add(child)
         if ctag[0] == "{":
             if len(child):  # nothing to check, but maybe too deep
                 self._measure(child, depth)
@@ -342,6 +350,9 @@ class Doc:
                 bucket = buckets.get(ctag)
                 if bucket is not None:
                     bucket.append(child)
+                    if bucket is self.files and el.tag == "geometry" and \
+                            used_shape(el) is not child:
+                        self.unread.add(child)
                 if len(child):
                     self._measure(child, depth + 1)
 
