@@ -301,7 +301,8 @@ def rule_inertia(root: etree._Element, r: RuleReport) -> None:
     ``eps = 10 * DBL_EPSILON * max(1, trace / 2)``, on the principal moments.
     """
     noted = False
-    for view in r.doc(root).links:
+    doc = r.doc(root)
+    for view in doc.links:
         link, inertial, inertia = view.el, view.inertial, view.inertia
         if inertial is None or inertia is None:
             continue
@@ -310,7 +311,7 @@ def rule_inertia(root: etree._Element, r: RuleReport) -> None:
                   "from the collision shapes unless loaded with URDF_USE_INERTIA_FROM_FILE "
                   "(urdfkit: --inertia-from-file)", inertia)
             noted = True
-        principal = _principal(inertia)
+        principal = _principal(inertia, doc.inertia_keys.get(inertia))
         if principal is None:
             continue
         trace, eps, a, b, c, moments = principal
@@ -347,15 +348,18 @@ def rule_inertia(root: etree._Element, r: RuleReport) -> None:
 STUB_SIZE = 0.01
 
 
-def _principal(inertia: etree._Element
+def _principal(inertia: etree._Element, key: tuple[Any, ...] | None = None
                ) -> tuple[float, float, float, float, float, str] | None:
     """(trace, tolerance, principal moments a <= b <= c, the moments as a message writes them).
 
     None if a component is missing or malformed. Kept per process by the element's
     attributes, which are all it depends on (bounded): files repeat their inertia values
-    (pybullet_data's thousand random objects all have ``ixx="1" ... izz="0"``).
+    (pybullet_data's thousand random objects all have ``ixx="1" ... izz="0"``). ``key``:
+    the element's tag and attributes as the document's walk keyed them
+    (:attr:`~urdfkit.model.index.Doc.inertia_keys`), when it has them.
     """
-    key = tuple(inertia.items())
+    if key is None:
+        key = (inertia.tag, *inertia.items())
     found: Any = _PRINCIPAL.get(key, _UNSEEN)
     if found is _UNSEEN:
         tensor = _inertia_tensor(inertia)
@@ -372,7 +376,7 @@ def _principal(inertia: etree._Element
     return found
 
 
-_PRINCIPAL: dict[tuple[tuple[str, str], ...],
+_PRINCIPAL: dict[tuple[Any, ...],
                  tuple[float, float, float, float, float, str] | None] = {}
 _PRINCIPAL_MAX = 4096
 

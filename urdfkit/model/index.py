@@ -204,11 +204,14 @@ class Doc:
             element, which PyBullet never reads (:func:`~urdfkit.model.spec.ignored_shape`).
         too_deep: The first element nested deeper than PyBullet reads, or None.
         element_findings: ``(code, level, message, element)`` of the element rules.
+        inertia_keys: The memo key the walk made of each ``<inertia>`` it judged on its
+            short road (its tag and attributes, as ``items()``), by element: what
+            ``rule_inertia`` keys its own memo by, without reading the attributes again.
     """
 
     __slots__ = ("root", "links", "joints", "materials", "deformables", "gazebo", "all_materials",
                  "geometries", "files", "transmissions", "unread", "too_deep",
-                 "element_findings",
+                 "element_findings", "inertia_keys",
                  "_buckets")
 
     def __init__(self, root: El) -> None:
@@ -225,6 +228,7 @@ class Doc:
         self.unread: set[El] = set()
         self.too_deep: El = None
         self.element_findings: list[tuple[str, str, str, El]] = []
+        self.inertia_keys: dict[El, tuple[Any, ...]] = {}
         #: Where each collected tag's elements go.
         self._buckets = {"material": self.all_materials, "geometry": self.geometries,
                          "transmission": self.transmissions,
@@ -299,6 +303,8 @@ class Doc:
                 key: tuple[Any, ...] | None = (ctag, *names) if names else None
             elif form is _VALUES:
                 key = (ctag, *child.items())
+            elif form is _INERTIA:  # as _VALUES, and kept for rule_inertia
+                key = self.inertia_keys[child] = (ctag, *child.items())
             else:
                 key = (ctag, *child.keys(), *map(child.get, form))
             if key is not None:
@@ -369,7 +375,7 @@ class Doc:
             if not names:
                 return  # <geometry>, <inertial>, <contact>: nothing to judge
             key: tuple[Any, ...] = (tag, *names)
-        elif form is _VALUES:  # every known attribute is a number: all of it is the key
+        elif form is _VALUES or form is _INERTIA:  # all known attributes numeric: all is key
             key = (tag, *el.items())
         else:  # names, then the numeric attributes' values (None when absent)
             key = (tag, *el.keys(), *map(el.get, form))
@@ -389,6 +395,8 @@ _COLLECTED = ("material", "geometry", "transmission", *FILE_TAGS)
 #: of the numeric attributes named (a tuple: ``<mesh filename= scale=>``).
 _NAMES: tuple[str, ...] = ("<names>",)
 _VALUES: tuple[str, ...] = ("<values>",)
+#: _VALUES for ``<inertia>``, whose keys the walk also keeps (Doc.inertia_keys).
+_INERTIA: tuple[str, ...] = ("<inertia values>",)
 _KEY_FORMS: dict[str, tuple[str, ...]] = {}
 for _tag, (_attrs, _kids) in SCHEMA.items():
     _numeric = tuple(sorted(NUMERIC_BY_TAG.get(_tag, ())))
@@ -396,6 +404,8 @@ for _tag, (_attrs, _kids) in SCHEMA.items():
                         else _numeric)
 for _tag, _num in NUMERIC_BY_TAG.items():
     _KEY_FORMS.setdefault(_tag, tuple(sorted(_num)))
+assert _KEY_FORMS["inertia"] is _VALUES
+_KEY_FORMS["inertia"] = _INERTIA
 #: The key forms of the tags :meth:`Doc._walk` handles on its short road: known, and neither
 #: collected (:data:`_COLLECTED`) nor opaque.
 _PLAIN: dict[object, tuple[str, ...]] = {
