@@ -19,7 +19,15 @@ from hypothesis import strategies as st
 from lxml import etree
 
 from urdfkit.model.index import Doc
-from urdfkit.model.spec import FILE_TAGS, MAX_XML_DEPTH, NUMERIC, OPAQUE, SCHEMA, used_shape
+from urdfkit.model.spec import (
+    FILE_TAGS,
+    MAX_XML_DEPTH,
+    NUMERIC,
+    OPAQUE,
+    SCHEMA,
+    ignored_shape,
+    used_shape,
+)
 from urdfkit.model.xmlio import parse_xml, read_bytes
 
 DATA = Path(pybullet_data.getDataPath())
@@ -75,6 +83,7 @@ def assert_same_as_lxml(root: etree._Element) -> None:
     assert doc.geometries == list(root.iter("geometry"))
     assert doc.files == list(root.iter(*FILE_TAGS))
     assert doc.transmissions == list(root.iter("transmission"))
+    assert doc.unread == {el for el in doc.files if ignored_shape(el)}
     deep = etree.XPath("/*" * (MAX_XML_DEPTH + 1))(root)
     assert doc.too_deep is (deep[0] if deep else None)
     for view in doc.links:
@@ -89,6 +98,19 @@ def assert_same_as_lxml(root: etree._Element) -> None:
         assert jv.children == jv.el.findall("child")
     got = [(code, message, el) for code, _, message, el in doc.element_findings]
     assert got == oracle_findings(root)
+    assert doc.gazebo is may_hold_gazebo(root)
+
+
+def may_hold_gazebo(root: etree._Element) -> bool:
+    """Where gazebo_contacts looks: a tag ending in gazebo among the root's children, or among
+    the children of a root's child whose tag ends in link (as rule_gazebo_contacts' own look
+    was written before the walk gave it)."""
+    def ends(el: etree._Element, suffix: str) -> bool:
+        return isinstance(el.tag, str) and el.tag.endswith(suffix)
+
+    return any(ends(child, "gazebo") or (ends(child, "link") and any(ends(g, "gazebo")
+                                                                     for g in child))
+               for child in root)
 
 
 REAL = sorted(p for p in DATA.rglob("*.urdf") if "random_urdfs" not in p.parts) + \
@@ -100,7 +122,7 @@ def test_the_walk_lists_what_lxml_lists_on_real_files(path: Path) -> None:
     assert_same_as_lxml(parse_xml(read_bytes(path), path).getroot())
 
 
-TAGS = [*SCHEMA, *OPAQUE, "sensor", "{urn:x}thing", "plugin"]
+TAGS = [*SCHEMA, *OPAQUE, "sensor", "{urn:x}thing", "plugin", "{urn:x}gazebo", "{urn:x}link"]
 ATTRS = sorted({a for attrs, _ in SCHEMA.values() for a in attrs} | {"bogus", "{urn:x}a"})
 VALUES = ["0", "1", "0 0 0", " 1  2\t3 ", "1 2", "nan", "-inf", "1e999", "x", "", "1_0",
           "0.5 0.5 0.5 1", "base"]
@@ -231,3 +253,36 @@ def test_the_views_read_what_lxml_finds(root: etree._Element) -> None:
     assert len(views) == len(found)
     for a, b in zip(views, found, strict=True):
         assert len(a) == len(b) and all(x is y for x, y in zip(a, b, strict=True)), (a, b)
+
+
+@pytest.mark.parametrize("text, held", [
+    (b"<robot><link name='a'><gazebo/></link></robot>", True),
+    (b"<robot><link name='a'><visual/></link><x:gazebo xmlns:x='urn:x'/></robot>", True),
+    (b"<robot><x:link xmlns:x='urn:x'><x:gazebo/></x:link></robot>", True),
+    (b"<robot><link name='a'><visual><gazebo/></visual></link></robot>", False),
+    (b"<robot><joint name='j'><gazebo/></joint><!-- gazebo --></robot>", False),
+])
+def test_the_walk_says_where_a_gazebo_block_may_stand(text: bytes, held: bool) -> None:
+    # rule_gazebo_contacts reads <gazebo> only where gazebo_contacts looks: the root's
+    # children and its links' children (a <gazebo> deeper is never read).
+    root = etree.fromstring(text)
+    assert may_hold_gazebo(root) is held
+    assert_same_as_lxml(root)
+
+
+@pytest.mark.parametrize("text, unread", [
+    (b"<robot><link name='a'><visual><geometry><box size='1 1 1'/><mesh filename='m.stl'/>"
+     b"</geometry></visual></link></robot>", 1),
+    (b"<robot><link name='a'><visual><geometry><mesh filename='m.stl'/><box/></geometry>"
+     b"</visual></link></robot>", 0),
+    (b"<robot><gazebo><geometry><box/><mesh filename='m.stl'/></geometry></gazebo></robot>", 1),
+    (b"<robot><gazebo><geometry><mesh filename='m.stl'/></geometry></gazebo></robot>", 0),
+    (b"<robot><x:a xmlns:x='urn:x'><geometry><!-- c --><cdf filename='c'/><mesh "
+     b"filename='m.stl'/></geometry></x:a></robot>", 1),
+])
+def test_the_walk_knows_which_files_pybullet_never_reads(text: bytes, unread: int) -> None:
+    # A mesh after the first element of a <geometry> is never opened (rule_meshes skips
+    # it), in the walked tree and in the subtrees the walk only measures alike.
+    root = etree.fromstring(text)
+    assert len(Doc(root).unread) == unread
+    assert_same_as_lxml(root)

@@ -29,7 +29,6 @@ from urdfkit.model.spec import (
     Matrix3,
     default_mass,
     extension_note,
-    ignored_shape,
     matmul,
     rotate,
     rpy_to_matrix,
@@ -302,7 +301,8 @@ def rule_inertia(root: etree._Element, r: RuleReport) -> None:
     ``eps = 10 * DBL_EPSILON * max(1, trace / 2)``, on the principal moments.
     """
     noted = False
-    for view in r.doc(root).links:
+    doc = r.doc(root)
+    for view in doc.links:
         link, inertial, inertia = view.el, view.inertial, view.inertia
         if inertial is None or inertia is None:
             continue
@@ -311,7 +311,7 @@ def rule_inertia(root: etree._Element, r: RuleReport) -> None:
                   "from the collision shapes unless loaded with URDF_USE_INERTIA_FROM_FILE "
                   "(urdfkit: --inertia-from-file)", inertia)
             noted = True
-        principal = _principal(inertia)
+        principal = _principal(inertia, doc.inertia_keys.get(inertia))
         if principal is None:
             continue
         trace, eps, a, b, c, moments = principal
@@ -348,15 +348,18 @@ def rule_inertia(root: etree._Element, r: RuleReport) -> None:
 STUB_SIZE = 0.01
 
 
-def _principal(inertia: etree._Element
+def _principal(inertia: etree._Element, key: tuple[Any, ...] | None = None
                ) -> tuple[float, float, float, float, float, str] | None:
     """(trace, tolerance, principal moments a <= b <= c, the moments as a message writes them).
 
     None if a component is missing or malformed. Kept per process by the element's
     attributes, which are all it depends on (bounded): files repeat their inertia values
-    (pybullet_data's thousand random objects all have ``ixx="1" ... izz="0"``).
+    (pybullet_data's thousand random objects all have ``ixx="1" ... izz="0"``). ``key``:
+    the element's tag and attributes as the document's walk keyed them
+    (:attr:`~urdfkit.model.index.Doc.inertia_keys`), when it has them.
     """
-    key = tuple(inertia.items())
+    if key is None:
+        key = (inertia.tag, *inertia.items())
     found: Any = _PRINCIPAL.get(key, _UNSEEN)
     if found is _UNSEEN:
         tensor = _inertia_tensor(inertia)
@@ -373,7 +376,7 @@ def _principal(inertia: etree._Element
     return found
 
 
-_PRINCIPAL: dict[tuple[tuple[str, str], ...],
+_PRINCIPAL: dict[tuple[Any, ...],
                  tuple[float, float, float, float, float, str] | None] = {}
 _PRINCIPAL_MAX = 4096
 
@@ -615,9 +618,10 @@ def rule_meshes(root: etree._Element, r: RuleReport) -> None:
     """U701-U705: mesh and texture files exist, are files, in formats PyBullet reads."""
     if r.folder is None:
         return
-    for el in r.doc(root).files:
+    doc = r.doc(root)
+    for el in doc.files:
         fn = (el.get("filename") or "").strip()
-        if fn and not ignored_shape(el):  # a mesh after the first shape is never opened
+        if fn and el not in doc.unread:  # a mesh after the first shape is never opened
             ref = r.reference(el.tag, fn)
             if ref.code is not None:
                 r.add(ref.code, ref.level, ref.message, el)
@@ -767,7 +771,7 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
     for the link (its ``<contact>``, else lateral friction 0.5 and a rigid contact). A link
     whose ``<contact>`` already carries the values gets nothing.
     """
-    if not _has_gazebo(root):
+    if not r.doc(root).gazebo:
         return  # most files: nothing to read, and no Gazebo reader to load
     from urdfkit.model.gazebo import NOT_CARRIED, PYBULLET_LATERAL_FRICTION, gazebo_contacts
 
@@ -822,26 +826,6 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
               "multiplies the two bodies' friction: on a ground of lateral friction 1, such "
               "as plane.urdf, the contact has the link's)" + "".join(f"; {n}" for n in notes),
               gz.element)
-
-
-def _has_gazebo(root: etree._Element) -> bool:
-    """Whether a ``<gazebo>`` may stand where gazebo_contacts looks for one.
-
-    That is: among the root's children, or among the children of a root's ``<link>``, in any
-    namespace. A look at tag names only, so a superset: ``<mygazebo>`` says True too.
-    """
-    for child in root:
-        tag = child.tag
-        if not isinstance(tag, str):
-            continue
-        if tag.endswith("gazebo"):
-            return True
-        if tag.endswith("link"):
-            for g in child:
-                gtag = g.tag
-                if isinstance(gtag, str) and gtag.endswith("gazebo"):
-                    return True
-    return False
 
 
 def _contact_values(link: etree._Element) -> dict[str, float]:

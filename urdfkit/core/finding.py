@@ -35,13 +35,15 @@ class Finding:
 
     def __init__(self, code: str, level: str, message: str, file: str,
                  line: int | None = None, origin: str | None = None) -> None:
-        _set = object.__setattr__
-        _set(self, "code", code)
-        _set(self, "level", level)
-        _set(self, "message", message)
-        _set(self, "file", file)
-        _set(self, "line", line)
-        _set(self, "origin", origin)
+        # Each slot's own setter (bound below the class): check makes thousands of findings,
+        # and object.__setattr__ looks the name up on every call (~1.2k instructions a
+        # field, the setter ~0.7k).
+        _set_code(self, code)
+        _set_level(self, level)
+        _set_message(self, message)
+        _set_file(self, file)
+        _set_line(self, line)
+        _set_origin(self, origin)
 
     def _key(self) -> tuple[str, str, str, str, int | None, str | None]:
         return (self.code, self.level, self.message, self.file, self.line, self.origin)
@@ -81,3 +83,8 @@ class Finding:
     def text(self) -> str:
         """The message, with where the element was written when that is another file."""
         return f"{self.message} (written at {self.origin})" if self.origin else self.message
+
+
+#: The slots' own setters (member descriptors), for Finding.__init__.
+_set_code, _set_level, _set_message, _set_file, _set_line, _set_origin = (
+    Finding.__dict__[name].__set__ for name in Finding.__slots__)

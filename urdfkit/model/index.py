@@ -89,9 +89,10 @@ class LinkView:
             ``<inertia>`` (None when absent).
         parts: Its ``<visual>`` and ``<collision>`` children, in order.
         collisions: Its ``<collision>`` children, in order.
+        gazebo: Whether a child's tag ends in ``gazebo`` (any namespace or prefix).
     """
 
-    __slots__ = ("el", "name", "inertial", "mass", "inertia", "parts", "collisions")
+    __slots__ = ("el", "name", "inertial", "mass", "inertia", "parts", "collisions", "gazebo")
 
     def __init__(self, el: El) -> None:
         self.el = el
@@ -101,15 +102,17 @@ class LinkView:
         self.inertia: El
         self.parts: list[El]
         self.collisions: list[El]
+        self.gazebo: bool
         (self.inertial, self.mass, self.inertia, self.parts,
-         self.collisions) = _link_parts(el)
+         self.collisions, self.gazebo) = _link_parts(el)
 
 
-def _link_parts(el: El) -> tuple[El, El, El, list[El], list[El]]:
-    """(inertial, mass, inertia, parts, collisions) of a link, in one look at its children."""
+def _link_parts(el: El) -> tuple[El, El, El, list[El], list[El], bool]:
+    """(inertial, mass, inertia, parts, collisions, gazebo) of a link, in one look."""
     inertial = mass = inertia = None
     parts: list[El] = []
     collisions: list[El] = []
+    gazebo = False
     for c in el:
         tag = c.tag
         if tag == "visual" or tag == "collision":
@@ -123,7 +126,9 @@ def _link_parts(el: El) -> tuple[El, El, El, list[El], list[El]]:
                     mass = k
                 elif k.tag == "inertia" and inertia is None:
                     inertia = k
-    return inertial, mass, inertia, parts, collisions
+        elif tag.__class__ is str and tag.endswith("gazebo"):
+            gazebo = True
+    return inertial, mass, inertia, parts, collisions, gazebo
 
 
 class JointView:
@@ -171,6 +176,15 @@ def _joint_parts(el: El) -> tuple[El, El, list[El], El, El, El, El]:
 _JOINT_SLOTS = frozenset({"parent", "limit", "axis", "origin", "mimic"})
 
 
+def _gazebo_child(el: El) -> bool:
+    """Whether a child of ``el`` has a tag ending in ``gazebo``."""
+    for c in el:
+        tag = c.tag
+        if tag.__class__ is str and tag.endswith("gazebo"):
+            return True
+    return False
+
+
 class Doc:
     """Everything the rules read from one document, collected in one walk.
 
@@ -179,15 +193,25 @@ class Doc:
         links, joints: :class:`LinkView` and :class:`JointView` of the root's children.
         materials: The root's ``<material>`` children.
         deformables: How many ``<deformable>`` children the root has.
+        gazebo: Whether a ``<gazebo>`` may stand where
+            :func:`urdfkit.model.gazebo.gazebo_contacts` looks for one: a tag ending in
+            ``gazebo`` (any namespace or prefix: a superset) among the root's children, or
+            among the children of a root's child whose tag ends in ``link``.
         all_materials, geometries, files, transmissions: Every ``<material>``,
             ``<geometry>``, ``<mesh>``/``<cdf>``/``<texture>`` and ``<transmission>`` in
             the document, in document order (as ``root.iter(tag)``).
+        unread: The elements of ``files`` that stand in a ``<geometry>`` after its first
+            element, which PyBullet never reads (:func:`~urdfkit.model.spec.ignored_shape`).
         too_deep: The first element nested deeper than PyBullet reads, or None.
         element_findings: ``(code, level, message, element)`` of the element rules.
+        inertia_keys: The memo key the walk made of each ``<inertia>`` it judged on its
+            short road (its tag and attributes, as ``items()``), by element: what
+            ``rule_inertia`` keys its own memo by, without reading the attributes again.
     """
 
-    __slots__ = ("root", "links", "joints", "materials", "deformables", "all_materials",
-                 "geometries", "files", "transmissions", "too_deep", "element_findings",
+    __slots__ = ("root", "links", "joints", "materials", "deformables", "gazebo", "all_materials",
+                 "geometries", "files", "transmissions", "unread", "too_deep",
+                 "element_findings", "inertia_keys",
                  "_buckets")
 
     def __init__(self, root: El) -> None:
@@ -196,12 +220,15 @@ class Doc:
         self.joints: list[JointView] = []
         self.materials: list[El] = []
         self.deformables = 0
+        self.gazebo = False
         self.all_materials: list[El] = []
         self.geometries: list[El] = []
         self.files: list[El] = []
         self.transmissions: list[El] = []
+        self.unread: set[El] = set()
         self.too_deep: El = None
         self.element_findings: list[tuple[str, str, str, El]] = []
+        self.inertia_keys: dict[El, tuple[Any, ...]] = {}
         #: Where each collected tag's elements go.
         self._buckets = {"material": self.all_materials, "geometry": self.geometries,
                          "transmission": self.transmissions,
@@ -214,13 +241,18 @@ class Doc:
             for child in root:  # the root's own children are also the top-level lists
                 ctag = child.tag
                 if ctag == "link":
-                    self.links.append(LinkView(child))
+                    view = LinkView(child)
+                    self.links.append(view)
+                    self.gazebo = self.gazebo or view.gazebo
                 elif ctag == "joint":
                     self.joints.append(JointView(child))
                 elif ctag == "material":
                     self.materials.append(child)
                 elif ctag == "deformable":
                     self.deformables += 1
+                elif ctag.__class__ is str and not self.gazebo:
+                    self.gazebo = ctag.endswith("gazebo") or (
+                        ctag.endswith("link") and _gazebo_child(child))
             if tag[0] == "{" or tag in _OPAQUE:
                 self._measure(root, 1)
             else:
@@ -235,36 +267,83 @@ class Doc:
         are only measured for depth (:meth:`_measure`).
         """
         self._check(el, tag)
+        self._children(el, tag, depth)
+
+    def _children(self, el: El, tag: str, depth: int) -> None:
+        """:meth:`_walk` below ``el``, which is checked already.
+
+        Most children are known tags that no list collects (origin, mass, inertia, link,
+        visual...): one lookup (:data:`_PLAIN`) gives such a child's memo key form, and it
+        is judged here, as :meth:`_check` would, without a call. Any other child takes
+        :meth:`_other`, the general road.
+        """
         known = SCHEMA.get(tag)
         allowed = known[1] if known is not None else None
         first = used_shape(el) if tag == "geometry" else None
         if depth == MAX_XML_DEPTH and self.too_deep is None:
             self.too_deep = next((c for c in el if isinstance(c.tag, str)), None)
         depth += 1
-        buckets = self._buckets
         for child in el:
             ctag = child.tag
-            if ctag.__class__ is not str:
-                continue  # comments, processing instructions, entities
-            bucket = buckets.get(ctag)
-            if bucket is not None:
-                bucket.append(child)
-            if ctag[0] == "{":
-                if len(child):  # nothing to check, but maybe too deep
-                    self._measure(child, depth)
+            form = _PLAIN.get(ctag)  # a comment's tag (a function) is no key: None
+            if form is None:
+                if ctag.__class__ is str:
+                    self._other(child, ctag, tag, allowed, first, depth)
                 continue
             if allowed is not None and ctag not in allowed:
                 self.element_findings.append((
                     "U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
                     "ignores it", child))
-            # A shape after the first in a <geometry> is never read (U507).
-            if ctag in _OPAQUE or (first is not None and child is not first):
+            if first is not None and child is not first:  # never read (U507)
                 if len(child):
                     self._measure(child, depth)
-            elif len(child):
-                self._walk(child, ctag, depth)
-            else:  # a leaf: its attributes are all there is to check
-                self._check(child, ctag)
+                continue
+            if form is _NAMES:
+                names = child.keys()
+                key: tuple[Any, ...] | None = (ctag, *names) if names else None
+            elif form is _VALUES:
+                key = (ctag, *child.items())
+            elif form is _INERTIA:  # as _VALUES, and kept for rule_inertia
+                key = self.inertia_keys[child] = (ctag, *child.items())
+            else:
+                key = (ctag, *child.keys(), *map(child.get, form))
+            if key is not None:
+                found = _VERDICTS.get(key)
+                if found is None:
+                    found = _remember(key, ctag, child.items())
+                if found:
+                    self.element_findings.extend([(*f, child) for f in found])
+            if len(child):
+                self._children(child, ctag, depth)
+
+    def _other(self, child: El, ctag: str, tag: str, allowed: frozenset[str] | None,
+               first: El, depth: int) -> None:
+        """:meth:`_walk`'s road for a child outside :data:`_PLAIN` (``depth``: the child's).
+
+        Collected tags (material, geometry, mesh...), namespaced and opaque elements,
+        unknown tags.
+        """
+        bucket = self._buckets.get(ctag)
+        if bucket is not None:
+            bucket.append(child)
+            if bucket is self.files and first is not None and child is not first:
+                self.unread.add(child)
+        if ctag[0] == "{":
+            if len(child):  # nothing to check, but maybe too deep
+                self._measure(child, depth)
+            return
+        if allowed is not None and ctag not in allowed:
+            self.element_findings.append((
+                "U801", "warning", f"<{ctag}> is not known inside <{tag}>; PyBullet "
+                "ignores it", child))
+        # A shape after the first in a <geometry> is never read (U507).
+        if ctag in _OPAQUE or (first is not None and child is not first):
+            if len(child):
+                self._measure(child, depth)
+        elif len(child):
+            self._walk(child, ctag, depth)
+        else:  # a leaf: its attributes are all there is to check
+            self._check(child, ctag)
 
     def _measure(self, el: El, depth: int) -> None:
         """Collect from an unchecked subtree, and find its first element too deep."""
@@ -277,6 +356,9 @@ class Doc:
                 bucket = buckets.get(ctag)
                 if bucket is not None:
                     bucket.append(child)
+                    if bucket is self.files and el.tag == "geometry" and \
+                            used_shape(el) is not child:
+                        self.unread.add(child)
                 if len(child):
                     self._measure(child, depth + 1)
 
@@ -293,16 +375,13 @@ class Doc:
             if not names:
                 return  # <geometry>, <inertial>, <contact>: nothing to judge
             key: tuple[Any, ...] = (tag, *names)
-        elif form is _VALUES:  # every known attribute is a number: all of it is the key
+        elif form is _VALUES or form is _INERTIA:  # all known attributes numeric: all is key
             key = (tag, *el.items())
         else:  # names, then the numeric attributes' values (None when absent)
             key = (tag, *el.keys(), *map(el.get, form))
         found = _VERDICTS.get(key)
         if found is None:
-            found = _verdict(tag, el.items())
-            if len(_VERDICTS) >= _VERDICTS_MAX:
-                _VERDICTS.clear()
-            _VERDICTS[key] = found
+            found = _remember(key, tag, el.items())
         if found:
             self.element_findings.extend([(*f, el) for f in found])
 
@@ -316,6 +395,8 @@ _COLLECTED = ("material", "geometry", "transmission", *FILE_TAGS)
 #: of the numeric attributes named (a tuple: ``<mesh filename= scale=>``).
 _NAMES: tuple[str, ...] = ("<names>",)
 _VALUES: tuple[str, ...] = ("<values>",)
+#: _VALUES for ``<inertia>``, whose keys the walk also keeps (Doc.inertia_keys).
+_INERTIA: tuple[str, ...] = ("<inertia values>",)
 _KEY_FORMS: dict[str, tuple[str, ...]] = {}
 for _tag, (_attrs, _kids) in SCHEMA.items():
     _numeric = tuple(sorted(NUMERIC_BY_TAG.get(_tag, ())))
@@ -323,12 +404,28 @@ for _tag, (_attrs, _kids) in SCHEMA.items():
                         else _numeric)
 for _tag, _num in NUMERIC_BY_TAG.items():
     _KEY_FORMS.setdefault(_tag, tuple(sorted(_num)))
+assert _KEY_FORMS["inertia"] is _VALUES
+_KEY_FORMS["inertia"] = _INERTIA
+#: The key forms of the tags :meth:`Doc._walk` handles on its short road: known, and neither
+#: collected (:data:`_COLLECTED`) nor opaque.
+_PLAIN: dict[object, tuple[str, ...]] = {
+    t: form for t, form in _KEY_FORMS.items() if t not in _COLLECTED and t not in _OPAQUE}
 
 
 #: The element rules' verdict on a tag with its attributes, for the whole process: real files
 #: repeat ``<origin rpy="0 0 0" xyz="0 0 0"/>`` thousands of times. Emptied past _VERDICTS_MAX.
 _VERDICTS: dict[tuple[str, ...], tuple[tuple[str, str, str], ...]] = {}
 _VERDICTS_MAX = 65536
+
+
+def _remember(key: tuple[Any, ...], tag: str, items: list[tuple[str, str]]
+              ) -> tuple[tuple[str, str, str], ...]:
+    """:func:`_verdict` of an element, kept in :data:`_VERDICTS` under ``key``."""
+    found = _verdict(tag, items)
+    if len(_VERDICTS) >= _VERDICTS_MAX:
+        _VERDICTS.clear()
+    _VERDICTS[key] = found
+    return found
 
 
 def _verdict(tag: str, items: list[tuple[str, str]]) -> tuple[tuple[str, str, str], ...]:
