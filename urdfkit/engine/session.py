@@ -17,7 +17,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, overload
+from typing import TYPE_CHECKING, Any, overload
 
 from urdfkit.core.errors import EngineError
 from urdfkit.model.spec import MAX_STATE_LINKS
@@ -243,24 +243,34 @@ class Bullet:
 
     ``bullet.stepSimulation()`` is ``p.stepSimulation(physicsClientId=client)``: the id is
     bound here once (as ``pybullet_utils.bullet_client.BulletClient`` does), so no other module
-    passes ``physicsClientId``. Each function is bound on first use and then kept as a plain
-    attribute, so a lookup in a hot loop costs what ``p.name`` costs; the partial adds ~60 ns a
-    call (bench/: bind the method to a local name outside a loop that calls it per step).
-    Constants (``bullet.POSITION_CONTROL``) and ``bullet.error`` are the module's own.
+    passes ``physicsClientId``. Every function is bound when the object is made (~50 us for
+    PyBullet's 144) and kept as a plain attribute beside the module's constants
+    (``bullet.POSITION_CONTROL``) and ``bullet.error``. No ``__getattr__`` runs: a class with
+    one is never specialised by CPython's attribute cache, and every ``bullet.name`` in a step
+    loop cost ~400 more instructions than ``p.name`` (callgrind, bench/README.md, issue 39).
+    The partial itself adds nothing to a call without keywords and ~900 instructions to one
+    with keywords (it copies its own into a new dict): bind a method to a local name outside
+    a loop that calls it per step.
     """
 
+    client: int
+
     def __init__(self, module: Any, client: int) -> None:
+        import functools
+
+        names = self.__dict__
+        bind = functools.partial
+        for name, attr in vars(module).items():
+            if name.startswith("_"):
+                continue
+            names[name] = bind(attr, physicsClientId=client) \
+                if callable(attr) and not isinstance(attr, type) else attr
         self._module = module
         self.client = client
 
-    def __getattr__(self, name: str) -> Any:
-        import functools
-
-        attr = getattr(self._module, name)
-        if callable(attr) and not isinstance(attr, type):
-            attr = functools.partial(attr, physicsClientId=self.client)
-        self.__dict__[name] = attr
-        return attr
+    if TYPE_CHECKING:
+        # PyBullet's functions and constants, bound above: Any to the type checker.
+        def __getattr__(self, name: str) -> Any: ...
 
 
 class Session:
