@@ -245,12 +245,13 @@ class Bullet:
     bound here once (as ``pybullet_utils.bullet_client.BulletClient`` does), so no other module
     passes ``physicsClientId``. Every function is bound when the object is made (~50 us for
     PyBullet's 144) and kept as a plain attribute beside the module's constants
-    (``bullet.POSITION_CONTROL``) and ``bullet.error``. No ``__getattr__`` runs: a class with
-    one is never specialised by CPython's attribute cache, and every ``bullet.name`` in a step
-    loop cost ~400 more instructions than ``p.name`` (callgrind, bench/README.md, issue 39).
-    The partial itself adds nothing to a call without keywords and ~900 instructions to one
-    with keywords (it copies its own into a new dict): bind a method to a local name outside
-    a loop that calls it per step.
+    (``bullet.POSITION_CONTROL``) and ``bullet.error``. No ``__getattr__`` runs: CPython
+    specialises no attribute access on a class with one, and each ``bullet.name`` cost ~390
+    instructions more than ``p.name`` (callgrind, bench/README.md, issue 39). A call
+    ``bullet.f(...)`` still costs ~240 more than ``p.f(...)`` (3.11 specialises no method call
+    on an instance attribute); ``f = bullet.f`` outside a hot loop, then ``f(...)``, costs what
+    ``p.f(...)`` does. The partial itself adds nothing to a call without keywords and ~900
+    instructions to one with keywords (it copies its own into a new dict).
     """
 
     client: int
