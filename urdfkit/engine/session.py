@@ -17,7 +17,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, overload
+from typing import TYPE_CHECKING, Any, overload
 
 from urdfkit.core.errors import EngineError
 from urdfkit.model.spec import MAX_STATE_LINKS
@@ -238,29 +238,62 @@ class LoadOptions:
         return flags
 
 
+#: Per module: its public constants (and ``error``), and its functions by name; split once.
+_SPLITS: dict[Any, tuple[dict[str, Any], list[tuple[str, Any]]]] = {}
+
+
+def _split(module: Any) -> tuple[dict[str, Any], list[tuple[str, Any]]]:
+    split = _SPLITS.get(module)
+    if split is None:
+        constants: dict[str, Any] = {}
+        functions: list[tuple[str, Any]] = []
+        for name, attr in vars(module).items():
+            if name.startswith("_"):
+                continue
+            if callable(attr) and not isinstance(attr, type):
+                functions.append((name, attr))
+            else:
+                constants[name] = attr
+        split = _SPLITS[module] = (constants, functions)
+    return split
+
+
 class Bullet:
     """The pybullet module with one client's id bound to every call.
 
     ``bullet.stepSimulation()`` is ``p.stepSimulation(physicsClientId=client)``: the id is
     bound here once (as ``pybullet_utils.bullet_client.BulletClient`` does), so no other module
-    passes ``physicsClientId``. Each function is bound on first use and then kept as a plain
-    attribute, so a lookup in a hot loop costs what ``p.name`` costs; the partial adds ~60 ns a
-    call (bench/: bind the method to a local name outside a loop that calls it per step).
-    Constants (``bullet.POSITION_CONTROL``) and ``bullet.error`` are the module's own.
+    passes ``physicsClientId``. Every function is bound when the object is made (~60 us for
+    PyBullet's 144) and kept as a plain attribute beside the module's constants
+    (``bullet.POSITION_CONTROL``) and ``bullet.error``. No ``__getattr__`` runs: CPython
+    specialises no attribute access on a class with one, and each ``bullet.name`` cost ~390
+    instructions more than ``p.name`` (callgrind, bench/README.md, issue 39). A call
+    ``bullet.f(...)`` still costs ~240 more than ``p.f(...)`` (3.11 specialises no method call
+    on an instance attribute); ``f = bullet.f`` outside a hot loop, then ``f(...)``, costs what
+    ``p.f(...)`` does. The partial itself adds nothing to a call without keywords and ~900
+    instructions to one with keywords (it copies its own into a new dict).
     """
 
+    client: int
+
     def __init__(self, module: Any, client: int) -> None:
+        import functools
+
+        constants, functions = _split(module)
+        names = self.__dict__
+        names.update(constants)
+        bind = functools.partial
+        names.update({name: bind(fn, physicsClientId=client) for name, fn in functions})
         self._module = module
         self.client = client
 
-    def __getattr__(self, name: str) -> Any:
-        import functools
+    if TYPE_CHECKING:
+        # PyBullet's functions and constants, bound above: Any to the type checker.
+        def __getattr__(self, name: str) -> Any: ...
 
-        attr = getattr(self._module, name)
-        if callable(attr) and not isinstance(attr, type):
-            attr = functools.partial(attr, physicsClientId=self.client)
-        self.__dict__[name] = attr
-        return attr
+
+#: Per module, the binding a closed session keeps (client -1: every call fails).
+_CLOSED: dict[Any, Bullet] = {}
 
 
 class Session:
@@ -322,8 +355,8 @@ class Session:
             self.diagnostics.extend(out.lines)
             self.client = -1
             # Calls after close fail as on any closed client, and never reach a later client
-            # that PyBullet gives the same id.
-            self.bullet = Bullet(self.p, -1)
+            # that PyBullet gives the same id. One such binding serves every closed session.
+            self.bullet = _CLOSED.get(self.p) or _CLOSED.setdefault(self.p, Bullet(self.p, -1))
 
     def call(self, fn: str, *args: Any, **kwargs: Any) -> Any:
         """Call ``p.<fn>`` on this client with stdout captured into :attr:`diagnostics`."""

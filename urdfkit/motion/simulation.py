@@ -243,9 +243,10 @@ class Simulation:
                       if r.override is not None or r.applied is not None or r.servo
                       or r.config.drive or r.config.joints]
         for _ in range(n):
-            t = world.step_count * world.time_step
-            for r, controller in controlled:
-                controller.control(r, t)
+            if controlled:  # the time only when a controller reads it
+                t = world.step_count * world.time_step
+                for r, controller in controlled:
+                    controller.control(r, t)
             step()
             world.step_count += 1
             for r in delayed:
