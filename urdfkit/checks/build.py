@@ -233,8 +233,8 @@ def unreachable_packages(data: bytes, out: Path) -> str | None:
 
     folder = out.resolve().parent
     lost: dict[str, None] = {}
-    parser = etree.XMLParser(resolve_entities=False, no_network=True)
-    for el in etree.fromstring(data, parser).iter("mesh", "texture"):
+    # As urdfkit read it (undeclared namespace prefixes too: fix keeps the file's bytes).
+    for el in parse_xml(data, out).getroot().iter("mesh", "texture"):
         fn = (el.get("filename") or "").strip()
         if fn.startswith("package://") and \
                 pybullet_search(fn[len("package://"):], folder) is None:
