@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -51,6 +51,24 @@ def pb() -> Iterator[tuple[object, int]]:
     finally:
         with quiet_stdout():
             p.disconnect(physicsClientId=client)
+
+
+
+@pytest.fixture
+def raw_loads() -> Callable[[Path], bool]:
+    """Whether raw PyBullet loads a URDF: ``p.loadURDF(path)``, nothing else, in a child
+    process (its C text goes to fd 1; a crash stays there)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, pybullet as p\nc = p.connect(p.DIRECT)\n"
+            "try:\n    p.loadURDF(sys.argv[1])\nexcept p.error:\n    sys.exit(1)\n")
+
+    def loads(path: Path) -> bool:
+        return subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
+                              timeout=60).returncode == 0
+
+    return loads
 
 
 # --------------------------------------------------------------------------- skips in CI

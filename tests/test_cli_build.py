@@ -7,6 +7,7 @@ import os
 import shutil
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -242,15 +243,8 @@ endsolid t
 """
 
 
-def _raw_loads(path: Path) -> bool:
-    """Whether raw PyBullet loads ``path`` (run in a child: its C text goes to fd 1)."""
-    code = ("import sys, pybullet as p\nc = p.connect(p.DIRECT)\n"
-            "try:\n    p.loadURDF(sys.argv[1])\nexcept p.error:\n    sys.exit(1)\n")
-    return subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
-                          timeout=60).returncode == 0
-
-
-def test_build_warns_when_raw_pybullet_cannot_reach_a_nested_package(tmp_path: Path) -> None:
+def test_build_warns_when_raw_pybullet_cannot_reach_a_nested_package(
+        tmp_path: Path, raw_loads: Callable[[Path], bool]) -> None:
     # As turtlebot4 includes create3_sim's irobot_create_common/irobot_create_description: a
     # package one folder deeper than its name, found by its package.xml only.
     pkg = tmp_path / "ws" / "group" / "mypkg"
@@ -273,5 +267,5 @@ def test_build_warns_when_raw_pybullet_cannot_reach_a_nested_package(tmp_path: P
         assert done.returncode == 0, done.stderr
         warned = "raw p.loadURDF will not find 1 package:// file(s)" in done.stderr
         # The warning says exactly what raw PyBullet then does with the written file.
-        assert warned == (out == outside) == (not _raw_loads(out)), (out, done.stderr)
+        assert warned == (out == outside) == (not raw_loads(out)), (out, done.stderr)
         assert ("package://mypkg/meshes/t.stl" in done.stderr) == warned

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -312,18 +313,8 @@ def test_whitespace_in_a_material_name_is_written_back_exactly(tmp_path: Path,
     assert [m.get("name") for m in root.iter("material")] == [name, name]
 
 
-def _raw_loads(path: Path) -> bool:
-    """Whether raw PyBullet loads ``path`` (in a child: its C text goes to fd 1)."""
-    import subprocess
-    import sys
-
-    code = ("import sys, pybullet as p\nc = p.connect(p.DIRECT)\n"
-            "try:\n    p.loadURDF(sys.argv[1])\nexcept p.error:\n    sys.exit(1)\n")
-    return subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
-                          timeout=60).returncode == 0
-
-
-def test_fix_warns_when_raw_pybullet_cannot_reach_a_nested_package(tmp_path: Path) -> None:
+def test_fix_warns_when_raw_pybullet_cannot_reach_a_nested_package(
+        tmp_path: Path, raw_loads: Callable[[Path], bool]) -> None:
     # A package one folder deeper than its name (turtlebot4 on create3_sim's
     # irobot_create_common/irobot_create_description), found by its package.xml only: the
     # repaired copy written outside the workspace is out of raw PyBullet's reach.
@@ -336,7 +327,7 @@ def test_fix_warns_when_raw_pybullet_cannot_reach_a_nested_package(tmp_path: Pat
                    '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="3"/></inertial>'
                    '<collision><geometry><mesh filename="package://mypkg/meshes/cube.stl"/>'
                    '</geometry></collision></link></robot>')
-    assert _raw_loads(src)
+    assert raw_loads(src)
     outside, inside = tmp_path / "out" / "r.urdf", tmp_path / "ws" / "group" / "fixed.urdf"
     outside.parent.mkdir()
     for out in (outside, inside):
@@ -345,4 +336,4 @@ def test_fix_warns_when_raw_pybullet_cannot_reach_a_nested_package(tmp_path: Pat
         assert 'izz="3"' not in out.read_text()  # the U604 inertia was repaired
         warned = "raw p.loadURDF will not find 1 package:// file(s)" in result.output
         # The warning says exactly what raw PyBullet then does with the written file.
-        assert warned == (out == outside) == (not _raw_loads(out)), (out, result.output)
+        assert warned == (out == outside) == (not raw_loads(out)), (out, result.output)
