@@ -642,6 +642,11 @@ class _Compare:
                 else (0.0, 1.0)
             q0[n] = float(rng.uniform(mid - half, mid + half))
         self.set_q(d, {n: q0[n] for n in self.matched})
+        unstable = self._explicit_damping_unstable(d)
+        if unstable:
+            res.add("swing", f"free swing, dt {self.o.time_step:g}", None, None, "",
+                    unstable, status="known")
+            return
         b = pb.b
         b.setTimeStep(self.o.time_step)
         pb.pose(q0)
@@ -676,6 +681,47 @@ class _Compare:
             "<mimic>" if mimic else ""
         res.add("swing", f"free swing {stop * self.o.time_step:g} s, dt {self.o.time_step:g}",
                 worst, TOL_SWING, "rad", f"{at}{why}{known}")
+
+
+    def _explicit_damping_unstable(self, d: Any) -> str:
+        """Why the swing cannot be compared when joint damping makes it unstable, else "".
+
+        Both sides step joint damping explicitly (PyBullet does; MuJoCo is set so, its
+        implicit ``eulerdamp`` off), so a joint's speed is multiplied by about
+        ``1 - dt * damping / inertia`` each step: past 2 it flips sign and grows. PyBullet
+        caps it at its 100 rad/s joint-speed limit, MuJoCo does not, so the two part by
+        radians in a few steps (a Shadow hand's 0.1 N m s/rad on fingertips of ~1e-6 kg m^2
+        at 1 ms: 100). The bound is the largest eigenvalue of ``dt M^-1 B`` at the start pose.
+        """
+        import numpy as np
+
+        mj, m = self.mj, self.fixed
+        dof = [int(m.jnt_dofadr[self.jnt[n]]) for n in self.pb.names]
+        damping = np.array([float(m.dof_damping[i]) for i in dof])
+        if not damping.any():
+            return ""
+        mj.mj_kinematics(m, d)
+        mj.mj_comPos(m, d)
+        mj.mj_crb(m, d)
+        full = np.zeros((m.nv, m.nv))
+        _full_mass_matrix(mj, m, d, full)
+        mass = full[np.ix_(dof, dof)]
+        dt = self.o.time_step
+        try:
+            rate = float(np.linalg.eigvals(np.linalg.solve(mass, np.diag(damping))).real.max())
+        except np.linalg.LinAlgError:  # a singular mass matrix: the dynamics rows say so
+            return ""
+        if rate * dt <= 2.0:
+            return ""
+        own = damping * dt / np.maximum(np.diag(mass), 1e-300)
+        k = int(own.argmax())
+        return (f"not compared: joint damping makes the swing unstable at this step: both "
+                f"engines step it explicitly, and dt x damping / inertia reaches "
+                f"{rate * dt:.3g} (stable under 2; {self.pb.names[k]}: damping "
+                f"{damping[k]:.3g} N m s/rad on "
+                f"{mass[k, k]:.3g} kg m^2), so joint speeds flip sign each "
+                f"step and grow, PyBullet's to its 100 rad/s cap; PyBullet's own simulation "
+                f"of this file is unstable at any step over {2.0 / rate:.3g} s")
 
 
 def agree(resolved: Any, model_path: str | Path, options: AgreeOptions | None = None
