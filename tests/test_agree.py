@@ -252,3 +252,22 @@ def test_a_swing_joint_damping_makes_unstable_is_said_so_not_failed(pb, tmp_path
     swing = next(r for r in data["rows"] if r["check"].startswith("free swing"))
     assert code == 0 and swing["status"] == "pass" and swing["check"].startswith(
         "free swing 1 s"), swing
+
+
+SHORT_FINGER = Path(__file__).parent / "fixtures" / "robots" / "short_finger.urdf"
+
+
+def test_a_short_finger_does_not_stop_the_swing_at_its_first_step(tmp_path: Path) -> None:
+    """youBot's arm: its 11.5 mm finger always started within agree's 0.01 "rad" of a limit,
+    so the swing stopped after one step and passed having compared nothing. The margin is now
+    an eighth of a short range: the pendulum swings, both engines alike, until the arm itself
+    nears its limit."""
+    out = tmp_path / "robot.xml"
+    _export(str(SHORT_FINGER), out, "--fixed-base")
+    code, data = _agree(str(SHORT_FINGER), out, "--fixed-base")
+    swing = next(r for r in data["rows"] if r["check"].startswith("free swing"))
+    assert code == 0 and swing["status"] == "pass", swing
+    seconds = float(re.match(r"free swing ([0-9.e-]+) s", swing["check"]).group(1))
+    assert seconds >= 0.2 and "finger_joint within" not in swing["detail"], swing
+    # the pendulum moved: the comparison is not of two bodies at rest
+    assert swing["detail"].startswith("shoulder"), swing

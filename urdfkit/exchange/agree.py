@@ -657,6 +657,11 @@ class _Compare:
             # contacts off on this side too (URDF_USE_SELF_COLLISION would collide links)
             b.setCollisionFilterGroupMask(pb.body, i, 0, 0)
         adr = [int(m.jnt_qposadr[self.jnt[n]]) for n in pb.names]
+        # how near a limit the swing may come: LIMIT_MARGIN, or an eighth of a short range
+        # (the start is a quarter of the range in from each limit), so that a gripper finger
+        # of 11.5 mm (youBot's) does not stop the whole swing at its first step
+        margin = {n: min(LIMIT_MARGIN, (joints[n].upper - joints[n].lower) / 8)
+                  for n in pb.names if joints[n].limited}
         steps = round(self.o.seconds / self.o.time_step)
         worst, at, stop, why = 0.0, "", steps, ""
         for step in range(steps):
@@ -670,11 +675,12 @@ class _Compare:
                 if e > worst:
                     worst, at = e, n
                 if j.limited and min(v - j.lower, j.upper - v, d.qpos[a] - j.lower,
-                                     j.upper - d.qpos[a]) < LIMIT_MARGIN:
+                                     j.upper - d.qpos[a]) < margin[n]:
                     near = n
             if near:
+                unit = "m" if joints[near].type == "prismatic" else "rad"
                 stop, why = step + 1, f"; stopped at {(step + 1) * self.o.time_step:g} s: " \
-                    f"{near} within {LIMIT_MARGIN} rad of a limit"
+                    f"{near} within {margin[near]:g} {unit} of a limit"
                 break
         mimic = [j.name for j in self.robot.movable() if j.mimic is not None]
         known = f"; mimic joints free on both sides ({', '.join(mimic)}): PyBullet ignores " \
