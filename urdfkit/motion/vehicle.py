@@ -506,9 +506,10 @@ def _find_hinges(scan: _Scan, wheel_list: list[int], named_wheels: bool
             if not wheel_list:
                 raise DrivetrainError(
                     "no wheels found: every wheel hangs from a swivel that turns all the "
-                    f"way round (casters: {', '.join(scan.names[j] for j in casters)}); name "
-                    "the wheels to drive with `wheels` and the joints that steer them with "
-                    "`hinges`", param="wheels")
+                    f"way round (swivels: {', '.join(scan.names[j] for j in swivels)}; the "
+                    f"wheels on them: {', '.join(scan.names[j] for j in trailing)}), which "
+                    "drive takes for casters; name the wheels to drive with `wheels` and the "
+                    "joints that steer them with `hinges`", param="wheels")
     return wheel_list, hinge_list, casters
 
 
