@@ -271,3 +271,40 @@ def test_a_short_finger_does_not_stop_the_swing_at_its_first_step(tmp_path: Path
     assert seconds >= 0.2 and "finger_joint within" not in swing["detail"], swing
     # the pendulum moved: the comparison is not of two bodies at rest
     assert swing["detail"].startswith("shoulder"), swing
+
+
+FLOAT32_QUATERNIONS = Path(__file__).parent / "fixtures" / "robots" / "float32_quaternions.urdf"
+
+
+def test_pybullets_float32_quaternions_are_read_as_pybullet_reads_them(pb,
+                                                                       tmp_path: Path) -> None:
+    """youBot's base: agree failed its frames' rotation row (1.4e-6 against 1.2e-6) on an
+    export that matches exact kinematics to 1e-15. Raw getLinkState hands quaternions off unit
+    length (turned inertial frames, float32); read with the unit formula that adds 2x the
+    excess to the matrix. Read as PyBullet's getMatrixFromQuaternion reads them, it passes."""
+    import numpy as np
+
+    from urdfkit.engine.session import quiet_stdout
+
+    p, c = pb
+    with quiet_stdout():
+        body = p.loadURDF(str(FLOAT32_QUATERNIONS), flags=p.URDF_USE_INERTIA_FROM_FILE,
+                          physicsClientId=c)
+    rng = np.random.default_rng(0)
+    worst = 0.0
+    for _ in range(200):
+        for j in range(p.getNumJoints(body, physicsClientId=c)):
+            p.resetJointState(body, j, float(rng.uniform(-np.pi, np.pi)), physicsClientId=c)
+        for j in range(p.getNumJoints(body, physicsClientId=c)):
+            orn = p.getLinkState(body, j, computeForwardKinematics=True,
+                                 physicsClientId=c)[5]
+            worst = max(worst, abs(float(np.linalg.norm(orn)) - 1.0))
+    assert worst > 1e-7  # raw PyBullet's quaternions are not unit length here
+
+    out = tmp_path / "robot.xml"
+    _export(str(FLOAT32_QUATERNIONS), out)
+    code, data = _agree(str(FLOAT32_QUATERNIONS), out)
+    rows = {r["check"]: r for r in data["rows"]}
+    assert code == 0, [r for r in data["rows"] if r["status"] == "fail"]
+    rotation = rows["frames vs PyBullet: rotation"]
+    assert rotation["status"] == "pass" and rotation["value"] < 1e-6, rotation

@@ -245,7 +245,11 @@ class _Pybullet:
                 pos, orn = self.b.multiplyTransforms(pos, orn, inv_p, inv_o)
             else:
                 pos, orn = by_index[i][4], by_index[i][5]
-            t[:3, :3] = quat_to_matrix(orn)
+            # PyBullet's quaternions are float32 products, up to ~4e-7 off unit length where
+            # a link's inertial frame is turned (youBot's casters): the unit formula would add
+            # 2x that to the matrix; normalised, as PyBullet's getMatrixFromQuaternion does
+            norm = math.sqrt(sum(c * c for c in orn))
+            t[:3, :3] = quat_to_matrix([c / norm for c in orn])
             t[:3, 3] = pos
             out[n] = t
         return out
