@@ -258,3 +258,18 @@ def test_wheels_all_on_swivels_are_named_apart_and_the_advice_drives() -> None:
                           wheels=wheels.split(", "), hinges=swivels.split(", ")))
     assert r.distance == pytest.approx(5 * 0.05 * 4, rel=0.02)
     assert abs(r.final_position[1]) < 0.01
+
+
+def test_every_wheel_on_a_hinge_turns_as_four_wheel_steering() -> None:
+    """youBot's casters named as hinges: the wheelbase came out 0 (front and rear pivots
+    averaged), every hinge took the steer angle, and at --steer 0.3 the base crabbed sideways
+    and reported "straight". The hinges ahead of the wheels' centre now steer against those
+    behind it; rolling without slip, the base circles the point 0.15 / tan(0.3) to its left."""
+    swivels = [f"swivel_joint_{c}" for c in ("fl", "fr", "bl", "br")]
+    wheels = [f"wheel_joint_{c}" for c in ("fl", "fr", "bl", "br")]
+    r = drive(DriveConfig(urdf=str(SWIVEL_WHEELS), throttle=5, seconds=8, steer=0.3,
+                          wheels=wheels, hinges=swivels))
+    d = r.to_dict()
+    expected = 0.15 / math.tan(0.3)  # the pivots' half wheelbase over tan(steer)
+    assert d["turning_radius"] == pytest.approx(expected, rel=0.02), d["turning_radius"]
+    assert r.distance == pytest.approx(5 * 0.05 * 8, rel=0.02)
