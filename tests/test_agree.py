@@ -206,3 +206,105 @@ def test_a_model_pybullet_cannot_take_the_mass_matrix_of_is_compared_on_the_rest
     # the other rows still compare: the frames, and the swing
     assert rows["frames vs PyBullet: position"]["status"] == "pass"
     assert any(k.startswith("free swing") and r["status"] == "pass" for k, r in rows.items())
+
+
+STIFF_DAMPING = Path(__file__).parent / "fixtures" / "robots" / "stiff_damping.urdf"
+
+
+def test_a_swing_joint_damping_makes_unstable_is_said_so_not_failed(pb, tmp_path: Path) -> None:
+    """The Shadow hand: its swing "failed" by 1.4 rad in 3 ms, as if the export were wrong.
+    Raw PyBullet steps joint damping explicitly: at dt x damping / inertia = 20 the finger's
+    speed flips sign every step and runs to PyBullet's 100 rad/s cap (MuJoCo, uncapped, runs
+    on). agree now says the swing cannot be compared, and why; below 2 it still compares."""
+    from urdfkit.engine.session import quiet_stdout
+
+    p, c = pb
+    with quiet_stdout():
+        body = p.loadURDF(str(STIFF_DAMPING), useFixedBase=True,
+                          flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=c)
+    p.setGravity(0, 0, -9.81, physicsClientId=c)
+    p.setTimeStep(0.001, physicsClientId=c)
+    p.setJointMotorControl2(body, 0, p.VELOCITY_CONTROL, force=0, physicsClientId=c)
+    for link in (-1, 0):
+        p.changeDynamics(body, link, linearDamping=0, angularDamping=0, physicsClientId=c)
+    speeds = []
+    for _ in range(8):
+        p.stepSimulation(physicsClientId=c)
+        speeds.append(p.getJointState(body, 0, physicsClientId=c)[1])
+    assert all(a * b < 0 for a, b in zip(speeds[1:], speeds[2:], strict=False)), speeds
+    assert max(map(abs, speeds)) == pytest.approx(100.0)  # gravity alone: ~0.4 rad/s
+
+    out = tmp_path / "robot.xml"
+    _export(str(STIFF_DAMPING), out, "--fixed-base")
+    code, data = _agree(str(STIFF_DAMPING), out, "--fixed-base")
+    rows = {r["check"]: r for r in data["rows"]}
+    swing = next(r for k, r in rows.items() if k.startswith("free swing"))
+    assert code == 0 and swing["status"] == "known", swing
+    assert "unstable" in swing["detail"] and "finger_joint" in swing["detail"]
+    assert "reaches 20 " in swing["detail"]
+    assert rows["mass matrix"]["status"] == "pass"
+
+    # a twentieth of the damping: 1 per step, stable, and the swing is compared
+    calm = tmp_path / "calm.urdf"
+    calm.write_text(STIFF_DAMPING.read_text().replace('damping="0.1"', 'damping="0.005"'))
+    _export(str(calm), out, "--fixed-base", "--force")
+    code, data = _agree(str(calm), out, "--fixed-base")
+    swing = next(r for r in data["rows"] if r["check"].startswith("free swing"))
+    assert code == 0 and swing["status"] == "pass" and swing["check"].startswith(
+        "free swing 1 s"), swing
+
+
+SHORT_FINGER = Path(__file__).parent / "fixtures" / "robots" / "short_finger.urdf"
+
+
+def test_a_short_finger_does_not_stop_the_swing_at_its_first_step(tmp_path: Path) -> None:
+    """youBot's arm: its 11.5 mm finger always started within agree's 0.01 "rad" of a limit,
+    so the swing stopped after one step and passed having compared nothing. The margin is now
+    an eighth of a short range: the pendulum swings, both engines alike, until the arm itself
+    nears its limit."""
+    out = tmp_path / "robot.xml"
+    _export(str(SHORT_FINGER), out, "--fixed-base")
+    code, data = _agree(str(SHORT_FINGER), out, "--fixed-base")
+    swing = next(r for r in data["rows"] if r["check"].startswith("free swing"))
+    assert code == 0 and swing["status"] == "pass", swing
+    seconds = float(re.match(r"free swing ([0-9.e-]+) s", swing["check"]).group(1))
+    assert seconds >= 0.2 and "finger_joint within" not in swing["detail"], swing
+    # the pendulum moved: the comparison is not of two bodies at rest
+    assert swing["detail"].startswith("shoulder"), swing
+
+
+FLOAT32_QUATERNIONS = Path(__file__).parent / "fixtures" / "robots" / "float32_quaternions.urdf"
+
+
+def test_pybullets_float32_quaternions_are_read_as_pybullet_reads_them(pb,
+                                                                       tmp_path: Path) -> None:
+    """youBot's base: agree failed its frames' rotation row (1.4e-6 against 1.2e-6) on an
+    export that matches exact kinematics to 1e-15. Raw getLinkState hands quaternions off unit
+    length (turned inertial frames, float32); read with the unit formula that adds 2x the
+    excess to the matrix. Read as PyBullet's getMatrixFromQuaternion reads them, it passes."""
+    import numpy as np
+
+    from urdfkit.engine.session import quiet_stdout
+
+    p, c = pb
+    with quiet_stdout():
+        body = p.loadURDF(str(FLOAT32_QUATERNIONS), flags=p.URDF_USE_INERTIA_FROM_FILE,
+                          physicsClientId=c)
+    rng = np.random.default_rng(0)
+    worst = 0.0
+    for _ in range(200):
+        for j in range(p.getNumJoints(body, physicsClientId=c)):
+            p.resetJointState(body, j, float(rng.uniform(-np.pi, np.pi)), physicsClientId=c)
+        for j in range(p.getNumJoints(body, physicsClientId=c)):
+            orn = p.getLinkState(body, j, computeForwardKinematics=True,
+                                 physicsClientId=c)[5]
+            worst = max(worst, abs(float(np.linalg.norm(orn)) - 1.0))
+    assert worst > 1e-7  # raw PyBullet's quaternions are not unit length here
+
+    out = tmp_path / "robot.xml"
+    _export(str(FLOAT32_QUATERNIONS), out)
+    code, data = _agree(str(FLOAT32_QUATERNIONS), out)
+    rows = {r["check"]: r for r in data["rows"]}
+    assert code == 0, [r for r in data["rows"] if r["status"] == "fail"]
+    rotation = rows["frames vs PyBullet: rotation"]
+    assert rotation["status"] == "pass" and rotation["value"] < 1e-6, rotation

@@ -90,6 +90,10 @@ CASES = [
     ("U310", doc(A, B, link("c"), joint("j1", "a", "b"),
                  '<joint name="j2" type="continuous"><parent link="a"/><child link="c"/>',
                  '<mimic joint="j1" multiplier="-1"/><!--HERE-->', "</joint>")),
+    ("U311", doc(A, link("b", '<inertial><mass value="0.01"/><inertia ixx="1e-6" iyy="1e-6" '
+                              'izz="1e-6" ixy="0" ixz="0" iyz="0"/></inertial>', ""),
+                 '<joint name="j" type="continuous"><parent link="a"/><child link="b"/>',
+                 '<axis xyz="0 0 1"/><dynamics damping="0.1"/><!--HERE-->', "</joint>")),
     ("U401", doc(A, B, '<joint name="j" type="fixed"><parent link="a"/><child link="b"/>',
                  '<origin xyz="0 nan 0"/><!--HERE-->', "</joint>")),
     ("U402", doc(A, B, '<joint name="j" type="fixed"><parent link="a"/><child link="b"/>',

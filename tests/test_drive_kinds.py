@@ -236,3 +236,40 @@ def test_the_readmes_skid_steer_example_turns() -> None:
     assert r.heading_change == pytest.approx(math.radians(83), rel=0.05)
     assert r.yaw_rate == pytest.approx(0.196, rel=0.05)
     assert any("39% of the 0.5 commanded" in w and "--steer 1.5" in w for w in r.warnings)
+
+
+SWIVEL_WHEELS = Path(__file__).parent / "fixtures" / "robots" / "swivel_wheels.urdf"
+
+
+def test_wheels_all_on_swivels_are_named_apart_and_the_advice_drives() -> None:
+    """youBot's base: each wheel on a swivel that turns all the way round. drive refused,
+    listing the wheels among the "casters" beside the swivels; it now names the swivels and
+    the wheels on them apart, and doing what it says (wheels to --wheels, swivels to
+    --hinges) rolls without slip: v = omega r."""
+    from urdfkit.motion.vehicle import DrivetrainError
+
+    with pytest.raises(DrivetrainError) as refused:
+        drive(DriveConfig(urdf=str(SWIVEL_WHEELS), throttle=5, seconds=1))
+    message = str(refused.value)
+    swivels = ", ".join(f"swivel_joint_{c}" for c in ("fl", "fr", "bl", "br"))
+    wheels = ", ".join(f"wheel_joint_{c}" for c in ("fl", "fr", "bl", "br"))
+    assert f"(swivels: {swivels}; the wheels on them: {wheels})" in message, message
+    r = drive(DriveConfig(urdf=str(SWIVEL_WHEELS), throttle=5, seconds=4,
+                          wheels=wheels.split(", "), hinges=swivels.split(", ")))
+    assert r.distance == pytest.approx(5 * 0.05 * 4, rel=0.02)
+    assert abs(r.final_position[1]) < 0.01
+
+
+def test_every_wheel_on_a_hinge_turns_as_four_wheel_steering() -> None:
+    """youBot's casters named as hinges: the wheelbase came out 0 (front and rear pivots
+    averaged), every hinge took the steer angle, and at --steer 0.3 the base crabbed sideways
+    and reported "straight". The hinges ahead of the wheels' centre now steer against those
+    behind it; rolling without slip, the base circles the point 0.15 / tan(0.3) to its left."""
+    swivels = [f"swivel_joint_{c}" for c in ("fl", "fr", "bl", "br")]
+    wheels = [f"wheel_joint_{c}" for c in ("fl", "fr", "bl", "br")]
+    r = drive(DriveConfig(urdf=str(SWIVEL_WHEELS), throttle=5, seconds=8, steer=0.3,
+                          wheels=wheels, hinges=swivels))
+    d = r.to_dict()
+    expected = 0.15 / math.tan(0.3)  # the pivots' half wheelbase over tan(steer)
+    assert d["turning_radius"] == pytest.approx(expected, rel=0.02), d["turning_radius"]
+    assert r.distance == pytest.approx(5 * 0.05 * 8, rel=0.02)

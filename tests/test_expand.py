@@ -182,3 +182,32 @@ def test_check_no_exec_reports_each_xacro(tmp_path: Path) -> None:
     assert [f["code"] for f in json.loads(env.stdout)["findings"]] == ["U006"]
     assert not marker.exists()
     os.environ.pop(NO_EXEC_ENV, None)
+
+
+def test_an_include_of_a_missing_file_names_it_once_and_its_includer(tmp_path: Path) -> None:
+    """Doosan's m1013.urdf.xacro with gripper:=robotiq_2f includes a file one folder off:
+    the error said the path twice (xacro's text, then the OSError's) and not which file
+    included it. Raw xacro fails on the same path; urdfkit now names it once, with the file
+    whose <xacro:include> named it (here one include deep)."""
+    import xacro
+
+    ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+    top = tmp_path / "top.urdf.xacro"
+    top.write_text(f'<robot name="r" {ns}><link name="a"/>'
+                   '<xacro:include filename="parts.xacro"/></robot>')
+    (tmp_path / "parts.xacro").write_text(f'<robot {ns}><xacro:include filename="gone.xacro"/>'
+                                          "</robot>")
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        with pytest.raises(Exception) as raw:
+            xacro.process_file(str(top))
+    finally:
+        os.chdir(cwd)
+    assert "gone.xacro" in str(raw.value)  # raw xacro fails on the same file
+    with pytest.raises(InputError) as ours:
+        expand_xacro(top, timeout=20)
+    message = str(ours.value)
+    gone, parts = str(tmp_path / "gone.xacro"), str(tmp_path / "parts.xacro")
+    assert message.count("gone.xacro") == 1, message
+    assert f"does not exist: {gone} (included by {parts})" in message, message

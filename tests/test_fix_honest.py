@@ -147,3 +147,36 @@ def test_the_mass_pybullet_loads_is_guarded_too(tmp_path: Path) -> None:
     mass = json.loads(r.stdout)["mass"]
     assert (mass["loaded_before"], mass["loaded_after"]) == (loaded(path), loaded(out)) == (5, 2)
     assert mass["before"] == mass["after"] == 2.0  # the file's own masses did not move
+
+
+def test_stray_text_before_the_first_child_does_not_stop_fix(tmp_path: Path) -> None:
+    """youBot (mas-group/youbot_description): `<robot ...>>` leaves a `>` as the robot's text,
+    and fix exited 3 ("the edited text does not parse to the edited tree") on any repair that
+    writes a first child. Now it writes them, and raw PyBullet loads the result as fixed:
+    the frame's 1 kg gone, the material drawn in the colour PyBullet drew it before."""
+    import pybullet as p
+
+    from urdfkit.engine.session import quiet_stdout
+
+    src = Path(__file__).parent / "fixtures" / "robots" / "stray_text.urdf"
+    out = tmp_path / "fixed.urdf"
+    result = runner.invoke(app, ["fix", str(src), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.count("fixed U706") == 1 and result.stdout.count("fixed U606") == 1
+
+    def loaded(path: Path) -> tuple[float, float, tuple[float, ...]]:
+        with quiet_stdout():
+            c = p.connect(p.DIRECT)
+            try:
+                body = p.loadURDF(str(path), physicsClientId=c)
+                masses = [p.getDynamicsInfo(body, i, physicsClientId=c)[0] for i in (-1, 0)]
+                colour = p.getVisualShapeData(body, physicsClientId=c)[0][7]
+            finally:
+                p.disconnect(physicsClientId=c)
+        return masses[0], masses[1], tuple(colour)
+
+    before, after = loaded(src), loaded(out)
+    assert before[:2] == (2.0, 1.0) and after[:2] == (2.0, 0.0)
+    assert after[2] == before[2]
+    assert not [f for f in check_paths([out], jobs=1, cache=False).findings
+                if f.code in ("U606", "U706")]

@@ -471,7 +471,7 @@ class _Plan:
         self._insert_first_child(job.link, [
             '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" '
             'izz="0"/></inertial>'])
-        job.link.insert(0, etree.fromstring(
+        _prepend(job.link, etree.fromstring(
             '<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" '
             'izz="0"/></inertial>'))
         self.repairs.append(Repair(job.code, job.line, f"link {job.name!r} is a frame (no shapes, "
@@ -585,7 +585,7 @@ class _Plan:
         self._insert_first_child(self.root, [xml])
         new = etree.Element("material", name=name)
         etree.SubElement(new, "color", rgba=UNDEFINED_RGBA)
-        self.root.insert(0, new)
+        _prepend(self.root, new)
         self.repairs.append(Repair("U706", line, f"material {name!r} was used but never "
                                    f"defined: defined it white ({UNDEFINED_RGBA}), the colour "
                                    "PyBullet draws it in; set the colour you meant"))
@@ -635,7 +635,7 @@ class _Plan:
                       "</inertial>"]
             self._insert_first_child(link, lines)
             new = etree.fromstring("".join(x.strip() for x in lines))
-            link.insert(0, new)
+            _prepend(link, new)
             return
         mass_el = inertial.find("mass")
         if not keep_mass:
@@ -643,11 +643,11 @@ class _Plan:
                 self._set_attribute(mass_el, "value", fmt_float(mass, 6))
             else:
                 self._insert_first_child(inertial, [f'<mass value="{fmt_float(mass, 6)}"/>'])
-                inertial.insert(0, etree.Element("mass", value=fmt_float(mass, 6)))
+                _prepend(inertial, etree.Element("mass", value=fmt_float(mass, 6)))
         if com is not None and inertial.find("origin") is None and any(com):
             self._insert_first_child(inertial, [f'<origin xyz="{fmt_vec(tuple(com))}" '
                                                 'rpy="0 0 0"/>'])
-            inertial.insert(0, etree.Element("origin", xyz=fmt_vec(tuple(com)), rpy="0 0 0"))
+            _prepend(inertial, etree.Element("origin", xyz=fmt_vec(tuple(com)), rpy="0 0 0"))
         old = inertial.find("inertia")
         if old is not None:
             self._replace_inertia(old, local)
@@ -780,6 +780,17 @@ class _Plan:
             raise AssertionError(f"{self.file}: the edited text does not parse to the edited "
                                  "tree; nothing written")
         return data
+
+
+def _prepend(parent: etree._Element, new: etree._Element) -> None:
+    """Make ``new`` the tree's first child of ``parent``, where the text edit puts it.
+
+    :meth:`_Plan._insert_first_child` writes it right after the start tag, so any text the
+    parent held before its first child (a stray ``>`` of ``<robot name="r">>``, as youBot's
+    xacro writes) now follows ``new``.
+    """
+    parent.insert(0, new)
+    new.tail, parent.text = parent.text, None
 
 
 def _iso(moment: float) -> tuple[tuple[float, float, float], ...]:

@@ -764,6 +764,122 @@ def rule_mimic(root: etree._Element, r: RuleReport) -> None:
                  "offset)" if multiplier else ""), mimic)
 
 
+#: PyBullet's default physics step (``setTimeStep``), which ``sim`` and ``drive`` keep.
+DEFAULT_TIME_STEP = 1.0 / 240.0
+
+
+def rule_damping(root: etree._Element, r: RuleReport) -> None:
+    """U311: joint damping so large for what the joint moves that PyBullet's step is unstable.
+
+    PyBullet applies ``<dynamics damping>`` explicitly: each step multiplies the joint speed by
+    about ``1 - dt x damping / inertia``, which past 2 flips its sign and grows it to
+    PyBullet's 100 rad/s joint-speed cap (measured: the Shadow hand, shadow-robot/sr_common,
+    0.1 N m s/rad on ~5e-6 kg m^2 fingers, chatters at +-100 rad/s from the third step). The
+    inertia is the joint-space one at the zero pose, ``M_ii``: everything below the joint about
+    its axis (a prismatic joint: the mass below it), the file's inertia, 1 kg and unit inertia
+    for a link without ``<inertial>``. The largest eigenvalue of ``M^-1 B`` is at least
+    ``b_i / M_ii``, so a finding here is unstable for certain; joints coupled through the
+    off-diagonal inertia can be unstable without one.
+    """
+    doc = r.doc(root)
+    damped = []
+    for jv in doc.joints:
+        if jv.type not in ("revolute", "continuous", "prismatic"):
+            continue
+        dyn = first(jv.el, "dynamics")
+        b = _num(dyn, "damping") if dyn is not None else None
+        if b is not None and b > 0:
+            damped.append((jv, b, dyn))
+    if not damped:
+        return
+    links = {lv.name: lv for lv in doc.links if lv.name is not None}
+    below: dict[str, list[Any]] = {}
+    for jv in doc.joints:
+        parent = jv.parent.get("link") if jv.parent is not None else None
+        if parent is not None and jv.child is not None:
+            below.setdefault(parent, []).append(jv)
+    for jv, b, dyn in damped:
+        inertia = _joint_inertia(jv, links, below)
+        if inertia is None or inertia <= 0:
+            continue
+        rate = DEFAULT_TIME_STEP * b / inertia
+        if rate <= 2.0:
+            continue
+        prismatic = jv.type == "prismatic"
+        unit, what = ("N s/m", "kg") if prismatic else ("N m s/rad", "kg m^2")
+        r.add("U311", "warning",
+              f"{label(jv.el)} has damping {b:g} {unit} against the {inertia:.3g} {what} it "
+              f"moves (at the zero pose, with the file's inertia): PyBullet applies joint "
+              f"damping explicitly, so each step of its default 1/240 s multiplies the joint's "
+              f"speed by 1 - {rate:.3g}, flipping its sign and growing it to PyBullet's "
+              f"100 {'m/s' if prismatic else 'rad/s'} cap: the joint chatters instead of "
+              f"settling; lower the damping under {2 * inertia / DEFAULT_TIME_STEP:.3g} or "
+              f"step under {2 * inertia / b:.3g} s", dyn)
+
+
+def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[Any]]
+                   ) -> float | None:
+    """``M_ii`` of joint ``jv`` at the zero pose, as PyBullet loads the file with its inertia.
+
+    None when a link below is missing or has no readable mass or inertia, or the tree loops.
+    """
+    axis = _vec(jv.axis, "xyz", 3, (1.0, 0.0, 0.0))  # None only when unreadable (U401)
+    if axis is None:
+        return None
+    norm = math.sqrt(sum(a * a for a in axis))
+    if norm == 0:
+        return None
+    a = tuple(x / norm for x in axis)
+    prismatic = jv.type == "prismatic"
+    identity: Matrix3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    # frames relative to the joint's own (its child link's frame at q = 0)
+    todo: list[tuple[str | None, Matrix3, tuple[float, ...]]] = [
+        (jv.child.get("link"), identity, (0.0, 0.0, 0.0))]
+    seen: set[str] = set()
+    total = 0.0
+    while todo:
+        name, rot, pos = todo.pop()
+        if name is None or name in seen or name not in links:
+            return None
+        seen.add(name)
+        lv = links[name]
+        mass = _mass_of(lv)
+        if mass is None:
+            return None
+        if lv.inertial is None:
+            com, tensor = pos, ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+            frame = rot
+        else:
+            origin = first(lv.inertial, "origin")
+            xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
+            rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
+            tensor_or_none = _inertia_tensor(lv.inertia) if lv.inertia is not None else None
+            if xyz is None or rpy is None or tensor_or_none is None:
+                return None
+            tensor = cast(Matrix3, tensor_or_none)
+            off = rotate(rot, xyz)
+            com = tuple(p + o for p, o in zip(pos, off, strict=True))
+            frame = matmul(rot, rpy_to_matrix(rpy))
+        if prismatic:
+            total += mass
+        else:
+            local = rotate(transpose(frame), a)  # the axis in the inertia's frame
+            total += sum(local[i] * tensor[i][j] * local[j] for i in range(3) for j in range(3))
+            along = sum(c * x for c, x in zip(com, a, strict=True))
+            total += mass * (sum(c * c for c in com) - along * along)
+        for child in below.get(name, ()):
+            origin = child.origin
+            xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
+            rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
+            if xyz is None or rpy is None:
+                return None
+            off = rotate(rot, xyz)
+            todo.append((child.child.get("link") if child.child is not None else None,
+                         matmul(rot, rpy_to_matrix(rpy)),
+                         tuple(p + o for p, o in zip(pos, off, strict=True))))
+    return total
+
+
 def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
     """U803: Gazebo contact parameters (mu1, mu2, kp, kd) PyBullet ignores, per link.
 
@@ -864,7 +980,7 @@ _SHAPE_NOTES = {key.partition(":")[2]: note for key, note in EXTENSIONS.items()
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
                                rule_inertia, rule_meshes, rule_mesh_shapes, rule_visual_meshes,
                                rule_references, rule_material_colours, rule_mimic,
-                               rule_gazebo_contacts, rule_portability)
+                               rule_damping, rule_gazebo_contacts, rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -907,6 +1023,7 @@ CODES: dict[str, str] = {
     "U307": "mimic refers to a missing joint",
     "U309": "mimic joints follow each other in a ring",
     "U310": "<mimic> that PyBullet ignores (the joint moves on its own; info)",
+    "U311": "joint damping too large for what the joint moves: PyBullet's 1/240 s step is unstable",
     "U308": "revolute/prismatic <limit> without lower or upper (PyBullet: unlimited)",
     "U401": "number does not parse or is not finite",
     "U402": "vector of the wrong length",

@@ -245,7 +245,11 @@ class _Pybullet:
                 pos, orn = self.b.multiplyTransforms(pos, orn, inv_p, inv_o)
             else:
                 pos, orn = by_index[i][4], by_index[i][5]
-            t[:3, :3] = quat_to_matrix(orn)
+            # PyBullet's quaternions are float32 products, up to ~4e-7 off unit length where
+            # a link's inertial frame is turned (youBot's casters): the unit formula would add
+            # 2x that to the matrix; normalised, as PyBullet's getMatrixFromQuaternion does
+            norm = math.sqrt(sum(c * c for c in orn))
+            t[:3, :3] = quat_to_matrix([c / norm for c in orn])
             t[:3, 3] = pos
             out[n] = t
         return out
@@ -642,6 +646,11 @@ class _Compare:
                 else (0.0, 1.0)
             q0[n] = float(rng.uniform(mid - half, mid + half))
         self.set_q(d, {n: q0[n] for n in self.matched})
+        unstable = self._explicit_damping_unstable(d)
+        if unstable:
+            res.add("swing", f"free swing, dt {self.o.time_step:g}", None, None, "",
+                    unstable, status="known")
+            return
         b = pb.b
         b.setTimeStep(self.o.time_step)
         pb.pose(q0)
@@ -652,6 +661,11 @@ class _Compare:
             # contacts off on this side too (URDF_USE_SELF_COLLISION would collide links)
             b.setCollisionFilterGroupMask(pb.body, i, 0, 0)
         adr = [int(m.jnt_qposadr[self.jnt[n]]) for n in pb.names]
+        # how near a limit the swing may come: LIMIT_MARGIN, or an eighth of a short range
+        # (the start is a quarter of the range in from each limit), so that a gripper finger
+        # of 11.5 mm (youBot's) does not stop the whole swing at its first step
+        margin = {n: min(LIMIT_MARGIN, (joints[n].upper - joints[n].lower) / 8)
+                  for n in pb.names if joints[n].limited}
         steps = round(self.o.seconds / self.o.time_step)
         worst, at, stop, why = 0.0, "", steps, ""
         for step in range(steps):
@@ -665,17 +679,59 @@ class _Compare:
                 if e > worst:
                     worst, at = e, n
                 if j.limited and min(v - j.lower, j.upper - v, d.qpos[a] - j.lower,
-                                     j.upper - d.qpos[a]) < LIMIT_MARGIN:
+                                     j.upper - d.qpos[a]) < margin[n]:
                     near = n
             if near:
+                unit = "m" if joints[near].type == "prismatic" else "rad"
                 stop, why = step + 1, f"; stopped at {(step + 1) * self.o.time_step:g} s: " \
-                    f"{near} within {LIMIT_MARGIN} rad of a limit"
+                    f"{near} within {margin[near]:g} {unit} of a limit"
                 break
         mimic = [j.name for j in self.robot.movable() if j.mimic is not None]
         known = f"; mimic joints free on both sides ({', '.join(mimic)}): PyBullet ignores " \
             "<mimic>" if mimic else ""
         res.add("swing", f"free swing {stop * self.o.time_step:g} s, dt {self.o.time_step:g}",
                 worst, TOL_SWING, "rad", f"{at}{why}{known}")
+
+
+    def _explicit_damping_unstable(self, d: Any) -> str:
+        """Why the swing cannot be compared when joint damping makes it unstable, else "".
+
+        Both sides step joint damping explicitly (PyBullet does; MuJoCo is set so, its
+        implicit ``eulerdamp`` off), so a joint's speed is multiplied by about
+        ``1 - dt * damping / inertia`` each step: past 2 it flips sign and grows. PyBullet
+        caps it at its 100 rad/s joint-speed limit, MuJoCo does not, so the two part by
+        radians in a few steps (a Shadow hand's 0.1 N m s/rad on fingertips of ~1e-6 kg m^2
+        at 1 ms: 100). The bound is the largest eigenvalue of ``dt M^-1 B`` at the start pose.
+        """
+        import numpy as np
+
+        mj, m = self.mj, self.fixed
+        dof = [int(m.jnt_dofadr[self.jnt[n]]) for n in self.pb.names]
+        damping = np.array([float(m.dof_damping[i]) for i in dof])
+        if not damping.any():
+            return ""
+        mj.mj_kinematics(m, d)
+        mj.mj_comPos(m, d)
+        mj.mj_crb(m, d)
+        full = np.zeros((m.nv, m.nv))
+        _full_mass_matrix(mj, m, d, full)
+        mass = full[np.ix_(dof, dof)]
+        dt = self.o.time_step
+        try:
+            rate = float(np.linalg.eigvals(np.linalg.solve(mass, np.diag(damping))).real.max())
+        except np.linalg.LinAlgError:  # a singular mass matrix: the dynamics rows say so
+            return ""
+        if rate * dt <= 2.0:
+            return ""
+        own = damping * dt / np.maximum(np.diag(mass), 1e-300)
+        k = int(own.argmax())
+        return (f"not compared: joint damping makes the swing unstable at this step: both "
+                f"engines step it explicitly, and dt x damping / inertia reaches "
+                f"{rate * dt:.3g} (stable under 2; {self.pb.names[k]}: damping "
+                f"{damping[k]:.3g} N m s/rad on "
+                f"{mass[k, k]:.3g} kg m^2), so joint speeds flip sign each "
+                f"step and grow, PyBullet's to its 100 rad/s cap; PyBullet's own simulation "
+                f"of this file is unstable at any step over {2.0 / rate:.3g} s")
 
 
 def agree(resolved: Any, model_path: str | Path, options: AgreeOptions | None = None

@@ -168,10 +168,21 @@ class Drivetrain:
 
     @property
     def wheelbase(self) -> float | None:
-        """Mean distance from the rear axle to the hinge pivots (None without hinges)."""
+        """Mean distance from the rear axle to the hinge pivots (None without hinges).
+
+        When every wheel hangs from a hinge (four-wheel steering: youBot's casters named as
+        hinges), the "rear axle" is the wheels' mean x and the distance is to the hinges ahead
+        of it; :meth:`hinge_angles` then turns those behind the other way. Taken over every
+        pivot, front and rear cancel to 0 and every hinge turned the same way: the base
+        crabbed sideways at the steer angle and never turned.
+        """
         pivots = [self.pivot[h][0] for h in self.hinges if h in self.pivot]
         if not pivots:
             return None
+        if all(self.carried_by.get(w) is not None for w in self.wheels):
+            ahead = [x for x in pivots if x > self.rear_x]
+            if ahead and len(ahead) < len(pivots):
+                pivots = ahead
         return sum(pivots) / len(pivots) - self.rear_x
 
     @property
@@ -506,9 +517,10 @@ def _find_hinges(scan: _Scan, wheel_list: list[int], named_wheels: bool
             if not wheel_list:
                 raise DrivetrainError(
                     "no wheels found: every wheel hangs from a swivel that turns all the "
-                    f"way round (casters: {', '.join(scan.names[j] for j in casters)}); name "
-                    "the wheels to drive with `wheels` and the joints that steer them with "
-                    "`hinges`", param="wheels")
+                    f"way round (swivels: {', '.join(scan.names[j] for j in swivels)}; the "
+                    f"wheels on them: {', '.join(scan.names[j] for j in trailing)}), which "
+                    "drive takes for casters; name the wheels to drive with `wheels` and the "
+                    "joints that steer them with `hinges`", param="wheels")
     return wheel_list, hinge_list, casters
 
 

@@ -293,7 +293,8 @@ def main(argv: list[str]) -> int:
                   f"`packages` ({name}=PATH) or a folder holding it with `package_paths` (or "
                   "set ROS_PACKAGE_PATH)", file=sys.stderr)
             return 1
-        print(_message(e), file=sys.stderr)
+        print(_message(e, list(getattr(sys.modules.get("xacro"), "filestack", None) or [])),
+              file=sys.stderr)
         return 1
     finally:
         _kill_descendants()
@@ -319,13 +320,23 @@ def main(argv: list[str]) -> int:
 SUBSTITUTIONS = ("find", "arg", "env", "optenv", "dirname")
 
 
-def _message(e: BaseException) -> str:
-    """One line for a xacro failure: the inner error, without xacro's class-name wrapping."""
+def _message(e: BaseException, filestack: list[str] | None = None) -> str:
+    """One line for a xacro failure: the inner error, without xacro's class-name wrapping.
+
+    ``filestack`` is xacro's stack of files being read when it failed: its last entry other
+    than the missing file is the one whose ``<xacro:include>`` named it.
+    """
     import re
 
     lines = [ln.strip() for ln in str(e).strip().splitlines() if ln.strip()]
     if not lines:
         return type(e).__name__
+    # an include of a missing file: xacro says the path twice (its text and the OSError's)
+    missing = re.match(r"No such file or directory: (.+?) \[Errno 2\]", lines[0])
+    if missing:
+        stack = [f for f in filestack or [] if f and f != missing.group(1)]
+        by = f" (included by {stack[-1]})" if stack else ""
+        return f"<xacro:include> of a file that does not exist: {missing.group(1)}{by}"
     # xacro prefixes the inner exception's class and repeats its text: keep it once.
     text = re.sub(r"^<class '[\w.]+'>: ", "", lines[0])
     inner = str(getattr(e, "exc", "") or "").strip()
