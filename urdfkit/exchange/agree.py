@@ -692,7 +692,6 @@ class _Compare:
         res.add("swing", f"free swing {stop * self.o.time_step:g} s, dt {self.o.time_step:g}",
                 worst, TOL_SWING, "rad", f"{at}{why}{known}")
 
-
     def _explicit_damping_unstable(self, d: Any) -> str:
         """Why the swing cannot be compared when joint damping makes it unstable, else "".
 
