@@ -119,7 +119,7 @@ class DriveConfig:
             else only the statistics are kept, and memory does not grow with the run.
         wheels: Joint names/indices to drive instead of the detected wheels.
         hinges: Joint names/indices to steer instead of the detected hinges.
-        sample_every: Steps between trajectory samples; default: 20 samples per second.
+        sample_every: Steps between trajectory samples; default: 10 samples per second.
         gravity: Vertical gravity (m/s^2).
         base_position: Where the car's base starts; None: resting on the ground at the
             origin (its lowest point just above the ground's top).
