@@ -85,10 +85,10 @@ def build(target: str, params: list[str] | None = None,
         base = None
     else:
         path = Path(target)
-        data = None if path.is_absolute() else pybullet_data_path()
+        pybullet_data = None if path.is_absolute() else pybullet_data_path()
         # A bare name is looked up in pybullet_data, as every command looks it up (locate).
         if path.suffix != ".xacro" and not path.exists() and not (
-                data is not None and (data / path).is_file()):
+                pybullet_data is not None and (pybullet_data / path).is_file()):
             from urdfkit.core.suggest import files, hint
 
             known = ", ".join(TEMPLATES)
