@@ -775,7 +775,9 @@ def _yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> 
     """
     c, train = sc.config, sc.drivetrain
     kind = "skid steering" if train.steering == "skid" else "differential steering"
-    said = f"{kind} turns at {rate:.3g} rad/s, {share:.0%} of the {sc.steer:g} commanded"
+    # round first: a share of -3e-5 is said "0%", not "-0%"
+    said = (f"{kind} turns at {rate:.3g} rad/s, {round(share, 2) + 0.0:.0%} of the "
+            f"{sc.steer:g} commanded")
     force = PYBULLET_DEFAULT_FORCE if c.max_force is None else c.max_force
     if not 0 < sim_time <= PROBE_LIMIT:
         return (f"{said}; not measured at more force (the run is over {PROBE_LIMIT:g} s): "
