@@ -49,6 +49,26 @@ def test_every_command_finds_a_bare_name(args: list[str], tmp_path: Path,
         assert (tmp_path / "out.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_build_expands_a_bare_name_found_in_pybullet_data(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # drive and joints say of pybullet_data's husky "holds xacro ...: expand it first: urdfkit
+    # build FILE" (U009); build once answered "neither a template nor a file" for that name.
+    import xml.etree.ElementTree as ET
+
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["build", "husky/husky.urdf"])
+    assert result.exit_code == 0, result.stderr
+    written = tmp_path / "husky.expanded.urdf"  # here, never beside pybullet_data's file
+    links = [el.get("name") for el in ET.parse(written).getroot().iter("link")]
+    assert links == [el.get("name") for el in
+                     ET.parse(_data() / "husky" / "husky.urdf").getroot().iter("link")]
+    imu = next(j for j in ET.parse(written).getroot().iter("joint")
+               if j.get("name") == "imu_joint").find("origin")
+    assert imu is not None  # $(optenv HUSKY_IMU_XYZ 0.19 0 0.149) expanded to its default
+    assert imu.get("xyz") == "0.19 0 0.149" and imu.get("rpy") == "0 -1.5708 3.1416"
+    assert not (_data() / "husky" / "husky.expanded.urdf").exists()
+
+
 def test_fix_in_place_refuses_to_rewrite_pybullet_data(tmp_path: Path,
                                                        monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)

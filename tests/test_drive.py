@@ -423,6 +423,21 @@ def test_trajectory_files_are_byte_identical_across_runs(runner: CliRunner,
     assert rows[-1]["base_to_left_hinge_angle"] == pytest.approx(0.3, abs=0.02)
 
 
+def test_help_states_the_sample_rate_a_trajectory_has(runner: CliRunner,
+                                                      tmp_path: Path) -> None:
+    # --sample-every's shown default once said 20 a second while runs wrote 10: the help
+    # must state what a default run writes, counted in its file.
+    out = tmp_path / "t.jsonl"
+    result = runner.invoke(app, ["drive", "--seconds", "2", "--trajectory", str(out)])
+    assert result.exit_code == 0, result.output
+    rows = [json.loads(line) for line in out.read_text().splitlines()]
+    written = (len(rows) - 1) / 2  # samples per simulated second; the first is t = 0
+    shown = runner.invoke(app, ["drive", "--help"], env={"COLUMNS": "300"}).output
+    stated = re.search(r"(\d+) samples per simulated second", " ".join(shown.split()))
+    assert stated is not None, shown
+    assert int(stated[1]) == written
+
+
 def test_plot_is_a_png(runner: CliRunner, tmp_path: Path) -> None:
     pytest.importorskip("matplotlib")
     out = tmp_path / "drive.png"

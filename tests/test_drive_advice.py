@@ -19,6 +19,7 @@ def test_advice_reaches_a_hundred_times_the_force_and_is_right() -> None:
     said = [w for w in weak.warnings if w.startswith("skid steering turns at")]
     assert len(said) == 1, weak.warnings
     assert weak.yaw_rate is not None and abs(weak.yaw_rate) < 0.01
+    assert " 0% of the 0.3 commanded" in said[0], said[0]  # its share rounds to 0, never "-0%"
     # The option as the command line spells it, at 100x the 10 N m default.
     assert said[0].endswith("run with --max-force 1000"), said[0]
     assert "max_force" not in said[0]

@@ -1,7 +1,8 @@
 """Every import the README and docs/ show works, and so does the public API the layout keeps.
 
 The names are read from the documents themselves, so a page that documents a new import is
-tested by adding it, and a move that breaks one fails here.
+tested by adding it, and a move that breaks one fails here. So are the options of every
+``urdfkit COMMAND ...`` line they show: a renamed or removed option fails here too.
 """
 
 from __future__ import annotations
@@ -57,3 +58,39 @@ def test_documented_import_works(doc: str, module: str, name: str | None) -> Non
 ])
 def test_public_api(module: str, name: str) -> None:
     assert callable(getattr(importlib.import_module(module), name))
+
+
+# `urdfkit CMD rest` on one line of a document (a `\` continuation joined first); the rest
+# stops at a comment, a pipe or the end of an inline code span.
+COMMAND = re.compile(r"urdfkit (\w+)([^`#\n|]*)")
+OPTION = re.compile(r"(?<![\w-])(--?[A-Za-z][\w-]*)")
+
+
+def _documented_options() -> list[tuple[str, str, str]]:
+    found: set[tuple[str, str, str]] = set()
+    for doc in DOCUMENTS:
+        if doc.name == "robots.md":  # a results log: its lines are what was run then
+            continue
+        text = re.sub(r"\\\n\s*", " ", doc.read_text("utf-8"))
+        for command, rest in COMMAND.findall(text):
+            for option in OPTION.findall(rest):
+                found.add((doc.name, command, option))
+    return sorted(found)
+
+
+def test_documented_options_exist() -> None:
+    import typer.main
+
+    from urdfkit.cli import COMMANDS, app
+
+    group = typer.main.get_command(app)
+    known = {name: {o for p in group.commands[name].params
+                    for o in (*p.opts, *p.secondary_opts)} | {"--help", "-h"}
+             for name in COMMANDS}
+    shown = [(doc, command, option) for doc, command, option in _documented_options()
+             if command in known]
+    # The reader finds them at all: the documents show well over a hundred.
+    assert len(shown) > 100, len(shown)
+    missing = [f"{doc}: urdfkit {command} {option}" for doc, command, option in shown
+               if option not in known[command]]
+    assert not missing, missing

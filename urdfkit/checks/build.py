@@ -26,6 +26,7 @@ from urdfkit.model.xmlio import parse_xml, read_bytes, to_bytes, xacro_marker
 from urdfkit.sources.expand import expand_xacro
 from urdfkit.sources.guard import GUARD_CODES, guard_findings, run_rules
 from urdfkit.sources.resolve import locate
+from urdfkit.sources.uris import pybullet_data_path
 
 
 @dataclass
@@ -84,7 +85,10 @@ def build(target: str, params: list[str] | None = None,
         base = None
     else:
         path = Path(target)
-        if path.suffix != ".xacro" and not path.exists():
+        pybullet_data = None if path.is_absolute() else pybullet_data_path()
+        # A bare name is looked up in pybullet_data, as every command looks it up (locate).
+        if path.suffix != ".xacro" and not path.exists() and not (
+                pybullet_data is not None and (pybullet_data / path).is_file()):
             from urdfkit.core.suggest import files, hint
 
             known = ", ".join(TEMPLATES)

@@ -72,7 +72,7 @@ def drive(
     trajectory: Annotated[str | None, typer.Option(
         metavar="FILE", help="Write samples to FILE.csv or FILE.jsonl.")] = None,
     sample_every: Annotated[int | None, typer.Option(
-        help="Steps between samples.", show_default="20 samples per simulated second")]
+        help="Steps between samples.", show_default="10 samples per simulated second")]
     = None,
     plot: Annotated[str | None, typer.Option(
         metavar="FILE.png", help="Draw the path and speed (needs urdfkit\\[plot]).")] = None,

@@ -119,7 +119,7 @@ class DriveConfig:
             else only the statistics are kept, and memory does not grow with the run.
         wheels: Joint names/indices to drive instead of the detected wheels.
         hinges: Joint names/indices to steer instead of the detected hinges.
-        sample_every: Steps between trajectory samples; default: 20 samples per second.
+        sample_every: Steps between trajectory samples; default: 10 samples per second.
         gravity: Vertical gravity (m/s^2).
         base_position: Where the car's base starts; None: resting on the ground at the
             origin (its lowest point just above the ground's top).
@@ -775,7 +775,9 @@ def _yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> 
     """
     c, train = sc.config, sc.drivetrain
     kind = "skid steering" if train.steering == "skid" else "differential steering"
-    said = f"{kind} turns at {rate:.3g} rad/s, {share:.0%} of the {sc.steer:g} commanded"
+    # round first: a share of -3e-5 is said "0%", not "-0%"
+    said = (f"{kind} turns at {rate:.3g} rad/s, {round(share, 2) + 0.0:.0%} of the "
+            f"{sc.steer:g} commanded")
     force = PYBULLET_DEFAULT_FORCE if c.max_force is None else c.max_force
     if not 0 < sim_time <= PROBE_LIMIT:
         return (f"{said}; not measured at more force (the run is over {PROBE_LIMIT:g} s): "
