@@ -124,3 +124,36 @@ def test_sim_view_readouts_show_the_first_robots_joints_as_the_run_leaves_them()
     for name, value in shown.items():
         lo, hi = float(viewer.sliders[name].min), float(viewer.sliders[name].max)
         assert value == pytest.approx(min(max(raw[name], lo), hi), abs=1e-6), name
+
+
+def test_a_run_that_waited_for_a_page_is_paced_from_its_start() -> None:
+    """The pace counts from the run's first step, not from when the page was set up.
+
+    The page is up before the wait for a browser; paced from then, a run that waited longer
+    than it lasts ran unpaced once a page came (measured: a 3 s scenario at real time over in
+    0.7 s after the page connected, having waited 6 s).
+    """
+    import time
+
+    doc = {"physics": {"time_step": 1 / 240}, "ground": "simpleplane", "duration": 1.0,
+           "robots": [{"name": "north", "template": "simplecar",
+                       "drive": [{"until": 1.0, "throttle": 10, "steer": 0}]}]}
+    with Simulation(doc) as s:
+        stream = _sim_view_of(s, pace=2.0)
+        try:
+            time.sleep(1.0)  # the wait for a page: longer than the run at 2x (0.5 s)
+            start = time.perf_counter()
+            s.run(sink=lambda _batch: stream.tick(s.t))
+            wall = time.perf_counter() - start
+        finally:
+            stream.viewer.close()
+    # 1 simulated second at twice real time takes half a second of wall time, at least.
+    assert wall >= 0.5, wall
+
+
+def _sim_view_of(s: Simulation, pace: float | None) -> RunStream:
+    """``sim --view``'s page for a simulation, not waiting for a browser."""
+    from urdfkit.commands.simulating import _sim_view
+
+    stream: RunStream = _sim_view(s, pace, None, wait=False)
+    return stream

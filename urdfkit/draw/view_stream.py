@@ -172,7 +172,9 @@ class RunStream:
 
     Each sample's poses are kept (:attr:`frames_kept`), so once the run is over the page can
     replay it: a time slider puts the robot where the run had it at that time. The camera
-    follows the robot, frames its whole path, or is left alone (a dropdown).
+    follows the robot, frames its whole path, or is left alone (a dropdown). The pacing
+    starts with the run's first sample, not with the stream: a run that waited for a page is
+    paced from when it starts.
     """
 
     def __init__(self, viewer: RunDisplay, poses: Any, speed: float | None,
@@ -201,7 +203,8 @@ class RunStream:
         self.summary = ""
         self._clock = time.perf_counter
         self._sleep = time.sleep
-        self._start = self._clock()
+        #: Wall and simulated time of the run's first sample (the pacing's origin).
+        self._start: tuple[float, float] | None = None
         self._last = -1.0
         self._stride = 1
         self._seen = 0
@@ -236,7 +239,10 @@ class RunStream:
     def tick(self, t: float) -> None:
         """The run is at simulated time ``t``: wait for the wall clock (paced), maybe push."""
         if self.speed is not None:
-            ahead = self._start + t / self.speed - self._clock()
+            now = self._clock()
+            if self._start is None:  # the run starts here (after any wait for a page)
+                self._start = (now, t)
+            ahead = self._start[0] + (t - self._start[1]) / self.speed - now
             if ahead > 0:
                 self._sleep(ahead)
         if not self._seen:  # a scenario run (no drive samples): keep what each tick shows
