@@ -4,8 +4,10 @@ the same scenario run without a page ends."""
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -157,3 +159,98 @@ def _sim_view_of(s: Simulation, pace: float | None) -> RunStream:
 
     stream: RunStream = _sim_view(s, pace, None, wait=False)
     return stream
+
+
+# --------------------------------------------------------------------------- in a browser
+
+def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
+        chromium: Any) -> None:
+    """two_cars on the page in headless Chromium (tests/conftest.py's ``chromium``).
+
+    The run waits for the page; the page's Camera dropdown picks the driving car; the camera
+    the browser reports (viser's camera messages come from the page, never from the server)
+    looks at that car where the run's own rows have it: at the end, and replayed to the start,
+    the middle and the end again; the replay's status line gives the same place.
+    """
+    import re
+    import socket
+    import threading
+    import time
+
+    with socket.socket() as sock:  # a free port, so the page's URL is known here
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    with Simulation.from_file(str(TWO_CARS)) as s:
+        started: list[RunStream] = []
+        # sim --view's own page, waiting for a browser as the command does.
+        from urdfkit.commands.simulating import _sim_view
+
+        waiter = threading.Thread(target=lambda: started.append(
+            _sim_view(s, 2.0, port, wait=True)), daemon=True)
+        waiter.start()
+        time.sleep(2.0)
+        assert waiter.is_alive() and s.step_count == 0  # unwatched: nothing has run
+        page = chromium.new_page(viewport={"width": 1000, "height": 700})
+        try:
+            page.goto(f"http://127.0.0.1:{port}")
+            waiter.join(60)
+            assert not waiter.is_alive() and started, "the page's connection did not start it"
+            stream = started[0]
+            viewer = stream.viewer
+            (client,) = viewer.server.get_clients().values()
+            seen: list[Any] = []  # look_at as the browser reports it
+            client.camera.on_update(lambda cam: seen.append(tuple(cam.look_at)))
+
+            def camera_at(where: Any) -> bool:
+                return _wait_for(lambda: bool(seen) and seen[-1] == pytest.approx(
+                    where, abs=1e-3), 30)
+
+            # The default follows the first robot (parked); the user picks the other.
+            page.locator("input[role=combobox][value='follow parked']").click()
+            page.get_by_role("option", name="follow north").click()
+            assert _wait_for(lambda: stream.camera.value == "follow north", 20)
+            start = time.perf_counter()
+            result = s.run(sink=lambda _batch: stream.tick(s.t))
+            wall = time.perf_counter() - start
+            stream.finish("**Done**")
+            north = [r for r in result.to_dicts() if r["robot"] == "north"]
+            parked_end = [r for r in result.to_dicts() if r["robot"] == "parked"][-1]
+            end = north[-1]["base_position"]
+            assert wall >= 1.5  # 3 simulated s at 2x, paced from the start, not the wait
+            assert abs(end[1] - north[0]["base_position"][1]) > 2.0  # north drove off
+            # The browser's camera ended on north's last row, 6 m from the parked car.
+            assert camera_at(end), (seen[-3:], end)
+            assert math.dist(seen[-1], parked_end["base_position"]) > 5.0
+
+            page.get_by_text("Time (s)").first.wait_for(timeout=30000)  # the replay slider
+            slider = page.locator("[role=slider]").first
+            slider.focus()
+            page.keyboard.press("Home")
+            assert camera_at(north[0]["base_position"]), (seen[-3:], north[0])
+            for _ in range(50):  # 100 steps over the run: 50 to the middle
+                page.keyboard.press("ArrowRight")
+            status = page.get_by_text(re.compile(r"t = 1\.50 s")).first
+            status.wait_for(timeout=30000)
+            mid = next(r for r in north if abs(r["t"] - 1.5) < 1e-6)["base_position"]
+            shown = re.search(r"north's base at x (\S+), y (\S+), z (\S+) m",
+                              status.inner_text())
+            assert shown is not None, status.inner_text()
+            assert [float(v) for v in shown.groups()] == pytest.approx(mid, abs=2e-3)
+            assert camera_at(mid), (seen[-3:], mid)
+            page.keyboard.press("End")  # the replay ends where the run ended
+            page.get_by_text(re.compile(r"t = 3\.00 s")).first.wait_for(timeout=30000)
+            assert camera_at(end), (seen[-3:], end)
+            assert viewer.robot_pose(1)[0] == pytest.approx(end, abs=1e-6)
+        finally:
+            page.close()
+            if started:
+                started[0].viewer.close()
+
+
+def _wait_for(cond: Any, seconds: float) -> bool:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.1)
+    return bool(cond())

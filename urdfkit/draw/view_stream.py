@@ -169,19 +169,24 @@ class RunStream:
         robots: ``poses`` gives one list per robot.
         joints: Returns the first robot's joint positions by name (the page's readouts), or
             None.
+        names: The robots' names, in the viewer's order (``sim --view``): with more than one,
+            the camera can follow any of them.
 
     Each sample's poses are kept (:attr:`frames_kept`), so once the run is over the page can
     replay it: a time slider puts the robot where the run had it at that time. The camera
-    follows the robot, frames its whole path, or is left alone (a dropdown). The pacing
-    starts with the run's first sample, not with the stream: a run that waited for a page is
-    paced from when it starts.
+    follows the robot (with several, the one chosen), frames every path, or is left alone
+    (a dropdown). The pacing starts with the run's first sample, not with the stream: a run
+    that waited for a page is paced from when it starts.
     """
 
     def __init__(self, viewer: RunDisplay, poses: Any, speed: float | None,
-                 total: float, robots: bool = False, joints: Any = None) -> None:
+                 total: float, robots: bool = False, joints: Any = None,
+                 names: Sequence[str] | None = None) -> None:
         import time
 
         self.viewer, self.speed, self.total = viewer, speed, total
+        #: The robots the camera can follow by name (empty: one robot, "follow the robot").
+        self.names = list(names) if names is not None and len(names) > 1 else []
         self.poses = poses if robots else (lambda: [poses()])
         self.joints = joints
         #: (t, every robot's link poses, joint positions) per sample, for the replay.
@@ -191,9 +196,10 @@ class RunStream:
         self.replay: Any = None
         self._aimed_at: tuple[float, float, float] | None = None
         gui = viewer.server.gui
+        follow = tuple(f"follow {n}" for n in self.names) or (FOLLOW,)
         with gui.add_folder("Run", order=0.5):
             self.camera = gui.add_dropdown(
-                "Camera", (FOLLOW, WHOLE_PATH, FREE), initial_value=FOLLOW,
+                "Camera", (*follow, WHOLE_PATH, FREE), initial_value=follow[0],
                 hint="Follow the robot, keep its whole path in view, or leave the camera be")
         self.camera.on_update(lambda _event: self._aim_all(force=True))
         self.path: list[tuple[float, float, float]] = []
@@ -284,12 +290,18 @@ class RunStream:
             self.viewer.status.content = status
         self._aim_all()
 
-    def _robot_box(self, poses: Sequence[Any]) -> tuple[Any, Any]:
-        """A box around the robot's link frames, padded by the robot's size on the page."""
+    def followed(self) -> int:
+        """The robot the camera follows or frames (its number; 0 unless another is chosen)."""
+        mode = self.camera.value
+        return next((k for k, n in enumerate(self.names) if mode == f"follow {n}"), 0)
+
+    def _robot_box(self, poses: Sequence[Any], robot: int = 0) -> tuple[Any, Any]:
+        """A box around a robot's link frames, padded by the robot's size on the page."""
         import numpy as np
 
         pts = np.asarray([p[0] for p in poses], dtype=float)
-        lo, hi = self.viewer.model.bounds()
+        model = self.viewer.model if robot == 0 else self.viewer.extra[robot - 1][0]
+        lo, hi = model.bounds()
         pad = max(max(b - a for a, b in zip(lo, hi, strict=True)), 0.1) / 2
         return pts.min(axis=0) - pad, pts.max(axis=0) + pad
 
@@ -301,9 +313,10 @@ class RunStream:
         if mode == FREE:
             self._aimed_at = None
             return
-        base = tuple(float(x) for x in self.viewer.robot_pose(0)[0])
+        k = self.followed()
+        base = tuple(float(x) for x in self.viewer.robot_pose(k)[0])
         clients = list(self.viewer.server.get_clients().values())
-        if mode == FOLLOW and self._aimed_at is not None and not force:
+        if mode != WHOLE_PATH and self._aimed_at is not None and not force:
             if base == self._aimed_at:
                 return
             for client in clients:  # keep the user's own orbit, around the robot's base
@@ -317,7 +330,7 @@ class RunStream:
                     continue
         else:
             frames = self._frames_now()
-            lo, hi = self._robot_box(frames[0])
+            lo, hi = self._robot_box(frames[k], k)
             if mode == WHOLE_PATH:
                 for path in (self.path, *self.paths):
                     if path:
@@ -368,8 +381,10 @@ class RunStream:
             self.viewer.show_poses(poses, robot=r)
         if joints:
             self.viewer.show_joint_values(joints)
-        x, y, z = self.viewer.robot_pose(0)[0]
-        self.viewer.status.content = (f"**Replay**: t = {at:.2f} s of {times[-1]:.2f}; base at "
-                                      f"x {x:.3f}, y {y:.3f}, z {z:.3f} m\n\n{self.summary}")
+        k = self.followed()
+        x, y, z = self.viewer.robot_pose(k)[0]
+        whose = f"{self.names[k]}'s base" if self.names else "base"
+        self.viewer.status.content = (f"**Replay**: t = {at:.2f} s of {times[-1]:.2f}; {whose} "
+                                      f"at x {x:.3f}, y {y:.3f}, z {z:.3f} m\n\n{self.summary}")
         self._aim_all()
         return at, every
