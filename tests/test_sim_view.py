@@ -241,6 +241,19 @@ def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
             page.get_by_text(re.compile(r"t = 3\.00 s")).first.wait_for(timeout=30000)
             assert camera_at(end), (seen[-3:], end)
             assert viewer.robot_pose(1)[0] == pytest.approx(end, abs=1e-6)
+            # A page opened after the run (here, reloaded) frames north where the run left
+            # it, not the origin where the file puts the first car.
+            late: list[Any] = []  # look_at as the new page reports it
+
+            def watch(new: Any) -> None:  # (viser also calls this for the pages already in)
+                if new.client_id != client.client_id:
+                    new.camera.on_update(lambda cam: late.append(tuple(cam.look_at)))
+
+            viewer.server.on_client_connect(watch)
+            page.reload()
+            # simplecar is 0.4 m long: the camera looks at the car, not beside it.
+            assert _wait_for(lambda: bool(late) and math.dist(late[-1], end) < 0.3, 30), \
+                (late[-3:], end)
         finally:
             page.close()
             if started:

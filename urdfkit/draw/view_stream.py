@@ -64,6 +64,8 @@ class RunDisplay:
     external_poses: bool
     #: More robots on the page (sim --view): each model and its link frames.
     extra: list[tuple[ViewedRobot, list[Any]]]
+    #: Aims a page that connects (``aim_page(client)``); None: at the model's bounds.
+    aim_page: Any
     _lock: threading.RLock
     _nodes: dict[Layer, list[Any]]
     _frames: list[Any]
@@ -202,6 +204,9 @@ class RunStream:
                 "Camera", (*follow, WHOLE_PATH, FREE), initial_value=follow[0],
                 hint="Follow the robot, keep its whole path in view, or leave the camera be")
         self.camera.on_update(lambda _event: self._aim_all(force=True))
+        # A page opened (or reloaded) during or after the run looks at the robot where the
+        # run has it, not where the file puts it.
+        viewer.aim_page = self._aim_page
         self.path: list[tuple[float, float, float]] = []
         #: Each robot's base path, sampled as frames are pushed (:meth:`tick`).
         self.paths: list[list[tuple[float, float, float]]] = []
@@ -329,19 +334,30 @@ class RunStream:
                 except AssertionError:  # a page that has not reported its camera yet
                     continue
         else:
-            frames = self._frames_now()
-            lo, hi = self._robot_box(frames[k], k)
-            if mode == WHOLE_PATH:
-                for path in (self.path, *self.paths):
-                    if path:
-                        pts = np.asarray(path, dtype=float)
-                        lo, hi = np.minimum(lo, pts.min(axis=0)), np.maximum(hi, pts.max(axis=0))
+            box = self._box()
             for client in clients:
                 try:
-                    self.viewer.aim(client, (lo, hi), self.viewer.aspect(client))
+                    self.viewer.aim(client, box, self.viewer.aspect(client))
                 except AssertionError:
                     continue
         self._aimed_at = base  # type: ignore[assignment]
+
+    def _box(self) -> tuple[Any, Any]:
+        """What the camera frames now: the followed robot, or with it every path."""
+        import numpy as np
+
+        k = self.followed()
+        lo, hi = self._robot_box(self._frames_now()[k], k)
+        if self.camera.value == WHOLE_PATH:
+            for path in (self.path, *self.paths):
+                if path:
+                    pts = np.asarray(path, dtype=float)
+                    lo, hi = np.minimum(lo, pts.min(axis=0)), np.maximum(hi, pts.max(axis=0))
+        return lo, hi
+
+    def _aim_page(self, client: Any) -> None:
+        """A page that has just connected: framed as the Camera says (free: the robot)."""
+        self.viewer.aim(client, self._box(), self.viewer.aspect(client))
 
     def _frames_now(self) -> list[Any]:
         """Every robot's link poses as the page shows them now."""
