@@ -170,7 +170,9 @@ def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
     The run waits for the page; the page's Camera dropdown picks the driving car; the camera
     the browser reports (viser's camera messages come from the page, never from the server)
     looks at that car where the run's own rows have it: at the end, and replayed to the start,
-    the middle and the end again; the replay's status line gives the same place.
+    the middle and the end again; the replay's status line gives the same place. Following
+    the other car moves the camera and the status line to it, and a page reloaded after the
+    run opens on it.
     """
     import re
     import socket
@@ -241,8 +243,20 @@ def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
             page.get_by_text(re.compile(r"t = 3\.00 s")).first.wait_for(timeout=30000)
             assert camera_at(end), (seen[-3:], end)
             assert viewer.robot_pose(1)[0] == pytest.approx(end, abs=1e-6)
-            # A page opened after the run (here, reloaded) frames north where the run left
-            # it, not the origin where the file puts the first car.
+            # Following the other car now: the status line and the camera go to it.
+            page.locator("input[role=combobox][value='follow north']").click()
+            page.get_by_role("option", name="follow parked").click()
+            status = page.get_by_text(re.compile(r"parked's base at")).first
+            status.wait_for(timeout=30000)
+            shown = re.search(r"t = 3\.00 s .* base at x (\S+), y (\S+), z (\S+) m",
+                              status.inner_text())
+            assert shown is not None, status.inner_text()
+            parked = parked_end["base_position"]
+            assert [float(v) for v in shown.groups()] == pytest.approx(parked, abs=2e-3)
+            # simplecar is 0.4 m long: the camera looks at the car (its box's middle).
+            assert _wait_for(lambda: math.dist(seen[-1], parked) < 0.3, 30), (seen[-3:], parked)
+            # A page opened after the run (here, reloaded) frames the followed car where the
+            # run left it, not the origin (2 m away) where the file puts a car.
             late: list[Any] = []  # look_at as the new page reports it
 
             def watch(new: Any) -> None:  # (viser also calls this for the pages already in)
@@ -251,9 +265,8 @@ def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
 
             viewer.server.on_client_connect(watch)
             page.reload()
-            # simplecar is 0.4 m long: the camera looks at the car, not beside it.
-            assert _wait_for(lambda: bool(late) and math.dist(late[-1], end) < 0.3, 30), \
-                (late[-3:], end)
+            assert _wait_for(lambda: bool(late) and math.dist(late[-1], parked) < 0.3, 30), \
+                (late[-3:], parked)
         finally:
             page.close()
             if started:

@@ -203,7 +203,9 @@ class RunStream:
             self.camera = gui.add_dropdown(
                 "Camera", (*follow, WHOLE_PATH, FREE), initial_value=follow[0],
                 hint="Follow the robot, keep its whole path in view, or leave the camera be")
-        self.camera.on_update(lambda _event: self._aim_all(force=True))
+        self.camera.on_update(lambda _event: self._camera_changed())
+        #: The simulated time the replay shows (None: the run's own end, no replay yet).
+        self._shown: float | None = None
         # A page opened (or reloaded) during or after the run looks at the robot where the
         # run has it, not where the file puts it.
         viewer.aim_page = self._aim_page
@@ -342,6 +344,12 @@ class RunStream:
                     continue
         self._aimed_at = base  # type: ignore[assignment]
 
+    def _camera_changed(self) -> None:
+        """The Camera dropdown changed: aim now; in a replay, the status names the robot."""
+        self._aim_all(force=True)
+        if self._shown is not None:
+            self.show_time(self._shown)
+
     def _box(self) -> tuple[Any, Any]:
         """What the camera frames now: the followed robot, or with it every path."""
         import numpy as np
@@ -393,6 +401,7 @@ class RunStream:
         if k == len(times) or (k > 0 and t - times[k - 1] <= times[k] - t):
             k -= 1
         at, every, joints = self.frames_kept[k]
+        self._shown = at
         for r, poses in enumerate(every):
             self.viewer.show_poses(poses, robot=r)
         if joints:
