@@ -75,7 +75,7 @@ def test_cli_sim_view_refuses_gui_and_real_time() -> None:
 
 def test_cli_sim_view_waits_for_a_page_before_the_run(tmp_path: Path) -> None:
     # Unwatched, the run does not start: the rows file is not written while it waits (an
-    # unpaced 3 s scenario takes well under the 5 s waited here), and it says why on stderr.
+    # unpaced 3 s scenario takes well under the 3 s waited here), and it says why on stderr.
     import signal
     import time
 
@@ -90,7 +90,7 @@ def test_cli_sim_view_waits_for_a_page_before_the_run(tmp_path: Path) -> None:
                 and proc.poll() is None:
             err += proc.stderr.readline()  # type: ignore[union-attr]
         assert "waiting for a page to connect" in err and "--no-wait" in err, err
-        time.sleep(5)
+        time.sleep(3)
         assert proc.poll() is None and not out.exists()
         proc.send_signal(signal.SIGINT)
         proc.communicate(timeout=30)
@@ -190,7 +190,7 @@ def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
         waiter = threading.Thread(target=lambda: started.append(
             _sim_view(s, 2.0, port, wait=True)), daemon=True)
         waiter.start()
-        time.sleep(2.0)
+        time.sleep(1.0)
         assert waiter.is_alive() and s.step_count == 0  # unwatched: nothing has run
         page = chromium.new_page(viewport={"width": 1000, "height": 700})
         try:
