@@ -201,7 +201,9 @@ def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
             viewer = stream.viewer
             (client,) = viewer.server.get_clients().values()
             seen: list[Any] = []  # look_at as the browser reports it
-            client.camera.on_update(lambda cam: seen.append(tuple(cam.look_at)))
+            views: list[Any] = []  # and the whole camera
+            client.camera.on_update(lambda cam: (seen.append(tuple(cam.look_at)), views.append(
+                (cam.position, cam.look_at, cam.up_direction, cam.fov, cam.aspect))))
 
             def camera_at(where: Any) -> bool:
                 return _wait_for(lambda: bool(seen) and seen[-1] == pytest.approx(
@@ -255,8 +257,24 @@ def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
             assert [float(v) for v in shown.groups()] == pytest.approx(parked, abs=2e-3)
             # simplecar is 0.4 m long: the camera looks at the car (its box's middle).
             assert _wait_for(lambda: math.dist(seen[-1], parked) < 0.3, 30), (seen[-3:], parked)
-            # A page opened after the run (here, reloaded) frames the followed car where the
-            # run left it, not the origin (2 m away) where the file puts a car.
+            # Framing every path: each row of both cars is inside the browser's camera view.
+            page.locator("input[role=combobox][value='follow parked']").click()
+            page.get_by_role("option", name="frame the whole path").click()
+            points = [r["base_position"] for r in result.to_dicts()]
+            assert _wait_for(lambda: _all_in_view(views[-1], points), 30), views[-1]
+            assert not _all_in_view(views[0], points)  # (the first view did not hold them)
+            # Free: the replay no longer moves the camera.
+            page.locator("input[role=combobox][value='frame the whole path']").click()
+            page.get_by_role("option", name="free").click()
+            assert _wait_for(lambda: stream.camera.value == "free", 20)
+            before = tuple(client.camera.look_at)
+            page.locator("[role=slider]").first.focus()
+            page.keyboard.press("Home")
+            page.get_by_text(re.compile(r"t = 0\.00 s")).first.wait_for(timeout=30000)
+            time.sleep(0.5)  # (show_time aims after it writes the status)
+            assert tuple(client.camera.look_at) == before
+            # A page opened after the run (here, reloaded) frames the first car where the run
+            # left it (free: the first), not the origin (2 m away) where the file puts a car.
             late: list[Any] = []  # look_at as the new page reports it
 
             def watch(new: Any) -> None:  # (viser also calls this for the pages already in)
@@ -271,6 +289,29 @@ def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
             page.close()
             if started:
                 started[0].viewer.close()
+
+
+def _all_in_view(view: Any, points: list[Any]) -> bool:
+    """Whether every point projects inside a pinhole camera's frame.
+
+    ``view``: (position, look_at, up, vertical field of view in radians, width / height), as
+    the page reported its camera.
+    """
+    import numpy as np
+
+    eye, target, up, fov, aspect = (np.asarray(v, dtype=float) for v in view)
+    forward = (target - eye) / np.linalg.norm(target - eye)
+    right = np.cross(forward, up)
+    right /= np.linalg.norm(right)
+    true_up = np.cross(right, forward)
+    half = math.tan(float(fov) / 2)
+    for point in points:
+        d = np.asarray(point, dtype=float) - eye
+        depth = float(d @ forward)
+        if depth <= 0 or abs(d @ true_up) > half * depth or \
+                abs(d @ right) > half * float(aspect) * depth:
+            return False
+    return True
 
 
 def _wait_for(cond: Any, seconds: float) -> bool:
