@@ -140,3 +140,32 @@ def served_run() -> Any:
         return proc.returncode, out, err + rest
 
     return run
+
+
+# --------------------------------------------------------------------------- a browser
+
+#: Debian's Chromium (Playwright's own download is not reachable); URDFKIT_CHROMIUM overrides.
+CHROMIUM = "/usr/bin/chromium"
+#: Software WebGL: the machines the suite runs on have no GPU.
+CHROMIUM_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+
+
+@pytest.fixture
+def chromium() -> Any:
+    """Debian's Chromium under Playwright (software WebGL); closed after the test.
+
+    A skip where there is none; CI installs it (.ci/run), and URDFKIT_CI=1 fails the skip.
+    """
+    import shutil
+
+    path = os.environ.get("URDFKIT_CHROMIUM") or shutil.which("chromium") or CHROMIUM
+    if not os.path.exists(path):
+        pytest.skip(f"no Chromium at {path}: apt-get install -y chromium (CI does)")
+    sync_api = pytest.importorskip("playwright.sync_api",
+                                   reason="pip install playwright (in urdfkit[test])")
+    with sync_api.sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=path, args=CHROMIUM_ARGS)
+        try:
+            yield b
+        finally:
+            b.close()

@@ -97,27 +97,7 @@ def test_cli_refuses_bad_view_options(args: list[str], says: str) -> None:
 
 # --------------------------------------------------------------------------- in a browser
 
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
-
-
-@pytest.fixture
-def chromium() -> Any:
-    """Debian's Chromium under Playwright (software WebGL); closed after the test."""
-    import os
-    import shutil
-
-    path = os.environ.get("URDFKIT_CHROMIUM") or shutil.which("chromium") or CHROMIUM
-    if not os.path.exists(path):
-        pytest.skip(f"no Chromium at {path}: apt-get install -y chromium (CI does)")
-    sync_api = pytest.importorskip("playwright.sync_api",
-                                   reason="pip install playwright (in urdfkit[test])")
-    with sync_api.sync_playwright() as pw:
-        b = pw.chromium.launch(executable_path=path, args=CHROMIUM_ARGS)
-        try:
-            yield b
-        finally:
-            b.close()
+# The ``chromium`` fixture (Debian's Chromium under Playwright) is tests/conftest.py's.
 
 
 def _lines_until(proc: Any, text: str, seconds: float, seen: list[str]) -> bool:

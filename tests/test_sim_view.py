@@ -4,8 +4,10 @@ the same scenario run without a page ends."""
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -73,7 +75,7 @@ def test_cli_sim_view_refuses_gui_and_real_time() -> None:
 
 def test_cli_sim_view_waits_for_a_page_before_the_run(tmp_path: Path) -> None:
     # Unwatched, the run does not start: the rows file is not written while it waits (an
-    # unpaced 3 s scenario takes well under the 5 s waited here), and it says why on stderr.
+    # unpaced 3 s scenario takes well under the 3 s waited here), and it says why on stderr.
     import signal
     import time
 
@@ -88,7 +90,7 @@ def test_cli_sim_view_waits_for_a_page_before_the_run(tmp_path: Path) -> None:
                 and proc.poll() is None:
             err += proc.stderr.readline()  # type: ignore[union-attr]
         assert "waiting for a page to connect" in err and "--no-wait" in err, err
-        time.sleep(5)
+        time.sleep(3)
         assert proc.poll() is None and not out.exists()
         proc.send_signal(signal.SIGINT)
         proc.communicate(timeout=30)
@@ -124,3 +126,198 @@ def test_sim_view_readouts_show_the_first_robots_joints_as_the_run_leaves_them()
     for name, value in shown.items():
         lo, hi = float(viewer.sliders[name].min), float(viewer.sliders[name].max)
         assert value == pytest.approx(min(max(raw[name], lo), hi), abs=1e-6), name
+
+
+def test_a_run_that_waited_for_a_page_is_paced_from_its_start() -> None:
+    """The pace counts from the run's first step, not from when the page was set up.
+
+    The page is up before the wait for a browser; paced from then, a run that waited longer
+    than it lasts ran unpaced once a page came (measured: a 3 s scenario at real time over in
+    0.7 s after the page connected, having waited 6 s).
+    """
+    import time
+
+    doc = {"physics": {"time_step": 1 / 240}, "ground": "simpleplane", "duration": 1.0,
+           "robots": [{"name": "north", "template": "simplecar",
+                       "drive": [{"until": 1.0, "throttle": 10, "steer": 0}]}]}
+    with Simulation(doc) as s:
+        stream = _sim_view_of(s, pace=2.0)
+        try:
+            time.sleep(1.0)  # the wait for a page: longer than the run at 2x (0.5 s)
+            start = time.perf_counter()
+            s.run(sink=lambda _batch: stream.tick(s.t))
+            wall = time.perf_counter() - start
+        finally:
+            stream.viewer.close()
+    # 1 simulated second at twice real time takes half a second of wall time, at least.
+    assert wall >= 0.5, wall
+
+
+def _sim_view_of(s: Simulation, pace: float | None) -> RunStream:
+    """``sim --view``'s page for a simulation, not waiting for a browser."""
+    from urdfkit.commands.simulating import _sim_view
+
+    stream: RunStream = _sim_view(s, pace, None, wait=False)
+    return stream
+
+
+# --------------------------------------------------------------------------- in a browser
+
+def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
+        chromium: Any) -> None:
+    """two_cars on the page in headless Chromium (tests/conftest.py's ``chromium``).
+
+    The run waits for the page; the page's Camera dropdown picks the driving car; the camera
+    the browser reports (viser's camera messages come from the page, never from the server)
+    looks at that car where the run's own rows have it: at the end, and replayed to the start,
+    the middle and the end again; the replay's status line gives the same place. Following
+    the other car moves the camera and the status line to it, and a page reloaded after the
+    run opens on it.
+    """
+    import re
+    import socket
+    import threading
+    import time
+
+    with socket.socket() as sock:  # a free port, so the page's URL is known here
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    with Simulation.from_file(str(TWO_CARS)) as s:
+        started: list[RunStream] = []
+        # sim --view's own page, waiting for a browser as the command does.
+        from urdfkit.commands.simulating import _sim_view
+
+        waiter = threading.Thread(target=lambda: started.append(
+            _sim_view(s, 2.0, port, wait=True)), daemon=True)
+        waiter.start()
+        time.sleep(1.0)
+        assert waiter.is_alive() and s.step_count == 0  # unwatched: nothing has run
+        page = chromium.new_page(viewport={"width": 1000, "height": 700})
+        try:
+            page.goto(f"http://127.0.0.1:{port}")
+            waiter.join(60)
+            assert not waiter.is_alive() and started, "the page's connection did not start it"
+            stream = started[0]
+            viewer = stream.viewer
+            (client,) = viewer.server.get_clients().values()
+            seen: list[Any] = []  # look_at as the browser reports it
+            views: list[Any] = []  # and the whole camera
+            client.camera.on_update(lambda cam: (seen.append(tuple(cam.look_at)), views.append(
+                (cam.position, cam.look_at, cam.up_direction, cam.fov, cam.aspect))))
+
+            def camera_at(where: Any) -> bool:
+                return _wait_for(lambda: bool(seen) and seen[-1] == pytest.approx(
+                    where, abs=1e-3), 30)
+
+            # The default follows the first robot (parked); the user picks the other.
+            page.locator("input[role=combobox][value='follow parked']").click()
+            page.get_by_role("option", name="follow north").click()
+            assert _wait_for(lambda: stream.camera.value == "follow north", 20)
+            start = time.perf_counter()
+            result = s.run(sink=lambda _batch: stream.tick(s.t))
+            wall = time.perf_counter() - start
+            stream.finish("**Done**")
+            north = [r for r in result.to_dicts() if r["robot"] == "north"]
+            parked_end = [r for r in result.to_dicts() if r["robot"] == "parked"][-1]
+            end = north[-1]["base_position"]
+            assert wall >= 1.5  # 3 simulated s at 2x, paced from the start, not the wait
+            assert abs(end[1] - north[0]["base_position"][1]) > 2.0  # north drove off
+            # The browser's camera ended on north's last row, 6 m from the parked car.
+            assert camera_at(end), (seen[-3:], end)
+            assert math.dist(seen[-1], parked_end["base_position"]) > 5.0
+
+            page.get_by_text("Time (s)").first.wait_for(timeout=30000)  # the replay slider
+            slider = page.locator("[role=slider]").first
+            slider.focus()
+            page.keyboard.press("Home")
+            assert camera_at(north[0]["base_position"]), (seen[-3:], north[0])
+            for _ in range(50):  # 100 steps over the run: 50 to the middle
+                page.keyboard.press("ArrowRight")
+            status = page.get_by_text(re.compile(r"t = 1\.50 s")).first
+            status.wait_for(timeout=30000)
+            mid = next(r for r in north if abs(r["t"] - 1.5) < 1e-6)["base_position"]
+            shown = re.search(r"north's base at x (\S+), y (\S+), z (\S+) m",
+                              status.inner_text())
+            assert shown is not None, status.inner_text()
+            assert [float(v) for v in shown.groups()] == pytest.approx(mid, abs=2e-3)
+            assert camera_at(mid), (seen[-3:], mid)
+            page.keyboard.press("End")  # the replay ends where the run ended
+            page.get_by_text(re.compile(r"t = 3\.00 s")).first.wait_for(timeout=30000)
+            assert camera_at(end), (seen[-3:], end)
+            assert viewer.robot_pose(1)[0] == pytest.approx(end, abs=1e-6)
+            # Following the other car now: the status line and the camera go to it.
+            page.locator("input[role=combobox][value='follow north']").click()
+            page.get_by_role("option", name="follow parked").click()
+            status = page.get_by_text(re.compile(r"parked's base at")).first
+            status.wait_for(timeout=30000)
+            shown = re.search(r"t = 3\.00 s .* base at x (\S+), y (\S+), z (\S+) m",
+                              status.inner_text())
+            assert shown is not None, status.inner_text()
+            parked = parked_end["base_position"]
+            assert [float(v) for v in shown.groups()] == pytest.approx(parked, abs=2e-3)
+            # simplecar is 0.4 m long: the camera looks at the car (its box's middle).
+            assert _wait_for(lambda: math.dist(seen[-1], parked) < 0.3, 30), (seen[-3:], parked)
+            # Framing every path: each row of both cars is inside the browser's camera view.
+            page.locator("input[role=combobox][value='follow parked']").click()
+            page.get_by_role("option", name="frame the whole path").click()
+            points = [r["base_position"] for r in result.to_dicts()]
+            assert _wait_for(lambda: _all_in_view(views[-1], points), 30), views[-1]
+            assert not _all_in_view(views[0], points)  # (the first view did not hold them)
+            # Free: the replay no longer moves the camera.
+            page.locator("input[role=combobox][value='frame the whole path']").click()
+            page.get_by_role("option", name="free").click()
+            assert _wait_for(lambda: stream.camera.value == "free", 20)
+            before = tuple(client.camera.look_at)
+            page.locator("[role=slider]").first.focus()
+            page.keyboard.press("Home")
+            page.get_by_text(re.compile(r"t = 0\.00 s")).first.wait_for(timeout=30000)
+            time.sleep(0.5)  # (show_time aims after it writes the status)
+            assert tuple(client.camera.look_at) == before
+            # A page opened after the run (here, reloaded) frames the first car where the run
+            # left it (free: the first), not the origin (2 m away) where the file puts a car.
+            late: list[Any] = []  # look_at as the new page reports it
+
+            def watch(new: Any) -> None:  # (viser also calls this for the pages already in)
+                if new.client_id != client.client_id:
+                    new.camera.on_update(lambda cam: late.append(tuple(cam.look_at)))
+
+            viewer.server.on_client_connect(watch)
+            page.reload()
+            assert _wait_for(lambda: bool(late) and math.dist(late[-1], parked) < 0.3, 30), \
+                (late[-3:], parked)
+        finally:
+            page.close()
+            if started:
+                started[0].viewer.close()
+
+
+def _all_in_view(view: Any, points: list[Any]) -> bool:
+    """Whether every point projects inside a pinhole camera's frame.
+
+    ``view``: (position, look_at, up, vertical field of view in radians, width / height), as
+    the page reported its camera.
+    """
+    import numpy as np
+
+    eye, target, up, fov, aspect = (np.asarray(v, dtype=float) for v in view)
+    forward = (target - eye) / np.linalg.norm(target - eye)
+    right = np.cross(forward, up)
+    right /= np.linalg.norm(right)
+    true_up = np.cross(right, forward)
+    half = math.tan(float(fov) / 2)
+    for point in points:
+        d = np.asarray(point, dtype=float) - eye
+        depth = float(d @ forward)
+        if depth <= 0 or abs(d @ true_up) > half * depth or \
+                abs(d @ right) > half * float(aspect) * depth:
+            return False
+    return True
+
+
+def _wait_for(cond: Any, seconds: float) -> bool:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.1)
+    return bool(cond())

@@ -193,7 +193,7 @@ def _sim_view(s: Any, pace: float | None, port: int | None, wait: bool = True) -
         # The joint readouts show the first robot's run, as the page's sliders stand for it.
         joints = joint_reader(s.bullet, bodies[0].body, viewer.model.joints)
         stream = RunStream(viewer, s.link_poses, pace, s.total_steps * s.time_step,
-                           robots=True, joints=joints)
+                           robots=True, joints=joints, names=[b.name for b in bodies])
         stream.push()
         say_streaming("sim", viewer, pace)
         wait_for_page("sim", viewer, wait)

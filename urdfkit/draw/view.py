@@ -117,6 +117,9 @@ class Viewer(RunDisplay):
         self.external_poses = False
         #: More robots on the page (sim --view): each model and its link frames.
         self.extra: list[tuple[ViewedRobot, list[Any]]] = []
+        #: Aims a page that connects (a run sets it: at the robot where the run has it);
+        #: None: at the model's bounds.
+        self.aim_page: Any = None
         self._gui: list[Any] = []
         self.sliders: dict[str, Any] = {}
         viser = _viser()
@@ -324,7 +327,10 @@ class Viewer(RunDisplay):
             while not client.camera.update_timestamp and time.monotonic() < end:
                 time.sleep(0.02)
             if client.camera.update_timestamp:
-                self.aim(client, self.model.bounds(), self.aspect(client))
+                if self.aim_page is not None:
+                    self.aim_page(client)
+                else:
+                    self.aim(client, self.model.bounds(), self.aspect(client))
         finally:
             self._connected.set()
 

@@ -64,6 +64,8 @@ class RunDisplay:
     external_poses: bool
     #: More robots on the page (sim --view): each model and its link frames.
     extra: list[tuple[ViewedRobot, list[Any]]]
+    #: Aims a page that connects (``aim_page(client)``); None: at the model's bounds.
+    aim_page: Any
     _lock: threading.RLock
     _nodes: dict[Layer, list[Any]]
     _frames: list[Any]
@@ -169,17 +171,24 @@ class RunStream:
         robots: ``poses`` gives one list per robot.
         joints: Returns the first robot's joint positions by name (the page's readouts), or
             None.
+        names: The robots' names, in the viewer's order (``sim --view``): with more than one,
+            the camera can follow any of them.
 
     Each sample's poses are kept (:attr:`frames_kept`), so once the run is over the page can
     replay it: a time slider puts the robot where the run had it at that time. The camera
-    follows the robot, frames its whole path, or is left alone (a dropdown).
+    follows the robot (with several, the one chosen), frames every path, or is left alone
+    (a dropdown). The pacing starts with the run's first sample, not with the stream: a run
+    that waited for a page is paced from when it starts.
     """
 
     def __init__(self, viewer: RunDisplay, poses: Any, speed: float | None,
-                 total: float, robots: bool = False, joints: Any = None) -> None:
+                 total: float, robots: bool = False, joints: Any = None,
+                 names: Sequence[str] | None = None) -> None:
         import time
 
         self.viewer, self.speed, self.total = viewer, speed, total
+        #: The robots the camera can follow by name (empty: one robot, "follow the robot").
+        self.names = list(names) if names is not None and len(names) > 1 else []
         self.poses = poses if robots else (lambda: [poses()])
         self.joints = joints
         #: (t, every robot's link poses, joint positions) per sample, for the replay.
@@ -189,11 +198,17 @@ class RunStream:
         self.replay: Any = None
         self._aimed_at: tuple[float, float, float] | None = None
         gui = viewer.server.gui
+        follow = tuple(f"follow {n}" for n in self.names) or (FOLLOW,)
         with gui.add_folder("Run", order=0.5):
             self.camera = gui.add_dropdown(
-                "Camera", (FOLLOW, WHOLE_PATH, FREE), initial_value=FOLLOW,
+                "Camera", (*follow, WHOLE_PATH, FREE), initial_value=follow[0],
                 hint="Follow the robot, keep its whole path in view, or leave the camera be")
-        self.camera.on_update(lambda _event: self._aim_all(force=True))
+        self.camera.on_update(lambda _event: self._camera_changed())
+        #: The simulated time the replay shows (None: the run's own end, no replay yet).
+        self._shown: float | None = None
+        # A page opened (or reloaded) during or after the run looks at the robot where the
+        # run has it, not where the file puts it.
+        viewer.aim_page = self._aim_page
         self.path: list[tuple[float, float, float]] = []
         #: Each robot's base path, sampled as frames are pushed (:meth:`tick`).
         self.paths: list[list[tuple[float, float, float]]] = []
@@ -201,7 +216,8 @@ class RunStream:
         self.summary = ""
         self._clock = time.perf_counter
         self._sleep = time.sleep
-        self._start = self._clock()
+        #: Wall and simulated time of the run's first sample (the pacing's origin).
+        self._start: tuple[float, float] | None = None
         self._last = -1.0
         self._stride = 1
         self._seen = 0
@@ -236,7 +252,10 @@ class RunStream:
     def tick(self, t: float) -> None:
         """The run is at simulated time ``t``: wait for the wall clock (paced), maybe push."""
         if self.speed is not None:
-            ahead = self._start + t / self.speed - self._clock()
+            now = self._clock()
+            if self._start is None:  # the run starts here (after any wait for a page)
+                self._start = (now, t)
+            ahead = self._start[0] + (t - self._start[1]) / self.speed - now
             if ahead > 0:
                 self._sleep(ahead)
         if not self._seen:  # a scenario run (no drive samples): keep what each tick shows
@@ -278,12 +297,18 @@ class RunStream:
             self.viewer.status.content = status
         self._aim_all()
 
-    def _robot_box(self, poses: Sequence[Any]) -> tuple[Any, Any]:
-        """A box around the robot's link frames, padded by the robot's size on the page."""
+    def followed(self) -> int:
+        """The robot the camera follows or frames (its number; 0 unless another is chosen)."""
+        mode = self.camera.value
+        return next((k for k, n in enumerate(self.names) if mode == f"follow {n}"), 0)
+
+    def _robot_box(self, poses: Sequence[Any], robot: int = 0) -> tuple[Any, Any]:
+        """A box around a robot's link frames, padded by the robot's size on the page."""
         import numpy as np
 
         pts = np.asarray([p[0] for p in poses], dtype=float)
-        lo, hi = self.viewer.model.bounds()
+        model = self.viewer.model if robot == 0 else self.viewer.extra[robot - 1][0]
+        lo, hi = model.bounds()
         pad = max(max(b - a for a, b in zip(lo, hi, strict=True)), 0.1) / 2
         return pts.min(axis=0) - pad, pts.max(axis=0) + pad
 
@@ -295,9 +320,10 @@ class RunStream:
         if mode == FREE:
             self._aimed_at = None
             return
-        base = tuple(float(x) for x in self.viewer.robot_pose(0)[0])
+        k = self.followed()
+        base = tuple(float(x) for x in self.viewer.robot_pose(k)[0])
         clients = list(self.viewer.server.get_clients().values())
-        if mode == FOLLOW and self._aimed_at is not None and not force:
+        if mode != WHOLE_PATH and self._aimed_at is not None and not force:
             if base == self._aimed_at:
                 return
             for client in clients:  # keep the user's own orbit, around the robot's base
@@ -310,19 +336,36 @@ class RunStream:
                 except AssertionError:  # a page that has not reported its camera yet
                     continue
         else:
-            frames = self._frames_now()
-            lo, hi = self._robot_box(frames[0])
-            if mode == WHOLE_PATH:
-                for path in (self.path, *self.paths):
-                    if path:
-                        pts = np.asarray(path, dtype=float)
-                        lo, hi = np.minimum(lo, pts.min(axis=0)), np.maximum(hi, pts.max(axis=0))
+            box = self._box()
             for client in clients:
                 try:
-                    self.viewer.aim(client, (lo, hi), self.viewer.aspect(client))
+                    self.viewer.aim(client, box, self.viewer.aspect(client))
                 except AssertionError:
                     continue
         self._aimed_at = base  # type: ignore[assignment]
+
+    def _camera_changed(self) -> None:
+        """The Camera dropdown changed: aim now; in a replay, the status names the robot."""
+        self._aim_all(force=True)
+        if self._shown is not None:
+            self.show_time(self._shown)
+
+    def _box(self) -> tuple[Any, Any]:
+        """What the camera frames now: the followed robot, or with it every path."""
+        import numpy as np
+
+        k = self.followed()
+        lo, hi = self._robot_box(self._frames_now()[k], k)
+        if self.camera.value == WHOLE_PATH:
+            for path in (self.path, *self.paths):
+                if path:
+                    pts = np.asarray(path, dtype=float)
+                    lo, hi = np.minimum(lo, pts.min(axis=0)), np.maximum(hi, pts.max(axis=0))
+        return lo, hi
+
+    def _aim_page(self, client: Any) -> None:
+        """A page that has just connected: framed as the Camera says (free: the robot)."""
+        self.viewer.aim(client, self._box(), self.viewer.aspect(client))
 
     def _frames_now(self) -> list[Any]:
         """Every robot's link poses as the page shows them now."""
@@ -358,12 +401,15 @@ class RunStream:
         if k == len(times) or (k > 0 and t - times[k - 1] <= times[k] - t):
             k -= 1
         at, every, joints = self.frames_kept[k]
+        self._shown = at
         for r, poses in enumerate(every):
             self.viewer.show_poses(poses, robot=r)
         if joints:
             self.viewer.show_joint_values(joints)
-        x, y, z = self.viewer.robot_pose(0)[0]
-        self.viewer.status.content = (f"**Replay**: t = {at:.2f} s of {times[-1]:.2f}; base at "
-                                      f"x {x:.3f}, y {y:.3f}, z {z:.3f} m\n\n{self.summary}")
+        k = self.followed()
+        x, y, z = self.viewer.robot_pose(k)[0]
+        whose = f"{self.names[k]}'s base" if self.names else "base"
+        self.viewer.status.content = (f"**Replay**: t = {at:.2f} s of {times[-1]:.2f}; {whose} "
+                                      f"at x {x:.3f}, y {y:.3f}, z {z:.3f} m\n\n{self.summary}")
         self._aim_all()
         return at, every
