@@ -151,6 +151,18 @@ CHROMIUM_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 
 
 @pytest.fixture
+def plain_lighting(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Viewer pages without viser's environment map (``URDFKIT_VIEW_ENVIRONMENT=none``).
+
+    Software WebGL prefilters it on every page, ~6 s of each page's first frame here
+    (docs/view.md); what these tests judge (controls, poses, the camera, tints) does not
+    depend on it. A test marked ``environment_map`` keeps the lighting users see.
+    """
+    if request.node.get_closest_marker("environment_map") is None:
+        monkeypatch.setenv("URDFKIT_VIEW_ENVIRONMENT", "none")
+
+
+@pytest.fixture
 def chromium() -> Any:
     """Debian's Chromium under Playwright (software WebGL); closed after the test.
 

@@ -14,7 +14,7 @@ import pytest
 
 #: One worker runs every page and server test (pytest-xdist --dist loadgroup): two Chromiums
 #: drawing WebGL in software on 2 cores starve each other.
-pytestmark = pytest.mark.xdist_group("browser")
+pytestmark = [pytest.mark.xdist_group("browser"), pytest.mark.usefixtures("plain_lighting")]
 
 pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
 

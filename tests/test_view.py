@@ -25,7 +25,7 @@ import pytest
 
 #: One worker runs every page and server test (pytest-xdist --dist loadgroup): two Chromiums
 #: drawing WebGL in software on 2 cores starve each other.
-pytestmark = pytest.mark.xdist_group("browser")
+pytestmark = [pytest.mark.xdist_group("browser"), pytest.mark.usefixtures("plain_lighting")]
 
 pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency)")
 
@@ -617,6 +617,7 @@ def _projected_share(camera: Any, lo: Any, hi: Any) -> tuple[float, float]:
     return (max(xs) - min(xs)) / 2, (max(ys) - min(ys)) / 2
 
 
+@pytest.mark.environment_map  # the colours as users see them: viser's own lighting
 def test_kuka_in_its_own_colours_with_a_legend_filling_the_view(page_of: Any,
                                                                 viewer_of: Any) -> None:
     import io

@@ -14,6 +14,7 @@ Three parts:
 from __future__ import annotations
 
 import math
+import os
 import threading
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -138,6 +139,11 @@ class Viewer(RunDisplay):
         self.port = int(self.server.get_port())
         self.url = f"http://{'localhost' if host in ('127.0.0.1', '::1') else host}:{self.port}"
         self.server.scene.set_up_direction("+z")
+        if os.environ.get("URDFKIT_VIEW_ENVIRONMENT", "").lower() in ("0", "off", "none"):
+            # No image-based lighting: a browser without a GPU (software WebGL) prefilters
+            # the environment map on every page it opens, ~6 s of a first frame (Chromium
+            # with SwiftShader, measured); directional light only.
+            self.server.scene.configure_environment_map(hdri=None)
         # A sidebar beside the canvas, not a panel floating over the scene; wide enough that
         # joint names and the pose fields are not cut.
         self.server.gui.configure_theme(control_width="large")
