@@ -70,3 +70,21 @@ def test_damping_pybullet_steps_stably_is_not_found(pb, tmp_path: Path) -> None:
     # it settles at the damped terminal speed, gravity's torque over the damping: m g d / b
     assert abs(speeds[-1]) == pytest.approx(0.01 * 9.81 * 0.02 / 0.001, rel=0.01)
     assert _u311(calm) == []
+
+
+def test_an_inertia_pybullet_zeroes_counts_as_zero(pb, tmp_path: Path) -> None:
+    # The finger's izz over ixx + iyy (no rigid body has it): PyBullet's importer warns "Bad
+    # inertia tensor properties" and zeroes the tensor (the Allegro hand's fingers in
+    # example-robot-data). About the y axis the file says 2e-6 + 0.01 x 0.02^2 = 6e-6 kg m^2;
+    # PyBullet moves 4e-6, the mass alone.
+    bad = tmp_path / "bad_inertia.urdf"
+    bad.write_text(STIFF.read_text().replace(
+        'ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"',
+        'ixx="1e-6" ixy="0" ixz="0" iyy="2e-6" iyz="0" izz="5e-6"'))
+    inertia, speeds = _raw(bad, pb)
+    assert inertia == pytest.approx(0.01 * 0.02**2, rel=1e-6)
+    assert max(map(abs, speeds)) == pytest.approx(100.0)
+    found = _u311(bad)
+    assert len(found) == 1, found
+    said = float(re.search(r"against the ([0-9.e+-]+) kg m\^2", found[0]["message"]).group(1))
+    assert said == pytest.approx(inertia, rel=5e-3)

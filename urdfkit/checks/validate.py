@@ -799,7 +799,8 @@ def rule_damping(root: etree._Element, r: RuleReport) -> None:
         if parent is not None and jv.child is not None:
             below.setdefault(parent, []).append(jv)
     for jv, b, dyn in damped:
-        inertia = _joint_inertia(jv, links, below)
+        # Past dt x b / 2 the joint is stable: the sum may stop there.
+        inertia = _joint_inertia(jv, links, below, DEFAULT_TIME_STEP * b / 2)
         if inertia is None or inertia <= 0:
             continue
         rate = DEFAULT_TIME_STEP * b / inertia
@@ -817,11 +818,16 @@ def rule_damping(root: etree._Element, r: RuleReport) -> None:
               f"step under {2 * inertia / b:.3g} s", dyn)
 
 
-def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[Any]]
-                   ) -> float | None:
+_ZERO_TENSOR: Matrix3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+
+
+def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[Any]],
+                   enough: float = math.inf) -> float | None:
     """``M_ii`` of joint ``jv`` at the zero pose, as PyBullet loads the file with its inertia.
 
     None when a link below is missing or has no readable mass or inertia, or the tree loops.
+    The sum stops once it passes ``enough`` while no link's term was negative (only an
+    invalid tensor gives one): the caller only asks whether it stays under.
     """
     axis = _vec(jv.axis, "xyz", 3, (1.0, 0.0, 0.0))  # None only when unreadable (U401)
     if axis is None:
@@ -857,16 +863,27 @@ def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[An
             if xyz is None or rpy is None or tensor_or_none is None:
                 return None
             tensor = cast(Matrix3, tensor_or_none)
+            principal = _principal(lv.inertia)
+            # PyBullet zeroes an inertia no rigid body has (a negative principal moment, or
+            # one over the other two: its importer's "Bad inertia tensor properties")
+            if principal is not None and (principal[2] < 0
+                                          or principal[4] > principal[2] + principal[3]):
+                tensor = _ZERO_TENSOR
             off = rotate(rot, xyz)
             com = tuple(p + o for p, o in zip(pos, off, strict=True))
             frame = matmul(rot, rpy_to_matrix(rpy))
         if prismatic:
-            total += mass
+            term = mass
         else:
             local = rotate(transpose(frame), a)  # the axis in the inertia's frame
-            total += sum(local[i] * tensor[i][j] * local[j] for i in range(3) for j in range(3))
             along = sum(c * x for c, x in zip(com, a, strict=True))
-            total += mass * (sum(c * c for c in com) - along * along)
+            term = sum(local[i] * tensor[i][j] * local[j] for i in range(3) for j in range(3)) \
+                + mass * (sum(c * c for c in com) - along * along)
+        total += term
+        if term < 0:
+            enough = math.inf
+        elif total > enough:
+            return total
         for child in below.get(name, ()):
             origin = child.origin
             xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
