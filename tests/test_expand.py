@@ -211,3 +211,33 @@ def test_an_include_of_a_missing_file_names_it_once_and_its_includer(tmp_path: P
     gone, parts = str(tmp_path / "gone.xacro"), str(tmp_path / "parts.xacro")
     assert message.count("gone.xacro") == 1, message
     assert f"does not exist: {gone} (included by {parts})" in message, message
+
+
+@pytest.mark.parametrize("where", ["property", "include"])
+def test_dirname_is_said_to_fail_as_raw_xacro_fails(tmp_path: Path, where: str) -> None:
+    """$(dirname): urdfkit's advice listed it among the substitutions that work without ROS,
+    but xacro 2.1.1 never tells its substitutions which file they stand in and refuses it
+    everywhere (youBot-style `$(dirname)/...` paths). The refusal now says so and what to
+    write instead; the advice no longer lists it."""
+    import xacro
+
+    ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+    body = ('<xacro:property name="d" value="$(dirname)"/><link name="a"><visual><geometry>'
+            '<mesh filename="file://${d}/m.stl"/></geometry></visual></link>'
+            if where == "property" else '<link name="a"/>'
+            '<xacro:include filename="$(dirname)/parts.xacro"/>')
+    top = tmp_path / "top.urdf.xacro"
+    top.write_text(f'<robot name="r" {ns}>{body}</robot>')
+    (tmp_path / "parts.xacro").write_text(f'<robot {ns}><link name="b"/></robot>')
+    with pytest.raises(Exception) as raw:
+        xacro.process_file(str(top))
+    assert "Cannot substitute $(dirname)" in str(raw.value)  # raw xacro refuses it too
+    r = runner.invoke(app, ["build", str(top), "-o", str(tmp_path / "out.urdf")])
+    assert r.exit_code == 2
+    assert "$(dirname) does not work" in r.stderr and "$(find PACKAGE)" in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+    # an unknown substitution's advice lists only what works
+    (tmp_path / "u.urdf.xacro").write_text(f'<robot name="r" {ns}><link name="$(pwd)"/></robot>')
+    r = runner.invoke(app, ["build", str(tmp_path / "u.urdf.xacro"), "-o",
+                            str(tmp_path / "u.urdf")])
+    assert r.exit_code == 2 and "$(optenv)" in r.stderr and "$(dirname)" not in r.stderr, r.stderr

@@ -316,8 +316,10 @@ def main(argv: list[str]) -> int:
     return 0
 
 
-#: xacro's substitutions that work without ROS (urdfkit answers $(find) itself).
-SUBSTITUTIONS = ("find", "arg", "env", "optenv", "dirname")
+#: xacro's substitutions that work without ROS (urdfkit answers $(find) itself). Not
+#: $(dirname): xacro 2.1.1 never tells its substitutions which file they stand in, so it
+#: refuses $(dirname) wherever it stands, in a property or an include alike.
+SUBSTITUTIONS = ("find", "arg", "env", "optenv")
 
 
 def _message(e: BaseException, filestack: list[str] | None = None) -> str:
@@ -352,6 +354,10 @@ def _message(e: BaseException, filestack: list[str] | None = None) -> str:
         return (f"$(arg {name}) has no value where it is used: give it with `xacro_args` "
                 f"({name}:=VALUE) (a <xacro:arg> default counts only after its declaration, "
                 "and never in the root element's attributes)")
+    if "Cannot substitute $(dirname)" in text:
+        return ("$(dirname) does not work in the xacro urdfkit runs (xacro 2.1.1 never knows "
+                "which file a substitution stands in, and refuses it); write the path from "
+                f"$(find PACKAGE) instead{f' ({context})' if context else ''}")
     unknown = re.search(r"Unknown substitution command \[([^\]]*)\]", text)
     if unknown:
         return (f"$({unknown.group(1)}) is a ROS substitution urdfkit cannot run; without ROS "
