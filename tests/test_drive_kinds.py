@@ -273,3 +273,51 @@ def test_every_wheel_on_a_hinge_turns_as_four_wheel_steering() -> None:
     expected = 0.15 / math.tan(0.3)  # the pivots' half wheelbase over tan(steer)
     assert d["turning_radius"] == pytest.approx(expected, rel=0.02), d["turning_radius"]
     assert r.distance == pytest.approx(5 * 0.05 * 8, rel=0.02)
+
+
+JOINTED_BALL_CASTER = Path(__file__).parent / "fixtures" / "robots" / "jointed_ball_caster.urdf"
+
+
+def _raw_ball_caster_run(seconds: float) -> float:
+    """Raw PyBullet: the two wheels at 5 rad/s (10 N m), the caster's joints free, on plane.urdf.
+
+    Returns how far the base went along x."""
+    import pybullet as p
+    import pybullet_data
+
+    c = p.connect(p.DIRECT)
+    try:
+        p.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=c)
+        p.setGravity(0, 0, -9.81, physicsClientId=c)
+        p.loadURDF("plane.urdf", physicsClientId=c)
+        body = p.loadURDF(str(JOINTED_BALL_CASTER), [0, 0, 0.051],
+                          flags=p.URDF_USE_IMPLICIT_CYLINDER, physicsClientId=c)
+        for j in range(p.getNumJoints(body, physicsClientId=c)):
+            name = p.getJointInfo(body, j, physicsClientId=c)[1].decode()
+            speed, force = (5.0, 10.0) if name.startswith("wheel") else (0.0, 0.0)
+            p.setJointMotorControl2(body, j, p.VELOCITY_CONTROL, targetVelocity=speed,
+                                    force=force, physicsClientId=c)
+        x0 = p.getBasePositionAndOrientation(body, physicsClientId=c)[0][0]
+        for _ in range(round(seconds * 240)):
+            p.stepSimulation(physicsClientId=c)
+        return p.getBasePositionAndOrientation(body, physicsClientId=c)[0][0] - x0
+    finally:
+        p.disconnect(c)
+
+
+def test_a_ball_caster_modelled_as_joints_rolls_free() -> None:
+    """HSR's passive wheels are a frame rolling about x, one about y and the ball on a joint
+    about z, each with an effort. drive held them at their start angles like an arm's joints,
+    so the ball was locked and dragged: HSR went 0.461 m in 4 s where raw PyBullet with them
+    free went 0.792 m, and this base did not move at all ("stuck"). They now roll free, as
+    casters, and drive goes as far as raw PyBullet and as v = omega r says."""
+    r = drive(DriveConfig(urdf=str(JOINTED_BALL_CASTER), throttle=5, seconds=3,
+                          plane="plane.urdf"))
+    d = r.to_dict()
+    assert [c["name"] for c in d["drivetrain"]["casters"]] == [
+        "caster_x_joint", "caster_y_joint", "caster_z_joint"]
+    assert d["simulated"]["held"] == []
+    raw = _raw_ball_caster_run(3)
+    assert raw == pytest.approx(5 * 0.05 * 3, rel=0.03)  # rolling without slip, less spin-up
+    assert r.final_position[0] == pytest.approx(raw, rel=0.02)
+    assert not r.problems
