@@ -211,3 +211,40 @@ def test_an_include_of_a_missing_file_names_it_once_and_its_includer(tmp_path: P
     gone, parts = str(tmp_path / "gone.xacro"), str(tmp_path / "parts.xacro")
     assert message.count("gone.xacro") == 1, message
     assert f"does not exist: {gone} (included by {parts})" in message, message
+
+
+def test_a_bare_xacro_macro_is_named_with_its_file_and_line(tmp_path: Path) -> None:
+    """Toyota HSR's common.xacro (written for Kinetic) defines `<macro name=... params="joint
+    reduction">` without the xacro: prefix. xacro has read only prefixed commands since 1.14
+    (Noetic): the bare macro is copied as XML, its `${joint}` evaluated where no `joint`
+    exists, and raw xacro fails with "name 'joint' is not defined", naming no file. urdfkit
+    fails the same way and now names the file and line of the bare command and the fix."""
+    import xacro
+
+    ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+    top = tmp_path / "robot.urdf.xacro"
+    top.write_text(f'<robot name="r" {ns}>\n<xacro:include filename="common.xacro"/>\n'
+                   '<link name="a"/>\n</robot>\n')
+    (tmp_path / "common.xacro").write_text(
+        f'<robot {ns}>\n  <!-- <macro> in a comment is not one -->\n'
+        '  <macro name="transmission" params="joint">\n'
+        '    <transmission name="${joint}_transmission"/>\n  </macro>\n</robot>\n')
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        with pytest.raises(Exception) as raw:
+            xacro.process_file(str(top))
+    finally:
+        os.chdir(cwd)
+    assert "name 'joint' is not defined" in str(raw.value)  # raw xacro, and no file named
+    assert "common.xacro" not in str(raw.value)
+    with pytest.raises(InputError) as ours:
+        expand_xacro(top, timeout=20)
+    message = str(ours.value)
+    assert "name 'joint' is not defined" in message, message
+    assert f"{tmp_path / 'common.xacro'}:3 writes <macro> without the xacro: prefix" in message
+    assert "write <xacro:macro>" in message
+    fixed = (tmp_path / "common.xacro").read_text().replace("<macro", "<xacro:macro") \
+        .replace("</macro>", "</xacro:macro>")
+    (tmp_path / "common.xacro").write_text(fixed)
+    assert expand_xacro(top, timeout=20)  # the advice, followed, expands
