@@ -248,3 +248,27 @@ def test_a_bare_xacro_macro_is_named_with_its_file_and_line(tmp_path: Path) -> N
         .replace("</macro>", "</xacro:macro>")
     (tmp_path / "common.xacro").write_text(fixed)
     assert expand_xacro(top, timeout=20)  # the advice, followed, expands
+
+
+def test_a_property_used_above_its_definition_is_named(tmp_path: Path) -> None:
+    """ABB YuMi's yumi.urdf.xacro (OrebroUniversity/yumi) uses ${yumi_parent} on line 16 and
+    defines it on line 31, as xacro before in-order reading allowed. Raw xacro fails with
+    "name 'yumi_parent' is not defined" and no file; urdfkit now says where it is defined and
+    why that is too late, and moving it up (the advice) expands."""
+    import xacro
+
+    ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+    use = '<link name="${parent}"/>\n'
+    define = '<xacro:property name="parent" value="world"/>\n'
+    top = tmp_path / "robot.urdf.xacro"
+    top.write_text(f'<robot name="r" {ns}>\n{use}{define}</robot>\n')
+    with pytest.raises(Exception) as raw:
+        xacro.process_file(str(top))
+    assert "name 'parent' is not defined" in str(raw.value)
+    assert "robot.urdf.xacro" not in str(raw.value)
+    with pytest.raises(InputError) as ours:
+        expand_xacro(top, timeout=20)
+    assert f"{top}:3 defines 'parent', but xacro knows a property only below its definition" \
+        in str(ours.value), str(ours.value)
+    top.write_text(f'<robot name="r" {ns}>\n{define}{use}</robot>\n')
+    assert expand_xacro(top, timeout=20)

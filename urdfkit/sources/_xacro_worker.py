@@ -297,7 +297,7 @@ def main(argv: list[str]) -> int:
         read = [source, *(getattr(module, "all_includes", None) or [])]
         text = _message(e, list(getattr(module, "filestack", None) or []))
         if any(k in text for k in ("is not defined", "unknown macro name", "has no value")):
-            text += _unprefixed(read)  # what a bare <macro>, <property> or <arg> leads to
+            text += _unprefixed(read) or _defined_later(text, read)
         print(text, file=sys.stderr)
         return 1
     finally:
@@ -388,6 +388,35 @@ def _unprefixed(files: list[str]) -> str:
                         return (f"; {path}:{number} writes <{tag}> without the xacro: prefix, "
                                 "which xacro has needed since 1.14 (ROS Noetic): write "
                                 f"<xacro:{tag}> (and so for every bare xacro command there)")
+        except OSError:
+            continue
+    return ""
+
+
+def _defined_later(text: str, files: list[str]) -> str:
+    """Where the property xacro did not know is defined, when a file read defines it, or "".
+
+    xacro reads in order (the default since ROS Melodic, the only way since Noetic): a
+    ``<xacro:property>`` counts only below its definition. ABB YuMi's yumi.urdf.xacro
+    (OrebroUniversity/yumi) uses ``${yumi_parent}`` on line 16 and defines it on line 31.
+    """
+    import re
+
+    name = re.search(r"name '([A-Za-z_]\w*)' is not defined", text)
+    if name is None:
+        return ""
+    pattern = re.compile(r"<xacro:property\s[^>]*name\s*=\s*[\"']" + re.escape(name.group(1))
+                         + r"[\"']")
+    for path in dict.fromkeys(files):
+        try:
+            with open(path, encoding="utf-8", errors="replace") as f:
+                for number, line in enumerate(f, 1):
+                    if pattern.search(line):
+                        return (f"; {path}:{number} defines {name.group(1)!r}, but xacro "
+                                "knows a property only below its definition (it reads in "
+                                "order: the default since ROS Melodic, the only way since "
+                                "Noetic) and, defined in a macro, only inside it: move the "
+                                "definition above its first use")
         except OSError:
             continue
     return ""
