@@ -551,3 +551,55 @@ def test_a_findings_json_form_is_its_fields_in_order() -> None:
     data = CheckResult([FileResult("f.urdf", findings)]).to_dict()
     assert [list(d.items()) for d in data["findings"]] == \
         [list(f.to_dict().items()) for f in findings]  # type: ignore[union-attr]
+
+
+def _cube_stl(path: Path) -> None:
+    """A binary STL unit cube (PyBullet reads binary STL)."""
+    import struct
+
+    v = [(x, y, z) for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)]
+    faces = ((0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7),
+             (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3))
+    data = b"\0" * 80 + struct.pack("<I", len(faces))
+    for face in faces:
+        data += struct.pack("<3f", 0, 0, 0) + b"".join(struct.pack("<3f", *v[i]) for i in face)
+        data += b"\0\0"
+    path.write_bytes(data)
+
+
+def test_a_missing_mesh_names_the_same_part_in_another_format(tmp_path: Path, pb) -> None:
+    """Toyota HSR's hsrb4s.urdf names `torso_v0/torso.std` where the folder holds torso.stl
+    (and .dae, .obj): U701 said only "file not found". It now names the files beside it with
+    that stem in a mesh format, or the same name in another case; not merely close names
+    (link_2.stl is another part than the missing link_1.stl). Raw PyBullet refuses the file as
+    written and loads it with the name U701 offers."""
+    from urdfkit.engine.session import quiet_stdout
+
+    (tmp_path / "meshes").mkdir()
+    for name in ("torso.stl", "link_2.stl"):
+        _cube_stl(tmp_path / "meshes" / name)
+
+    def robot(torso: str) -> str:
+        return doc(link("a", body=f'<collision><geometry><mesh filename="meshes/{torso}"/>'
+                        "</geometry></collision>"),
+                   link("b", body='<visual><geometry><mesh filename="meshes/link_1.stl"/>'
+                        "</geometry></visual>"), joint())
+
+    path = tmp_path / "r.urdf"
+    path.write_text(robot("torso.std"))
+    r = runner.invoke(app, ["check", str(path), "--json", "--no-cache"])
+    found = {f["message"].split("'")[1]: f["message"] for f in json.loads(r.stdout)["findings"]
+             if f["code"] == "U701"}
+    assert "; beside it: 'torso.stl';" in found["meshes/torso.std"], found
+    assert "beside it" not in found["meshes/link_1.stl"], found
+    p, c = pb
+    with quiet_stdout(), pytest.raises(p.error):
+        p.loadURDF(str(path), physicsClientId=c)  # raw PyBullet refuses it as written
+    _cube_stl(tmp_path / "meshes" / "link_1.stl")
+    path.write_text(robot("torso.stl"))
+    fresh = p.connect(p.DIRECT)  # a fresh client: the same paths failed once in this one
+    try:
+        with quiet_stdout():
+            assert p.loadURDF(str(path), physicsClientId=fresh) >= 0  # and loads it so
+    finally:
+        p.disconnect(fresh)

@@ -88,3 +88,59 @@ def test_an_inertia_pybullet_zeroes_counts_as_zero(pb, tmp_path: Path) -> None:
     assert len(found) == 1, found
     said = float(re.search(r"against the ([0-9.e+-]+) kg m\^2", found[0]["message"]).group(1))
     assert said == pytest.approx(inertia, rel=5e-3)
+
+
+COUPLED = Path(__file__).parent / "fixtures" / "robots" / "coupled_damping.urdf"
+
+
+def _raw_coupled(pb, damping_scale: float) -> tuple[float, list[tuple[float, float]]]:
+    """Raw PyBullet on the coupled fixture, base fixed, gravity and motors off: the largest
+    eigenvalue of dt M^-1 B from its own mass matrix, and both joints' speeds over 8 steps
+    from 0.01 rad/s along the relative motion (the joints turned against each other)."""
+    import numpy as np
+
+    from urdfkit.engine.session import quiet_stdout
+
+    p, c = pb
+    p.resetSimulation(physicsClientId=c)
+    with quiet_stdout():
+        body = p.loadURDF(str(COUPLED), useFixedBase=True, flags=p.URDF_USE_INERTIA_FROM_FILE,
+                          physicsClientId=c)
+    m = np.array(p.calculateMassMatrix(body, [0.0, 0.0], physicsClientId=c))
+    b = np.array([p.getJointInfo(body, j, physicsClientId=c)[6] for j in (0, 1)])
+    rate = float(np.linalg.eigvals(np.linalg.solve(m, np.diag(b))).real.max()) / 240
+    p.setGravity(0, 0, 0, physicsClientId=c)
+    p.setTimeStep(1 / 240, physicsClientId=c)
+    for j, v in ((0, -0.01), (1, 0.01)):
+        p.changeDynamics(body, j, jointDamping=float(b[j]) * damping_scale, linearDamping=0,
+                         angularDamping=0, physicsClientId=c)
+        p.setJointMotorControl2(body, j, p.VELOCITY_CONTROL, force=0, physicsClientId=c)
+        p.resetJointState(body, j, 0.0, v, physicsClientId=c)
+    speeds = []
+    for _ in range(8):
+        p.stepSimulation(physicsClientId=c)
+        s = p.getJointStates(body, [0, 1], physicsClientId=c)
+        speeds.append((s[0][1], s[1][1]))
+    return rate, speeds
+
+
+def test_joints_unstable_together_though_not_alone_are_found(pb) -> None:
+    """HSR's hand: each damped joint alone moves enough inertia (dt b / M_ii 0.13), so the
+    joint-by-joint rule was silent, but turned against each other the two carry only the small
+    link between them: the largest eigenvalue of dt M^-1 B is 5.46 and raw PyBullet's speeds
+    flip sign and grow 4.5x a step. check now judges the whole mass matrix; the figure it gives
+    is raw PyBullet's, and its advice (the damping scaled under 2 / eigenvalue) settles it."""
+    rate, speeds = _raw_coupled(pb, 1.0)
+    finger = [s[1] for s in speeds]
+    assert all(a * b < 0 for a, b in zip(finger, finger[1:], strict=False)), finger
+    assert abs(finger[3]) > 10 * abs(finger[0])  # grows, as 1 - rate says
+    found = _u311(COUPLED)
+    assert len(found) == 1, found
+    message = found[0]["message"]
+    assert "finger_joint" in message and "spring_joint" in message, message
+    said = float(re.search(r"eigenvalue of dt M\^-1 B at its default 1/240 s is ([0-9.e+-]+)",
+                           message).group(1))
+    assert said == pytest.approx(rate, rel=5e-3)
+    scale = float(re.search(r"damping under ([0-9.e+-]+) of what it is", message).group(1))
+    _, settled = _raw_coupled(pb, 0.9 * scale)
+    assert all(abs(s[1]) <= 0.0101 for s in settled), settled  # decays, without flipping

@@ -273,3 +273,91 @@ def test_every_wheel_on_a_hinge_turns_as_four_wheel_steering() -> None:
     expected = 0.15 / math.tan(0.3)  # the pivots' half wheelbase over tan(steer)
     assert d["turning_radius"] == pytest.approx(expected, rel=0.02), d["turning_radius"]
     assert r.distance == pytest.approx(5 * 0.05 * 8, rel=0.02)
+
+
+JOINTED_BALL_CASTER = Path(__file__).parent / "fixtures" / "robots" / "jointed_ball_caster.urdf"
+
+
+def _raw_ball_caster_run(seconds: float) -> float:
+    """Raw PyBullet: the two wheels at 5 rad/s (10 N m), the caster's joints free, on plane.urdf.
+
+    Returns how far the base went along x."""
+    import pybullet as p
+    import pybullet_data
+
+    c = p.connect(p.DIRECT)
+    try:
+        p.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=c)
+        p.setGravity(0, 0, -9.81, physicsClientId=c)
+        p.loadURDF("plane.urdf", physicsClientId=c)
+        body = p.loadURDF(str(JOINTED_BALL_CASTER), [0, 0, 0.051],
+                          flags=p.URDF_USE_IMPLICIT_CYLINDER, physicsClientId=c)
+        for j in range(p.getNumJoints(body, physicsClientId=c)):
+            name = p.getJointInfo(body, j, physicsClientId=c)[1].decode()
+            speed, force = (5.0, 10.0) if name.startswith("wheel") else (0.0, 0.0)
+            p.setJointMotorControl2(body, j, p.VELOCITY_CONTROL, targetVelocity=speed,
+                                    force=force, physicsClientId=c)
+        x0 = p.getBasePositionAndOrientation(body, physicsClientId=c)[0][0]
+        for _ in range(round(seconds * 240)):
+            p.stepSimulation(physicsClientId=c)
+        return p.getBasePositionAndOrientation(body, physicsClientId=c)[0][0] - x0
+    finally:
+        p.disconnect(c)
+
+
+def test_a_ball_caster_modelled_as_joints_rolls_free() -> None:
+    """HSR's passive wheels are a frame rolling about x, one about y and the ball on a joint
+    about z, each with an effort. drive held them at their start angles like an arm's joints,
+    so the ball was locked and dragged: HSR went 0.461 m in 4 s where raw PyBullet with them
+    free went 0.792 m, and this base did not move at all ("stuck"). They now roll free, as
+    casters, and drive goes as far as raw PyBullet and as v = omega r says."""
+    r = drive(DriveConfig(urdf=str(JOINTED_BALL_CASTER), throttle=5, seconds=3,
+                          plane="plane.urdf"))
+    d = r.to_dict()
+    assert [c["name"] for c in d["drivetrain"]["casters"]] == [
+        "caster_x_joint", "caster_y_joint", "caster_z_joint"]
+    assert d["simulated"]["held"] == []
+    raw = _raw_ball_caster_run(3)
+    assert raw == pytest.approx(5 * 0.05 * 3, rel=0.03)  # rolling without slip, less spin-up
+    assert r.final_position[0] == pytest.approx(raw, rel=0.02)
+    assert not r.problems
+
+
+def test_wheels_named_on_free_swivels_are_said_to_hang_from_them() -> None:
+    """Toyota HSR's two drive wheels sit on one swivel (base_roll_joint), youBot's each on its
+    own. Naming only the wheels left the swivels free; HSR at --steer 0.5 yawed 0.13 rad and
+    the run blamed wheel slip. Raw PyBullet, the same wheels at 5 rad/s and the swivels free:
+    the swivels turn (radians in 4 s) and the base goes a fraction of omega r t. drive now
+    names the swivels and how to hold them; given as hinges, nothing is said."""
+    import pybullet as p
+    import pybullet_data
+
+    c = p.connect(p.DIRECT)
+    try:
+        p.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=c)
+        p.setGravity(0, 0, -9.81, physicsClientId=c)
+        p.loadURDF("plane.urdf", physicsClientId=c)
+        body = p.loadURDF(str(SWIVEL_WHEELS), [0, 0, 0.101], physicsClientId=c,
+                          flags=p.URDF_USE_IMPLICIT_CYLINDER | p.URDF_USE_INERTIA_FROM_FILE)
+        joints = {p.getJointInfo(body, j, physicsClientId=c)[1].decode(): j
+                  for j in range(p.getNumJoints(body, physicsClientId=c))}
+        for name, j in joints.items():
+            speed, force = (5.0, 10.0) if name.startswith("wheel") else (0.0, 0.0)
+            p.setJointMotorControl2(body, j, p.VELOCITY_CONTROL, targetVelocity=speed,
+                                    force=force, physicsClientId=c)
+        for _ in range(960):
+            p.stepSimulation(physicsClientId=c)
+        turned = max(abs(p.getJointState(body, j, physicsClientId=c)[0])
+                     for n, j in joints.items() if n.startswith("swivel"))
+        went = math.hypot(*p.getBasePositionAndOrientation(body, physicsClientId=c)[0][:2])
+    finally:
+        p.disconnect(c)
+    assert turned > 1.0 and went < 0.2 * 5 * 0.05 * 4, (turned, went)
+    wheels = [f"wheel_joint_{k}" for k in ("fl", "fr", "bl", "br")]
+    swivels = [f"swivel_joint_{k}" for k in ("fl", "fr", "bl", "br")]
+    r = drive(DriveConfig(urdf=str(SWIVEL_WHEELS), throttle=5, seconds=1, wheels=wheels))
+    said = [w for w in r.warnings if "free swivel" in w]
+    assert len(said) == 1 and f"give {', '.join(swivels)} to --hinges" in said[0], r.warnings
+    held = drive(DriveConfig(urdf=str(SWIVEL_WHEELS), throttle=5, seconds=1, wheels=wheels,
+                             hinges=swivels))
+    assert not [w for w in held.warnings if "free swivel" in w], held.warnings

@@ -241,3 +241,62 @@ def test_dirname_is_said_to_fail_as_raw_xacro_fails(tmp_path: Path, where: str) 
     r = runner.invoke(app, ["build", str(tmp_path / "u.urdf.xacro"), "-o",
                             str(tmp_path / "u.urdf")])
     assert r.exit_code == 2 and "$(optenv)" in r.stderr and "$(dirname)" not in r.stderr, r.stderr
+def test_a_bare_xacro_macro_is_named_with_its_file_and_line(tmp_path: Path) -> None:
+    """Toyota HSR's common.xacro (written for Kinetic) defines `<macro name=... params="joint
+    reduction">` without the xacro: prefix. xacro has read only prefixed commands since 1.14
+    (Noetic): the bare macro is copied as XML, its `${joint}` evaluated where no `joint`
+    exists, and raw xacro fails with "name 'joint' is not defined", naming no file. urdfkit
+    fails the same way and now names the file and line of the bare command and the fix."""
+    import xacro
+
+    ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+    top = tmp_path / "robot.urdf.xacro"
+    top.write_text(f'<robot name="r" {ns}>\n<xacro:include filename="common.xacro"/>\n'
+                   '<link name="a"/>\n</robot>\n')
+    (tmp_path / "common.xacro").write_text(
+        f'<robot {ns}>\n  <!-- <macro> in a comment is not one -->\n'
+        '  <macro name="transmission" params="joint">\n'
+        '    <transmission name="${joint}_transmission"/>\n  </macro>\n</robot>\n')
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        with pytest.raises(Exception) as raw:
+            xacro.process_file(str(top))
+    finally:
+        os.chdir(cwd)
+    assert "name 'joint' is not defined" in str(raw.value)  # raw xacro, and no file named
+    assert "common.xacro" not in str(raw.value)
+    with pytest.raises(InputError) as ours:
+        expand_xacro(top, timeout=20)
+    message = str(ours.value)
+    assert "name 'joint' is not defined" in message, message
+    assert f"{tmp_path / 'common.xacro'}:3 writes <macro> without the xacro: prefix" in message
+    assert "write <xacro:macro>" in message
+    fixed = (tmp_path / "common.xacro").read_text().replace("<macro", "<xacro:macro") \
+        .replace("</macro>", "</xacro:macro>")
+    (tmp_path / "common.xacro").write_text(fixed)
+    assert expand_xacro(top, timeout=20)  # the advice, followed, expands
+
+
+def test_a_property_used_above_its_definition_is_named(tmp_path: Path) -> None:
+    """ABB YuMi's yumi.urdf.xacro (OrebroUniversity/yumi) uses ${yumi_parent} on line 16 and
+    defines it on line 31, as xacro before in-order reading allowed. Raw xacro fails with
+    "name 'yumi_parent' is not defined" and no file; urdfkit now says where it is defined and
+    why that is too late, and moving it up (the advice) expands."""
+    import xacro
+
+    ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+    use = '<link name="${parent}"/>\n'
+    define = '<xacro:property name="parent" value="world"/>\n'
+    top = tmp_path / "robot.urdf.xacro"
+    top.write_text(f'<robot name="r" {ns}>\n{use}{define}</robot>\n')
+    with pytest.raises(Exception) as raw:
+        xacro.process_file(str(top))
+    assert "name 'parent' is not defined" in str(raw.value)
+    assert "robot.urdf.xacro" not in str(raw.value)
+    with pytest.raises(InputError) as ours:
+        expand_xacro(top, timeout=20)
+    assert f"{top}:3 defines 'parent', but xacro knows a property only below its definition" \
+        in str(ours.value), str(ours.value)
+    top.write_text(f'<robot name="r" {ns}>\n{define}{use}</robot>\n')
+    assert expand_xacro(top, timeout=20)

@@ -798,6 +798,7 @@ def rule_damping(root: etree._Element, r: RuleReport) -> None:
         parent = jv.parent.get("link") if jv.parent is not None else None
         if parent is not None and jv.child is not None:
             below.setdefault(parent, []).append(jv)
+    found: set[str] = set()
     for jv, b, dyn in damped:
         # Past dt x b / 2 the joint is stable: the sum may stop there.
         inertia = _joint_inertia(jv, links, below, DEFAULT_TIME_STEP * b / 2)
@@ -806,6 +807,7 @@ def rule_damping(root: etree._Element, r: RuleReport) -> None:
         rate = DEFAULT_TIME_STEP * b / inertia
         if rate <= 2.0:
             continue
+        found.add(jv.name or "")
         prismatic = jv.type == "prismatic"
         unit, what = ("N s/m", "kg") if prismatic else ("N m s/rad", "kg m^2")
         r.add("U311", "warning",
@@ -816,9 +818,214 @@ def rule_damping(root: etree._Element, r: RuleReport) -> None:
               f"100 {'m/s' if prismatic else 'rad/s'} cap: the joint chatters instead of "
               f"settling; lower the damping under {2 * inertia / DEFAULT_TIME_STEP:.3g} or "
               f"step under {2 * inertia / b:.3g} s", dyn)
+    _coupled_damping(doc, links, below, damped, found, r)
+
+
+def _coupled_damping(doc: Doc, links: dict[str, LinkView], below: dict[str, list[Any]],
+                     damped: list[tuple[Any, float, etree._Element]], found: set[str],
+                     r: RuleReport) -> None:
+    """U311 for damped joints unstable together though each alone is not.
+
+    Toyota HSR's hand (hsr_description): ``hand_r_spring_proximal_joint`` and
+    ``hand_r_mimic_distal_joint``, 1 N m s/rad each, move 0.033 and 0.030 kg m^2 alone (dt b /
+    M_ii 0.13), but turned against each other the distal link keeps still and only the small
+    link between moves: the largest eigenvalue of dt M^-1 B is 5.46, and raw PyBullet's speeds
+    along that motion flip sign and grow 4.5x a step. Judged on the joint-space mass matrix of
+    the whole tree at the zero pose, base fixed (a floating base only raises the eigenvalue).
+    """
+    got = _mass_matrix(doc, links, below)
+    if got is None:
+        return
+    names, m = got
+    index = {n: i for i, n in enumerate(names)}
+    rows = [(index[jv.name], jv, b, dyn) for jv, b, dyn in damped if jv.name in index]
+    low = _cholesky(m)
+    if not rows or low is None:
+        return
+    # A = dt B^1/2 M^-1 B^1/2 over the damped joints: C = L^-1 B^1/2 e_k, A = dt C^T C
+    cols = [_forward_solve(low, [math.sqrt(b) if i == k else 0.0 for i in range(len(names))])
+            for k, _, b, _ in rows]
+    a = [[DEFAULT_TIME_STEP * sum(x * y for x, y in zip(ci, cj, strict=True)) for cj in cols]
+         for ci in cols]
+    if max(sum(abs(x) for x in row) for row in a) <= 2.0:
+        return  # Gershgorin: no eigenvalue past 2 (most files end here, without numpy)
+    import numpy as np
+
+    sym = np.array(a)
+    root_b = np.sqrt(np.array([b for _, _, b, _ in rows]))
+    values, vectors = np.linalg.eigh((sym + sym.T) / 2)
+    said = set(found)
+    for e in range(len(values) - 1, -1, -1):
+        rate = float(values[e])
+        if not rate > 2.0 or not math.isfinite(rate):
+            break
+        mode = vectors[:, e] / root_b  # the joint speeds of that motion
+        mode = mode / np.abs(mode).max()
+        part = [k for k in np.argsort(-np.abs(mode)) if abs(mode[k]) >= 0.2]
+        if any(rows[k][1].name in said for k in part):
+            continue  # said already, joint by joint or as a stiffer motion
+        said.update(rows[k][1].name for k in part)
+        lead = rows[part[0]]
+        others = ", ".join(rows[k][1].name for k in part[1:4])
+        motion = ", ".join(f"{rows[k][1].name} x {mode[k]:+.2f}" for k in part[:4])
+        r.add("U311", "warning",
+              f"{label(lead[1].el)}, moving with {others or 'no other damped joint'} "
+              f"({motion}), is damped too hard for PyBullet's step, though each joint alone is "
+              f"not: so moving they carry little inertia (at the zero pose, base fixed, the "
+              f"file's inertia), and the largest eigenvalue of dt M^-1 B at its default "
+              f"1/240 s is {rate:.3g}, past 2: each step multiplies that motion's speed by "
+              f"1 - {rate:.3g}, flipping its sign and growing it to PyBullet's joint-speed "
+              f"cap; scale those joints' damping under {2 / rate:.3g} of what it is or step "
+              f"under {2 * DEFAULT_TIME_STEP / rate:.3g} s", lead[3])
+
+
+Chain = list[tuple[int, tuple[float, ...], tuple[float, ...], bool]]
+
+
+def _zero_pose_tree(doc: Doc, links: dict[str, LinkView], below: dict[str, list[Any]]
+                    ) -> tuple[list[str], list[str], dict[str, Any], dict[str, Chain]] | None:
+    """The tree at the zero pose, or None when it does not read.
+
+    Returns the moving joints' names, the links root first, each link's frame (rotation,
+    origin) and the moving joints above it (index, axis, a point on it, prismatic). It does not
+    read with not one root, a loop, a missing link or a bad number.
+    """
+    children = {jv.child.get("link") for jv in doc.joints if jv.child is not None}
+    roots = [n for n in links if n not in children]
+    if len(roots) != 1:
+        return None
+    identity: Matrix3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    frame: dict[str, Any] = {roots[0]: (identity, (0.0, 0.0, 0.0))}
+    chain: dict[str, Chain] = {roots[0]: []}
+    names: list[str] = []
+    order: list[str] = []
+    stack = [roots[0]]
+    while stack:
+        name = stack.pop()
+        order.append(name)
+        rot, pos = frame[name]
+        for jv in below.get(name, ()):
+            child = jv.child.get("link") if jv.child is not None else None
+            xyz = _vec(jv.origin, "xyz", 3, (0.0, 0.0, 0.0))
+            rpy = _vec(jv.origin, "rpy", 3, (0.0, 0.0, 0.0))
+            if child is None or child in frame or child not in links or xyz is None \
+                    or rpy is None:
+                return None
+            crot = matmul(rot, rpy_to_matrix(rpy))
+            cpos = tuple(p + o for p, o in zip(pos, rotate(rot, xyz), strict=True))
+            frame[child] = (crot, cpos)
+            chain[child] = list(chain[name])
+            if jv.type in ("revolute", "continuous", "prismatic"):
+                axis = _vec(jv.axis, "xyz", 3, (1.0, 0.0, 0.0))
+                if axis is None or jv.name is None:
+                    return None
+                norm = math.sqrt(sum(x * x for x in axis))
+                if norm == 0.0:
+                    return None
+                world = rotate(crot, tuple(x / norm for x in axis))
+                chain[child].append((len(names), world, cpos, jv.type == "prismatic"))
+                names.append(jv.name)
+            stack.append(child)
+    return names, order, frame, chain
+
+
+def _mass_matrix(doc: Doc, links: dict[str, LinkView], below: dict[str, list[Any]]
+                 ) -> tuple[list[str], list[list[float]]] | None:
+    """The joint-space mass matrix at the zero pose, base fixed, as PyBullet loads the file.
+
+    With the file's inertia (1 kg and unit inertia for a link without ``<inertial>``),
+    ``M_ij`` sums, over the links below both joints, ``m J_v,i . J_v,j + J_w,i^T I J_w,j``
+    (each link's Jacobian columns at its centre of mass). Plain Python: the tree's depth, not
+    its size, sets the cost. None when the tree does not read, has no moving joint, or is too
+    big to be worth it.
+    """
+    tree = _zero_pose_tree(doc, links, below)
+    if tree is None:
+        return None
+    names, order, frame, chain = tree
+    n = len(names)
+    if n == 0 or n > 200:
+        return None
+    identity: Matrix3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    m = [[0.0] * n for _ in range(n)]
+    for name in order:
+        above = chain[name]
+        if not above:
+            continue
+        lv = links[name]
+        mass = _mass_of(lv)
+        rot, pos = frame[name]
+        if mass is None:
+            return None
+        com: tuple[float, ...] = pos
+        tensor: Matrix3 = identity
+        if lv.inertial is not None:
+            origin = first(lv.inertial, "origin")
+            xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
+            rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
+            t = _loaded_tensor(lv.inertia)
+            if xyz is None or rpy is None or t is None:
+                return None
+            turn = matmul(rot, rpy_to_matrix(rpy))
+            com = tuple(p + o for p, o in zip(pos, rotate(rot, xyz), strict=True))
+            tensor = matmul(matmul(turn, t), transpose(turn))
+        cols: list[tuple[int, tuple[float, ...], tuple[float, ...], tuple[float, ...]]] = []
+        for i, a, at, prismatic in above:
+            if prismatic:
+                cols.append((i, a, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
+                continue
+            r_ = tuple(c - q for c, q in zip(com, at, strict=True))
+            lin = (a[1] * r_[2] - a[2] * r_[1], a[2] * r_[0] - a[0] * r_[2],
+                   a[0] * r_[1] - a[1] * r_[0])
+            cols.append((i, lin, a, rotate(tensor, a)))
+        for i, lin_i, _, iw_i in cols:
+            for j, lin_j, w_j, _ in cols:
+                m[i][j] += mass * sum(x * y for x, y in zip(lin_i, lin_j, strict=True)) \
+                    + sum(x * y for x, y in zip(iw_i, w_j, strict=True))
+    return names, m
+
+
+def _cholesky(m: list[list[float]]) -> list[list[float]] | None:
+    """Lower-triangular L with L L^T = m, or None when m is not positive definite."""
+    n = len(m)
+    low = [[0.0] * n for _ in range(n)]
+    for i in range(n):
+        for j in range(i + 1):
+            acc = m[i][j] - sum(low[i][k] * low[j][k] for k in range(j))
+            if i == j:
+                if not acc > 0.0:
+                    return None
+                low[i][i] = math.sqrt(acc)
+            else:
+                low[i][j] = acc / low[j][j]
+    return low
+
+
+def _forward_solve(low: list[list[float]], b: list[float]) -> list[float]:
+    """The x with L x = b, L lower-triangular."""
+    x: list[float] = []
+    for i, row in enumerate(low):
+        x.append((b[i] - sum(row[k] * x[k] for k in range(i))) / row[i])
+    return x
 
 
 _ZERO_TENSOR: Matrix3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+
+
+def _loaded_tensor(inertia: etree._Element | None) -> Matrix3 | None:
+    """The ``<inertia>`` tensor as PyBullet loads it with the file's inertia, or None.
+
+    Zero where no rigid body has it (a negative principal moment, or one over the other
+    two): PyBullet's importer says "Bad inertia tensor properties" and zeroes it (the Allegro
+    hand's fingers in example-robot-data).
+    """
+    tensor = _inertia_tensor(inertia) if inertia is not None else None
+    if tensor is None or inertia is None:
+        return None
+    principal = _principal(inertia)
+    if principal is not None and (principal[2] < 0 or principal[4] > principal[2] + principal[3]):
+        return _ZERO_TENSOR
+    return cast(Matrix3, tensor)
 
 
 def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[Any]],
@@ -859,16 +1066,10 @@ def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[An
             origin = first(lv.inertial, "origin")
             xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
             rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
-            tensor_or_none = _inertia_tensor(lv.inertia) if lv.inertia is not None else None
+            tensor_or_none = _loaded_tensor(lv.inertia)
             if xyz is None or rpy is None or tensor_or_none is None:
                 return None
-            tensor = cast(Matrix3, tensor_or_none)
-            principal = _principal(lv.inertia)
-            # PyBullet zeroes an inertia no rigid body has (a negative principal moment, or
-            # one over the other two: its importer's "Bad inertia tensor properties")
-            if principal is not None and (principal[2] < 0
-                                          or principal[4] > principal[2] + principal[3]):
-                tensor = _ZERO_TENSOR
+            tensor = tensor_or_none
             off = rotate(rot, xyz)
             com = tuple(p + o for p, o in zip(pos, off, strict=True))
             frame = matmul(rot, rpy_to_matrix(rpy))

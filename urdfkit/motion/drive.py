@@ -418,6 +418,7 @@ class Scenario:
         if note:
             self.warnings.append(note)
         self._warn_phantom_mass()
+        self._warn_free_swivels()
         self._plan_holds()
         self.columns = list(BASE_COLUMNS)
         for j in train.wheels + train.hinges:
@@ -472,6 +473,34 @@ class Scenario:
                 f"PyBullet gives the {len(self._phantom)} link(s) without <inertial> 1 kg each "
                 f"({names}): {made_up:g} of the {total:.4g} kg simulated; if they are frames, "
                 "`urdfkit fix` gives them mass 0")
+
+    def _warn_free_swivels(self) -> None:
+        """Say so when driven wheels hang from a swivel left free (a caster's).
+
+        Naming only the wheels of a base whose wheels all sit on swivels (youBot's, Toyota
+        HSR's drive unit on ``base_roll_joint``) leaves the swivels rolling free: the unit
+        turns under the body, and the body's path and yaw are not the wheels'. HSR at
+        ``--steer 0.5`` yawed 0.13 rad while its drive unit turned, and the run blamed wheel
+        slip.
+        """
+        assert self.session is not None
+        p, train = self.session.bullet, self.drivetrain
+        free = set(train.casters)
+        swivels: dict[int, list[str]] = {}
+        for w in train.wheels:
+            k = p.getJointInfo(self.body, w)[16]
+            while k >= 0:
+                if k in free and k not in train.wheels:
+                    swivels.setdefault(k, []).append(train.joint_names[w])
+                k = p.getJointInfo(self.body, k)[16]
+        if swivels:
+            named = ", ".join(train.joint_names[k] for k in swivels)
+            wheels = ", ".join(w for ws in swivels.values() for w in ws)
+            them = "it" if len(swivels) == 1 else "them"
+            self.warnings.append(
+                f"the driven wheels {wheels} hang from free swivel(s) {named}, which turn "
+                "under the base as the wheels push: the base's path and yaw are not the "
+                f"wheels'; give {named} to --hinges to hold {them}")
 
     def _plan_holds(self) -> None:
         """Which passive joints hold their start angle, with what force, and which go limp.

@@ -111,7 +111,8 @@ class Drivetrain:
         forward: The direction "forward" (x, y components in the base frame): the way the
             wheels roll that is closest to the base's +x (+y when they roll along y).
         casters: Caster joints (swivels without limits that carry a wheel, and those
-            wheels): passive, and always free.
+            wheels; and the full-turn joints a caster link rolls on): passive, and always
+            free.
         caster_links: Links other than the wheels that rest on the ground at the start (a
             fixed ball or skid under the base), by index.
         link_names: Name of every link index (-1 the base).
@@ -399,10 +400,11 @@ def detect_drivetrain(p: Bullet, body: int,
     link_names = {k: infos[k][12].decode("utf-8", "replace") for k in range(n)}
     link_names[-1] = p.getBodyInfo(body)[0].decode("utf-8", "replace")
     efforts = {j: float(infos[j][10]) for j in movable}
+    caster_links = _caster_links(scan, wheel_list, casters)
+    free = set(casters) | _caster_rollers(scan, caster_links, wheel_list, hinge_list)
     return Drivetrain(wheel_list, hinge_list, passive, names, hinge_limits, wheel_signs,
                       hinge_signs, mode, radius, contact, carried_by, pivot, in_base,
-                      [j for j in movable if j in set(casters)],
-                      _caster_links(scan, wheel_list, casters), link_names, efforts)
+                      [j for j in movable if j in free], caster_links, link_names, efforts)
 
 
 class _Scan:
@@ -577,6 +579,34 @@ def _caster_links(scan: _Scan, wheel_list: list[int], casters: list[int]) -> lis
             rolling.add(j)
     return [k for k in range(scan.n) if k not in rolling and scan.link_points[k]
             and min(pt[2] for pt in scan.link_points[k]) - scan.lowest <= 0.005]
+
+
+def _caster_rollers(scan: _Scan, caster_links: list[int], wheel_list: list[int],
+                    hinge_list: list[int]) -> set[int]:
+    """The full-turn joints a caster link rolls on: a ball caster modelled as joints.
+
+    Toyota's HSR models each passive wheel as a frame rolling about x, one about y and the ball
+    on a joint about z, each with an effort. Held at their start angles they lock the ball,
+    which then drags on the ground (HSR went 0.461 m where raw PyBullet with them free goes
+    0.792 m). Walking up from each caster link, every continuous joint is the caster's own,
+    until a joint that is not continuous or that also carries a wheel (a turning drive unit).
+    """
+    carrying: set[int] = set()
+    for w in wheel_list:
+        k = scan.infos[w][16]
+        while k >= 0:
+            carrying.add(k)
+            k = scan.infos[k][16]
+    rollers: set[int] = set()
+    for k in caster_links:
+        j = k
+        while j >= 0 and j not in carrying:
+            if j in scan.movable:
+                if not _is_continuous(scan.infos[j]) or j in wheel_list or j in hinge_list:
+                    break
+                rollers.add(j)
+            j = scan.infos[j][16]
+    return rollers
 
 
 def _forward(wheel_axes: list[Vec], base_x: Vec, base_y: Vec) -> Vec:

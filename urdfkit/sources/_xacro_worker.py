@@ -293,8 +293,12 @@ def main(argv: list[str]) -> int:
                   f"`packages` ({name}=PATH) or a folder holding it with `package_paths` (or "
                   "set ROS_PACKAGE_PATH)", file=sys.stderr)
             return 1
-        print(_message(e, list(getattr(sys.modules.get("xacro"), "filestack", None) or [])),
-              file=sys.stderr)
+        module = sys.modules.get("xacro")
+        read = [source, *(getattr(module, "all_includes", None) or [])]
+        text = _message(e, list(getattr(module, "filestack", None) or []))
+        if any(k in text for k in ("is not defined", "unknown macro name", "has no value")):
+            text += _unprefixed(read) or _defined_later(text, read)
+        print(text, file=sys.stderr)
         return 1
     finally:
         _kill_descendants()
@@ -363,6 +367,65 @@ def _message(e: BaseException, filestack: list[str] | None = None) -> str:
         return (f"$({unknown.group(1)}) is a ROS substitution urdfkit cannot run; without ROS "
                 f"only {', '.join(f'$({s})' for s in SUBSTITUTIONS)} work")
     return text
+
+
+#: The xacro commands ROS 1's xacro read without their ``xacro:`` prefix until 1.14 (Noetic).
+UNPREFIXED = ("macro", "property", "include", "arg", "insert_block", "if", "unless")
+
+
+def _unprefixed(files: list[str]) -> str:
+    """A note on the first xacro command written without ``xacro:`` in the files read, or "".
+
+    xacro 1.14 (ROS Noetic) and 2.x read only ``<xacro:macro>`` and its kind: a bare
+    ``<macro>`` is copied as plain XML, so its body's ``${param}`` is evaluated where no
+    parameter exists, and xacro fails with "name 'param' is not defined" and no file or line
+    (Toyota HSR's ``common.xacro``, written for Kinetic).
+    """
+    import re
+
+    pattern = re.compile(r"<(" + "|".join(UNPREFIXED) + r")[\s/>]")
+    for path in dict.fromkeys(files):
+        try:
+            with open(path, encoding="utf-8", errors="replace") as f:
+                for number, line in enumerate(f, 1):
+                    found = pattern.search(re.sub(r"<!--.*?(-->|$)", "", line))
+                    if found:
+                        tag = found.group(1)
+                        return (f"; {path}:{number} writes <{tag}> without the xacro: prefix, "
+                                "which xacro has needed since 1.14 (ROS Noetic): write "
+                                f"<xacro:{tag}> (and so for every bare xacro command there)")
+        except OSError:
+            continue
+    return ""
+
+
+def _defined_later(text: str, files: list[str]) -> str:
+    """Where the property xacro did not know is defined, when a file read defines it, or "".
+
+    xacro reads in order (the default since ROS Melodic, the only way since Noetic): a
+    ``<xacro:property>`` counts only below its definition. ABB YuMi's yumi.urdf.xacro
+    (OrebroUniversity/yumi) uses ``${yumi_parent}`` on line 16 and defines it on line 31.
+    """
+    import re
+
+    name = re.search(r"name '([A-Za-z_]\w*)' is not defined", text)
+    if name is None:
+        return ""
+    pattern = re.compile(r"<xacro:property\s[^>]*name\s*=\s*[\"']" + re.escape(name.group(1))
+                         + r"[\"']")
+    for path in dict.fromkeys(files):
+        try:
+            with open(path, encoding="utf-8", errors="replace") as f:
+                for number, line in enumerate(f, 1):
+                    if pattern.search(line):
+                        return (f"; {path}:{number} defines {name.group(1)!r}, but xacro "
+                                "knows a property only below its definition (it reads in "
+                                "order: the default since ROS Melodic, the only way since "
+                                "Noetic) and, defined in a macro, only inside it: move the "
+                                "definition above its first use")
+        except OSError:
+            continue
+    return ""
 
 
 def _declared_args(files: list[str]) -> set[str]:

@@ -573,8 +573,8 @@ def reference(tag: str, fn: str, base: Path | str,
             return Reference(str(path), str(data / fn), "U703", "warning", f"{label}: not "
                              "beside the file, found only in pybullet_data's search path; make "
                              "the path relative to the file")
-        return Reference(str(path), None, "U701", "error", f"{label}: file not found ({path}); "
-                         "PyBullet refuses a URDF whose mesh is missing")
+        return Reference(str(path), None, "U701", "error", f"{label}: file not found ({path})"
+                         f"{_near_miss(path)}; PyBullet refuses a URDF whose mesh is missing")
     if why is not None:
         return Reference(str(path), None, "U704", "error", f"{label}: {path} is {why}; "
                          "PyBullet hangs, aborts or fails on it")
@@ -600,6 +600,34 @@ def _folder_path(folder: str) -> Path:
     share its folder.
     """
     return Path(folder)
+
+
+def _near_miss(path: Path, limit: int = 2000) -> str:
+    """``"; beside it: 'torso.stl'"``: files beside ``path`` it may have meant, or "".
+
+    Those whose name differs only in case (``Link1.STL`` for ``link1.stl``, which a
+    case-insensitive file system forgave), or whose stem is the same with a mesh format's
+    suffix: Toyota HSR's hsrb4s.urdf names ``torso_v0/torso.std`` where the folder holds
+    ``torso.stl``. Not merely close names: ``link_1.stl`` is another part than ``link_2.stl``.
+    Only the missing file's own folder is read (bounded).
+    """
+    folder = path.parent
+    deps.note_listing(folder)
+    want, stem = path.name.lower(), path.stem.lower()
+    found: list[str] = []
+    try:
+        with os.scandir(folder) as it:
+            for count, entry in enumerate(it):
+                if count >= limit:
+                    break
+                name = entry.name.lower()
+                root, suffix = os.path.splitext(name)
+                if (name == want or (root == stem and suffix in MESH_FORMATS)) \
+                        and entry.is_file():
+                    found.append(entry.name)
+    except OSError:
+        return ""
+    return "; beside it: " + " or ".join(repr(n) for n in sorted(found)) if found else ""
 
 
 def _only_through_package_xml(fn: str, base: Path, package: str | None,
