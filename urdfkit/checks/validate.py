@@ -838,7 +838,12 @@ def _coupled_damping(doc: Doc, links: dict[str, LinkView], below: dict[str, list
         return
     names, m = got
     index = {n: i for i, n in enumerate(names)}
-    rows = [(index[jv.name], jv, b, dyn) for jv, b, dyn in damped if jv.name in index]
+    # Only the joints stable alone: the motions among them (the principal submatrix of
+    # dt B^1/2 M^-1 B^1/2 over them, whose largest eigenvalue is at most the whole one's, so
+    # each motion found is unstable in the whole too). A joint found alone is said already,
+    # and over the rest the cheap bound below usually ends it (kuka_iiwa: no numpy).
+    rows = [(index[jv.name], jv, b, dyn) for jv, b, dyn in damped
+            if jv.name in index and jv.name not in found]
     low = _cholesky(m)
     if not rows or low is None:
         return
