@@ -386,7 +386,10 @@ def test_a_file_written_just_before_a_run_is_read_again(cache: Path, tmp_path: P
                                                         monkeypatch: pytest.MonkeyPatch) -> None:
     # Within the clock's grain an edit can keep a file's stat (git's "racily clean" entry):
     # a file modified less than two seconds before the run that recorded it is never trusted.
-    robot = tmp_path / "r.urdf"
+    # (In a folder of its own: the missing mesh's U701 depends on its folder's listing, which
+    # the cache folder appearing in tmp_path would change.)
+    robot = tmp_path / "robot" / "r.urdf"
+    robot.parent.mkdir()
     robot.write_text(ARM.format(mesh="missing.stl"))
     check_paths([robot], jobs=1)
     hits = _manifest_hits(monkeypatch)
