@@ -984,9 +984,11 @@ def _mass_matrix(doc: Doc, links: dict[str, LinkView], below: dict[str, list[Any
                    a[0] * r_[1] - a[1] * r_[0])
             cols.append((i, lin, a, rotate(tensor, a)))
         for i, lin_i, _, iw_i in cols:
-            for j, lin_j, w_j, _ in cols:
-                m[i][j] += mass * sum(x * y for x, y in zip(lin_i, lin_j, strict=True)) \
-                    + sum(x * y for x, y in zip(iw_i, w_j, strict=True))
+            row = m[i]
+            for j, lin_j, w_j, _ in cols:  # the dot products written out: the rule's hot loop
+                row[j] += mass * (lin_i[0] * lin_j[0] + lin_i[1] * lin_j[1]
+                                  + lin_i[2] * lin_j[2]) \
+                    + (iw_i[0] * w_j[0] + iw_i[1] * w_j[1] + iw_i[2] * w_j[2])
     return names, m
 
 
