@@ -55,6 +55,36 @@ def pb() -> Iterator[tuple[object, int]]:
 
 
 @pytest.fixture
+def free_swing(pb: tuple[object, int]) -> Callable[[Path, float], tuple[float, list[float]]]:
+    """Raw PyBullet on a one-joint robot, base fixed, with its file's inertia: ``M_00`` at the
+    zero pose, and the joint's speeds over 8 steps of ``dt`` under gravity, motor and link
+    damping off (only the joint damping and gravity act)."""
+    from urdfkit.engine.session import quiet_stdout
+
+    p: Any
+    p, c = pb
+
+    def swing(path: Path, dt: float) -> tuple[float, list[float]]:
+        p.resetSimulation(physicsClientId=c)
+        with quiet_stdout():
+            body = p.loadURDF(str(path), useFixedBase=True, flags=p.URDF_USE_INERTIA_FROM_FILE,
+                              physicsClientId=c)
+        inertia = p.calculateMassMatrix(body, [0.0], physicsClientId=c)[0][0]
+        p.setGravity(0, 0, -9.81, physicsClientId=c)
+        p.setTimeStep(dt, physicsClientId=c)
+        p.setJointMotorControl2(body, 0, p.VELOCITY_CONTROL, force=0, physicsClientId=c)
+        for link in (-1, 0):
+            p.changeDynamics(body, link, linearDamping=0, angularDamping=0, physicsClientId=c)
+        speeds = []
+        for _ in range(8):
+            p.stepSimulation(physicsClientId=c)
+            speeds.append(p.getJointState(body, 0, physicsClientId=c)[1])
+        return inertia, speeds
+
+    return swing
+
+
+@pytest.fixture
 def raw_loads() -> Callable[[Path], bool]:
     """Whether raw PyBullet loads a URDF: ``p.loadURDF(path)``, nothing else, in a child
     process (its C text goes to fd 1; a crash stays there)."""

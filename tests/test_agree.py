@@ -212,26 +212,13 @@ def test_a_model_pybullet_cannot_take_the_mass_matrix_of_is_compared_on_the_rest
 STIFF_DAMPING = Path(__file__).parent / "fixtures" / "robots" / "stiff_damping.urdf"
 
 
-def test_a_swing_joint_damping_makes_unstable_is_said_so_not_failed(pb, tmp_path: Path) -> None:
+def test_a_swing_joint_damping_makes_unstable_is_said_so_not_failed(free_swing,
+                                                                     tmp_path: Path) -> None:
     """The Shadow hand: its swing "failed" by 1.4 rad in 3 ms, as if the export were wrong.
     Raw PyBullet steps joint damping explicitly: at dt x damping / inertia = 20 the finger's
     speed flips sign every step and runs to PyBullet's 100 rad/s cap (MuJoCo, uncapped, runs
     on). agree now says the swing cannot be compared, and why; below 2 it still compares."""
-    from urdfkit.engine.session import quiet_stdout
-
-    p, c = pb
-    with quiet_stdout():
-        body = p.loadURDF(str(STIFF_DAMPING), useFixedBase=True,
-                          flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=c)
-    p.setGravity(0, 0, -9.81, physicsClientId=c)
-    p.setTimeStep(0.001, physicsClientId=c)
-    p.setJointMotorControl2(body, 0, p.VELOCITY_CONTROL, force=0, physicsClientId=c)
-    for link in (-1, 0):
-        p.changeDynamics(body, link, linearDamping=0, angularDamping=0, physicsClientId=c)
-    speeds = []
-    for _ in range(8):
-        p.stepSimulation(physicsClientId=c)
-        speeds.append(p.getJointState(body, 0, physicsClientId=c)[1])
+    _, speeds = free_swing(STIFF_DAMPING, 0.001)
     assert all(a * b < 0 for a, b in zip(speeds[1:], speeds[2:], strict=False)), speeds
     assert max(map(abs, speeds)) == pytest.approx(100.0)  # gravity alone: ~0.4 rad/s
 

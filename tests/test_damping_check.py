@@ -16,37 +16,14 @@ runner = CliRunner()
 STIFF = Path(__file__).parent / "fixtures" / "robots" / "stiff_damping.urdf"
 
 
-def _raw(path: Path, pb) -> tuple[float, list[float]]:
-    """Raw PyBullet: M_ii at the zero pose, and the free joint's speeds over 8 steps of 1/240 s
-    (motor off, link damping off, so only the joint damping and gravity act)."""
-    from urdfkit.engine.session import quiet_stdout
-
-    p, c = pb
-    p.resetSimulation(physicsClientId=c)
-    with quiet_stdout():
-        body = p.loadURDF(str(path), useFixedBase=True, flags=p.URDF_USE_INERTIA_FROM_FILE,
-                          physicsClientId=c)
-    inertia = p.calculateMassMatrix(body, [0.0], physicsClientId=c)[0][0]
-    p.setGravity(0, 0, -9.81, physicsClientId=c)
-    p.setTimeStep(1 / 240, physicsClientId=c)
-    p.setJointMotorControl2(body, 0, p.VELOCITY_CONTROL, force=0, physicsClientId=c)
-    for link in (-1, 0):
-        p.changeDynamics(body, link, linearDamping=0, angularDamping=0, physicsClientId=c)
-    speeds = []
-    for _ in range(8):
-        p.stepSimulation(physicsClientId=c)
-        speeds.append(p.getJointState(body, 0, physicsClientId=c)[1])
-    return inertia, speeds
-
-
 def _u311(path: Path) -> list[dict]:
     r = runner.invoke(app, ["check", str(path), "--json"])
     assert r.exit_code in (0, 1), r.output
     return [f for f in json.loads(r.stdout)["findings"] if f["code"] == "U311"]
 
 
-def test_damping_pybullet_cannot_step_is_found_with_pybullets_inertia(pb) -> None:
-    inertia, speeds = _raw(STIFF, pb)
+def test_damping_pybullet_cannot_step_is_found_with_pybullets_inertia(free_swing) -> None:
+    inertia, speeds = free_swing(STIFF, 1 / 240)
     # raw PyBullet: the speed flips sign every step and runs to the 100 rad/s cap
     assert all(a * b < 0 for a, b in zip(speeds[1:], speeds[2:], strict=False)), speeds
     assert max(map(abs, speeds)) == pytest.approx(100.0)
@@ -60,11 +37,11 @@ def test_damping_pybullet_cannot_step_is_found_with_pybullets_inertia(pb) -> Non
     assert rate == pytest.approx(0.1 / 240 / inertia, rel=5e-3)
 
 
-def test_damping_pybullet_steps_stably_is_not_found(pb, tmp_path: Path) -> None:
+def test_damping_pybullet_steps_stably_is_not_found(free_swing, tmp_path: Path) -> None:
     # a hundredth of the damping: 0.83 per step, under 2
     calm = tmp_path / "calm.urdf"
     calm.write_text(STIFF.read_text().replace('damping="0.1"', 'damping="0.001"'))
-    inertia, speeds = _raw(calm, pb)
+    inertia, speeds = free_swing(calm, 1 / 240)
     assert 0.001 / 240 / inertia < 2
     assert all(a * b > 0 for a, b in zip(speeds[1:], speeds[2:], strict=False)), speeds
     # it settles at the damped terminal speed, gravity's torque over the damping: m g d / b
@@ -72,7 +49,7 @@ def test_damping_pybullet_steps_stably_is_not_found(pb, tmp_path: Path) -> None:
     assert _u311(calm) == []
 
 
-def test_an_inertia_pybullet_zeroes_counts_as_zero(pb, tmp_path: Path) -> None:
+def test_an_inertia_pybullet_zeroes_counts_as_zero(free_swing, tmp_path: Path) -> None:
     # The finger's izz over ixx + iyy (no rigid body has it): PyBullet's importer warns "Bad
     # inertia tensor properties" and zeroes the tensor (the Allegro hand's fingers in
     # example-robot-data). About the y axis the file says 2e-6 + 0.01 x 0.02^2 = 6e-6 kg m^2;
@@ -81,7 +58,7 @@ def test_an_inertia_pybullet_zeroes_counts_as_zero(pb, tmp_path: Path) -> None:
     bad.write_text(STIFF.read_text().replace(
         'ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"',
         'ixx="1e-6" ixy="0" ixz="0" iyy="2e-6" iyz="0" izz="5e-6"'))
-    inertia, speeds = _raw(bad, pb)
+    inertia, speeds = free_swing(bad, 1 / 240)
     assert inertia == pytest.approx(0.01 * 0.02**2, rel=1e-6)
     assert max(map(abs, speeds)) == pytest.approx(100.0)
     found = _u311(bad)

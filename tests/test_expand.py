@@ -184,12 +184,25 @@ def test_check_no_exec_reports_each_xacro(tmp_path: Path) -> None:
     os.environ.pop(NO_EXEC_ENV, None)
 
 
+def _raw_xacro_error(top: Path) -> str:
+    """What raw xacro (``xacro.process_file``, run from the file's folder) fails with."""
+    import xacro
+
+    cwd = os.getcwd()
+    os.chdir(top.parent)
+    try:
+        with pytest.raises(Exception) as raw:
+            xacro.process_file(str(top))
+    finally:
+        os.chdir(cwd)
+    return str(raw.value)
+
+
 def test_an_include_of_a_missing_file_names_it_once_and_its_includer(tmp_path: Path) -> None:
     """Doosan's m1013.urdf.xacro with gripper:=robotiq_2f includes a file one folder off:
     the error said the path twice (xacro's text, then the OSError's) and not which file
     included it. Raw xacro fails on the same path; urdfkit now names it once, with the file
     whose <xacro:include> named it (here one include deep)."""
-    import xacro
 
     ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
     top = tmp_path / "top.urdf.xacro"
@@ -197,14 +210,8 @@ def test_an_include_of_a_missing_file_names_it_once_and_its_includer(tmp_path: P
                    '<xacro:include filename="parts.xacro"/></robot>')
     (tmp_path / "parts.xacro").write_text(f'<robot {ns}><xacro:include filename="gone.xacro"/>'
                                           "</robot>")
-    cwd = os.getcwd()
-    os.chdir(tmp_path)
-    try:
-        with pytest.raises(Exception) as raw:
-            xacro.process_file(str(top))
-    finally:
-        os.chdir(cwd)
-    assert "gone.xacro" in str(raw.value)  # raw xacro fails on the same file
+    raw = _raw_xacro_error(top)
+    assert "gone.xacro" in raw  # raw xacro fails on the same file
     with pytest.raises(InputError) as ours:
         expand_xacro(top, timeout=20)
     message = str(ours.value)
@@ -219,7 +226,6 @@ def test_dirname_is_said_to_fail_as_raw_xacro_fails(tmp_path: Path, where: str) 
     but xacro 2.1.1 never tells its substitutions which file they stand in and refuses it
     everywhere (youBot-style `$(dirname)/...` paths). The refusal now says so and what to
     write instead; the advice no longer lists it."""
-    import xacro
 
     ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
     body = ('<xacro:property name="d" value="$(dirname)"/><link name="a"><visual><geometry>'
@@ -229,9 +235,8 @@ def test_dirname_is_said_to_fail_as_raw_xacro_fails(tmp_path: Path, where: str) 
     top = tmp_path / "top.urdf.xacro"
     top.write_text(f'<robot name="r" {ns}>{body}</robot>')
     (tmp_path / "parts.xacro").write_text(f'<robot {ns}><link name="b"/></robot>')
-    with pytest.raises(Exception) as raw:
-        xacro.process_file(str(top))
-    assert "Cannot substitute $(dirname)" in str(raw.value)  # raw xacro refuses it too
+    raw = _raw_xacro_error(top)
+    assert "Cannot substitute $(dirname)" in raw  # raw xacro refuses it too
     r = runner.invoke(app, ["build", str(top), "-o", str(tmp_path / "out.urdf")])
     assert r.exit_code == 2
     assert "$(dirname) does not work" in r.stderr and "$(find PACKAGE)" in r.stderr, r.stderr
@@ -247,7 +252,6 @@ def test_a_bare_xacro_macro_is_named_with_its_file_and_line(tmp_path: Path) -> N
     (Noetic): the bare macro is copied as XML, its `${joint}` evaluated where no `joint`
     exists, and raw xacro fails with "name 'joint' is not defined", naming no file. urdfkit
     fails the same way and now names the file and line of the bare command and the fix."""
-    import xacro
 
     ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
     top = tmp_path / "robot.urdf.xacro"
@@ -257,15 +261,9 @@ def test_a_bare_xacro_macro_is_named_with_its_file_and_line(tmp_path: Path) -> N
         f'<robot {ns}>\n  <!-- <macro> in a comment is not one -->\n'
         '  <macro name="transmission" params="joint">\n'
         '    <transmission name="${joint}_transmission"/>\n  </macro>\n</robot>\n')
-    cwd = os.getcwd()
-    os.chdir(tmp_path)
-    try:
-        with pytest.raises(Exception) as raw:
-            xacro.process_file(str(top))
-    finally:
-        os.chdir(cwd)
-    assert "name 'joint' is not defined" in str(raw.value)  # raw xacro, and no file named
-    assert "common.xacro" not in str(raw.value)
+    raw = _raw_xacro_error(top)
+    assert "name 'joint' is not defined" in raw  # raw xacro, and no file named
+    assert "common.xacro" not in raw
     with pytest.raises(InputError) as ours:
         expand_xacro(top, timeout=20)
     message = str(ours.value)
@@ -283,17 +281,15 @@ def test_a_property_used_above_its_definition_is_named(tmp_path: Path) -> None:
     defines it on line 31, as xacro before in-order reading allowed. Raw xacro fails with
     "name 'yumi_parent' is not defined" and no file; urdfkit now says where it is defined and
     why that is too late, and moving it up (the advice) expands."""
-    import xacro
 
     ns = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
     use = '<link name="${parent}"/>\n'
     define = '<xacro:property name="parent" value="world"/>\n'
     top = tmp_path / "robot.urdf.xacro"
     top.write_text(f'<robot name="r" {ns}>\n{use}{define}</robot>\n')
-    with pytest.raises(Exception) as raw:
-        xacro.process_file(str(top))
-    assert "name 'parent' is not defined" in str(raw.value)
-    assert "robot.urdf.xacro" not in str(raw.value)
+    raw = _raw_xacro_error(top)
+    assert "name 'parent' is not defined" in raw
+    assert "robot.urdf.xacro" not in raw
     with pytest.raises(InputError) as ours:
         expand_xacro(top, timeout=20)
     assert f"{top}:3 defines 'parent', but xacro knows a property only below its definition" \
