@@ -192,9 +192,8 @@ def plain_lighting(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPat
         monkeypatch.setenv("URDFKIT_VIEW_ENVIRONMENT", "none")
 
 
-@pytest.fixture
-def chromium() -> Any:
-    """Debian's Chromium under Playwright (software WebGL); closed after the test.
+def _chromium() -> Iterator[Any]:
+    """Debian's Chromium under Playwright (software WebGL), closed at the end.
 
     A skip where there is none; CI installs it (.ci/run), and URDFKIT_CI=1 fails the skip.
     """
@@ -211,3 +210,15 @@ def chromium() -> Any:
             yield b
         finally:
             b.close()
+
+
+@pytest.fixture
+def chromium() -> Iterator[Any]:
+    """:func:`_chromium` for one test."""
+    yield from _chromium()
+
+
+@pytest.fixture(scope="module")
+def module_chromium() -> Iterator[Any]:
+    """:func:`_chromium` shared by a module's tests (each closes the pages it opens)."""
+    yield from _chromium()

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -33,9 +32,6 @@ from urdfkit.draw import view_page  # noqa: E402
 from urdfkit.draw.view import TINTS, TOUCHING_RGB, Viewer  # noqa: E402
 
 DOCS = Path(__file__).parent.parent / "docs"
-CHROMIUM = os.environ.get("URDFKIT_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
-#: Software WebGL: what a CI machine without a GPU has.
-CHROMIUM_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 
 #: Green visuals, so robot pixels are told from the white page and grey grid.
 ARM = """<?xml version="1.0"?>
@@ -394,21 +390,8 @@ def test_xacro_with_args(tmp_path: Path, viewer_of: Any) -> None:
 # --------------------------------------------------------------------------- the page
 
 
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    """Debian's Chromium under Playwright; the page tests skip, saying why, without it."""
-    if not os.path.exists(CHROMIUM):
-        pytest.skip(f"no Chromium at {CHROMIUM}: apt-get install -y chromium (CI does)")
-    sync_api = pytest.importorskip("playwright.sync_api",
-                                   reason="pip install playwright (in urdfkit[test])")
-    with sync_api.sync_playwright() as pw:
-        b = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        yield b
-        b.close()
-
-
 @pytest.fixture
-def page_of(browser: Any) -> Iterator[Any]:
+def page_of(module_chromium: Any) -> Iterator[Any]:
     """Open a viewer's page, connected; every page a test opens is closed after it.
 
     A page left open keeps drawing WebGL in software: a dozen of them starved the last
@@ -417,7 +400,7 @@ def page_of(browser: Any) -> Iterator[Any]:
     opened: list[Any] = []
 
     def open_page(v: Viewer) -> Any:
-        page = browser.new_page(viewport={"width": 1000, "height": 700})
+        page = module_chromium.new_page(viewport={"width": 1000, "height": 700})
         opened.append(page)
         page.goto(v.url)
         page.get_by_text("Connected").wait_for(timeout=30000)
