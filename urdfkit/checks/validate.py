@@ -899,8 +899,7 @@ def _zero_pose_tree(doc: Doc, links: dict[str, LinkView], below: dict[str, list[
     roots = [n for n in links if n not in children]
     if len(roots) != 1:
         return None
-    identity: Matrix3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-    frame: dict[str, Any] = {roots[0]: (identity, (0.0, 0.0, 0.0))}
+    frame: dict[str, Any] = {roots[0]: (_IDENTITY, (0.0, 0.0, 0.0))}
     chain: dict[str, Chain] = {roots[0]: []}
     names: list[str] = []
     order: list[str] = []
@@ -911,23 +910,16 @@ def _zero_pose_tree(doc: Doc, links: dict[str, LinkView], below: dict[str, list[
         rot, pos = frame[name]
         for jv in below.get(name, ()):
             child = jv.child.get("link") if jv.child is not None else None
-            xyz = _vec(jv.origin, "xyz", 3, (0.0, 0.0, 0.0))
-            rpy = _vec(jv.origin, "rpy", 3, (0.0, 0.0, 0.0))
-            if child is None or child in frame or child not in links or xyz is None \
-                    or rpy is None:
+            placed = _child_frame(jv, rot, pos)
+            if child is None or child in frame or child not in links or placed is None:
                 return None
-            crot = matmul(rot, rpy_to_matrix(rpy))
-            cpos = tuple(p + o for p, o in zip(pos, rotate(rot, xyz), strict=True))
-            frame[child] = (crot, cpos)
+            crot, cpos = frame[child] = placed
             chain[child] = list(chain[name])
             if jv.type in ("revolute", "continuous", "prismatic"):
-                axis = _vec(jv.axis, "xyz", 3, (1.0, 0.0, 0.0))
+                axis = _unit_axis(jv)
                 if axis is None or jv.name is None:
                     return None
-                norm = math.sqrt(sum(x * x for x in axis))
-                if norm == 0.0:
-                    return None
-                world = rotate(crot, tuple(x / norm for x in axis))
+                world = rotate(crot, axis)
                 chain[child].append((len(names), world, cpos, jv.type == "prismatic"))
                 names.append(jv.name)
             stack.append(child)
@@ -951,29 +943,17 @@ def _mass_matrix(doc: Doc, links: dict[str, LinkView], below: dict[str, list[Any
     n = len(names)
     if n == 0 or n > 200:
         return None
-    identity: Matrix3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
     m = [[0.0] * n for _ in range(n)]
     for name in order:
         above = chain[name]
         if not above:
             continue
-        lv = links[name]
-        mass = _mass_of(lv)
-        rot, pos = frame[name]
-        if mass is None:
+        body = _link_inertia(links[name], *frame[name])
+        if body is None:
             return None
-        com: tuple[float, ...] = pos
-        tensor: Matrix3 = identity
-        if lv.inertial is not None:
-            origin = first(lv.inertial, "origin")
-            xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
-            rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
-            t = _loaded_tensor(lv.inertia)
-            if xyz is None or rpy is None or t is None:
-                return None
-            turn = matmul(rot, rpy_to_matrix(rpy))
-            com = tuple(p + o for p, o in zip(pos, rotate(rot, xyz), strict=True))
-            tensor = matmul(matmul(turn, t), transpose(turn))
+        mass, com, turn, t = body
+        # in the world frame (the unit inertia of a link without <inertial> is so everywhere)
+        tensor = t if t is _IDENTITY else matmul(matmul(turn, t), transpose(turn))
         cols: list[tuple[int, tuple[float, ...], tuple[float, ...], tuple[float, ...]]] = []
         for i, a, at, prismatic in above:
             if prismatic:
@@ -1035,6 +1015,51 @@ def _loaded_tensor(inertia: etree._Element | None) -> Matrix3 | None:
     return cast(Matrix3, tensor)
 
 
+_IDENTITY: Matrix3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def _link_inertia(lv: LinkView, rot: Matrix3, pos: tuple[float, ...]
+                  ) -> tuple[float, tuple[float, ...], Matrix3, Matrix3] | None:
+    """(mass, centre of mass, the inertia's frame, its tensor there) of a link at (rot, pos).
+
+    As PyBullet loads the file with its inertia: without ``<inertial>`` 1 kg (0 for
+    ``world``) and :data:`_IDENTITY` at the link's frame. None where a number does not read.
+    """
+    mass = _mass_of(lv)
+    if mass is None:
+        return None
+    if lv.inertial is None:
+        return mass, pos, rot, _IDENTITY
+    origin = first(lv.inertial, "origin")
+    xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
+    rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
+    tensor = _loaded_tensor(lv.inertia)
+    if xyz is None or rpy is None or tensor is None:
+        return None
+    return (mass, tuple(p + o for p, o in zip(pos, rotate(rot, xyz), strict=True)),
+            matmul(rot, rpy_to_matrix(rpy)), tensor)
+
+
+def _child_frame(jv: Any, rot: Matrix3, pos: tuple[float, ...]
+                 ) -> tuple[Matrix3, tuple[float, ...]] | None:
+    """The frame of joint ``jv``'s child link at q = 0, its parent's being (rot, pos)."""
+    xyz = _vec(jv.origin, "xyz", 3, (0.0, 0.0, 0.0))
+    rpy = _vec(jv.origin, "rpy", 3, (0.0, 0.0, 0.0))
+    if xyz is None or rpy is None:
+        return None
+    return (matmul(rot, rpy_to_matrix(rpy)),
+            tuple(p + o for p, o in zip(pos, rotate(rot, xyz), strict=True)))
+
+
+def _unit_axis(jv: Any) -> tuple[float, ...] | None:
+    """Joint ``jv``'s axis as a unit vector (x when absent); None when unreadable or zero."""
+    axis = _vec(jv.axis, "xyz", 3, (1.0, 0.0, 0.0))  # None only when unreadable (U401)
+    if axis is None:
+        return None
+    norm = math.sqrt(sum(x * x for x in axis))
+    return None if norm == 0 else tuple(x / norm for x in axis)
+
+
 def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[Any]],
                    enough: float = math.inf) -> float | None:
     """``M_ii`` of joint ``jv`` at the zero pose, as PyBullet loads the file with its inertia.
@@ -1043,18 +1068,13 @@ def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[An
     The sum stops once it passes ``enough`` while no link's term was negative (only an
     invalid tensor gives one): the caller only asks whether it stays under.
     """
-    axis = _vec(jv.axis, "xyz", 3, (1.0, 0.0, 0.0))  # None only when unreadable (U401)
-    if axis is None:
+    a = _unit_axis(jv)
+    if a is None:
         return None
-    norm = math.sqrt(sum(a * a for a in axis))
-    if norm == 0:
-        return None
-    a = tuple(x / norm for x in axis)
     prismatic = jv.type == "prismatic"
-    identity: Matrix3 = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
     # frames relative to the joint's own (its child link's frame at q = 0)
     todo: list[tuple[str | None, Matrix3, tuple[float, ...]]] = [
-        (jv.child.get("link"), identity, (0.0, 0.0, 0.0))]
+        (jv.child.get("link"), _IDENTITY, (0.0, 0.0, 0.0))]
     seen: set[str] = set()
     total = 0.0
     while todo:
@@ -1062,24 +1082,10 @@ def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[An
         if name is None or name in seen or name not in links:
             return None
         seen.add(name)
-        lv = links[name]
-        mass = _mass_of(lv)
-        if mass is None:
+        body = _link_inertia(links[name], rot, pos)
+        if body is None:
             return None
-        if lv.inertial is None:
-            com, tensor = pos, ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-            frame = rot
-        else:
-            origin = first(lv.inertial, "origin")
-            xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
-            rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
-            tensor_or_none = _loaded_tensor(lv.inertia)
-            if xyz is None or rpy is None or tensor_or_none is None:
-                return None
-            tensor = tensor_or_none
-            off = rotate(rot, xyz)
-            com = tuple(p + o for p, o in zip(pos, off, strict=True))
-            frame = matmul(rot, rpy_to_matrix(rpy))
+        mass, com, frame, tensor = body
         if prismatic:
             term = mass
         else:
@@ -1093,15 +1099,11 @@ def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[An
         elif total > enough:
             return total
         for child in below.get(name, ()):
-            origin = child.origin
-            xyz = _vec(origin, "xyz", 3, (0.0, 0.0, 0.0))
-            rpy = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0))
-            if xyz is None or rpy is None:
+            placed = _child_frame(child, rot, pos)
+            if placed is None:
                 return None
-            off = rotate(rot, xyz)
             todo.append((child.child.get("link") if child.child is not None else None,
-                         matmul(rot, rpy_to_matrix(rpy)),
-                         tuple(p + o for p, o in zip(pos, off, strict=True))))
+                         *placed))
     return total
 
 
