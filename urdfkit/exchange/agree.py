@@ -297,6 +297,18 @@ def _full_mass_matrix(mj: Any, m: Any, d: Any, out: Any) -> None:
         mj.mj_fullM(m, out, d.qM)
 
 
+def _joint_mass_matrix(mj: Any, m: Any, d: Any, dof: list[int]) -> Any:
+    """MuJoCo's joint-space mass matrix at ``d``'s pose, over the degrees of freedom ``dof``."""
+    import numpy as np
+
+    mj.mj_kinematics(m, d)
+    mj.mj_comPos(m, d)
+    mj.mj_crb(m, d)
+    full = np.zeros((m.nv, m.nv))
+    _full_mass_matrix(mj, m, d, full)
+    return full[np.ix_(dof, dof)]
+
+
 def _frame_error(a: Any, b: Any) -> tuple[float, float]:
     import numpy as np
 
@@ -546,12 +558,7 @@ class _Compare:
         finally:
             pb.b.setGravity(*map(float, m.opt.gravity))
         self.set_q(d, {n: q[n] for n in self.matched}, qd)
-        mj.mj_kinematics(m, d)
-        mj.mj_comPos(m, d)
-        mj.mj_crb(m, d)
-        full = np.zeros((m.nv, m.nv))
-        _full_mass_matrix(mj, m, d, full)
-        mm = full[np.ix_(dof, dof)]
+        mm = _joint_mass_matrix(mj, m, d, dof)
         scale = max(float(np.abs(pm).max()), 1e-300)
         e = np.abs(pm - mm) / scale
         mass = (float(e.max()), pb.names[int(np.unravel_index(e.argmax(), e.shape)[0])])
@@ -761,12 +768,7 @@ class _Compare:
         damping = np.array([float(m.dof_damping[i]) for i in dof])
         if not damping.any():
             return ""
-        mj.mj_kinematics(m, d)
-        mj.mj_comPos(m, d)
-        mj.mj_crb(m, d)
-        full = np.zeros((m.nv, m.nv))
-        _full_mass_matrix(mj, m, d, full)
-        mass = full[np.ix_(dof, dof)]
+        mass = _joint_mass_matrix(mj, m, d, dof)
         dt = self.o.time_step
         try:
             rate = float(np.linalg.eigvals(np.linalg.solve(mass, np.diag(damping))).real.max())
