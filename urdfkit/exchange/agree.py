@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from urdfkit.core.errors import EngineError, InputError, MissingDependencyError
+from urdfkit.exchange.agree_tree import match_models, tree_errors
 from urdfkit.exchange.fk import fused, link_frames
 from urdfkit.exchange.mjcf import combine
 from urdfkit.exchange.robot import Inertial, Robot
@@ -42,6 +43,7 @@ TOL_FK = 1e-12             # against double-precision forward kinematics
 TOL_DYNAMICS = 1e-9        # mass matrix, inverse dynamics, relative
 TOL_SWING = 1e-9           # rad over the free swing
 LIMIT_MARGIN = 0.01        # rad: the swing is compared until a joint comes this close
+_ZERO3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 #: What MuJoCo warned while loading the last model (see :func:`load_mjcf`).
 LOAD_WARNINGS: list[str] = []
 
@@ -77,6 +79,8 @@ class AgreeOptions:
         seed: The poses' seed.
         seconds: The free swing's length.
         time_step: Its step.
+        name_map: URDF link or joint name -> MJCF body, site or joint name, for pairs whose
+            names differ (``--map``); the rest match by name, then by the tree's shape.
     """
 
     fixed_base: bool = False
@@ -86,6 +90,7 @@ class AgreeOptions:
     seed: int = 0
     seconds: float = 1.0
     time_step: float = 1e-3
+    name_map: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass
@@ -98,6 +103,8 @@ class Agreement:
     unmatched_links: list[str] = field(default_factory=list)
     unmatched_joints: list[str] = field(default_factory=list)
     extra_joints: list[str] = field(default_factory=list)
+    #: pairs not matched by name: {"urdf", "mjcf", "how": "map" | "structure"}
+    matched_by: list[dict[str, str]] = field(default_factory=list)
     load_flags: list[str] = field(default_factory=list)
     #: What MuJoCo said while loading the model (its decoders' warnings).
     warnings: list[str] = field(default_factory=list)
@@ -328,10 +335,13 @@ class _Compare:
         self.result = Agreement(robot.file, model_path, load_flags=self.pb.flags,
                                 warnings=list(LOAD_WARNINGS))
         m = self.fixed
-        self.jnt = {_name(m, mujoco.mjtObj.mjOBJ_JOINT, i): i for i in range(m.njnt)}
-        self.body = {_name(m, mujoco.mjtObj.mjOBJ_BODY, i): i for i in range(m.nbody)}
-        self.site = {_name(m, mujoco.mjtObj.mjOBJ_SITE, i): i for i in range(m.nsite)}
-        self.body.pop("world", None)
+        #: URDF names -> MuJoCo ids: by name, by ``--map``, then by the tree's shape
+        self.match = match_models(mujoco, m, robot, self.pb.names, options.name_map)
+        self.jnt = self.match.joints
+        self.body = self.match.bodies
+        self.site = self.match.sites
+        self.result.matched_by = [{"urdf": a, "mjcf": b, "how": how}
+                                  for a, b, how in self.match.pairs]
         self.matched = [n for n in self.pb.names if n in self.jnt]
         # PyBullet's world has no gravity until set: MuJoCo's, for inverse dynamics and swing
         self.pb.b.setGravity(*map(float, self.fixed.opt.gravity))
@@ -348,52 +358,98 @@ class _Compare:
         got = "free joint" if free else "welded"
         res.add("structure", "base", None, None, "", f"PyBullet: {want}; MJCF: {got}",
                 "pass" if want == got else "fail")
-        mj_names = [n for n in self.jnt if m.jnt_type[self.jnt[n]] != mj.mjtJoint.mjJNT_FREE]
-        res.unmatched_joints = [n for n in pb.names if n not in self.jnt]
-        res.extra_joints = [n for n in mj_names if n not in pb.names]
-        missing = res.unmatched_joints + [f"+{n}" for n in res.extra_joints]
-        res.add("structure", "joint names", float(len(missing)), 0.0, "unmatched",
-                ", ".join(missing[:6]) + (" ..." if len(missing) > 6 else ""))
-        order = [n for n in mj_names if n in pb.names]
-        bad = next((a for a, b in zip(order, self.matched, strict=True) if a != b), "")
-        res.add("structure", "joint order", 0.0 if not bad else 1.0, 0.0, "moved",
-                f"first out of place: {bad}" if bad else "")
-        joints = {j.name: j for j in self.robot.joints}
-        kinds = {0: mj.mjtJoint.mjJNT_HINGE, 1: mj.mjtJoint.mjJNT_SLIDE,
-                 2: mj.mjtJoint.mjJNT_BALL}
-        wrong, limits, damping = [], [], []
-        for i, n in zip(pb.movable, pb.names, strict=True):
-            if n not in self.jnt:
-                continue
-            info, k = pb.info[i], self.jnt[n]
-            if int(kinds[info[2]]) != int(m.jnt_type[k]):
-                wrong.append(n)
-            if info[2] == 2:
-                continue  # a ball joint has no limits or damping PyBullet reads
-            # PyBullet limits a revolute or prismatic joint with lower <= upper, never a
-            # continuous one (getJointInfo shows a continuous joint's <limit> all the same)
-            pb_limited = joints[n].limited
-            if pb_limited and joints[n].lower == joints[n].upper and not m.jnt_limited[k]:
-                pass  # locked: MuJoCo has no empty range (export holds it with an equality)
-            elif pb_limited != bool(m.jnt_limited[k]):
-                limits.append((math.inf, n))
-            elif pb_limited:
-                limits.append((max(abs(info[8] - m.jnt_range[k][0]),
-                                   abs(info[9] - m.jnt_range[k][1])), n))
-            if int(kinds[info[2]]) == int(m.jnt_type[k]):
-                damping.append((abs(info[6] - m.dof_damping[m.jnt_dofadr[k]]), n))
-        res.add("structure", "joint kinds", float(len(wrong)), 0.0, "differ", ", ".join(wrong))
+        self.joint_rows()
         mimic = [f"{j.name} = {j.mimic[1]:g} x {j.mimic[0]} + {j.mimic[2]:g}"
                  for j in self.robot.movable() if j.mimic is not None and j.name in self.jnt]
         if mimic:
             res.add("structure", "mimic joints", float(len(mimic)), None, "known",
                     "PyBullet ignores <mimic>; an MJCF equality means it: " + "; ".join(mimic),
                     status="known")
-        v, d = _worst(limits)
-        res.add("structure", "joint limits", v, TOL_EXACT, "rad|m", d)
-        v, d = _worst(damping)
-        res.add("structure", "joint damping", v, TOL_EXACT, "N m s/rad", d)
         self.masses()
+        errors, groups = tree_errors(mj, self.model, m, self.robot, self.match)
+        if groups:
+            res.add("structure", "body tree", float(len(errors)), 0.0, "differ",
+                    "; ".join(errors[:3]) + (" ..." if len(errors) > 3 else "")
+                    or f"{groups} bodies, each under its PyBullet parent")
+        else:
+            res.add("structure", "body tree", None, None, "", "not compared: no link has a "
+                    "body or site in the MJCF")
+
+    def joint_rows(self) -> None:
+        """Names, order, kinds, limits, damping, armature and friction of the matched joints."""
+        mj, m, pb, res = self.mj, self.fixed, self.pb, self.result
+        mine = {k: n for n, k in self.jnt.items()}
+        names = [_name(m, mj.mjtObj.mjOBJ_JOINT, k) for k in range(m.njnt)]
+        res.unmatched_joints = [n for n in pb.names if n not in self.jnt]
+        res.extra_joints = [names[k] or f"joint {k}" for k in range(m.njnt) if k not in mine]
+        missing = res.unmatched_joints + [f"+{n}" for n in res.extra_joints]
+        res.add("structure", "joint names", float(len(missing)), 0.0, "unmatched",
+                ", ".join(missing[:6]) + (" ..." if len(missing) > 6 else ""))
+        if not self.matched:
+            for what in ("joint order", "joint kinds", "joint limits", "joint damping"):
+                res.add("structure", what, None, None, "",
+                        "no movable joints" if not pb.names and not res.extra_joints else
+                        "not compared: no joint matched", status="info"
+                        if not pb.names and not res.extra_joints else None)
+            return
+        order = [mine[k] for k in range(m.njnt) if k in mine]
+        bad = next((a for a, b in zip(order, self.matched, strict=True) if a != b), "")
+        res.add("structure", "joint order", 0.0 if not bad else 1.0, 0.0, "moved",
+                f"first out of place: {bad}" if bad else f"{len(order)} joints")
+        joints = {j.name: j for j in self.robot.joints}
+        kinds = {0: mj.mjtJoint.mjJNT_HINGE, 1: mj.mjtJoint.mjJNT_SLIDE,
+                 2: mj.mjtJoint.mjJNT_BALL}
+        wrong, limits, damping, armature, friction = [], [], [], [], []
+        known_friction = []
+        for i, n in zip(pb.movable, pb.names, strict=True):
+            if n not in self.jnt:
+                continue
+            info, k = pb.info[i], self.jnt[n]
+            dof = int(m.jnt_dofadr[k])
+            if int(kinds[info[2]]) != int(m.jnt_type[k]):
+                wrong.append(n)
+            armature.append((abs(float(m.dof_armature[dof])), n))
+            loss = float(m.dof_frictionloss[dof])
+            if loss and loss == joints[n].friction:
+                known_friction.append(f"{n} {loss:g}")
+            else:
+                friction.append((abs(loss), n))  # PyBullet 3.2.7 simulates none
+            if info[2] == 2:
+                continue  # a ball joint has no limits or damping PyBullet reads
+            limits.append((self._limit_error(joints[n], info, k), n))
+            if int(kinds[info[2]]) == int(m.jnt_type[k]):
+                damping.append((abs(info[6] - m.dof_damping[dof]), n))
+        res.add("structure", "joint kinds", float(len(wrong)), 0.0, "differ", ", ".join(wrong))
+        for what, items, unit in (("joint limits", limits, "rad|m"),
+                                  ("joint damping", damping, "N m s/rad")):
+            v, d = _worst(items)
+            res.add("structure", what, v, TOL_EXACT, unit, d if items else
+                    "not compared: only ball joints matched", status=None if items else "info")
+        v, d = _worst(armature)
+        res.add("structure", "joint armature", v, TOL_EXACT, "kg m^2",
+                f"{d}: MuJoCo adds rotor inertia PyBullet does not have" if v > TOL_EXACT
+                else d)
+        v, d = _worst(friction)
+        res.add("structure", "joint frictionloss", v, TOL_EXACT, "N m",
+                f"{d}: MuJoCo simulates a dry friction PyBullet 3.2.7 does not" if v > TOL_EXACT
+                else d)
+        if known_friction:
+            res.add("structure", "joint friction of the URDF", float(len(known_friction)), None,
+                    "known", "PyBullet 3.2.7 does not simulate <dynamics friction>; the MJCF's "
+                    "frictionloss does: " + "; ".join(known_friction[:4]), status="known")
+
+    def _limit_error(self, joint: Any, info: Any, k: int) -> float:
+        """How far MuJoCo's range is from the limits PyBullet loaded (inf: one side only)."""
+        m = self.fixed
+        # PyBullet limits a revolute or prismatic joint with lower <= upper, never a
+        # continuous one (getJointInfo shows a continuous joint's <limit> all the same)
+        if joint.limited and joint.lower == joint.upper and not m.jnt_limited[k]:
+            return 0.0  # locked: MuJoCo has no empty range (export holds it with an equality)
+        if joint.limited != bool(m.jnt_limited[k]):
+            return math.inf
+        if not joint.limited:
+            return 0.0
+        return float(max(abs(info[8] - m.jnt_range[k][0]), abs(info[9] - m.jnt_range[k][1])))
 
     def masses(self) -> None:
         """Mass, centre of mass and inertia, welded groups compared at the zero pose."""
@@ -413,33 +469,35 @@ class _Compare:
         d.qpos[:] = 0
         mj.mj_kinematics(m, d)
         mj.mj_comPos(m, d)
-        weld: dict[str, list[tuple[Inertial, Any]]] = {}
+        weld: dict[int, list[tuple[Inertial, Any]]] = {}
         for b in range(1, m.nbody):
-            w = int(m.body_weldid[b])
-            key = _name(m, mj.mjtObj.mjOBJ_BODY, w) if w else robot.root
             t = np.eye(4)
             t[:3, :3] = d.ximat[b].reshape(3, 3)
             t[:3, 3] = d.xipos[b]
             own = Inertial(float(m.body_mass[b]), (0.0, 0.0, 0.0),
                            tuple(map(tuple, np.diag(m.body_inertia[b]))))  # type: ignore[arg-type]
-            weld.setdefault(key, []).append((own, t))
+            weld.setdefault(int(m.body_weldid[b]), []).append((own, t))
+        image = self._weld_image(where)
         total_pb = sum(i.mass for parts in groups.values() for i, _ in parts)
         total_mj = float(m.body_mass[1:].sum())
         res.add("structure", "total mass", abs(total_pb - total_mj) / max(total_pb, 1e-300),
-                TOL_EXACT, "relative", f"PyBullet {total_pb!r} kg, MuJoCo {total_mj!r} kg")
+                TOL_EXACT, "relative", f"PyBullet {total_pb!r} kg, MuJoCo {total_mj!r} kg"
+                + self._defaults_said(list(robot.links), abs(total_pb - total_mj)))
         mass: list[tuple[float, str]] = []
         com: list[tuple[float, str]] = []
         inertia: list[tuple[float, str]] = []
         missing: list[str] = []
+        zeroed = self.zeroed_inertia()
         for body, parts in groups.items():
-            if body not in weld:
+            if body not in image:
                 if not (body == robot.root == "world" and combine(parts).mass == 0):
                     missing.append(body)  # (a massless `world` is MuJoCo's world body)
                 continue
-            ours, theirs = combine(parts), combine(weld[body])
+            ours, theirs = combine(parts), combine(weld.get(image[body], []) or
+                                                   [(Inertial(0.0, (0, 0, 0), _ZERO3), np.eye(4))])
             mass.append((abs(ours.mass - theirs.mass) / max(ours.mass, theirs.mass, 1e-300),
                          body))
-            if ours.mass > 0:
+            if ours.mass > 0 and not any(where[z][0] == body for z in zeroed):
                 com.append((float(np.abs(ours.com - theirs.com).max()), body))
                 scale = max(float(np.abs(ours.tensor).max()), 1e-300)
                 inertia.append((float(np.abs(ours.tensor - theirs.tensor).max()) / scale, body))
@@ -447,11 +505,63 @@ class _Compare:
             res.add("structure", "bodies", float(len(missing)), 0.0, "unmatched",
                     ", ".join(missing))
         v, dd = _worst(mass)
-        res.add("structure", "body masses", v, TOL_EXACT, "relative", dd)
+        members = [n for n, (g, _) in where.items() if g == dd]
+        res.add("structure", "body masses", v, TOL_EXACT, "relative",
+                dd + (self._defaults_said(members, v) if v > TOL_EXACT else ""))
         v, dd = _worst(com)
         res.add("structure", "centres of mass", v, TOL_COM, "m", dd)
         v, dd = _worst(inertia)
         res.add("structure", "inertia tensors", v, TOL_INERTIA, "relative", dd)
+        if zeroed:
+            res.add("structure", "inertia PyBullet zeroes", float(len(zeroed)), None, "known",
+                    f"{', '.join(zeroed[:4])}: the file's tensor breaks the triangle inequality, "
+                    "PyBullet sets it to zero and MuJoCo refuses a moving body without one; "
+                    "their bodies' inertia, the dynamics and the swing are not compared",
+                    status="known")
+
+    def _weld_image(self, where: dict[str, tuple[str, Any]]) -> dict[str, int]:
+        """Each PyBullet body group -> the MuJoCo weld group its matched links are in."""
+        m = self.fixed
+        image: dict[str, int] = {}
+        for link, (group, _) in where.items():
+            if group in image:
+                continue
+            if link in self.body:
+                image[group] = int(m.body_weldid[self.body[link]])
+            elif link in self.site:
+                image[group] = int(m.body_weldid[int(m.site_bodyid[self.site[link]])])
+        return image
+
+    def _defaults_said(self, links: list[str], off: float) -> str:
+        """A mass difference's likely cause: links PyBullet gives its default 1 kg."""
+        if off <= 0:
+            return ""
+        made = [n for n in links if not self.robot.links[n].inertial.given]
+        if not made:
+            return ""
+        return (f"; {len(made)} link(s) without <inertial> ({', '.join(made[:3])}"
+                f"{' ...' if len(made) > 3 else ''}) weigh PyBullet's default 1 kg each")
+
+    def zeroed_inertia(self) -> list[str]:
+        """Moving links whose file inertia PyBullet zeroed (it breaks the triangle inequality)."""
+        if not self.o.inertia_from_file:
+            return []
+        out = []
+        where = fused(self.robot)
+        for n, link in self.robot.links.items():
+            given = link.inertial
+            if not given.given or given.mass <= 0 or n not in self.pb.link_index:
+                continue
+            if not any(given.tensor[k][k] for k in range(3)):
+                continue
+            loaded = self.pb.inertial(n).tensor
+            if any(loaded[k][k] for k in range(3)):
+                continue
+            group = where[n][0]
+            if group != self.robot.root or (not self.o.fixed_base
+                                             and self.robot.links[group].inertial.mass != 0):
+                out.append(n)
+        return out
 
     # ------------------------------------------------------------------ poses
 
