@@ -143,8 +143,10 @@ def match_models(mj: Any, fixed: Any, robot: Robot, movable: list[str],
 
 
 def _root_body(model: _Model) -> int | None:
-    """The body the robot hangs from: the only child of the world that has children or a
-    joint (a ground plane or a light is not a body)."""
+    """The body the robot hangs from.
+
+    The only child of the world that has children or a joint (a ground is not a robot).
+    """
     top = [b for b in model.children(0) if model.children(b) or model.joints_of(b)]
     return top[0] if len(top) == 1 else None
 

@@ -1,0 +1,300 @@
+"""Collision geometry and contact parameters: PyBullet's shapes against MuJoCo's geoms.
+
+PyBullet's side is what it loaded (``getCollisionShapeData``: kind, dimensions, the shape's
+frame in the link's inertial frame; ``getDynamicsInfo``: friction), not the file. Both sides
+are placed in the world at the zero pose, base at the origin, and each PyBullet shape takes the
+nearest unused MuJoCo collision geom (``contype`` or ``conaffinity`` set) of the same kind in
+the body its link is welded to. A shape nothing matches is missing, a geom left over is extra,
+and a matched pair is as far apart as the farthest of its sizes and corners. Meshes are
+compared by the box around their vertices (MuJoCo keeps them in float32).
+
+Contact parameters are compared per matched pair: friction (sliding, torsional, rolling), the
+contact dimension that makes MuJoCo use the last two, that the geom meets MuJoCo's default
+geoms (a ground), and that its priority makes MuJoCo take the robot's friction against a
+ground, as PyBullet multiplies it by a ground's 1.0 (MuJoCo takes the larger of two equals).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+#: Sizes and places of primitives (m); measured 1.7e-16 at worst on r2d2, racecar, husky.
+TOL_SHAPE = 1e-9
+#: Mesh boxes, relative to the mesh's size (MuJoCo stores vertices in float32).
+TOL_MESH = 1e-6
+TOL_FRICTION = 1e-12
+#: PyBullet's geometry codes (GEOM_*) -> MuJoCo's geom type names.
+_PB_KIND = {2: "sphere", 3: "box", 4: "cylinder", 5: "mesh", 6: "plane", 7: "capsule"}
+_MJ_KIND = {0: "plane", 2: "sphere", 3: "capsule", 5: "cylinder", 6: "box", 7: "mesh"}
+
+
+@dataclass
+class Shape:
+    """One collision shape in the world at the zero pose, in MuJoCo's terms."""
+
+    link: str
+    kind: str
+    size: tuple[float, ...]      # MuJoCo's: half sizes; sphere (r,), cylinder (r, half)
+    frame: Any                   # 4x4, world
+    box: Any = None              # meshes: (min, max) of the vertices in the world
+    group: str = ""
+
+
+@dataclass
+class Verdict:
+    """What the comparison found, for the rows."""
+
+    shape_error: tuple[float, str] | None    # None: no primitive on either side
+    mesh_error: tuple[float, str] | None
+    missing: list[str]
+    extra: list[str]
+    skipped: list[str]
+    contact: list[str]
+    pairs: int
+    links_compared: int
+
+
+def _matrix(quat: Any) -> Any:
+    import numpy as np
+
+    from urdfkit.model.spec import quat_to_matrix
+
+    n = math.sqrt(sum(c * c for c in quat)) or 1.0
+    return np.array(quat_to_matrix([c / n for c in quat]))
+
+
+def _transform(pos: Any, quat: Any) -> Any:
+    import numpy as np
+
+    t = np.eye(4)
+    t[:3, :3] = _matrix(quat)
+    t[:3, 3] = pos
+    return t
+
+
+_MESH_BOXES: dict[tuple[str, tuple[float, ...]], Any] = {}
+
+
+def _mesh_points(path: str, scale: tuple[float, ...]) -> Any:
+    """A mesh's vertices as PyBullet places them (urdfkit's readers), scaled; None if none."""
+    import numpy as np
+
+    from urdfkit.sources.meshes import read_triangles
+
+    key = (path, scale)
+    if key not in _MESH_BOXES:
+        found = read_triangles(Path(path))
+        pts = None
+        if found is not None and len(found[0]):
+            pts = np.asarray(found[0], dtype=float) * np.array(scale)
+            pts = pts[np.isfinite(pts).all(axis=1)]
+        _MESH_BOXES[key] = pts if pts is not None and len(pts) else None
+    return _MESH_BOXES[key]
+
+
+def _why_skipped(kind: str, size: tuple[float, ...], scale: tuple[float, ...],
+                 static: bool) -> str:
+    if kind == "plane" and not static:
+        return "a plane on a moving link (MuJoCo allows planes on static bodies only)"
+    if kind in ("sphere", "box", "cylinder", "capsule") and not all(
+            s > 0 for s in size[:{"sphere": 1, "box": 3}.get(kind, 2)]):
+        return "a zero-size shape (MuJoCo refuses it)"
+    if kind == "mesh" and not all(s != 0 for s in scale):
+        return "a mesh scaled by 0 (MuJoCo refuses it)"
+    return ""
+
+
+def pybullet_shapes(b: Any, body: int, link_index: dict[str, int], zero: dict[str, Any],
+                    group: dict[str, str], static: set[str]) -> tuple[list[Shape], list[str]]:
+    """PyBullet's collision shapes at the zero pose, and those MuJoCo cannot hold (said)."""
+    shapes: list[Shape] = []
+    skipped: list[str] = []
+    for link, i in link_index.items():
+        if link not in zero:
+            continue
+        d = b.getDynamicsInfo(body, i)
+        at = zero[link] @ _transform(d[3], d[4])
+        for s in b.getCollisionShapeData(body, i):
+            kind = _PB_KIND.get(int(s[2]))
+            dims = tuple(float(x) for x in s[3])
+            if kind is None:
+                skipped.append(f"{link}: PyBullet geometry {int(s[2])}")
+                continue
+            scale = dims if kind == "mesh" else (1.0, 1.0, 1.0)
+            why = _why_skipped(kind, dims, scale, group[link] in static)
+            if why:
+                skipped.append(f"{link}: {why}")
+                continue
+            frame = at @ _transform(s[5], s[6])
+            size: tuple[float, ...] = ()
+            box = None
+            if kind == "sphere":
+                size = (dims[0],)
+            elif kind == "box":
+                size = (dims[0] / 2, dims[1] / 2, dims[2] / 2)
+            elif kind in ("cylinder", "capsule"):
+                size = (dims[1], dims[0] / 2)
+            elif kind == "mesh":
+                pts = _mesh_points(s[4].decode("utf-8", "replace"), scale)
+                if pts is None:
+                    skipped.append(f"{link}: a mesh urdfkit's readers find no vertices in")
+                    continue
+                world = pts @ frame[:3, :3].T + frame[:3, 3]
+                box = (world.min(axis=0), world.max(axis=0))
+            shapes.append(Shape(link, kind, size, frame, box, group[link]))
+    return shapes, skipped
+
+
+def mujoco_geoms(mj: Any, m: Any, d: Any, keep_world: bool) -> list[tuple[int, Shape]]:
+    """MuJoCo's collision geoms at ``d``'s pose: (geom id, shape; ``link`` empty)."""
+    import numpy as np
+
+    out = []
+    for g in range(m.ngeom):
+        if not (int(m.geom_contype[g]) or int(m.geom_conaffinity[g])):
+            continue  # a visual
+        kind = _MJ_KIND.get(int(m.geom_type[g]), f"type {int(m.geom_type[g])}")
+        if int(m.geom_bodyid[g]) == 0 and not keep_world:
+            continue  # the world's own geoms: a ground, not the robot
+        frame = np.eye(4)
+        frame[:3, :3] = d.geom_xmat[g].reshape(3, 3)
+        frame[:3, 3] = d.geom_xpos[g]
+        size = tuple(float(x) for x in m.geom_size[g])
+        box = None
+        if kind == "mesh":
+            k = int(m.geom_dataid[g])
+            start, n = int(m.mesh_vertadr[k]), int(m.mesh_vertnum[k])
+            pts = np.asarray(m.mesh_vert[start:start + n], dtype=float)
+            world = pts @ frame[:3, :3].T + frame[:3, 3]
+            box = (world.min(axis=0), world.max(axis=0))
+        size = {"sphere": size[:1], "box": size, "cylinder": size[:2], "capsule": size[:2]
+                }.get(kind, ())
+        out.append((g, Shape("", kind, size, frame, box)))
+    return out
+
+
+def _corners(s: Shape) -> Any:
+    import itertools
+
+    import numpy as np
+
+    signs = np.array(list(itertools.product((-1, 1), repeat=3)), dtype=float)
+    return (signs * np.array(s.size)) @ s.frame[:3, :3].T + s.frame[:3, 3]
+
+
+def distance(a: Shape, b: Shape) -> float:
+    """How far apart two shapes of one kind are (m): sizes, places and axes."""
+    import numpy as np
+
+    centre = float(np.abs(a.frame[:3, 3] - b.frame[:3, 3]).max())
+    if a.kind == "sphere":
+        return max(abs(a.size[0] - b.size[0]), centre)
+    if a.kind == "box":
+        # the box's corners as sets: a box turned onto itself is the same box
+        ca, cb = _corners(a), _corners(b)
+        gap = np.abs(ca[:, None, :] - cb[None, :, :]).max(axis=2)
+        return float(max(gap.min(axis=1).max(), gap.min(axis=0).max()))
+    if a.kind in ("cylinder", "capsule"):
+        za, zb = a.frame[:3, 2], b.frame[:3, 2]
+        axis = min(float(np.abs(za - zb).max()), float(np.abs(za + zb).max()))
+        return max(abs(a.size[0] - b.size[0]), abs(a.size[1] - b.size[1]), centre,
+                   axis * max(a.size[1], a.size[0]))
+    if a.kind == "mesh":
+        return max(float(np.abs(a.box[0] - b.box[0]).max()),
+                   float(np.abs(a.box[1] - b.box[1]).max()))
+    if a.kind == "plane":  # the same normal, and b's point on a's plane
+        return max(abs(float(a.frame[:3, 2] @ (b.frame[:3, 3] - a.frame[:3, 3]))),
+                   float(np.abs(a.frame[:3, 2] - b.frame[:3, 2]).max()))
+    return math.inf
+
+
+def _extent(s: Shape) -> float:
+    import numpy as np
+
+    return max(1.0, float(np.abs(np.concatenate(s.box)).max())) if s.box is not None else 1.0
+
+
+def compare(pb_shapes: list[Shape], geoms: list[tuple[int, Shape]], body_weld: Any,
+            image: dict[str, int], names: dict[int, str]) -> tuple[list[tuple[Shape, int, float]],
+                                                                list[str], list[str]]:
+    """Pair each PyBullet shape with the nearest MuJoCo geom: (pairs, missing, extra)."""
+    used: set[int] = set()
+    pairs: list[tuple[Shape, int, float]] = []
+    missing: list[str] = []
+    for s in pb_shapes:
+        best, at = math.inf, -1
+        for g, t in geoms:
+            if g in used or t.kind != s.kind:
+                continue
+            if s.group in image and int(body_weld(g)) != image[s.group]:
+                continue
+            e = distance(s, t)
+            if e < best:
+                best, at = e, g
+        if at < 0:
+            missing.append(f"{s.link} ({s.kind})")
+            continue
+        used.add(at)
+        pairs.append((s, at, best))
+    extra = [f"{names.get(g, g)} ({t.kind})" for g, t in geoms if g not in used]
+    return pairs, missing, extra
+
+
+def contact_errors(b: Any, body: int, link_index: dict[str, int], m: Any,
+                   pairs: list[tuple[Shape, int, float]], geom_name: dict[int, str]) -> list[str]:
+    """Friction, contact dimension, what the geom meets, and priority: one line a link."""
+    out: list[str] = []
+    seen: set[str] = set()
+    for s, g, _ in pairs:
+        if s.link in seen:
+            continue
+        d = b.getDynamicsInfo(body, link_index[s.link])
+        lateral, rolling, spinning = float(d[1]), float(d[6]), float(d[7])
+        slide, torsion, roll = (float(x) for x in m.geom_friction[g])
+        condim = int(m.geom_condim[g])
+        said = []
+        if abs(slide - lateral) > TOL_FRICTION:
+            said.append(f"friction {slide:g}, PyBullet's lateral {lateral:g}")
+        got_spin = torsion if condim >= 4 else 0.0
+        if abs(got_spin - spinning) > TOL_FRICTION:
+            said.append(f"torsional friction {got_spin:g} (condim {condim}), PyBullet's "
+                        f"spinning {spinning:g}")
+        got_roll = roll if condim >= 6 else 0.0
+        if abs(got_roll - rolling) > TOL_FRICTION:
+            said.append(f"rolling friction {got_roll:g} (condim {condim}), PyBullet's "
+                        f"{rolling:g}")
+        if not (int(m.geom_contype[g]) & 1 or int(m.geom_conaffinity[g]) & 1):
+            said.append("meets no default geom (contype and conaffinity without bit 1): it "
+                        "falls through a ground")
+        if int(m.geom_priority[g]) <= 0:
+            said.append(f"priority {int(m.geom_priority[g])}: against a ground MuJoCo takes the "
+                        "larger friction, PyBullet the product")
+        if said:
+            seen.add(s.link)
+            out.append(f"{s.link} ({geom_name.get(g, g)}): " + "; ".join(said))
+    return out
+
+
+def collision_verdict(mj: Any, m: Any, b: Any, body: int, link_index: dict[str, int],
+                      zero: dict[str, Any], group: dict[str, str], image: dict[str, int],
+                      static: set[str], keep_world: bool) -> Verdict:
+    """Collision geometry and contact parameters of both engines, compared."""
+    d = mj.MjData(m)
+    d.qpos[:] = m.qpos0
+    mj.mj_kinematics(m, d)
+    names = {g: mj.mj_id2name(m, mj.mjtObj.mjOBJ_GEOM, g) or
+             f"geom {g} of {mj.mj_id2name(m, mj.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g]))}"
+             for g in range(m.ngeom)}
+    shapes, skipped = pybullet_shapes(b, body, link_index, zero, group, static)
+    geoms = mujoco_geoms(mj, m, d, keep_world)
+    pairs, missing, extra = compare(
+        shapes, geoms, lambda g: m.body_weldid[int(m.geom_bodyid[g])], image, names)
+    prim = [(e, f"{s.link} ({s.kind})") for s, _, e in pairs if s.kind != "mesh"]
+    mesh = [(e / _extent(s), f"{s.link} ({s.kind})") for s, _, e in pairs if s.kind == "mesh"]
+    return Verdict(max(prim, key=lambda x: x[0]) if prim else None,
+                   max(mesh, key=lambda x: x[0]) if mesh else None, missing, extra, skipped,
+                   contact_errors(b, body, link_index, m, pairs, names), len(pairs),
+                   len({s.link for s in shapes}))
