@@ -99,13 +99,29 @@ def test_reads_an_mjcf_it_did_not_write_and_lists_what_it_cannot_match(kuka: Pat
     renamed = kuka.parent / "renamed.xml"
     doc.write(str(renamed))
     code, data = _agree("kuka_iiwa/model.urdf", renamed)
+    # the two are matched by the tree's shape and frames, and said so; then all agrees
+    assert code == 0
+    assert {(p["urdf"], p["mjcf"], p["how"]) for p in data["matched_by"]} == {
+        ("lbr_iiwa_joint_7", "wrist_roll", "structure"),
+        ("lbr_iiwa_link_6", "forearm", "structure")}
+    assert data["unmatched_joints"] == [] and data["extra_joints"] == []
+    # a body the tree cannot place (moved off its frame) is listed, the rest compared
+    doc.find(".//body[@name='forearm']").set("name", "elsewhere")
+    doc.find(".//body[@name='elsewhere']").set("pos", "0 0 0.5")
+    doc.find(".//joint[@name='lbr_iiwa_joint_6']").set("name", "elbow")
+    for a in doc.iterfind(".//actuator/*"):
+        if a.get("joint") == "lbr_iiwa_joint_6":
+            a.set("joint", "elbow")
+    moved = kuka.parent / "moved.xml"
+    doc.write(str(moved))
+    code, data = _agree("kuka_iiwa/model.urdf", moved)
     assert code == 1
-    assert data["unmatched_joints"] == ["lbr_iiwa_joint_7"]
-    assert data["extra_joints"] == ["wrist_roll"]
     assert "lbr_iiwa_link_6" in data["unmatched_links"]
-    # what does match is still compared: every other frame agrees
+    assert data["unmatched_joints"] == ["lbr_iiwa_joint_6"]
+    assert data["extra_joints"] == ["elbow"]
     rows = {r["check"]: r for r in data["rows"]}
-    assert rows["frames vs exact FK: position"]["status"] == "pass"
+    assert rows["frames vs PyBullet: position"]["status"] == "fail"  # link_7 hangs lower
+    assert rows["free swing"]["detail"] == "not compared: the joints differ"
 
 
 def test_export_verify_and_bad_model(kuka: Path, tmp_path: Path) -> None:

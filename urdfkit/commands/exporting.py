@@ -56,7 +56,7 @@ def agreement_dict(a: Any) -> dict[str, Any]:
                       "tolerance": r.tolerance, "unit": r.unit, "status": r.status,
                       "detail": r.detail} for r in a.rows],
             "unmatched_links": a.unmatched_links, "unmatched_joints": a.unmatched_joints,
-            "extra_joints": a.extra_joints, "warnings": a.warnings}
+            "extra_joints": a.extra_joints, "matched_by": a.matched_by, "warnings": a.warnings}
 
 
 def agreement_report(a: Any, show_all: bool = False) -> None:
@@ -74,8 +74,12 @@ def agreement_report(a: Any, show_all: bool = False) -> None:
         show.warn(f"{a.model}: MuJoCo: {w}")
     show.table(title, columns, rows, show_all)
     if a.unmatched_links:
-        show.note(f"{len(a.unmatched_links)} link(s) with no body or site of that name: "
+        show.note(f"{len(a.unmatched_links)} link(s) with no body or site matched: "
                   + ", ".join(a.unmatched_links), stderr=False)
+    if a.matched_by:
+        show.note(f"{len(a.matched_by)} pair(s) matched by another way than the name: "
+                  + ", ".join(f"{p['urdf']} = {p['mjcf']} ({p['how']})" for p in a.matched_by),
+                  stderr=False)
     show.note("PyBullet loaded with " + (" | ".join(a.load_flags) or "no flags")
               + "; its link damping and velocity motors off for the swing", stderr=False)
 
@@ -189,6 +193,10 @@ def agree(
     self_collision: SelfCollisionOpt = False,
     poses: Annotated[int, typer.Option("--poses", min=1, help="Seeded random poses.")] = 100,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the poses.")] = 0,
+    name_map: Annotated[list[str] | None, typer.Option(
+        "--map", metavar="URDF=MJCF", help="A URDF link or joint and the MJCF body, site or "
+        "joint it is, where names differ (repeatable; the rest match by name, then by the "
+        "tree's shape).")] = None,
     as_json: JsonOpt = False,
     show_all: AllOpt = False,
     package: PackageOpt = None,
@@ -204,11 +212,13 @@ def agree(
     Needs urdfkit[mujoco]. See docs/export.md.
     """
     from urdfkit.exchange.agree import agree as run_agree
+    from urdfkit.exchange.agree_tree import parse_map
 
+    options = _verify_options(fixed_base, inertia_from_shapes, self_collision, poses, seed)
+    options.name_map = parse_map(name_map)
     with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
                              package_paths=package_path) as resolved:
-        result = run_agree(resolved, model, _verify_options(
-            fixed_base, inertia_from_shapes, self_collision, poses, seed))
+        result = run_agree(resolved, model, options)
     if as_json:
         show.print_json(agreement_dict(result))
     else:

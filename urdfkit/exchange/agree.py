@@ -154,6 +154,8 @@ def load_mjcf(path: str | Path) -> tuple[Any, Any]:
             model = spec.compile()
         LOAD_WARNINGS[:] = sorted({str(w.message) for w in said})
         fixed_spec = mujoco.MjSpec.from_file(str(p))
+        for key in list(fixed_spec.keys):
+            fixed_spec.delete(key)  # a keyframe's qpos holds the free joints removed below
         for j in list(fixed_spec.joints):
             if j.type == mujoco.mjtJoint.mjJNT_FREE:
                 # welded where PyBullet's fixed load puts the root: at the origin (a model
@@ -632,7 +634,7 @@ class _Compare:
         if lost or v.shape_error is not None:
             worst, at = v.shape_error or (0.0, "")
             res.add("contacts", "collision shapes", math.inf if lost else worst, TOL_SHAPE, "m",
-                    "; ".join([*lost, at]) if lost else at)
+                    "; ".join(x for x in [*lost, at] if x))
         if v.mesh_error is not None:
             res.add("contacts", "collision meshes", v.mesh_error[0], TOL_MESH, "relative",
                     v.mesh_error[1])
@@ -787,6 +789,10 @@ class _Compare:
             and not pb.spherical
         dof = [int(m.jnt_dofadr[self.jnt[n]]) for n in self.matched]
         refused: str | None = None  # the PyBullet call that failed on this model
+        zeroed = self.zeroed_inertia()
+        if dyn and zeroed:
+            refused = f"model zeroes the inertia of {', '.join(zeroed[:3])} (see the " \
+                "structure rows)"
         d_contact = mj.MjData(m)
         tol = pybullet_frame_tolerances(robot)
         from urdfkit.model.spec import quat_to_matrix
@@ -1015,7 +1021,7 @@ class _Compare:
                     status="known")
             return
         body = pb.swinger(floating, {n: q0.get(n, 0.0) for n in pb.names},
-                          {n: v0[n] for n in pb.names} if floating else {}, self.o.time_step)
+                          {n: v0[n] for n in names} if floating else {}, self.o.time_step)
         if floating:
             # uniform gravity moves a free robot's every body alike: off, the base's motion
             # is the joints' reaction alone, a few cm, where PyBullet's float32 base frame is
@@ -1167,8 +1173,8 @@ def agree(resolved: Any, model_path: str | Path, options: AgreeOptions | None = 
     with Session() as session:
         c = _Compare(robot, str(model_path), session, str(resolved.load_path), o)
         c.structure()
-        c.collisions()
         c.poses()
+        c.collisions()
         c.swing()
         return c.result
 

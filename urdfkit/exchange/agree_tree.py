@@ -172,13 +172,31 @@ def _match_by_shape(model: _Model, robot: Robot, movable: set[str], out: Matchin
     taken_j = set(out.joints.values())
     taken_b = set(out.bodies.values())
     for j in robot.joints:
-        if not j.moves or j.child in out.bodies or j.child in out.sites:
+        if not j.moves:
+            continue
+        want = zero[j.child]
+        axis = want[:3, :3] @ np.array(unit(j.axis)) if j.type != "spherical" else None
+        if j.child in out.bodies or j.child in out.sites:
+            # the body is matched (by name): its joint may still be named otherwise
+            b = _mj_body_of(out, model, j.child)
+            if j.name in out.joints or j.name not in movable or b is None:
+                continue
+            ks = [k for k in _joints_like(model, b, j.type, axis) if k not in taken_j]
+            if len(ks) == 1:
+                out.joints[j.name] = ks[0]
+                taken_j.add(ks[0])
+                out.pairs.append((j.name, _joint_name(model, ks[0]), "structure"))
+            continue
+        if j.name in out.joints:  # the joint is matched: its body is the link
+            b = int(model.m.jnt_bodyid[out.joints[j.name]])
+            if b not in taken_b:
+                out.bodies[j.child] = b
+                taken_b.add(b)
+                out.pairs.append((j.child, _body_name(model, b), "structure"))
             continue
         parent = _mj_body_of(out, model, j.parent)
         if parent is None:
             continue
-        want = zero[j.child]
-        axis = want[:3, :3] @ np.array(unit(j.axis)) if j.type != "spherical" else None
         found = []
         for b in model.below(parent):
             if b in taken_b:
@@ -187,12 +205,7 @@ def _match_by_shape(model: _Model, robot: Robot, movable: set[str], out: Matchin
             t[:3, :3], t[:3, 3] = model.xmat[b], model.xpos[b]
             if _close(t, want) > FRAME_TOL:
                 continue
-            for k in model.joints_of(b):
-                if k in taken_j or model.kind.get(int(model.m.jnt_type[k])) != _KINDS[j.type]:
-                    continue
-                if axis is not None and float(np.abs(model.xaxis[k] - axis).max()) > FRAME_TOL:
-                    continue
-                found.append((b, k))
+            found += [(b, k) for k in _joints_like(model, b, j.type, axis) if k not in taken_j]
         if len(found) != 1:
             continue  # none, or ambiguous: left unmatched (and said)
         b, k = found[0]
@@ -203,6 +216,20 @@ def _match_by_shape(model: _Model, robot: Robot, movable: set[str], out: Matchin
             out.joints[j.name] = k
             taken_j.add(k)
             out.pairs.append((j.name, _joint_name(model, k), "structure"))
+
+
+def _joints_like(model: _Model, b: int, kind: str, axis: Any) -> list[int]:
+    """The joints of body ``b`` of PyBullet's ``kind`` about ``axis`` (world, zero pose)."""
+    import numpy as np
+
+    out = []
+    for k in model.joints_of(b):
+        if model.kind.get(int(model.m.jnt_type[k])) != _KINDS[kind]:
+            continue
+        if axis is not None and float(np.abs(model.xaxis[k] - axis).max()) > FRAME_TOL:
+            continue
+        out.append(k)
+    return out
 
 
 def _body_name(model: _Model, b: int) -> str:
