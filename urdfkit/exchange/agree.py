@@ -850,6 +850,16 @@ class _Compare:
             res.add("kinematics", what, v, limit, "m" if "position" in what else "matrix",
                     f"{n} ({len(links)} frames x {self.o.poses} poses)")
         self._say_snapped(snapped)
+        self._dynamics_rows(bool(dyn), refused, mass_err, id_err)
+        pairs = sorted(set(contacts))
+        res.add("contacts", "self-contacts at the poses", float(len(contacts)), 0.0, "contacts",
+                ", ".join(pairs[:4]) + (" ..." if len(pairs) > 4 else ""),
+                status="info" if self.o.self_collision else None)
+
+    def _dynamics_rows(self, dyn: bool, refused: str | None,
+                       mass_err: list[tuple[float, str]], id_err: list[tuple[float, str]]
+                       ) -> None:
+        res, pb = self.result, self.pb
         if dyn and refused is not None:
             res.add("dynamics", "mass matrix, inverse dynamics", None, None, "",
                     f"not compared: raw PyBullet's {refused}", status="known")
@@ -868,10 +878,6 @@ class _Compare:
         else:
             res.add("dynamics", "mass matrix, inverse dynamics", None, None, "",
                     "not compared: the joints differ")
-        pairs = sorted(set(contacts))
-        res.add("contacts", "self-contacts at the poses", float(len(contacts)), 0.0, "contacts",
-                ", ".join(pairs[:4]) + (" ..." if len(pairs) > 4 else ""),
-                status="info" if self.o.self_collision else None)
 
     # ------------------------------------------------------------------ swing
 

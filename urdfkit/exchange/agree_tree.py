@@ -176,23 +176,8 @@ def _match_by_shape(model: _Model, robot: Robot, movable: set[str], out: Matchin
             continue
         want = zero[j.child]
         axis = want[:3, :3] @ np.array(unit(j.axis)) if j.type != "spherical" else None
-        if j.child in out.bodies or j.child in out.sites:
-            # the body is matched (by name): its joint may still be named otherwise
-            b = _mj_body_of(out, model, j.child)
-            if j.name in out.joints or j.name not in movable or b is None:
-                continue
-            ks = [k for k in _joints_like(model, b, j.type, axis) if k not in taken_j]
-            if len(ks) == 1:
-                out.joints[j.name] = ks[0]
-                taken_j.add(ks[0])
-                out.pairs.append((j.name, _joint_name(model, ks[0]), "structure"))
-            continue
-        if j.name in out.joints:  # the joint is matched: its body is the link
-            b = int(model.m.jnt_bodyid[out.joints[j.name]])
-            if b not in taken_b:
-                out.bodies[j.child] = b
-                taken_b.add(b)
-                out.pairs.append((j.child, _body_name(model, b), "structure"))
+        if j.child in out.bodies or j.child in out.sites or j.name in out.joints:
+            _match_one_side(model, j, axis, movable, out, taken_j, taken_b)
             continue
         parent = _mj_body_of(out, model, j.parent)
         if parent is None:
@@ -216,6 +201,27 @@ def _match_by_shape(model: _Model, robot: Robot, movable: set[str], out: Matchin
             out.joints[j.name] = k
             taken_j.add(k)
             out.pairs.append((j.name, _joint_name(model, k), "structure"))
+
+
+def _match_one_side(model: _Model, j: Any, axis: Any, movable: set[str], out: Matching,
+                    taken_j: set[int], taken_b: set[int]) -> None:
+    """A joint whose body is matched (by name) or a body whose joint is: the other half."""
+    if j.child in out.bodies or j.child in out.sites:
+        # the body is matched: its joint may still be named otherwise (h1's `_joint`)
+        b = _mj_body_of(out, model, j.child)
+        if j.name in out.joints or j.name not in movable or b is None:
+            return
+        ks = [k for k in _joints_like(model, b, j.type, axis) if k not in taken_j]
+        if len(ks) == 1:
+            out.joints[j.name] = ks[0]
+            taken_j.add(ks[0])
+            out.pairs.append((j.name, _joint_name(model, ks[0]), "structure"))
+        return
+    b = int(model.m.jnt_bodyid[out.joints[j.name]])  # the joint is matched: its body is
+    if b not in taken_b:
+        out.bodies[j.child] = b
+        taken_b.add(b)
+        out.pairs.append((j.child, _body_name(model, b), "structure"))
 
 
 def _joints_like(model: _Model, b: int, kind: str, axis: Any) -> list[int]:
