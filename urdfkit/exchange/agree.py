@@ -550,14 +550,19 @@ class _Compare:
         if missing:
             res.add("structure", "bodies", float(len(missing)), 0.0, "unmatched",
                     ", ".join(missing))
-        v, dd = _worst(mass)
-        members = [n for n, (g, _) in where.items() if g == dd]
-        res.add("structure", "body masses", v, TOL_EXACT, "relative",
-                dd + (self._defaults_said(members, v) if v > TOL_EXACT else ""))
-        v, dd = _worst(com)
-        res.add("structure", "centres of mass", v, TOL_COM, "m", dd)
-        v, dd = _worst(inertia)
-        res.add("structure", "inertia tensors", v, TOL_INERTIA, "relative", dd)
+        if not mass:
+            res.add("structure", "body masses", None, None, "", "not compared: no link has a "
+                    "body or site in the MJCF")
+        else:
+            v, dd = _worst(mass)
+            members = [n for n, (g, _) in where.items() if g == dd]
+            res.add("structure", "body masses", v, TOL_EXACT, "relative",
+                    dd + (self._defaults_said(members, v) if v > TOL_EXACT else ""))
+        for what, items, tol in (("centres of mass", com, TOL_COM),
+                                 ("inertia tensors", inertia, TOL_INERTIA)):
+            if items:
+                v, dd = _worst(items)
+                res.add("structure", what, v, tol, "m" if what[0] == "c" else "relative", dd)
         if zeroed:
             res.add("structure", "inertia PyBullet zeroes", float(len(zeroed)), None, "known",
                     f"{', '.join(zeroed[:4])}: the file's tensor breaks the triangle inequality, "
