@@ -135,6 +135,9 @@ def load_mjcf(path: str | Path) -> tuple[Any, Any]:
     if why is not None:
         raise InputError("no such file" if why == "missing" else f"is {why}, not an MJCF "
                          "file", file=str(path))
+    from urdfkit.exchange.mjcf_files import check_mjcf_files
+
+    check_mjcf_files(p)  # its includes, meshes, textures...: MuJoCo would block on a FIFO too
     import warnings
 
     try:
