@@ -232,9 +232,12 @@ class _Pybullet:
     def frames(self, links: list[str]) -> dict[str, Any]:
         import numpy as np
 
+        from urdfkit.exchange.bullet_state import unreadable_state
         from urdfkit.model.spec import quat_to_matrix
 
-        out = {}
+        out: dict[str, Any] = {}
+        if unreadable_state(self.info):
+            return out  # past PyBullet's state queries: none to compare (the row says why)
         idx = [self.link_index[n] for n in links if self.link_index[n] >= 0]
         states = self.b.getLinkStates(self.body, idx, computeForwardKinematics=1) if idx else []
         by_index = dict(zip(idx, states or [], strict=True))
@@ -472,6 +475,17 @@ class _Compare:
             t[:3, 3] = d.site_xpos[i]
         return t
 
+    def _say_unreadable(self, links: list[str]) -> None:
+        """Known rows saying why the frames are not compared with PyBullet's, if they are not."""
+        from urdfkit.exchange.bullet_state import unreadable_state
+
+        why = unreadable_state(self.pb.info)
+        if not links or not why:
+            return
+        for what in ("frames vs PyBullet: position", "frames vs PyBullet: rotation"):
+            self.result.add("kinematics", what, None, None, "", f"not compared: {why}; the "
+                            "exact-FK rows cover every frame", status="known")
+
     def _say_snapped(self, snapped: dict[str, tuple[str, Any, float]]) -> None:
         """A known row naming the sites MuJoCo computes at their body's frame, if any."""
         if not snapped:
@@ -542,6 +556,10 @@ class _Compare:
         from urdfkit.engine.session import dynamics_call
 
         mj, m, pb = self.mj, self.fixed, self.pb
+        from urdfkit.exchange.bullet_state import unreliable_dynamics
+
+        if unreliable_dynamics(len(pb.names)):
+            return unreliable_dynamics(len(pb.names))
         qs = [q[n] for n in pb.names]
         try:
             pm = np.array(dynamics_call(pb.b, "calculateMassMatrix", pb.body, qs))
@@ -611,13 +629,13 @@ class _Compare:
             self.set_q(d, {n: q[n] for n in self.matched if n in q})
             mj.mj_kinematics(m, d)
             pb.pose(q)
-            pb_frames = pb.frames(links)
+            # none where PyBullet cannot report the body's state (_say_unreadable)
+            pb_err = {n: _frame_error(self.mj_frame(d, n), t) for n, t in pb.frames(links).items()}
+            pb_pos += [(a / tol[n], n) for n, (a, _) in pb_err.items()]
+            pb_rot += [(b / tol[n], n) for n, (_, b) in pb_err.items()]
             exact = link_frames(robot, q)
             for n in links:
                 f = self.mj_frame(d, n)
-                a, b = _frame_error(f, pb_frames[n])
-                pb_pos.append((a / tol[n], n))
-                pb_rot.append((b / tol[n], n))
                 ref = exact[n] if n not in snapped else exact[snapped[n][0]] @ snapped[n][1]
                 a, b = _frame_error(f, ref)
                 fk_pos.append((a, n))
@@ -639,12 +657,13 @@ class _Compare:
         if not links:
             res.add("kinematics", "link frames", None, None, "", "not compared: no link has "
                     "a body or site of its name")
+        self._say_unreadable(links)
         for what, items, fixed in (("frames vs PyBullet: position", pb_pos, None),
                                    ("frames vs PyBullet: rotation", pb_rot, None),
                                    ("frames vs exact FK: position", fk_pos, TOL_FK),
                                    ("frames vs exact FK: rotation", fk_rot, TOL_FK)):
-            if not links:
-                break
+            if not items:  # no link matched, or PyBullet cannot report the frames (said above)
+                continue
             v, n = _worst(items)
             limit = fixed if fixed is not None else tol[n]
             if fixed is None:
@@ -690,6 +709,12 @@ class _Compare:
         if self.pb.spherical:
             res.add("swing", "free swing", None, None, "", "not compared: spherical joints",
                     status="info")
+            return
+        from urdfkit.exchange.bullet_state import unreadable_state
+
+        if unreadable_state(pb.info):  # getJointStates would raise or misread
+            res.add("swing", "free swing", None, None, "", "not compared: "
+                    + unreadable_state(pb.info), status="known")
             return
         m = self.fixed
         m.opt.timestep = self.o.time_step
