@@ -143,6 +143,9 @@ def load_mjcf(path: str | Path) -> tuple[Any, Any]:
     if why is not None:
         raise InputError("no such file" if why == "missing" else f"is {why}, not an MJCF "
                          "file", file=str(path))
+    from urdfkit.exchange.mjcf_files import check_mjcf_files
+
+    check_mjcf_files(p)  # its includes, meshes, textures...: MuJoCo would block on a FIFO too
     import warnings
 
     try:
@@ -281,9 +284,12 @@ class _Pybullet:
     def frames(self, links: list[str]) -> dict[str, Any]:
         import numpy as np
 
+        from urdfkit.exchange.bullet_state import unreadable_state
         from urdfkit.model.spec import quat_to_matrix
 
-        out = {}
+        out: dict[str, Any] = {}
+        if unreadable_state(self.info):
+            return out  # past PyBullet's state queries: none to compare (the row says why)
         idx = [self.link_index[n] for n in links if self.link_index[n] >= 0]
         states = self.b.getLinkStates(self.body, idx, computeForwardKinematics=1) if idx else []
         by_index = dict(zip(idx, states or [], strict=True))
@@ -671,6 +677,17 @@ class _Compare:
             t[:3, 3] = d.site_xpos[i]
         return t
 
+    def _say_unreadable(self, links: list[str]) -> None:
+        """Known rows saying why the frames are not compared with PyBullet's, if they are not."""
+        from urdfkit.exchange.bullet_state import unreadable_state
+
+        why = unreadable_state(self.pb.info)
+        if not links or not why:
+            return
+        for what in ("frames vs PyBullet: position", "frames vs PyBullet: rotation"):
+            self.result.add("kinematics", what, None, None, "", f"not compared: {why}; the "
+                            "exact-FK rows cover every frame", status="known")
+
     def _say_snapped(self, snapped: dict[str, tuple[str, Any, float]]) -> None:
         """A known row naming the sites MuJoCo computes at their body's frame, if any."""
         if not snapped:
@@ -741,6 +758,10 @@ class _Compare:
         from urdfkit.engine.session import dynamics_call
 
         mj, m, pb = self.mj, self.fixed, self.pb
+        from urdfkit.exchange.bullet_state import unreliable_dynamics
+
+        if unreliable_dynamics(len(pb.names)):
+            return unreliable_dynamics(len(pb.names))
         qs = [q[n] for n in pb.names]
         try:
             pm = np.array(dynamics_call(pb.b, "calculateMassMatrix", pb.body, qs))
@@ -814,13 +835,13 @@ class _Compare:
             self.set_q(d, {n: q[n] for n in self.matched if n in q})
             mj.mj_kinematics(m, d)
             pb.pose(q)
-            pb_frames = pb.frames(links)
+            # none where PyBullet cannot report the body's state (_say_unreadable)
+            pb_err = {n: _frame_error(self.mj_frame(d, n), t) for n, t in pb.frames(links).items()}
+            pb_pos += [(a / tol[n], n) for n, (a, _) in pb_err.items()]
+            pb_rot += [(b / tol[n], n) for n, (_, b) in pb_err.items()]
             exact = link_frames(robot, q)
             for n in links:
                 f = self.mj_frame(d, n)
-                a, b = _frame_error(f, pb_frames[n])
-                pb_pos.append((a / tol[n], n))
-                pb_rot.append((b / tol[n], n))
                 ref = exact[n] if n not in snapped else exact[snapped[n][0]] @ snapped[n][1]
                 a, b = _frame_error(f, ref)
                 fk_pos.append((a, n))
@@ -842,12 +863,13 @@ class _Compare:
         if not links:
             res.add("kinematics", "link frames", None, None, "", "not compared: no link has "
                     "a body or site of its name")
+        self._say_unreadable(links)
         for what, items, fixed in (("frames vs PyBullet: position", pb_pos, None),
                                    ("frames vs PyBullet: rotation", pb_rot, None),
                                    ("frames vs exact FK: position", fk_pos, TOL_FK),
                                    ("frames vs exact FK: rotation", fk_rot, TOL_FK)):
-            if not links:
-                break
+            if not items:  # no link matched, or PyBullet cannot report the frames (said above)
+                continue
             v, n = _worst(items)
             limit = fixed if fixed is not None else tol[n]
             if fixed is None:
@@ -912,6 +934,10 @@ class _Compare:
             return "not compared: the joints differ", None
         if self.pb.spherical:
             return "not compared: spherical joints", "info"
+        from urdfkit.exchange.bullet_state import unreadable_state
+
+        if unreadable_state(self.pb.info):  # getJointStates would raise or misread
+            return "not compared: " + unreadable_state(self.pb.info), "known"
         zeroed = self.zeroed_inertia()
         if zeroed:
             return (f"not compared: PyBullet zeroes the inertia of {', '.join(zeroed[:3])} "

@@ -253,6 +253,18 @@ def did_you_mean(names: Sequence[str], tags: bool = True) -> str:
 #: PyBullet's state queries (getJointState, getLinkState, getBasePositionAndOrientation) fail
 #: on bodies with this many links or more (its MAX_DEGREE_OF_FREEDOM).
 MAX_STATE_LINKS = 128
+#: What those queries hold, measured on 3.2.7 (tests/test_agree_big.py): 128 position and 128
+#: velocity coordinates (MAX_DEGREE_OF_FREEDOM), the base's 7 and 6 first, a fixed base too,
+#: then each joint's from its ``qIndex`` / ``uIndex``. A body of 128 joints (129 links) or more
+#: fails every state query at every index (getLinkState(s), getJointState(s),
+#: getBasePositionAndOrientation, getBaseVelocity); below that, a joint whose ``qIndex`` is
+#: 128 or more reads 0 in getJointState(s), and resetting any joint puts it back to 0 (its
+#: ``resetJointState`` alone moves it), and link 0's reported frame can be wrong (124 links
+#: after stepping, 128 without), without an error. ``calculateMassMatrix`` and
+#: ``calculateInverseDynamics`` take the joint positions as arguments and answer right on any
+#: body of at most 128 degrees of freedom (a fixed base; 600 links with 120 of them too),
+#: wrong past it, without a word (measured: 0.02-4% on 129-139).
+MAX_STATE_COORDINATES = 128
 #: Bodies with more links than this are refused before loading: PyBullet takes minutes.
 MAX_LOADABLE_LINKS = 1000
 #: Deepest element nesting PyBullet 3.2.7's XML parser (tinyxml2) reads, <robot> counting 1:
