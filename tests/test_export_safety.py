@@ -128,3 +128,29 @@ def test_what_pybullet_does_with_a_zero_sphere_is_what_the_note_says(
     low, high = p.getAABB(body, -1, physicsClientId=client)
     assert low == high  # a point
     assert p.getCollisionShapeData(body, -1, physicsClientId=client)[0][3] == (0.0, 0.0, 0.0)
+
+
+# ------------------------------------------------------------------ 4. mimics MuJoCo refuses
+
+def test_a_joint_mimicking_itself_or_a_ring_of_mimics_is_not_written(tmp_path: Path) -> None:
+    links = {n: '<visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual>'
+             for n in ("base", "l1", "l2", "l3", "l4")}
+    text = urdf(links, {"j1": '<mimic joint="j1"/>',  # itself
+                        "j2": '<mimic joint="j3"/>', "j3": '<mimic joint="j2"/>',  # a ring
+                        "j4": '<mimic joint="j2" multiplier="2"/>'})  # follows the ring
+    robot = tmp_path / "mimic.urdf"
+    robot.write_text(text)
+    out = tmp_path / "mimic.xml"
+    data = export(robot, out)
+    m = mujoco.MjModel.from_xml_path(str(out))  # "element 'j1' is repeated" before
+    # j4 = 2 j2 is written; the others are ordinary joints, each with its motor
+    assert m.neq == 1
+    eq = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.eq_obj1id[0])),
+          mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, int(m.eq_obj2id[0]))]
+    assert eq == ["j4", "j2"] and m.eq_data[0][:2].tolist() == [0, 2]
+    assert [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a) for a in range(m.nu)] == \
+        ["j1", "j2", "j3"]
+    dropped = {n["line"]: n["message"] for n in notes(data, "dropped") if "<mimic>" in n["message"]}
+    assert set(dropped) == {line_of(text, f'name="j{k}"') for k in (1, 2, 3)}
+    assert "itself" in dropped[line_of(text, 'name="j1"')]
+    assert "'j3' -> 'j2' -> 'j3'" in dropped[line_of(text, 'name="j3"')]

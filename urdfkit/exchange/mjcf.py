@@ -537,16 +537,54 @@ class _Writer:
 
     # ------------------------------------------------------------------ the rest
 
+    def mimics(self) -> list[Any]:
+        """The ``<mimic>`` joints written as equalities; each one left out is said.
+
+        Left out, each an ordinary joint as PyBullet has it (with an actuator): a mimic of a
+        joint that does not move, of itself (MuJoCo refuses it: "element 'a' is repeated in
+        equality constraint") and each of a ring of mimics (``b`` follows ``c`` follows
+        ``b``: none has a leader to take its position from, check's U309).
+        """
+        moving = {j.name for j in self.robot.movable()}
+        leader = {j.name: j.mimic[0] for j in self.robot.movable() if j.mimic is not None}
+        rings: dict[str, list[str]] = {}
+        for start in leader:
+            ring, name = [start], leader[start]
+            while name in leader and name not in ring:
+                ring.append(name)
+                name = leader[name]
+            if name == start and len(ring) > 1:
+                rings[start] = ring
+        written = []
+        for j in self.robot.movable():
+            if j.mimic is None:
+                continue
+            if j.mimic[0] not in moving:
+                why = "which does not move"
+            elif j.mimic[0] == j.name:
+                why = "itself, which MuJoCo refuses"
+            elif j.name in rings:
+                ring = rings[j.name]
+                why = ("a ring of mimics (" + " -> ".join(repr(n) for n in [*ring, j.name])
+                       + "): none has a leader to take its position from")
+            else:
+                written.append(j)
+                continue
+            self.note("dropped", f"joint {j.name!r}: <mimic> of {j.mimic[0]!r}, {why}; not "
+                      "written (an ordinary joint, as PyBullet has it)", j.line)
+        return written
+
     def actuators(self) -> None:
         E = self.E
         kind = self.o.actuators
-        movable = [j for j in self.robot.movable() if j.type != "spherical"]
+        mimics = self.mimics()
+        followers = {j.name for j in mimics}
+        movable = [j for j in self.robot.movable() if j.type != "spherical"
+                   and j.name not in followers]
         if kind != "none" and movable:
             act = E.SubElement(self.root, "actuator")
             gain = self.o.gain if self.o.gain is not None else DEFAULT_GAIN.get(kind)
             for j in movable:
-                if j.mimic is not None:
-                    continue
                 el = E.SubElement(act, kind, name=j.name, joint=j.name)
                 if kind == "motor":
                     if j.effort > 0:
@@ -559,28 +597,19 @@ class _Writer:
                         el.set("ctrlrange", nums((j.lower, j.upper)))
                     elif kind == "velocity" and j.velocity > 0:
                         el.set("ctrlrange", nums((-j.velocity, j.velocity)))
-        mimics = [j for j in self.robot.movable() if j.mimic is not None]
-        names = {j.name for j in self.robot.movable()}
         eq = E.SubElement(self.root, "equality") if mimics or self.locked else None
         for j in self.locked:
             E.SubElement(eq, "joint", joint1=j.name, polycoef=nums((j.lower, 0, 0, 0, 0)))
             self.note("approximated", f"joint {j.name!r} has lower == upper: PyBullet locks it "
                       "there with a limit; MuJoCo refuses an empty range, so a joint equality "
                       "holds it", j.line)
-        if mimics:
-            assert eq is not None
-            for j in mimics:
-                assert j.mimic is not None
-                leader, mult, offset = j.mimic
-                if leader not in names:
-                    self.note("dropped", f"joint {j.name!r}: <mimic> of {leader!r}, which does "
-                              "not move; not written", j.line)
-                    continue
-                E.SubElement(eq, "joint", joint1=j.name, joint2=leader,
-                             polycoef=nums((offset, mult, 0, 0, 0)))
-                self.note("approximated", f"joint {j.name!r} mimics {leader!r}: written as a "
-                          "joint equality (what the URDF means); PyBullet ignores <mimic>, so "
-                          "it is a known difference and has no actuator", j.line)
+        for j in mimics:
+            leader, mult, offset = j.mimic
+            E.SubElement(eq, "joint", joint1=j.name, joint2=leader,
+                         polycoef=nums((offset, mult, 0, 0, 0)))
+            self.note("approximated", f"joint {j.name!r} mimics {leader!r}: written as a "
+                      "joint equality (what the URDF means); PyBullet ignores <mimic>, so "
+                      "it is a known difference and has no actuator", j.line)
 
     def ground(self) -> None:
         E = self.E
