@@ -258,32 +258,48 @@ class _Writer:
 
     # ------------------------------------------------------------------ geoms
 
-    def geom(self, body: Any, shape: Shape, at: Any, visual: bool, link: Link) -> None:
-        E = self.E
-        t = at @ origin_matrix(shape.xyz, shape.rpy)
-        g = E.Element("geom")
-        if shape.kind == "box":
-            g.set("type", "box")
-            g.set("size", nums([s / 2 for s in shape.size]))
-        elif shape.kind in ("cylinder", "capsule"):
-            g.set("type", shape.kind)
-            g.set("size", nums([shape.size[0], shape.size[1] / 2]))
-        elif shape.kind == "sphere":
-            g.set("type", "sphere")
-            g.set("size", num(shape.size[0]))
-        elif shape.kind == "plane":
-            if body is not self.world and not self.static_root_body(body):
-                self.note("dropped", f"<plane> of link {link.name!r}: MuJoCo allows planes "
-                          "only on static bodies", shape.line)
-                return
-            g.set("type", "plane")
-            g.set("size", "0 0 1")
+    def sized(self, shape: Shape, visual: bool, link: Link) -> bool:
+        """Whether the shape has a size in every dimension (a mesh's scale nonzero).
+
+        MuJoCo refuses a geom whose size is not positive ("size 0 must be positive in
+        geom") and a mesh scaled to nothing ("mesh surface area is too small"). PyBullet
+        keeps such a shape (measured: a 0-radius sphere or a 0 0 0 box is a point the body
+        rests on, a 0-length cylinder a disc, a 0 scale component a flat mesh); the files
+        that hold one use it as a placeholder for nothing (atlas_drc's ``<sphere
+        radius="0"/>``, upkie's ``<box size="0 0 0"/>``), so it is left out, said. A capsule of
+        length 0 is a sphere, and is written as one.
+        """
+        if shape.kind == "plane":
+            return True
+        if shape.kind == "mesh":
+            values: tuple[float, ...] = tuple(shape.scale)
+            ok = all(math.isfinite(x) and x != 0 for x in values)  # negative: a mirror
+            what = f'<mesh scale="{nums(values)}">'
         else:
-            name = self.mesh(shape)
-            if name is None:
-                return
-            g.set("type", "mesh")
-            g.set("mesh", name)
+            values = tuple(shape.size)
+            # a capsule's length may be 0 (a sphere); every other size must be positive
+            sizes = values[:1] if shape.kind == "capsule" and values[1:] == (0.0,) else values
+            ok = all(math.isfinite(x) and x > 0 for x in sizes)
+            what = f'<box size="{nums(values)}">' if shape.kind == "box" else \
+                f"<{shape.kind} " + " ".join(f'{a}="{num(v)}"' for a, v in zip(
+                    ("radius", "length"), values, strict=False)) + ">"
+        if not ok:
+            part = "visual" if visual else "collision"
+            why = ("squashes the mesh flat (a scale of 0), as a zero-size primitive"
+                   if shape.kind == "mesh" else "has a size that is not positive, which MuJoCo "
+                   "refuses")
+            self.note("dropped", f"{part} of link {link.name!r}: {what} {why}; left out "
+                      "(PyBullet keeps it as a point, line or flat shape"
+                      + ("" if visual else " it collides with") + ")", shape.line)
+        return ok
+
+    def geom(self, body: Any, shape: Shape, at: Any, visual: bool, link: Link) -> None:
+        if not self.sized(shape, visual, link):
+            return
+        t = at @ origin_matrix(shape.xyz, shape.rpy)
+        g = self.E.Element("geom")
+        if not self.shape_type(g, body, shape, link):
+            return
         _place(g, t)
         if visual:
             g.set("contype", "0")
@@ -312,6 +328,37 @@ class _Writer:
             elif link.spinning_friction > 0:
                 g.set("condim", "4")
         body.append(g)
+
+    def shape_type(self, g: Any, body: Any, shape: Shape, link: Link) -> bool:
+        """Set the geom's type and size (or mesh); False when it cannot be written."""
+        if shape.kind == "box":
+            g.set("type", "box")
+            g.set("size", nums([s / 2 for s in shape.size]))
+        elif shape.kind == "capsule" and shape.size[1] == 0:
+            g.set("type", "sphere")
+            g.set("size", num(shape.size[0]))
+            self.note("converted", f"capsule of link {link.name!r} has length 0: written as "
+                      "the sphere it is (MuJoCo refuses a capsule of length 0)", shape.line)
+        elif shape.kind in ("cylinder", "capsule"):
+            g.set("type", shape.kind)
+            g.set("size", nums([shape.size[0], shape.size[1] / 2]))
+        elif shape.kind == "sphere":
+            g.set("type", "sphere")
+            g.set("size", num(shape.size[0]))
+        elif shape.kind == "plane":
+            if body is not self.world and not self.static_root_body(body):
+                self.note("dropped", f"<plane> of link {link.name!r}: MuJoCo allows planes "
+                          "only on static bodies", shape.line)
+                return False
+            g.set("type", "plane")
+            g.set("size", "0 0 1")
+        else:
+            name = self.mesh(shape)
+            if name is None:
+                return False
+            g.set("type", "mesh")
+            g.set("mesh", name)
+        return True
 
     def static_root_body(self, body: Any) -> bool:
         return body.get("name") == self.robot.root and self.static
@@ -490,16 +537,54 @@ class _Writer:
 
     # ------------------------------------------------------------------ the rest
 
+    def mimics(self) -> list[Any]:
+        """The ``<mimic>`` joints written as equalities; each one left out is said.
+
+        Left out, each an ordinary joint as PyBullet has it (with an actuator): a mimic of a
+        joint that does not move, of itself (MuJoCo refuses it: "element 'a' is repeated in
+        equality constraint") and each of a ring of mimics (``b`` follows ``c`` follows
+        ``b``: none has a leader to take its position from, check's U309).
+        """
+        moving = {j.name for j in self.robot.movable()}
+        leader = {j.name: j.mimic[0] for j in self.robot.movable() if j.mimic is not None}
+        rings: dict[str, list[str]] = {}
+        for start in leader:
+            ring, name = [start], leader[start]
+            while name in leader and name not in ring:
+                ring.append(name)
+                name = leader[name]
+            if name == start and len(ring) > 1:
+                rings[start] = ring
+        written = []
+        for j in self.robot.movable():
+            if j.mimic is None:
+                continue
+            if j.mimic[0] not in moving:
+                why = "which does not move"
+            elif j.mimic[0] == j.name:
+                why = "itself, which MuJoCo refuses"
+            elif j.name in rings:
+                ring = rings[j.name]
+                why = ("a ring of mimics (" + " -> ".join(repr(n) for n in [*ring, j.name])
+                       + "): none has a leader to take its position from")
+            else:
+                written.append(j)
+                continue
+            self.note("dropped", f"joint {j.name!r}: <mimic> of {j.mimic[0]!r}, {why}; not "
+                      "written (an ordinary joint, as PyBullet has it)", j.line)
+        return written
+
     def actuators(self) -> None:
         E = self.E
         kind = self.o.actuators
-        movable = [j for j in self.robot.movable() if j.type != "spherical"]
+        mimics = self.mimics()
+        followers = {j.name for j in mimics}
+        movable = [j for j in self.robot.movable() if j.type != "spherical"
+                   and j.name not in followers]
         if kind != "none" and movable:
             act = E.SubElement(self.root, "actuator")
             gain = self.o.gain if self.o.gain is not None else DEFAULT_GAIN.get(kind)
             for j in movable:
-                if j.mimic is not None:
-                    continue
                 el = E.SubElement(act, kind, name=j.name, joint=j.name)
                 if kind == "motor":
                     if j.effort > 0:
@@ -512,28 +597,19 @@ class _Writer:
                         el.set("ctrlrange", nums((j.lower, j.upper)))
                     elif kind == "velocity" and j.velocity > 0:
                         el.set("ctrlrange", nums((-j.velocity, j.velocity)))
-        mimics = [j for j in self.robot.movable() if j.mimic is not None]
-        names = {j.name for j in self.robot.movable()}
         eq = E.SubElement(self.root, "equality") if mimics or self.locked else None
         for j in self.locked:
             E.SubElement(eq, "joint", joint1=j.name, polycoef=nums((j.lower, 0, 0, 0, 0)))
             self.note("approximated", f"joint {j.name!r} has lower == upper: PyBullet locks it "
                       "there with a limit; MuJoCo refuses an empty range, so a joint equality "
                       "holds it", j.line)
-        if mimics:
-            assert eq is not None
-            for j in mimics:
-                assert j.mimic is not None
-                leader, mult, offset = j.mimic
-                if leader not in names:
-                    self.note("dropped", f"joint {j.name!r}: <mimic> of {leader!r}, which does "
-                              "not move; not written", j.line)
-                    continue
-                E.SubElement(eq, "joint", joint1=j.name, joint2=leader,
-                             polycoef=nums((offset, mult, 0, 0, 0)))
-                self.note("approximated", f"joint {j.name!r} mimics {leader!r}: written as a "
-                          "joint equality (what the URDF means); PyBullet ignores <mimic>, so "
-                          "it is a known difference and has no actuator", j.line)
+        for j in mimics:
+            leader, mult, offset = j.mimic
+            E.SubElement(eq, "joint", joint1=j.name, joint2=leader,
+                         polycoef=nums((offset, mult, 0, 0, 0)))
+            self.note("approximated", f"joint {j.name!r} mimics {leader!r}: written as a "
+                      "joint equality (what the URDF means); PyBullet ignores <mimic>, so "
+                      "it is a known difference and has no actuator", j.line)
 
     def ground(self) -> None:
         E = self.E
