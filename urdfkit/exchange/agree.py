@@ -395,6 +395,8 @@ class _Compare:
         self.result.matched_by = [{"urdf": a, "mjcf": b, "how": how}
                                   for a, b, how in self.match.pairs]
         self.matched = [n for n in self.pb.names if n in self.jnt]
+        #: links PyBullet zeroes whose body the MJCF gives another inertia (see masses)
+        self.repaired: list[str] = []
         # PyBullet's world has no gravity until set: MuJoCo's, for inverse dynamics and swing
         self.pb.b.setGravity(*map(float, self.fixed.opt.gravity))
 
@@ -540,6 +542,7 @@ class _Compare:
         inertia: list[tuple[float, str]] = []
         missing: list[str] = []
         zeroed = self.zeroed_inertia()
+        self.repaired = []
         for body, parts in groups.items():
             if body not in image:
                 if not (body == robot.root == "world" and combine(parts).mass == 0):
@@ -549,10 +552,18 @@ class _Compare:
                                                    [(Inertial(0.0, (0, 0, 0), _ZERO3), np.eye(4))])
             mass.append((abs(ours.mass - theirs.mass) / max(ours.mass, theirs.mass, 1e-300),
                          body))
-            if ours.mass > 0 and not any(where[z][0] == body for z in zeroed):
-                com.append((float(np.abs(ours.com - theirs.com).max()), body))
-                scale = max(float(np.abs(ours.tensor).max()), 1e-300)
-                inertia.append((float(np.abs(ours.tensor - theirs.tensor).max()) / scale, body))
+            if ours.mass <= 0:
+                continue
+            scale = max(float(np.abs(ours.tensor).max()), 1e-300)
+            off = float(np.abs(ours.tensor - theirs.tensor).max()) / scale
+            mine = [z for z in zeroed if where[z][0] == body]
+            if mine and off > TOL_INERTIA:
+                # PyBullet zeroed a link's tensor here and the MJCF holds another (export
+                # writes the one `fix` would: MuJoCo refuses a moving body without one)
+                self.repaired += mine
+                continue
+            com.append((float(np.abs(ours.com - theirs.com).max()), body))
+            inertia.append((off, body))
         if missing:
             res.add("structure", "bodies", float(len(missing)), 0.0, "unmatched",
                     ", ".join(missing))
@@ -569,9 +580,10 @@ class _Compare:
             if items:
                 v, dd = _worst(items)
                 res.add("structure", what, v, tol, "m" if what[0] == "c" else "relative", dd)
-        if zeroed:
-            res.add("structure", "inertia PyBullet zeroes", float(len(zeroed)), None, "known",
-                    f"{', '.join(zeroed[:4])}: the file's tensor breaks the triangle inequality, "
+        if self.repaired:
+            res.add("structure", "inertia PyBullet zeroes", float(len(self.repaired)), None,
+                    "known", f"{', '.join(self.repaired[:4])}: the file's tensor breaks the "
+                    "triangle inequality, "
                     "PyBullet sets it to zero and MuJoCo refuses a moving body without one; "
                     "their bodies' inertia, the dynamics and the swing are not compared",
                     status="known")
@@ -815,7 +827,7 @@ class _Compare:
             and not pb.spherical
         dof = [int(m.jnt_dofadr[self.jnt[n]]) for n in self.matched]
         refused: str | None = None  # the PyBullet call that failed on this model
-        zeroed = self.zeroed_inertia()
+        zeroed = self.repaired
         if dyn and zeroed:
             refused = f"model zeroes the inertia of {', '.join(zeroed[:3])} (see the " \
                 "structure rows)"
@@ -938,7 +950,7 @@ class _Compare:
 
         if unreadable_state(self.pb.info):  # getJointStates would raise or misread
             return "not compared: " + unreadable_state(self.pb.info), "known"
-        zeroed = self.zeroed_inertia()
+        zeroed = self.repaired
         if zeroed:
             return (f"not compared: PyBullet zeroes the inertia of {', '.join(zeroed[:3])} "
                     "(see the structure rows)", "known")
