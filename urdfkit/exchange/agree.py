@@ -275,10 +275,24 @@ def pybullet_frame_tolerances(robot: Robot) -> dict[str, float]:
     for j in robot.joints:
         reach = 0.0
         if j.moves:
-            reach = max(abs(j.lower), abs(j.upper)) if j.limited else \
+            reach = max(map(abs, sample_range(j))) if j.limited else \
                 (1.0 if j.type == "prismatic" else math.pi)
         acc[j.child] = acc[j.parent] + 1.0 + reach
     return {n: max(TOL_PYBULLET_FRAME, 2.0 ** -22 * a) for n, a in acc.items()}
+
+
+#: How far from the point of its range nearest zero a limited joint is sampled: a turn each
+#: way (a revolute pose repeats past it), a metre along a prismatic one. Real ranges fit
+#: whole (UR's +-2 pi); +-1e308 overflowed the sampler (exit 3), and poses that far out
+#: would make every figure meaningless (float32 PyBullet, sines of 1e300).
+SAMPLE_REACH = {"revolute": 2 * math.pi, "prismatic": 1.0}
+
+
+def sample_range(j: Any) -> tuple[float, float]:
+    """The part of a limited joint's range poses and the swing start are drawn from."""
+    reach = SAMPLE_REACH["prismatic" if j.type == "prismatic" else "revolute"]
+    near = min(max(0.0, j.lower), j.upper)
+    return max(j.lower, near - reach), min(j.upper, near + reach)
 
 
 def _sample(robot: Robot, names: list[str], rng: Any) -> dict[str, float]:
@@ -287,7 +301,7 @@ def _sample(robot: Robot, names: list[str], rng: Any) -> dict[str, float]:
     for n in names:
         j = joints[n]
         if j.limited:
-            q[n] = float(rng.uniform(j.lower, j.upper))
+            q[n] = float(rng.uniform(*sample_range(j)))
         elif j.type == "prismatic":
             q[n] = float(rng.uniform(-1.0, 1.0))
         else:
@@ -729,8 +743,9 @@ class _Compare:
         q0 = {}
         for n in pb.names:
             j = joints[n]
-            mid, half = ((j.lower + j.upper) / 2, (j.upper - j.lower) / 4) if j.limited \
-                else (0.0, 1.0)
+            lo, hi = sample_range(j) if j.limited else (-2.0, 2.0)
+            mid = (lo + hi) / 2 if math.isfinite(lo + hi) else lo / 2 + hi / 2  # 1e308 and up
+            half = (hi - lo) / 4
             q0[n] = float(rng.uniform(mid - half, mid + half))
         self.set_q(d, {n: q0[n] for n in self.matched})
         unstable = self._explicit_damping_unstable(d)
