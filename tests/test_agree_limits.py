@@ -66,3 +66,38 @@ def test_the_frame_tolerances_stay_float32_sized() -> None:
     robot = read_robot(load_xml(HUGE).getroot(), str(HUGE))
     tolerances = pybullet_frame_tolerances(robot)
     assert max(tolerances.values()) == pytest.approx(2.0 ** -22 * (3 + 4 * math.pi + 1))
+
+
+def _agree_in_a_process(tmp_path: Path, edit: tuple[str, str]) -> tuple[int, list[str]]:
+    """Export the huge-limits robot, edit the MJCF, run agree as a user: code, stderr lines
+    (MuJoCo's C code prints on the process's own stderr, which CliRunner does not see)."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "model.xml"
+    r = runner.invoke(app, ["export", "mjcf", str(HUGE), "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    text = out.read_text()
+    assert edit[0] in text
+    out.write_text(text.replace(edit[0], edit[1], 1))
+    r2 = subprocess.run([sys.executable, "-m", "urdfkit", "agree", str(HUGE), str(out),
+                         "--poses", "2"], capture_output=True, text=True, timeout=120)
+    return r2.returncode, [ln for ln in r2.stderr.splitlines() if ln.strip()]
+
+
+def test_a_nan_mujoco_refuses_is_one_line(tmp_path: Path) -> None:
+    code, lines = _agree_in_a_process(tmp_path, ('ctrlrange="-1 1"',
+                                                 'ctrlrange="NaN inf 0"'))
+    assert code == 2
+    # MuJoCo's parser also said "WARNING: XML contains a 'NaN'" and a blank line on stderr
+    assert len(lines) == 1 and "model.xml: MuJoCo cannot load it: " in lines[0], lines
+
+
+def test_a_diverging_model_fails_its_rows_and_prints_only_urdfkits_lines(tmp_path: Path
+                                                                        ) -> None:
+    code, lines = _agree_in_a_process(tmp_path, ('<option integrator="implicitfast"/>',
+                                                 '<option gravity="0 0 -1e300"/>'))
+    assert code == 1
+    # MuJoCo's "WARNING: Nan, Inf or huge value in QACC" and numpy's overflow warnings before
+    assert lines and all(ln.startswith("urdfkit: warning: ") for ln in lines), lines
+    assert any("MuJoCo: Nan, Inf or huge value in QACC" in ln for ln in lines), lines

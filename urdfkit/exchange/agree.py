@@ -140,14 +140,17 @@ def load_mjcf(path: str | Path) -> tuple[Any, Any]:
     check_mjcf_files(p)  # its includes, meshes, textures...: MuJoCo would block on a FIFO too
     import warnings
 
+    from urdfkit.exchange.mjwarn import mujoco_warnings
+
     try:
         # MuJoCo's decoders warn through Python (an OBJ's texture coordinates dropped): kept
         # for the report, not printed
-        with warnings.catch_warnings(record=True) as said:
+        with warnings.catch_warnings(record=True) as said, \
+                mujoco_warnings(mujoco) as said_in_c:  # its C parser's too ("a 'NaN'")
             warnings.simplefilter("always")
             spec = mujoco.MjSpec.from_file(str(p))
             model = spec.compile()
-        LOAD_WARNINGS[:] = sorted({str(w.message) for w in said})
+        LOAD_WARNINGS[:] = sorted({str(w.message) for w in said} | set(said_in_c))
         fixed_spec = mujoco.MjSpec.from_file(str(p))
         for j in list(fixed_spec.joints):
             if j.type == mujoco.mjtJoint.mjJNT_FREE:
@@ -838,17 +841,23 @@ def agree(resolved: Any, model_path: str | Path, options: AgreeOptions | None = 
         InputError: MuJoCo cannot load the MJCF.
         MissingDependencyError: MuJoCo is not installed.
     """
+    import numpy as np
+
     from urdfkit.engine.session import Session
+    from urdfkit.exchange.mjwarn import mujoco_warnings
     from urdfkit.exchange.robot import read_robot
 
     o = options or AgreeOptions()
     robot = read_robot(resolved.root, resolved.name)
-    import_mujoco()
-    with Session() as session:
+    mujoco = import_mujoco()
+    # a model that diverges says so in its rows (inf, NaN: null in JSON) and in MuJoCo's
+    # warnings, not in numpy's or MuJoCo's lines on stderr
+    with Session() as session, mujoco_warnings(mujoco) as said, np.errstate(all="ignore"):
         c = _Compare(robot, str(model_path), session, str(resolved.load_path), o)
         c.structure()
         c.poses()
         c.swing()
+        c.result.warnings += [w for w in dict.fromkeys(said) if w not in c.result.warnings]
         return c.result
 
 
