@@ -128,7 +128,12 @@ def test_what_mujoco_would_not_open_is_not_checked(tmp_path: Path) -> None:
     os.mkfifo(tmp_path / "pipe.png")
     os.mkfifo(tmp_path / "pipe.obj")
     assert check_mjcf_files(top) == []
-    assert mujoco.MjModel.from_xml_path(str(top)).nmesh == 1
+    from urdfkit.exchange.mjwarn import mujoco_warnings
+
+    with mujoco_warnings(mujoco) as said:  # not into ./MUJOCO_LOG.TXT
+        assert mujoco.MjModel.from_xml_path(str(top)).nmesh == 1
+    assert said == ["flex 'f' is not rigid and has no equality constraints or passive forces "
+                    "(Element name 'f', id 0)"]
 
 
 @pytest.mark.parametrize(("files", "special", "message"), [

@@ -148,14 +148,17 @@ def load_mjcf(path: str | Path) -> tuple[Any, Any]:
     check_mjcf_files(p)  # its includes, meshes, textures...: MuJoCo would block on a FIFO too
     import warnings
 
+    from urdfkit.exchange.mjwarn import mujoco_warnings
+
     try:
         # MuJoCo's decoders warn through Python (an OBJ's texture coordinates dropped): kept
         # for the report, not printed
-        with warnings.catch_warnings(record=True) as said:
+        with warnings.catch_warnings(record=True) as said, \
+                mujoco_warnings(mujoco) as said_in_c:  # its C parser's too ("a 'NaN'")
             warnings.simplefilter("always")
             spec = mujoco.MjSpec.from_file(str(p))
             model = spec.compile()
-        LOAD_WARNINGS[:] = sorted({str(w.message) for w in said})
+        LOAD_WARNINGS[:] = sorted({str(w.message) for w in said} | set(said_in_c))
         fixed_spec = mujoco.MjSpec.from_file(str(p))
         for key in list(fixed_spec.keys):
             fixed_spec.delete(key)  # a keyframe's qpos holds the free joints removed below
@@ -327,10 +330,24 @@ def pybullet_frame_tolerances(robot: Robot) -> dict[str, float]:
     for j in robot.joints:
         reach = 0.0
         if j.moves:
-            reach = max(abs(j.lower), abs(j.upper)) if j.limited else \
+            reach = max(map(abs, sample_range(j))) if j.limited else \
                 (1.0 if j.type == "prismatic" else math.pi)
         acc[j.child] = acc[j.parent] + 1.0 + reach
     return {n: max(TOL_PYBULLET_FRAME, 2.0 ** -22 * a) for n, a in acc.items()}
+
+
+#: How far from the point of its range nearest zero a limited joint is sampled: a turn each
+#: way (a revolute pose repeats past it), a metre along a prismatic one. Real ranges fit
+#: whole (UR's +-2 pi); +-1e308 overflowed the sampler (exit 3), and poses that far out
+#: would make every figure meaningless (float32 PyBullet, sines of 1e300).
+SAMPLE_REACH = {"revolute": 2 * math.pi, "prismatic": 1.0}
+
+
+def sample_range(j: Any) -> tuple[float, float]:
+    """The part of a limited joint's range poses and the swing start are drawn from."""
+    reach = SAMPLE_REACH["prismatic" if j.type == "prismatic" else "revolute"]
+    near = min(max(0.0, j.lower), j.upper)
+    return max(j.lower, near - reach), min(j.upper, near + reach)
 
 
 def _sample(robot: Robot, names: list[str], rng: Any) -> dict[str, float]:
@@ -339,7 +356,7 @@ def _sample(robot: Robot, names: list[str], rng: Any) -> dict[str, float]:
     for n in names:
         j = joints[n]
         if j.limited:
-            q[n] = float(rng.uniform(j.lower, j.upper))
+            q[n] = float(rng.uniform(*sample_range(j)))
         elif j.type == "prismatic":
             q[n] = float(rng.uniform(-1.0, 1.0))
         else:
@@ -1026,8 +1043,9 @@ class _Compare:
         q0, v0 = {}, {}
         for n in self.pb.names:
             j = joints[n]
-            mid, half = ((j.lower + j.upper) / 2, (j.upper - j.lower) / 4) if j.limited \
-                else (0.0, 1.0)
+            lo, hi = sample_range(j) if j.limited else (-2.0, 2.0)
+            mid = (lo + hi) / 2 if math.isfinite(lo + hi) else lo / 2 + hi / 2  # 1e308 and up
+            half = (hi - lo) / 4
             q0[n] = float(rng.uniform(mid - half, mid + half))
         for n in self.pb.names:
             v0[n] = float(rng.uniform(-1.0, 1.0))
@@ -1213,18 +1231,24 @@ def agree(resolved: Any, model_path: str | Path, options: AgreeOptions | None = 
         InputError: MuJoCo cannot load the MJCF.
         MissingDependencyError: MuJoCo is not installed.
     """
+    import numpy as np
+
     from urdfkit.engine.session import Session
+    from urdfkit.exchange.mjwarn import mujoco_warnings
     from urdfkit.exchange.robot import read_robot
 
     o = options or AgreeOptions()
     robot = read_robot(resolved.root, resolved.name)
-    import_mujoco()
-    with Session() as session:
+    mujoco = import_mujoco()
+    # a model that diverges says so in its rows (inf, NaN: null in JSON) and in MuJoCo's
+    # warnings, not in numpy's or MuJoCo's lines on stderr
+    with Session() as session, mujoco_warnings(mujoco) as said, np.errstate(all="ignore"):
         c = _Compare(robot, str(model_path), session, str(resolved.load_path), o)
         c.structure()
         c.poses()
         c.collisions()
         c.swing()
+        c.result.warnings += [w for w in dict.fromkeys(said) if w not in c.result.warnings]
         return c.result
 
 
