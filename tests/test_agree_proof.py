@@ -412,3 +412,49 @@ def test_a_mass_difference_names_pybullets_default_mass(tmp_path: Path) -> None:
     assert code == 1
     detail = _failing(data)["body masses"]
     assert detail.startswith("l0") and "l1" in detail and "default 1 kg" in detail
+
+
+def test_a_ground_on_the_world_is_not_the_robot(tmp_path: Path) -> None:
+    """pendulum5's root is `world`: its shapes are compared on MuJoCo's world body, where
+    `--ground` also puts a plane, which is the scene, not an extra collision shape."""
+    out = tmp_path / "p5.xml"
+    _export("pendulum5.urdf", out, "--ground")
+    code, data = _agree("pendulum5.urdf", out)
+    assert code == 0, _failing(data)
+    assert _rows(data)["collision shapes"]["value"] < 1e-9
+
+
+def test_a_second_free_body_is_extra(exports: dict[str, Path]) -> None:
+    def box(doc: etree._ElementTree) -> None:
+        b = etree.SubElement(doc.find("worldbody"), "body", pos="3 0 1")
+        etree.SubElement(b, "freejoint")
+        etree.SubElement(b, "geom", type="ellipsoid", size="0.1 0.2 0.3", mass="25")
+
+    code, data = _agree("r2d2.urdf", _tamper(exports["r2d2.urdf"], "second.xml", box))
+    failing = _failing(data)
+    assert code == 1 and failing["bodies"].startswith("+body ")
+    assert "extra in the MJCF" in failing["collision shapes"] and "total mass" in failing
+    assert "body masses" not in failing  # the robot's own bodies still weigh the same
+
+
+def test_a_zero_size_shape_is_a_known_difference(tmp_path: Path) -> None:
+    urdf = tmp_path / "zero.urdf"
+    urdf.write_text(PENDULUM.format(links=LINK.format(i=0, dynamics="").replace(
+        "</collision>", '</collision><collision><geometry><sphere radius="0"/></geometry>'
+        "</collision>"), joints=JOINT.format(i=0, parent="base", z=0, axis="1 0 0", lo=-1,
+                                            hi=1, dynamics="")))
+    p = pybullet
+    c = p.connect(p.DIRECT)
+    try:  # PyBullet loads the sphere of radius 0 as a shape of its own
+        body = p.loadURDF(str(urdf), physicsClientId=c)
+        kinds = [s[2] for s in p.getCollisionShapeData(body, 0, physicsClientId=c)]
+        assert kinds.count(p.GEOM_SPHERE) == 1
+    finally:
+        p.disconnect(c)
+    out = tmp_path / "zero.xml"
+    _export(str(urdf), out)
+    mujoco.MjModel.from_xml_path(str(out))
+    code, data = _agree(str(urdf), out)
+    assert code == 0, _failing(data)
+    row = _rows(data)["shapes MuJoCo cannot hold"]
+    assert row["status"] == "known" and row["detail"].startswith("l0: a zero-size shape")

@@ -547,8 +547,10 @@ class _Compare:
             t[:3, 3] = d.xipos[b]
             own = Inertial(float(m.body_mass[b]), (0.0, 0.0, 0.0),
                            tuple(map(tuple, np.diag(m.body_inertia[b]))))  # type: ignore[arg-type]
-            weld.setdefault(int(m.body_weldid[b]), []).append((own, t))
-        image = self._weld_image(where)
+            # grouped as written: a body with a free joint of its own that no link matches
+            # (a second robot, a loose box) is a group of its own, said as extra
+            weld.setdefault(int(self.model.body_weldid[b]), []).append((own, t))
+        image = self._weld_image(where, self.model)
         total_pb = sum(i.mass for parts in groups.values() for i, _ in parts)
         total_mj = float(m.body_mass[1:].sum())
         res.add("structure", "total mass", abs(total_pb - total_mj) / max(total_pb, 1e-300),
@@ -581,9 +583,13 @@ class _Compare:
                 continue
             com.append((float(np.abs(ours.com - theirs.com).max()), body))
             inertia.append((off, body))
+        taken = set(image.values())
+        missing += [f"+{_name(self.model, mj.mjtObj.mjOBJ_BODY, w) or f'body {w}'}"
+                    for w, parts in weld.items() if w and w not in taken
+                    and sum(i.mass for i, _ in parts) > 0]
         if missing:
             res.add("structure", "bodies", float(len(missing)), 0.0, "unmatched",
-                    ", ".join(missing))
+                    ", ".join(missing[:6]) + (" ..." if len(missing) > 6 else ""))
         if not mass:
             res.add("structure", "body masses", None, None, "", "not compared: no link has a "
                     "body or site in the MJCF")
@@ -605,9 +611,12 @@ class _Compare:
                     "their bodies' inertia, the dynamics and the swing are not compared",
                     status="known")
 
-    def _weld_image(self, where: dict[str, tuple[str, Any]]) -> dict[str, int]:
-        """Each PyBullet body group -> the MuJoCo weld group its matched links are in."""
-        m = self.fixed
+    def _weld_image(self, where: dict[str, tuple[str, Any]], m: Any = None) -> dict[str, int]:
+        """Each PyBullet body group -> the MuJoCo weld group its matched links are in.
+
+        In ``m``'s weld groups: the base-welded copy's by default (body ids are the same).
+        """
+        m = self.fixed if m is None else m
         image: dict[str, int] = {}
         for link, (group, _) in where.items():
             if group in image:
@@ -887,8 +896,8 @@ class _Compare:
             for c in d_contact.contact[:d_contact.ncon]:
                 b1, b2 = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
                 if b1 and b2:
-                    contacts.append(f"{_name(m, mj.mjtObj.mjOBJ_BODY, b1)}/"
-                                    f"{_name(m, mj.mjtObj.mjOBJ_BODY, b2)}")
+                    contacts.append(f"{_name(m, mj.mjtObj.mjOBJ_BODY, b1) or f'body {b1}'}/"
+                                    f"{_name(m, mj.mjtObj.mjOBJ_BODY, b2) or f'body {b2}'}")
         if not links:
             res.add("kinematics", "link frames", None, None, "", "not compared: no link has "
                     "a body or site of its name")

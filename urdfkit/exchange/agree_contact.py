@@ -218,8 +218,8 @@ def _extent(s: Shape) -> float:
 
 
 def compare(pb_shapes: list[Shape], geoms: list[tuple[int, Shape]], body_weld: Any,
-            image: dict[str, int], names: dict[int, str]) -> tuple[list[tuple[Shape, int, float]],
-                                                                list[str], list[str]]:
+            image: dict[str, int], names: dict[int, str], on_world: Any = None
+            ) -> tuple[list[tuple[Shape, int, float]], list[str], list[str]]:
     """Pair each PyBullet shape with the nearest MuJoCo geom: (pairs, missing, extra)."""
     used: set[int] = set()
     pairs: list[tuple[Shape, int, float]] = []
@@ -239,7 +239,9 @@ def compare(pb_shapes: list[Shape], geoms: list[tuple[int, Shape]], body_weld: A
             continue
         used.add(at)
         pairs.append((s, at, best))
-    extra = [f"{names.get(g, g)} ({t.kind})" for g, t in geoms if g not in used]
+    # the world's own geoms that no shape of the URDF's `world` link took: a ground, scenery
+    extra = [f"{names.get(g, g)} ({t.kind})" for g, t in geoms
+             if g not in used and not (on_world and on_world(g))]
     return pairs, missing, extra
 
 
@@ -285,13 +287,17 @@ def collision_verdict(mj: Any, m: Any, b: Any, body: int, link_index: dict[str, 
     d = mj.MjData(m)
     d.qpos[:] = m.qpos0
     mj.mj_kinematics(m, d)
-    names = {g: mj.mj_id2name(m, mj.mjtObj.mjOBJ_GEOM, g) or
-             f"geom {g} of {mj.mj_id2name(m, mj.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g]))}"
+    def owner(g: int) -> str:
+        b = int(m.geom_bodyid[g])
+        return mj.mj_id2name(m, mj.mjtObj.mjOBJ_BODY, b) or f"body {b}"
+
+    names = {g: mj.mj_id2name(m, mj.mjtObj.mjOBJ_GEOM, g) or f"geom {g} of {owner(g)}"
              for g in range(m.ngeom)}
     shapes, skipped = pybullet_shapes(b, body, link_index, zero, group, static)
     geoms = mujoco_geoms(mj, m, d, keep_world)
     pairs, missing, extra = compare(
-        shapes, geoms, lambda g: m.body_weldid[int(m.geom_bodyid[g])], image, names)
+        shapes, geoms, lambda g: m.body_weldid[int(m.geom_bodyid[g])], image, names,
+        lambda g: int(m.geom_bodyid[g]) == 0)
     prim = [(e, f"{s.link} ({s.kind})") for s, _, e in pairs if s.kind != "mesh"]
     mesh = [(e / _extent(s), f"{s.link} ({s.kind})") for s, _, e in pairs if s.kind == "mesh"]
     return Verdict(max(prim, key=lambda x: x[0]) if prim else None,
