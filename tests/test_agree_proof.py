@@ -4,12 +4,12 @@ export's are read truthfully, each row saying what it compared (issue 48)."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 from lxml import etree
+from test_agree import _agree, _export
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
@@ -18,17 +18,6 @@ mujoco = pytest.importorskip("mujoco")  # in the test extra: CI never skips it
 pybullet = pytest.importorskip("pybullet")
 
 runner = CliRunner()
-
-
-def _export(robot: str, out: Path, *args: str) -> None:
-    r = runner.invoke(app, ["export", "mjcf", robot, "-o", str(out), *args])
-    assert r.exit_code == 0, r.output
-
-
-def _agree(robot: str, model: Path, *args: str) -> tuple[int, dict]:
-    r = runner.invoke(app, ["agree", robot, str(model), "--json", *args])
-    assert r.exit_code in (0, 1), r.output
-    return r.exit_code, json.loads(r.stdout)
 
 
 def _rows(data: dict) -> dict[str, dict]:
