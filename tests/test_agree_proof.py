@@ -447,3 +447,25 @@ def test_a_zero_size_shape_is_a_known_difference(tmp_path: Path) -> None:
     assert code == 0, _failing(data)
     row = _rows(data)["shapes MuJoCo cannot hold"]
     assert row["status"] == "known" and row["detail"].startswith("l0: a zero-size shape")
+
+
+def test_an_inertial_frame_mujoco_snaps_to_its_body_is_said(tmp_path: Path) -> None:
+    """A product of inertia of 3.6e-13 on moments of ~1e-5 (toddlerbot's sho_yaw_link) turns
+    the principal axes by ~1e-7 rad: MuJoCo's compiler takes that frame as the body's
+    (body_sameframe) and simulates the tensor without the product."""
+    link = ('<link name="l0"><inertial><origin xyz="0 0 -0.02"/><mass value="0.0145"/>'
+            '<inertia ixx="9.2365904614004e-06" iyy="5.8163826335079e-06" '
+            'izz="4.5074356741562e-06" ixy="3.5862833440690e-13" ixz="0" iyz="0"/>'
+            '</inertial></link>')
+    urdf = tmp_path / "snap.urdf"
+    urdf.write_text(PENDULUM.format(links=link, joints=JOINT.format(
+        i=0, parent="base", z=0, axis="0 0 1", lo=-1, hi=1, dynamics="")))
+    out = tmp_path / "snap.xml"
+    _export(str(urdf), out)
+    m = mujoco.MjModel.from_xml_path(str(out))
+    b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "l0")
+    assert m.body_sameframe[b] != 0 and abs(m.body_iquat[b][3]) > 1e-9
+    code, data = _agree(str(urdf), out)
+    assert code == 0, _failing(data)
+    row = _rows(data)["inertial frames MuJoCo puts on their body"]
+    assert row["status"] == "known" and row["detail"].startswith("l0") and row["value"] > 1e-9

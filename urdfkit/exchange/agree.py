@@ -540,16 +540,7 @@ class _Compare:
         d.qpos[:] = 0
         mj.mj_kinematics(m, d)
         mj.mj_comPos(m, d)
-        weld: dict[int, list[tuple[Inertial, Any]]] = {}
-        for b in range(1, m.nbody):
-            t = np.eye(4)
-            t[:3, :3] = d.ximat[b].reshape(3, 3)
-            t[:3, 3] = d.xipos[b]
-            own = Inertial(float(m.body_mass[b]), (0.0, 0.0, 0.0),
-                           tuple(map(tuple, np.diag(m.body_inertia[b]))))  # type: ignore[arg-type]
-            # grouped as written: a body with a free joint of its own that no link matches
-            # (a second robot, a loose box) is a group of its own, said as extra
-            weld.setdefault(int(self.model.body_weldid[b]), []).append((own, t))
+        weld, snapped = self._mujoco_weld_groups(d)
         image = self._weld_image(where, self.model)
         total_pb = sum(i.mass for parts in groups.values() for i, _ in parts)
         total_mj = float(m.body_mass[1:].sum())
@@ -603,6 +594,12 @@ class _Compare:
             if items:
                 v, dd = _worst(items)
                 res.add("structure", what, v, tol, "m" if what[0] == "c" else "relative", dd)
+        v, dd = _worst(snapped)
+        if v > 0:
+            res.add("structure", "inertial frames MuJoCo puts on their body", v, None,
+                    "relative", f"{dd}: MuJoCo's compiler takes an inertial frame this close "
+                    "to its body's as the body's (body_sameframe) and simulates the tensor "
+                    "so turned; the inertia row compares the MJCF's own", status="known")
         if self.repaired:
             res.add("structure", "inertia PyBullet zeroes", float(len(self.repaired)), None,
                     "known", f"{', '.join(self.repaired[:4])}: the file's tensor breaks the "
@@ -610,6 +607,41 @@ class _Compare:
                     "PyBullet sets it to zero and MuJoCo refuses a moving body without one; "
                     "their bodies' inertia, the dynamics and the swing are not compared",
                     status="known")
+
+    def _mujoco_weld_groups(self, d: Any) -> tuple[dict[int, list[tuple[Inertial, Any]]],
+                                                    list[tuple[float, str]]]:
+        """MuJoCo's bodies' mass properties by weld group (as written), placed by ``d``.
+
+        And the bodies whose inertial frame MuJoCo's compiler snapped onto the body's, with the
+        relative change of their tensor.
+        """
+        import numpy as np
+
+        mj, m = self.mj, self.fixed
+        weld: dict[int, list[tuple[Inertial, Any]]] = {}
+        snapped: list[tuple[float, str]] = []
+        for b in range(1, m.nbody):
+            # the inertial frame as the MJCF gives it (body_ipos, body_iquat): MuJoCo's
+            # compiler puts one within ~1e-6 of the body's frame at that frame
+            # (body_sameframe), which ximat then shows; said in a known row below
+            turn = np.zeros(9)
+            mj.mju_quat2Mat(turn, m.body_iquat[b])
+            t = np.eye(4)
+            t[:3, :3] = d.xmat[b].reshape(3, 3) @ turn.reshape(3, 3)
+            t[:3, 3] = d.xpos[b] + d.xmat[b].reshape(3, 3) @ m.body_ipos[b]
+            own = Inertial(float(m.body_mass[b]), (0.0, 0.0, 0.0),
+                           tuple(map(tuple, np.diag(m.body_inertia[b]))))  # type: ignore[arg-type]
+            if int(m.body_sameframe[b]):
+                sim = d.ximat[b].reshape(3, 3)
+                full = t[:3, :3] @ np.diag(m.body_inertia[b]) @ t[:3, :3].T
+                off = sim @ np.diag(m.body_inertia[b]) @ sim.T - full
+                snapped.append((float(np.abs(off).max()) / max(float(np.abs(full).max()),
+                                                                1e-300),
+                                _name(m, mj.mjtObj.mjOBJ_BODY, b)))
+            # grouped as written: a body with a free joint of its own that no link matches
+            # (a second robot, a loose box) is a group of its own, said as extra
+            weld.setdefault(int(self.model.body_weldid[b]), []).append((own, t))
+        return weld, snapped
 
     def _weld_image(self, where: dict[str, tuple[str, Any]], m: Any = None) -> dict[str, int]:
         """Each PyBullet body group -> the MuJoCo weld group its matched links are in.
@@ -1175,7 +1207,7 @@ class _Compare:
             status = "known"
             known += (f"; the axis of {skew[0][1]} is {skew[0][0]:.2g} off unit length in the "
                       "file: PyBullet's step uses it so (its own mass matrix normalises it), "
-                      "MuJoCo normalises it: the engines part by about that much")
+                      "MuJoCo normalises it, so the two step slightly different robots")
         res.add("swing", what, worst, TOL_SWING, "rad", f"{at}{why}{known}", status=status)
         if floating:
             # the engines turn a spinning base by different first-order steps (measured on
