@@ -11,13 +11,13 @@ What is dropped or approximated is said in :attr:`Export.notes` (docs/export.md 
 from __future__ import annotations
 
 import math
-import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from urdfkit.core.errors import InputError, OutputError, ParameterError
 from urdfkit.exchange.fk import fused, origin_matrix
+from urdfkit.exchange.mjcf_mesh import MeshAsset, mesh_asset, unusable
 from urdfkit.exchange.robot import Inertial, Link, Robot, Shape
 
 #: ``--actuators`` choices.
@@ -181,8 +181,11 @@ class _Writer:
         self.asset_dir = asset_dir
         self.notes: list[Note] = []
         self.assets: dict[str, bytes | Path] = {}
-        self.meshes: dict[tuple[str, tuple[float, ...]], str | None] = {}
-        self.mesh_files: dict[str, str] = {}
+        self.meshes: dict[tuple[str, tuple[float, ...]], str] = {}
+        self.mesh_files: dict[str, MeshAsset | None] = {}
+        self.mesh_names: dict[str, str] = {}
+        self.digests: dict[str, str] = {}
+        self.uses: dict[tuple[str, tuple[float, float, float], bool], str | None] = {}
         self.bodies: list[str] = []
         self.sites: list[str] = []
         self.members: dict[str, list[str]] = {}
@@ -204,57 +207,60 @@ class _Writer:
 
     # ------------------------------------------------------------------ meshes
 
-    def mesh(self, shape: Shape) -> str | None:
-        """The asset name of a mesh shape (added on first use), None when unreadable."""
+    def mesh(self, shape: Shape, visual: bool, link: Link) -> str | None:
+        """The asset name of a mesh shape (added on first use), None when it is left out."""
         assert shape.filename is not None
-        key = (shape.filename, tuple(shape.scale))
-        if key in self.meshes:
-            return self.meshes[key]
-        file = self.mesh_file(Path(shape.filename), shape.line)
-        name = None
-        if file is not None:
-            name = f"mesh{len([m for m in self.meshes.values() if m])}"
+        asset = self.mesh_file(Path(shape.filename), shape.line)
+        if asset is None:
+            return None
+        scale = (shape.scale[0], shape.scale[1], shape.scale[2])
+        use = (shape.filename, scale, not visual)
+        if use not in self.uses:
+            self.uses[use] = unusable(asset, scale, collides=not visual)
+        why = self.uses[use]
+        if why is not None:
+            self.note("dropped", f"{'visual' if visual else 'collision'} of link "
+                      f"{link.name!r}: mesh {Path(shape.filename).name}: {why}; left out",
+                      shape.line)
+            return None
+        key = (shape.filename, scale)
+        if key not in self.meshes:
+            name = f"mesh{len(self.meshes)}"
             # inertia="shell": the bodies' inertia is written, never taken from meshes, and
             # MuJoCo refuses a flat mesh's volume (plane.urdf: "mesh volume is too small")
-            el = self.E.SubElement(self.asset, "mesh", name=name, file=file, inertia="shell")
-            if tuple(shape.scale) != (1.0, 1.0, 1.0):
-                el.set("scale", nums(shape.scale))
-        self.meshes[key] = name
-        return name
+            el = self.E.SubElement(self.asset, "mesh", name=name,
+                                   file=self.mesh_names[str(shape.filename)], inertia="shell")
+            if scale != (1.0, 1.0, 1.0):
+                el.set("scale", nums(scale))
+            self.meshes[key] = name
+        return self.meshes[key]
 
-    def mesh_file(self, path: Path, line: int | None) -> str | None:
-        """The file name in the assets folder of a mesh (copied or converted once)."""
+    def mesh_file(self, path: Path, line: int | None) -> MeshAsset | None:
+        """A mesh file as it will be written (read, checked, copied or converted once).
+
+        Its name in the assets folder is content-addressed, ``stem.<8 hex of its SHA-256>``:
+        the same bytes always get the same name, so a new export never replaces a file an
+        old XML names (see :func:`write_export`).
+        """
         source = str(path)
         if source in self.mesh_files:
-            return self.mesh_files[source] or None  # "": unreadable, said once
-        suffix = path.suffix.lower()
-        data: bytes | Path | None = path
-        out_suffix = suffix
-        if suffix == ".stl" and not _binary_stl(path):
-            data, out_suffix = _stl_bytes(path), ".stl"
-            what = "ASCII STL (MuJoCo reads binary STL only)"
-        elif suffix not in (".stl", ".obj"):
-            data, out_suffix = _stl_bytes(path), ".stl"
-            what = f"{suffix[1:].upper()} (MuJoCo cannot read it)"
-        else:
-            what = ""
-        if data is None:
-            self.note("dropped", f"mesh {path.name}: urdfkit's readers found no triangles in "
-                      "it; its geoms are left out", line)
-            self.mesh_files[source] = ""
+            return self.mesh_files[source]
+        found = mesh_asset(path)
+        if isinstance(found, str):
+            self.note("dropped", f"mesh {path.name}: {found}; its geoms are left out", line)
+            self.mesh_files[source] = None
             return None
-        stem = "".join(c if c.isalnum() or c in "-_." else "_" for c in path.stem) or "mesh"
-        name = f"{stem}{out_suffix}"
-        k = 1
-        while name in self.assets:
-            k += 1
-            name = f"{stem}_{k}{out_suffix}"
-        self.assets[name] = data
-        if what:
-            self.note("converted", f"mesh {path.name}: {what}, converted to binary STL "
-                      f"{name} with urdfkit's mesh reader (materials and UVs dropped)", line)
-        self.mesh_files[source] = name
-        return name
+        stem = "".join(c if c.isalnum() or c in "-_" else "_" for c in path.stem) or "mesh"
+        name = f"{stem}.{found.digest[:8]}{found.suffix}"
+        if name in self.assets and self.digests[name] != found.digest:
+            name = f"{stem}.{found.digest[:16]}{found.suffix}"  # 8 hex digits collided
+        self.assets[name] = found.data
+        self.digests[name] = found.digest
+        if found.converted:
+            self.note("converted", f"mesh {path.name}: {found.converted}, as {name}", line)
+        self.mesh_files[source] = found
+        self.mesh_names[source] = name
+        return found
 
     # ------------------------------------------------------------------ geoms
 
@@ -298,7 +304,7 @@ class _Writer:
             return
         t = at @ origin_matrix(shape.xyz, shape.rpy)
         g = self.E.Element("geom")
-        if not self.shape_type(g, body, shape, link):
+        if not self.shape_type(g, body, shape, link, visual):
             return
         _place(g, t)
         if visual:
@@ -329,7 +335,7 @@ class _Writer:
                 g.set("condim", "4")
         body.append(g)
 
-    def shape_type(self, g: Any, body: Any, shape: Shape, link: Link) -> bool:
+    def shape_type(self, g: Any, body: Any, shape: Shape, link: Link, visual: bool) -> bool:
         """Set the geom's type and size (or mesh); False when it cannot be written."""
         if shape.kind == "box":
             g.set("type", "box")
@@ -353,7 +359,7 @@ class _Writer:
             g.set("type", "plane")
             g.set("size", "0 0 1")
         else:
-            name = self.mesh(shape)
+            name = self.mesh(shape, visual, link)
             if name is None:
                 return False
             g.set("type", "mesh")
@@ -619,40 +625,6 @@ class _Writer:
             friction="1 0 0"))
         self.world.insert(0, E.Element("light", name="sun", pos="0 0 5", dir="0 0 -1",
                                        directional="true"))
-
-
-def _binary_stl(path: Path) -> bool:
-    try:
-        with path.open("rb") as f:
-            head = f.read(84)
-            size = path.stat().st_size
-    except OSError:
-        return False
-    if len(head) < 84:
-        return False
-    return 84 + 50 * struct.unpack_from("<I", head, 80)[0] == size
-
-
-def _stl_bytes(path: Path) -> bytes | None:
-    """A mesh as binary STL, read by urdfkit's readers (placed as PyBullet places it)."""
-    import numpy as np
-
-    from urdfkit.sources.meshes import read_triangles
-
-    found = read_triangles(path)
-    if found is None:
-        return None
-    vertices, faces = found
-    tri = np.asarray(vertices, dtype=float)[np.asarray(faces)]
-    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    lengths = np.linalg.norm(normals, axis=1)
-    normals = normals / np.where(lengths > 0, lengths, 1.0)[:, None]
-    rec = np.zeros(len(tri), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)),
-                                              ("a", "<u2")]))
-    rec["n"] = normals
-    rec["v"] = tri
-    header = b"urdfkit export: converted mesh".ljust(80, b" ")
-    return header + struct.pack("<I", len(rec)) + rec.tobytes()
 
 
 def export_mjcf(robot: Robot, options: ExportOptions | None = None,
