@@ -208,7 +208,7 @@ def test_meshes_mujoco_refuses_are_dropped_or_salvaged_and_the_file_loads(
     # what MuJoCo itself says of each, as found: every one but the cube is refused
     verdicts = {n: mujoco_mesh(tmp_path / n, collides=True) for n in files}
     assert [n for n, v in verdicts.items() if v is None] == ["cube.obj"], verdicts
-    links = {"base": f'<visual><geometry><mesh filename="cube.obj"/></geometry></visual>'}
+    links = {"base": '<visual><geometry><mesh filename="cube.obj"/></geometry></visual>'}
     for name in files:
         stem = name.split(".")[0]
         links[stem] = f'<visual><geometry><mesh filename="{name}"/></geometry></visual>'
@@ -244,7 +244,7 @@ def test_meshes_mujoco_refuses_are_dropped_or_salvaged_and_the_file_loads(
     assert "fewer than 4 vertices" in said[at["triangle"]]
     assert "normals" in said[at["normals"]]
     # the copy is the file itself, byte for byte
-    copied = [p for p in (out.parent / "meshes_assets").iterdir() if p.name.startswith("cube.")]
+    copied = [p for p in (out.parent / "meshes_assets").iterdir() if p.name.startswith("cube_")]
     assert [p.read_bytes() for p in copied] == [files["cube.obj"]]
 
 

@@ -11,11 +11,12 @@ What is dropped or approximated is said in :attr:`Export.notes` (docs/export.md 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from urdfkit.core.errors import InputError, OutputError, ParameterError
+from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.exchange.fk import fused, origin_matrix
 from urdfkit.exchange.mjcf_mesh import MeshAsset, mesh_asset, unusable
 from urdfkit.exchange.robot import Inertial, Link, Robot, Shape
@@ -76,7 +77,8 @@ class Export:
 
     Attributes:
         xml: The document.
-        assets: File name in the assets folder -> bytes to write, or a Path to copy.
+        assets: File name in the assets folder -> bytes to write, or a Path to copy. Names
+            are content-addressed (``stem_<8 hex of SHA-256>.stl``): ``digests`` holds each.
         asset_dir: The assets folder's name (beside the XML, the compiler's meshdir).
         notes: What was dropped, approximated or defaulted.
         bodies, sites: Link names written as bodies / as sites.
@@ -89,6 +91,7 @@ class Export:
     bodies: list[str] = field(default_factory=list)
     sites: list[str] = field(default_factory=list)
     paths: list[str] = field(default_factory=list)   # filled by write_export
+    digests: dict[str, str] = field(default_factory=dict)   # asset name -> SHA-256 (hex)
 
 
 def num(x: float) -> str:
@@ -238,7 +241,7 @@ class _Writer:
     def mesh_file(self, path: Path, line: int | None) -> MeshAsset | None:
         """A mesh file as it will be written (read, checked, copied or converted once).
 
-        Its name in the assets folder is content-addressed, ``stem.<8 hex of its SHA-256>``:
+        Its name in the assets folder is content-addressed, ``stem_<8 hex of its SHA-256>``:
         the same bytes always get the same name, so a new export never replaces a file an
         old XML names (see :func:`write_export`).
         """
@@ -251,9 +254,10 @@ class _Writer:
             self.mesh_files[source] = None
             return None
         stem = "".join(c if c.isalnum() or c in "-_" else "_" for c in path.stem) or "mesh"
-        name = f"{stem}.{found.digest[:8]}{found.suffix}"
+        # "_", not ".": "link_3.1e5fa2b0.stl" reads as numbers to a tool that edits them all
+        name = f"{stem}_{found.digest[:8]}{found.suffix}"
         if name in self.assets and self.digests[name] != found.digest:
-            name = f"{stem}.{found.digest[:16]}{found.suffix}"  # 8 hex digits collided
+            name = f"{stem}_{found.digest[:16]}{found.suffix}"  # 8 hex digits collided
         self.assets[name] = found.data
         self.digests[name] = found.digest
         if found.converted:
@@ -665,7 +669,7 @@ def export_mjcf(robot: Robot, options: ExportOptions | None = None,
            "written: --actuators chooses the actuators")
     w.E.indent(w.root, space="  ")
     xml = w.E.tostring(w.root, xml_declaration=False, encoding="unicode").encode() + b"\n"
-    return Export(xml, w.assets, asset_dir, w.notes, w.bodies, w.sites)
+    return Export(xml, w.assets, asset_dir, w.notes, w.bodies, w.sites, digests=w.digests)
 
 
 def asset_dir_for(path: str | Path) -> str:
@@ -673,42 +677,25 @@ def asset_dir_for(path: str | Path) -> str:
     return f"{Path(path).stem}_assets"
 
 
-def write_export(export: Export, path: str | Path, *, force: bool = False) -> list[str]:
-    """Write the XML and its assets folder beside it; return the paths written.
+def write_export(export: Export, path: str | Path, *, force: bool = False,
+                 verify: Callable[[Path], bool] | None = None) -> list[str]:
+    """Write the XML and its assets folder beside it, crash-safe; return the paths written.
 
-    The assets go to a temp folder first, renamed into place; the XML is written atomically
-    last, so a failure never leaves an XML pointing at missing meshes. Without ``force``
-    neither the XML nor the assets folder may exist.
+    At every step the XML on disk, old or new, names only files that are there with the
+    bytes it expects (:mod:`urdfkit.exchange.mjcf_files`): mesh files are named by their
+    content and only added until the new XML replaces the old one atomically; then the
+    files it does not name are removed. Without ``force`` neither the XML nor a non-empty
+    assets folder may exist. ``verify`` is handed the staged XML before it takes its place:
+    when it returns False, nothing of this run is left and ``[]`` is returned.
+
+    Raises:
+        OutputError: What cannot be written (a full disk, an assets path that is a symlink),
+            one line naming the file; nothing of this run is left.
     """
-    import os
-    import shutil
-    import tempfile
-
-    from urdfkit.core.output import atomic_write, check_output
+    from urdfkit.core.output import check_output
+    from urdfkit.exchange.mjcf_files import write_pair
 
     out = check_output(path, force=force, suffixes=(".xml",), what="the MJCF file")
-    folder = out.parent / export.asset_dir
-    written: list[str] = []
-    if export.assets:
-        if folder.exists() and not force:
-            raise OutputError("exists; pass `force=True` to overwrite it", file=folder,
-                              param="force")
-        if folder.exists() and not folder.is_dir():
-            raise OutputError("exists and is not a folder", file=folder)
-        try:
-            tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=out.parent))
-            for name, data in export.assets.items():
-                if isinstance(data, Path):
-                    shutil.copyfile(data, tmp / name)
-                else:
-                    (tmp / name).write_bytes(data)
-                written.append(str(folder / name))
-            if folder.exists():
-                shutil.rmtree(folder)
-            os.replace(tmp, folder)
-        except OSError as e:
-            raise OutputError(f"cannot write the meshes: {e.strerror or e}", file=folder) \
-                from None
-    atomic_write(out, export.xml, force=force)
-    export.paths = [str(out), *written]
+    export.paths = write_pair(out, export.xml, export.assets, export.digests, export.asset_dir,
+                              force=force, verify=verify)
     return export.paths
