@@ -270,3 +270,38 @@ def test_a_mesh_over_mujocos_stl_face_limit_is_written_whole_as_obj(tmp_path: Pa
     (note,) = [n for n in notes(data, "converted") if "big.stl" in n["message"]]
     assert "200001 faces" in note["message"] and "OBJ" in note["message"]
     assert note["line"] == line_of(text, "big.stl")
+
+
+# ------------------------------------------------------------------ 7. nothing from outside
+
+@pytest.mark.parametrize("reference", ["package://pkg/../secret.obj", "../../secret.obj",
+                                       "package://pkg/meshes/../../../ws/secret.obj"])
+def test_a_mesh_from_outside_its_package_is_refused_by_every_command(
+        tmp_path: Path, reference: str) -> None:
+    ws = tmp_path / "ws"
+    (ws / "pkg" / "urdf").mkdir(parents=True)
+    (ws / "pkg" / "meshes").mkdir()
+    (ws / "pkg" / "package.xml").write_text("<package><name>pkg</name></package>")
+    (ws / "secret.obj").write_text(CUBE_OBJ)  # beside the package, not in it
+    (ws / "pkg" / "meshes" / "ok.obj").write_text(CUBE_OBJ)
+    text = urdf({"base": '<visual><geometry><mesh filename="../meshes/ok.obj"/></geometry>'
+                         '</visual>',
+                 "arm": f'<visual><geometry><mesh filename="{reference}"/></geometry></visual>'})
+    robot = ws / "pkg" / "urdf" / "robot.urdf"
+    robot.write_text(text)
+    out = tmp_path / "robot.xml"
+    r = runner.invoke(app, ["export", "mjcf", str(robot), "-o", str(out)])
+    assert r.exit_code == 2, r.output
+    (err,) = r.stderr.strip().splitlines()
+    line = line_of(text, 'name="arm"')
+    assert f"robot.urdf:{line}:" in err and "climbs out" in err
+    assert not out.exists() and not (tmp_path / "robot_assets").exists()
+    # one rule for all: the loading commands refuse it, check reports it (U702)
+    assert runner.invoke(app, ["joints", str(robot)]).exit_code == 2
+    r = runner.invoke(app, ["check", str(robot), "--json"])
+    found = json.loads(r.stdout)["findings"]
+    assert [f["code"] for f in found if "climbs out" in f["message"]] == ["U702"]
+    # a path that climbs only within the package is fine
+    robot.write_text(text.replace(reference, "../meshes/../meshes/ok.obj"))
+    export(robot, out)
+    assert mujoco.MjModel.from_xml_path(str(out)).nmesh == 1
