@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from lxml import etree
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
@@ -305,3 +306,56 @@ def test_a_mesh_from_outside_its_package_is_refused_by_every_command(
     robot.write_text(text.replace(reference, "../meshes/../meshes/ok.obj"))
     export(robot, out)
     assert mujoco.MjModel.from_xml_path(str(out)).nmesh == 1
+
+
+# ------------------------------------------------------------------ 8. a way through U604
+
+def body_tensor(m: object, name: str) -> np.ndarray:
+    """A body's inertia about its centre of mass, in the body's axes, as MuJoCo compiled it."""
+    b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+    r = np.zeros(9)
+    mujoco.mju_quat2Mat(r, m.body_iquat[b])
+    r = r.reshape(3, 3)
+    return r @ np.diag(m.body_inertia[b]) @ r.T
+
+
+def inertia_of(urdf_text: bytes, link: str) -> np.ndarray:
+    el = etree.fromstring(urdf_text).find(f"link[@name='{link}']/inertial/inertia")
+    g = {k: float(el.get(k)) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
+    return np.array([[g["ixx"], g["ixy"], g["ixz"]], [g["ixy"], g["iyy"], g["iyz"]],
+                     [g["ixz"], g["iyz"], g["izz"]]])
+
+
+@pytest.mark.parametrize(("robot", "links", "fix_args"), [
+    ("xarm/xarm6_robot.urdf", ["link2", "link3"], []),  # derived from its collision shapes
+    ("mini_cheetah/mini_cheetah.urdf",  # no closed collision solid: balanced
+     ["thigh_fr", "thigh_fl", "thigh_hr", "thigh_hl"], ["--balance"])])
+def test_a_tensor_pybullet_zeroes_is_written_as_urdfkit_fix_writes_it(
+        tmp_path: Path, pb: tuple, robot: str, links: list[str], fix_args: list[str]) -> None:
+    import pybullet_data
+
+    source = Path(pybullet_data.getDataPath()) / robot
+    text = source.read_text()
+    # PyBullet zeroes those links' tensors (each breaks the triangle inequality)
+    p, client = pb
+    body = p.loadURDF(str(source), flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)
+    index = {p.getJointInfo(body, i, physicsClientId=client)[12].decode(): i
+             for i in range(p.getNumJoints(body, physicsClientId=client))}
+    for name in links:
+        assert p.getDynamicsInfo(body, index[name], physicsClientId=client)[2] == (0, 0, 0)
+    out = tmp_path / "robot.xml"
+    data = export(Path(robot), out)  # refused with U604 before
+    assert data["repaired"] == links
+    said = {n["line"]: n["message"] for n in notes(data, "repaired")}
+    assert sorted(said) == sorted(line_of(text[text.index(f'<link name="{n}"'):], "<inertial")
+                                  + text[:text.index(f'<link name="{n}"')].count("\n")
+                                  for n in links)
+    assert all("PyBullet zeroes it" in s and "known difference" in s for s in said.values())
+    m = mujoco.MjModel.from_xml_path(str(out))
+    # what was written is what `urdfkit fix` writes into the file for each of them
+    fixed = tmp_path / "fixed.urdf"
+    r = runner.invoke(app, ["fix", str(source), "-o", str(fixed), *fix_args])
+    assert r.exit_code == 0, r.output
+    for name in links:
+        assert body_tensor(m, name) == pytest.approx(inertia_of(fixed.read_bytes(), name),
+                                                     rel=1e-12, abs=1e-18), name

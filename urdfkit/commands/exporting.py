@@ -82,7 +82,7 @@ def agreement_report(a: Any, show_all: bool = False) -> None:
 
 def _export_dict(file: str, e: Any, flags: list[str]) -> dict[str, Any]:
     return {"file": file, "written": bool(e.paths), "paths": e.paths, "bodies": e.bodies,
-            "sites": e.sites, "mirrored_flags": flags,
+            "sites": e.sites, "repaired": e.repaired, "mirrored_flags": flags,
             "notes": [{"kind": n.kind, "message": n.message, "line": n.line} for n in e.notes]}
 
 
@@ -181,14 +181,16 @@ def export(
         robot = read_robot(resolved.root, resolved.name)
         for w in robot.warnings:
             show.warn(f"{resolved.name}: {w}")
-        from urdfkit.exchange.bullet import loaded_inertials
+        from urdfkit.exchange.bullet import loaded_inertials, zeroed_repairs
 
         # what PyBullet simulates: its diagonalised tensors, its defaults, its recomputation
         inertials = loaded_inertials(resolved, inertia_from_file=not inertia_from_shapes)
+        # where PyBullet zeroed a tensor, what `urdfkit fix` writes (used where MuJoCo needs it)
+        repairs = zeroed_repairs(resolved, robot, inertials) if not inertia_from_shapes else {}
         e = export_mjcf(robot, ExportOptions(
             fixed_base=fixed_base, self_collision=self_collision, actuators=actuators,
             gain=gain, ground=ground, inertials=inertials,
-            inertia_from_shapes=inertia_from_shapes), asset_dir_for(out))
+            inertia_from_shapes=inertia_from_shapes, repairs=repairs), asset_dir_for(out))
         # cylinders are written as true cylinders: PyBullet's with URDF_USE_IMPLICIT_CYLINDER
         flags = ["URDF_USE_INERTIA_FROM_FILE"] if not inertia_from_shapes else []
         flags += ["URDF_USE_IMPLICIT_CYLINDER"]

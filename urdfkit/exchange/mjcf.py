@@ -51,6 +51,11 @@ class ExportOptions:
             sweeps, which leave it up to ~1e-8 relative from the file's (panda_link1: 8.2e-9).
         inertia_from_shapes: Those are PyBullet's recomputation from the collision shapes
             (no notes about links without ``<inertial>``).
+        repairs: For each link whose file tensor PyBullet zeroed (it breaks the triangle
+            inequality), what ``urdfkit fix`` writes for it: its mass properties, the
+            ``<inertia>`` element and how it was made
+            (:func:`urdfkit.exchange.bullet.zeroed_repairs`). Written only where the zero
+            would leave a moving body MuJoCo refuses; each such link is said and listed.
     """
 
     fixed_base: bool = False
@@ -60,13 +65,14 @@ class ExportOptions:
     ground: bool = False
     inertials: dict[str, Inertial] | None = None
     inertia_from_shapes: bool = False
+    repairs: dict[str, tuple[Inertial, str, str]] | None = None
 
 
 @dataclass
 class Note:
     """One thing dropped, approximated or defaulted on the way to MuJoCo."""
 
-    kind: str        # default, dropped, converted, approximated, mirrored
+    kind: str        # default, dropped, converted, approximated, mirrored, repaired
     message: str
     line: int | None = None
 
@@ -91,6 +97,7 @@ class Export:
     bodies: list[str] = field(default_factory=list)
     sites: list[str] = field(default_factory=list)
     paths: list[str] = field(default_factory=list)   # filled by write_export
+    repaired: list[str] = field(default_factory=list)   # links given fix's tensor
     digests: dict[str, str] = field(default_factory=dict)   # asset name -> SHA-256 (hex)
 
 
@@ -193,6 +200,7 @@ class _Writer:
         self.sites: list[str] = []
         self.members: dict[str, list[str]] = {}
         self.locked: list[Any] = []
+        self.repaired: list[str] = []
         self.root = etree.Element("mujoco", model=robot.name or "robot")
         self.compiler = etree.SubElement(self.root, "compiler", angle="radian",
                                          meshdir=asset_dir, autolimits="true")
@@ -204,6 +212,8 @@ class _Writer:
         self.notes.append(Note(kind, message, line))
 
     def inertial(self, link: Link) -> Inertial:
+        if link.name in self.repaired and self.o.repairs:
+            return self.o.repairs[link.name][0]
         if self.o.inertials is not None and link.name in self.o.inertials:
             return self.o.inertials[link.name]
         return link.inertial
@@ -417,9 +427,8 @@ class _Writer:
         """A body's inertial, geoms and sites, from the links fused into it."""
         robot = self.robot
         if inertial:
-            parts = [(self.inertial(robot.links[n]), where[n][1]) for n in links]
-            m = combine(parts)
             moving = moving and not (name == robot.root and self.static)
+            m = self.body_mass(name, links, where, moving)
             self.check_mass(name, m, moving)
             el = self.E.Element("inertial", pos=nums(m.com), mass=num(m.mass))
             t = m.tensor
@@ -459,6 +468,34 @@ class _Writer:
         if name == "world":
             self.sites.append("world")
             self.E.SubElement(body, "site", name="world")
+
+    def body_mass(self, name: str, links: list[str], where: dict[str, Any],
+                  moving: bool) -> _Mass:
+        """A body's mass properties, from the links fused into it.
+
+        Where PyBullet zeroed a link's tensor (the triangle inequality) and that leaves a
+        moving body with a zero principal moment, which MuJoCo refuses, the tensor
+        ``urdfkit fix`` writes for the link is written instead: a way through, said per link.
+        """
+        import numpy as np
+
+        def mass() -> _Mass:
+            return combine([(self.inertial(self.robot.links[n]), where[n][1]) for n in links])
+
+        m = mass()
+        fixable = [n for n in links if n in (self.o.repairs or {})]
+        if not moving or not fixable or not np.isfinite(m.tensor).all() \
+                or np.linalg.eigvalsh(m.tensor)[0] > 1e-15:  # mjMINVAL, as check_mass
+            return m
+        assert self.o.repairs is not None
+        for n in fixable:
+            inertial, xml, how = self.o.repairs[n]
+            self.repaired.append(n)
+            self.note("repaired", f"link {n!r}: its inertia breaks the triangle inequality; "
+                      f"PyBullet zeroes it, which leaves the moving body {name!r} without the "
+                      f"inertia MuJoCo requires, so written instead: {xml}, {how}. agree "
+                      "lists this link's rows as a known difference", inertial.line)
+        return mass()
 
     def check_mass(self, name: str, m: _Mass, moving: bool) -> None:
         """Refuse what MuJoCo refuses, with check's code (U602-U604, U608) and the line."""
@@ -669,7 +706,8 @@ def export_mjcf(robot: Robot, options: ExportOptions | None = None,
            "written: --actuators chooses the actuators")
     w.E.indent(w.root, space="  ")
     xml = w.E.tostring(w.root, xml_declaration=False, encoding="unicode").encode() + b"\n"
-    return Export(xml, w.assets, asset_dir, w.notes, w.bodies, w.sites, digests=w.digests)
+    return Export(xml, w.assets, asset_dir, w.notes, w.bodies, w.sites, digests=w.digests,
+                  repaired=w.repaired)
 
 
 def asset_dir_for(path: str | Path) -> str:
