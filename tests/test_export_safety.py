@@ -359,3 +359,18 @@ def test_a_tensor_pybullet_zeroes_is_written_as_urdfkit_fix_writes_it(
     for name in links:
         assert body_tensor(m, name) == pytest.approx(inertia_of(fixed.read_bytes(), name),
                                                      rel=1e-12, abs=1e-18), name
+
+
+def test_a_zeroed_tensor_fix_cannot_repair_is_still_refused_saying_so(tmp_path: Path) -> None:
+    """reachy's r_antenna, romeo's thighs: not positive definite, no collision solid."""
+    text = urdf({"base": "", "antenna": ""}).replace(
+        f'<link name="antenna"><inertial><mass value="1"/>{INERTIA}',
+        '<link name="antenna"><inertial><mass value="1"/><inertia ixx="-0.01" iyy="0.02" '
+        'izz="0.02" ixy="0" ixz="0" iyz="0"/>')
+    robot = tmp_path / "antenna.urdf"
+    robot.write_text(text)
+    r = runner.invoke(app, ["export", "mjcf", str(robot), "-o", str(tmp_path / "a.xml")])
+    assert r.exit_code == 2, r.output
+    (err,) = r.stderr.strip().splitlines()
+    assert f"antenna.urdf:{line_of(text, '-0.01')}: U603" in err
+    assert "cannot repair it either" in err

@@ -550,10 +550,17 @@ class _Writer:
             return
         a, b, c = sorted(eig)
         if a + b < c - 1e-9 * max(abs(c), 1e-300):
-            raise InputError(f"U604: inertia of link {name!r} violates the triangle inequality "
-                             f"({a:.6g} + {b:.6g} < {c:.6g}): PyBullet zeroes it and MuJoCo "
-                             "refuses it (`urdfkit fix` can derive one from the shapes)",
-                             file=self.robot.file, line=line)
+            what = (f"U603: inertia of link {name!r} is not positive definite (principal "
+                    f"moments {a:.6g}, {b:.6g}, {c:.6g})" if a < 0 else
+                    f"U604: inertia of link {name!r} violates the triangle inequality "
+                    f"({a:.6g} + {b:.6g} < {c:.6g})")
+            # export writes what fix writes where there is one (see body_mass)
+            hint = ("`urdfkit fix` can derive one from the shapes" if self.o.repairs is None
+                    else "`urdfkit fix` cannot repair it either: it has no collision solid to "
+                    "derive one from, and such a tensor cannot be balanced; write its "
+                    "<inertial> by hand")
+            raise InputError(f"{what}: PyBullet zeroes it and MuJoCo refuses the body it "
+                             f"leaves ({hint})", file=self.robot.file, line=line)
 
     def joint(self, body: Any, j: Any) -> None:
         E = self.E
