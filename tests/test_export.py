@@ -174,7 +174,11 @@ def test_joints_actuators_mimic_contacts_and_the_converted_mesh(
     assert (v.max(axis=0) - v.min(axis=0)).tolist() == pytest.approx([2, 2, 2], abs=1e-6)
     notes = " ".join(n["message"] for n in data["notes"])
     assert "cube.dae" in notes and "arm" in notes and "velocity limits" in notes
-    assert (tmp_path / "robot_assets" / "cube.stl").is_file()
+    # named by its content: cube_<the first 8 hex digits of the STL's SHA-256>.stl
+    import hashlib
+
+    (written,) = (tmp_path / "robot_assets").iterdir()
+    assert written.name == f"cube_{hashlib.sha256(written.read_bytes()).hexdigest()[:8]}.stl"
 
 
 def test_fixed_base_welds_and_ground_adds_a_plane(robot: Path, tmp_path: Path) -> None:

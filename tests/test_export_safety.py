@@ -9,9 +9,12 @@ line; where the note says what PyBullet does, PyBullet is asked.
 from __future__ import annotations
 
 import json
+import struct
 from pathlib import Path
 
+import numpy as np
 import pytest
+from lxml import etree
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
@@ -154,3 +157,220 @@ def test_a_joint_mimicking_itself_or_a_ring_of_mimics_is_not_written(tmp_path: P
     assert set(dropped) == {line_of(text, f'name="j{k}"') for k in (1, 2, 3)}
     assert "itself" in dropped[line_of(text, 'name="j1"')]
     assert "'j3' -> 'j2' -> 'j3'" in dropped[line_of(text, 'name="j3"')]
+
+
+# ------------------------------------------------------------------ 2-3. mesh files
+
+def cube_triangles() -> np.ndarray:
+    """The unit cube's 12 triangles, (12, 3, 3)."""
+    rows = CUBE_OBJ.splitlines()
+    v = np.array([[float(x) for x in r.split()[1:]] for r in rows if r.startswith("v ")])
+    f = np.array([[int(x) - 1 for x in r.split()[1:]] for r in rows if r.startswith("f ")])
+    return v[f]
+
+
+def binary_stl(triangles: np.ndarray) -> bytes:
+    rec = np.zeros(len(triangles), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = triangles
+    return b"fixture".ljust(80) + struct.pack("<I", len(rec)) + rec.tobytes()
+
+
+def mujoco_mesh(path: Path, collides: bool) -> str | None:
+    """MuJoCo's own verdict on a mesh file (None: it loads), in a geom that collides or not."""
+    flags = "" if collides else 'contype="0" conaffinity="0"'
+    xml = (f'<mujoco><asset><mesh name="m" file="{path}" inertia="shell"/></asset><worldbody>'
+           f'<body><freejoint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+           f'<geom type="mesh" mesh="m" density="0" {flags}/></body></worldbody></mujoco>')
+    try:
+        mujoco.MjModel.from_xml_string(xml)
+    except ValueError as e:
+        return str(e)
+    return None
+
+
+def test_meshes_mujoco_refuses_are_dropped_or_salvaged_and_the_file_loads(
+        tmp_path: Path) -> None:
+    cube = cube_triangles()
+    nan = cube.copy()
+    nan[[1, 4, 7], 0, 2] = np.nan  # three triangles with a NaN vertex
+    files = {
+        "empty.obj": b"",
+        "garbage.obj": b"Lorem ipsum dolor sit amet\n7 8 9 fq\x00\xff\n",
+        "nan.stl": binary_stl(nan),
+        "all_nan.stl": binary_stl(np.full((4, 3, 3), np.nan)),
+        "flat.obj": b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n",
+        "triangle.obj": b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        # legal OBJ, refused by MuJoCo: normals given, faces naming none of them
+        "normals.obj": CUBE_OBJ.encode() + b"vn 0 0 1\n",
+        "cube.obj": CUBE_OBJ.encode(),
+    }
+    for name, data in files.items():
+        (tmp_path / name).write_bytes(data)
+    # what MuJoCo itself says of each, as found: every one but the cube is refused
+    verdicts = {n: mujoco_mesh(tmp_path / n, collides=True) for n in files}
+    assert [n for n, v in verdicts.items() if v is None] == ["cube.obj"], verdicts
+    links = {"base": '<visual><geometry><mesh filename="cube.obj"/></geometry></visual>'}
+    for name in files:
+        stem = name.split(".")[0]
+        links[stem] = f'<visual><geometry><mesh filename="{name}"/></geometry></visual>'
+        if "nan" not in name:  # PyBullet 3.2.7 hangs on a collision mesh with a NaN vertex
+            links[stem] += f'<collision><geometry><mesh filename="{name}"/></geometry></collision>'
+    text = urdf(links)
+    robot = tmp_path / "meshes.urdf"
+    robot.write_text(text)
+    out = tmp_path / "out" / "meshes.xml"
+    out.parent.mkdir()
+    data = export(robot, out)
+    m = mujoco.MjModel.from_xml_path(str(out))
+    geoms = {}
+    for g in range(m.ngeom):
+        body = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[g]))
+        geoms.setdefault(body, []).append("collision" if m.geom_contype[g] else "visual")
+    # kept: the cube (copied), the NaN STL's 9 sound triangles, the re-written OBJ, and the
+    # flat square as a visual (MuJoCo draws it; it cannot hull it to collide)
+    assert geoms == {"base": ["visual"], "nan": ["visual"],
+                     "flat": ["visual"], "normals": ["visual", "collision"],
+                     "cube": ["visual", "collision"]}
+    faces = {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_MESH, k): int(m.mesh_facenum[k])
+             for k in range(m.nmesh)}
+    assert sorted(faces.values()) == [2, 9, 12, 12]
+    said = {n["line"]: n["message"] for n in notes(data) if n["kind"] in ("dropped", "converted")
+            and "mesh" in n["message"]}
+    at = {stem: line_of(text, f'name="{stem}"') for stem in
+          ("empty", "garbage", "nan", "all_nan", "flat", "triangle", "normals")}
+    assert "no triangles" in said[at["empty"]] and "no triangles" in said[at["garbage"]]
+    assert "3 of its 12 triangles" in said[at["nan"]]
+    assert "none of its 4 triangle(s)" in said[at["all_nan"]]
+    assert "collision of link 'flat'" in said[at["flat"]] and "no volume" in said[at["flat"]]
+    assert "fewer than 4 vertices" in said[at["triangle"]]
+    assert "normals" in said[at["normals"]]
+    # the copy is the file itself, byte for byte
+    copied = [p for p in (out.parent / "meshes_assets").iterdir() if p.name.startswith("cube_")]
+    assert [p.read_bytes() for p in copied] == [files["cube.obj"]]
+
+
+def test_a_mesh_over_mujocos_stl_face_limit_is_written_whole_as_obj(tmp_path: Path) -> None:
+    """MuJoCo 4.0 reads at most 200,000 faces from a binary STL, and any number from an OBJ."""
+    triangles = cube_triangles()
+    limit = binary_stl(triangles[np.arange(200_000) % 12])
+    over = binary_stl(triangles[np.arange(200_001) % 12])
+    (tmp_path / "limit.stl").write_bytes(limit)
+    (tmp_path / "big.stl").write_bytes(over)
+    assert mujoco_mesh(tmp_path / "limit.stl", collides=False) is None
+    assert "between 1 and 200000" in str(mujoco_mesh(tmp_path / "big.stl", collides=False))
+    text = urdf({"base": '<visual><geometry><mesh filename="big.stl"/></geometry></visual>'
+                         '<collision><geometry><mesh filename="big.stl"/></geometry>'
+                         "</collision>"})
+    robot = tmp_path / "big.urdf"
+    robot.write_text(text)
+    out = tmp_path / "big.xml"
+    data = export(robot, out)
+    m = mujoco.MjModel.from_xml_path(str(out))
+    assert m.nmesh == 1 and m.mesh_facenum.tolist() == [200_001]  # no face lost
+    assert m.ngeom == 2
+    (note,) = [n for n in notes(data, "converted") if "big.stl" in n["message"]]
+    assert "200001 faces" in note["message"] and "OBJ" in note["message"]
+    assert note["line"] == line_of(text, "big.stl")
+
+
+# ------------------------------------------------------------------ 7. nothing from outside
+
+@pytest.mark.parametrize("reference", ["package://pkg/../secret.obj", "../../secret.obj",
+                                       "package://pkg/meshes/../../../ws/secret.obj"])
+def test_a_mesh_from_outside_its_package_is_refused_by_every_command(
+        tmp_path: Path, reference: str) -> None:
+    ws = tmp_path / "ws"
+    (ws / "pkg" / "urdf").mkdir(parents=True)
+    (ws / "pkg" / "meshes").mkdir()
+    (ws / "pkg" / "package.xml").write_text("<package><name>pkg</name></package>")
+    (ws / "secret.obj").write_text(CUBE_OBJ)  # beside the package, not in it
+    (ws / "pkg" / "meshes" / "ok.obj").write_text(CUBE_OBJ)
+    text = urdf({"base": '<visual><geometry><mesh filename="../meshes/ok.obj"/></geometry>'
+                         '</visual>',
+                 "arm": f'<visual><geometry><mesh filename="{reference}"/></geometry></visual>'})
+    robot = ws / "pkg" / "urdf" / "robot.urdf"
+    robot.write_text(text)
+    out = tmp_path / "robot.xml"
+    r = runner.invoke(app, ["export", "mjcf", str(robot), "-o", str(out)])
+    assert r.exit_code == 2, r.output
+    (err,) = r.stderr.strip().splitlines()
+    line = line_of(text, 'name="arm"')
+    assert f"robot.urdf:{line}:" in err and "climbs out" in err
+    assert not out.exists() and not (tmp_path / "robot_assets").exists()
+    # one rule for all: the loading commands refuse it, check reports it (U702)
+    assert runner.invoke(app, ["joints", str(robot)]).exit_code == 2
+    r = runner.invoke(app, ["check", str(robot), "--json"])
+    found = json.loads(r.stdout)["findings"]
+    assert [f["code"] for f in found if "climbs out" in f["message"]] == ["U702"]
+    # a path that climbs only within the package is fine
+    robot.write_text(text.replace(reference, "../meshes/../meshes/ok.obj"))
+    export(robot, out)
+    assert mujoco.MjModel.from_xml_path(str(out)).nmesh == 1
+
+
+# ------------------------------------------------------------------ 8. a way through U604
+
+def body_tensor(m: object, name: str) -> np.ndarray:
+    """A body's inertia about its centre of mass, in the body's axes, as MuJoCo compiled it."""
+    b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+    r = np.zeros(9)
+    mujoco.mju_quat2Mat(r, m.body_iquat[b])
+    r = r.reshape(3, 3)
+    return r @ np.diag(m.body_inertia[b]) @ r.T
+
+
+def inertia_of(urdf_text: bytes, link: str) -> np.ndarray:
+    el = etree.fromstring(urdf_text).find(f"link[@name='{link}']/inertial/inertia")
+    g = {k: float(el.get(k)) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
+    return np.array([[g["ixx"], g["ixy"], g["ixz"]], [g["ixy"], g["iyy"], g["iyz"]],
+                     [g["ixz"], g["iyz"], g["izz"]]])
+
+
+@pytest.mark.parametrize(("robot", "links", "fix_args"), [
+    ("xarm/xarm6_robot.urdf", ["link2", "link3"], []),  # derived from its collision shapes
+    ("mini_cheetah/mini_cheetah.urdf",  # no closed collision solid: balanced
+     ["thigh_fr", "thigh_fl", "thigh_hr", "thigh_hl"], ["--balance"])])
+def test_a_tensor_pybullet_zeroes_is_written_as_urdfkit_fix_writes_it(
+        tmp_path: Path, pb: tuple, robot: str, links: list[str], fix_args: list[str]) -> None:
+    import pybullet_data
+
+    source = Path(pybullet_data.getDataPath()) / robot
+    text = source.read_text()
+    # PyBullet zeroes those links' tensors (each breaks the triangle inequality)
+    p, client = pb
+    body = p.loadURDF(str(source), flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)
+    index = {p.getJointInfo(body, i, physicsClientId=client)[12].decode(): i
+             for i in range(p.getNumJoints(body, physicsClientId=client))}
+    for name in links:
+        assert p.getDynamicsInfo(body, index[name], physicsClientId=client)[2] == (0, 0, 0)
+    out = tmp_path / "robot.xml"
+    data = export(Path(robot), out)  # refused with U604 before
+    assert data["repaired"] == links
+    said = {n["line"]: n["message"] for n in notes(data, "repaired")}
+    assert sorted(said) == sorted(line_of(text[text.index(f'<link name="{n}"'):], "<inertial")
+                                  + text[:text.index(f'<link name="{n}"')].count("\n")
+                                  for n in links)
+    assert all("PyBullet zeroes it" in s and "known difference" in s for s in said.values())
+    m = mujoco.MjModel.from_xml_path(str(out))
+    # what was written is what `urdfkit fix` writes into the file for each of them
+    fixed = tmp_path / "fixed.urdf"
+    r = runner.invoke(app, ["fix", str(source), "-o", str(fixed), *fix_args])
+    assert r.exit_code == 0, r.output
+    for name in links:
+        assert body_tensor(m, name) == pytest.approx(inertia_of(fixed.read_bytes(), name),
+                                                     rel=1e-12, abs=1e-18), name
+
+
+def test_a_zeroed_tensor_fix_cannot_repair_is_still_refused_saying_so(tmp_path: Path) -> None:
+    """reachy's r_antenna, romeo's thighs: not positive definite, no collision solid."""
+    text = urdf({"base": "", "antenna": ""}).replace(
+        f'<link name="antenna"><inertial><mass value="1"/>{INERTIA}',
+        '<link name="antenna"><inertial><mass value="1"/><inertia ixx="-0.01" iyy="0.02" '
+        'izz="0.02" ixy="0" ixz="0" iyz="0"/>')
+    robot = tmp_path / "antenna.urdf"
+    robot.write_text(text)
+    r = runner.invoke(app, ["export", "mjcf", str(robot), "-o", str(tmp_path / "a.xml")])
+    assert r.exit_code == 2, r.output
+    (err,) = r.stderr.strip().splitlines()
+    assert f"antenna.urdf:{line_of(text, '-0.01')}: U603" in err
+    assert "cannot repair it either" in err

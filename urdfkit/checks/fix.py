@@ -351,6 +351,9 @@ _TOKEN = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|</[^>]*>|<(?=[^!?
 
 
 
+#: Why a link's inertia was left: nothing to derive it from.
+_NO_SOLID = ("no collision solid to derive inertia from (no <collision>, a capsule, plane or "
+             "SDF, or a mesh that is unreadable or not closed); write <inertial> by hand")
 #: Why a link's inertia was derived, by the code that found it wrong.
 _WHY = {"U609": "had no <inertia>", "U610": "had an incomplete <inertia>",
         "U603": "had an inertia that is not positive definite",
@@ -457,13 +460,12 @@ class _Plan:
             self._massless_frame(job)
         elif code == "U602":
             self._small_mass(job)
-        elif job.solid is None:
-            self.left.append(job.skip(
-                "no collision solid to derive inertia from (no <collision>, a capsule, plane "
-                "or SDF, or a mesh that is unreadable or not closed); write <inertial> by hand"))
+        elif job.solid is None and not (self.balance and code == "U604"):
+            self.left.append(job.skip(_NO_SOLID))
         elif code in ("U606", "U601"):
+            assert job.solid is not None
             self._missing_mass(job, job.solid)
-        else:
+        else:  # --balance balances a U604 tensor without a solid: it needs none
             self._inertia(job, job.solid)
 
     def _massless_frame(self, job: _LinkJob) -> None:
@@ -516,7 +518,7 @@ class _Plan:
                                    f" m^3 at {fmt_float(self.density)} kg/m^3) and the "
                                    "inertia of its collision shapes"))
 
-    def _inertia(self, job: _LinkJob, solid: Solid) -> None:
+    def _inertia(self, job: _LinkJob, solid: Solid | None) -> None:
         """U603-U605, U608-U610: the inertia derived from the shapes (or balanced)."""
         code, mass = job.code, job.mass
         if mass is None or mass <= 0:
@@ -539,6 +541,9 @@ class _Plan:
                                            "principal moment set to their mean, "
                                            f"{fmt_float(mean, 4)})"))
                 return
+        if solid is None:
+            self.left.append(job.skip(_NO_SOLID))
+            return
         if code == "U605" and solid.size < STUB_SIZE:
             self.left.append(job.skip(
                 "its collision shapes are stubs (under 1 cm), nothing to derive inertia from"))
@@ -623,9 +628,7 @@ class _Plan:
         ``tensor`` is in link axes; it is written in the frame of the inertial's ``<origin
         rpy>``. An existing ``<origin>`` is kept; ``com`` gives a new one.
         """
-        rot = rpy_to_matrix(frame)
-        local = _rotate_tensor(transpose(rot), tensor)
-        inertia_xml = _inertia_xml(local)
+        local, inertia_xml = _in_frame(tensor, frame)
         inertial = link.find("inertial")
         if inertial is None:
             lines = ["<inertial>"]
@@ -791,6 +794,44 @@ def _prepend(parent: etree._Element, new: etree._Element) -> None:
     """
     parent.insert(0, new)
     new.tail, parent.text = parent.text, None
+
+
+def triangle_repair(link: etree._Element, report: RuleReport | None,
+                    mass: float) -> tuple[str, str] | None:
+    """The ``<inertia>`` fix writes for a link whose inertia breaks the triangle inequality.
+
+    U604's repair, as :meth:`_Plan._inertia` makes it: the tensor of the link's collision
+    solid at its mass, in the frame of the inertial's ``<origin rpy>`` (kept), written with
+    9 significant digits; for a link without a solid, every principal moment set to their
+    mean (MuJoCo's ``balanceinertia``, what ``fix --balance`` writes). Returns the element's
+    XML and how it was made, or None when fix has nothing to write. ``urdfkit export`` writes
+    it where PyBullet zeroes such a tensor and MuJoCo would refuse the body it leaves.
+    """
+    if not mass > 0:
+        return None
+    inertial = link.find("inertial")
+    origin = inertial.find("origin") if inertial is not None else None
+    frame = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0)) or (0.0, 0.0, 0.0)
+    solid = link_solid(link, report)
+    if solid is not None:
+        return (_in_frame(solid.inertia(mass), frame)[1], "the inertia of its collision shapes "
+                f"at its mass {fmt_float(mass, 6)} kg, as `urdfkit fix` writes it")
+    from urdfkit.checks.validate import _inertia_tensor
+
+    inertia = inertial.find("inertia") if inertial is not None else None
+    file_tensor = _inertia_tensor(inertia) if inertia is not None else None
+    mean = balanced(file_tensor) if file_tensor is not None else None
+    if mean is None:
+        return None
+    return (_inertia_xml(_iso(mean)), "every principal moment set to their mean (MuJoCo's "
+            "balanceinertia; it has no collision solid), as `urdfkit fix --balance` writes it")
+
+
+def _in_frame(tensor: Sequence[Sequence[float]], frame: Sequence[float]
+              ) -> tuple[tuple[tuple[float, float, float], ...], str]:
+    """A tensor in link axes, turned into the inertial's ``rpy`` frame, and its ``<inertia>``."""
+    local = _rotate_tensor(transpose(rpy_to_matrix(frame)), tensor)
+    return local, _inertia_xml(local)
 
 
 def _iso(moment: float) -> tuple[tuple[float, float, float], ...]:

@@ -1276,7 +1276,7 @@ CODES: dict[str, str] = {
     "U613": "mesh in the wrong units (200x larger or smaller than the joint spacing)",
     "U614": "concave collision mesh on a moving link (PyBullet collides with its hull)",
     "U701": "mesh or texture file not found",
-    "U702": "package:// package not found",
+    "U702": "package:// package not found, or a path climbing out of its package",
     "U703": "mesh found only through pybullet_data's search path",
     "U704": "mesh or texture is a directory, FIFO, device or unreadable",
     "U705": "mesh in a format PyBullet does not read (it reads .stl, .obj, .dae)",

@@ -85,9 +85,46 @@ def agreement_report(a: Any, show_all: bool = False) -> None:
 
 
 def _export_dict(file: str, e: Any, flags: list[str]) -> dict[str, Any]:
-    return {"file": file, "paths": e.paths, "bodies": e.bodies, "sites": e.sites,
-            "mirrored_flags": flags,
+    return {"file": file, "written": bool(e.paths), "paths": e.paths, "bodies": e.bodies,
+            "sites": e.sites, "repaired": e.repaired, "mirrored_flags": flags,
             "notes": [{"kind": n.kind, "message": n.message, "line": n.line} for n in e.notes]}
+
+
+class _Verify:
+    """``--verify``: agree run on the staged XML before it takes its place (kept for the report).
+
+    A refusal (agree exits 1) leaves nothing of the export behind; MuJoCo refusing the file
+    raises agree's InputError, which leaves nothing either (``write_export``).
+    """
+
+    def __init__(self, resolved: Any, out: str, options: Any) -> None:
+        self.resolved, self.out, self.options = resolved, out, options
+        self.agreement: Any = None
+
+    def __call__(self, staged: Path) -> bool:
+        from urdfkit.exchange.agree import agree as run_agree
+
+        self.agreement = run_agree(self.resolved, staged, self.options)
+        self.agreement.model = self.out  # the file the user named, not the staged one
+        return bool(self.agreement.ok)
+
+
+def _report(name: str, out: str, e: Any, flags: list[str], fixed_base: bool,
+            agreement: Any) -> None:
+    """The lines of export: its notes, what was written (or that nothing was), agree's table."""
+    for n in e.notes:
+        where = f"{name}:{n.line}: " if n.line else f"{name}: "
+        show.note(f"{where}{n.kind}: {n.message}")
+    if e.paths:
+        show.wrote(out, f"{len(e.bodies)} bodies, {len(e.sites)} sites, "
+                   f"{len(e.paths) - 1} mesh file(s); mirrors loadURDF with "
+                   + (" | ".join(flags) or "no flags")
+                   + (" and useFixedBase" if fixed_base else ""))
+    if agreement is not None:
+        agreement_report(agreement)
+    if not e.paths:
+        show.warn(f"{out}: not written: it disagrees with PyBullet (the rows above); nothing "
+                  "of this export was left behind")
 
 
 @command(examples(
@@ -135,51 +172,44 @@ def export(
     from urdfkit.core.errors import ParameterError
     from urdfkit.core.output import check_output
     from urdfkit.exchange.mjcf import ExportOptions, asset_dir_for, export_mjcf, write_export
+    from urdfkit.exchange.mjcf_write import check_asset_dir
     from urdfkit.exchange.robot import read_robot
 
     if kind.lower() != "mjcf":
         raise ParameterError(f"unknown format {kind!r}: export writes mjcf", param="kind")
     out = output or f"{Path(file).name.split('.')[0] or 'robot'}.xml"
     check_output(out, force=force, suffixes=(".xml",), what="the MJCF file")
+    check_asset_dir(Path(out).parent / asset_dir_for(out))
     with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
                              package_paths=package_path) as resolved:
         robot = read_robot(resolved.root, resolved.name)
         for w in robot.warnings:
             show.warn(f"{resolved.name}: {w}")
-        from urdfkit.exchange.bullet import loaded_inertials
+        from urdfkit.exchange.bullet import loaded_inertials, zeroed_repairs
 
         # what PyBullet simulates: its diagonalised tensors, its defaults, its recomputation
         inertials = loaded_inertials(resolved, inertia_from_file=not inertia_from_shapes)
+        # where PyBullet zeroed a tensor, what `urdfkit fix` writes (used where MuJoCo needs it)
+        repairs = zeroed_repairs(resolved, robot, inertials) if not inertia_from_shapes else {}
         e = export_mjcf(robot, ExportOptions(
             fixed_base=fixed_base, self_collision=self_collision, actuators=actuators,
             gain=gain, ground=ground, inertials=inertials,
-            inertia_from_shapes=inertia_from_shapes), asset_dir_for(out))
+            inertia_from_shapes=inertia_from_shapes, repairs=repairs), asset_dir_for(out))
         # cylinders are written as true cylinders: PyBullet's with URDF_USE_IMPLICIT_CYLINDER
         flags = ["URDF_USE_INERTIA_FROM_FILE"] if not inertia_from_shapes else []
         flags += ["URDF_USE_IMPLICIT_CYLINDER"]
         flags += ["URDF_USE_SELF_COLLISION"] if self_collision else []
-        write_export(e, out, force=force)
-        agreement = None
-        if verify:
-            from urdfkit.exchange.agree import agree as run_agree
-
-            agreement = run_agree(resolved, out, _verify_options(
-                fixed_base, inertia_from_shapes, self_collision, 100, 0))
+        checker = _Verify(resolved, out, _verify_options(
+            fixed_base, inertia_from_shapes, self_collision, 100, 0)) if verify else None
+        write_export(e, out, force=force, verify=checker)
+        agreement = checker.agreement if checker is not None else None
     if as_json:
         data = _export_dict(resolved.name, e, flags)
         data["agreement"] = agreement_dict(agreement) if agreement is not None else None
         show.print_json(data)
     else:
-        for n in e.notes:
-            where = f"{resolved.name}:{n.line}: " if n.line else f"{resolved.name}: "
-            show.note(f"{where}{n.kind}: {n.message}")
-        show.wrote(out, f"{len(e.bodies)} bodies, {len(e.sites)} sites, "
-                   f"{len(e.paths) - 1} mesh file(s); mirrors loadURDF with "
-                   + (" | ".join(flags) or "no flags")
-                   + (" and useFixedBase" if fixed_base else ""))
-        if agreement is not None:
-            agreement_report(agreement)
-    raise typer.Exit(1 if agreement is not None and not agreement.ok else 0)
+        _report(resolved.name, out, e, flags, fixed_base, agreement)
+    raise typer.Exit(0 if e.paths else 1)
 
 
 @command(examples(

@@ -40,12 +40,18 @@ _WHY = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is excee
         errno.EROFS: "the file system is read-only", errno.EACCES: "permission denied",
         errno.EPERM: "permission denied", errno.ENAMETOOLONG: "the name is too long",
         errno.ENOENT: "its folder does not exist", errno.ENOTDIR: "a part of the path is not a "
-        "folder", errno.EISDIR: "it is a folder"}
+        "folder", errno.EISDIR: "it is a folder",
+        errno.EFBIG: "the file size limit is reached (ulimit -f)"}
 
 
 def _oserror(e: OSError, path: Path) -> OutputError:
     why = _WHY.get(e.errno or 0, e.strerror or type(e).__name__)
     return OutputError(f"cannot write: {why}", file=path)
+
+
+def output_error(e: OSError, path: Path) -> OutputError:
+    """The one line an OS error writing ``path`` becomes (a full disk, a read-only folder)."""
+    return _oserror(e, path)
 
 
 def check_output(path: str | Path, *, force: bool = False,
@@ -119,10 +125,12 @@ class StreamingFile:
 
     def __init__(self, path: str | Path, *, force: bool = False,
                  suffixes: Sequence[str] | None = None, keep_on_interrupt: bool = False,
-                 like: str | Path | None = None):
+                 like: str | Path | None = None, temp_suffix: str = ".tmp"):
         self.path = check_output(path, force=force, suffixes=suffixes)
         self.force = force
         self.keep_on_interrupt = keep_on_interrupt
+        #: The temp file's name ends so (``.tmp.xml``: MuJoCo reads a file by its suffix).
+        self.temp_suffix = temp_suffix
         #: Where the bytes go: the path, or the regular file a symlink at the path points to.
         self.target = _write_target(self.path)
         #: Whose mode and owner the new file takes: ``like``, else the file it replaces.
@@ -136,8 +144,8 @@ class StreamingFile:
         clean_stale(self.target)
         folder = self.target.parent if str(self.target.parent) else Path(".")
         try:
-            self._fd, self._tmp = tempfile.mkstemp(prefix=f".{self.target.name}.", suffix=".tmp",
-                                                   dir=folder)
+            self._fd, self._tmp = tempfile.mkstemp(prefix=f".{self.target.name}.",
+                                                   suffix=self.temp_suffix, dir=folder)
             _take_mode(self._fd, self._like)
         except OSError as e:
             self._discard()
@@ -185,6 +193,19 @@ class StreamingFile:
         except BaseException:
             self._discard()
             raise
+
+    @property
+    def temp(self) -> Path | None:
+        """The temp file the bytes go to until :meth:`commit` (None after it).
+
+        For a caller that checks the written file before it takes its place (``urdfkit export
+        --verify`` loads it in MuJoCo).
+        """
+        return None if self._tmp is None else Path(self._tmp)
+
+    def discard(self) -> None:
+        """Remove the temp file: the target stays as it was."""
+        self._discard()
 
     def _discard(self) -> None:
         if self._fd is not None:

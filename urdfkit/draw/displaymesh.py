@@ -1,8 +1,9 @@
 """Meshes made lighter for display: a convex hull without scipy, and vertex-clustering decimation.
 
-For ``urdfkit view`` only: PyBullet keeps every triangle it loaded, and collides with a mesh's
+For ``urdfkit view``: PyBullet keeps every triangle it loaded, and collides with a mesh's
 convex hull; the page draws the hull, and a very large visual mesh with fewer triangles. Both
-are plain numpy, so the viewer needs nothing beyond urdfkit's own dependencies.
+are plain numpy, so the viewer needs nothing beyond urdfkit's own dependencies. ``urdfkit
+export`` asks :func:`spans_volume` whether MuJoCo can build a collision mesh's hull.
 
 - :func:`convex_hull`: quickhull (Barber, Dobkin and Huhdanpaa, 1996): start from a
   tetrahedron of extreme points, and repeatedly lift the face with points outside it to its
@@ -51,6 +52,21 @@ def convex_hull(points: Any) -> tuple[Any, Any] | None:
     index = {old: new for new, old in enumerate(used)}
     tris = np.array([[index[i] for i in tri] for tri in hull.faces.values()], dtype=np.int64)
     return pts[used], tris
+
+
+def spans_volume(points: Any) -> bool:
+    """Whether 3-D ``points`` span a volume, so that a convex hull of them exists.
+
+    Four of them are off one plane by more than :func:`convex_hull`'s tolerance, 1e-9 of
+    their extent.
+    """
+    import numpy as np
+
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    if len(pts) < 4 or not np.isfinite(pts).all():
+        return False
+    scale = float(np.max(np.ptp(pts, axis=0))) or 1.0
+    return _tetrahedron(pts, 1e-9 * scale) is not None
 
 
 class _Quickhull:

@@ -1,10 +1,15 @@
-"""What PyBullet computes for a URDF that the MJCF writer mirrors (its recomputed inertia)."""
+"""What PyBullet computes for a URDF that the MJCF writer mirrors, and what fix writes instead.
+
+PyBullet's recomputed inertia (:func:`loaded_inertials`), and, for a tensor PyBullet zeroes,
+the one ``urdfkit fix`` writes (:func:`zeroed_repairs`).
+"""
 
 from __future__ import annotations
 
+import copy
 from typing import Any
 
-from urdfkit.exchange.robot import Inertial
+from urdfkit.exchange.robot import Inertial, Robot, read_inertial
 
 
 def loaded_inertials(resolved: Any, *, inertia_from_file: bool) -> dict[str, Inertial]:
@@ -34,4 +39,44 @@ def loaded_inertials(resolved: Any, *, inertia_from_file: bool) -> dict[str, Ine
             out[name] = Inertial(float(d[0]), (d[3][0], d[3][1], d[3][2]),
                                  ((t[0, 0], t[0, 1], t[0, 2]), (t[1, 0], t[1, 1], t[1, 2]),
                                   (t[2, 0], t[2, 1], t[2, 2])))
+    return out
+
+
+def zeroed_repairs(resolved: Any, robot: Robot,
+                   inertials: dict[str, Inertial]) -> dict[str, tuple[Inertial, str, str]]:
+    """The links whose file tensor PyBullet zeroed, each with what ``urdfkit fix`` writes.
+
+    PyBullet sets a tensor that breaks the triangle inequality to zero ("Bad inertia tensor
+    properties"): the file gave one, PyBullet loaded none. For each such link: its
+    mass properties as read from the link fix would write (mass and centre kept, the
+    ``<inertia>`` of :func:`urdfkit.checks.fix.triangle_repair`), that ``<inertia>`` element,
+    and how it was made. A link fix cannot repair is left out.
+    """
+    zeroed = [name for name, link in robot.links.items()
+              if name in inertials and link.inertial.given and link.inertial.mass > 0
+              and not any(inertials[name].tensor[k][k] for k in range(3))
+              and any(link.inertial.tensor[k][k] for k in range(3))]
+    if not zeroed:
+        return {}
+    from lxml import etree
+
+    from urdfkit.checks.fix import triangle_repair
+    from urdfkit.sources.guard import RuleReport
+
+    report = RuleReport(resolved.name, resolved.source.absolute().parent)
+    elements = {el.get("name", ""): el for el in resolved.root.iterchildren("link")}
+    out: dict[str, tuple[Inertial, str, str]] = {}
+    for name in zeroed:
+        given = robot.links[name].inertial
+        if name not in elements:
+            continue
+        found = triangle_repair(elements[name], report, given.mass)
+        if found is None:
+            continue
+        fixed = copy.deepcopy(elements[name])
+        inertial = fixed.find("inertial")
+        inertial.replace(inertial.find("inertia"), etree.fromstring(found[0]))
+        repaired = read_inertial(fixed)
+        repaired.line = given.line
+        out[name] = (repaired, found[0], found[1])
     return out

@@ -11,13 +11,14 @@ What is dropped or approximated is said in :attr:`Export.notes` (docs/export.md 
 from __future__ import annotations
 
 import math
-import struct
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from urdfkit.core.errors import InputError, OutputError, ParameterError
+from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.exchange.fk import fused, origin_matrix
+from urdfkit.exchange.mjcf_mesh import MeshAsset, mesh_asset, unusable
 from urdfkit.exchange.robot import Inertial, Link, Robot, Shape
 
 #: ``--actuators`` choices.
@@ -50,6 +51,11 @@ class ExportOptions:
             sweeps, which leave it up to ~1e-8 relative from the file's (panda_link1: 8.2e-9).
         inertia_from_shapes: Those are PyBullet's recomputation from the collision shapes
             (no notes about links without ``<inertial>``).
+        repairs: For each link whose file tensor PyBullet zeroed (it breaks the triangle
+            inequality), what ``urdfkit fix`` writes for it: its mass properties, the
+            ``<inertia>`` element and how it was made
+            (:func:`urdfkit.exchange.bullet.zeroed_repairs`). Written only where the zero
+            would leave a moving body MuJoCo refuses; each such link is said and listed.
     """
 
     fixed_base: bool = False
@@ -59,13 +65,14 @@ class ExportOptions:
     ground: bool = False
     inertials: dict[str, Inertial] | None = None
     inertia_from_shapes: bool = False
+    repairs: dict[str, tuple[Inertial, str, str]] | None = None
 
 
 @dataclass
 class Note:
     """One thing dropped, approximated or defaulted on the way to MuJoCo."""
 
-    kind: str        # default, dropped, converted, approximated, mirrored
+    kind: str        # default, dropped, converted, approximated, mirrored, repaired
     message: str
     line: int | None = None
 
@@ -76,7 +83,8 @@ class Export:
 
     Attributes:
         xml: The document.
-        assets: File name in the assets folder -> bytes to write, or a Path to copy.
+        assets: File name in the assets folder -> bytes to write, or a Path to copy. Names
+            are content-addressed (``stem_<8 hex of SHA-256>.stl``): ``digests`` holds each.
         asset_dir: The assets folder's name (beside the XML, the compiler's meshdir).
         notes: What was dropped, approximated or defaulted.
         bodies, sites: Link names written as bodies / as sites.
@@ -89,6 +97,8 @@ class Export:
     bodies: list[str] = field(default_factory=list)
     sites: list[str] = field(default_factory=list)
     paths: list[str] = field(default_factory=list)   # filled by write_export
+    repaired: list[str] = field(default_factory=list)   # links given fix's tensor
+    digests: dict[str, str] = field(default_factory=dict)   # asset name -> SHA-256 (hex)
 
 
 def num(x: float) -> str:
@@ -181,12 +191,16 @@ class _Writer:
         self.asset_dir = asset_dir
         self.notes: list[Note] = []
         self.assets: dict[str, bytes | Path] = {}
-        self.meshes: dict[tuple[str, tuple[float, ...]], str | None] = {}
-        self.mesh_files: dict[str, str] = {}
+        self.meshes: dict[tuple[str, tuple[float, ...]], str] = {}
+        self.mesh_files: dict[str, MeshAsset | None] = {}
+        self.mesh_names: dict[str, str] = {}
+        self.digests: dict[str, str] = {}
+        self.uses: dict[tuple[str, tuple[float, float, float], bool], str | None] = {}
         self.bodies: list[str] = []
         self.sites: list[str] = []
         self.members: dict[str, list[str]] = {}
         self.locked: list[Any] = []
+        self.repaired: list[str] = []
         self.root = etree.Element("mujoco", model=robot.name or "robot")
         self.compiler = etree.SubElement(self.root, "compiler", angle="radian",
                                          meshdir=asset_dir, autolimits="true")
@@ -198,63 +212,69 @@ class _Writer:
         self.notes.append(Note(kind, message, line))
 
     def inertial(self, link: Link) -> Inertial:
+        if link.name in self.repaired and self.o.repairs:
+            return self.o.repairs[link.name][0]
         if self.o.inertials is not None and link.name in self.o.inertials:
             return self.o.inertials[link.name]
         return link.inertial
 
     # ------------------------------------------------------------------ meshes
 
-    def mesh(self, shape: Shape) -> str | None:
-        """The asset name of a mesh shape (added on first use), None when unreadable."""
+    def mesh(self, shape: Shape, visual: bool, link: Link) -> str | None:
+        """The asset name of a mesh shape (added on first use), None when it is left out."""
         assert shape.filename is not None
-        key = (shape.filename, tuple(shape.scale))
-        if key in self.meshes:
-            return self.meshes[key]
-        file = self.mesh_file(Path(shape.filename), shape.line)
-        name = None
-        if file is not None:
-            name = f"mesh{len([m for m in self.meshes.values() if m])}"
+        asset = self.mesh_file(Path(shape.filename), shape.line)
+        if asset is None:
+            return None
+        scale = (shape.scale[0], shape.scale[1], shape.scale[2])
+        use = (shape.filename, scale, not visual)
+        if use not in self.uses:
+            self.uses[use] = unusable(asset, scale, collides=not visual)
+        why = self.uses[use]
+        if why is not None:
+            self.note("dropped", f"{'visual' if visual else 'collision'} of link "
+                      f"{link.name!r}: mesh {Path(shape.filename).name}: {why}; left out",
+                      shape.line)
+            return None
+        key = (shape.filename, scale)
+        if key not in self.meshes:
+            name = f"mesh{len(self.meshes)}"
             # inertia="shell": the bodies' inertia is written, never taken from meshes, and
             # MuJoCo refuses a flat mesh's volume (plane.urdf: "mesh volume is too small")
-            el = self.E.SubElement(self.asset, "mesh", name=name, file=file, inertia="shell")
-            if tuple(shape.scale) != (1.0, 1.0, 1.0):
-                el.set("scale", nums(shape.scale))
-        self.meshes[key] = name
-        return name
+            el = self.E.SubElement(self.asset, "mesh", name=name,
+                                   file=self.mesh_names[str(shape.filename)], inertia="shell")
+            if scale != (1.0, 1.0, 1.0):
+                el.set("scale", nums(scale))
+            self.meshes[key] = name
+        return self.meshes[key]
 
-    def mesh_file(self, path: Path, line: int | None) -> str | None:
-        """The file name in the assets folder of a mesh (copied or converted once)."""
+    def mesh_file(self, path: Path, line: int | None) -> MeshAsset | None:
+        """A mesh file as it will be written (read, checked, copied or converted once).
+
+        Its name in the assets folder is content-addressed, ``stem_<8 hex of its SHA-256>``:
+        the same bytes always get the same name, so a new export never replaces a file an
+        old XML names (see :func:`write_export`).
+        """
         source = str(path)
         if source in self.mesh_files:
-            return self.mesh_files[source] or None  # "": unreadable, said once
-        suffix = path.suffix.lower()
-        data: bytes | Path | None = path
-        out_suffix = suffix
-        if suffix == ".stl" and not _binary_stl(path):
-            data, out_suffix = _stl_bytes(path), ".stl"
-            what = "ASCII STL (MuJoCo reads binary STL only)"
-        elif suffix not in (".stl", ".obj"):
-            data, out_suffix = _stl_bytes(path), ".stl"
-            what = f"{suffix[1:].upper()} (MuJoCo cannot read it)"
-        else:
-            what = ""
-        if data is None:
-            self.note("dropped", f"mesh {path.name}: urdfkit's readers found no triangles in "
-                      "it; its geoms are left out", line)
-            self.mesh_files[source] = ""
+            return self.mesh_files[source]
+        found = mesh_asset(path)
+        if isinstance(found, str):
+            self.note("dropped", f"mesh {path.name}: {found}; its geoms are left out", line)
+            self.mesh_files[source] = None
             return None
-        stem = "".join(c if c.isalnum() or c in "-_." else "_" for c in path.stem) or "mesh"
-        name = f"{stem}{out_suffix}"
-        k = 1
-        while name in self.assets:
-            k += 1
-            name = f"{stem}_{k}{out_suffix}"
-        self.assets[name] = data
-        if what:
-            self.note("converted", f"mesh {path.name}: {what}, converted to binary STL "
-                      f"{name} with urdfkit's mesh reader (materials and UVs dropped)", line)
-        self.mesh_files[source] = name
-        return name
+        stem = "".join(c if c.isalnum() or c in "-_" else "_" for c in path.stem) or "mesh"
+        # "_", not ".": "link_3.1e5fa2b0.stl" reads as numbers to a tool that edits them all
+        name = f"{stem}_{found.digest[:8]}{found.suffix}"
+        if name in self.assets and self.digests[name] != found.digest:
+            name = f"{stem}_{found.digest[:16]}{found.suffix}"  # 8 hex digits collided
+        self.assets[name] = found.data
+        self.digests[name] = found.digest
+        if found.converted:
+            self.note("converted", f"mesh {path.name}: {found.converted}, as {name}", line)
+        self.mesh_files[source] = found
+        self.mesh_names[source] = name
+        return found
 
     # ------------------------------------------------------------------ geoms
 
@@ -298,7 +318,7 @@ class _Writer:
             return
         t = at @ origin_matrix(shape.xyz, shape.rpy)
         g = self.E.Element("geom")
-        if not self.shape_type(g, body, shape, link):
+        if not self.shape_type(g, body, shape, link, visual):
             return
         _place(g, t)
         if visual:
@@ -329,7 +349,7 @@ class _Writer:
                 g.set("condim", "4")
         body.append(g)
 
-    def shape_type(self, g: Any, body: Any, shape: Shape, link: Link) -> bool:
+    def shape_type(self, g: Any, body: Any, shape: Shape, link: Link, visual: bool) -> bool:
         """Set the geom's type and size (or mesh); False when it cannot be written."""
         if shape.kind == "box":
             g.set("type", "box")
@@ -353,7 +373,7 @@ class _Writer:
             g.set("type", "plane")
             g.set("size", "0 0 1")
         else:
-            name = self.mesh(shape)
+            name = self.mesh(shape, visual, link)
             if name is None:
                 return False
             g.set("type", "mesh")
@@ -407,9 +427,8 @@ class _Writer:
         """A body's inertial, geoms and sites, from the links fused into it."""
         robot = self.robot
         if inertial:
-            parts = [(self.inertial(robot.links[n]), where[n][1]) for n in links]
-            m = combine(parts)
             moving = moving and not (name == robot.root and self.static)
+            m = self.body_mass(name, links, where, moving)
             self.check_mass(name, m, moving)
             el = self.E.Element("inertial", pos=nums(m.com), mass=num(m.mass))
             t = m.tensor
@@ -449,6 +468,34 @@ class _Writer:
         if name == "world":
             self.sites.append("world")
             self.E.SubElement(body, "site", name="world")
+
+    def body_mass(self, name: str, links: list[str], where: dict[str, Any],
+                  moving: bool) -> _Mass:
+        """A body's mass properties, from the links fused into it.
+
+        Where PyBullet zeroed a link's tensor (the triangle inequality) and that leaves a
+        moving body with a zero principal moment, which MuJoCo refuses, the tensor
+        ``urdfkit fix`` writes for the link is written instead: a way through, said per link.
+        """
+        import numpy as np
+
+        def mass() -> _Mass:
+            return combine([(self.inertial(self.robot.links[n]), where[n][1]) for n in links])
+
+        m = mass()
+        fixable = [n for n in links if n in (self.o.repairs or {})]
+        if not moving or not fixable or not np.isfinite(m.tensor).all() \
+                or np.linalg.eigvalsh(m.tensor)[0] > 1e-15:  # mjMINVAL, as check_mass
+            return m
+        assert self.o.repairs is not None
+        for n in fixable:
+            inertial, xml, how = self.o.repairs[n]
+            self.repaired.append(n)
+            self.note("repaired", f"link {n!r}: its inertia breaks the triangle inequality; "
+                      f"PyBullet zeroes it, which leaves the moving body {name!r} without the "
+                      f"inertia MuJoCo requires, so written instead: {xml}, {how}. agree "
+                      "lists this link's rows as a known difference", inertial.line)
+        return mass()
 
     def check_mass(self, name: str, m: _Mass, moving: bool) -> None:
         """Refuse what MuJoCo refuses, with check's code (U602-U604, U608) and the line."""
@@ -503,10 +550,17 @@ class _Writer:
             return
         a, b, c = sorted(eig)
         if a + b < c - 1e-9 * max(abs(c), 1e-300):
-            raise InputError(f"U604: inertia of link {name!r} violates the triangle inequality "
-                             f"({a:.6g} + {b:.6g} < {c:.6g}): PyBullet zeroes it and MuJoCo "
-                             "refuses it (`urdfkit fix` can derive one from the shapes)",
-                             file=self.robot.file, line=line)
+            what = (f"U603: inertia of link {name!r} is not positive definite (principal "
+                    f"moments {a:.6g}, {b:.6g}, {c:.6g})" if a < 0 else
+                    f"U604: inertia of link {name!r} violates the triangle inequality "
+                    f"({a:.6g} + {b:.6g} < {c:.6g})")
+            # export writes what fix writes where there is one (see body_mass)
+            hint = ("`urdfkit fix` can derive one from the shapes" if self.o.repairs is None
+                    else "`urdfkit fix` cannot repair it either: it has no collision solid to "
+                    "derive one from, and such a tensor cannot be balanced; write its "
+                    "<inertial> by hand")
+            raise InputError(f"{what}: PyBullet zeroes it and MuJoCo refuses the body it "
+                             f"leaves ({hint})", file=self.robot.file, line=line)
 
     def joint(self, body: Any, j: Any) -> None:
         E = self.E
@@ -621,40 +675,6 @@ class _Writer:
                                        directional="true"))
 
 
-def _binary_stl(path: Path) -> bool:
-    try:
-        with path.open("rb") as f:
-            head = f.read(84)
-            size = path.stat().st_size
-    except OSError:
-        return False
-    if len(head) < 84:
-        return False
-    return 84 + 50 * struct.unpack_from("<I", head, 80)[0] == size
-
-
-def _stl_bytes(path: Path) -> bytes | None:
-    """A mesh as binary STL, read by urdfkit's readers (placed as PyBullet places it)."""
-    import numpy as np
-
-    from urdfkit.sources.meshes import read_triangles
-
-    found = read_triangles(path)
-    if found is None:
-        return None
-    vertices, faces = found
-    tri = np.asarray(vertices, dtype=float)[np.asarray(faces)]
-    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    lengths = np.linalg.norm(normals, axis=1)
-    normals = normals / np.where(lengths > 0, lengths, 1.0)[:, None]
-    rec = np.zeros(len(tri), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)),
-                                              ("a", "<u2")]))
-    rec["n"] = normals
-    rec["v"] = tri
-    header = b"urdfkit export: converted mesh".ljust(80, b" ")
-    return header + struct.pack("<I", len(rec)) + rec.tobytes()
-
-
 def export_mjcf(robot: Robot, options: ExportOptions | None = None,
                 asset_dir: str = "robot_assets") -> Export:
     """The MJCF of ``robot`` and the meshes it needs (nothing is written here).
@@ -693,7 +713,8 @@ def export_mjcf(robot: Robot, options: ExportOptions | None = None,
            "written: --actuators chooses the actuators")
     w.E.indent(w.root, space="  ")
     xml = w.E.tostring(w.root, xml_declaration=False, encoding="unicode").encode() + b"\n"
-    return Export(xml, w.assets, asset_dir, w.notes, w.bodies, w.sites)
+    return Export(xml, w.assets, asset_dir, w.notes, w.bodies, w.sites, digests=w.digests,
+                  repaired=w.repaired)
 
 
 def asset_dir_for(path: str | Path) -> str:
@@ -701,42 +722,25 @@ def asset_dir_for(path: str | Path) -> str:
     return f"{Path(path).stem}_assets"
 
 
-def write_export(export: Export, path: str | Path, *, force: bool = False) -> list[str]:
-    """Write the XML and its assets folder beside it; return the paths written.
+def write_export(export: Export, path: str | Path, *, force: bool = False,
+                 verify: Callable[[Path], bool] | None = None) -> list[str]:
+    """Write the XML and its assets folder beside it, crash-safe; return the paths written.
 
-    The assets go to a temp folder first, renamed into place; the XML is written atomically
-    last, so a failure never leaves an XML pointing at missing meshes. Without ``force``
-    neither the XML nor the assets folder may exist.
+    At every step the XML on disk, old or new, names only files that are there with the
+    bytes it expects (:mod:`urdfkit.exchange.mjcf_write`): mesh files are named by their
+    content and only added until the new XML replaces the old one atomically; then the
+    files it does not name are removed. Without ``force`` neither the XML nor a non-empty
+    assets folder may exist. ``verify`` is handed the staged XML before it takes its place:
+    when it returns False, nothing of this run is left and ``[]`` is returned.
+
+    Raises:
+        OutputError: What cannot be written (a full disk, an assets path that is a symlink),
+            one line naming the file; nothing of this run is left.
     """
-    import os
-    import shutil
-    import tempfile
-
-    from urdfkit.core.output import atomic_write, check_output
+    from urdfkit.core.output import check_output
+    from urdfkit.exchange.mjcf_write import write_pair
 
     out = check_output(path, force=force, suffixes=(".xml",), what="the MJCF file")
-    folder = out.parent / export.asset_dir
-    written: list[str] = []
-    if export.assets:
-        if folder.exists() and not force:
-            raise OutputError("exists; pass `force=True` to overwrite it", file=folder,
-                              param="force")
-        if folder.exists() and not folder.is_dir():
-            raise OutputError("exists and is not a folder", file=folder)
-        try:
-            tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=out.parent))
-            for name, data in export.assets.items():
-                if isinstance(data, Path):
-                    shutil.copyfile(data, tmp / name)
-                else:
-                    (tmp / name).write_bytes(data)
-                written.append(str(folder / name))
-            if folder.exists():
-                shutil.rmtree(folder)
-            os.replace(tmp, folder)
-        except OSError as e:
-            raise OutputError(f"cannot write the meshes: {e.strerror or e}", file=folder) \
-                from None
-    atomic_write(out, export.xml, force=force)
-    export.paths = [str(out), *written]
+    export.paths = write_pair(out, export.xml, export.assets, export.digests, export.asset_dir,
+                              force=force, verify=verify)
     return export.paths

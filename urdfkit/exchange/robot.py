@@ -199,6 +199,11 @@ def _inertial(link: Any, name: str) -> Inertial:
     return Inertial(mass, _vec3(origin, "xyz"), tensor, line=line_of(el))
 
 
+def read_inertial(link: Any) -> Inertial:
+    """A ``<link>`` element's mass properties, as :func:`read_robot` reads them."""
+    return _inertial(link, link.get("name", ""))
+
+
 def _rgba(visual: Any, materials: dict[str, Any]) -> tuple[tuple[float, ...] | None, str | None,
                                                            bool]:
     mat = visual.find("material")

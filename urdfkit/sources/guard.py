@@ -545,7 +545,7 @@ def reference(tag: str, fn: str, base: Path | str,
     it to the search path, so loaders point PyBullet there), U705 a mesh format PyBullet does
     not read.
     """
-    if ":" not in fn and not fn.startswith("/"):
+    if ":" not in fn and not fn.startswith("/") and ".." not in fn:
         # The common case, a plain relative path to a regular file: one stat answers what
         # resolve_uri and not_a_file would ask (the same path, the same notes to deps).
         folder = base if isinstance(base, str) else os.fspath(base)

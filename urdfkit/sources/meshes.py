@@ -56,6 +56,24 @@ def _read_mesh(path: Path, suffix: str | None = None) -> tuple[Any, Any, list[in
         data = read_regular(path, limit=MAX_MESH_BYTES, kind="mesh")
     except InputError:
         return None
+    parsed = parse_mesh(data, suffix, path)
+    if parsed is None:
+        return None
+    vertices, faces, starts = parsed
+    if (len(faces) == 0 or len(vertices) == 0 or faces.min() < 0
+            or faces.max() >= len(vertices) or not np.isfinite(vertices).all()):
+        return None
+    return vertices, faces, starts
+
+
+def parse_mesh(data: bytes, suffix: str, path: Path) -> tuple[Any, Any, list[int]] | None:
+    """A mesh file's bytes as vertices, triangles and (OBJ) piece starts, unchecked.
+
+    Placed as PyBullet places them, as :func:`read_triangles`, but as written: vertices may
+    be non-finite and vertex indices out of range (``urdfkit export`` keeps the triangles
+    that are sound). ``path`` names a COLLADA file's folder. None if unsupported or not
+    parsable at all.
+    """
     starts: list[int] = []
     try:
         if suffix == ".stl":
@@ -69,11 +87,36 @@ def _read_mesh(path: Path, suffix: str | None = None) -> tuple[Any, Any, list[in
     except (ValueError, struct.error, IndexError, OverflowError, KeyError, InputError,
             AttributeError, StopIteration, TypeError):
         return None
-    if (vertices is None or faces is None or len(faces) == 0 or len(vertices) == 0
-            or faces.min() < 0 or faces.max() >= len(vertices)
-            or not np.isfinite(vertices).all()):
+    if vertices is None or faces is None:
         return None
     return vertices, faces, starts
+
+
+#: A ``vn`` line of an OBJ, and the normal index of a face vertex (``v/vt/vn`` or ``v//vn``).
+_OBJ_VN = re.compile(rb"\nvn[ \t]")
+_OBJ_NORMAL_REF = re.compile(rb"[ \t]-?\d+/-?\d*/(-?\d+)")
+
+
+def obj_normals_complete(data: bytes) -> bool:
+    """Whether every face vertex of an OBJ that has ``vn`` lines names one of them.
+
+    MuJoCo 4.0 refuses an OBJ with normals and a face vertex without one, or one out of
+    range ("mesh_facenormal normal index out of bounds"; measured), which PyBullet and the
+    OBJ format allow.
+    """
+    import numpy as np
+
+    data = b"\n" + data
+    count = len(_OBJ_VN.findall(data))
+    if not count:
+        return True
+    flines = _OBJ_F.findall(data)
+    text = b"".join(b" " + line + b" \n" for line in flines)
+    refs = _OBJ_NORMAL_REF.findall(text)
+    if len(refs) != int(_words_per_line(b"\n".join(flines), len(flines)).sum()):
+        return False
+    index = np.array(refs, dtype=np.int64)
+    return bool((((index >= 1) & (index <= count)) | ((index < 0) & (index >= -count))).all())
 
 
 def _stl(data: bytes) -> tuple[Any, Any]:

@@ -223,9 +223,73 @@ class Target(NamedTuple):
     problem: str | None = None
 
 
+def climbs_out(rest: str) -> bool:
+    """Whether a relative path leaves the folder it starts from (its ``..`` go above it).
+
+    Read as written, not through symlinks: ``meshes/../meshes/a.stl`` stays, ``../a.stl``
+    and ``a/../../b.stl`` leave.
+    """
+    depth = 0
+    for part in rest.replace("\\", "/").split("/"):
+        if part == "..":
+            depth -= 1
+            if depth < 0:
+                return True
+        elif part not in ("", "."):
+            depth += 1
+    return False
+
+
+def _package_root(base: Path) -> Path | None:
+    """The nearest folder at or above ``base`` with a ``package.xml``, or None."""
+    for folder in [base, *base.parents]:
+        if _is_file(folder / "package.xml"):
+            return folder
+    return None
+
+
+def _climbing(uri: str, base: Path) -> Target | None:
+    """A reference that climbs out of its package with ``..``, refused; else None.
+
+    ``package://NAME/rest`` (and ``model://``) whose ``rest`` climbs above the package; a
+    relative path that leaves the package the file is in (a file in no package has none to
+    leave). An absolute path is taken as written.
+    """
+    scheme, sep, stripped = uri.partition("://")
+    if sep and scheme in ("package", "model"):
+        pkg, _, rest = stripped.partition("/")
+        if not climbs_out(rest):
+            return None
+        return Target(None, pkg if scheme == "package" else None,
+                      f"{uri!r} climbs out of {scheme} {pkg!r} with '..'; nothing from outside "
+                      "a package is read: name the file inside its package")
+    if sep or ".." not in Path(uri).parts or Path(uri).is_absolute():
+        return None
+    root = _package_root(base)
+    if root is None:
+        return None
+    target = os.path.normpath(base / uri)
+    if target == str(root) or target.startswith(str(root).rstrip(os.sep) + os.sep):
+        return None
+    return Target(None, None, f"{uri!r} climbs out of package "
+                  f"{package_xml_name(str(root)) or root.name!r} ({root}) with '..'; nothing "
+                  "from outside a package is read: move the file into it, or name its "
+                  "package with package://")
+
+
 def resolve_uri(uri: str, base: Path, packages: Mapping[str, Path] | None = None) -> Target:
-    """Resolve a ``filename`` attribute written in a URDF whose folder is ``base``."""
+    """Resolve a ``filename`` attribute written in a URDF whose folder is ``base``.
+
+    One rule for every command: nothing from outside a package. A ``package://NAME/rest``
+    (or ``model://``) whose ``rest`` climbs above the package with ``..``, and a relative
+    path that climbs out of the package the file is in, resolve to nothing (``problem``
+    says why); an absolute path is taken as written.
+    """
     uri = uri.strip()
+    if ".." in uri:
+        climbing = _climbing(uri, base)
+        if climbing is not None:
+            return climbing
     if uri.startswith("package://"):
         stripped = uri[len("package://"):]
         pkg, _, rest = stripped.partition("/")
