@@ -4,6 +4,7 @@ export's are read truthfully, each row saying what it compared (issue 48)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -469,3 +470,46 @@ def test_an_inertial_frame_mujoco_snaps_to_its_body_is_said(tmp_path: Path) -> N
     assert code == 0, _failing(data)
     row = _rows(data)["inertial frames MuJoCo puts on their body"]
     assert row["status"] == "known" and row["detail"].startswith("l0") and row["value"] > 1e-9
+
+
+@pytest.mark.parametrize("fixed", [False, True])
+def test_a_tensor_pybullet_zeroes_exports_and_is_a_known_difference(tmp_path: Path,
+                                                                     fixed: bool) -> None:
+    """xarm6's link2 and link3 break the triangle inequality: PyBullet zeroes them (read here
+    from raw PyBullet), export writes fix's tensor (MuJoCo refuses a moving body without
+    one), and agree says which rows it cannot compare, comparing the rest."""
+    p = pybullet
+    c = p.connect(p.DIRECT)
+    try:
+        import pybullet_data
+
+        body = p.loadURDF(f"{pybullet_data.getDataPath()}/xarm/xarm6_robot.urdf",
+                          flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=c)
+        zeroed = [p.getJointInfo(body, i, physicsClientId=c)[12].decode()
+                  for i in range(p.getNumJoints(body, physicsClientId=c))
+                  if p.getDynamicsInfo(body, i, physicsClientId=c)[2] == (0.0, 0.0, 0.0)
+                  and p.getDynamicsInfo(body, i, physicsClientId=c)[0] > 0]
+    finally:
+        p.disconnect(c)
+    assert zeroed == ["link2", "link3"]
+    out = tmp_path / "xarm.xml"
+    flag = ["--fixed-base"] if fixed else []
+    r = runner.invoke(app, ["export", "mjcf", "xarm/xarm6_robot.urdf", "-o", str(out),
+                            "--json", *flag])
+    assert r.exit_code == 0, r.output
+    assert sorted(json.loads(r.stdout)["repaired"]) == zeroed
+    mujoco.MjModel.from_xml_path(str(out))
+    code, data = _agree("xarm/xarm6_robot.urdf", out, *flag)
+    assert code == 0, _failing(data)
+    rows = _rows(data)
+    assert rows["inertia PyBullet zeroes"]["status"] == "known"
+    assert rows["inertia PyBullet zeroes"]["detail"].startswith("link2, link3")
+    assert rows["mass matrix, inverse dynamics"]["status"] == "known"
+    assert rows["body masses"]["status"] == "pass" and rows["centres of mass"]["status"] == "pass"
+    # a mass tampered on a repaired body still fails
+    doc = etree.parse(str(out))
+    el = doc.find(".//body[@name='link2']/inertial")
+    el.set("mass", repr(float(el.get("mass")) * 1.1))
+    doc.write(str(out))
+    code, data = _agree("xarm/xarm6_robot.urdf", out, *flag)
+    assert code == 1 and _failing(data)["body masses"].startswith("link2")

@@ -564,6 +564,7 @@ class _Compare:
                          body))
             if ours.mass <= 0:
                 continue
+            com.append((float(np.abs(ours.com - theirs.com).max()), body))
             scale = max(float(np.abs(ours.tensor).max()), 1e-300)
             off = float(np.abs(ours.tensor - theirs.tensor).max()) / scale
             mine = [z for z in zeroed if where[z][0] == body]
@@ -572,7 +573,6 @@ class _Compare:
                 # writes the one `fix` would: MuJoCo refuses a moving body without one)
                 self.repaired += mine
                 continue
-            com.append((float(np.abs(ours.com - theirs.com).max()), body))
             inertia.append((off, body))
         taken = set(image.values())
         missing += [f"+{_name(self.model, mj.mjtObj.mjOBJ_BODY, w) or f'body {w}'}"
@@ -605,7 +605,8 @@ class _Compare:
                     "known", f"{', '.join(self.repaired[:4])}: the file's tensor breaks the "
                     "triangle inequality, "
                     "PyBullet sets it to zero and MuJoCo refuses a moving body without one; "
-                    "their bodies' inertia, the dynamics and the swing are not compared",
+                    "their bodies' inertia tensors (not their masses or centres of mass), "
+                    "the dynamics and the swing are not compared",
                     status="known")
 
     def _mujoco_weld_groups(self, d: Any) -> tuple[dict[int, list[tuple[Inertial, Any]]],
