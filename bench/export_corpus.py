@@ -215,13 +215,18 @@ def _agree_cell(res: dict[str, Any], mode: str) -> str:
     return _cell(step)
 
 
+def _short(res: dict[str, Any], text: str, width: int = 200) -> str:
+    """A stderr line without the robot's folder (the file's name is enough in the table)."""
+    return text.replace(str(Path(res["path"]).parent) + os.sep, "")[:width]
+
+
 def _why(res: dict[str, Any]) -> str:
     bits: list[str] = []
     if not res["raw"]["loaded"]:
         bits.append(f"raw: {res['raw']['error'][:80]}")
     build = res["steps"].get("build")
     if build and build["kind"] != "ok":
-        bits.append(f"build: {build['stderr'][:120]}")
+        bits.append(f"build: {_short(res, build['stderr'])}")
     for mode in MODES:
         e = res["steps"].get(f"export_{mode}")
         if e and e["kind"] != "ok":
@@ -229,13 +234,13 @@ def _why(res: dict[str, Any]) -> str:
                 "stderr"
             ]:
                 continue
-            bits.append(f"export {mode}: {e['stderr'][:140]}")
+            bits.append(f"export {mode}: {_short(res, e['stderr'])}")
         mj = res["steps"].get(f"mujoco_{mode}")
         if mj and not mj.get("loaded"):
             bits.append(f"MuJoCo {mode}: {mj.get('error', '')[:120]}")
         a = res["steps"].get(f"agree_{mode}")
         if a and a["kind"] not in ("ok", "findings"):
-            bits.append(f"agree {mode}: {a['stderr'][:140]}")
+            bits.append(f"agree {mode}: {_short(res, a['stderr'])}")
         elif a and a["failing"]:
             rows = "; ".join(
                 f"{r['check']} {_num(r['value'])} > {_num(r['tolerance'])}"
