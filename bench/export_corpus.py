@@ -7,7 +7,7 @@ Usage:
 
 MANIFEST is bench/corpus.py's (same reader, same fields: name, path, packages, package_path,
 ros_package_path, args, group, notes; see `python bench/corpus.py --help`).
-bench/corpus-example.json runs it on four of pybullet_data's robots.
+bench/export-corpus-example.json runs it on pybullet_data's 19 robots (docs/export.md's).
 
 For each entry, one command at a time, each a subprocess bounded by --timeout:
 
