@@ -222,6 +222,9 @@ def run(cmd: list[str], env: dict[str, str], timeout: float) -> Run:
         kind = "bug"  # bad input gets one line, never a traceback
     elif kind == "refusal" and len(lines) > 1 and not lines[-1].startswith("urdfkit: error"):
         first = f"{first} (+{len(lines) - 1} more stderr lines)"
+    elif kind == "refusal" and not first.startswith("urdfkit: error"):
+        # Warnings come first; the refusal's reason is its one error line.
+        first = next((line for line in lines if line.startswith("urdfkit: error")), first)
     if kind in ("ok", "findings") and "--json" in cmd:
         try:
             json.loads(proc.stdout)
