@@ -513,3 +513,18 @@ def test_a_tensor_pybullet_zeroes_exports_and_is_a_known_difference(tmp_path: Pa
     doc.write(str(out))
     code, data = _agree("xarm/xarm6_robot.urdf", out, *flag)
     assert code == 1 and _failing(data)["body masses"].startswith("link2")
+
+
+@pytest.mark.parametrize(("edit", "said"), [
+    (lambda doc: doc.find(".//joint[@name='lbr_iiwa_joint_3']").set("stiffness", "5"),
+     "joint lbr_iiwa_joint_3 stiffness 5"),
+    (lambda doc: doc.find(".//body[@name='lbr_iiwa_link_4']").set("gravcomp", "1"),
+     "body lbr_iiwa_link_4 gravcomp 1"),
+    (lambda doc: etree.SubElement(doc.getroot(), "option", gravity="0 0 0"), "gravity 0 0 0"),
+    (lambda doc: etree.SubElement(doc.getroot(), "option", density="1.2", viscosity="1e-5"),
+     "density 1.2; viscosity 1e-05"),
+])
+def test_forces_only_mujoco_applies_fail(kuka: Path, edit, said: str) -> None:
+    code, data = _agree("kuka_iiwa/model.urdf", _tamper(kuka, "forces.xml", edit))
+    assert code == 1
+    assert _failing(data)["forces MuJoCo alone applies"].startswith(said)

@@ -445,6 +445,39 @@ class _Compare:
         else:
             res.add("structure", "body tree", None, None, "", "not compared: no link has a "
                     "body or site in the MJCF")
+        self.forces_of_mujoco_alone()
+
+    def forces_of_mujoco_alone(self) -> None:
+        """What MuJoCo would push the robot with that PyBullet has no counterpart of.
+
+        Joint springs (``stiffness``), gravity compensation (``gravcomp``), the medium's
+        forces (``density``, ``viscosity``, ``wind``), and a gravity other than the
+        0 0 -9.81 urdfkit's PyBullet commands set. Each would move MuJoCo's robot otherwise
+        while the rows at poses (kinematics, mass matrix) still agreed.
+        """
+        import numpy as np
+
+        mj, m, res = self.mj, self.model, self.result
+        said = []
+        for k in range(m.njnt):
+            if float(m.jnt_stiffness[k]):
+                said.append(f"joint {_name(m, mj.mjtObj.mjOBJ_JOINT, k) or k} stiffness "
+                            f"{float(m.jnt_stiffness[k]):g}")
+        for b in range(1, m.nbody):
+            if float(m.body_gravcomp[b]):
+                said.append(f"body {_name(m, mj.mjtObj.mjOBJ_BODY, b) or b} gravcomp "
+                            f"{float(m.body_gravcomp[b]):g}")
+        if not np.allclose(m.opt.gravity, (0.0, 0.0, -9.81), rtol=0.0, atol=1e-12):
+            said.append(f"gravity {' '.join(f'{g:g}' for g in m.opt.gravity)} (PyBullet's "
+                        "commands: 0 0 -9.81)")
+        for what in ("density", "viscosity"):
+            if float(getattr(m.opt, what)):
+                said.append(f"{what} {float(getattr(m.opt, what)):g}")
+        if np.any(m.opt.wind):
+            said.append(f"wind {' '.join(f'{w:g}' for w in m.opt.wind)}")
+        res.add("structure", "forces MuJoCo alone applies", float(len(said)), 0.0, "found",
+                "; ".join(said[:3]) + (" ..." if len(said) > 3 else "")
+                or "no joint springs, gravity compensation or medium; gravity 0 0 -9.81")
 
     def joint_rows(self) -> None:
         """Names, order, kinds, limits, damping, armature and friction of the matched joints."""
