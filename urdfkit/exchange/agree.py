@@ -1143,10 +1143,13 @@ class _Compare:
         d = mj.MjData(m)
         q0, v0 = self._swing_start()
         names = [n for n in pb.names if n not in locked]
-        ids = {n: mj.mj_name2id(m, mj.mjtObj.mjOBJ_JOINT, _name(
-            self.fixed, mj.mjtObj.mjOBJ_JOINT, self.jnt[n])) for n in names}
-        if not locked and not floating:
-            ids = {n: self.jnt[n] for n in names}
+        # the swing model's joints are the base-welded copy's, in order, less the locked
+        # ones (welded): matched by position, as unnamed joints have no name to look up
+        gone = {self.jnt[n] for n in locked}
+        kept = [k for k in range(self.fixed.njnt) if k not in gone]
+        own = [k for k in range(m.njnt) if m.jnt_type[k] != mj.mjtJoint.mjJNT_FREE]
+        to_swing = dict(zip(kept, own, strict=True))
+        ids = {n: to_swing[self.jnt[n]] for n in names}
         for n in names:
             d.qpos[m.jnt_qposadr[ids[n]]] = q0[n]
             if floating:
