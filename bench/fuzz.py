@@ -1,6 +1,7 @@
-"""The full fuzz run (issues 11 and 12): mutants of real robots through every command.
+"""The full fuzz run (issues 11, 12 and 48): mutants of real robots through every command.
 
-Usage: ``python bench/fuzz.py --mutants 1500 --seed 1 --jobs 2 [--keep /tmp/fuzz]``
+Usage: ``python bench/fuzz.py --mutants 1500 --seed 1 --jobs 2 [--keep /tmp/fuzz]``, and
+``--campaign mjcf`` for mutants of real MJCF exports through ``urdfkit agree``.
 
 Prints runs by class and command with mean seconds per run, lists every failure (signal, hang,
 traceback, bug, bad exit, multi-line error, unnamed refusal, dirty JSON), saves each failing
@@ -17,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
-from fuzz.runner import campaign  # noqa: E402
+from fuzz.runner import campaign, mjcf_campaign  # noqa: E402
 
 
 def main() -> int:
@@ -27,9 +28,11 @@ def main() -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=30.0)
     ap.add_argument("--keep", type=Path, default=None)
+    ap.add_argument("--campaign", choices=["urdf", "mjcf"], default="urdf")
     a = ap.parse_args()
     start = time.perf_counter()
-    report = campaign(a.mutants, a.seed, jobs=a.jobs, timeout=a.timeout, keep=a.keep)
+    run = campaign if a.campaign == "urdf" else mjcf_campaign
+    report = run(a.mutants, a.seed, jobs=a.jobs, timeout=a.timeout, keep=a.keep)
     print(f"{report.mutants} mutants, {report.runs} runs, seed {a.seed}, "
           f"{time.perf_counter() - start:.0f} s")
     print(report.table())

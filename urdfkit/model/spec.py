@@ -251,7 +251,9 @@ def did_you_mean(names: Sequence[str], tags: bool = True) -> str:
 # --------------------------------------------------------------------------- PyBullet's limits
 
 #: PyBullet's state queries (getJointState, getLinkState, getBasePositionAndOrientation) fail
-#: on bodies with this many links or more (its MAX_DEGREE_OF_FREEDOM).
+#: on bodies with more links than this (128 joints: its MAX_DEGREE_OF_FREEDOM); the simulating
+#: commands and U208 stop at this many, where a body of one-dof joints already reads wrong
+#: (see MAX_STATE_COORDINATES).
 MAX_STATE_LINKS = 128
 #: What those queries hold, measured on 3.2.7 (tests/test_agree_big.py): 128 position and 128
 #: velocity coordinates (MAX_DEGREE_OF_FREEDOM), the base's 7 and 6 first, a fixed base too,
