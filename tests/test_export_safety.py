@@ -374,3 +374,50 @@ def test_a_zeroed_tensor_fix_cannot_repair_is_still_refused_saying_so(tmp_path: 
     (err,) = r.stderr.strip().splitlines()
     assert f"antenna.urdf:{line_of(text, '-0.01')}: U603" in err
     assert "cannot repair it either" in err
+
+
+HINGE = """<robot name="h">
+  <link name="base"><inertial><mass value="1"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="0 0 -0.5"/><mass value="{mass}"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/>
+    <axis xyz="1 0 0"/><limit lower="{lower}" upper="{upper}" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+@pytest.mark.parametrize("upper", ["inf", "nan", "1e309"])
+def test_a_limit_that_is_not_finite_is_refused(tmp_path: Path, upper: str) -> None:
+    """PyBullet loads such a bound as written (read here); MuJoCo's range cannot hold it, and
+    export once wrote a different range instead (the default -3 -1)."""
+    import pybullet as p
+
+    urdf = tmp_path / "h.urdf"
+    urdf.write_text(HINGE.format(mass=1, lower=-3, upper=upper))
+    c = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(str(urdf), physicsClientId=c)
+        loaded = p.getJointInfo(body, 0, physicsClientId=c)[9]
+    finally:
+        p.disconnect(c)
+    assert not np.isfinite(loaded)
+    out = tmp_path / "h.xml"
+    r = runner.invoke(app, ["export", "mjcf", str(urdf), "-o", str(out)])
+    assert r.exit_code == 2 and not out.exists()
+    assert f'h.urdf:6: joint \'hinge\': <limit upper="{upper}">' in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+
+
+def test_a_mass_under_mujocos_floor_is_refused(tmp_path: Path) -> None:
+    urdf = tmp_path / "h.urdf"
+    urdf.write_text(HINGE.format(mass="1e-320", lower=-1, upper=1))
+    # MuJoCo's own verdict on such a body
+    xml = ('<mujoco><worldbody><body><joint type="hinge"/><inertial pos="0 0 0" mass="1e-320" '
+           'diaginertia="0.1 0.1 0.1"/></body></worldbody></mujoco>')
+    with pytest.raises(ValueError, match="mjMINVAL"):
+        mujoco.MjModel.from_xml_string(xml)
+    out = tmp_path / "h.xml"
+    r = runner.invoke(app, ["export", "mjcf", str(urdf), "-o", str(out)])
+    assert r.exit_code == 2 and not out.exists()
+    assert "h.urdf:4: U602: link 'arm' moves but has mass 1e-320 kg" in r.stderr

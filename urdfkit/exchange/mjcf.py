@@ -510,9 +510,10 @@ class _Writer:
                              file=self.robot.file, line=line)
         if not moving:
             return
-        if m.mass <= 0:
-            raise InputError(f"U602: link {name!r} moves but has mass 0 (with the links fused "
-                             "into it); MuJoCo refuses a massless moving body",
+        if m.mass <= 1e-15:  # mjMINVAL: MuJoCo's floor for a moving body's mass
+            what = "0" if m.mass <= 0 else f"{m.mass:.3g} kg, under MuJoCo's floor of 1e-15"
+            raise InputError(f"U602: link {name!r} moves but has mass {what} (with the links "
+                             "fused into it); MuJoCo refuses a massless moving body",
                              file=self.robot.file, line=line)
         with np.errstate(all="ignore"):
             eig = np.linalg.eigvalsh(m.tensor)
@@ -564,6 +565,10 @@ class _Writer:
 
     def joint(self, body: Any, j: Any) -> None:
         E = self.E
+        if j.odd_limit:
+            raise InputError(f"joint {j.name!r}: <limit {j.odd_limit}>: PyBullet loads a bound "
+                             "that is not a finite number as written; MuJoCo's range cannot "
+                             "hold it", file=self.robot.file, line=j.line)
         if j.type == "spherical":
             el = E.SubElement(body, "joint", name=j.name, type="ball")
         else:

@@ -112,6 +112,8 @@ class Joint:
     mimic: tuple[str, float, float] | None = None   # (joint, multiplier, offset)
     declared_type: str = ""
     line: int | None = None
+    #: a <limit> bound written as inf, nan or past a double (1e309): PyBullet reads it so
+    odd_limit: str = ""
 
     @property
     def moves(self) -> bool:
@@ -291,12 +293,23 @@ def _joint(el: Any) -> Joint:
     if mimic_el is not None and mimic_el.get("joint"):
         mimic = (mimic_el.get("joint", ""), attr_float(mimic_el, "multiplier", 1.0) or 0.0,
                  attr_float(mimic_el, "offset", 0.0) or 0.0)
+    odd = [f'{a}="{limit.get(a)}"' for a in ("lower", "upper")
+           if limit is not None and _non_finite(limit.get(a))]
     return Joint(
         el.get("name", ""), kind, el.find("parent").get("link", ""),
         el.find("child").get("link", ""), _vec3(origin, "xyz"), _vec3(origin, "rpy"), axis,
         limited, lower, upper, attr_float(limit, "effort", 0.0) or 0.0,
         attr_float(limit, "velocity", 0.0) or 0.0, attr_float(dyn, "damping", 0.0) or 0.0,
-        attr_float(dyn, "friction", 0.0) or 0.0, mimic, declared, line_of(el))
+        attr_float(dyn, "friction", 0.0) or 0.0, mimic, declared, line_of(el),
+        " ".join(odd) if kind in ("revolute", "prismatic") else "")
+
+
+def _non_finite(text: str | None) -> bool:
+    """Whether an attribute is one number that is not finite (inf, nan, 1e309)."""
+    try:
+        return text is not None and not math.isfinite(float(text))
+    except ValueError:
+        return False
 
 
 def read_robot(root: Any, file: str) -> Robot:
