@@ -53,6 +53,7 @@ import os
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -441,6 +442,32 @@ def summarize(results: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+def each_robot(args: argparse.Namespace,
+               survey_one: Callable[[dict[str, Any]], dict[str, Any]]) -> list[dict[str, Any]]:
+    """Each manifest entry's result (``--only``, ``--resume``, ``--table-only``), kept as
+    ``OUT/results/NAME.json`` as soon as it is made, so an interrupted run resumes."""
+    entries = load_manifest(args.manifest)
+    if args.only:
+        entries = [e for e in entries if e["name"] in set(args.only)]
+    store = args.out / "results"
+    store.mkdir(parents=True, exist_ok=True)
+    results: list[dict[str, Any]] = []
+    for entry in entries:
+        stored = store / f"{entry['name']}.json"
+        if (args.resume or args.table_only) and stored.exists():
+            results.append(json.loads(stored.read_text()))
+            continue
+        if args.table_only:
+            continue
+        print(f"... {entry['name']}", file=sys.stderr, flush=True)
+        started = time.monotonic()
+        res = survey_one(entry)
+        print(f"    {time.monotonic() - started:.1f} s", file=sys.stderr, flush=True)
+        stored.write_text(json.dumps(res, indent=1))
+        results.append(res)
+    return results
+
+
 def main(argv: list[str] | None = None) -> int:
     """Command line entry point."""
     parser = argparse.ArgumentParser(
@@ -468,23 +495,8 @@ def main(argv: list[str] | None = None) -> int:
         "--table-only", action="store_true", help="print the table from stored results"
     )
     args = parser.parse_args(argv)
-    entries = load_manifest(args.manifest)
-    if args.only:
-        entries = [e for e in entries if e["name"] in set(args.only)]
-    store = args.out / "results"
-    store.mkdir(parents=True, exist_ok=True)
-    results: list[dict[str, Any]] = []
-    for entry in entries:
-        stored = store / f"{entry['name']}.json"
-        if (args.resume or args.table_only) and stored.exists():
-            results.append(json.loads(stored.read_text()))
-            continue
-        if args.table_only:
-            continue
-        print(f"... {entry['name']}", file=sys.stderr, flush=True)
-        res = asdict(survey(entry, args.out, args.timeout, args.size, not args.no_beside))
-        stored.write_text(json.dumps(res, indent=1))
-        results.append(res)
+    results = each_robot(args, lambda entry: asdict(
+        survey(entry, args.out, args.timeout, args.size, not args.no_beside)))
     summary = summarize(results)
     (args.out / "summary.json").write_text(
         json.dumps({"summary": summary, "results": results}, indent=1)

@@ -46,7 +46,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from corpus import _common, _env, _urdfkit, expand, load_manifest, raw_load, run  # noqa: E402
+from corpus import _common, _env, _urdfkit, each_robot, expand, raw_load, run  # noqa: E402
 
 FLAGS = ["URDF_USE_INERTIA_FROM_FILE", "URDF_USE_IMPLICIT_CYLINDER"]
 MODES = ("float", "fixed")
@@ -330,24 +330,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--resume", action="store_true", help="skip robots with a stored result")
     parser.add_argument("--table-only", action="store_true", help="table from stored results")
     args = parser.parse_args(argv)
-    entries = load_manifest(args.manifest)
-    if args.only:
-        entries = [e for e in entries if e["name"] in set(args.only)]
-    store = args.out / "results"
-    store.mkdir(parents=True, exist_ok=True)
-    results: list[dict[str, Any]] = []
-    for entry in entries:
-        stored = store / f"{entry['name']}.json"
-        if (args.resume or args.table_only) and stored.exists():
-            results.append(json.loads(stored.read_text()))
-            continue
-        if args.table_only:
-            continue
-        print(f"... {entry['name']}", file=sys.stderr, flush=True)
-        res = survey(entry, args.out, args.timeout, args.poses)
-        print(f"    {res['seconds']:.1f} s", file=sys.stderr, flush=True)
-        stored.write_text(json.dumps(res, indent=1))
-        results.append(res)
+    results = each_robot(args, lambda entry: survey(entry, args.out, args.timeout, args.poses))
     summary = summarize(results)
     (args.out / "summary.json").write_text(
         json.dumps({"summary": summary, "results": results}, indent=1)
