@@ -361,19 +361,35 @@ def test_a_tensor_pybullet_zeroes_is_written_as_urdfkit_fix_writes_it(
                                                      rel=1e-12, abs=1e-18), name
 
 
-def test_a_zeroed_tensor_fix_cannot_repair_is_still_refused_saying_so(tmp_path: Path) -> None:
-    """reachy's r_antenna, romeo's thighs: not positive definite, no collision solid."""
+def test_a_zeroed_tensor_fix_cannot_repair_gets_pybullets_own_from_the_shapes(
+        tmp_path: Path, pb: tuple) -> None:
+    """reachy's r_antenna, romeo's thighs: not positive definite, no collision solid, so fix
+    has nothing to write; export writes the tensor PyBullet itself computes without
+    URDF_USE_INERTIA_FROM_FILE (read here from raw PyBullet), not a dead end."""
     text = urdf({"base": "", "antenna": ""}).replace(
         f'<link name="antenna"><inertial><mass value="1"/>{INERTIA}',
         '<link name="antenna"><inertial><mass value="1"/><inertia ixx="-0.01" iyy="0.02" '
         'izz="0.02" ixy="0" ixz="0" iyz="0"/>')
     robot = tmp_path / "antenna.urdf"
     robot.write_text(text)
-    r = runner.invoke(app, ["export", "mjcf", str(robot), "-o", str(tmp_path / "a.xml")])
-    assert r.exit_code == 2, r.output
-    (err,) = r.stderr.strip().splitlines()
-    assert f"antenna.urdf:{line_of(text, '-0.01')}: U603" in err
-    assert "cannot repair it either" in err
+    p, client = pb
+    body = p.loadURDF(str(robot), physicsClientId=client)  # without the flag
+    index = {p.getJointInfo(body, i, physicsClientId=client)[12].decode(): i
+             for i in range(p.getNumJoints(body, physicsClientId=client))}
+    own = sorted(p.getDynamicsInfo(body, index["antenna"], physicsClientId=client)[2])
+    out = tmp_path / "a.xml"
+    data = export(robot, out)
+    assert data["repaired"] == ["antenna"]
+    (said,) = [n for n in notes(data, "repaired")]
+    assert said["line"] == line_of(text, "-0.01") and "URDF_USE_INERTIA_FROM_FILE is off" in \
+        said["message"]
+    m = mujoco.MjModel.from_xml_path(str(out))
+    assert sorted(np.linalg.eigvalsh(body_tensor(m, "antenna"))) == pytest.approx(own,
+                                                                                  rel=1e-9)
+    r = runner.invoke(app, ["agree", str(robot), str(out), "--json"])
+    assert r.exit_code == 0, r.output
+    rows = {x["check"]: x for x in json.loads(r.stdout)["rows"]}
+    assert rows["inertia PyBullet zeroes"]["status"] == "known"
 
 
 HINGE = """<robot name="h">

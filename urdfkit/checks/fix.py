@@ -628,7 +628,7 @@ class _Plan:
         ``tensor`` is in link axes; it is written in the frame of the inertial's ``<origin
         rpy>``. An existing ``<origin>`` is kept; ``com`` gives a new one.
         """
-        local, inertia_xml = _in_frame(tensor, frame)
+        local, inertia_xml = inertia_in_frame(tensor, frame)
         inertial = link.find("inertial")
         if inertial is None:
             lines = ["<inertial>"]
@@ -796,14 +796,17 @@ def _prepend(parent: etree._Element, new: etree._Element) -> None:
     new.tail, parent.text = parent.text, None
 
 
-def triangle_repair(link: etree._Element, report: RuleReport | None,
-                    mass: float) -> tuple[str, str] | None:
+def triangle_repair(link: etree._Element, report: RuleReport | None, mass: float,
+                    fallback: Sequence[Sequence[float]] | None = None) -> tuple[str, str] | None:
     """The ``<inertia>`` fix writes for a link whose inertia breaks the triangle inequality.
 
     U604's repair, as :meth:`_Plan._inertia` makes it: the tensor of the link's collision
     solid at its mass, in the frame of the inertial's ``<origin rpy>`` (kept), written with
     9 significant digits; for a link without a solid, every principal moment set to their
-    mean (MuJoCo's ``balanceinertia``, what ``fix --balance`` writes). Returns the element's
+    mean (MuJoCo's ``balanceinertia``, what ``fix --balance`` writes); for a tensor that cannot
+    be balanced either (not positive definite), ``fallback`` when given: the tensor (link axes)
+    PyBullet computes from the collision shapes' box without URDF_USE_INERTIA_FROM_FILE,
+    which export passes so that no robot PyBullet loads is a dead end. Returns the element's
     XML and how it was made, or None when fix has nothing to write. ``urdfkit export`` writes
     it where PyBullet zeroes such a tensor and MuJoCo would refuse the body it leaves.
     """
@@ -814,20 +817,24 @@ def triangle_repair(link: etree._Element, report: RuleReport | None,
     frame = _vec(origin, "rpy", 3, (0.0, 0.0, 0.0)) or (0.0, 0.0, 0.0)
     solid = link_solid(link, report)
     if solid is not None:
-        return (_in_frame(solid.inertia(mass), frame)[1], "the inertia of its collision shapes "
-                f"at its mass {fmt_float(mass, 6)} kg, as `urdfkit fix` writes it")
+        return (inertia_in_frame(solid.inertia(mass), frame)[1], "the inertia of its collision "
+                f"shapes at its mass {fmt_float(mass, 6)} kg, as `urdfkit fix` writes it")
     from urdfkit.checks.validate import _inertia_tensor
 
     inertia = inertial.find("inertia") if inertial is not None else None
     file_tensor = _inertia_tensor(inertia) if inertia is not None else None
     mean = balanced(file_tensor) if file_tensor is not None else None
+    if mean is None and fallback is not None:
+        return (inertia_in_frame(fallback, frame)[1], "the inertia PyBullet computes from the "
+                "box around its collision shapes when URDF_USE_INERTIA_FROM_FILE is off (fix "
+                "has no solid to derive one from, and the file's tensor cannot be balanced)")
     if mean is None:
         return None
     return (_inertia_xml(_iso(mean)), "every principal moment set to their mean (MuJoCo's "
             "balanceinertia; it has no collision solid), as `urdfkit fix --balance` writes it")
 
 
-def _in_frame(tensor: Sequence[Sequence[float]], frame: Sequence[float]
+def inertia_in_frame(tensor: Sequence[Sequence[float]], frame: Sequence[float]
               ) -> tuple[tuple[tuple[float, float, float], ...], str]:
     """A tensor in link axes, turned into the inertial's ``rpy`` frame, and its ``<inertia>``."""
     local = _rotate_tensor(transpose(rpy_to_matrix(frame)), tensor)

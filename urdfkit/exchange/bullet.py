@@ -50,7 +50,9 @@ def zeroed_repairs(resolved: Any, robot: Robot,
     properties"): the file gave one, PyBullet loaded none. For each such link: its
     mass properties as read from the link fix would write (mass and centre kept, the
     ``<inertia>`` of :func:`urdfkit.checks.fix.triangle_repair`), that ``<inertia>`` element,
-    and how it was made. A link fix cannot repair is left out.
+    and how it was made. Where fix has nothing to write (no collision solid, and a tensor
+    that cannot be balanced: reachy's ``r_antenna``, romeo's thighs), the tensor PyBullet
+    itself computes from the collision shapes' box without URDF_USE_INERTIA_FROM_FILE.
     """
     zeroed = [name for name, link in robot.links.items()
               if name in inertials and link.inertial.given and link.inertial.mass > 0
@@ -66,11 +68,16 @@ def zeroed_repairs(resolved: Any, robot: Robot,
     report = RuleReport(resolved.name, resolved.source.absolute().parent)
     elements = {el.get("name", ""): el for el in resolved.root.iterchildren("link")}
     out: dict[str, tuple[Inertial, str, str]] = {}
+    boxes: dict[str, Inertial] = {}
     for name in zeroed:
         given = robot.links[name].inertial
         if name not in elements:
             continue
         found = triangle_repair(elements[name], report, given.mass)
+        if found is None:  # PyBullet's own inertia without the file's, from the shapes' box
+            boxes = boxes or loaded_inertials(resolved, inertia_from_file=False)
+            found = triangle_repair(elements[name], report, given.mass,
+                                    boxes[name].tensor if name in boxes else None)
         if found is None:
             continue
         fixed = copy.deepcopy(elements[name])
