@@ -528,3 +528,42 @@ def test_forces_only_mujoco_applies_fail(kuka: Path, edit, said: str) -> None:
     code, data = _agree("kuka_iiwa/model.urdf", _tamper(kuka, "forces.xml", edit))
     assert code == 1
     assert _failing(data)["forces MuJoCo alone applies"].startswith(said)
+
+
+STRAY_CUBE = "".join(f"v {x} {y} {z}\n" for z in (-0.5, 0.5) for y, x in (
+    (-0.5, -0.5), (-0.5, 0.5), (0.5, 0.5), (0.5, -0.5))) + "v 5 5 5\n" + "".join(
+    f"f {a} {b} {c}\n" for a, b, c in ((1, 3, 2), (1, 4, 3), (5, 6, 7), (5, 7, 8), (1, 2, 6),
+                                       (1, 6, 5), (2, 3, 7), (2, 7, 6), (3, 4, 8), (3, 8, 7),
+                                       (4, 1, 5), (4, 5, 8)))
+
+
+def test_a_vertex_no_triangle_uses_is_left_out_and_caught(tmp_path: Path) -> None:
+    """PyBullet's hull of an OBJ leaves out a vertex no face uses (its box, read from raw
+    PyBullet, is the cube's); MuJoCo's takes it. export writes the used vertices only, and
+    agree fails the file that keeps the stray vertex."""
+    (tmp_path / "c.obj").write_text(STRAY_CUBE)
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r"><link name="a"><inertial><mass value="1"/><inertia '
+                    'ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial><collision>'
+                    '<geometry><mesh filename="c.obj"/></geometry></collision></link></robot>')
+    p = pybullet
+    c = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(str(urdf), physicsClientId=c)
+        assert max(p.getAABB(body, -1, physicsClientId=c)[1]) < 0.51
+    finally:
+        p.disconnect(c)
+    out = tmp_path / "r.xml"
+    _export(str(urdf), out)
+    m = mujoco.MjModel.from_xml_path(str(out))
+    assert int(m.mesh_vertnum[0]) == 8
+    code, data = _agree(str(urdf), out)
+    assert code == 0, _failing(data)
+    # the same MJCF with the file as it was: MuJoCo's hull reaches 5 5 5
+    doc = etree.parse(str(out))
+    mesh = doc.find(".//asset/mesh")
+    (tmp_path / "r_assets" / "c.obj").write_text(STRAY_CUBE)
+    mesh.set("file", "c.obj")
+    doc.write(str(out))
+    code, data = _agree(str(urdf), out)
+    assert code == 1 and _failing(data)["collision meshes"] == "a (mesh)"

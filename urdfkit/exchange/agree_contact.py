@@ -88,8 +88,11 @@ def _mesh_points(path: str, scale: tuple[float, ...]) -> Any:
     if key not in _MESH_BOXES:
         found = read_triangles(Path(path))
         pts = None
-        if found is not None and len(found[0]):
-            pts = np.asarray(found[0], dtype=float) * np.array(scale)
+        if found is not None and len(found[1]):
+            # the vertices its triangles use: a COLLADA file's arrays may hold more (tiago's
+            # torso_lift_collision_*.dae hold the same 154, each file's triangles 16 to 74)
+            used = np.unique(np.asarray(found[1]))
+            pts = np.asarray(found[0], dtype=float)[used] * np.array(scale)
             pts = pts[np.isfinite(pts).all(axis=1)]
         _MESH_BOXES[key] = pts if pts is not None and len(pts) else None
     return _MESH_BOXES[key]
@@ -220,25 +223,30 @@ def _extent(s: Shape) -> float:
 def compare(pb_shapes: list[Shape], geoms: list[tuple[int, Shape]], body_weld: Any,
             image: dict[str, int], names: dict[int, str], on_world: Any = None
             ) -> tuple[list[tuple[Shape, int, float]], list[str], list[str]]:
-    """Pair each PyBullet shape with the nearest MuJoCo geom: (pairs, missing, extra)."""
-    used: set[int] = set()
-    pairs: list[tuple[Shape, int, float]] = []
-    missing: list[str] = []
-    for s in pb_shapes:
-        best, at = math.inf, -1
+    """Pair each PyBullet shape with the nearest MuJoCo geom: (pairs, missing, extra).
+
+    Nearest first over all candidate pairs (same kind, same welded body), so that a link with
+    several meshes (tiago's torso_lift_link: three) does not give its first shape a
+    neighbour's geom.
+    """
+    options = []
+    for i, s in enumerate(pb_shapes):
         for g, t in geoms:
-            if g in used or t.kind != s.kind:
+            if t.kind != s.kind:
                 continue
             if s.group in image and int(body_weld(g)) != image[s.group]:
                 continue
-            e = distance(s, t)
-            if e < best:
-                best, at = e, g
-        if at < 0:
-            missing.append(f"{s.link} ({s.kind})")
+            options.append((distance(s, t), i, g))
+    options.sort(key=lambda x: (x[0], x[1], x[2]))
+    used: set[int] = set()
+    paired: dict[int, tuple[int, float]] = {}
+    for e, i, g in options:
+        if i in paired or g in used:
             continue
-        used.add(at)
-        pairs.append((s, at, best))
+        paired[i] = (g, e)
+        used.add(g)
+    pairs = [(s, paired[i][0], paired[i][1]) for i, s in enumerate(pb_shapes) if i in paired]
+    missing = [f"{s.link} ({s.kind})" for i, s in enumerate(pb_shapes) if i not in paired]
     # the world's own geoms that no shape of the URDF's `world` link took: a ground, scenery
     extra = [f"{names.get(g, g)} ({t.kind})" for g, t in geoms
              if g not in used and not (on_world and on_world(g))]

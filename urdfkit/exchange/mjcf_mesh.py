@@ -83,12 +83,15 @@ def mesh_asset(path: Path) -> MeshAsset | str:
         return (f"none of its {len(faces)} triangle(s) has finite vertices (as MuJoCo's floats) "
                 "and vertex indices in range")
     binary = suffix == ".stl" and 84 + 50 * _stl_count(data) == len(data)
-    copy = bool(sound.all()) and (
+    # vertices no triangle uses: PyBullet's collision hull leaves them out, MuJoCo's takes
+    # them (an OBJ cube with one stray vertex at 5 5 5: PyBullet's box 0.5, MuJoCo's 5)
+    stray = len(vertices) - len(np.unique(faces[sound]))
+    copy = bool(sound.all()) and not stray and (
         (binary and len(faces) <= STL_MAX_FACES)
         or (suffix == ".obj" and obj_normals_complete(data)))
     if copy:
         return MeshAsset(path, suffix, hashlib.sha256(data).hexdigest(), vertices, faces)
-    why = _why_converted(suffix, binary, len(faces), int(sound.sum()), data)
+    why = _why_converted(suffix, binary, len(faces), int(sound.sum()), data, stray)
     used = faces[sound]
     keep = np.unique(used)
     vertices, faces = vertices[keep], np.searchsorted(keep, used)
@@ -115,7 +118,8 @@ def _sound(vertices: Any, faces: Any) -> Any:
     return ok
 
 
-def _why_converted(suffix: str, binary: bool, faces: int, sound: int, data: bytes) -> str:
+def _why_converted(suffix: str, binary: bool, faces: int, sound: int, data: bytes,
+                   stray: int = 0) -> str:
     """Why a mesh is not copied as it is (the start of its note)."""
     from urdfkit.sources.meshes import obj_normals_complete
 
@@ -130,6 +134,9 @@ def _why_converted(suffix: str, binary: bool, faces: int, sound: int, data: byte
     if suffix == ".obj" and sound == faces and not obj_normals_complete(data):
         reasons.append("an OBJ whose faces do not all name one of its normals, which MuJoCo "
                        "refuses; normals and UVs dropped (MuJoCo computes its own normals)")
+    if stray and suffix != ".dae":
+        reasons.append(f"{stray} vertices no triangle uses, which MuJoCo's collision hull "
+                       "would take and PyBullet's does not; left out")
     if binary and faces > STL_MAX_FACES:
         reasons.append(f"a binary STL of {faces} faces, over the {STL_MAX_FACES} MuJoCo reads "
                        "from one")
