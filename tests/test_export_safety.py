@@ -389,7 +389,7 @@ def test_a_zeroed_tensor_fix_cannot_repair_gets_pybullets_own_from_the_shapes(
     r = runner.invoke(app, ["agree", str(robot), str(out), "--json"])
     assert r.exit_code == 0, r.output
     rows = {x["check"]: x for x in json.loads(r.stdout)["rows"]}
-    assert rows["inertia PyBullet zeroes"]["status"] == "known"
+    assert rows["inertia MuJoCo cannot take"]["status"] == "known"
 
 
 HINGE = """<robot name="h">

@@ -634,10 +634,10 @@ class _Compare:
                     "to its body's as the body's (body_sameframe) and simulates the tensor "
                     "so turned; the inertia row compares the MJCF's own", status="known")
         if self.repaired:
-            res.add("structure", "inertia PyBullet zeroes", float(len(self.repaired)), None,
-                    "known", f"{', '.join(self.repaired[:4])}: the file's tensor breaks the "
-                    "triangle inequality, "
-                    "PyBullet sets it to zero and MuJoCo refuses a moving body without one; "
+            res.add("structure", "inertia MuJoCo cannot take", float(len(self.repaired)), None,
+                    "known", f"{', '.join(self.repaired[:4])}: PyBullet simulates a singular "
+                    "tensor here (zero where the file's breaks the triangle inequality) and "
+                    "MuJoCo refuses a moving body without one; "
                     "their bodies' inertia tensors (not their masses or centres of mass), "
                     "the dynamics and the swing are not compared",
                     status="known")
@@ -704,19 +704,23 @@ class _Compare:
                 f"{' ...' if len(made) > 3 else ''}) weigh PyBullet's default 1 kg each")
 
     def zeroed_inertia(self) -> list[str]:
-        """Moving links whose file inertia PyBullet zeroed (it breaks the triangle inequality)."""
+        """Moving links PyBullet simulates with a singular tensor.
+
+        A principal moment under MuJoCo's 1e-15: zeroed where the file's breaks the triangle
+        inequality, or so in the file (laikago's chassis). MuJoCo refuses a moving body
+        without inertia.
+        """
+        import numpy as np
+
         if not self.o.inertia_from_file:
             return []
         out = []
         where = fused(self.robot)
         for n, link in self.robot.links.items():
-            given = link.inertial
-            if not given.given or given.mass <= 0 or n not in self.pb.link_index:
+            if not link.inertial.given or link.inertial.mass <= 0 or n not in self.pb.link_index:
                 continue
-            if not any(given.tensor[k][k] for k in range(3)):
-                continue
-            loaded = self.pb.inertial(n).tensor
-            if any(loaded[k][k] for k in range(3)):
+            loaded = np.array(self.pb.inertial(n).tensor)
+            if not np.isfinite(loaded).all() or np.linalg.eigvalsh(loaded)[0] > 1e-15:
                 continue
             group = where[n][0]
             if group != self.robot.root or (not self.o.fixed_base
@@ -921,7 +925,7 @@ class _Compare:
         refused: str | None = None  # the PyBullet call that failed on this model
         zeroed = self.repaired
         if dyn and zeroed:
-            refused = f"model zeroes the inertia of {', '.join(zeroed[:3])} (see the " \
+            refused = f"model has a singular inertia on {', '.join(zeroed[:3])} (see the " \
                 "structure rows)"
         d_contact = mj.MjData(m)
         tol = pybullet_frame_tolerances(robot)
@@ -1044,7 +1048,8 @@ class _Compare:
             return "not compared: " + unreadable_state(self.pb.info), "known"
         zeroed = self.repaired
         if zeroed:
-            return (f"not compared: PyBullet zeroes the inertia of {', '.join(zeroed[:3])} "
+            return (f"not compared: PyBullet simulates a singular inertia on "
+                    f"{', '.join(zeroed[:3])} "
                     "(see the structure rows)", "known")
         return None
 

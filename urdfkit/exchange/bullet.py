@@ -42,22 +42,35 @@ def loaded_inertials(resolved: Any, *, inertia_from_file: bool) -> dict[str, Ine
     return out
 
 
-def zeroed_repairs(resolved: Any, robot: Robot,
-                   inertials: dict[str, Inertial]) -> dict[str, tuple[Inertial, str, str]]:
-    """The links whose file tensor PyBullet zeroed, each with what ``urdfkit fix`` writes.
+def zeroed_repairs(resolved: Any, robot: Robot, inertials: dict[str, Inertial]
+                   ) -> dict[str, tuple[Inertial, str, str, str]]:
+    """The links PyBullet simulates with a singular tensor, each with what ``fix`` writes.
 
     PyBullet sets a tensor that breaks the triangle inequality to zero ("Bad inertia tensor
-    properties"): the file gave one, PyBullet loaded none. For each such link: its
+    properties"): the file gave one, PyBullet loaded none; and a file may give a singular one
+    itself (laikago's chassis: 0 0 0; biped2d's y_prismatic: a moment of 5e-18), which
+    PyBullet loads as it is. MuJoCo refuses either on a moving body. For each such link: its
     mass properties as read from the link fix would write (mass and centre kept, the
     ``<inertia>`` of :func:`urdfkit.checks.fix.triangle_repair`), that ``<inertia>`` element,
     and how it was made. Where fix has nothing to write (no collision solid, and a tensor
     that cannot be balanced: reachy's ``r_antenna``, romeo's thighs), the tensor PyBullet
     itself computes from the collision shapes' box without URDF_USE_INERTIA_FROM_FILE.
     """
-    zeroed = [name for name, link in robot.links.items()
-              if name in inertials and link.inertial.given and link.inertial.mass > 0
-              and not any(inertials[name].tensor[k][k] for k in range(3))
-              and any(link.inertial.tensor[k][k] for k in range(3))]
+    import numpy as np
+
+    zeroed = {}
+    for name, link in robot.links.items():
+        if name not in inertials or not link.inertial.given or not link.inertial.mass > 0:
+            continue
+        loaded = np.array(inertials[name].tensor)
+        if not np.isfinite(loaded).all() or np.linalg.eigvalsh(loaded)[0] > 1e-15:
+            continue  # mjMINVAL: MuJoCo's floor for a moving body's principal moments
+        if not loaded.any() and any(link.inertial.tensor[k][k] for k in range(3)):
+            zeroed[name] = "a zero tensor: the file's breaks the triangle inequality, and " \
+                "PyBullet zeroes it"
+        else:
+            moments = ", ".join(f"{x:.3g}" for x in np.linalg.eigvalsh(loaded))
+            zeroed[name] = f"the file's singular tensor (principal moments {moments})"
     if not zeroed:
         return {}
     from lxml import etree
@@ -67,7 +80,7 @@ def zeroed_repairs(resolved: Any, robot: Robot,
 
     report = RuleReport(resolved.name, resolved.source.absolute().parent)
     elements = {el.get("name", ""): el for el in resolved.root.iterchildren("link")}
-    out: dict[str, tuple[Inertial, str, str]] = {}
+    out: dict[str, tuple[Inertial, str, str, str]] = {}
     boxes: dict[str, Inertial] = {}
     for name in zeroed:
         given = robot.links[name].inertial
@@ -85,5 +98,5 @@ def zeroed_repairs(resolved: Any, robot: Robot,
         inertial.replace(inertial.find("inertia"), etree.fromstring(found[0]))
         repaired = read_inertial(fixed)
         repaired.line = given.line
-        out[name] = (repaired, found[0], found[1])
+        out[name] = (repaired, found[0], found[1], zeroed[name])
     return out

@@ -51,9 +51,9 @@ class ExportOptions:
             sweeps, which leave it up to ~1e-8 relative from the file's (panda_link1: 8.2e-9).
         inertia_from_shapes: Those are PyBullet's recomputation from the collision shapes
             (no notes about links without ``<inertial>``).
-        repairs: For each link whose file tensor PyBullet zeroed (it breaks the triangle
-            inequality), what ``urdfkit fix`` writes for it: its mass properties, the
-            ``<inertia>`` element and how it was made
+        repairs: For each link PyBullet simulates with a singular tensor (zeroed for breaking
+            the triangle inequality, or so in the file), what ``urdfkit fix`` writes for it:
+            its mass properties, the ``<inertia>`` element, how it was made and why
             (:func:`urdfkit.exchange.bullet.zeroed_repairs`). Written only where the zero
             would leave a moving body MuJoCo refuses; each such link is said and listed.
     """
@@ -65,7 +65,7 @@ class ExportOptions:
     ground: bool = False
     inertials: dict[str, Inertial] | None = None
     inertia_from_shapes: bool = False
-    repairs: dict[str, tuple[Inertial, str, str]] | None = None
+    repairs: dict[str, tuple[Inertial, str, str, str]] | None = None
 
 
 @dataclass
@@ -489,12 +489,12 @@ class _Writer:
             return m
         assert self.o.repairs is not None
         for n in fixable:
-            inertial, xml, how = self.o.repairs[n]
+            inertial, xml, how, why = self.o.repairs[n]
             self.repaired.append(n)
-            self.note("repaired", f"link {n!r}: its inertia breaks the triangle inequality; "
-                      f"PyBullet zeroes it, which leaves the moving body {name!r} without the "
-                      f"inertia MuJoCo requires, so written instead: {xml}, {how}. agree "
-                      "lists this link's rows as a known difference", inertial.line)
+            self.note("repaired", f"link {n!r}: PyBullet simulates it with {why}, which "
+                      f"leaves the moving body {name!r} without the inertia MuJoCo "
+                      f"requires, so written instead: {xml}, {how}. agree lists this link's "
+                      "rows as a known difference", inertial.line)
         return mass()
 
     def check_mass(self, name: str, m: _Mass, moving: bool) -> None:

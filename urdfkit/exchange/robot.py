@@ -151,12 +151,32 @@ class Robot:
 #: 0.3), and takes the first three (checks/collisions.py reads them the same way, measured).
 _ATOF = re.compile(r"[+-]?(?:inf(?:inity)?|nan|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)", re.I)
 #: Vectors read PyBullet's way that were not plain numbers: (element, attribute, values).
-_ODD: list[tuple[Any, str, Vec]] = []
+_ODD: list[tuple[Any, str, tuple[float, ...]]] = []
 
 
 def _atof(token: str) -> float:
     match = _ATOF.match(token)
     return float(match.group()) if match else 0.0
+
+
+def _scalar(el: Any, attr: str, default: float) -> float:
+    """One number as PyBullet reads it: a plain one, else C's atof of the text.
+
+    biped2d_pybullet's ``lower="-1.57."`` is -1.57 to PyBullet (its getJointInfo): read as
+    the default 0 it exported a range of 0 to 1.57. A bound that is not finite stays the
+    default here (:attr:`Joint.odd_limit` says it).
+    """
+    x = attr_float(el, attr, None)
+    if x is not None:
+        return x
+    text = el.get(attr) if el is not None else None
+    if text is None:
+        return default
+    value = _atof(text.strip())
+    if not math.isfinite(value):
+        return default
+    _ODD.append((el, attr, (value,)))
+    return value
 
 
 def _vec3(el: Any, attr: str, default: Vec = (0.0, 0.0, 0.0)) -> Vec:
@@ -280,9 +300,8 @@ def _joint(el: Any) -> Joint:
     axis = _vec3(el.find("axis"), "xyz", (1.0, 0.0, 0.0))
     limit = el.find("limit")
     # PyBullet's defaults when <limit> leaves them out: lower 0, upper -1 (unlimited; measured)
-    lower = attr_float(limit, "lower", 0.0) or 0.0
-    upper = attr_float(limit, "upper", -1.0)
-    upper = -1.0 if upper is None else upper
+    lower = _scalar(limit, "lower", 0.0)
+    upper = _scalar(limit, "upper", -1.0)
     if kind == "continuous":
         limited, lower, upper = False, 0.0, -1.0
     else:
@@ -298,9 +317,9 @@ def _joint(el: Any) -> Joint:
     return Joint(
         el.get("name", ""), kind, el.find("parent").get("link", ""),
         el.find("child").get("link", ""), _vec3(origin, "xyz"), _vec3(origin, "rpy"), axis,
-        limited, lower, upper, attr_float(limit, "effort", 0.0) or 0.0,
-        attr_float(limit, "velocity", 0.0) or 0.0, attr_float(dyn, "damping", 0.0) or 0.0,
-        attr_float(dyn, "friction", 0.0) or 0.0, mimic, declared, line_of(el),
+        limited, lower, upper, _scalar(limit, "effort", 0.0), _scalar(limit, "velocity", 0.0),
+        _scalar(dyn, "damping", 0.0), _scalar(dyn, "friction", 0.0), mimic, declared,
+        line_of(el),
         " ".join(odd) if kind in ("revolute", "prismatic") else "")
 
 
