@@ -567,3 +567,36 @@ def test_a_vertex_no_triangle_uses_is_left_out_and_caught(tmp_path: Path) -> Non
     doc.write(str(out))
     code, data = _agree(str(urdf), out)
     assert code == 1 and _failing(data)["collision meshes"] == "a (mesh)"
+
+
+@pytest.mark.parametrize("robot", ["laikago/laikago.urdf", "biped/biped2d_pybullet.urdf"])
+def test_a_singular_tensor_in_the_file_exports_and_agrees(tmp_path: Path, robot: str) -> None:
+    """laikago's legs have inertia 0 0 0 in the file, biped2d's a moment of 5e-18 (read here
+    from raw PyBullet, which simulates them so); biped2d's `lower="-1.57."` PyBullet reads
+    as -1.57. Both were refused; now each exports and agrees on every row it can compare."""
+    import pybullet_data
+
+    p = pybullet
+    c = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(f"{pybullet_data.getDataPath()}/{robot}",
+                          flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=c)
+        singular = [i for i in range(-1, p.getNumJoints(body, physicsClientId=c))
+                    if min(p.getDynamicsInfo(body, i, physicsClientId=c)[2]) <= 1e-15
+                    and p.getDynamicsInfo(body, i, physicsClientId=c)[0] > 0]
+        limits = {p.getJointInfo(body, i, physicsClientId=c)[1].decode():
+                  p.getJointInfo(body, i, physicsClientId=c)[8:10]
+                  for i in range(p.getNumJoints(body, physicsClientId=c))}
+    finally:
+        p.disconnect(c)
+    assert singular
+    out = tmp_path / "robot.xml"
+    _export(robot, out)
+    m = mujoco.MjModel.from_xml_path(str(out))
+    for name, (lo, hi) in limits.items():
+        k = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+        if k >= 0 and m.jnt_limited[k]:
+            assert tuple(m.jnt_range[k]) == (lo, hi), name
+    code, data = _agree(robot, out)
+    assert code == 0, _failing(data)
+    assert _rows(data)["inertia MuJoCo cannot take"]["status"] == "known"
