@@ -413,3 +413,31 @@ def test_a_real_gap_stays_open(tmp_path: Path, how: str) -> None:
         else _stl_box(tmp_path / "open.stl", size, drop=3)
     props = meshstore.properties(path)
     assert props is not None and not props.closed
+
+
+def test_dae_geometries_that_repeat_their_ids_keep_their_own_points(tmp_path: Path,
+                                                                      pb) -> None:
+    """Files exported geometry by geometry repeat the same source ids in each (jaxon's
+    LLEG_LINK3.dae: eight "geo0.positions"): PyBullet reads each geometry's own points; the
+    document-wide id put both boxes here on the second's points (its box was 1 x 1 x 1 m)."""
+    one = box_dae(unit=0.001)
+    # a second geometry with the same source ids, 1 m along x, in a second node
+    geo = one[one.index("<geometry id=\"box\">"):one.index("</geometry>") + len("</geometry>")]
+    far = geo.replace('id="box"', 'id="box2"')
+    corners = far[far.index('count="24">') + 11:far.index("</float_array>")]
+    moved = " ".join(str(float(v) + (1000.0 if k % 3 == 0 else 0.0))
+                     for k, v in enumerate(corners.split()))
+    far = far.replace(corners, moved)
+    text = one.replace("</library_geometries>", far + "</library_geometries>").replace(
+        '<node id="n"><instance_geometry url="#box"/></node>',
+        '<node id="n"><instance_geometry url="#box"/></node>'
+        '<node id="m"><instance_geometry url="#box2"/></node>')
+    path = tmp_path / "two.dae"
+    path.write_text(text)
+    vertices, faces = meshes._dae(path.read_bytes(), path)
+    used = vertices[np.unique(faces)]
+    p, client = pb
+    lo, hi = (np.array(v) for v in pybullet_aabb(p, client, path, tmp_path))
+    assert used.min(axis=0) == pytest.approx(lo + 0.002, abs=1e-6)
+    assert used.max(axis=0) == pytest.approx(hi - 0.002, abs=1e-6)
+    assert hi[0] - lo[0] == pytest.approx(1.1 + 0.004, abs=1e-6)  # both boxes, 1 m apart

@@ -25,6 +25,10 @@ from typing import Any
 TOL_SHAPE = 1e-9
 #: Mesh boxes, relative to the mesh's size (MuJoCo stores vertices in float32).
 TOL_MESH = 1e-6
+#: PyBullet's own collision vertices (getMeshData) against MuJoCo's: the hull Bullet builds
+#: puts its points up to 4.9e-5 of the mesh's size off the file's (tiago's base_link;
+#: kuka_iiwa's link_3 1.3e-5, r2d2's right_tip 5.6e-6), measured; its cause not traced.
+TOL_BULLET_HULL = 1e-4
 TOL_FRICTION = 1e-12
 #: PyBullet's geometry codes (GEOM_*) -> MuJoCo's geom type names.
 _PB_KIND = {2: "sphere", 3: "box", 4: "cylinder", 5: "mesh", 6: "plane", 7: "capsule"}
@@ -49,6 +53,7 @@ class Verdict:
 
     shape_error: tuple[float, str] | None    # None: no primitive on either side
     mesh_error: tuple[float, str] | None
+    hull_error: tuple[float, str] | None     # PyBullet's own mesh data vs MuJoCo's
     missing: list[str]
     extra: list[str]
     skipped: list[str]
@@ -79,21 +84,24 @@ _MESH_BOXES: dict[tuple[str, tuple[float, ...]], Any] = {}
 
 
 def _mesh_points(path: str, scale: tuple[float, ...]) -> Any:
-    """A mesh's vertices as PyBullet places them (urdfkit's readers), scaled; None if none."""
+    """A mesh's vertices as PyBullet places them, scaled; None if none.
+
+    Read as export reads it (:func:`urdfkit.exchange.mjcf_mesh.mesh_asset`: the triangles
+    MuJoCo can take), and only the vertices those triangles use: a COLLADA file's arrays may
+    hold more (tiago's torso_lift_collision_*.dae hold the same 154, each file's triangles 16
+    to 74), and PyBullet's hull leaves out an OBJ's stray vertex.
+    """
     import numpy as np
 
-    from urdfkit.sources.meshes import read_triangles
+    from urdfkit.exchange.mjcf_mesh import mesh_asset
 
     key = (path, scale)
     if key not in _MESH_BOXES:
-        found = read_triangles(Path(path))
+        asset = mesh_asset(Path(path))
         pts = None
-        if found is not None and len(found[1]):
-            # the vertices its triangles use: a COLLADA file's arrays may hold more (tiago's
-            # torso_lift_collision_*.dae hold the same 154, each file's triangles 16 to 74)
-            used = np.unique(np.asarray(found[1]))
-            pts = np.asarray(found[0], dtype=float)[used] * np.array(scale)
-            pts = pts[np.isfinite(pts).all(axis=1)]
+        if not isinstance(asset, str) and len(asset.faces):
+            used = np.unique(np.asarray(asset.faces))
+            pts = np.asarray(asset.vertices, dtype=float)[used] * np.array(scale)
         _MESH_BOXES[key] = pts if pts is not None and len(pts) else None
     return _MESH_BOXES[key]
 
@@ -149,6 +157,55 @@ def pybullet_shapes(b: Any, body: int, link_index: dict[str, int], zero: dict[st
                 box = (world.min(axis=0), world.max(axis=0))
             shapes.append(Shape(link, kind, size, frame, box, group[link]))
     return shapes, skipped
+
+
+def pybullet_mesh_boxes(b: Any, body: int, link_index: dict[str, int], zero: dict[str, Any],
+                        shapes: list[Shape], skipped: list[str]) -> dict[str, Any]:
+    """PyBullet's own vertices of each link whose collision shapes are all meshes, as a box.
+
+    ``getMeshData(body, link, -1)`` gives every collision vertex PyBullet keeps for a link, in
+    its inertial frame (measured: it matches the files' placed vertices exactly, and leaves out
+    an OBJ's stray vertex): a check of urdfkit's mesh reading by PyBullet itself.
+    """
+    import numpy as np
+
+    kinds: dict[str, set[str]] = {}
+    for sh in shapes:
+        kinds.setdefault(sh.link, set()).add(sh.kind)
+    out = {}
+    for link, k in kinds.items():
+        if k != {"mesh"} or any(x.startswith(f"{link}: ") for x in skipped):
+            continue
+        try:
+            n, vertices = b.getMeshData(body, link_index[link], -1)
+        except Exception:  # noqa: BLE001 - PyBullet raises plain errors; no data, no box
+            continue
+        if not n:
+            continue
+        d = b.getDynamicsInfo(body, link_index[link])
+        at = zero[link] @ _transform(d[3], d[4])
+        world = np.asarray(vertices, dtype=float) @ at[:3, :3].T + at[:3, 3]
+        out[link] = (world.min(axis=0), world.max(axis=0))
+    return out
+
+
+def _union_errors(pairs: list[tuple[Shape, int, float]], geoms: list[tuple[int, Shape]],
+                  boxes: dict[str, Any]) -> list[tuple[float, str]]:
+    """Each link's PyBullet mesh box against the box of the MuJoCo geoms paired with it."""
+    import numpy as np
+
+    by_geom = dict(geoms)
+    errors = []
+    for link, (lo, hi) in boxes.items():
+        mine = [by_geom[g].box for sh, g, _ in pairs if sh.link == link]
+        if not mine:
+            continue
+        mlo = np.min([b[0] for b in mine], axis=0)
+        mhi = np.max([b[1] for b in mine], axis=0)
+        scale = max(1.0, float(np.abs(np.concatenate((lo, hi))).max()))
+        errors.append((max(float(np.abs(mlo - lo).max()), float(np.abs(mhi - hi).max()))
+                       / scale, link))
+    return errors
 
 
 def mujoco_geoms(mj: Any, m: Any, d: Any, keep_world: bool) -> list[tuple[int, Shape]]:
@@ -308,7 +365,10 @@ def collision_verdict(mj: Any, m: Any, b: Any, body: int, link_index: dict[str, 
         lambda g: int(m.geom_bodyid[g]) == 0)
     prim = [(e, f"{s.link} ({s.kind})") for s, _, e in pairs if s.kind != "mesh"]
     mesh = [(e / _extent(s), f"{s.link} ({s.kind})") for s, _, e in pairs if s.kind == "mesh"]
+    hull = _union_errors(pairs, geoms, pybullet_mesh_boxes(b, body, link_index, zero, shapes,
+                                                           skipped))
     return Verdict(max(prim, key=lambda x: x[0]) if prim else None,
-                   max(mesh, key=lambda x: x[0]) if mesh else None, missing, extra, skipped,
+                   max(mesh, key=lambda x: x[0]) if mesh else None,
+                   max(hull, key=lambda x: x[0]) if hull else None, missing, extra, skipped,
                    contact_errors(b, body, link_index, m, pairs, names), len(pairs),
                    len({s.link for s in shapes}))

@@ -335,7 +335,14 @@ class _Collada:
             raise ValueError("not a mesh")
         verts = mesh.find("{*}vertices")
         position = next(i for i in verts.iterfind("{*}input") if i.get("semantic") == "POSITION")
-        source = self.ref(position.get("source"))
+        # a source of this <mesh> first: files exported geometry by geometry repeat the same
+        # ids in each (jaxon's LLEG_LINK3.dae: eight "geo0.positions"), and PyBullet reads each
+        # geometry's own; the document's last one put every geometry on one part's points
+        wanted = (position.get("source") or "").lstrip("#")
+        source = next((el for el in mesh.iterfind("{*}source") if el.get("id") == wanted),
+                      None)
+        if source is None:
+            source = self.ref(position.get("source"))
         accessor = source.find("{*}technique_common/{*}accessor")
         stride = int(accessor.get("stride", "3")) if accessor is not None else 3
         points = self.numbers(source.find("{*}float_array")).reshape(-1, stride)[:, :3]

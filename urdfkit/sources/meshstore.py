@@ -46,7 +46,8 @@ _CACHE_DIRS: dict[tuple[str | None, ...], Path | None] = {}
 #: a stored value would come out differently, or entries written before go on being read. The
 #: hull-volume convexity test (issue 41) changed depths without a bump: a cache filled before it
 #: gave pr2's l_finger_collision.stl a depth of 0.0972 m where a cold run says 0.0501 m.
-_FOLDER = "meshes-6"
+#: meshes-7: a COLLADA geometry reads its own sources first (jaxon's repeated ids, issue 48).
+_FOLDER = "meshes-7"
 _MEMORY: dict[str, Integrals | None] = {}
 _MISSING = object()
 
@@ -102,7 +103,7 @@ def stated(name: str, st: os.stat_result,
 # pack entry is keyed like any entry (path, size, mtime, inode), so an edited mesh misses it
 # and is looked up as before; a pack that is damaged in any byte is ignored whole.
 
-_PACKS = "mesh-packs-3"
+_PACKS = "mesh-packs-4"
 _PACK_MAGIC = b"MP2\n"
 #: Each pack entry: its key's length, its entry's length; then the two.
 _PACK_HEAD = struct.Struct("<IH")
