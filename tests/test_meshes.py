@@ -133,7 +133,7 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     path = tmp_path / "box.obj"
     path.write_text(box_obj((1.0, 2.0, 3.0)))
     check_box(meshstore.properties(path), (1.0, 2.0, 3.0))
-    entries = list((tmp_path / "cache" / "meshes-6").iterdir())
+    entries = list((tmp_path / "cache" / meshstore._FOLDER).iterdir())
     assert len(entries) == 1
     # A new process (empty memory) reads the entry, not the mesh.
     monkeypatch.setattr(meshstore, "_MEMORY", {})
@@ -151,11 +151,11 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     os.utime(path, ns=(1, 1))
     check_box(meshstore.properties(path), (3.0, 2.0, 1.0))
     # A damaged entry is read past and rewritten.
-    for entry in (tmp_path / "cache" / "meshes-6").iterdir():
+    for entry in (tmp_path / "cache" / meshstore._FOLDER).iterdir():
         entry.write_bytes(b"garbage")
     monkeypatch.setattr(meshstore, "_MEMORY", {})
     check_box(meshstore.properties(path), (3.0, 2.0, 1.0))
-    good = [e for e in (tmp_path / "cache" / "meshes-6").iterdir()
+    good = [e for e in (tmp_path / "cache" / meshstore._FOLDER).iterdir()
             if e.read_bytes().startswith(b"M5")]
     assert len(good) == 1  # the current key's, rewritten (the first box's stays unused)
 
@@ -271,10 +271,10 @@ def test_a_run_s_pack_serves_the_next_run_and_follows_edits(
     _robot_with_box(folder, (1.0, 2.0, 3.0))
     _new_process(monkeypatch)
     check_paths([folder], jobs=1, cache=False)
-    packs = list((tmp_path / "cache" / "mesh-packs-3").iterdir())
+    packs = list((tmp_path / "cache" / meshstore._PACKS).iterdir())
     assert len(packs) == 1
     # The next run reads the pack alone: no entry file, no mesh.
-    for entry in (tmp_path / "cache" / "meshes-6").iterdir():
+    for entry in (tmp_path / "cache" / meshstore._FOLDER).iterdir():
         entry.unlink()
     _new_process(monkeypatch)
 
@@ -302,7 +302,7 @@ def test_a_damaged_pack_is_ignored_whole(tmp_path: Path,
     _robot_with_box(folder, (1.0, 2.0, 3.0))
     _new_process(monkeypatch)
     check_paths([folder], jobs=1, cache=False)
-    (pack,) = (tmp_path / "cache" / "mesh-packs-3").iterdir()
+    (pack,) = (tmp_path / "cache" / meshstore._PACKS).iterdir()
     good = pack.read_bytes()
     for damaged in (good[:-1], good[:20] + bytes([good[20] ^ 1]) + good[21:], b"MP1\n",
                     b"garbage"):
@@ -320,7 +320,7 @@ def test_packs_are_capped(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
         _new_process(monkeypatch)
         meshstore.properties(folder / "box.obj")
         assert meshstore.save_pack([str(folder), f"run{n}"])
-    assert len(list((tmp_path / "cache" / "mesh-packs-3").iterdir())) == 3
+    assert len(list((tmp_path / "cache" / meshstore._PACKS).iterdir())) == 3
     _new_process(monkeypatch)
     meshstore.properties(folder / "box.obj")
     assert meshstore.load_pack([str(folder), "run5"]) == 1
