@@ -765,7 +765,7 @@ class _Compare:
         if v.hull_error is not None:
             res.add("contacts", "collision meshes vs PyBullet's own vertices",
                     v.hull_error[0], TOL_BULLET_HULL, "relative", f"{v.hull_error[1]} "
-                    "(getMeshData: Bullet's hull points lie up to ~5e-5 off the file's, measured)")
+                    "(getMeshData: Bullet's hull points lie up to ~2e-4 off the file's, measured)")
         res.add("contacts", "contact parameters", float(len(v.contact)), 0.0, "links",
                 "; ".join(v.contact[:2]) + (" ..." if len(v.contact) > 2 else "")
                 or f"friction, condim, priority of {v.pairs} geoms")
