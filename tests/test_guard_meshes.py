@@ -327,3 +327,22 @@ def test_sound_meshes_are_scanned_without_numpy(tmp_path: Path) -> None:
                            "--json"], capture_output=True, text=True, timeout=60)
     assert done.stdout.split()[-3:] == ["EXIT", "0", "True"]  # the scan found it, and read it
     assert "mix NaN with numbers" in done.stderr and "not needed to read the tree" in done.stderr
+
+
+def test_build_writes_no_urdf_whose_mesh_pybullet_crashes_on(tmp_path: Path,
+                                                             monkeypatch: pytest.MonkeyPatch
+                                                             ) -> None:
+    # build writes what PyBullet loads; a mesh it crashes on is refused as a missing one is
+    # (exit 1, nothing written), by the same rule.
+    monkeypatch.chdir(tmp_path)
+    for code in ("U712", "U713"):
+        case = next(c for c in REFUSED if c.code == code)
+        folder = tmp_path / code
+        urdf = write(folder, case)
+        source = folder / "robot.urdf.xacro"
+        source.write_text(urdf.read_text().replace(
+            '<robot name="r">', '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'))
+        result = CliRunner().invoke(app, ["build", str(source), "-o", str(folder / "out.urdf")])
+        assert result.exit_code == 1, result.output
+        assert f"({case.code}); nothing written" in result.output
+        assert not (folder / "out.urdf").exists()
