@@ -161,6 +161,12 @@ CASES = [
                                 '<visual><geometry><box size="1 1 1"/></geometry>'
                                 '<material name="m">\n<color rgba="0 1 0 1"/><!--HERE-->\n'
                                 '</material></visual>'))),
+    ("U712", doc(link("a", body=f'<visual><geometry>\n<mesh filename='
+                                f'"{MESHES / "no_asset.dae"}"/><!--HERE-->\n</geometry>'
+                                '</visual>'))),
+    ("U713", doc(link("a", body=f'<collision><geometry>\n<mesh filename='
+                                f'"{MESHES / "nan_vertex.stl"}"/><!--HERE-->\n</geometry>'
+                                '</collision>'))),
     ("U706", doc(link("a", body='<visual><geometry><box size="1 1 1"/></geometry>\n'
                                 '<material name="steel"/><!--HERE-->\n</visual>'))),
     ("U707", doc('<material name="m">\n<texture/><!--HERE-->\n</material>', A)),
@@ -182,7 +188,8 @@ def _line(text: str) -> int:
 
 # U008 (a line PyBullet breaks) is tested against raw PyBullet in tests/test_guard.py; U009
 # (a .urdf holding xacro) in tests/test_build_unseen.py; U715 (a visual PyBullet draws
-# nothing of) against PyBullet's own picture in tests/test_no_silent_misses.py.
+# nothing of) against PyBullet's own picture in tests/test_no_silent_misses.py; U712 and U713
+# (mesh files PyBullet crashes or hangs on) against raw PyBullet in tests/test_guard_meshes.py.
 def test_every_code_has_a_case() -> None:
     # U950 and U951 need PyBullet (check --physics): tests/test_collisions.py.
     # U010 (a fragment) needs its includer in the run: tests/test_fragments.py.

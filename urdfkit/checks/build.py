@@ -207,10 +207,11 @@ def _unloadable(root: etree._Element, base: Path, packages: Mapping[str, Path] |
 
     The loaders' rule (:func:`urdfkit.sources.resolve.resolve`): a mesh or SDF that is missing,
     not a regular file or in a format PyBullet does not read, or any reference to an unknown
-    package or a FIFO/device; a missing texture is drawn without.
+    package or a FIFO/device; a missing texture is drawn without. A mesh file PyBullet
+    crashes or hangs on (:func:`urdfkit.sources.guard.mesh_crash`, U712-U713) is refused too.
     """
     from urdfkit.model.spec import FILE_SHAPES, FILE_TAGS, ignored_shape
-    from urdfkit.sources.guard import reference
+    from urdfkit.sources.guard import mesh_crash, reference
 
     for el in root.iter(*FILE_TAGS):
         fn = (el.get("filename") or "").strip()
@@ -220,6 +221,9 @@ def _unloadable(root: etree._Element, base: Path, packages: Mapping[str, Path] |
         if ref.level == "error" and ref.code is not None and (
                 el.tag in FILE_SHAPES or ref.code in ("U702", "U704")):
             return ref.code, ref.message
+        crash = mesh_crash(el, ref) if el.tag == "mesh" else None
+        if crash is not None:
+            return crash
     return None
 
 

@@ -39,7 +39,7 @@ from urdfkit.model.spec import (
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.sources.guard import GUARD_RULES, Rule, RuleReport, label
+from urdfkit.sources.guard import GUARD_RULES, Rule, RuleReport, label, mesh_crash
 from urdfkit.sources.meshstore import CONCAVE_FRACTION, MeshProperties
 from urdfkit.sources.meshstore import properties as mesh_properties
 from urdfkit.sources.meshstore import stated as stated_properties
@@ -627,6 +627,26 @@ def rule_meshes(root: etree._Element, r: RuleReport) -> None:
                 r.add(ref.code, ref.level, ref.message, el)
 
 
+def rule_mesh_crashes(root: etree._Element, r: RuleReport) -> None:
+    """U712-U713: mesh files PyBullet crashes or hangs on, which every loader refuses.
+
+    The guard's own rule (:func:`urdfkit.sources.guard.mesh_crash`), said as a finding: COLLADA
+    PyBullet's reader crashes on, NaN vertices in a collision mesh it builds a hull of.
+    """
+    if r.folder is None:
+        return
+    for _, _, _, mesh in r.parts(root):
+        if mesh is None or mesh.tag != "mesh":
+            continue
+        fn = (mesh.get("filename") or "").strip()
+        if not fn or (ref := r.reference("mesh", fn)).load is None or (
+                ref.code is not None and ref.level == "error"):
+            continue
+        crash = mesh_crash(mesh, ref)
+        if crash is not None:
+            r.add(crash[0], "error", crash[1], mesh)
+
+
 def rule_visual_meshes(root: etree._Element, r: RuleReport) -> None:
     """U715: a visual mesh PyBullet draws nothing or only part of.
 
@@ -1205,9 +1225,9 @@ _SHAPE_NOTES = {key.partition(":")[2]: note for key, note in EXTENSIONS.items()
 
 #: Every rule ``urdfkit check`` runs, in order.
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
-                               rule_inertia, rule_meshes, rule_mesh_shapes, rule_visual_meshes,
-                               rule_references, rule_material_colours, rule_mimic,
-                               rule_damping, rule_gazebo_contacts, rule_portability)
+                               rule_inertia, rule_meshes, rule_mesh_crashes, rule_mesh_shapes,
+                               rule_visual_meshes, rule_references, rule_material_colours,
+                               rule_mimic, rule_damping, rule_gazebo_contacts, rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -1286,6 +1306,8 @@ CODES: dict[str, str] = {
     "U709": "transmission names a missing joint",
     "U710": "one material name given several colours (PyBullet draws them all in the last)",
     "U711": "package:// found only through a package.xml, which raw PyBullet does not read",
+    "U712": "COLLADA mesh PyBullet's reader crashes on (no <asset> or <library_geometries>, ...)",
+    "U713": "collision mesh with NaN beside numbers on an axis: PyBullet's hull crashes or hangs",
     "U715": "visual mesh PyBullet draws nothing or only part of (empty, COLLADA <instance_node>)",
     "U801": "unknown tag",
     "U802": "unknown attribute",

@@ -592,6 +592,55 @@ def reference(tag: str, fn: str, base: Path | str,
     return Reference(str(path), str(path))
 
 
+def mesh_crash(mesh: etree._Element, ref: Reference) -> tuple[str, str] | None:
+    """U712, U713: what in the file a ``<mesh>`` names makes PyBullet 3.2.7 crash or hang.
+
+    The one rule ``check`` reports and every loader refuses by
+    (:mod:`urdfkit.sources.meshfaults` holds the measured facts). ``ref`` is the mesh's
+    :func:`reference`; only the first shape of a link's ``<visual>`` or ``<collision>`` is
+    judged, as PyBullet opens no other. U712: COLLADA whose reader PyBullet crashes, visual
+    or collision alike. U713: NaN vertices in a collision mesh PyBullet builds a convex hull
+    of (not ``concave``, which makes a triangle mesh of it; a visual mesh with NaN loads).
+    Cheap: a visual STL or OBJ is not opened, nor is meshfaults imported for it.
+    """
+    load = ref.load
+    if load is None:
+        return None
+    suffix = mesh_suffix(load)
+    geometry = mesh.getparent()
+    part = geometry.getparent() if geometry is not None else None
+    if (not suffix or part is None or part.tag not in ("visual", "collision")
+            or geometry.tag != "geometry" or used_shape(geometry) is not mesh):
+        return None
+    link = part.getparent()
+    robot = link.getparent() if link is not None else None
+    if link is None or link.tag != "link" or robot is None or robot.getparent() is not None:
+        return None  # PyBullet reads the links of the <robot> alone
+    hull = part.tag == "collision" and part.get("concave") is None  # any value: a trimesh
+    if suffix != ".dae" and not hull:
+        return None
+    from urdfkit.sources import meshfaults
+
+    fn = (mesh.get("filename") or "").strip()
+    name = f"<mesh filename={fn!r}>"
+    if suffix == ".dae":
+        why = meshfaults.collada_fault(load, ref.stat)
+        if why is not None:
+            return ("U712", f"{name}: PyBullet 3.2.7's COLLADA reader crashes (a segfault or "
+                    f"an abort) on {load}: the file {why}")
+    if hull:
+        # PyBullet reads the first three numbers, NaN and infinities included.
+        vals = numbers(mesh.get("scale"))
+        scale = vals[:3] if vals is not None and len(vals) >= 3 else (1.0, 1.0, 1.0)
+        why = meshfaults.hull_fault(load, scale, ref.stat)
+        if why is not None:
+            return ("U713", f"{name} of the <collision> of {label(link)}: its vertices "
+                    f"{why}; PyBullet 3.2.7's convex hull of them segfaults, never returns or "
+                    "loads, by where the NaN falls: remove the NaN vertices (a visual mesh may "
+                    "keep them)")
+    return None
+
+
 @lru_cache(maxsize=256)
 def _folder_path(folder: str) -> Path:
     """``Path(folder)``, made once per folder (bounded).

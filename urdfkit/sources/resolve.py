@@ -46,7 +46,13 @@ from urdfkit.model.xmlio import (
     xacro_note,
 )
 from urdfkit.sources.expand import expand_xacro
-from urdfkit.sources.guard import GUARD_WARNINGS, STRICTER, reference, refuse_oversized
+from urdfkit.sources.guard import (
+    GUARD_WARNINGS,
+    STRICTER,
+    mesh_crash,
+    reference,
+    refuse_oversized,
+)
 from urdfkit.sources.guard import guard as run_guard
 from urdfkit.sources.uris import not_a_file, pybullet_data_path
 from urdfkit.sources.uris import (
@@ -145,8 +151,9 @@ def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
     Each reference is judged by :func:`urdfkit.sources.guard.reference`, the rule ``check`` runs:
     a missing or unreadable mesh, a folder/FIFO/device, a format PyBullet does not read, an
     unknown package is one line naming the file and the URDF line, before PyBullet sees it
-    (which would fail with "Could not parse visual element", hang or abort). A missing
-    texture is left to PyBullet, which warns and draws without it.
+    (which would fail with "Could not parse visual element", hang or abort). So is a mesh
+    file PyBullet crashes or hangs on (:func:`urdfkit.sources.guard.mesh_crash`, U712-U713). A
+    missing texture is left to PyBullet, which warns and draws without it.
     """
     changed = False
     for el in root.iter(*FILE_TAGS):
@@ -157,6 +164,9 @@ def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
         if ref.level == "error" and ref.code is not None and (
                 el.tag in FILE_SHAPES or ref.code in ("U702", "U704")):
             raise InputError(ref.message, file=name, line=line_of(el))
+        crash = mesh_crash(el, ref) if el.tag == "mesh" else None
+        if crash is not None:
+            raise InputError(crash[1], file=name, line=line_of(el))
         if ref.load_path is not None:
             changed |= ref.code == "U703" or fn.startswith(("package://", "file://"))
             el.set("filename", str(ref.load_path.resolve()))
