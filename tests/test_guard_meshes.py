@@ -17,12 +17,12 @@ import math
 import struct
 import subprocess
 import sys
-import textwrap
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from test_guard import raw_outcome
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
@@ -191,27 +191,6 @@ def write(folder: Path, case: Case) -> Path:
     return path
 
 
-def raw_outcome(path: Path, timeout: float = 5.0) -> str:
-    """What raw PyBullet does loading the file, in a subprocess (a crash must not kill pytest)."""
-    code = textwrap.dedent(f"""
-        import pybullet as p
-        p.connect(p.DIRECT)
-        try:
-            p.loadURDF({str(path)!r})
-        except p.error:
-            raise SystemExit(3)
-        print("LOADED")
-    """)
-    try:
-        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                              timeout=timeout, cwd=path.parent)
-    except subprocess.TimeoutExpired:
-        return "hang"
-    if done.returncode < 0:
-        return "crash"
-    return "loads" if "LOADED" in done.stdout else f"exit {done.returncode}"
-
-
 IDS = [c.name for c in CASES]
 REFUSED = [c for c in CASES if c.code is not None]
 
@@ -220,7 +199,7 @@ def test_raw_pybullet_still_behaves_as_recorded(tmp_path: Path) -> None:
     # Re-measured every run (two at a time; the hangs cost their 5 s timeout).
     paths = [write(tmp_path / str(i), case) for i, case in enumerate(CASES)]
     with ThreadPoolExecutor(max_workers=2) as pool:
-        outcomes = list(pool.map(raw_outcome, paths))
+        outcomes = list(pool.map(lambda path: raw_outcome(path, timeout=5.0), paths))
     assert [(c.name, got) for c, got in zip(CASES, outcomes, strict=True) if got != c.raw] == []
 
 

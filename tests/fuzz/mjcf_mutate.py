@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 from lxml import etree
 
-from .mutate import NUMERIC_VALUES
+from .mutate import NUMERIC_VALUES, byte_mutation
 
 #: Numbers for MJCF attributes: mostly ones MuJoCo's parser reads (huge, tiny, NaN, zero,
 #: negative, too many), so that the mutant reaches the comparison; then the URDF campaign's.
@@ -242,13 +242,7 @@ SPECIAL_TEXT = {
 def mutate_mjcf(seed_name: str, data: bytes, rng: random.Random) -> MjcfMutant:
     """One mutant: one or two tree mutations, or a byte-level one."""
     if rng.random() < 0.06:
-        if rng.random() < 0.5:
-            cut = rng.randrange(1, len(data))
-            return MjcfMutant(seed_name, data[:cut], [f"truncated at {cut}"])
-        flipped = bytearray(data)
-        for _ in range(rng.randint(1, 8)):
-            flipped[rng.randrange(len(flipped))] = rng.randrange(256)
-        return MjcfMutant(seed_name, bytes(flipped), ["byte flips"])
+        return MjcfMutant(seed_name, *byte_mutation(data, rng))
     root = etree.fromstring(data, etree.XMLParser(remove_blank_text=True,
                                                   resolve_entities=False))
     mutant = MjcfMutant(seed_name, b"")

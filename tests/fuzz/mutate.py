@@ -183,17 +183,22 @@ TREE_MUTATIONS: list[Callable[[etree._Element, random.Random], str]] = [
     m_delete, m_duplicate, m_move, m_nest, m_mesh, m_material_name]
 
 
+def byte_mutation(data: bytes, rng: random.Random) -> tuple[bytes, list[str]]:
+    """The file cut short, or up to 8 of its bytes replaced at random."""
+    if rng.random() < 0.5:
+        cut = rng.randrange(1, len(data))
+        return data[:cut], [f"truncated at {cut}"]
+    flipped = bytearray(data)
+    for _ in range(rng.randint(1, 8)):
+        i = rng.randrange(len(flipped))  # before the new byte: the seeded samples' order
+        flipped[i] = rng.randrange(256)
+    return bytes(flipped), ["byte flips"]
+
+
 def mutate(seed_name: str, data: bytes, rng: random.Random) -> Mutant:
     """One mutant: one or two tree mutations, or a byte-level one."""
     if rng.random() < 0.15:
-        if rng.random() < 0.5:
-            cut = rng.randrange(1, len(data))
-            return Mutant(seed_name, data[:cut], [f"truncated at {cut}"])
-        flipped = bytearray(data)
-        for _ in range(rng.randint(1, 8)):
-            i = rng.randrange(len(flipped))
-            flipped[i] = rng.randrange(256)
-        return Mutant(seed_name, bytes(flipped), ["byte flips"])
+        return Mutant(seed_name, *byte_mutation(data, rng))
     root = etree.fromstring(data, etree.XMLParser(remove_blank_text=True,
                                                   resolve_entities=False))
     done = []
