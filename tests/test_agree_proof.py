@@ -600,3 +600,99 @@ def test_a_singular_tensor_in_the_file_exports_and_agrees(tmp_path: Path, robot:
     code, data = _agree(robot, out)
     assert code == 0, _failing(data)
     assert _rows(data)["inertia MuJoCo cannot take"]["status"] == "known"
+
+
+# ---------------------------------------------------------------- found by review (stop 47)
+
+def test_one_mjcf_name_for_two_urdf_names_is_refused(exports: dict[str, Path]) -> None:
+    r = runner.invoke(app, ["agree", "r2d2.urdf", str(exports["r2d2.urdf"]), "--map",
+                            "head_swivel=gripper_extension", "--map",
+                            "gripper_extension=gripper_extension"])
+    assert r.exit_code == 2 and "named for two URDF names" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(("edit", "row"), [
+    (lambda doc: next(doc.iterfind(".//geom[@group='3']")).set("friction", "nan 0 0"),
+     "contact parameters"),
+    (lambda doc: doc.find(".//body[@name='head']").set("quat", "nan 0 0 0"),
+     "frames vs exact FK: position"),
+])
+def test_a_nan_in_the_mjcf_fails(exports: dict[str, Path], edit, row: str) -> None:
+    code, data = _agree("r2d2.urdf", _tamper(exports["r2d2.urdf"], "nan.xml", edit))
+    assert code == 1 and row in _failing(data)
+
+
+def test_an_equality_the_urdf_has_not_fails(exports: dict[str, Path]) -> None:
+    def weld(doc: etree._ElementTree) -> None:
+        eq = etree.SubElement(doc.getroot(), "equality")
+        etree.SubElement(eq, "weld", name="glued", body1="left_gripper", body2="right_gripper")
+
+    code, data = _agree("r2d2.urdf", _tamper(exports["r2d2.urdf"], "weld.xml", weld))
+    assert code == 1 and "weld glued" in _failing(data)["forces MuJoCo alone applies"]
+
+
+def test_a_range_on_a_ball_joint_fails(tmp_path: Path) -> None:
+    """PyBullet's spherical joint has no limit: a ranged ball in the MJCF is another robot."""
+    out = tmp_path / "humanoid.xml"
+    _export("humanoid/humanoid.urdf", out)
+    doc = etree.parse(str(out))
+    ball = doc.find(".//joint[@type='ball']")
+    ball.set("range", "0 0.05")
+    doc.write(str(out))
+    code, data = _agree("humanoid/humanoid.urdf", out)
+    assert code == 1 and _failing(data)["joint limits"] == ball.get("name")
+
+
+def test_a_loose_free_body_is_no_base(exports: dict[str, Path]) -> None:
+    def weld_root(doc: etree._ElementTree) -> None:
+        root = doc.find("worldbody/body")
+        root.remove(root.find("freejoint"))
+        loose = etree.SubElement(doc.find("worldbody"), "body", name="loose", pos="3 0 1")
+        etree.SubElement(loose, "freejoint")
+        etree.SubElement(loose, "geom", type="box", size=".1 .1 .1", mass="1e-9",
+                         contype="0", conaffinity="0")
+
+    code, data = _agree("r2d2.urdf", _tamper(exports["r2d2.urdf"], "loose.xml", weld_root))
+    assert code == 1 and _rows(data)["base"]["detail"] == "PyBullet: free joint; MJCF: welded"
+    assert not any(k.startswith("floating swing") for k in _rows(data))
+
+
+def test_bodies_below_fused_links_match_by_the_tree(exports: dict[str, Path]) -> None:
+    """r2d2's wheels hang from right_base and left_base, fixed links fused into base_link with
+    no site once sites are gone: renamed, they are found below base_link's body."""
+    def rename(doc: etree._ElementTree) -> None:
+        for site in list(doc.iter("site")):
+            site.getparent().remove(site)
+        for el in doc.iter("body", "joint"):
+            if "wheel" in (el.get("name") or ""):
+                el.set("name", el.get("name").replace("wheel", "roller"))
+        act = doc.find("actuator")
+        if act is not None:
+            act.getparent().remove(act)
+
+    code, data = _agree("r2d2.urdf", _tamper(exports["r2d2.urdf"], "rollers.xml", rename))
+    assert data["unmatched_joints"] == [] and data["extra_joints"] == []
+    assert any(p["mjcf"] == "right_front_roller_joint" for p in data["matched_by"])
+    assert code == 0, _failing(data)
+    # the fused links' own frames have no site left to compare: listed, not passed over
+    assert "right_base" in data["unmatched_links"]
+
+
+def test_an_unnamed_locked_joint_is_welded_by_its_place(tmp_path: Path) -> None:
+    urdf = _pendulum(tmp_path, "locked.urdf", limits=((-3, 3), (0.3, 0.3), (-3, 3)))
+    out = tmp_path / "locked.xml"
+    _export(str(urdf), out)
+
+    def unname(doc: etree._ElementTree) -> None:
+        for tag in ("equality", "actuator"):
+            el = doc.find(tag)
+            if el is not None:
+                el.getparent().remove(el)
+        for j in doc.iter("joint"):
+            if j.get("name") in ("j1", "j2"):
+                del j.attrib["name"]
+
+    code, data = _agree(str(urdf), _tamper(out, "unnamed.xml", unname))
+    swing = next(r for r in data["rows"] if r["check"].startswith("free swing"))
+    assert swing["value"] < 1e-9, swing

@@ -118,7 +118,7 @@ class Agreement:
     def add(self, group: str, what: str, value: float | None, tolerance: float | None,
             unit: str, detail: str = "", status: str | None = None) -> None:
         """A row; its status from the figure and the tolerance unless given."""
-        if status is None:
+        if status is None:  # (a NaN figure fails: NaN <= tolerance is False)
             status = "pass" if value is not None and tolerance is not None and \
                 value <= tolerance else "fail"
         self.rows.append(Row(group, what, value, tolerance, unit, status, detail))
@@ -180,7 +180,8 @@ def load_mjcf(path: str | Path) -> tuple[Any, Any]:
 
 
 def _worst(items: list[tuple[float, str]]) -> tuple[float, str]:
-    return max(items, key=lambda x: x[0]) if items else (0.0, "")
+    """The largest figure, a NaN above all (a NaN in the MJCF must not pass as 0)."""
+    return max(items, key=lambda x: math.inf if x[0] != x[0] else x[0]) if items else (0.0, "")
 
 
 def _name(m: Any, kind: Any, i: int) -> str:
@@ -421,12 +422,11 @@ class _Compare:
 
     def structure(self) -> None:
         mj, m, res = self.mj, self.fixed, self.result
-        free = [i for i in range(self.model.njnt)
-                if self.model.jnt_type[i] == mj.mjtJoint.mjJNT_FREE]
         moving_root = not self.o.fixed_base and self.robot.links[self.robot.root].inertial.mass \
             != 0 and self.robot.root != "world"
         want = "free joint" if moving_root else "welded"
-        got = "free joint" if free else "welded"
+        # the root's own free joint: another free body (a loose box) is no robot base
+        got = "free joint" if self._root_free(self.model) is not None else "welded"
         res.add("structure", "base", None, None, "", f"PyBullet: {want}; MJCF: {got}",
                 "pass" if want == got else "fail")
         self.joint_rows()
@@ -475,9 +475,42 @@ class _Compare:
                 said.append(f"{what} {float(getattr(m.opt, what)):g}")
         if np.any(m.opt.wind):
             said.append(f"wind {' '.join(f'{w:g}' for w in m.opt.wind)}")
+        said += self._equalities_of_mujoco_alone()
         res.add("structure", "forces MuJoCo alone applies", float(len(said)), 0.0, "found",
                 "; ".join(said[:3]) + (" ..." if len(said) > 3 else "")
                 or "no joint springs, gravity compensation or medium; gravity 0 0 -9.81")
+
+    def _equalities_of_mujoco_alone(self) -> list[str]:
+        """Active MJCF equalities that are not the export's.
+
+        The export's are a URDF ``<mimic>`` and a joint PyBullet locks (lower == upper). The
+        swing turns equalities off, so a weld or a held joint the URDF has not would
+        otherwise pass unseen.
+        """
+        mj, m = self.mj, self.model
+        mimic = {j.name: j.mimic[0] for j in self.robot.movable() if j.mimic is not None}
+        locked = {j.name for j in self.robot.movable() if j.limited and j.lower == j.upper}
+        out = []
+        for e in range(m.neq):
+            if not m.eq_active0[e]:
+                continue
+            kind = int(m.eq_type[e])
+            if kind == int(mj.mjtEq.mjEQ_JOINT):
+                a = _name(m, mj.mjtObj.mjOBJ_JOINT, int(m.eq_obj1id[e]))
+                b = _name(m, mj.mjtObj.mjOBJ_JOINT, int(m.eq_obj2id[e])) \
+                    if int(m.eq_obj2id[e]) >= 0 else ""
+                urdf = next((n for n, k in self.jnt.items()
+                             if _name(self.fixed, mj.mjtObj.mjOBJ_JOINT, k) == a), a)
+                lead = next((n for n, k in self.jnt.items()
+                             if _name(self.fixed, mj.mjtObj.mjOBJ_JOINT, k) == b), b)
+                if (b and mimic.get(urdf) == lead) or (not b and urdf in locked):
+                    continue
+                out.append(f"equality on joint {a or e}" + (f" and {b}" if b else ""))
+            else:
+                kinds = {int(mj.mjtEq.mjEQ_WELD): "weld", int(mj.mjtEq.mjEQ_CONNECT): "connect"}
+                out.append(f"{kinds.get(kind, 'equality')} "
+                           f"{_name(m, mj.mjtObj.mjOBJ_EQUALITY, e) or e}")
+        return out
 
     def joint_rows(self) -> None:
         """Names, order, kinds, limits, damping, armature and friction of the matched joints."""
@@ -518,8 +551,9 @@ class _Compare:
                 known_friction.append(f"{n} {loss:g}")
             else:
                 friction.append((abs(loss), n))  # PyBullet 3.2.7 simulates none
-            if info[2] == 2:
-                continue  # a ball joint has no limits or damping PyBullet reads
+            if info[2] == 2:  # PyBullet's spherical joint has no limit
+                limits.append((math.inf if m.jnt_limited[k] else 0.0, n))
+                continue
             limits.append((self._limit_error(joints[n], info, k), n))
             if int(kinds[info[2]]) == int(m.jnt_type[k]):
                 damping.append((abs(info[6] - m.dof_damping[dof]), n))
@@ -828,7 +862,7 @@ class _Compare:
         """
         import numpy as np
 
-        m, mj = self.fixed, self.mj
+        m = self.fixed
         frames = {j.child for j in self.robot.joints} | {self.robot.root}
         out: dict[str, tuple[str, Any, float]] = {}
         for n in links:
@@ -849,7 +883,9 @@ class _Compare:
                 continue
             if by == 0.0:
                 continue
-            body = _name(m, mj.mjtObj.mjOBJ_BODY, int(m.site_bodyid[i]))
+            # the URDF link of the site's body (matched by name or by the tree's shape)
+            body = next((link for link, b in self.body.items()
+                         if b == int(m.site_bodyid[i])), "")
             if body in frames:
                 out[n] = (body, where, by)
         return out
@@ -1033,10 +1069,14 @@ class _Compare:
             res.add("swing", "free swing", None, None, "", blocked[0], status=blocked[1])
             return
         self._swing(floating=False)
-        free = [i for i in range(self.model.njnt)
-                if self.model.jnt_type[i] == self.mj.mjtJoint.mjJNT_FREE]
-        if len(free) == 1 and self.robot.root in self.body and not self._pybullet_static():
+        if self._root_free(self.model) is not None and not self._pybullet_static():
             self._swing(floating=True)
+
+    def _root_free(self, m: Any) -> int | None:
+        """The free joint of the robot's root body in ``m`` (not another free body's)."""
+        root = self.body.get(self.robot.root)
+        return next((i for i in range(m.njnt) if m.jnt_type[i] == self.mj.mjtJoint.mjJNT_FREE
+                     and int(m.jnt_bodyid[i]) == root), None) if root is not None else None
 
     def _pybullet_static(self) -> bool:
         root = self.robot.links[self.robot.root]
@@ -1087,15 +1127,22 @@ class _Compare:
 
         mj, m = self.mj, self.fixed
         spec = mj.MjSpec.from_file(self.path)
-        names = {_name(m, mj.mjtObj.mjOBJ_JOINT, self.jnt[n]): q for n, q in locked.items()}
-        for j in list(spec.joints):
+        # the spec's joints in the written model's order (checked by type below): a locked
+        # joint by its position, as an unnamed joint has no name to find it by
+        kept = [i for i in range(self.model.njnt)
+                if self.model.jnt_type[i] != mj.mjtJoint.mjJNT_FREE]
+        weld_at = {kept[self.jnt[n]]: (self.jnt[n], q) for n, q in locked.items()}
+        joints = list(spec.joints)
+        if [int(j.type) for j in joints] != [int(t) for t in self.model.jnt_type]:
+            raise ValueError("the MJCF's joints are not in the order MuJoCo compiles them")
+        for i, j in enumerate(joints):
             if j.type == mj.mjtJoint.mjJNT_FREE and not floating:
                 j.parent.pos, j.parent.quat = [0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]
                 spec.delete(j)
-            elif j.name in names:
-                k = mj.mj_name2id(m, mj.mjtObj.mjOBJ_JOINT, j.name)
+            elif i in weld_at:
+                k, q = weld_at[i]
                 body, b = j.parent, int(m.jnt_bodyid[k])
-                axis, at, q = np.array(m.jnt_axis[k]), np.array(m.jnt_pos[k]), names[j.name]
+                axis, at = np.array(m.jnt_axis[k]), np.array(m.jnt_pos[k])
                 turn = np.array(axis_angle_matrix(tuple(axis), q)) if int(m.jnt_type[k]) == int(
                     mj.mjtJoint.mjJNT_HINGE) else np.eye(3)
                 shift = at - turn @ at if int(m.jnt_type[k]) == int(
@@ -1107,10 +1154,10 @@ class _Compare:
                 body.alt.type = mj.mjtOrientation.mjORIENTATION_QUAT
                 body.pos = list(np.array(m.body_pos[b]) + rb.reshape(3, 3) @ shift)
                 body.quat = list(quat)
-                for e in list(spec.equalities):
+                for e in list(spec.equalities) if j.name else ():
                     if j.name in (e.name1, e.name2):
                         spec.delete(e)
-                for a in list(spec.actuators):
+                for a in list(spec.actuators) if j.name else ():
                     if a.target == j.name:
                         spec.delete(a)
                 spec.delete(j)
@@ -1169,7 +1216,8 @@ class _Compare:
             if floating:
                 d.qvel[m.jnt_dofadr[ids[n]]] = v0[n]
         if floating:
-            free = next(i for i in range(m.njnt) if m.jnt_type[i] == mj.mjtJoint.mjJNT_FREE)
+            free = self._root_free(m)
+            assert free is not None  # swing() runs the floating swing only then
             d.qpos[m.jnt_qposadr[free]:m.jnt_qposadr[free] + 7] = [0, 0, 0, 1, 0, 0, 0]
         at_start = mj.MjData(self.fixed)
         self.set_q(at_start, {n: q0[n] for n in self.matched})
@@ -1208,8 +1256,7 @@ class _Compare:
         # of 11.5 mm (youBot's) does not stop the whole swing at its first step
         margin = {n: min(LIMIT_MARGIN, (joints[n].upper - joints[n].lower) / 8)
                   for n in names if joints[n].limited}
-        free_joint = next((i for i in range(m.njnt) if m.jnt_type[i] == mj.mjtJoint.mjJNT_FREE),
-                          None)
+        free_joint = self._root_free(m) if floating else None
         free = int(m.jnt_qposadr[free_joint]) if free_joint is not None else 0
         spin = int(m.jnt_dofadr[free_joint]) + 3 if free_joint is not None else 0
         turn = np.zeros(9)
@@ -1224,16 +1271,17 @@ class _Compare:
             for n, a, v in zip(names, adr, qp, strict=True):
                 j = joints[n]
                 e = abs(d.qpos[a] - v)
-                if e > worst:
-                    worst, at = e, n
+                if e > worst or e != e:
+                    worst, at = (e if e == e else math.inf), n
                 if j.limited and min(v - j.lower, j.upper - v, d.qpos[a] - j.lower,
                                      j.upper - d.qpos[a]) < margin[n]:
                     near = n
             if floating:  # the root's frame is its free joint's qpos (xpos lags a step)
                 t = pb.base_frame(body)
                 mj.mju_quat2Mat(turn, d.qpos[free + 3:free + 7])
-                base = max(base, float(np.abs(t[:3, 3] - d.qpos[free:free + 3]).max()),
-                           float(np.abs(t[:3, :3] - turn.reshape(3, 3)).max()))
+                off = max(float(np.abs(t[:3, 3] - d.qpos[free:free + 3]).max()),
+                          float(np.abs(t[:3, :3] - turn.reshape(3, 3)).max()))
+                base = max(base, off if off == off else math.inf)
                 spun += float(d.qvel[spin:spin + 3] @ d.qvel[spin:spin + 3]) * self.o.time_step
             if near:
                 unit = "m" if joints[near].type == "prismatic" else "rad"

@@ -325,14 +325,14 @@ def contact_errors(b: Any, body: int, link_index: dict[str, int], m: Any,
         slide, torsion, roll = (float(x) for x in m.geom_friction[g])
         condim = int(m.geom_condim[g])
         said = []
-        if abs(slide - lateral) > TOL_FRICTION:
+        if not abs(slide - lateral) <= TOL_FRICTION:  # (a NaN fails too)
             said.append(f"friction {slide:g}, PyBullet's lateral {lateral:g}")
         got_spin = torsion if condim >= 4 else 0.0
-        if abs(got_spin - spinning) > TOL_FRICTION:
+        if not abs(got_spin - spinning) <= TOL_FRICTION:
             said.append(f"torsional friction {got_spin:g} (condim {condim}), PyBullet's "
                         f"spinning {spinning:g}")
         got_roll = roll if condim >= 6 else 0.0
-        if abs(got_roll - rolling) > TOL_FRICTION:
+        if not abs(got_roll - rolling) <= TOL_FRICTION:
             said.append(f"rolling friction {got_roll:g} (condim {condim}), PyBullet's "
                         f"{rolling:g}")
         if not (int(m.geom_contype[g]) & 1 or int(m.geom_conaffinity[g]) & 1):

@@ -112,10 +112,15 @@ def match_models(mj: Any, fixed: Any, robot: Robot, movable: list[str],
     out = Matching()
     links = set(robot.links)
     movable_set = set(movable)
+    name_map_targets_seen: set[str] = set()
     for urdf, mjcf in name_map.items():
         if urdf not in links and urdf not in movable_set:
             raise ParameterError(f"--map: the URDF has no link or movable joint {urdf!r}",
                                  param="name_map")
+        if mjcf in name_map_targets_seen:
+            raise ParameterError(f"--map: {mjcf!r} is named for two URDF names",
+                                 param="name_map")
+        name_map_targets_seen.add(mjcf)
         if urdf in movable_set and mjcf in model.joint:
             out.joints[urdf] = model.joint[mjcf]
         elif urdf in links and mjcf in model.body:
@@ -164,6 +169,7 @@ def _match_by_shape(model: _Model, robot: Robot, movable: set[str], out: Matchin
     import numpy as np
 
     zero = link_frames(robot, {})
+    group = {link: body for link, (body, _) in fused(robot).items()}
     if robot.root not in out.bodies and robot.root not in out.sites and robot.root != "world":
         root = _root_body(model)
         if root is not None and root not in out.bodies.values():
@@ -180,6 +186,8 @@ def _match_by_shape(model: _Model, robot: Robot, movable: set[str], out: Matchin
             _match_one_side(model, j, axis, movable, out, taken_j, taken_b)
             continue
         parent = _mj_body_of(out, model, j.parent)
+        if parent is None:  # a fixed link fused into its group's body, with no site of its own
+            parent = _mj_body_of(out, model, group[j.parent])
         if parent is None:
             continue
         found = []
