@@ -10,13 +10,13 @@ a cycle; a sub-model that names its parent; truncation and byte flips.
 
 from __future__ import annotations
 
-import copy
 import random
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from lxml import etree
 
+from . import mutate
 from .mutate import NUMERIC_VALUES, byte_mutation
 
 #: Numbers for MJCF attributes: mostly ones MuJoCo's parser reads (huge, tiny, NaN, zero,
@@ -96,12 +96,7 @@ def m_zero(root: etree._Element, rng: random.Random, m: MjcfMutant) -> str:
 
 def m_delete(root: etree._Element, rng: random.Random, m: MjcfMutant) -> str:
     """Delete a random element (a body with its subtree, an inertial, the compiler...)."""
-    els = _elements(root)
-    if not els:
-        return "nothing"
-    el = rng.choice(els)
-    el.getparent().remove(el)
-    return f"deleted <{el.tag}>"
+    return mutate.m_delete(root, rng)  # the URDF campaign's, with the MJCF mutators' signature
 
 
 def m_rename_tag(root: etree._Element, rng: random.Random, m: MjcfMutant) -> str:
@@ -138,24 +133,12 @@ def m_rename(root: etree._Element, rng: random.Random, m: MjcfMutant) -> str:
 
 def m_duplicate(root: etree._Element, rng: random.Random, m: MjcfMutant) -> str:
     """Duplicate an element in place (duplicate names, two free joints, two compilers...)."""
-    els = _elements(root)
-    if not els:
-        return "nothing"
-    el = rng.choice(els)
-    el.addnext(copy.deepcopy(el))
-    return f"duplicated <{el.tag}>"
+    return mutate.m_duplicate(root, rng)  # the URDF campaign's, with the MJCF mutators' signature
 
 
 def m_move(root: etree._Element, rng: random.Random, m: MjcfMutant) -> str:
     """Move an element under another parent."""
-    els = _elements(root)
-    if len(els) < 2:
-        return "nothing"
-    el, target = rng.sample(els, 2)
-    if el in list(target.iterancestors()) or el is target:
-        return "no move"
-    target.append(el)
-    return f"moved <{el.tag}> into <{target.tag}>"
+    return mutate.m_move(root, rng)  # the URDF campaign's, with the MJCF mutators' signature
 
 
 def m_include(root: etree._Element, rng: random.Random, m: MjcfMutant) -> str:
