@@ -222,3 +222,15 @@ def chromium() -> Iterator[Any]:
 def module_chromium() -> Iterator[Any]:
     """:func:`_chromium` shared by a module's tests (each closes the pages it opens)."""
     yield from _chromium()
+
+
+@pytest.fixture
+def settled(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The test's files count as settled: changed long before the run (as a checked-out
+    tree's are), which a test cannot fake (no call sets a ctime back) nor wait two seconds for.
+    """
+    from urdfkit.checks import resultcache
+    from urdfkit.core import deps
+
+    monkeypatch.setattr(deps, "RACY_NS", 0)
+    monkeypatch.setattr(resultcache, "RACY_NS", 0)

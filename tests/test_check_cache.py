@@ -312,13 +312,6 @@ def test_the_keyed_size_limit_is_the_readers() -> None:
 
 # The run manifest: one file per run that lets a re-run skip reading each file and its entry.
 
-def _age(*paths: Path) -> None:
-    """Give files an mtime an hour ago: older than any run, as a checked-out tree's are."""
-    old = (os.stat(paths[0]).st_mtime_ns - 3600 * 10**9,) * 2
-    for p in paths:
-        os.utime(p, ns=old)
-
-
 def _manifest_hits(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     from urdfkit.checks.resultcache import RunManifest
 
@@ -336,11 +329,10 @@ def _manifest_hits(monkeypatch: pytest.MonkeyPatch) -> list[str]:
 
 
 def test_an_unchanged_tree_is_answered_from_the_manifest(
-        cache: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+        cache: Path, settled: None, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     _stl(tmp_path / "a.stl", 0.1)
     (tmp_path / "r.urdf").write_text(ARM.format(mesh="a.stl"))
     (tmp_path / "s.urdf").write_text(ARM.format(mesh="missing.stl"))
-    _age(tmp_path / "a.stl", tmp_path / "r.urdf", tmp_path / "s.urdf")
     truth = _fresh([tmp_path])
     hits = _manifest_hits(monkeypatch)
     check_paths([tmp_path], jobs=1)
@@ -355,18 +347,16 @@ def test_an_unchanged_tree_is_answered_from_the_manifest(
     assert warm.to_dict()["findings"] == truth
 
 
-def test_the_manifest_misses_on_any_change(cache: Path, tmp_path: Path,
+def test_the_manifest_misses_on_any_change(cache: Path, settled: None, tmp_path: Path,
                                            monkeypatch: pytest.MonkeyPatch) -> None:
     _stl(tmp_path / "a.stl", 0.1)
     robot, other = tmp_path / "r.urdf", tmp_path / "s.urdf"
     robot.write_text(ARM.format(mesh="a.stl"))
     other.write_text(ARM.format(mesh="missing.stl"))
-    _age(tmp_path / "a.stl", robot, other)
     check_paths([tmp_path], jobs=1)
     hits = _manifest_hits(monkeypatch)
     # A mesh of another size: only the file that reads it misses, and its findings change.
     _stl(tmp_path / "a.stl", 0.3)
-    _age(tmp_path / "a.stl")
     result = check_paths([tmp_path], jobs=1)
     assert hits == ["s.urdf"]
     assert result.to_dict()["findings"] == _fresh([tmp_path])
@@ -397,10 +387,10 @@ def test_a_file_written_just_before_a_run_is_read_again(cache: Path, tmp_path: P
     assert hits == []
 
 
-def test_a_damaged_manifest_is_never_trusted(cache: Path, tmp_path: Path) -> None:
+def test_a_damaged_manifest_is_never_trusted(cache: Path, settled: None,
+                                            tmp_path: Path) -> None:
     robot = tmp_path / "r.urdf"
     robot.write_text(ARM.format(mesh="missing.stl"))
-    _age(robot)
     truth = _fresh([robot])
     check_paths([robot], jobs=1)
     (manifest,) = (cache / FOLDER / "runs").glob("*.json")
@@ -417,3 +407,37 @@ def test_a_damaged_manifest_is_never_trusted(cache: Path, tmp_path: Path) -> Non
     manifest.unlink()
     os.mkfifo(manifest)  # a FIFO in its place is skipped, not waited on
     assert check_paths([robot], jobs=1).to_dict()["findings"] == truth
+
+
+def _rescale_in_place(path: Path, size: float) -> None:
+    """Rewrite a mesh's bytes in place (same inode, same size), its mtime put back."""
+    before = os.stat(path)
+    _stl(path, size)
+    os.utime(path, ns=(before.st_atime_ns, before.st_mtime_ns))
+    after = os.stat(path)
+    assert (after.st_size, after.st_mtime_ns, after.st_ino) == \
+        (before.st_size, before.st_mtime_ns, before.st_ino)
+
+
+@pytest.mark.parametrize("cached", [True, False])
+def test_a_mesh_rescaled_in_place_with_its_mtime_kept_gives_fresh_findings(
+        cache: Path, tmp_path: Path, cached: bool) -> None:
+    # A binary STL in millimetres rescaled to metres keeps its triangle count, so its size;
+    # a tool that puts the mtime back (rsync -t, tar, a careful script) keeps that too. Only
+    # the ctime (and the bytes) tell: every cache must see the edit, the result cache's and
+    # the mesh cache's, in memory and on disk.
+    folder = tmp_path / "robot"
+    folder.mkdir()
+    _stl(folder / "a.stl", 100.0)  # 100 m across: U613, millimetres read as metres
+    robot = folder / "r.urdf"
+    robot.write_text(ARM.format(mesh="a.stl").replace(
+        "</robot>", '<joint name="k" type="fixed"><parent link="tip"/><child link="c"/>'
+        '<origin xyz="0 0 0.3"/></joint><link name="c"/></robot>'))
+    assert "U613" in _codes(check_paths([robot], jobs=1, cache=cached), "r.urdf")
+    _rescale_in_place(folder / "a.stl", 0.1)
+    truth = subprocess.run(
+        [sys.executable, "-m", "urdfkit", "check", "--json", str(robot)],
+        env={**os.environ, "URDFKIT_CACHE_DIR": ""}, capture_output=True, text=True)
+    fresh = {f["code"] for f in json.loads(truth.stdout)["findings"]}
+    assert "U613" not in fresh
+    assert _codes(check_paths([robot], jobs=1, cache=cached), "r.urdf") == fresh

@@ -128,7 +128,16 @@ def test_broken_meshes_are_unreadable_not_a_crash(tmp_path: Path, text: str) -> 
     assert meshstore.properties(path) is None
 
 
-def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
+def test_a_mesh_changed_just_now_is_not_kept_on_disk(tmp_path: Path) -> None:
+    # Within the clock's grain an edit can keep a file's stat, ctime included: an answer
+    # about a mesh changed under two seconds ago stays in memory only.
+    path = tmp_path / "box.obj"
+    path.write_text(box_obj((1.0, 2.0, 3.0)))
+    check_box(meshstore.properties(path), (1.0, 2.0, 3.0))
+    assert not (tmp_path / "cache" / meshstore._FOLDER).exists()
+
+
+def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path, settled: None,
                                                         monkeypatch: pytest.MonkeyPatch) -> None:
     path = tmp_path / "box.obj"
     path.write_text(box_obj((1.0, 2.0, 3.0)))
@@ -141,10 +150,10 @@ def test_cache_serves_the_second_read_and_follows_edits(tmp_path: Path,
     def refuse(*_: object) -> None:
         raise AssertionError("the mesh was read again")
 
+    read = meshes.read_integrals
     monkeypatch.setattr(meshes, "read_integrals", refuse)
     check_box(meshstore.properties(path, (2.0, 2.0, 2.0)), (2.0, 4.0, 6.0))
-    monkeypatch.undo()
-    monkeypatch.setenv("URDFKIT_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(meshes, "read_integrals", read)
     monkeypatch.setattr(meshstore, "_MEMORY", {})
     # An edit (new size and time) is a new key: the new box, never the old one's values.
     path.write_text(box_obj((3.0, 2.0, 1.0)))
@@ -264,7 +273,7 @@ def _robot_with_box(folder: Path, size: tuple[float, float, float]) -> Path:
 
 
 def test_a_run_s_pack_serves_the_next_run_and_follows_edits(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+        tmp_path: Path, settled: None, monkeypatch: pytest.MonkeyPatch) -> None:
     from urdfkit.checks.check import check_paths
 
     folder = tmp_path / "robot"
@@ -294,7 +303,7 @@ def test_a_run_s_pack_serves_the_next_run_and_follows_edits(
     check_box(meshstore.properties(folder / "box.obj"), (3.0, 2.0, 1.0))
 
 
-def test_a_damaged_pack_is_ignored_whole(tmp_path: Path,
+def test_a_damaged_pack_is_ignored_whole(tmp_path: Path, settled: None,
                                          monkeypatch: pytest.MonkeyPatch) -> None:
     from urdfkit.checks.check import check_paths
 
@@ -312,7 +321,7 @@ def test_a_damaged_pack_is_ignored_whole(tmp_path: Path,
         assert meshstore._MEMORY == {}
 
 
-def test_packs_are_capped(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_packs_are_capped(tmp_path: Path, settled: None, monkeypatch: pytest.MonkeyPatch) -> None:
     folder = tmp_path / "robot"
     _robot_with_box(folder, (1.0, 1.0, 1.0))
     monkeypatch.setattr(meshstore, "MAX_PACKS", 3)
@@ -328,7 +337,7 @@ def test_packs_are_capped(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
 
 
 def test_workers_hand_their_entries_to_the_run_s_pack(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+        tmp_path: Path, settled: None, monkeypatch: pytest.MonkeyPatch) -> None:
     from urdfkit.checks.check import check_paths
 
     (tmp_path / "robots").mkdir()

@@ -236,9 +236,9 @@ class ResultCache:
 
 #: What a manifest keeps of a file's own ``stat``: size, mtime, inode, ctime.
 FileStat = tuple[int, int, int, int]
-#: A file modified this close to the start of the run that recorded it is read again, as git
+#: A file changed this close to the start of the run that recorded it is read again, as git
 #: treats a "racily clean" index entry: within the clock's grain an edit can keep the stat.
-RACY_NS = 2_000_000_000
+RACY_NS = deps.RACY_NS
 
 
 def file_stat(path: str) -> FileStat | None:
@@ -247,7 +247,7 @@ def file_stat(path: str) -> FileStat | None:
         st = os.stat(path)
     except (OSError, ValueError):
         return None
-    return (st.st_size, st.st_mtime_ns, st.st_ino, st.st_ctime_ns)
+    return deps.version(st)
 
 
 def _pack(findings: list[dict[str, Any]], display: str) -> list[list[Any]]:
@@ -325,7 +325,7 @@ class RunManifest:
                 and isinstance(record[2], dict) and isinstance(record[3], list)):
             return None
         now = file_stat(path)
-        if now is None or list(now) != record[1] or now[1] + RACY_NS >= self._old_started:
+        if now is None or list(now) != record[1] or now[3] + RACY_NS >= self._old_started:
             return None
         findings = _unpack(record[3], display)
         if findings is None or not deps.unchanged(record[2], self.memo):

@@ -7,10 +7,11 @@ appears later changes the findings as surely as one that changes). Readers and p
 :func:`note`; it costs nothing unless :func:`record` is active.
 
 A path's signature is what ``stat`` says, and for a file also a digest of its bytes: its
-size, modification time (ns), inode, mode and BLAKE2b. A result is reused only while every
-path is unchanged, judged as git judges its index: the same ``stat`` is unchanged at no cost;
-a different ``stat`` with the same size is read and compared by digest (a fresh checkout in CI
-gives every file a new modification time, not new bytes). A folder signs as only being one;
+size, modification time, inode, mode, change time (ns) and BLAKE2b. A result is reused only
+while every path is unchanged, judged as git judges its index: the same ``stat`` is unchanged
+at no cost; a different ``stat`` with the same size is read and compared by digest (a fresh
+checkout in CI gives every file a new modification time, not new bytes). A file changed within
+:data:`RACY_NS` of being signed is always compared by digest. A folder signs as only being one;
 nothing there as ``None``.
 """
 
@@ -21,13 +22,38 @@ import stat
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 
-#: A path's signature: (size, mtime_ns, inode, mode, digest) for a file, ("dir",) for a
-#: folder, None when nothing is there, or ("other", mode) for a FIFO, device or socket.
-Signature = tuple[int, int, int, int, str] | tuple[str] | tuple[str, int] | None
+#: A path's signature: (size, mtime_ns, inode, mode, ctime_ns, digest) for a file, ("dir",)
+#: for a folder, None when nothing is there, or ("other", mode) for a FIFO, device or socket.
+Signature = tuple[int, int, int, int, int, str] | tuple[str] | tuple[str, int] | None
+#: Within this of a file's last change its ``stat`` may not show the next change (the clock's
+#: grain; git's "racily clean" index entry), so a file changed this recently is never trusted
+#: by its ``stat`` alone.
+RACY_NS = 2_000_000_000
 #: A file larger than this is judged by its stat alone (never read just to sign it).
 MAX_DIGEST_BYTES = 256 * 1024 * 1024
 
 _active: list[dict[str, Signature]] = []
+
+
+def version(st: os.stat_result) -> tuple[int, int, int, int]:
+    """The key of a file's version by its ``stat``: size, mtime, inode and ctime (ns).
+
+    An edit in place can keep the size (a binary STL rescaled keeps its triangle count) and put
+    the mtime back (``touch -r``, ``rsync -t``, ``tar``); the ctime still changes, and no call
+    can set it. Caches keyed by ``stat`` key by this.
+    """
+    return (st.st_size, st.st_mtime_ns, st.st_ino, st.st_ctime_ns)
+
+
+def settled(st: os.stat_result) -> bool:
+    """Whether a file last changed more than :data:`RACY_NS` ago.
+
+    Only then will its :func:`version` show its next change: an answer about a file not
+    settled is not kept on disk.
+    """
+    import time
+
+    return time.time_ns() - st.st_ctime_ns > RACY_NS
 
 
 def digest(path: str, size: int) -> str:
@@ -60,7 +86,10 @@ def signature(path: str) -> Signature:
     except (OSError, ValueError):
         return None
     if stat.S_ISREG(st.st_mode):
-        return (st.st_size, st.st_mtime_ns, st.st_ino, st.st_mode, digest(path, st.st_size))
+        # A file not settled signs with a ctime that matches nothing, so the next run compares
+        # its bytes: an edit within the clock's grain keeps the stat, never the digest.
+        return (st.st_size, st.st_mtime_ns, st.st_ino, st.st_mode,
+                st.st_ctime_ns if settled(st) else -1, digest(path, st.st_size))
     if stat.S_ISDIR(st.st_mode):
         return ("dir",)
     return ("other", st.st_mode)
@@ -139,8 +168,8 @@ def _unchanged(path: str, was: object) -> bool:
         return was is None
     if not stat.S_ISREG(st.st_mode):
         return was == (("dir",) if stat.S_ISDIR(st.st_mode) else ("other", st.st_mode))
-    if not (isinstance(was, tuple) and len(was) == 5):
+    if not (isinstance(was, tuple) and len(was) == 6):
         return False
-    if was[:4] == (st.st_size, st.st_mtime_ns, st.st_ino, st.st_mode):
+    if was[:5] == (st.st_size, st.st_mtime_ns, st.st_ino, st.st_mode, st.st_ctime_ns):
         return True  # the same stat: the same file, as git's index judges it
-    return bool(was[0] == st.st_size and was[4] and digest(path, st.st_size) == was[4])
+    return bool(was[0] == st.st_size and was[5] and digest(path, st.st_size) == was[5])

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, overload
 
+from urdfkit.core import deps
 from urdfkit.core.errors import EngineError
 from urdfkit.model.spec import MAX_STATE_LINKS
 
@@ -323,7 +324,7 @@ class Session:
         self.gui = gui
         self.diagnostics: list[str] = []
         self.client = -1
-        self._loaded: dict[str, tuple[int, int, int]] = {}  # path -> (size, mtime_ns, inode)
+        self._loaded: dict[str, tuple[int, int, int, int]] = {}  # path -> deps.version
         self.p: Any = import_pybullet()
         with quiet_stdout() as out:
             mode = self.p.GUI if gui else self.p.DIRECT
@@ -402,7 +403,7 @@ class Session:
             st = os.stat(path)
         except OSError:
             return
-        sig = (st.st_size, st.st_mtime_ns, st.st_ino)
+        sig = deps.version(st)
         if self._loaded.setdefault(path, sig) != sig:
             self._loaded[path] = sig
             self.call("setPhysicsEngineParameter", enableFileCaching=0)

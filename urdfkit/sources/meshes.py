@@ -24,6 +24,7 @@ import struct
 from pathlib import Path
 from typing import Any
 
+from urdfkit.core import deps
 from urdfkit.core.errors import InputError
 from urdfkit.model.spec import axis_angle_matrix
 from urdfkit.sources.meshdata import MAX_MESH_BYTES, Integrals
@@ -724,7 +725,7 @@ def undrawn_visual(path: Path | str) -> str | None:
         st = os.stat(path)
     except OSError:
         return None  # missing or unreadable: U701, U704, said by the references
-    key = (os.fspath(path), st.st_size, st.st_mtime_ns, st.st_ino)
+    key = (os.fspath(path), *deps.version(st))
     if key not in _UNDRAWN:
         if len(_UNDRAWN) > 4096:
             _UNDRAWN.clear()
@@ -733,7 +734,7 @@ def undrawn_visual(path: Path | str) -> str | None:
 
 
 #: :func:`undrawn_visual`'s answers, by path and stat.
-_UNDRAWN: dict[tuple[str, int, int, int], str | None] = {}
+_UNDRAWN: dict[tuple[str, int, int, int, int], str | None] = {}
 
 
 def _undrawn(path: Path | str) -> str | None:

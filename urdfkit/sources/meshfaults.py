@@ -35,6 +35,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from urdfkit.core import deps
 from urdfkit.core.errors import InputError
 
 #: The largest mesh scanned for a crash. PyBullet reads a larger one as well, so the limit is
@@ -54,12 +55,12 @@ def _remembered(path: str, st: os.stat_result | None, question: tuple[object, ..
             st = os.stat(path)
         except (OSError, ValueError):
             return None  # missing or unreadable: the reference says so (U701, U704)
-    key = (path, st.st_size, st.st_mtime_ns, st.st_ino, *question)
+    key = (path, *deps.version(st), *question)
     found = _ANSWERS.get(key, _UNSEEN)
     if found is _UNSEEN:
         if len(_ANSWERS) > 4096:
             _ANSWERS.clear()
-        found = _ANSWERS[key] = _stored(key, answer)
+        found = _ANSWERS[key] = _stored(key, answer, deps.settled(st))
     return found
 
 
@@ -70,11 +71,12 @@ def _remembered(path: str, st: os.stat_result | None, question: tuple[object, ..
 _FOLDER = "mesh-faults-1"
 
 
-def _stored(key: tuple[object, ...], answer: Callable[[], str | None]) -> str | None:
+def _stored(key: tuple[object, ...], answer: Callable[[], str | None], keep: bool
+            ) -> str | None:
     """``answer()`` from the cache folder when a run before worked it out, else worked out.
 
-    What is worked out is kept; a file's version is in the key, as in the mesh cache's, so an
-    edited mesh misses.
+    What is worked out is kept if ``keep`` (the file is settled: :func:`urdfkit.core.deps.
+    settled`); a file's version is in the key, as in the mesh cache's, so an edited mesh misses.
     """
     import hashlib
 
@@ -88,7 +90,7 @@ def _stored(key: tuple[object, ...], answer: Callable[[], str | None]) -> str | 
         if data is not None:
             return None if data == b"-" else data.decode("utf-8", "replace")
     found = answer()
-    if entry is not None:
+    if entry is not None and keep:
         write_entry(entry, b"-" if found is None else found.encode("utf-8"))
     return found
 

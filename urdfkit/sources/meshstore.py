@@ -87,13 +87,17 @@ def stated(name: str, st: os.stat_result,
     # An absolute name is its own key (normalizing it would cost more than the rare second
     # entry a spelling like "a/../m.stl" makes).
     where = name if name.startswith(_ROOT) else os.path.abspath(name)
-    key = f"{where}\0{st.st_size}\0{st.st_mtime_ns}\0{st.st_ino}"
+    key = where + "".join(f"\0{n}" for n in deps.version(st))
     found = _MEMORY.get(key, _MISSING)
     if found is _MISSING or (concavity and isinstance(found, Integrals)
                              and math.isnan(found.concavity)):
-        found = _MEMORY[key] = _integrals(Path(name), mesh_suffix(name), key, concavity)
+        keep = deps.settled(st)
+        found = _MEMORY[key] = _integrals(Path(name), mesh_suffix(name), key, concavity, keep)
+    else:
+        keep = key in USED or deps.settled(st)
     assert found is None or isinstance(found, Integrals)
-    USED[key] = found
+    if keep:  # packed for the next run
+        USED[key] = found
     return found.scaled(scale) if found is not None else None
 
 
@@ -185,8 +189,13 @@ def save_pack(paths: Sequence[str]) -> bool:
     return True
 
 
-def _integrals(path: Path, suffix: str, key: str, concavity: bool) -> Integrals | None:
-    """The integrals of a mesh missing from memory: its cache entry, else the mesh read."""
+def _integrals(path: Path, suffix: str, key: str, concavity: bool,
+               keep: bool) -> Integrals | None:
+    """The integrals of a mesh missing from memory: its cache entry, else the mesh read.
+
+    ``keep``: whether the mesh is settled (:func:`urdfkit.core.deps.settled`); one changed
+    within the clock's grain is read and not written to the cache.
+    """
     import hashlib
 
     from urdfkit.sources import meshes  # the readers (numpy), on a miss only
@@ -207,7 +216,7 @@ def _integrals(path: Path, suffix: str, key: str, concavity: bool) -> Integrals 
                 if not (concavity and math.isnan(cached.concavity)):
                     return cached
     found = meshes.read_integrals(path, suffix, concavity=concavity)
-    if entry is not None:
+    if entry is not None and keep:
         write_entry(entry, found.pack() if found is not None else _ENTRY + b"-")
     return found
 
