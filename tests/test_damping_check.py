@@ -121,3 +121,18 @@ def test_joints_unstable_together_though_not_alone_are_found(pb) -> None:
     scale = float(re.search(r"damping under ([0-9.e+-]+) of what it is", message).group(1))
     _, settled = _raw_coupled(pb, 0.9 * scale)
     assert all(abs(s[1]) <= 0.0101 for s in settled), settled  # decays, without flipping
+
+
+def test_a_damped_joint_without_a_child_is_a_finding_not_a_crash(tmp_path: Path) -> None:
+    # Found by the fuzz campaign (10 of 1,500 mutants): U311 walked the links below a joint
+    # from its <child>, which the mutant had lost.
+    text = STIFF.read_text()
+    cut = re.sub(r"<child link=\"[^\"]*\"\s*/>", "", text, count=1)
+    assert cut != text and "damping" in cut
+    path = tmp_path / "no_child.urdf"
+    path.write_text(cut)
+    r = runner.invoke(app, ["check", str(path), "--json"])
+    assert r.exit_code == 1, r.output
+    assert "U201" in {f["code"] for f in json.loads(r.stdout)["findings"]}
+    r = runner.invoke(app, ["fix", str(path), "--diff"])
+    assert r.exit_code in (0, 1), r.output

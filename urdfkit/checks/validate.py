@@ -18,7 +18,7 @@ from typing import Any, cast
 
 from lxml import etree
 
-from urdfkit.model.index import Doc, LinkView, collision_parts, first
+from urdfkit.model.index import Doc, JointView, LinkView, collision_parts, first
 from urdfkit.model.spec import (
     EXTENSIONS,
     LIMITED_JOINT_TYPES,
@@ -1080,7 +1080,7 @@ def _unit_axis(jv: Any) -> tuple[float, ...] | None:
     return None if norm == 0 else tuple(x / norm for x in axis)
 
 
-def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[Any]],
+def _joint_inertia(jv: JointView, links: dict[str, LinkView], below: dict[str, list[Any]],
                    enough: float = math.inf) -> float | None:
     """``M_ii`` of joint ``jv`` at the zero pose, as PyBullet loads the file with its inertia.
 
@@ -1094,7 +1094,7 @@ def _joint_inertia(jv: Any, links: dict[str, LinkView], below: dict[str, list[An
     prismatic = jv.type == "prismatic"
     # frames relative to the joint's own (its child link's frame at q = 0)
     todo: list[tuple[str | None, Matrix3, tuple[float, ...]]] = [
-        (jv.child.get("link"), _IDENTITY, (0.0, 0.0, 0.0))]
+        (jv.child.get("link") if jv.child is not None else None, _IDENTITY, (0.0, 0.0, 0.0))]
     seen: set[str] = set()
     total = 0.0
     while todo:

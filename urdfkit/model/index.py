@@ -148,13 +148,13 @@ class JointView:
         self.el = el
         self.name: str | None = el.get("name")
         self.type: str | None = el.get("type")
-        self.parent: El
-        self.child: El
+        self.parent: El | None
+        self.child: El | None
         self.children: list[El]
-        self.limit: El
-        self.axis: El
-        self.origin: El
-        self.mimic: El
+        self.limit: El | None
+        self.axis: El | None
+        self.origin: El | None
+        self.mimic: El | None
         (self.parent, self.child, self.children, self.limit, self.axis, self.origin,
          self.mimic) = _joint_parts(el)
 
