@@ -25,7 +25,6 @@ mechanism does, so a gripper's mirrored fingers are never posed into each other 
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,7 +35,7 @@ from lxml import etree
 from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.engine.joints import JointInfo, base_link_name, joint_table, pose_joints
 from urdfkit.engine.session import Bullet, LoadOptions, Session
-from urdfkit.model.spec import ignored_shape
+from urdfkit.model.spec import atof, ignored_shape, numbers
 from urdfkit.model.xmlio import children, line_of
 from urdfkit.sources.resolve import Resolved
 
@@ -241,18 +240,7 @@ _PLACING = (("joint/origin", ("xyz", "rpy")), ("joint/axis", ("xyz",)),
             ("link/collision/geometry/capsule", ("radius", "length")),
             ("link/collision/geometry/mesh", ("scale",)))
 
-
-#: A number as C's atof reads the start of a token (PyBullet's URDF parser reads each
-#: space-separated token so, and 0 where none starts it: "$(optenv" is 0, "0.3)" is 0.3).
-_ATOF = re.compile(r"[+-]?(?:inf(?:inity)?|nan|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)", re.I)
-
-
 _VECTORS = frozenset({"xyz", "rpy", "size", "scale"})
-
-
-def _atof(token: str) -> float:
-    match = _ATOF.match(token)
-    return float(match.group()) if match else 0.0
 
 
 def _refuse_non_finite(resolved: Resolved) -> list[str]:
@@ -276,20 +264,16 @@ def _refuse_non_finite(resolved: Resolved) -> list[str]:
                 text = el.get(attr)
                 if text is None:
                     continue
-                values = [_atof(x) for x in text.split()]
+                values = [atof(x) for x in text.split()]
                 shown = text if len(text) <= 60 else f"{text[:60]}... ({len(text)} characters)"
                 if el.tag == "mimic":  # urdfkit's own sampler reads it, not PyBullet: numbers only
-                    try:
-                        values = [float(x) for x in text.split()]
-                    except ValueError:
-                        values = [math.nan]
+                    plain = numbers(text)
+                    values = plain if plain is not None else [math.nan]
                 if not all(map(math.isfinite, values)):
                     raise InputError(f"<{el.tag} {attr}={shown!r}> is not a finite number; "
                                      "collisions cannot place or size a shape with it",
                                      file=resolved.name, line=line_of(el))
-                try:
-                    [float(x) for x in text.split()]
-                except ValueError:
+                if numbers(text) is None:
                     # Vectors take the first three tokens (measured), a scalar the first.
                     used = values[:3] if attr in _VECTORS else values[:1]
                     read = " ".join(f"{v:g}" for v in used)

@@ -27,6 +27,7 @@ from urdfkit.model.spec import (
     SOLIDS,
     WORLD_LINK,
     Matrix3,
+    atof,
     default_mass,
     extension_note,
     matmul,
@@ -102,6 +103,18 @@ def _mass_of(link: LinkView) -> float | None:
     return _num(link.mass, "value")
 
 
+def _loaded_mass(link: LinkView) -> float | None:
+    """:func:`_mass_of`, with a malformed number read as PyBullet reads it (C's atof).
+
+    ``"abc"`` is 0 kg to PyBullet, ``"nan"`` NaN: only a mass it reads as 0 makes U602 and
+    U611 true (U401 says the number is malformed).
+    """
+    mass = _mass_of(link)
+    if mass is None and link.mass is not None and (text := link.mass.get("value")) is not None:
+        return atof(text.strip())
+    return mass
+
+
 def rule_mass(root: etree._Element, r: RuleReport) -> None:
     """U601-U602, U606: mass >= 0, > 0 on links that move; warn on missing <inertial>."""
     doc = r.doc(root)
@@ -149,7 +162,7 @@ def rule_mass(root: etree._Element, r: RuleReport) -> None:
     # children weigh (a mass-0 base_footprint over a 28 kg base_link hangs in the air). A
     # root with no <inertial> gets 1 kg, so it moves (U606 says so).
     # A root named world without <inertial> gets mass 0 from PyBullet (measured), so it too.
-    own = _mass_of(roots[0]) if len(roots) == 1 and (
+    own = _loaded_mass(roots[0]) if len(roots) == 1 and (
         roots[0].inertial is not None or roots[0].name == WORLD_LINK) else None
     if own is not None and own == 0:
         base, static = roots[0].el, not moving
@@ -184,7 +197,8 @@ def _rigid_mass(name: str, views: dict[str, LinkView],
         if n in seen or n not in views:
             continue
         seen.add(n)
-        total += max(0.0, _mass_of(views[n]) or 0.0)
+        mass = _loaded_mass(views[n]) or 0.0
+        total += 0.0 if mass < 0 else mass  # NaN stays NaN: not a mass of 0
         stack.extend(fixed_children.get(n, []))
     return total
 

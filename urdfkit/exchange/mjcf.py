@@ -505,8 +505,12 @@ class _Writer:
         line = link.inertial.line or link.line
         if not (math.isfinite(m.mass) and np.isfinite(m.com).all()
                 and np.isfinite(m.tensor).all()):
+            nan = math.isnan(m.mass) or np.isnan(m.com).any() or np.isnan(m.tensor).any()
+            what = ("are not numbers (NaN) as PyBullet loads them: a mass, origin or inertia "
+                    "written nan, or infinities that cancel (urdfkit check names it, U401)"
+                    if nan else "overflow a double")
             raise InputError(f"the mass properties of link {name!r} (with the links fused into "
-                             "it) overflow a double; MuJoCo cannot use them",
+                             f"it) {what}; MuJoCo cannot use them",
                              file=self.robot.file, line=line)
         if not moving:
             return

@@ -12,14 +12,15 @@ lateral friction 0.5 unless ``<contact>`` says otherwise, and the first shape of
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 from typing import Any
 
 from urdfkit.core.errors import InputError
 from urdfkit.model.spec import (
+    atof,
     attr_float,
     attr_vec,
+    c_number,
     depth_first,
     matmul,
     rpy_to_matrix,
@@ -145,18 +146,8 @@ class Robot:
         """The joints with degrees of freedom, in PyBullet's order."""
         return [j for j in self.joints if j.moves]
 
-
-#: A number as C's atof reads the start of a token: PyBullet's URDF parser reads each
-#: space-separated token of a vector so, 0 where none starts it ("$(optenv" is 0, "0.3)" is
-#: 0.3), and takes the first three (checks/collisions.py reads them the same way, measured).
-_ATOF = re.compile(r"[+-]?(?:inf(?:inity)?|nan|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)", re.I)
 #: Vectors read PyBullet's way that were not plain numbers: (element, attribute, values).
 _ODD: list[tuple[Any, str, tuple[float, ...]]] = []
-
-
-def _atof(token: str) -> float:
-    match = _ATOF.match(token)
-    return float(match.group()) if match else 0.0
 
 
 def _scalar(el: Any, attr: str, default: float) -> float:
@@ -172,7 +163,7 @@ def _scalar(el: Any, attr: str, default: float) -> float:
     text = el.get(attr) if el is not None else None
     if text is None:
         return default
-    value = _atof(text.strip())
+    value = atof(text.strip())
     if not math.isfinite(value):
         return default
     _ODD.append((el, attr, (value,)))
@@ -186,7 +177,7 @@ def _vec3(el: Any, attr: str, default: Vec = (0.0, 0.0, 0.0)) -> Vec:
     text = el.get(attr) if el is not None else None
     if text is None:
         return default
-    values = [_atof(x) for x in text.split()]
+    values = [atof(x) for x in text.split()]
     if len(values) < 3:  # PyBullet: "Couldn't parse vector3", the default kept
         return default
     out = (values[0], values[1], values[2])
@@ -325,10 +316,8 @@ def _joint(el: Any) -> Joint:
 
 def _non_finite(text: str | None) -> bool:
     """Whether an attribute is one number that is not finite (inf, nan, 1e309)."""
-    try:
-        return text is not None and not math.isfinite(float(text))
-    except ValueError:
-        return False
+    x = c_number(text.strip()) if text is not None else None
+    return x is not None and not math.isfinite(x)
 
 
 def read_robot(root: Any, file: str) -> Robot:

@@ -30,6 +30,7 @@ from urdfkit.model.spec import (
     NUMERIC,
     OPAQUE,
     SCHEMA,
+    is_hex,
     numbers,
     used_shape,
 )
@@ -442,6 +443,11 @@ def _verdict(tag: str, items: list[tuple[str, str]]) -> tuple[tuple[str, str, st
             if vals is None or not all(map(math.isfinite, vals)):
                 out.append(("U401", "error", f"<{tag} {attr}={text!r}>: expected "
                             f"{'a finite number' if n == 1 else f'{n} finite numbers'}"))
+            elif is_hex(text):
+                read = " ".join(f"{v:.17g}" for v in vals)
+                out.append(("U401", "warning", f"<{tag} {attr}={text!r}>: C hexadecimal "
+                            f"notation; PyBullet reads {read}, but urdfdom (ROS), Python and "
+                            f"most URDF readers refuse it: write {read}"))
             elif len(vals) != n:
                 out.append(("U402", "error", f"<{tag} {attr}={text!r}>: expected {n} numbers, "
                             f"got {len(vals)}"))

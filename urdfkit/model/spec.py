@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from collections.abc import Callable, Hashable, Mapping, Sequence
 from typing import Any, Literal, Protocol, TypeVar
 
@@ -331,18 +332,63 @@ def finite(value: Any) -> float:
     return x
 
 
+# PyBullet 3.2.7 reads every number of a URDF with C's atof (strtod): a token is read as far
+# as a number goes, 0 where none starts it (measured: mass "8abc" is 8 kg, "0x1p3" 8 kg, "1_0"
+# 1 kg, "８" 0). Python's float() differs both ways: it refuses C's hexadecimal numbers and
+# takes "1_0" as 10 and other scripts' digits, so no number here is read by float() alone.
+
+#: A C hexadecimal floating number, whole (strtod's grammar; float.fromhex reads it).
+_C_HEX = re.compile(r"[+-]?0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)(?:[pP][+-]?[0-9]+)?")
+#: The start of a token as C's atof reads it: hexadecimal, infinity, NaN or decimal.
+_C_PREFIX = re.compile(r"[+-]?(?:0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)"
+                       r"(?:[pP][+-]?[0-9]+)?|inf(?:inity)?|nan|(?:[0-9]+\.?[0-9]*|\.[0-9]+)"
+                       r"(?:[eE][+-]?[0-9]+)?)", re.IGNORECASE)
+
+
+def c_number(token: str) -> float | None:
+    """A whole token as C's strtod reads it (decimal, hexadecimal, inf, nan), else None.
+
+    None for a token strtod reads only part of (``8abc``, ``1_0``): what
+    :func:`atof` makes of it is not what it says.
+    """
+    if token.isascii() and "_" not in token:
+        try:  # the common case: Python's and C's grammars agree on ASCII without "_"
+            return float(token)
+        except ValueError:
+            if _C_HEX.fullmatch(token):
+                return float.fromhex(token)
+    return None
+
+
+def atof(token: str) -> float:
+    """A token as PyBullet reads it: C's atof of its start, 0 where no number starts it."""
+    match = _C_PREFIX.match(token)
+    if match is None:
+        return 0.0
+    text = match.group()
+    return float.fromhex(text) if "x" in text or "X" in text else float(text)
+
+
+def is_hex(text: str) -> bool:
+    """Whether ``text`` holds a C hexadecimal number (PyBullet reads it; most readers do not)."""
+    return ("x" in text or "X" in text) and any(map(_C_HEX.fullmatch, text.split()))
+
+
 def numbers(text: str | None) -> list[float] | None:
     """The whitespace-separated numbers in ``text``; None when absent or malformed.
 
-    Non-finite values (``nan``, ``inf``) parse; callers that need finite ones use
-    :func:`vector`.
+    Each is read by :func:`c_number`. Non-finite values (``nan``, ``inf``) parse; callers that
+    need finite ones use :func:`vector`.
     """
     if text is None:
         return None
-    try:
-        return [float(x) for x in text.split()]
-    except ValueError:
-        return None
+    out = []
+    for token in text.split():
+        x = c_number(token)
+        if x is None:
+            return None
+        out.append(x)
+    return out
 
 
 def vector(text: str | None, n: int) -> tuple[float, ...] | None:
@@ -356,10 +402,8 @@ def vector(text: str | None, n: int) -> tuple[float, ...] | None:
     found = _VECTORS.get(key, _NONE)
     if found is not _NONE:
         return found
-    try:
-        vals: tuple[float, ...] | None = tuple(map(float, text.split()))
-    except ValueError:
-        vals = None
+    listed = numbers(text)
+    vals = tuple(listed) if listed is not None else None
     if vals is not None and (len(vals) != n or not all(map(math.isfinite, vals))):
         vals = None
     if len(_VECTORS) >= _VECTORS_MAX:
@@ -388,11 +432,8 @@ def attr_float(el: _HasGet | None, attr: str, default: float | None = None) -> f
     text = el.get(attr) if el is not None else None
     if text is None:
         return default
-    try:  # the common case, one plain number, without splitting (checks are a hot path)
-        x = float(text)
-    except ValueError:
-        return default
-    return x if math.isfinite(x) else default
+    x = c_number(text.strip())
+    return x if x is not None and math.isfinite(x) else default
 
 
 # --------------------------------------------------------------------------- rotations

@@ -21,6 +21,8 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from urdfkit.model.spec import c_number
+
 if TYPE_CHECKING:
     from lxml import etree
 
@@ -43,11 +45,9 @@ class Mimic:
 
 
 def _number(text: str | None, default: float) -> float:
-    try:
-        x = float(text) if text is not None else default
-    except ValueError:
-        return default
-    return x if math.isfinite(x) else default
+    """A finite number as PyBullet would read it (:func:`~urdfkit.model.spec.c_number`)."""
+    x = c_number(text.strip()) if text is not None else default
+    return x if x is not None and math.isfinite(x) else default
 
 
 def mimic_relations(root: etree._Element) -> list[Mimic]:
