@@ -178,6 +178,8 @@ CASES = [
     ("U802", doc(link("a", body='<collision><geometry>\n<box size="1 1 1" colour="red"/>'
                                 '<!--HERE-->\n</geometry></collision>'))),
     ("U803", doc(A, '<gazebo reference="a"><!--HERE-->\n<mu1>0.9</mu1></gazebo>')),
+    ("U804", doc(link("a", body=BOX + '<contact>\n<stiffness value="0"/><!--HERE-->\n'
+                                '<damping value="1"/></contact>'))),
     ("U901", doc(A, B, joint(jtype="spherical", inner="") + "<!--HERE-->")),
 ]
 

@@ -170,3 +170,60 @@ def test_one_way_grip_is_carried_as_the_larger_so_the_robot_drives(pb, tmp_path:
     findings = json.loads(_run("check", str(ONE_WAY), "--json")[1])["findings"]
     notes = [f["message"] for f in findings if f["code"] == "U803"]
     assert len(notes) == 4 and all("fix writes the larger, 1" in m for m in notes)
+
+
+BOX_ON_GAZEBO = """<robot name="box"><link name="box">
+  <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>
+  </inertial>
+  <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+  <gazebo reference="box"><mu1>{mu}</mu1><mu2>{mu}</mu2><kp>{kp}</kp><kd>{kd}</kd></gazebo>
+</robot>
+"""
+
+
+def _rest_height(pb, path: Path, seconds: float = 2.0) -> float:
+    """Raw PyBullet: the box set on plane.urdf; its height after ``seconds``."""
+    import pybullet_data
+
+    p, c = pb
+    p.resetSimulation(physicsClientId=c)
+    p.setGravity(0, 0, -G, physicsClientId=c)
+    p.loadURDF(str(Path(pybullet_data.getDataPath()) / "plane.urdf"), physicsClientId=c)
+    body = p.loadURDF(str(path), [0, 0, 0.1], physicsClientId=c)
+    for _ in range(int(240 * seconds)):
+        p.stepSimulation(physicsClientId=c)
+    return p.getBasePositionAndOrientation(body, physicsClientId=c)[0][2]
+
+
+@pytest.mark.parametrize(("kp", "kd", "mu"), [("0", "1", "0.8"), ("-1e5", "1", "0.8"),
+                                              ("1e-310", "1", "0.8"), ("1e5", "-5", "-0.8")])
+def test_values_that_are_no_contact_are_refused_and_named(pb, tmp_path: Path, kp: str, kd: str,
+                                                         mu: str) -> None:
+    # A fuzzed or mistyped block: fix once wrote stiffness 0 and the box fell 13.7 m through
+    # plane.urdf in 2 s, and check was clean afterwards.
+    path = tmp_path / "box.urdf"
+    path.write_text(BOX_ON_GAZEBO.format(kp=kp, kd=kd, mu=mu))
+    out = tmp_path / "fixed.urdf"
+    code, text = _run("fix", str(path), "--gazebo-contacts", "-o", str(out), "--json")
+    assert code in (0, 1), text
+    if out.exists():  # what fix wrote holds the box up, as raw PyBullet shows
+        assert _rest_height(pb, out) == pytest.approx(0.1, abs=0.01)
+        written = etree.parse(str(out)).getroot().find("link/contact")
+        values = {c.tag: float(c.get("value")) for c in written} if written is not None else {}
+        assert "stiffness" not in values or values["stiffness"] > 0
+        assert all(v >= 0 for v in values.values())
+    # check names what it refuses, in the file as written and on the values written by hand
+    found = json.loads(_run("check", str(path), "--json")[1])["findings"]
+    u803 = " ".join(f["message"] for f in found if f["code"] == "U803")
+    assert "not carried" in u803 or "does not carry" in u803
+    contact = ('<contact><stiffness value="{kp}"/><damping value="{kd}"/>'
+               '<lateral_friction value="{mu}"/></contact>').format(kp=kp, kd=kd, mu=mu)
+    hand = tmp_path / "hand.urdf"
+    hand.write_text(BOX_ON_GAZEBO.format(kp=kp, kd=kd, mu=mu).replace(
+        "<collision>", contact + "<collision>"))
+    found = json.loads(_run("check", str(hand), "--json")[1])["findings"]
+    u804 = [f for f in found if f["code"] == "U804"]
+    assert u804 and all(f["line"] == 4 for f in u804)
+    if float(kp) < 2.3e-308:  # PyBullet: the box sinks; check says so
+        assert _rest_height(pb, hand) < -1.0
+        assert any("sinks" in f["message"] for f in u804)

@@ -422,7 +422,10 @@ class _Plan:
         kept = sorted(set(gz.pybullet()) - set(new))
         if not new:
             self.left.append(Repair("U803", line, f"link {name!r}: its <contact> already sets "
-                                    f"{', '.join(kept)}; left as written"))
+                                    f"{', '.join(kept)}; left as written" if kept else
+                                    f"link {name!r}: Gazebo's contact is not carried: "
+                                    + "; ".join(f"{k} {fmt_float(gz.given()[k])} is {why}"
+                                                for k, why in gz.refused.items())))
             return
         xml = "".join(f'<{k} value="{fmt_float(v)}"/>' for k, v in new.items())
         if contact is None:
@@ -433,16 +436,23 @@ class _Plan:
         for k, v in new.items():
             etree.SubElement(contact, k, value=fmt_float(v))
         said = ", ".join(f"{k} {fmt_float(v)}" for k, v in new.items())
-        source = ("the larger of mu1 and mu2 (the other is 0, which would leave no grip)"
-                  if gz.grip_only_one_way else
-                  "the smaller of mu1 and mu2" if gz.mu1 is not None and gz.mu2 is not None
-                  and gz.mu1 != gz.mu2 else "mu1" if gz.mu1 is not None else "mu2")
+        mu1, mu2 = (None if "mu1" in gz.refused else gz.mu1,
+                    None if "mu2" in gz.refused else gz.mu2)
+        source = [] if "lateral_friction" not in new else [
+            "lateral_friction from " + (
+                "the larger of mu1 and mu2 (the other is 0, which would leave no grip)"
+                if gz.grip_only_one_way else "the smaller of mu1 and mu2"
+                if mu1 is not None and mu2 is not None and mu1 != mu2
+                else "mu1" if mu1 is not None else "mu2")]
+        if "stiffness" in new:
+            source.append("stiffness and damping from kp and kd")
+        refused = [f"{k} {fmt_float(gz.given()[k])} ({why})" for k, why in gz.refused.items()]
         self.repairs.append(Repair(
             "U803", line, f"link {name!r}: wrote Gazebo's contact into <contact>: {said} "
-            f"(lateral_friction from {source}"
-            + (", stiffness and damping from kp and kd" if "stiffness" in new else "") + ")"
+            f"({', '.join(source)})"
             + (f"; kept its own {', '.join(kept)}" if kept else "")
-            + (f"; not carried: {', '.join(gz.not_carried)}" if gz.not_carried else "")))
+            + (f"; not carried: {', '.join(gz.not_carried)}" if gz.not_carried else "")
+            + (f"; refused: {'; '.join(refused)}" if refused else "")))
 
     def fix_link(self, link: etree._Element, codes: list[tuple[str, int | None]]) -> None:
         before = len(self.repairs)

@@ -1166,9 +1166,14 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
         want = gz.pybullet()
         differ = {k: v for k, v in want.items()
                   if not math.isclose(have.get(k, math.nan), v, rel_tol=1e-9)}
-        if not differ:
-            continue
         given = ", ".join(f"{k} {v:g}" for k, v in gz.given().items())
+        refused = "; ".join(f"{k} {gz.given()[k]:g} is {why}" for k, why in gz.refused.items())
+        if not differ:
+            if refused:
+                r.add("U803", "warning", f"<gazebo reference={name!r}> gives {label(link)} "
+                      f"{given}, which PyBullet ignores, and `urdfkit fix --gazebo-contacts` "
+                      f"does not carry: {refused}", gz.element)
+            continue
         parts = []
         if "lateral_friction" in differ:
             now = have.get("lateral_friction", PYBULLET_LATERAL_FRICTION)
@@ -1196,6 +1201,8 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
         if gz.not_carried:
             notes.append("not carried: " + "; ".join(f"{k} ({NOT_CARRIED[k]})"
                                                      for k in gz.not_carried))
+        if refused:
+            notes.append(f"not carried: {refused}")
         written = ", ".join(f"{k} {v:g}" for k, v in differ.items())
         r.add("U803", "warning", f"<gazebo reference={name!r}> gives {label(link)} {given}, "
               f"which PyBullet ignores: it loads {' and '.join(parts)}; `urdfkit fix "
@@ -1203,6 +1210,28 @@ def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:
               "multiplies the two bodies' friction: on a ground of lateral friction 1, such "
               "as plane.urdf, the contact has the link's)" + "".join(f"; {n}" for n in notes),
               gz.element)
+
+
+def rule_contact_values(root: etree._Element, r: RuleReport) -> None:
+    """U804: ``<contact>`` values that are no contact (:func:`urdfkit.model.gazebo.unusable`).
+
+    A stiffness of 0, negative or subnormal (PyBullet loads 2.2e-16 N/m and the link sinks
+    through the ground), negative damping or friction.
+    """
+    from urdfkit.model.gazebo import unusable
+
+    for view in r.doc(root).links:
+        contact = first(view.el, "contact")
+        if contact is None:
+            continue
+        for child in contact:
+            if not isinstance(child.tag, str):
+                continue
+            value = _num(child, "value")
+            why = unusable(child.tag, value) if value is not None else None
+            if why is not None:
+                r.add("U804", "warning", f"<contact><{child.tag} value={child.get('value')!r}> "
+                      f"of {label(view.el)}: {why}", child)
 
 
 def _contact_values(link: etree._Element) -> dict[str, float]:
@@ -1241,7 +1270,8 @@ _SHAPE_NOTES = {key.partition(":")[2]: note for key, note in EXTENSIONS.items()
 ALL_RULES: tuple[Rule, ...] = (*GUARD_RULES, rule_link_count, rule_elements, rule_mass,
                                rule_inertia, rule_meshes, rule_mesh_crashes, rule_mesh_shapes,
                                rule_visual_meshes, rule_references, rule_material_colours,
-                               rule_mimic, rule_damping, rule_gazebo_contacts, rule_portability)
+                               rule_mimic, rule_damping, rule_gazebo_contacts, rule_contact_values,
+                               rule_portability)
 
 #: Every finding code with a one-line summary (for ``--select``/``--ignore`` and the docs).
 CODES: dict[str, str] = {
@@ -1326,6 +1356,8 @@ CODES: dict[str, str] = {
     "U801": "unknown tag",
     "U802": "unknown attribute",
     "U803": "Gazebo contact parameters (mu1, mu2, kp, kd) PyBullet ignores (fix --gazebo-contacts)",
+    "U804": "<contact> that is no contact: stiffness not positive (the link sinks), negative "
+            "damping or friction",
     "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
     "U950": "links in contact at the zero pose (check --physics: self-collision jitters)",
     "U951": "PyBullet cannot load the file (check --physics)",

@@ -28,6 +28,10 @@ What carries over to PyBullet's ``<contact>`` (:meth:`GazeboContact.pybullet`):
   both engines (ERP = h kp / (h kp + kd), CFM = 1 / (h kp + kd) at time step h), so the
   mapping is one to one; written only when both are given (PyBullet's contact spring takes
   the pair).
+- **Refused** (:func:`unusable`): values that are no contact at all, as a fuzzed or mistyped
+  block gives them: a stiffness of 0, negative or subnormal (PyBullet loads it as 2.2e-16 N/m
+  and the link sinks through the ground), a negative damping or friction. Check and fix name
+  them; fix writes the rest.
 - **Not carried** (:data:`NOT_CARRIED`): ``fdir1`` (PyBullet's anisotropic friction is set
   at run time, not in a URDF), ``slip1``/``slip2`` (force-dependent slip; PyBullet has none),
   ``minDepth`` and ``maxVel`` (per-link penetration and correction speed; PyBullet's are
@@ -39,6 +43,7 @@ Nothing here imports lxml: elements are read through ``get``, ``tag``, ``text``,
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -59,6 +64,29 @@ NOT_CARRIED = {
     "torsional": "torsional friction: PyBullet's spinning friction means another thing",
     "bounce": "restitution with a velocity threshold: not mapped",
 }
+#: The smallest contact stiffness PyBullet keeps (N/m): a stiffness of 0, negative or subnormal
+#: loads as 2.2e-16 (DBL_EPSILON), a contact that holds nothing up (measured on 3.2.7: a 1 kg
+#: box written so falls 3.9 m through plane.urdf in 2 s).
+MIN_STIFFNESS = sys.float_info.min
+
+
+def unusable(name: str, value: float) -> str | None:
+    """Why a contact parameter cannot be carried to PyBullet, or None if it can.
+
+    ``name`` is a Gazebo name (mu1, mu2, kp, kd) or a ``<contact>`` child's tag.
+    """
+    if name in ("mu1", "mu2", "lateral_friction", "rolling_friction", "spinning_friction"):
+        if value < 0:
+            return "a negative friction coefficient, which means nothing (PyBullet uses its size)"
+    elif name in ("kp", "stiffness"):
+        if not value >= MIN_STIFFNESS:
+            return ("not a positive stiffness: PyBullet loads it as 2.2e-16 N/m, a contact that "
+                    "holds nothing up, and the link sinks through the ground")
+    elif name in ("kd", "damping") and value < 0:
+        return "a negative contact damping, which adds energy at every contact"
+    return None
+
+
 #: The SDF names of the parameters read (``mu`` under ``<friction><ode>`` is mu1).
 _SDF_NAMES = {"mu": "mu1", "mu2": "mu2", "kp": "kp", "kd": "kd"}
 
@@ -73,6 +101,8 @@ class GazeboContact:
         mu1, mu2: Friction coefficients (None when not given).
         kp, kd: Contact stiffness (N/m) and damping (N s/m).
         not_carried: Names of other contact parameters given, which PyBullet cannot take.
+
+    A value :func:`unusable` refuses is not carried (:attr:`refused` says why).
     """
 
     link: str
@@ -84,13 +114,22 @@ class GazeboContact:
     not_carried: list[str] = field(default_factory=list)
 
     @property
+    def refused(self) -> dict[str, str]:
+        """The given values that cannot be carried, {name: why} (:func:`unusable`)."""
+        return {k: why for k, v in self.given().items() if (why := unusable(k, v)) is not None}
+
+    def _usable(self, name: str) -> float | None:
+        value = getattr(self, name)
+        return None if value is None or unusable(name, value) is not None else value
+
+    @property
     def lateral_friction(self) -> float | None:
         """PyBullet's one coefficient for mu1 and mu2: the smaller when they differ.
 
         The larger when the smaller is 0: a coefficient of 0 in every direction is no grip
         where Gazebo grips (:attr:`grip_only_one_way`).
         """
-        given = [m for m in (self.mu1, self.mu2) if m is not None]
+        given = [m for m in (self._usable("mu1"), self._usable("mu2")) if m is not None]
         if not given:
             return None
         return max(given) if self.grip_only_one_way else min(given)
@@ -98,17 +137,18 @@ class GazeboContact:
     @property
     def grip_only_one_way(self) -> bool:
         """mu1 and mu2 are both given, one 0 and the other not (a wheel that only rolls)."""
-        return (self.mu1 is not None and self.mu2 is not None
-                and min(self.mu1, self.mu2) == 0 < max(self.mu1, self.mu2))
+        mu1, mu2 = self._usable("mu1"), self._usable("mu2")
+        return mu1 is not None and mu2 is not None and min(mu1, mu2) == 0 < max(mu1, mu2)
 
     def pybullet(self) -> dict[str, float]:
         """The ``<contact>`` children that carry these over: {tag: value}."""
         out: dict[str, float] = {}
         if self.lateral_friction is not None:
             out["lateral_friction"] = self.lateral_friction
-        if self.kp is not None and self.kd is not None:
-            out["stiffness"] = self.kp
-            out["damping"] = self.kd
+        kp, kd = self._usable("kp"), self._usable("kd")
+        if kp is not None and kd is not None:
+            out["stiffness"] = kp
+            out["damping"] = kd
         return out
 
     def given(self) -> dict[str, float]:
