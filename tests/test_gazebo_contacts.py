@@ -216,8 +216,8 @@ def test_values_that_are_no_contact_are_refused_and_named(pb, tmp_path: Path, kp
     found = json.loads(_run("check", str(path), "--json")[1])["findings"]
     u803 = " ".join(f["message"] for f in found if f["code"] == "U803")
     assert "not carried" in u803 or "does not carry" in u803
-    contact = ('<contact><stiffness value="{kp}"/><damping value="{kd}"/>'
-               '<lateral_friction value="{mu}"/></contact>').format(kp=kp, kd=kd, mu=mu)
+    contact = (f'<contact><stiffness value="{kp}"/><damping value="{kd}"/>'
+               f'<lateral_friction value="{mu}"/></contact>')
     hand = tmp_path / "hand.urdf"
     hand.write_text(BOX_ON_GAZEBO.format(kp=kp, kd=kd, mu=mu).replace(
         "<collision>", contact + "<collision>"))
