@@ -217,7 +217,7 @@ def _unloadable(root: etree._Element, base: Path, packages: Mapping[str, Path] |
         fn = (el.get("filename") or "").strip()
         if not fn or ignored_shape(el):
             continue
-        ref = reference(el.tag, fn, base, packages)
+        ref = reference(str(el.tag), fn, base, packages)
         if ref.level == "error" and ref.code is not None and (
                 el.tag in FILE_SHAPES or ref.code in ("U702", "U704")):
             return ref.code, ref.message

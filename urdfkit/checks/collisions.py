@@ -270,14 +270,14 @@ def _refuse_non_finite(resolved: Resolved) -> list[str]:
                     plain = numbers(text)
                     values = plain if plain is not None else [math.nan]
                 if not all(map(math.isfinite, values)):
-                    raise InputError(f"<{el.tag} {attr}={shown!r}> is not a finite number; "
+                    raise InputError(f"<{el.tag!s} {attr}={shown!r}> is not a finite number; "
                                      "collisions cannot place or size a shape with it",
                                      file=resolved.name, line=line_of(el))
                 if numbers(text) is None:
                     # Vectors take the first three tokens (measured), a scalar the first.
                     used = values[:3] if attr in _VECTORS else values[:1]
                     read = " ".join(f"{v:g}" for v in used)
-                    warnings.append(f"{resolved.name}:{line_of(el)}: <{el.tag} {attr}={shown!r}> "
+                    warnings.append(f"{resolved.name}:{line_of(el)}: <{el.tag!s} {attr}={shown!r}> "
                                     f"is not numbers (xacro left in a .urdf?): PyBullet reads "
                                     f"each token as a number or 0, so {read!r}")
     return warnings

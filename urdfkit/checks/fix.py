@@ -708,7 +708,7 @@ class _Plan:
                          for x in lines)
         if closed:  # <link name="x"/> becomes <link name="x"> ... </link>
             head = self.text[start:tag_end].rstrip(">").rstrip().rstrip("/").rstrip()
-            self.edits.append((start, tag_end, f"{head}>\n{body}\n{indent}</{parent.tag}>"))
+            self.edits.append((start, tag_end, f"{head}>\n{body}\n{indent}</{parent.tag!s}>"))
         else:
             self.edits.append((tag_end, tag_end, "\n" + body))
 
@@ -753,7 +753,7 @@ class _Plan:
         while True:
             m = _TOKEN.search(self.text, pos)
             if m is None:  # pragma: no cover - the document is well formed
-                raise AssertionError(f"no end of <{el.tag}>")
+                raise AssertionError(f"no end of <{el.tag!s}>")
             if m.group().startswith("</"):
                 depth -= 1
                 if depth == 0:

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
+
+if TYPE_CHECKING:
+    from urdfkit.exchange.mjcf import Export
 
 from urdfkit.commands import present as show
 from urdfkit.commands.shared import (
@@ -84,7 +87,7 @@ def agreement_report(a: Any, show_all: bool = False) -> None:
               + "; its link damping and velocity motors off for the swing", stderr=False)
 
 
-def _export_dict(file: str, e: Any, flags: list[str]) -> dict[str, Any]:
+def _export_dict(file: str, e: Export, flags: list[str]) -> dict[str, Any]:
     return {"file": file, "written": bool(e.paths), "paths": e.paths, "bodies": e.bodies,
             "sites": e.sites, "repaired": e.repaired, "mirrored_flags": flags,
             "notes": [{"kind": n.kind, "message": n.message, "line": n.line} for n in e.notes]}

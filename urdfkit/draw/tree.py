@@ -122,11 +122,13 @@ def kinematic_tree(root: etree._Element) -> TreeNode:
 
 
 def _child_link(j: etree._Element) -> str:
-    return str(j.find("child").get("link", ""))
+    el = j.find("child")
+    return el.get("link", "") if el is not None else ""
 
 
 def _parent_link(j: etree._Element) -> str:
-    return str(j.find("parent").get("link", ""))
+    el = j.find("parent")
+    return el.get("link", "") if el is not None else ""
 
 
 def _tree_joint(j: etree._Element, index: int) -> TreeJoint:

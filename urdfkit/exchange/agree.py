@@ -26,13 +26,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import EngineError, InputError, MissingDependencyError
 from urdfkit.exchange.agree_tree import match_models, tree_errors
 from urdfkit.exchange.fk import fused, link_frames
 from urdfkit.exchange.mjcf import combine
 from urdfkit.exchange.robot import Inertial, Robot
+
+if TYPE_CHECKING:
+    from urdfkit.engine.session import Session
 
 #: Tolerances (docs/export.md explains each).
 TOL_EXACT = 1e-12          # joint limits, damping (absolute); masses (relative)
@@ -193,7 +196,8 @@ def _name(m: Any, kind: Any, i: int) -> str:
 class _Pybullet:
     """The URDF in PyBullet: a floating load for masses, a fixed one for the rest."""
 
-    def __init__(self, session: Any, path: str, display: str, options: AgreeOptions) -> None:
+    def __init__(self, session: Session, path: str, display: str, options: AgreeOptions
+                 ) -> None:
         from urdfkit.engine.session import LoadOptions
 
         load = LoadOptions(fixed_base=True, inertia_from_file=options.inertia_from_file,

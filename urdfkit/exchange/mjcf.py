@@ -14,12 +14,15 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.exchange.fk import fused, origin_matrix
 from urdfkit.exchange.mjcf_mesh import MeshAsset, mesh_asset, unusable
-from urdfkit.exchange.robot import Inertial, Link, Robot, Shape
+from urdfkit.exchange.robot import Inertial, Joint, Link, Robot, Shape
+
+if TYPE_CHECKING:
+    from lxml import etree
 
 #: ``--actuators`` choices.
 ACTUATORS = ("motor", "position", "velocity", "none")
@@ -133,7 +136,7 @@ def mat_to_quat(m: Any) -> tuple[float, float, float, float]:
     return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
 
 
-def _place(el: Any, t: Any) -> None:
+def _place(el: etree._Element, t: Any) -> None:
     """Set ``pos`` and ``quat`` of ``el`` from a 4x4 transform (left out when identity)."""
     if any(t[:3, 3]):
         el.set("pos", nums(t[:3, 3]))
@@ -313,7 +316,7 @@ class _Writer:
                       + ("" if visual else " it collides with") + ")", shape.line)
         return ok
 
-    def geom(self, body: Any, shape: Shape, at: Any, visual: bool, link: Link) -> None:
+    def geom(self, body: etree._Element, shape: Shape, at: Any, visual: bool, link: Link) -> None:
         if not self.sized(shape, visual, link):
             return
         t = at @ origin_matrix(shape.xyz, shape.rpy)
@@ -349,7 +352,8 @@ class _Writer:
                 g.set("condim", "4")
         body.append(g)
 
-    def shape_type(self, g: Any, body: Any, shape: Shape, link: Link, visual: bool) -> bool:
+    def shape_type(self, g: etree._Element, body: etree._Element, shape: Shape, link: Link,
+                   visual: bool) -> bool:
         """Set the geom's type and size (or mesh); False when it cannot be written."""
         if shape.kind == "box":
             g.set("type", "box")
@@ -380,7 +384,7 @@ class _Writer:
             g.set("mesh", name)
         return True
 
-    def static_root_body(self, body: Any) -> bool:
+    def static_root_body(self, body: etree._Element) -> bool:
         return body.get("name") == self.robot.root and self.static
 
     # ------------------------------------------------------------------ bodies
@@ -422,7 +426,7 @@ class _Writer:
                 self.joint(b, j)
             self.fill(b, j.child, members[j.child], where, moving=j.moves)
 
-    def fill(self, body: Any, name: str, links: list[str], where: dict[str, Any],
+    def fill(self, body: etree._Element, name: str, links: list[str], where: dict[str, Any],
              inertial: bool = True, moving: bool = True) -> None:
         """A body's inertial, geoms and sites, from the links fused into it."""
         robot = self.robot
@@ -567,7 +571,7 @@ class _Writer:
             raise InputError(f"{what}: PyBullet zeroes it and MuJoCo refuses the body it "
                              f"leaves ({hint})", file=self.robot.file, line=line)
 
-    def joint(self, body: Any, j: Any) -> None:
+    def joint(self, body: etree._Element, j: Joint) -> None:
         E = self.E
         if j.odd_limit:
             raise InputError(f"joint {j.name!r}: <limit {j.odd_limit}>: PyBullet loads a bound "

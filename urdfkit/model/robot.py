@@ -263,7 +263,7 @@ class _Ctx:
     def attr(self, el: etree._Element, name: str, required: bool = True) -> str | None:
         value = el.get(name)
         if value is None and required:
-            raise self.error(el, f"<{el.tag}> is missing attribute '{name}'")
+            raise self.error(el, f"<{el.tag!s}> is missing attribute '{name}'")
         return value
 
     def build(self, el: etree._Element, factory: Callable[..., Any], **kw: Any) -> Any:
@@ -286,7 +286,7 @@ class _Ctx:
         except ModelError as e:
             if not self.strict:
                 return as_written(raw)
-            raise self.error(el, f"<{el.tag} {name}>: {e.message}") from None
+            raise self.error(el, f"<{el.tag!s} {name}>: {e.message}") from None
 
 
 #: Checks of what identifies an element or holds the model together: never relaxed.
@@ -346,7 +346,7 @@ def _write_origin(parent: etree._Element, origin: Origin) -> None:
 
 def _parse_geometry(ctx: _Ctx, el: etree._Element | None, owner: etree._Element) -> Geometry:
     if el is None:
-        raise ctx.error(owner, f"<{owner.tag}> has no <geometry>")
+        raise ctx.error(owner, f"<{owner.tag!s}> has no <geometry>")
     elements = [c for c in el if isinstance(c.tag, str)]
     # PyBullet reads the first element as the shape and ignores what follows it (an <origin>
     # misplaced there, say); anything else is not one shape. Read leniently, the first
@@ -355,11 +355,11 @@ def _parse_geometry(ctx: _Ctx, el: etree._Element | None, owner: etree._Element)
     shapes = [c for c in elements if c.tag != "origin"]
     if not elements or (ctx.strict and (len(shapes) != 1 or elements[0] is not shapes[0])):
         raise ctx.error(el, f"<geometry> must hold exactly one shape, first, found "
-                        f"{', '.join(f'<{c.tag}>' for c in elements) or 'nothing'}")
+                        f"{', '.join(f'<{c.tag!s}>' for c in elements) or 'nothing'}")
     s = elements[0]
-    cls = SHAPE_CLASSES.get(s.tag)
+    cls = SHAPE_CLASSES.get(str(s.tag))
     if cls is None:
-        raise ctx.error(s, f"unknown shape <{s.tag}>; expected one of {', '.join(SHAPES)}")
+        raise ctx.error(s, f"unknown shape <{s.tag!s}>; expected one of {', '.join(SHAPES)}")
     if s.tag in SHAPE_SIZES:
         sizes = {a: ctx.attr(s, a, ctx.strict) if a == "size" else ctx.num(s, a)
                  for a in SHAPE_SIZES[s.tag]}
@@ -586,9 +586,9 @@ _JOINT_CHILDREN: tuple[tuple[str, str, Callable[..., Any], Callable[..., None]],
 
 def _parse_joint(ctx: _Ctx, el: etree._Element) -> Joint:
     parent, child, axis = el.find("parent"), el.find("child"), el.find("axis")
-    for tag, sub in (("parent", parent), ("child", child)):
-        if sub is None:
-            raise ctx.error(el, f"<joint name={el.get('name')!r}> has no <{tag} link=...>")
+    if parent is None or child is None:
+        tag = "parent" if parent is None else "child"
+        raise ctx.error(el, f"<joint name={el.get('name')!r}> has no <{tag} link=...>")
     kw: dict[str, Any] = {
         attr: None if (sub := el.find(tag)) is None else parse(ctx, sub)
         for tag, attr, parse, _ in _JOINT_CHILDREN
@@ -620,7 +620,7 @@ _KNOWN_TOP = ("link", "joint", "material")
 def _parse_robot(el: etree._Element, file: str, strict: bool = True) -> Robot:
     ctx = _Ctx(file, strict)
     if el.tag != "robot":
-        raise ctx.error(el, f"root element is <{el.tag}>, expected <robot>")
+        raise ctx.error(el, f"root element is <{el.tag!s}>, expected <robot>")
     robot = ctx.build(el, Robot, name=ctx.attr(el, "name"))
     for child in el:
         if not isinstance(child.tag, str):

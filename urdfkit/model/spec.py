@@ -314,7 +314,7 @@ def default_mass(link_name: str | None) -> float:
 
 
 class _HasGet(Protocol):
-    def get(self, key: str, default: Any = ...) -> Any: ...
+    def get(self, key: str, /) -> str | None: ...
 
 
 def finite(value: Any) -> float:

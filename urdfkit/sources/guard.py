@@ -141,10 +141,10 @@ def label(el: etree._Element) -> str:
     """How a message names an element: ``<link name='base'>``, long names cut short."""
     name = el.get("name")
     if name is None:
-        return f"<{el.tag}>"
+        return f"<{el.tag!s}>"
     if len(name) > 60:  # a 3,000-character name would drown the message
-        return f"<{el.tag} name={name[:40]!r}... ({len(name)} characters)>"
-    return f"<{el.tag} name={name!r}>"
+        return f"<{el.tag!s} name={name[:40]!r}... ({len(name)} characters)>"
+    return f"<{el.tag!s} name={name!r}>"
 
 
 #: Lifted by ``guard=False`` (``--no-guard``): refusals where the guard is stricter than
@@ -159,7 +159,7 @@ STRICTER = " (PyBullet 3.2.7 loads this, but the guard refuses it; `guard=False`
 def rule_document(root: etree._Element, r: RuleReport) -> None:
     """U001-U003: root is <robot>, has a name, and has links."""
     if root.tag != "robot":
-        r.add("U001", "error", f"root element is <{root.tag}>, expected <robot>", root)
+        r.add("U001", "error", f"root element is <{root.tag!s}>, expected <robot>", root)
         return
     if not root.get("name"):
         r.add("U002", "error", "<robot> has no name attribute; add name=\"...\"", root)
@@ -178,7 +178,7 @@ def rule_document(root: etree._Element, r: RuleReport) -> None:
 def _check_name(el: etree._Element, r: RuleReport) -> str | None:
     name = el.get("name")
     if name is None or not name.strip():
-        r.add("U101", "error", f"<{el.tag}> has no name; give it a unique name=\"...\"", el)
+        r.add("U101", "error", f"<{el.tag!s}> has no name; give it a unique name=\"...\"", el)
         return None
     _check_percent(el, name, r)
     _check_length(el, name, r)
@@ -206,10 +206,10 @@ def _check_length(el: etree._Element, name: str, r: RuleReport) -> None:
     if size <= MAX_NAME_BYTES:
         return
     # PyBullet's buffers count UTF-8 bytes, not characters: 700 'é' are 1,400 bytes.
-    crash = CRASH_NAME_BYTES.get(el.tag)
-    what = f"<{el.tag}> name is {size} bytes long ({len(name)} characters)"
+    crash = CRASH_NAME_BYTES.get(str(el.tag))
+    what = f"<{el.tag!s}> name is {size} bytes long ({len(name)} characters)"
     if crash is not None and size >= crash:
-        r.add("U106", "error", f"{what}; PyBullet crashes on {el.tag} names from {crash} bytes: "
+        r.add("U106", "error", f"{what}; PyBullet crashes on {el.tag!s} names from {crash} bytes: "
               f"keep names under {MAX_NAME_BYTES} bytes", el)
     else:
         r.add("U108", "error", f"{what}; keep names under {MAX_NAME_BYTES} bytes, as PyBullet's "
@@ -405,7 +405,7 @@ def rule_geometry(root: etree._Element, r: RuleReport) -> None:
     """U501-U506: one shape per <geometry>, first; positive sizes; meshes have a filename."""
     for view, part, geometry, _ in r.parts(root):
         if geometry is None:
-            r.add("U506", "error", f"<{part.tag}> of {label(view.el)} has no <geometry>, "
+            r.add("U506", "error", f"<{part.tag!s}> of {label(view.el)} has no <geometry>, "
                   "which PyBullet refuses; add one or remove the element", part)
     for geom in r.doc(root).geometries:
         # The common case, one child and a shape, has nothing for _sole_shape to say.
@@ -414,15 +414,15 @@ def rule_geometry(root: etree._Element, r: RuleReport) -> None:
             shape = _sole_shape(geom, r)
             if shape is None:
                 continue
-        for attr in SHAPE_SIZES.get(shape.tag, ()):
+        for attr in SHAPE_SIZES.get(str(shape.tag), ()):
             text = shape.get(attr)
             if text is None:
-                r.add("U501", "error", f"<{shape.tag}> has no {attr}; add {attr}=\"...\"",
+                r.add("U501", "error", f"<{shape.tag!s}> has no {attr}; add {attr}=\"...\"",
                       shape)
                 continue
             vals = numbers(text)
             if vals and all(math.isfinite(v) for v in vals) and min(vals) <= 0:
-                r.add("U501", "error", f"<{shape.tag} {attr}={text!r}>: sizes must be > 0",
+                r.add("U501", "error", f"<{shape.tag!s} {attr}={text!r}>: sizes must be > 0",
                       shape)
         if shape.tag in ("mesh", "cdf") and not (shape.get("filename") or "").strip():
             r.add("U503", "error", f"<{shape.tag}> has no filename", shape)
@@ -433,7 +433,7 @@ def _sole_shape(geom: etree._Element, r: RuleReport) -> etree._Element | None:
     elements = [c for c in geom if isinstance(c.tag, str)]
     shapes = [c for c in elements if c.tag in SHAPES]
     if shapes and elements[0].tag not in SHAPES:
-        r.add("U505", "error", f"<{elements[0].tag}> comes before the shape in <geometry>; "
+        r.add("U505", "error", f"<{elements[0].tag!s}> comes before the shape in <geometry>; "
               "PyBullet reads the first element as the shape and refuses the file",
               elements[0])
     for c in elements:
@@ -442,8 +442,9 @@ def _sole_shape(geom: etree._Element, r: RuleReport) -> etree._Element | None:
                   "it in the enclosing <visual> or <collision>", c)
     if len(shapes) != 1:
         owner = geom.getparent()
-        what = f"<{owner.tag}> of {label(owner.getparent())}" if owner is not None \
-            and owner.getparent() is not None else "<geometry>"
+        holder = owner.getparent() if owner is not None else None
+        what = f"<{owner.tag!s}> of {label(holder)}" if owner is not None \
+            and holder is not None else "<geometry>"
         if not shapes:
             r.add("U502", "error", f"<geometry> in {what} holds no shape, which PyBullet "
                   f"refuses; it needs one of {', '.join(SHAPES[:4])}", geom)
@@ -451,8 +452,8 @@ def _sole_shape(geom: etree._Element, r: RuleReport) -> etree._Element | None:
         # Measured (PyBullet 3.2.7): the file loads, visual and collision alike built from
         # the first shape; the others are ignored.
         r.add("U507", "warning", f"<geometry> in {what} holds {len(shapes)} shapes "
-              f"({', '.join(f'<{c.tag}>' for c in shapes)}); PyBullet uses the first, "
-              f"<{shapes[0].tag}>, and ignores the rest: keep one", shapes[1])
+              f"({', '.join(f'<{c.tag!s}>' for c in shapes)}); PyBullet uses the first, "
+              f"<{shapes[0].tag!s}>, and ignores the rest: keep one", shapes[1])
     return shapes[0]  # PyBullet reads none after the first (measured)
 
 
@@ -609,7 +610,7 @@ def mesh_crash(mesh: etree._Element, ref: Reference) -> tuple[str, str] | None:
     suffix = mesh_suffix(load)
     geometry = mesh.getparent()
     part = geometry.getparent() if geometry is not None else None
-    if (not suffix or part is None or part.tag not in ("visual", "collision")
+    if (not suffix or geometry is None or part is None or part.tag not in ("visual", "collision")
             or geometry.tag != "geometry" or used_shape(geometry) is not mesh):
         return None
     link = part.getparent()

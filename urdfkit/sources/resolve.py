@@ -160,7 +160,7 @@ def _check_files(root: etree._Element, base: Path, packages: Mapping[str, Path],
         fn = el.get("filename")
         if not fn or ignored_shape(el):  # PyBullet never opens a shape after the first
             continue
-        ref = reference(el.tag, fn.strip(), base, packages)
+        ref = reference(str(el.tag), fn.strip(), base, packages)
         if ref.level == "error" and ref.code is not None and (
                 el.tag in FILE_SHAPES or ref.code in ("U702", "U704")):
             raise InputError(ref.message, file=name, line=line_of(el))
@@ -224,8 +224,9 @@ def misspelt_tags(root: etree._Element) -> list[tuple[int | None, str]]:
     out: list[tuple[int | None, str]] = []
 
     def look(el: etree._Element, depth: int) -> None:
-        known = SCHEMA.get(el.tag)
-        built = BUILT_CHILDREN.get(el.tag)
+        parent = str(el.tag)
+        known = SCHEMA.get(parent)
+        built = BUILT_CHILDREN.get(parent)
         if known is None or built is None:
             return
         for child in el:
@@ -233,9 +234,9 @@ def misspelt_tags(root: etree._Element) -> list[tuple[int | None, str]]:
             if not isinstance(tag, str) or tag[:1] == "{":
                 continue
             if tag not in known[1]:
-                near = [n for n in nearest_tags(tag, el.tag) if n in built]
+                near = [n for n in nearest_tags(tag, parent) if n in built]
                 if near:
-                    out.append((line_of(child), f"<{tag}> is not a URDF tag inside <{el.tag}>"
+                    out.append((line_of(child), f"<{tag}> is not a URDF tag inside <{el.tag!s}>"
                                 f"{did_you_mean(near)} PyBullet builds the robot without it "
                                 "(U801)"))
             elif depth < 2:
