@@ -9,7 +9,7 @@ import pickle
 from pathlib import Path
 
 import urdfkit
-from urdfkit.checks.validate import Solid
+from urdfkit.checks.rules_mass import Solid
 from urdfkit.core.finding import Finding
 from urdfkit.sources.guard import Reference
 from urdfkit.sources.meshstore import Integrals

@@ -100,7 +100,7 @@ def _plant(source: str) -> tuple[str, int, str]:
 #: typed parameter, so a misspelt one must fail mypy. Five of these passed it once, when their
 #: parameters were ``Any`` (an lxml element, a Joint, an Export, a Session).
 TARGETS: list[tuple[str, str, str]] = [
-    ("checks/validate.py", "_joint_inertia", "jv"),
+    ("checks/rules_joints.py", "_joint_inertia", "jv"),
     ("checks/fix.py", "_Plan.carry_contacts", "link"),
     ("exchange/mjcf.py", "_Writer.joint", "j"),
     ("exchange/mjcf.py", "_Writer.fill", "body"),

@@ -6,9 +6,9 @@ its own); this module decides the repair, element by element:
 
 - **Inertia.** Where it is missing (U606, U609, U610), impossible (U603 not positive definite,
   U604 triangle inequality), singular (U608) or far from the shapes (U605), the tensor is
-  derived from the link's collision solid (:func:`urdfkit.checks.validate.link_solid`: primitives in
-  closed form, meshes integrated) at the link's mass, and written in the ``<inertial>``'s own
-  frame, which is kept. A link with no ``<inertial>`` gets the mass of its solid at
+  derived from the link's collision solid (:func:`urdfkit.checks.rules_mass.link_solid`:
+  primitives in closed form, meshes integrated) at the link's mass, and written in the
+  ``<inertial>``'s own frame, which is kept. A link with no ``<inertial>`` gets the mass of its solid at
   ``density`` (water, 1000 kg/m^3, unless told). ``balance=True`` keeps the file's values
   where it can: a triangle-inequality violation is balanced as MuJoCo's ``balanceinertia``
   does (every principal moment set to their mean, the trace kept), and U605/U608 are left.
@@ -42,7 +42,8 @@ from typing import Any
 
 from lxml import etree
 
-from urdfkit.checks.validate import ALL_RULES, STUB_SIZE, Solid, link_solid
+from urdfkit.checks.rules_mass import STUB_SIZE, Solid, link_solid
+from urdfkit.checks.validate import ALL_RULES
 from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
@@ -540,9 +541,9 @@ class _Plan:
             self.left.append(job.skip(f"{code} left as it is: --balance keeps the file's values"))
             return
         if self.balance and code == "U604" and inertia is not None:
-            from urdfkit.checks.validate import _inertia_tensor
+            from urdfkit.checks.rules_mass import inertia_tensor
 
-            file_tensor = _inertia_tensor(inertia)
+            file_tensor = inertia_tensor(inertia)
             mean = balanced(file_tensor) if file_tensor is not None else None
             if mean is not None:
                 self._replace_inertia(inertia, _iso(mean))
@@ -829,10 +830,10 @@ def triangle_repair(link: etree._Element, report: RuleReport | None, mass: float
     if solid is not None:
         return (inertia_in_frame(solid.inertia(mass), frame)[1], "the inertia of its collision "
                 f"shapes at its mass {fmt_float(mass, 6)} kg, as `urdfkit fix` writes it")
-    from urdfkit.checks.validate import _inertia_tensor
+    from urdfkit.checks.rules_mass import inertia_tensor
 
     inertia = inertial.find("inertia") if inertial is not None else None
-    file_tensor = _inertia_tensor(inertia) if inertia is not None else None
+    file_tensor = inertia_tensor(inertia) if inertia is not None else None
     mean = balanced(file_tensor) if file_tensor is not None else None
     if mean is None and fallback is not None:
         return (inertia_in_frame(fallback, frame)[1], "the inertia PyBullet computes from the "
