@@ -8,8 +8,8 @@ its own); this module decides the repair, element by element:
   U604 triangle inequality), singular (U608) or far from the shapes (U605), the tensor is
   derived from the link's collision solid (:func:`urdfkit.checks.rules_mass.link_solid`:
   primitives in closed form, meshes integrated) at the link's mass, and written in the
-  ``<inertial>``'s own frame, which is kept. A link with no ``<inertial>`` gets the mass of its solid at
-  ``density`` (water, 1000 kg/m^3, unless told). ``balance=True`` keeps the file's values
+  ``<inertial>``'s own frame, which is kept. A link with no ``<inertial>`` gets the mass of
+  its solid at ``density`` (water, 1000 kg/m^3, unless told). ``balance=True`` keeps the file's values
   where it can: a triangle-inequality violation is balanced as MuJoCo's ``balanceinertia``
   does (every principal moment set to their mean, the trace kept), and U605/U608 are left.
 - **Massless moving links** (U602) get 1 g and 1e-6 kg m^2 about each axis (or their solid's
