@@ -9,9 +9,10 @@ its own); this module decides the repair, element by element:
   derived from the link's collision solid (:func:`urdfkit.checks.rules_mass.link_solid`:
   primitives in closed form, meshes integrated) at the link's mass, and written in the
   ``<inertial>``'s own frame, which is kept. A link with no ``<inertial>`` gets the mass of
-  its solid at ``density`` (water, 1000 kg/m^3, unless told). ``balance=True`` keeps the file's values
-  where it can: a triangle-inequality violation is balanced as MuJoCo's ``balanceinertia``
-  does (every principal moment set to their mean, the trace kept), and U605/U608 are left.
+  its solid at ``density`` (water, 1000 kg/m^3, unless told). ``balance=True`` keeps the
+  file's values where it can: a triangle-inequality violation is balanced as MuJoCo's
+  ``balanceinertia`` does (every principal moment set to their mean, the trace kept), and
+  U605/U608 are left.
 - **Massless moving links** (U602) get 1 g and 1e-6 kg m^2 about each axis (or their solid's
   inertia at 1 g): enough for the solver, too little to change the robot's dynamics.
 - **Materials** used but never defined (U706) are defined at the top, white: the colour
