@@ -99,7 +99,8 @@ class LinkDynamics:
 @dataclass(frozen=True)
 class JointState:
     """One joint's state now: position, velocity, the reaction wrench on it (6, where the
-    engine measures it; zeros elsewhere) and the motor torque applied in the last step."""
+    engine measures it; zeros elsewhere) and the motor torque applied in the last step.
+    """
 
     position: float
     velocity: float
@@ -258,7 +259,8 @@ class Simulator(Model, Protocol):
                targets: Sequence[float], forces: Sequence[float] | None = None,
                velocities: Sequence[float] | None = None) -> None:
         """Drive joints: to target velocities or positions under force caps (kept until
-        changed), or by torques (``targets``, for the next step only)."""
+        changed), or by torques (``targets``, for the next step only).
+        """
         ...
 
     def change_dynamics(self, body: int, link: int, **values: float | Sequence[float]
@@ -266,7 +268,8 @@ class Simulator(Model, Protocol):
         """Change a link's (or the body's) dynamics, by PyBullet's ``changeDynamics`` names
         (``lateralFriction``, ``mass``, ``localInertiaDiagonal``, ``jointDamping``,
         ``linearDamping``, ``contactStiffness`` ...); an engine that cannot carry one
-        raises :class:`urdfkit.core.errors.ParameterError` naming it."""
+        raises :class:`urdfkit.core.errors.ParameterError` naming it.
+        """
         ...
 
     def contacts(self, body: int, link: int | None = None, other: int | None = None
