@@ -98,8 +98,10 @@ class LinkDynamics:
 
 @dataclass(frozen=True)
 class JointState:
-    """One joint's state now: position, velocity, the reaction wrench on it (6, where the
-    engine measures it; zeros elsewhere) and the motor torque applied in the last step.
+    """One joint's state now.
+
+    Its position, velocity, the reaction wrench on it (6, where the engine measures it; zeros
+    elsewhere) and the motor torque applied in the last step.
     """
 
     position: float
@@ -258,17 +260,21 @@ class Simulator(Model, Protocol):
     def motors(self, body: int, joints: Sequence[int], mode: MotorMode,
                targets: Sequence[float], forces: Sequence[float] | None = None,
                velocities: Sequence[float] | None = None) -> None:
-        """Drive joints: to target velocities or positions under force caps (kept until
-        changed), or by torques (``targets``, for the next step only).
+        """Drive joints.
+
+        To target velocities or positions under force caps (kept until changed), or by
+        torques (``targets``, for the next step only).
         """
         ...
 
     def change_dynamics(self, body: int, link: int, **values: float | Sequence[float]
                         ) -> None:
-        """Change a link's (or the body's) dynamics, by PyBullet's ``changeDynamics`` names
-        (``lateralFriction``, ``mass``, ``localInertiaDiagonal``, ``jointDamping``,
-        ``linearDamping``, ``contactStiffness`` ...); an engine that cannot carry one
-        raises :class:`urdfkit.core.errors.ParameterError` naming it.
+        """Change a link's (or the body's) dynamics.
+
+        By PyBullet's ``changeDynamics`` names (``lateralFriction``, ``mass``,
+        ``localInertiaDiagonal``, ``jointDamping``, ``linearDamping``, ``contactStiffness``
+        ...); an engine that cannot carry one raises
+        :class:`urdfkit.core.errors.ParameterError` naming it.
         """
         ...
 
