@@ -11,8 +11,8 @@ from pathlib import Path
 import urdfkit
 from urdfkit.checks.rules_mass import Solid
 from urdfkit.core.finding import Finding
-from urdfkit.sources.guard import Reference
 from urdfkit.sources.meshstore import Integrals
+from urdfkit.sources.references import Reference
 
 
 def test_the_package_is_plain_python() -> None:

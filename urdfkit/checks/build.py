@@ -211,7 +211,7 @@ def _unloadable(root: etree._Element, base: Path, packages: Mapping[str, Path] |
     crashes or hangs on (:func:`urdfkit.sources.guard.mesh_crash`, U712-U713) is refused too.
     """
     from urdfkit.model.spec import FILE_SHAPES, FILE_TAGS, ignored_shape
-    from urdfkit.sources.guard import mesh_crash, reference
+    from urdfkit.sources.references import mesh_crash, reference
 
     for el in root.iter(*FILE_TAGS):
         fn = (el.get("filename") or "").strip()

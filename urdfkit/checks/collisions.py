@@ -380,8 +380,8 @@ class _Sampler:
 def _concave_links(resolved: Resolved, packages: Mapping[str, Path] | None) -> set[str]:
     """Links with a collision mesh PyBullet replaces by its convex hull, concave or not."""
     from urdfkit.model.spec import attr_vec
-    from urdfkit.sources.guard import reference
     from urdfkit.sources.meshstore import CONCAVE_FRACTION, properties
+    from urdfkit.sources.references import reference
 
     base = resolved.source.resolve().parent
     out = set()

@@ -11,7 +11,8 @@ from lxml import etree
 
 from urdfkit.model.index import first
 from urdfkit.model.spec import attr_float as _num
-from urdfkit.sources.guard import RuleReport, label
+from urdfkit.sources.guard import RuleReport
+from urdfkit.sources.references import label
 
 
 def rule_gazebo_contacts(root: etree._Element, r: RuleReport) -> None:

@@ -22,7 +22,8 @@ from urdfkit.model.spec import (
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.sources.guard import RuleReport, label
+from urdfkit.sources.guard import RuleReport
+from urdfkit.sources.references import label
 
 
 def rule_mimic(root: etree._Element, r: RuleReport) -> None:

@@ -33,10 +33,11 @@ from urdfkit.model.spec import (
 )
 from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.sources.guard import RuleReport, label
+from urdfkit.sources.guard import RuleReport
 from urdfkit.sources.meshstore import MeshProperties
 from urdfkit.sources.meshstore import properties as mesh_properties
 from urdfkit.sources.meshstore import stated as stated_properties
+from urdfkit.sources.references import label
 
 #: Drake's tolerance unit for inertia checks (DBL_EPSILON).
 _DBL_EPSILON = sys.float_info.epsilon

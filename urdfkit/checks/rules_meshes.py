@@ -13,8 +13,9 @@ from lxml import etree
 
 from urdfkit.checks.rules_mass import mesh_properties_of, moving_of
 from urdfkit.model.spec import attr_vec as _vec
-from urdfkit.sources.guard import RuleReport, label, mesh_crash
+from urdfkit.sources.guard import RuleReport
 from urdfkit.sources.meshstore import CONCAVE_FRACTION
+from urdfkit.sources.references import label, mesh_crash
 
 
 def rule_meshes(root: etree._Element, r: RuleReport) -> None:

@@ -26,7 +26,8 @@ from urdfkit.model.spec import (
     MAX_STATE_LINKS,
     extension_note,
 )
-from urdfkit.sources.guard import GUARD_RULES, Rule, RuleReport, label
+from urdfkit.sources.guard import GUARD_RULES, Rule, RuleReport
+from urdfkit.sources.references import label
 
 # --------------------------------------------------------------------------- structural rules
 # These are the rules PyBullet crashes on when they are broken; the guard runs exactly these.

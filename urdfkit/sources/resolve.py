@@ -46,14 +46,9 @@ from urdfkit.model.xmlio import (
     xacro_note,
 )
 from urdfkit.sources.expand import expand_xacro
-from urdfkit.sources.guard import (
-    GUARD_WARNINGS,
-    STRICTER,
-    mesh_crash,
-    reference,
-    refuse_oversized,
-)
+from urdfkit.sources.guard import GUARD_WARNINGS, STRICTER, refuse_oversized
 from urdfkit.sources.guard import guard as run_guard
+from urdfkit.sources.references import mesh_crash, reference
 from urdfkit.sources.uris import not_a_file, pybullet_data_path
 from urdfkit.sources.uris import (
     parse_packages as parse_packages,  # re-exported: callers import it here
@@ -316,8 +311,8 @@ def undrawn_visuals(resolved: Resolved) -> tuple[int, list[str]]:
     For ``render`` and ``view`` to say how much of the robot is missing from the picture
     (check's U715 says it of the file): an empty mesh file, COLLADA through ``<instance_node>``.
     """
-    from urdfkit.sources.guard import reference
     from urdfkit.sources.meshes import mesh_kind, undrawn_visual
+    from urdfkit.sources.references import reference
 
     total, out = 0, []
     base = resolved.source.resolve().parent
