@@ -180,7 +180,8 @@ def fix(
         check_output(output, force=force)
     result = fix_file(file, balance=balance, density=density,
                       packages=parse_packages(package, package_path), select=codes,
-                      gazebo_contacts=gazebo_contacts)
+                      gazebo_contacts=gazebo_contacts,
+                      output=output if output not in (None, "-") else None)
     _say_mass_changes(file, result, refuse=not allow_mass_change and not show_diff,
                       quiet=as_json)
     if in_place and result.changed:
@@ -260,6 +261,12 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
 
     backup = f"{file}.orig"
     if output == "-":
+        if result.relative_paths and Path.cwd().resolve() != \
+                locate(file).absolute().parent.resolve():
+            show.warn(f"{file}: {len(result.relative_paths)} mesh or texture path(s) are "
+                      f"relative to its folder ({result.relative_paths[0]!r}, ...) and are "
+                      "written as they are: save the output in that folder, or use -o FILE, "
+                      "which rewrites them for where it writes")
         report()
         sys.stdout.buffer.write(result.fixed)
         sys.stdout.flush()
@@ -272,12 +279,6 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
             show.wrote(Path(file), f"original kept as {backup}")
     else:
         assert output is not None
-        if result.relative_paths and Path(output).absolute().parent.resolve() != \
-                locate(file).absolute().parent.resolve():
-            show.warn(f"{output}: {len(result.relative_paths)} mesh or texture path(s) in it are "
-                      f"relative to {file}'s folder ({result.relative_paths[0]!r}, ...) and "
-                      "do not resolve from where it is written: write it beside the original "
-                      "(or --in-place), or copy what it names")
         from urdfkit.checks.build import unreachable_packages
 
         lost = unreachable_packages(result.fixed, Path(output))
@@ -286,7 +287,9 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
         path = atomic_write(output, result.fixed, force=force)
         report()
         if not as_json:
-            show.wrote(path, f"{len(result.repairs)} fix(es)")
+            moved = (f"; {len(result.moved_paths)} relative mesh or texture path(s) rewritten "
+                     "for its folder" if result.moved_paths else "")
+            show.wrote(path, f"{len(result.repairs)} fix(es){moved}")
 
 
 # ---- drive: a headless throttle/steer run (urdfkit/drive.py, vehicle.py, plot.py)
