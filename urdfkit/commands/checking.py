@@ -297,7 +297,7 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
 
 @command(examples(
     "urdfkit collisions panda.urdf", "urdfkit collisions arm.urdf --samples 100 --json",
-    "urdfkit collisions arm.urdf --samples 200 --srdf >> arm.srdf",
+    "urdfkit collisions arm.urdf --samples 200 --srdf > arm_collisions.srdf",
     "urdfkit collisions hand.urdf --joints finger_joint=0.04 --python"))
 def collisions(
     file: FileArg,
@@ -313,8 +313,8 @@ def collisions(
         "--margin", metavar="M", help="Count links closer than this (m) as touching.")] = 0.0,
     as_json: JsonOpt = False,
     srdf: Annotated[bool, typer.Option(
-        "--srdf", help="Print MoveIt <disable_collisions> entries for the pairs in contact "
-        "in every pose.")] = False,
+        "--srdf", help="Print a MoveIt SRDF document with <disable_collisions> entries for "
+        "the pairs in contact in every pose.")] = False,
     python: Annotated[bool, typer.Option(
         "--python", help="Print p.setCollisionFilterPair calls for the pairs in contact in "
         "every pose.")] = False,
