@@ -173,8 +173,9 @@ def fix(
 
     codes = _check_fix_options(output, in_place, show_diff, as_json, select)
     if in_place and not Path(file).expanduser().exists() and locate(file).exists():
-        raise ParameterError(f"{file}: found in pybullet_data, which --in-place would rewrite; "
-                             "write the repaired copy with -o FILE")
+        raise ParameterError(f"{file}: not a file here (found in pybullet_data, or a built-in "
+                             "template), which --in-place would rewrite; write the repaired "
+                             "copy with -o FILE")
     backup = f"{file}.orig"
     if output not in (None, "-"):
         check_output(output, force=force)

@@ -86,7 +86,8 @@ TypeOpt = Annotated[list[str] | None, typer.Option(
     help="Only joints of this type (repeatable): revolute, continuous, prismatic, fixed, ...")]
 AllOpt = Annotated[bool, typer.Option("--all", help="Show every field, however wide.")]
 FileArg = Annotated[str, typer.Argument(
-    help="A .urdf or .xacro file; a bare name is also looked up in pybullet_data.")]
+    help="A .urdf or .xacro file; a bare name is also looked up in pybullet_data, and a "
+    "template name (simplecar) is that template.")]
 
 
 def open_input_and_warn(file: str, *, packages: list[str] | None,
@@ -131,7 +132,7 @@ TimeStepOpt = Annotated[float, typer.Option(help="Physics time step, s.", show_d
 MaxForceOpt = Annotated[float | None, typer.Option(
     help="Wheel motor torque limit, N m.", show_default="10")]
 UrdfOpt = Annotated[str | None, typer.Option(
-    help="Car to drive (.urdf/.xacro; pybullet_data names work).",
+    help="Car to drive (.urdf/.xacro; pybullet_data and template names work).",
     show_default="the built-in simplecar")]
 PlaneOpt = Annotated[str | None, typer.Option(
     help="Ground to drive on.", show_default="the built-in simpleplane")]

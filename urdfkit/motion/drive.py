@@ -59,7 +59,7 @@ from urdfkit.motion.vehicle import (
     disable_default_motors,
 )
 from urdfkit.motion.vehicle_shapes import base_link_pose, lowest_point, set_base_link_pose
-from urdfkit.sources.cache import cache_dir, write_entry
+from urdfkit.sources.builtin import builtin_file as builtin_file  # re-exported: gym, sim, tests
 
 if TYPE_CHECKING:
     from urdfkit.model.gazebo import GazeboContact
@@ -260,41 +260,6 @@ def drive_to_file(scenario: Scenario, path: str | Path, *, force: bool = False,
 
 
 ProgressFn = Callable[[int, int], None]
-
-
-def builtin_file(name: str, params: Mapping[str, str] | None = None) -> Path | None:
-    """A built-in template, built with ``params``, from the cache (built on a miss).
-
-    Expanding simplecar with xacro and checking it through the builder costs ~0.07 s of CPU,
-    as much as 400 physics steps, on every ``urdfkit drive``. The result depends only on the
-    template's source, the parameters and the urdfkit version, which make the cache key; a
-    stale or broken entry can therefore not be hit. Returns None (build into a temp folder
-    instead) when the cache cannot be written. Nothing is ever written to the user's folder.
-    """
-    import zlib
-
-    from urdfkit import __version__
-    from urdfkit.model.templatedir import template_dir
-
-    folder = cache_dir()
-    if folder is None:
-        return None
-    # The package folder directly: importlib.resources (and the zipfile it imports) would
-    # cost more than the lookup saves. A zipped install simply skips the cache.
-    try:
-        source = (template_dir() / f"{name}.urdf.xacro").read_bytes()
-    except (OSError, TypeError):
-        return None
-    given = "".join(f"{k}={v};" for k, v in sorted((params or {}).items())).encode()
-    key = f"{zlib.crc32(source):08x}{len(source):x}-{zlib.crc32(given):08x}-{__version__}" \
-        if given else f"{zlib.crc32(source):08x}{len(source):x}-{__version__}"
-    path = folder / f"{name}-{key}.urdf"
-    if path.is_file():
-        return path
-    from urdfkit.model.catalog import build_template
-
-    data = build_template(name, params).to_bytes()
-    return path if write_entry(path, data) else None
 
 
 #: The longest run (simulated s) repeated at more force to test the advice to raise it.
