@@ -96,8 +96,9 @@ def locate(name: str | Path) -> Path:
     if os.sep not in str(name):
         close += close_names(str(name), template_names())
     more = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
-    raise InputError("no such file (looked in the current folder, in pybullet_data and among "
-                     f"the built-in templates){more}", file=name)
+    where = "" if path.is_absolute() else \
+        " (looked in the current folder, in pybullet_data and among the built-in templates)"
+    raise InputError(f"no such file{where}{more}", file=name)
 
 
 def where(f: Finding) -> str:
