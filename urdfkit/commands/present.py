@@ -178,6 +178,20 @@ def nums(v: Iterable[float]) -> str:
     return " ".join(num(x) for x in v)
 
 
+#: A decimal number in text, with more significant digits than a reader can use.
+_NOISY = re.compile(r"(?<![\w.])-?(?=(?:\d\.?){13})\d+\.\d+(?:e[-+]?\d+)?(?![\w.])")
+
+
+def tidy(text: str) -> str:
+    """``text`` with each number of 13 or more significant digits cut to 12.
+
+    For human text built by the library with exact values (agree's "PyBullet
+    65.24999999999999 kg"): float noise goes (65.25), a real difference of one part in
+    10^11 stays. JSON keeps the exact text.
+    """
+    return _NOISY.sub(lambda m: f"{float(m.group()):.12g}", text) if "." in text else text
+
+
 def fixed(x: float, digits: int = 3) -> str:
     """Fixed decimals, without a ``-`` on a value that rounds to zero."""
     text = f"{x:.{digits}f}"
