@@ -559,15 +559,23 @@ def diff_report(result: Any) -> None:
 # --------------------------------------------------------------------------- progress
 
 
+def _isatty(stream: Any) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError):
+        return False
+
+
 def progress(label: str, unit: str, enabled: bool = True, rate: bool = False
              ) -> tuple[Callable[[int, int], None] | None, Callable[[], None]]:
     """A progress callback that shows a bar on stderr once a run looks longer than ~1 s.
 
     Returns ``(update(done, total), stop())``; ``update`` is None when not ``enabled`` or
-    when stdout or stderr is not a terminal (a bar in a log file is noise). ``rate`` adds
-    units per second.
+    when stderr, where the bar goes, is not a terminal (a bar in a log file is noise). A
+    piped stdout (``urdfkit drive | tee run.txt``) still gets it on the terminal: the bar
+    never touches stdout. The bar shows the time left; ``rate`` adds units per second.
     """
-    if not (enabled and sys.stdout.isatty() and sys.stderr.isatty()):
+    if not (enabled and _isatty(sys.stderr)):
         return None, lambda: None
     import time
 
