@@ -195,12 +195,17 @@ def test_every_help_ends_with_examples(command: str) -> None:
 
 
 def test_help_text_reflows_and_keeps_its_words() -> None:
-    # rich keeps a docstring's line breaks; the help must read as whole paragraphs.
+    # A docstring's line breaks are not the help's: its paragraphs are wrapped anew, to the
+    # terminal's width up to 100 columns (tests/test_help_words.py: no word is cut).
     _, out, _ = invoke("drive", "--help", env={"COLUMNS": "300"})
+    lines = out.splitlines()
+    at = next(n for n, line in enumerate(lines) if line.startswith("  Wheels (continuous"))
+    assert lines[at] == "  Wheels (continuous joints about a horizontal axis) and steering " \
+        "hinges (revolute joints about a"  # up to 100 columns, not the docstring's 92
     assert "Wheels (continuous joints about a horizontal axis) and steering hinges (revolute " \
-        "joints about a vertical axis that carry wheels) are detected." in out
+        "joints about a vertical axis that carry wheels) are detected." in " ".join(out.split())
     _, out, _ = invoke("tree", "--help", env={"COLUMNS": "300"})
-    assert "[n] is the index PyBullet will give the joint." in out
+    assert "[n] is the index PyBullet will give the joint." in " ".join(out.split())
 
 
 def test_help_keeps_brackets_and_shows_readable_defaults() -> None:

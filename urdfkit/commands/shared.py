@@ -71,7 +71,7 @@ JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on 
 FixedBaseOpt = Annotated[bool, typer.Option("--fixed-base", help="Pin the root link to the world.")]
 FlagsOpt = Annotated[str | None, typer.Option(
     "--flags", metavar="NAMES",
-    help="Exactly these PyBullet loadURDF flags, comma-separated (URDF_USE_INERTIA_FROM_FILE,"
+    help="Exactly these PyBullet loadURDF flags, comma-separated (URDF_USE_INERTIA_FROM_FILE, "
     "URDF_USE_IMPLICIT_CYLINDER, ...; the URDF_ may be left out), or none: to match your own "
     "p.loadURDF call. Default: URDF_USE_IMPLICIT_CYLINDER (true cylinders).",
     show_default=False)]
