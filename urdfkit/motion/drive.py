@@ -813,11 +813,52 @@ def _yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> 
             assert r is not None
             first = f"more wheel force does not help ({'; '.join(tried)})" if tried \
                 else "at PyBullet's default wheel force"
-            return (f"{said}; {first}: the wheels slip sideways, and --steer {more:.3g} "
-                    f"turns at {r:.3g} rad/s: command more yaw rate (--steer {more:.3g})")
+            return f"{said}; {first}: the wheels slip sideways, and " + _aim(
+                lambda x: probe(steer=x), sc.steer, (sc.steer, rate), (more, r), widest)
         tried.append(f"--steer {more:.3g}: {shown(r)}")
     return (f"{said}; neither more force nor more yaw rate turns it faster "
             f"({'; '.join(tried)}): the wheels slip sideways")
+
+
+#: How close advice must land to the yaw rate asked for to be advised as reaching it.
+AIM = 0.1
+#: Re-runs the search for that command may take (beyond the first at more yaw rate).
+AIM_RUNS = 4
+
+
+def _aim(measure: Callable[[float], float | None], asked: float, start: tuple[float, float],
+         more: tuple[float, float], widest: float) -> str:
+    """The ``--steer`` to command for the yaw rate ``asked``, found by running it.
+
+    A skid-steered base turns slower than commanded, and not in proportion: three times the
+    command may turn it faster than asked (r2d2 at --throttle 5: --steer 0.9 turns at 0.5
+    rad/s for 0.3 asked). From the two runs made (``start``, the user's, and ``more``), the
+    secant method picks the next command, rounded to the three digits the advice prints,
+    and runs it, up to :data:`AIM_RUNS` times, until one lands within :data:`AIM` of
+    ``asked`` (capped at ``widest``, where the inner wheels stop). The advice names that
+    command and what it measured; if none lands, the nearest, and says it missed.
+    """
+    runs = [start, more]
+    for _ in range(AIM_RUNS):
+        (s0, r0), (s1, r1) = runs[-2], runs[-1]
+        if abs(r1 - asked) <= AIM * abs(asked) or r1 == r0:
+            break
+        s = s1 + (asked - r1) * (s1 - s0) / (r1 - r0)
+        s = math.copysign(min(abs(s), widest), asked) if s * asked > 0 else s1 / 2
+        s = float(f"{s:.3g}")
+        if any(s == x for x, _ in runs):
+            break
+        r = measure(s)
+        if r is None:
+            break
+        runs.append((s, r))
+    s, r = min(runs[1:], key=lambda x: abs(x[1] - asked))
+    if abs(r - asked) <= AIM * abs(asked):
+        return (f"--steer {s:.3g} turns at {r:.3g} rad/s ({r / asked:.0%} of the {asked:g} "
+                f"asked): command more yaw rate (--steer {s:.3g})")
+    tried = "; ".join(f"--steer {x:.3g}: {y:.3g} rad/s" for x, y in runs[1:])
+    return (f"no command tried turns within {AIM:.0%} of the {asked:g} asked ({tried}); "
+            f"--steer {s:.3g} comes nearest, at {r:.3g} rad/s ({r / asked:.0%})")
 
 
 class _GuiControls:
