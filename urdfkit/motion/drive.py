@@ -764,8 +764,10 @@ def _yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> 
     would reach: ten and a hundred times the wheel force (capped at PyBullet's default), then,
     if no force helps, up to three times the yaw rate (capped where the inner wheels would
     stop: 2 v / track). Advice is given only when its run turns clearly faster (1.5x); it
-    names the option as the command line spells it. At most three re-runs, only when this
-    warning is printed; runs over :data:`PROBE_LIMIT` s are not repeated.
+    names the option as the command line spells it. More yaw rate is then searched for the
+    command that turns within 10% of what was asked (:func:`_aim`). At most three re-runs and
+    :data:`AIM_RUNS` more, only when this warning is printed; runs over :data:`PROBE_LIMIT` s
+    are not repeated.
     """
     c, train = sc.config, sc.drivetrain
     kind = "skid steering" if train.steering == "skid" else "differential steering"
