@@ -415,3 +415,21 @@ def test_fix_warns_when_raw_pybullet_cannot_reach_a_nested_package(
         warned = "raw p.loadURDF will not find 1 package:// file(s)" in result.output
         # The warning says exactly what raw PyBullet then does with the written file.
         assert warned == (out == outside) == (not raw_loads(out)), (out, result.output)
+
+
+def test_a_package_uri_repaired_elsewhere_is_named_from_there(
+        tmp_path: Path, raw_loads: Callable[[Path], bool]) -> None:
+    # U708 without a package.xml becomes a relative path: relative to where it is written.
+    src, out = tmp_path / "src", tmp_path / "out"
+    src.mkdir()
+    out.mkdir()
+    shutil.copy(MESHES / "unit_cube.stl", src / "cube.stl")
+    path = src / "r.urdf"
+    path.write_text('<robot name="r"><link name="b"><inertial><mass value="1"/><inertia '
+                    'ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>'
+                    '<visual><geometry><mesh filename="package:///cube.stl"/></geometry>'
+                    '</visual></link></robot>')
+    code, _, err = _cli("fix", str(path), "--select", "U708", "-o", str(out / "r.urdf"))
+    assert code == 0, err
+    assert 'filename="../src/cube.stl"' in (out / "r.urdf").read_text()
+    assert raw_loads(out / "r.urdf")

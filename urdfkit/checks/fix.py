@@ -645,7 +645,11 @@ class _Plan:
                 new = f"package://{name}/{target.relative_to(folder).as_posix()}"
                 break
         if new is None:
-            new = Path(os.path.relpath(target, self.folder or base)).as_posix()
+            new = Path(os.path.relpath(target, base)).as_posix()
+            if self.folder is not None:  # written elsewhere: named from there
+                from urdfkit.sources.uris import rebased
+
+                new = rebased(new, base, self.folder) or new
         self._set_attribute(el, "filename", new)
         self.renamed.add(el)
         self.repairs.append(Repair("U708", line, f"{old!r} -> {new!r} (package:/// has no "
