@@ -75,6 +75,8 @@ def test_fix_in_place_refuses_to_rewrite_pybullet_data(tmp_path: Path,
     before = (_data() / "r2d2.urdf").read_bytes()
     result = runner.invoke(app, ["fix", "r2d2.urdf", "--in-place"])
     assert result.exit_code == 2 and "found in pybullet_data" in result.stderr
+    result = runner.invoke(app, ["fix", "simplecar", "--in-place"])
+    assert result.exit_code == 2 and "a built-in template" in result.stderr
     assert (_data() / "r2d2.urdf").read_bytes() == before
 
 
@@ -83,3 +85,41 @@ def test_a_misspelt_bare_name_in_check_gets_a_suggestion(tmp_path: Path,
     monkeypatch.chdir(tmp_path)
     result = runner.invoke(app, ["check", "r2d3.urdf"])
     assert result.exit_code == 2 and "did you mean 'r2d2.urdf'?" in result.stderr
+
+
+@pytest.mark.parametrize("args", [
+    ["joints", "simplecar", "--json"], ["links", "simplecar", "--json"], ["tree", "simplecar"],
+    ["info", "simplecar", "--json"], ["check", "simplecar", "--json"],
+    ["diff", "simplecar", "built.urdf"], ["fix", "simplecar", "-o", "out.urdf"],
+    ["render", "simplecar", "-o", "out.png", "--size", "64x48"],
+    ["collisions", "simplecar", "--json"], ["export", "mjcf", "simplecar", "-o", "out.xml"],
+    ["drive", "--urdf", "simplecar", "--seconds", "0.2", "--json"]])
+def test_every_command_reads_a_template_name(args: list[str], tmp_path: Path,
+                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    # Issue 49: `joints simplecar`, `render simplecar`, `export mjcf simplecar` said "no such
+    # file"; a template name is the template built with its defaults, as drive drives it.
+    from urdfkit.model.catalog import build_template
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "built.urdf").write_bytes(build_template("simplecar").to_bytes())
+    result = runner.invoke(app, args)
+    assert "no such file" not in result.stderr, result.stderr
+    assert result.exit_code == 0, result.stderr
+    assert not (tmp_path / "simplecar.urdf").exists()  # nothing written here
+    if args[0] == "joints":
+        names = [j["jointName"] for j in json.loads(result.stdout)["joints"]]
+        assert names == [j.name for j in build_template("simplecar").joints]
+    if args[0] == "info":
+        assert json.loads(result.stdout)["robot"] == "simplecar"
+    if args[0] == "diff":  # the very robot `urdfkit build simplecar` writes
+        assert "are the same robot" in result.stdout
+
+
+def test_a_file_here_wins_over_a_template_and_a_typo_is_told(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "simplecar").write_text('<robot name="mine"><link name="only"/></robot>')
+    result = runner.invoke(app, ["info", "simplecar", "--json"])
+    assert result.exit_code == 0 and json.loads(result.stdout)["robot"] == "mine"
+    result = runner.invoke(app, ["joints", "simplecr"])
+    assert result.exit_code == 2 and "did you mean 'simplecar'?" in result.stderr

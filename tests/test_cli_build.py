@@ -269,3 +269,34 @@ def test_build_warns_when_raw_pybullet_cannot_reach_a_nested_package(
         # The warning says exactly what raw PyBullet then does with the written file.
         assert warned == (out == outside) == (not raw_loads(out)), (out, done.stderr)
         assert ("package://mypkg/meshes/t.stl" in done.stderr) == warned
+
+
+def test_build_rewrites_relative_mesh_paths_for_where_it_writes(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        raw_loads: Callable[[Path], bool]) -> None:
+    # Issue 49: a written file must load. A xacro's relative mesh path names a file beside
+    # the xacro; written into another folder, the path is rewritten to name the same file.
+    src = tmp_path / "src"
+    (src / "meshes").mkdir(parents=True)
+    (src / "meshes" / "t.stl").write_text(_TETRA_STL)
+    xacro = src / "robot.urdf.xacro"
+    xacro.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="a">'
+                     '<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" '
+                     'iyz="0" izz="1"/></inertial><visual><geometry><mesh '
+                     'filename="meshes/t.stl"/></geometry></visual><collision><geometry>'
+                     '<mesh filename="meshes/t.stl"/></geometry></collision></link></robot>')
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    result = CliRunner().invoke(app, ["build", str(xacro)])  # robot.urdf, here
+    assert result.exit_code == 0, result.output
+    assert "2 relative mesh or texture path(s) rewritten" in result.stderr
+    written = work / "robot.urdf"
+    assert 'filename="../src/meshes/t.stl"' in written.read_text()
+    assert raw_loads(written)
+    beside = CliRunner().invoke(app, ["build", str(xacro), "-o", str(src / "r.urdf")])
+    assert beside.exit_code == 0 and "rewritten" not in beside.stderr
+    assert 'filename="meshes/t.stl"' in (src / "r.urdf").read_text()
+    piped = CliRunner().invoke(app, ["build", str(xacro), "-o", "-"])
+    assert 'filename="meshes/t.stl"' in piped.stdout
+    assert "2 mesh or texture path(s) are relative to its folder" in piped.stderr

@@ -207,11 +207,26 @@ def test_cli_table_and_exit_codes(sweeper: Path) -> None:
 def test_srdf_lists_pairs_in_contact_in_every_pose(gripper: Path) -> None:
     code, out, _ = _cli("collisions", str(gripper), "--srdf")
     assert code == 0
-    entries = etree.fromstring(f"<robot>{out}</robot>").findall("disable_collisions")
+    root = etree.fromstring(out.encode())
+    assert root.tag == "robot" and root.get("name") == "gripper"
+    entries = root.findall("disable_collisions")
     assert [(e.get("link1"), e.get("link2"), e.get("reason")) for e in entries] == \
         [("left_finger", "right_finger", "Default")]
-    # Sampled, the fingers come apart in most poses: nothing is always in contact.
-    assert _cli("collisions", str(gripper), "--srdf", "--samples", "50")[1] == ""
+
+
+def test_srdf_without_pairs_is_a_commented_document() -> None:
+    # Issue 49: `collisions r2d2.urdf --samples 50 --srdf` printed nothing at all.
+    code, out, _ = _cli("collisions", "r2d2.urdf", "--srdf", "--samples", "50")
+    assert code == 0
+    root = etree.fromstring(out.encode())
+    import pybullet_data
+
+    robot = etree.parse(str(Path(pybullet_data.getDataPath()) / "r2d2.urdf")).getroot()
+    assert root.tag == "robot" and root.get("name") == robot.get("name") == "physics"
+    assert root.findall("disable_collisions") == []
+    said = " ".join(c.text for c in root.itersiblings(etree.Comment, preceding=True)) + \
+        " ".join(c.text for c in root.iter(etree.Comment))
+    assert "51 poses tested" in said and "nothing to disable" in said
 
 
 def test_python_output_disables_the_pairs_in_pybullet(gripper: Path,

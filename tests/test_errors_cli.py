@@ -142,6 +142,26 @@ def test_did_you_mean_looks_beside_the_file(tmp_path: Path, simplecar_urdf: Path
     assert f"did you mean '{tmp_path / 'my_arm.urdf'}'?" in one_error_line(err)
 
 
+def test_did_you_mean_goes_path_component_by_component(
+        tmp_path: Path, simplecar_urdf: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # Issue 49: `joints kuka_iwa/model.urdf` got nothing; `joints ./my_robt.urdf` suggested
+    # pybullet_data's cube_rotate.urdf.
+    monkeypatch.chdir(tmp_path)
+    _, _, err = invoke("joints", "kuka_iwa/model.urdf")
+    assert one_error_line(err).endswith("did you mean 'kuka_iiwa/model.urdf'?")
+    _, _, err = invoke("joints", "kuka_iwa/modl.urdf")  # a folder and the file both misspelt
+    assert one_error_line(err).endswith("did you mean 'kuka_iiwa/model.urdf'?")
+    _, _, err = invoke("joints", "./my_robt.urdf")  # nothing close: nothing suggested
+    assert "did you mean" not in one_error_line(err)
+    (tmp_path / "my_robot.urdf").write_bytes(simplecar_urdf.read_bytes())
+    _, _, err = invoke("joints", "./my_robt.urdf")  # the file here, spelt as the user spelt it
+    assert one_error_line(err).endswith("did you mean './my_robot.urdf'?")
+    (tmp_path / "robots" / "arm").mkdir(parents=True)
+    (tmp_path / "robots" / "arm" / "arm.urdf").write_bytes(simplecar_urdf.read_bytes())
+    _, _, err = invoke("joints", "robot/arms/arm.urdf")
+    assert one_error_line(err).endswith("did you mean 'robots/arm/arm.urdf'?")
+
+
 # --------------------------------------------------------------------------- JSON
 
 
@@ -175,12 +195,17 @@ def test_every_help_ends_with_examples(command: str) -> None:
 
 
 def test_help_text_reflows_and_keeps_its_words() -> None:
-    # rich keeps a docstring's line breaks; the help must read as whole paragraphs.
+    # A docstring's line breaks are not the help's: its paragraphs are wrapped anew, to the
+    # terminal's width up to 100 columns (tests/test_help_words.py: no word is cut).
     _, out, _ = invoke("drive", "--help", env={"COLUMNS": "300"})
+    lines = out.splitlines()
+    at = next(n for n, line in enumerate(lines) if line.startswith("  Wheels (continuous"))
+    assert lines[at] == "  Wheels (continuous joints about a horizontal axis) and steering " \
+        "hinges (revolute joints about a"  # up to 100 columns, not the docstring's 92
     assert "Wheels (continuous joints about a horizontal axis) and steering hinges (revolute " \
-        "joints about a vertical axis that carry wheels) are detected." in out
+        "joints about a vertical axis that carry wheels) are detected." in " ".join(out.split())
     _, out, _ = invoke("tree", "--help", env={"COLUMNS": "300"})
-    assert "[n] is the index PyBullet will give the joint." in out
+    assert "[n] is the index PyBullet will give the joint." in " ".join(out.split())
 
 
 def test_help_keeps_brackets_and_shows_readable_defaults() -> None:

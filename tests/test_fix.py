@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import re
 import shutil
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 from typer.testing import CliRunner
@@ -258,9 +261,84 @@ def test_stub_shapes_and_relative_paths(tmp_path: Path) -> None:
     elsewhere = tmp_path / "out"
     elsewhere.mkdir()
     code, _, err = _cli("fix", str(path), *MASS, "-o", str(elsewhere / "r.urdf"))
-    assert "do not resolve" in err and "'cube.stl'" in err
+    # PyBullet finds cube.stl from there too (it searches the folders above): kept.
+    assert "rewritten" not in err and 'filename="cube.stl"' in (elsewhere / "r.urdf").read_text()
+    side = tmp_path.parent / f"{tmp_path.name}-side"
+    side.mkdir()
+    code, _, err = _cli("fix", str(path), *MASS, "-o", str(side / "r.urdf"))
+    assert "1 relative mesh or texture path(s) rewritten" in err
+    assert f'filename="../{tmp_path.name}/cube.stl"' in (side / "r.urdf").read_text()
     code, _, err = _cli("fix", str(path), *MASS, "-o", str(tmp_path / "r_fixed.urdf"))
-    assert "do not resolve" not in err
+    assert "rewritten" not in err
+    assert 'filename="cube.stl"' in (tmp_path / "r_fixed.urdf").read_text()
+
+
+def _meshes(pb: tuple[Any, int], path: Path) -> tuple[list[str], list[Any]]:
+    """What raw PyBullet loads for ``path``: the visual mesh files (real paths), and each
+    collision mesh's shape data and its link's bounding box (PyBullet names a collision
+    mesh's file "unknown_file": its hull is what tells the meshes apart)."""
+    from urdfkit.engine.session import quiet_stdout
+
+    p, c = pb
+    with quiet_stdout():
+        body = p.loadURDF(str(path), physicsClientId=c)
+    visual = [os.path.realpath(v[4].decode()) for v in
+              p.getVisualShapeData(body, physicsClientId=c) if v[2] == p.GEOM_MESH]
+    collision = [(s[1], s[3], s[5], p.getAABB(body, link, physicsClientId=c))
+                 for link in range(-1, p.getNumJoints(body, physicsClientId=c))
+                 for s in p.getCollisionShapeData(body, link, physicsClientId=c)
+                 if s[2] == p.GEOM_MESH]
+    return visual, collision
+
+
+def test_written_elsewhere_it_loads_the_same_meshes(tmp_path: Path, pb: tuple[Any, int],
+                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    # Issue 49: `fix racecar/racecar.urdf --gazebo-contacts -o racecar_fixed.urdf` wrote a file
+    # whose 8 mesh paths no longer resolved, and `urdfkit diff` then failed on it.
+    import pybullet_data
+
+    src = tmp_path / "src" / "racecar"
+    shutil.copytree(Path(pybullet_data.getDataPath()) / "racecar", src)
+    original = src / "racecar.urdf"
+    beside, elsewhere = src / "beside.urdf", tmp_path / "out" / "deep" / "racecar_fixed.urdf"
+    elsewhere.parent.mkdir(parents=True)
+    for out in (beside, elsewhere):
+        code, _, err = _cli("fix", str(original), "--gazebo-contacts", "-o", str(out))
+        assert code == 0, err
+    assert "8 relative mesh or texture path(s) rewritten" in err
+    # Only the filename attributes differ from the copy written beside the original.
+    blank = re.compile(rb'filename="[^"]*"')
+    assert blank.sub(b"", elsewhere.read_bytes()) == blank.sub(b"", beside.read_bytes())
+    assert elsewhere.read_bytes() != beside.read_bytes()
+    # Raw PyBullet loads the very same mesh files from it.
+    visual, collision = _meshes(pb, original)
+    assert len(visual) == 8 and len(collision) == 4  # 4 links collide as meshes
+    assert _meshes(pb, elsewhere) == (visual, collision)
+    assert _cli("diff", str(beside), str(elsewhere))[0] == 0  # the same robot
+    code, out, err = _cli("diff", str(original), str(elsewhere))
+    assert code == 1 and "inertia" in out and "error" not in err
+    # As the issue ran it: a pybullet_data name, written in the current folder.
+    monkeypatch.chdir(tmp_path)
+    code, _, err = _cli("fix", "racecar/racecar.urdf", "--gazebo-contacts", "-o",
+                        "racecar_fixed.urdf")
+    assert code == 0, err
+    here = _meshes(pb, tmp_path / "racecar_fixed.urdf")
+    assert here == _meshes(pb, Path(pybullet_data.getDataPath()) / "racecar" / "racecar.urdf")
+    code, _, err = _cli("diff", "racecar/racecar.urdf", "racecar_fixed.urdf")
+    assert code == 1 and "error" not in err
+
+
+def test_stdout_keeps_the_paths_and_says_so(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+                                            ) -> None:
+    import pybullet_data
+
+    monkeypatch.chdir(tmp_path)
+    code, out, err = _cli("fix", "racecar/racecar.urdf", "-o", "-")
+    assert 'filename="meshes/chassis.STL"' in out
+    assert "8 mesh or texture path(s) are relative to its folder" in err
+    monkeypatch.chdir(Path(pybullet_data.getDataPath()) / "racecar")
+    code, out, err = _cli("fix", "racecar.urdf", "-o", "-")
+    assert "relative to its folder" not in err
 
 
 def test_a_frame_with_frames_below_gets_mass_0(tmp_path: Path) -> None:
@@ -337,3 +415,21 @@ def test_fix_warns_when_raw_pybullet_cannot_reach_a_nested_package(
         warned = "raw p.loadURDF will not find 1 package:// file(s)" in result.output
         # The warning says exactly what raw PyBullet then does with the written file.
         assert warned == (out == outside) == (not raw_loads(out)), (out, result.output)
+
+
+def test_a_package_uri_repaired_elsewhere_is_named_from_there(
+        tmp_path: Path, raw_loads: Callable[[Path], bool]) -> None:
+    # U708 without a package.xml becomes a relative path: relative to where it is written.
+    src, out = tmp_path / "src", tmp_path / "out"
+    src.mkdir()
+    out.mkdir()
+    shutil.copy(MESHES / "unit_cube.stl", src / "cube.stl")
+    path = src / "r.urdf"
+    path.write_text('<robot name="r"><link name="b"><inertial><mass value="1"/><inertia '
+                    'ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>'
+                    '<visual><geometry><mesh filename="package:///cube.stl"/></geometry>'
+                    '</visual></link></robot>')
+    code, _, err = _cli("fix", str(path), "--select", "U708", "-o", str(out / "r.urdf"))
+    assert code == 0, err
+    assert 'filename="../src/cube.stl"' in (out / "r.urdf").read_text()
+    assert raw_loads(out / "r.urdf")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -112,9 +113,15 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     broken = (ROOT / "tests" / "fixtures" / "robots" / "broken_arm.urdf").read_text()
     broken = broken.replace("<cylinder ", "<capsule ").replace(
         '<origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>', '<origin xyz="0 0 0.5"/><axis xyz="0 0 0"/>')
-    (tmp / "broken.urdf").write_text(broken)
-    runs["fix"] = ["fix", str(tmp / "broken.urdf"), "-o", str(tmp / "fixed.urdf"), "--json",
-                   "--allow-mass-change"]
+    # Its visual mesh relative to it, written into another folder: a path moved for it.
+    broken = broken.replace('<visual><geometry><mesh filename="package:///meshes/unit_cube.stl"',
+                            '<visual><geometry><mesh filename="unit_cube.stl"')
+    for folder in ("src", "out"):
+        (tmp / folder).mkdir()
+    (tmp / "src" / "broken.urdf").write_text(broken)
+    shutil.copy(ROOT / "tests" / "fixtures" / "meshes" / "unit_cube.stl", tmp / "src")
+    runs["fix"] = ["fix", str(tmp / "src" / "broken.urdf"), "-o", str(tmp / "out" / "fixed.urdf"),
+                   "--json", "--allow-mass-change"]
     runs["sweep"] = ["sweep", "drive", "--steps", "5", "--vary", "steer=0.1,0.2", "--json"]
     # r2d2: fixed links (sites), meshes (paths), notes of every common kind
     runs["export"] = ["export", "mjcf", "r2d2.urdf", "-o", str(tmp / "r2d2.xml"), "--json"]

@@ -97,3 +97,30 @@ def test_the_skip_checker_sees_a_reasonless_skip(tmp_path: Path) -> None:
                      "@pytest.mark.skipif(True, reason='why')\ndef test_b():\n    pass\n\n"
                      "def test_c():\n    pytest.skip()\n")
     assert _skips_without_reason(probe) == [3, 12]
+
+
+def test_the_readme_counts_the_browser_tests(tmp_path: Path) -> None:
+    # Issue 49: the README's test command did not say that most skips are the browser tests,
+    # which need Chromium. Its count is the tests that take the `chromium` fixtures (directly
+    # or through another fixture), as pytest collects them.
+    import os
+    import re
+    import subprocess
+    import sys
+
+    (tmp_path / "browser_count.py").write_text(
+        "def pytest_collection_finish(session):\n"
+        "    n = sum(bool({'chromium', 'module_chromium'} & set(getattr(i, 'fixturenames', ())))"
+        " for i in session.items)\n"
+        "    print(f'BROWSER TESTS {n}')\n")
+    files = [str(p) for p in _modules() if "chromium" in p.read_text("utf-8")]
+    done = subprocess.run([sys.executable, "-m", "pytest", "--co", "-q", "-n", "0", "-p",
+                           "browser_count", *files], capture_output=True, text=True,
+                          timeout=300, cwd=TESTS.parent,
+                          env={**os.environ, "PYTHONPATH": os.pathsep.join(
+                              [str(tmp_path), os.environ.get("PYTHONPATH", "")])})
+    counted = re.search(r"BROWSER TESTS (\d+)", done.stdout)
+    assert counted is not None, done.stdout + done.stderr
+    said = re.search(r"^- (\d+) are the browser tests", (TESTS.parent / "README.md").read_text(),
+                     re.M)
+    assert said is not None and int(said[1]) == int(counted[1]) > 0

@@ -23,7 +23,7 @@ from collections.abc import Callable, Iterable, Sequence
 from typing import Annotated, Any
 
 import typer
-from typer.core import TyperGroup
+from typer.core import TyperCommand, TyperGroup
 
 from urdfkit import __version__
 from urdfkit.commands import present as show
@@ -67,8 +67,35 @@ def _usage_message(e: Any) -> str:
     return where + text
 
 
+def _help(command: Any, ctx: Any, formatter: Any) -> None:
+    """Write ``command``'s help, words whole at any width (:mod:`urdfkit.commands.helptext`).
+
+    Not typer's rich panels: their option table cuts a word wider than its column in two,
+    or to an ellipsis, at any common terminal width.
+    """
+    from urdfkit.commands.helptext import plain_help
+
+    ctx.ensure_object(dict)
+    if isinstance(ctx.obj, dict):  # typer escapes "[default: ...]" for rich unless told not
+        ctx.obj["TYPER_RICH_MARKUP_MODE"] = None
+    formatter.write(plain_help(command, ctx, show.terminal_width(),
+                               styled=show.styled(sys.stdout)) + "\n")
+
+
+class UrdfkitCommand(TyperCommand):
+    """A command whose help keeps every word whole (:func:`_help`)."""
+
+    def format_help(self, ctx: Any, formatter: Any) -> None:
+        """The help, laid out by :func:`_help`."""
+        _help(self, ctx, formatter)
+
+
 class UrdfkitGroup(TyperGroup):
     """urdfkit's click group: its :meth:`main` is the one error handler of the CLI."""
+
+    def format_help(self, ctx: Any, formatter: Any) -> None:
+        """The list of commands, laid out by :func:`_help`."""
+        _help(self, ctx, formatter)
 
     def main(self, args: Sequence[str] | None = None, prog_name: str | None = None,
              complete_var: str | None = None, standalone_mode: bool = True,
@@ -167,7 +194,7 @@ def _build(names: Iterable[str], *, library_defaults: bool = True, listing: bool
     built.callback()(_root)
     for name in names:
         func = _command(name, library_defaults and not listing)
-        built.command(name=name, epilog=func.__dict__["epilog"],
+        built.command(name=name, cls=UrdfkitCommand, epilog=func.__dict__["epilog"],
                       help=_reflow(inspect.cleandoc(func.__doc__ or "")))(
             _listed if listing else func)
     return built

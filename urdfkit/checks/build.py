@@ -40,6 +40,8 @@ class BuildResult:
         joints: How many joints.
         warnings: ``check``'s errors on it (a xacro build writes them as warnings), each
             ``file[:line]: message (code)`` with the file and line it was written on.
+        base: The folder its relative mesh and texture paths start from (the xacro file's),
+            or None (a template names no files).
     """
 
     data: bytes
@@ -47,6 +49,30 @@ class BuildResult:
     links: int
     joints: int
     warnings: list[str] = field(default_factory=list)
+    base: Path | None = None
+
+    def written_at(self, out: str | Path) -> tuple[bytes, list[tuple[str, str]]]:
+        """The bytes to write at ``out``, and the ``(old, new)`` paths rewritten for it.
+
+        Written in another folder than the xacro file's, each relative mesh and texture path
+        is rewritten to name the same file from there
+        (:func:`urdfkit.sources.uris.rebased`), so the file loads where it is written.
+        """
+        from urdfkit.model.spec import FILE_TAGS
+        from urdfkit.sources.uris import rebased
+
+        if self.base is None:
+            return self.data, []
+        folder = Path(out).expanduser().absolute().parent
+        root = parse_xml(self.data, str(out)).getroot()
+        moved = []
+        for el in root.iter(*FILE_TAGS):
+            old = el.get("filename")
+            new = None if old is None else rebased(old, self.base, folder)
+            if old is not None and new is not None:
+                el.set("filename", new)
+                moved.append((old, new))
+        return (to_bytes(root) if moved else self.data), moved
 
 
 class BuildFindings(InputError):
@@ -190,7 +216,8 @@ def _build_xacro(source: Path, target: str, args: Mapping[str, str],
                 for f in errors]
     links = sum(1 for el in root if el.tag == "link")
     joints = sum(1 for el in root if el.tag == "joint")
-    return BuildResult(to_bytes(root), default, links, joints, warnings)
+    return BuildResult(to_bytes(root), default, links, joints, warnings,
+                       base=source.absolute().parent)
 
 
 #: check's error codes for what makes ``p.loadURDF`` fail outright (docs/check.md): a

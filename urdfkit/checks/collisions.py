@@ -120,20 +120,33 @@ class Collisions:
                 "links_without_collision": self.without_shapes, "warnings": self.warnings}
 
     def srdf(self) -> str:
-        """``<disable_collisions>`` entries (MoveIt SRDF) for the pairs always in contact.
+        """A MoveIt SRDF document disabling the pairs always in contact, commented.
 
+        One ``<disable_collisions>`` per pair, inside ``<robot name>`` with the robot's name;
+        a comment says what was tested, and none is a document that says nothing matched.
         The reason is MoveIt Setup Assistant's: ``Default`` for a pair in contact at the one
         pose tested, ``Always`` for one in contact at every sampled pose too.
         """
         reason = "Always" if self.samples else "Default"
-        out = []
-        for x in self.always():
+        always = self.always()
+        tested = (f"{self.poses} poses tested (the start pose and {self.samples} random, seed "
+                  f"{self.seed})" if self.samples else "the one pose tested (the start pose)")
+        out = ['<?xml version="1.0"?>\n',
+               f"<!-- urdfkit collisions {_comment(self.file)}: {len(always)} link pair(s) in "
+               f"contact in {'all ' if self.samples else ''}{tested}, margin "
+               f"{self.margin:g} m.{' Merge these entries into the robot SRDF.' if always else ''}"
+               " -->\n",
+               f'<robot name="{_attr(self.robot)}">\n']
+        if not always:
+            out.append("  <!-- no pair is in contact in every pose: nothing to disable -->\n")
+        for x in always:
             if x.hull:  # MoveIt (FCL) collides the mesh itself: the pair may be clear there
-                out.append(f"<!-- {_attr(', '.join(x.hull))}: a concave mesh PyBullet collides "
-                           "as its convex hull; MoveIt checks the mesh itself, so check this "
-                           "pair there before disabling it -->\n")
-            out.append(f'<disable_collisions link1="{_attr(x.link_a)}" '
+                out.append(f"  <!-- {_comment(', '.join(x.hull))}: a concave mesh PyBullet "
+                           "collides as its convex hull; MoveIt checks the mesh itself, so "
+                           "check this pair there before disabling it -->\n")
+            out.append(f'  <disable_collisions link1="{_attr(x.link_a)}" '
                        f'link2="{_attr(x.link_b)}" reason="{reason}"/>\n')
+        out.append("</robot>\n")
         return "".join(out)
 
     def python(self) -> str:
@@ -150,6 +163,13 @@ class Collisions:
 
 def _attr(text: str) -> str:
     return text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+
+
+def _comment(text: str) -> str:
+    """``text`` safe inside an XML comment, which may hold no ``--`` (nor end in ``-``)."""
+    while "--" in text:
+        text = text.replace("--", "- -")
+    return text + " " if text.endswith("-") else text
 
 
 def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = None,

@@ -100,7 +100,9 @@ class FixResult:
         other_errors: Error findings ``fix`` does not repair (a zero axis, a missing limit):
             ``check`` explains them.
         relative_paths: Mesh and texture paths relative to the file's folder: a copy
-            written elsewhere no longer finds them.
+            written elsewhere no longer finds them as written.
+        moved_paths: ``(old, new)`` of each ``filename`` rewritten for the folder the result
+            is written to (``output``): only those attributes change.
     """
 
     file: str
@@ -117,6 +119,7 @@ class FixResult:
     left: list[Repair] = field(default_factory=list)
     other_errors: list[Repair] = field(default_factory=list)
     relative_paths: list[str] = field(default_factory=list)
+    moved_paths: list[tuple[str, str]] = field(default_factory=list)
 
     @property
     def changed(self) -> bool:
@@ -140,12 +143,14 @@ class FixResult:
                          "loaded_after": self.loaded_after},
                 "fixes": [x.to_dict() for x in self.repairs],
                 "left": [x.to_dict() for x in self.left],
-                "other_errors": [x.to_dict() for x in self.other_errors]}
+                "other_errors": [x.to_dict() for x in self.other_errors],
+                "moved_paths": [{"from": a, "to": b} for a, b in self.moved_paths]}
 
 
 def fix_file(path: str | Path, *, balance: bool = False, density: float | None = None,
              packages: Mapping[str, Path] | None = None,
-             select: Sequence[str] = (), gazebo_contacts: bool = False) -> FixResult:
+             select: Sequence[str] = (), gazebo_contacts: bool = False,
+             output: str | Path | None = None) -> FixResult:
     """Repair a URDF file's fixable findings; return the new text (nothing is written).
 
     Args:
@@ -162,6 +167,10 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
         select: Only these codes (or prefixes); empty for all of :data:`FIXABLE`.
         gazebo_contacts: Carry Gazebo's contact parameters over to ``<contact>`` (U803);
             without it they are left as they are, and not counted as left.
+        output: Where the result will be written. In another folder than ``path``, each
+            relative mesh and texture path is rewritten to name the same file from there
+            (:func:`urdfkit.sources.uris.rebased`), so the written file loads as the
+            original does; only those ``filename`` attributes change.
 
     Raises:
         InputError: the file cannot be read or parsed, or is xacro.
@@ -178,8 +187,10 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
     # A fix counts only if check then passes its rule: re-check the repaired links, and redo
     # without those still flagged (a mass of 1e308 has no inertia a float can hold).
     still = _unfixed(fixed, display, source, packages, plan.repairs)
-    if still:
-        plan, fixed = run(still)
+    # The paths are moved last: the re-check above reads the meshes from the file's folder.
+    folder = _elsewhere(source, output)
+    if still or folder is not None:
+        plan, fixed = run(still, folder)
     others = [Repair(f.code, f.line, f.message) for f in report.findings
               if f.level == "error" and f.code not in FIXABLE]
     from urdfkit.model.spec import FILE_TAGS
@@ -193,7 +204,16 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
                      loaded_after=_total_mass(new_root, loaded=True),
                      repairs=sorted(plan.repairs, key=_by_line),
                      left=sorted(plan.left, key=_by_line), other_errors=others,
-                     relative_paths=relative)
+                     relative_paths=relative, moved_paths=plan.moved)
+
+
+def _elsewhere(source: Path, output: str | Path | None) -> Path | None:
+    """The folder ``output`` is in, when it is not ``source``'s; else None."""
+    if output is None:
+        return None
+    folder = Path(output).expanduser().absolute().parent
+    same = os.path.realpath(folder) == os.path.realpath(source.absolute().parent)
+    return None if same else folder
 
 
 def _read_source(path: str | Path, density: float | None) -> tuple[str, Path, bytes, str]:
@@ -234,12 +254,17 @@ class _Fixing:
     wanted: tuple[str, ...]
     gazebo_contacts: bool = False
 
-    def run(self, skip: Mapping[str, str]) -> tuple[_Plan, bytes]:
-        """Plan every repair (but those of the links in ``skip``, said why) and apply them."""
+    def run(self, skip: Mapping[str, str], folder: Path | None = None) -> tuple[_Plan, bytes]:
+        """Plan every repair (but those of the links in ``skip``, said why) and apply them.
+
+        ``folder``: where the result goes, when not beside the file; relative paths are
+        rewritten for it.
+        """
         # A fresh tree each time (the plan edits the tree it is given); the findings' elements
         # are the pristine ``root``'s, mapped to it by position.
         tree = parse_xml(self.data, self.display).getroot()
-        plan = _Plan(self.text, tree, self.display, self.balance, self.density, self.report)
+        plan = _Plan(self.text, tree, self.display, self.balance, self.density, self.report,
+                     folder)
         for el, codes in self._targets(_same_elements(self.root, tree)).items():
             name = el.get("name", "")
             if el.tag == "link" and name in skip:
@@ -252,6 +277,8 @@ class _Fixing:
                 plan.define_material(el, codes[0][1])
             else:
                 plan.normalise_uri(el, codes[0][1], self.packages)
+        if folder is not None:
+            plan.move_paths()
         return plan, plan.finish()
 
     def _targets(self, elements: Mapping[etree._Element, etree._Element]
@@ -386,8 +413,13 @@ class _Plan:
     """The edits to one file: spliced into its text and made on its tree, side by side."""
 
     def __init__(self, text: str, root: etree._Element, file: str, balance: bool,
-                 density: float | None, report: RuleReport):
+                 density: float | None, report: RuleReport, folder: Path | None = None):
         self.text = text
+        #: Where the result goes, when not beside the file (relative paths are for it).
+        self.folder = folder
+        #: ``(old, new)`` of each filename rewritten for ``folder``.
+        self.moved: list[tuple[str, str]] = []
+        self.renamed: set[etree._Element] = set()
         self.root = root
         self.file = file
         self.balance = balance
@@ -626,9 +658,30 @@ class _Plan:
                 break
         if new is None:
             new = Path(os.path.relpath(target, base)).as_posix()
+            if self.folder is not None:  # written elsewhere: named from there
+                from urdfkit.sources.uris import rebased
+
+                new = rebased(new, base, self.folder) or new
         self._set_attribute(el, "filename", new)
+        self.renamed.add(el)
         self.repairs.append(Repair("U708", line, f"{old!r} -> {new!r} (package:/// has no "
                                    "package name; ROS tools refuse it)"))
+
+    def move_paths(self) -> None:
+        """Rewrite each relative mesh and texture path for :attr:`folder` (nothing else)."""
+        from urdfkit.model.spec import FILE_TAGS
+        from urdfkit.sources.uris import rebased
+
+        base = self.report.base
+        assert base is not None and self.folder is not None
+        for el in self.root.iter(*FILE_TAGS):
+            old = el.get("filename")
+            if old is None or el in self.renamed or el not in self.tag_at:
+                continue
+            new = rebased(old, base, self.folder)
+            if new is not None:
+                self._set_attribute(el, "filename", new)
+                self.moved.append((old, new))
 
     # ---- edits, on the text and the tree alike
 

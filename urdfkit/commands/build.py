@@ -53,15 +53,24 @@ def build(
     for w in result.warnings:
         show.warn(w)
     if out == "-":
+        here = result.written_at(Path.cwd() / "-")[1]  # what would move for a file here
+        if here:
+            show.warn(f"{target}: {len(here)} mesh or texture path(s) are relative to its "
+                      f"folder ({here[0][0]!r}, ...) and are written as they are: save the "
+                      "output in that folder, or use -o FILE, which rewrites them for where "
+                      "it writes")
         sys.stdout.buffer.write(result.data)
         sys.stdout.flush()
         return
-    lost = building.unreachable_packages(result.data, Path(out))
+    data, moved = result.written_at(out)
+    lost = building.unreachable_packages(data, Path(out))
     if lost is not None:
         show.warn(lost)
-    path = building.write_output(out, result.data, force=force)
+    path = building.write_output(out, data, force=force)
     show.wrote(path, f"{show.counted(result.links, 'link')}, "
-                     f"{show.counted(result.joints, 'joint')}")
+                     f"{show.counted(result.joints, 'joint')}"
+                     + (f"; {len(moved)} relative mesh or texture path(s) rewritten for its "
+                        "folder" if moved else ""))
 
 
 @command(examples("urdfkit templates", "urdfkit templates --json"))

@@ -173,14 +173,16 @@ def fix(
 
     codes = _check_fix_options(output, in_place, show_diff, as_json, select)
     if in_place and not Path(file).expanduser().exists() and locate(file).exists():
-        raise ParameterError(f"{file}: found in pybullet_data, which --in-place would rewrite; "
-                             "write the repaired copy with -o FILE")
+        raise ParameterError(f"{file}: not a file here (found in pybullet_data, or a built-in "
+                             "template), which --in-place would rewrite; write the repaired "
+                             "copy with -o FILE")
     backup = f"{file}.orig"
     if output not in (None, "-"):
         check_output(output, force=force)
     result = fix_file(file, balance=balance, density=density,
                       packages=parse_packages(package, package_path), select=codes,
-                      gazebo_contacts=gazebo_contacts)
+                      gazebo_contacts=gazebo_contacts,
+                      output=output if output not in (None, "-") else None)
     _say_mass_changes(file, result, refuse=not allow_mass_change and not show_diff,
                       quiet=as_json)
     if in_place and result.changed:
@@ -260,6 +262,12 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
 
     backup = f"{file}.orig"
     if output == "-":
+        if result.relative_paths and Path.cwd().resolve() != \
+                locate(file).absolute().parent.resolve():
+            show.warn(f"{file}: {len(result.relative_paths)} mesh or texture path(s) are "
+                      f"relative to its folder ({result.relative_paths[0]!r}, ...) and are "
+                      "written as they are: save the output in that folder, or use -o FILE, "
+                      "which rewrites them for where it writes")
         report()
         sys.stdout.buffer.write(result.fixed)
         sys.stdout.flush()
@@ -272,12 +280,6 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
             show.wrote(Path(file), f"original kept as {backup}")
     else:
         assert output is not None
-        if result.relative_paths and Path(output).absolute().parent.resolve() != \
-                locate(file).absolute().parent.resolve():
-            show.warn(f"{output}: {len(result.relative_paths)} mesh or texture path(s) in it are "
-                      f"relative to {file}'s folder ({result.relative_paths[0]!r}, ...) and "
-                      "do not resolve from where it is written: write it beside the original "
-                      "(or --in-place), or copy what it names")
         from urdfkit.checks.build import unreachable_packages
 
         lost = unreachable_packages(result.fixed, Path(output))
@@ -286,7 +288,9 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
         path = atomic_write(output, result.fixed, force=force)
         report()
         if not as_json:
-            show.wrote(path, f"{len(result.repairs)} fix(es)")
+            moved = (f"; {len(result.moved_paths)} relative mesh or texture path(s) rewritten "
+                     "for its folder" if result.moved_paths else "")
+            show.wrote(path, f"{len(result.repairs)} fix(es){moved}")
 
 
 # ---- drive: a headless throttle/steer run (urdfkit/drive.py, vehicle.py, plot.py)
@@ -294,7 +298,7 @@ def _write_fixed(file: str, result: Any, output: str | None, *, in_place: bool, 
 
 @command(examples(
     "urdfkit collisions panda.urdf", "urdfkit collisions arm.urdf --samples 100 --json",
-    "urdfkit collisions arm.urdf --samples 200 --srdf >> arm.srdf",
+    "urdfkit collisions arm.urdf --samples 200 --srdf > arm_collisions.srdf",
     "urdfkit collisions hand.urdf --joints finger_joint=0.04 --python"))
 def collisions(
     file: FileArg,
@@ -310,8 +314,8 @@ def collisions(
         "--margin", metavar="M", help="Count links closer than this (m) as touching.")] = 0.0,
     as_json: JsonOpt = False,
     srdf: Annotated[bool, typer.Option(
-        "--srdf", help="Print MoveIt <disable_collisions> entries for the pairs in contact "
-        "in every pose.")] = False,
+        "--srdf", help="Print a MoveIt SRDF document with <disable_collisions> entries for "
+        "the pairs in contact in every pose.")] = False,
     python: Annotated[bool, typer.Option(
         "--python", help="Print p.setCollisionFilterPair calls for the pairs in contact in "
         "every pose.")] = False,

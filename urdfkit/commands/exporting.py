@@ -65,7 +65,7 @@ def agreement_dict(a: Any) -> dict[str, Any]:
 def agreement_report(a: Any, show_all: bool = False) -> None:
     """``agree``'s table: one row per comparison, the tolerance beside each figure."""
     rows = [[r.group, r.what, _figure(r.value), _figure(r.tolerance), r.unit,
-             {"pass": "ok", "fail": "FAIL"}.get(r.status, r.status), r.detail]
+             {"pass": "ok", "fail": "FAIL"}.get(r.status, r.status), show.tidy(r.detail)]
             for r in a.rows]
     columns: list[show.Column] = [("group", 1, "left"), ("check", 0, "left"),
                                   ("worst", 0, "right"), ("tolerance", 0, "right"),

@@ -178,6 +178,20 @@ def nums(v: Iterable[float]) -> str:
     return " ".join(num(x) for x in v)
 
 
+#: A decimal number in text, with more significant digits than a reader can use.
+_NOISY = re.compile(r"(?<![\w.])-?(?=(?:\d\.?){13})\d+\.\d+(?:e[-+]?\d+)?(?![\w.])")
+
+
+def tidy(text: str) -> str:
+    """``text`` with each number of 13 or more significant digits cut to 12.
+
+    For human text built by the library with exact values (agree's "PyBullet
+    65.24999999999999 kg"): float noise goes (65.25), a real difference of one part in
+    10^11 stays. JSON keeps the exact text.
+    """
+    return _NOISY.sub(lambda m: f"{float(m.group()):.12g}", text) if "." in text else text
+
+
 def fixed(x: float, digits: int = 3) -> str:
     """Fixed decimals, without a ``-`` on a value that rounds to zero."""
     text = f"{x:.{digits}f}"
@@ -545,15 +559,23 @@ def diff_report(result: Any) -> None:
 # --------------------------------------------------------------------------- progress
 
 
+def _isatty(stream: Any) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError):
+        return False
+
+
 def progress(label: str, unit: str, enabled: bool = True, rate: bool = False
              ) -> tuple[Callable[[int, int], None] | None, Callable[[], None]]:
     """A progress callback that shows a bar on stderr once a run looks longer than ~1 s.
 
     Returns ``(update(done, total), stop())``; ``update`` is None when not ``enabled`` or
-    when stdout or stderr is not a terminal (a bar in a log file is noise). ``rate`` adds
-    units per second.
+    when stderr, where the bar goes, is not a terminal (a bar in a log file is noise). A
+    piped stdout (``urdfkit drive | tee run.txt``) still gets it on the terminal: the bar
+    never touches stdout. The bar shows the time left; ``rate`` adds units per second.
     """
-    if not (enabled and sys.stdout.isatty() and sys.stderr.isatty()):
+    if not (enabled and _isatty(sys.stderr)):
         return None, lambda: None
     import time
 

@@ -71,7 +71,7 @@ JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on 
 FixedBaseOpt = Annotated[bool, typer.Option("--fixed-base", help="Pin the root link to the world.")]
 FlagsOpt = Annotated[str | None, typer.Option(
     "--flags", metavar="NAMES",
-    help="Exactly these PyBullet loadURDF flags, comma-separated (URDF_USE_INERTIA_FROM_FILE,"
+    help="Exactly these PyBullet loadURDF flags, comma-separated (URDF_USE_INERTIA_FROM_FILE, "
     "URDF_USE_IMPLICIT_CYLINDER, ...; the URDF_ may be left out), or none: to match your own "
     "p.loadURDF call. Default: URDF_USE_IMPLICIT_CYLINDER (true cylinders).",
     show_default=False)]
@@ -86,7 +86,8 @@ TypeOpt = Annotated[list[str] | None, typer.Option(
     help="Only joints of this type (repeatable): revolute, continuous, prismatic, fixed, ...")]
 AllOpt = Annotated[bool, typer.Option("--all", help="Show every field, however wide.")]
 FileArg = Annotated[str, typer.Argument(
-    help="A .urdf or .xacro file; a bare name is also looked up in pybullet_data.")]
+    help="A .urdf or .xacro file; a bare name is also looked up in pybullet_data, and a "
+    "template name (simplecar) is that template.")]
 
 
 def open_input_and_warn(file: str, *, packages: list[str] | None,
@@ -131,7 +132,7 @@ TimeStepOpt = Annotated[float, typer.Option(help="Physics time step, s.", show_d
 MaxForceOpt = Annotated[float | None, typer.Option(
     help="Wheel motor torque limit, N m.", show_default="10")]
 UrdfOpt = Annotated[str | None, typer.Option(
-    help="Car to drive (.urdf/.xacro; pybullet_data names work).",
+    help="Car to drive (.urdf/.xacro; pybullet_data and template names work).",
     show_default="the built-in simplecar")]
 PlaneOpt = Annotated[str | None, typer.Option(
     help="Ground to drive on.", show_default="the built-in simpleplane")]

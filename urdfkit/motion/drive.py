@@ -59,7 +59,7 @@ from urdfkit.motion.vehicle import (
     disable_default_motors,
 )
 from urdfkit.motion.vehicle_shapes import base_link_pose, lowest_point, set_base_link_pose
-from urdfkit.sources.cache import cache_dir, write_entry
+from urdfkit.sources.builtin import builtin_file as builtin_file  # re-exported: gym, sim, tests
 
 if TYPE_CHECKING:
     from urdfkit.model.gazebo import GazeboContact
@@ -260,41 +260,6 @@ def drive_to_file(scenario: Scenario, path: str | Path, *, force: bool = False,
 
 
 ProgressFn = Callable[[int, int], None]
-
-
-def builtin_file(name: str, params: Mapping[str, str] | None = None) -> Path | None:
-    """A built-in template, built with ``params``, from the cache (built on a miss).
-
-    Expanding simplecar with xacro and checking it through the builder costs ~0.07 s of CPU,
-    as much as 400 physics steps, on every ``urdfkit drive``. The result depends only on the
-    template's source, the parameters and the urdfkit version, which make the cache key; a
-    stale or broken entry can therefore not be hit. Returns None (build into a temp folder
-    instead) when the cache cannot be written. Nothing is ever written to the user's folder.
-    """
-    import zlib
-
-    from urdfkit import __version__
-    from urdfkit.model.templatedir import template_dir
-
-    folder = cache_dir()
-    if folder is None:
-        return None
-    # The package folder directly: importlib.resources (and the zipfile it imports) would
-    # cost more than the lookup saves. A zipped install simply skips the cache.
-    try:
-        source = (template_dir() / f"{name}.urdf.xacro").read_bytes()
-    except (OSError, TypeError):
-        return None
-    given = "".join(f"{k}={v};" for k, v in sorted((params or {}).items())).encode()
-    key = f"{zlib.crc32(source):08x}{len(source):x}-{zlib.crc32(given):08x}-{__version__}" \
-        if given else f"{zlib.crc32(source):08x}{len(source):x}-{__version__}"
-    path = folder / f"{name}-{key}.urdf"
-    if path.is_file():
-        return path
-    from urdfkit.model.catalog import build_template
-
-    data = build_template(name, params).to_bytes()
-    return path if write_entry(path, data) else None
 
 
 #: The longest run (simulated s) repeated at more force to test the advice to raise it.
@@ -799,8 +764,10 @@ def _yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> 
     would reach: ten and a hundred times the wheel force (capped at PyBullet's default), then,
     if no force helps, up to three times the yaw rate (capped where the inner wheels would
     stop: 2 v / track). Advice is given only when its run turns clearly faster (1.5x); it
-    names the option as the command line spells it. At most three re-runs, only when this
-    warning is printed; runs over :data:`PROBE_LIMIT` s are not repeated.
+    names the option as the command line spells it. More yaw rate is then searched for the
+    command that turns within 10% of what was asked (:func:`_aim`). At most three re-runs and
+    :data:`AIM_RUNS` more, only when this warning is printed; runs over :data:`PROBE_LIMIT` s
+    are not repeated.
     """
     c, train = sc.config, sc.drivetrain
     kind = "skid steering" if train.steering == "skid" else "differential steering"
@@ -848,11 +815,52 @@ def _yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> 
             assert r is not None
             first = f"more wheel force does not help ({'; '.join(tried)})" if tried \
                 else "at PyBullet's default wheel force"
-            return (f"{said}; {first}: the wheels slip sideways, and --steer {more:.3g} "
-                    f"turns at {r:.3g} rad/s: command more yaw rate (--steer {more:.3g})")
+            return f"{said}; {first}: the wheels slip sideways, and " + _aim(
+                lambda x: probe(steer=x), sc.steer, (sc.steer, rate), (more, r), widest)
         tried.append(f"--steer {more:.3g}: {shown(r)}")
     return (f"{said}; neither more force nor more yaw rate turns it faster "
             f"({'; '.join(tried)}): the wheels slip sideways")
+
+
+#: How close advice must land to the yaw rate asked for to be advised as reaching it.
+AIM = 0.1
+#: Re-runs the search for that command may take (beyond the first at more yaw rate).
+AIM_RUNS = 4
+
+
+def _aim(measure: Callable[[float], float | None], asked: float, start: tuple[float, float],
+         more: tuple[float, float], widest: float) -> str:
+    """The ``--steer`` to command for the yaw rate ``asked``, found by running it.
+
+    A skid-steered base turns slower than commanded, and not in proportion: three times the
+    command may turn it faster than asked (r2d2 at --throttle 5: --steer 0.9 turns at 0.5
+    rad/s for 0.3 asked). From the two runs made (``start``, the user's, and ``more``), the
+    secant method picks the next command, rounded to the three digits the advice prints,
+    and runs it, up to :data:`AIM_RUNS` times, until one lands within :data:`AIM` of
+    ``asked`` (capped at ``widest``, where the inner wheels stop). The advice names that
+    command and what it measured; if none lands, the nearest, and says it missed.
+    """
+    runs = [start, more]
+    for _ in range(AIM_RUNS):
+        (s0, r0), (s1, r1) = runs[-2], runs[-1]
+        if abs(r1 - asked) <= AIM * abs(asked) or r1 == r0:
+            break
+        s = s1 + (asked - r1) * (s1 - s0) / (r1 - r0)
+        s = math.copysign(min(abs(s), widest), asked) if s * asked > 0 else s1 / 2
+        s = float(f"{s:.3g}")
+        if any(s == x for x, _ in runs):
+            break
+        r = measure(s)
+        if r is None:
+            break
+        runs.append((s, r))
+    s, r = min(runs[1:], key=lambda x: abs(x[1] - asked))
+    if abs(r - asked) <= AIM * abs(asked):
+        return (f"--steer {s:.3g} turns at {r:.3g} rad/s ({r / asked:.0%} of the {asked:g} "
+                f"asked): command more yaw rate (--steer {s:.3g})")
+    tried = "; ".join(f"--steer {x:.3g}: {y:.3g} rad/s" for x, y in runs[1:])
+    return (f"no command tried turns within {AIM:.0%} of the {asked:g} asked ({tried}); "
+            f"--steer {s:.3g} comes nearest, at {r:.3g} rad/s ({r / asked:.0%})")
 
 
 class _GuiControls:

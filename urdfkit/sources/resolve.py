@@ -61,7 +61,12 @@ def _clip(text: str, most: int = 120) -> str:
 
 
 def locate(name: str | Path) -> Path:
-    """Find a file as given, else in pybullet_data; refuse folders."""
+    """Find a file as given, else in pybullet_data, else a built-in template's; refuse folders.
+
+    A bare template name (``simplecar``) that is no file here nor in pybullet_data is the
+    template built with its defaults (:func:`urdfkit.sources.builtin.template_file`), as
+    ``drive`` drives it.
+    """
     path = Path(name).expanduser()
     why = not_a_file(path)
     if why is None:
@@ -74,12 +79,21 @@ def locate(name: str | Path) -> Path:
     data = None if path.is_absolute() else pybullet_data_path()
     if data is not None and (data / path).is_file():
         return data / path
+    from urdfkit.sources.builtin import template_file, template_names
+
+    built = template_file(str(name))
+    if built is not None:
+        return built
+    from urdfkit.core.suggest import close as close_names
     from urdfkit.core.suggest import files
 
     close = [c for c in files(str(name), data) if c != str(name)]
+    if os.sep not in str(name):
+        close += close_names(str(name), template_names())
     more = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
-    raise InputError(f"no such file (looked in the current folder and in pybullet_data){more}",
-                     file=name)
+    where = "" if path.is_absolute() else \
+        " (looked in the current folder, in pybullet_data and among the built-in templates)"
+    raise InputError(f"no such file{where}{more}", file=name)
 
 
 def where(f: Finding) -> str:

@@ -333,6 +333,31 @@ def resolve_uri(uri: str, base: Path, packages: Mapping[str, Path] | None = None
     return Target(base / path)
 
 
+def rebased(filename: str, base: Path, folder: Path) -> str | None:
+    """A relative ``filename`` of a URDF in ``base``, rewritten for a copy in ``folder``.
+
+    What PyBullet opens for it from ``base`` (:func:`pybullet_search`: that folder, then
+    those above), named from ``folder``: relative, unless that would climb out of a package
+    ``folder`` is in (which every loader refuses), then absolute. None when nothing needs to
+    change: not a plain relative path (``package://``, ``file://``, absolute), a file PyBullet
+    does not find from ``base`` either (``check`` reports it), or one it finds from ``folder``
+    as it is.
+    """
+    fn = filename.strip()
+    if not fn or "://" in fn or os.path.isabs(fn):
+        return None
+    found = pybullet_search(fn, base)
+    if found is None:
+        return None
+    real = os.path.realpath(found)
+    there = pybullet_search(fn, folder)
+    if there is not None and os.path.realpath(there) == real:
+        return None
+    home = Path(os.path.realpath(folder))
+    new = Path(os.path.relpath(real, home)).as_posix()
+    return real if _climbing(new, home) is not None else new
+
+
 def not_a_file(path: Path) -> str | None:
     """Why ``path`` cannot be read as a mesh or texture, or None if it is a regular file.
 
