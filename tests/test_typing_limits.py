@@ -107,7 +107,7 @@ TARGETS: list[tuple[str, str, str]] = [
     ("exchange/agree.py", "_Pybullet.__init__", "session"),
     ("commands/exporting.py", "_export_dict", "e"),
     ("model/robot.py", "_parse_joint", "el"),
-    ("sources/guard.py", "label", "el"),
+    ("sources/references.py", "label", "el"),
     ("draw/view_model.py", "ViewedRobot.set_positions", "self"),
     ("engine/session.py", "Session.load_urdf", "self"),
     ("core/finding.py", "Finding.to_dict", "self"),
