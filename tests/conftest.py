@@ -182,14 +182,16 @@ CHROMIUM_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 
 @pytest.fixture
 def plain_lighting(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Viewer pages without viser's environment map (``URDFKIT_VIEW_ENVIRONMENT=none``).
+    """Viewer pages lit as by default (``URDFKIT_VIEW_ENVIRONMENT=none``: a sky light).
 
-    Software WebGL prefilters it on every page, ~6 s of each page's first frame here
-    (docs/view.md); what these tests judge (controls, poses, the camera, tints) does not
-    depend on it. A test marked ``environment_map`` keeps the lighting users see.
+    A test marked ``environment_map`` gets viser's own environment map (``city``) instead:
+    software WebGL prefilters it on every page, ~6 s of each page's first frame here
+    (docs/view.md).
     """
     if request.node.get_closest_marker("environment_map") is None:
         monkeypatch.setenv("URDFKIT_VIEW_ENVIRONMENT", "none")
+    else:
+        monkeypatch.setenv("URDFKIT_VIEW_ENVIRONMENT", "city")
 
 
 def _chromium() -> Iterator[Any]:
