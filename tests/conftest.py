@@ -134,44 +134,6 @@ def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
             terminalreporter.write_line(f"  {nodeid}: {reason}", red=True)
 
 
-# --------------------------------------------------------------------------- runs on a page
-
-@pytest.fixture
-def served_run() -> Any:
-    """Run ``urdfkit ARGS`` (a ``--view`` run) until its page is up after the run, check the
-    page serves, Ctrl-C it, and return ``(exit code, stdout, stderr)``.
-
-    The page must say "until Ctrl-C" within two minutes; the process is always reaped.
-    """
-    import signal
-    import subprocess
-    import sys
-    import time
-    import urllib.request
-
-    def run(*args: str) -> tuple[int, str, str]:
-        proc = subprocess.Popen([sys.executable, "-m", "urdfkit", *args],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        err = ""
-        try:
-            deadline = time.monotonic() + 120
-            while "until Ctrl-C" not in err and time.monotonic() < deadline and \
-                    proc.poll() is None:
-                err += proc.stderr.readline()  # type: ignore[union-attr]
-            assert "until Ctrl-C" in err, err
-            with urllib.request.urlopen(err.split("stays at ")[1].split()[0], timeout=10) as r:
-                assert r.status == 200
-            proc.send_signal(signal.SIGINT)
-            out, rest = proc.communicate(timeout=30)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-                proc.communicate()
-        return proc.returncode, out, err + rest
-
-    return run
-
-
 # --------------------------------------------------------------------------- a browser
 
 #: Debian's Chromium (Playwright's own download is not reachable); URDFKIT_CHROMIUM overrides.
