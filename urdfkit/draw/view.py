@@ -7,7 +7,8 @@ Three parts:
   kinematics.
 - :class:`Viewer` (here) shows a :class:`ViewedRobot` with viser (a web server whose client
   ships in its wheel, so it works offline), and reloads it when the file or anything it read
-  changes; the page's text is written by view_page.py.
+  changes; the page's text is written by view_page.py, its cameras and lights are placed by
+  view_camera.py.
 - :class:`~urdfkit.draw.view_stream.RunStream` (view_stream.py) streams a simulated run to the page.
 """
 

@@ -185,23 +185,20 @@ class PageCameras:
 
         with self._lock:
             aimed = self._aimed.get(client.client_id)
-            direction, zoom, offset = ISO, 1.0, None
-            if aimed is not None:
-                direction, zoom = aimed.direction, aimed.zoom
-            try:
-                offset = np.asarray(client.camera.position) - np.asarray(client.camera.look_at)
-            except AssertionError:
-                offset = None
+            direction: Any = ISO if aimed is None else aimed.direction
+            zoom = 1.0 if aimed is None else aimed.zoom
             # A new page's first report is the page's default camera, not one a user chose
             # (nor always the initial one this server set): it opens on the iso view.
-            user = offset is not None and aimed is not None and self.moved(client) and \
-                float(np.linalg.norm(offset)) > 1e-9
-            if user:
-                direction = offset
+            reach = 0.0
+            if aimed is not None and self.moved(client):
+                offset = np.asarray(client.camera.position) - np.asarray(client.camera.look_at)
+                reach = float(np.linalg.norm(offset))
+                if reach > 1e-9:
+                    direction = offset
             eye, target, _ = fit(box(), aspect_of(client), direction, at())
             distance = float(np.linalg.norm(np.asarray(eye) - np.asarray(target)))
-            if user:
-                zoom = max(1.0, float(np.linalg.norm(offset)) / distance)
+            if reach > 1e-9:  # the user's own distance, never nearer than the fit
+                zoom = max(1.0, reach / distance)
             back = (np.asarray(eye) - np.asarray(target)) / distance
             eye = np.asarray(target) + back * distance * zoom
             self._set(client, eye, target, again=lambda c: self.follow(c, box, at), zoom=zoom)
