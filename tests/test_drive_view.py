@@ -132,6 +132,7 @@ def test_cli_without_a_terminal_says_it_waits_and_wait_timeout_ends_the_wait() -
     (["--view", "--speed", "fast"], "--speed takes a positive factor or max"),
     (["--wait-timeout", "2"], "--wait-timeout bounds --view's wait for a page; add --view"),
     (["--view", "--no-wait", "--wait-timeout", "2"], "--no-wait waits for no page"),
+    (["--view", "--wait-timeout", "nan"], "--wait-timeout takes a number of seconds, got nan"),
 ])
 def test_cli_refuses_bad_view_options(args: list[str], says: str) -> None:
     r = subprocess.run([sys.executable, "-m", "urdfkit", "drive", *args], capture_output=True,

@@ -184,8 +184,13 @@ def say_streaming(command: str, viewer: Any, pace: float | None) -> None:
 
 def check_wait(view: bool, no_wait: bool, wait_timeout: float | None) -> None:
     """``--wait-timeout`` takes ``--view``, and not ``--no-wait`` (which waits for nothing)."""
+    import math
+
     from urdfkit.core.errors import ParameterError
 
+    if wait_timeout is not None and not math.isfinite(wait_timeout):
+        raise ParameterError(f"`wait_timeout` takes a number of seconds, got {wait_timeout}",
+                             param="wait_timeout")
     if wait_timeout is not None and not view:
         raise ParameterError("`wait_timeout` bounds --view's wait for a page; add --view",
                              param="wait_timeout")
