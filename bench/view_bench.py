@@ -158,14 +158,15 @@ def drive_commands(seconds: float) -> tuple[float, float]:
     subprocess.run(args, check=True, capture_output=True)
     plain = time.perf_counter() - t0
     t0 = time.perf_counter()
-    proc = subprocess.Popen([*args, "--view", "--speed", "max"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    # --no-wait: the run starts at once, and the command ends with it (its page closed).
+    proc = subprocess.Popen([*args, "--view", "--speed", "max", "--no-wait"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            stdin=subprocess.DEVNULL)
     assert proc.stderr is not None
-    while "until Ctrl-C" not in proc.stderr.readline():
+    while "the run is over" not in proc.stderr.readline():
         if proc.poll() is not None:
             raise RuntimeError("drive --view ended before its summary")
     viewed = time.perf_counter() - t0
-    proc.send_signal(2)
     proc.communicate(timeout=30)
     return plain, viewed
 

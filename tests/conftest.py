@@ -134,44 +134,6 @@ def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
             terminalreporter.write_line(f"  {nodeid}: {reason}", red=True)
 
 
-# --------------------------------------------------------------------------- runs on a page
-
-@pytest.fixture
-def served_run() -> Any:
-    """Run ``urdfkit ARGS`` (a ``--view`` run) until its page is up after the run, check the
-    page serves, Ctrl-C it, and return ``(exit code, stdout, stderr)``.
-
-    The page must say "until Ctrl-C" within two minutes; the process is always reaped.
-    """
-    import signal
-    import subprocess
-    import sys
-    import time
-    import urllib.request
-
-    def run(*args: str) -> tuple[int, str, str]:
-        proc = subprocess.Popen([sys.executable, "-m", "urdfkit", *args],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        err = ""
-        try:
-            deadline = time.monotonic() + 120
-            while "until Ctrl-C" not in err and time.monotonic() < deadline and \
-                    proc.poll() is None:
-                err += proc.stderr.readline()  # type: ignore[union-attr]
-            assert "until Ctrl-C" in err, err
-            with urllib.request.urlopen(err.split("stays at ")[1].split()[0], timeout=10) as r:
-                assert r.status == 200
-            proc.send_signal(signal.SIGINT)
-            out, rest = proc.communicate(timeout=30)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-                proc.communicate()
-        return proc.returncode, out, err + rest
-
-    return run
-
-
 # --------------------------------------------------------------------------- a browser
 
 #: Debian's Chromium (Playwright's own download is not reachable); URDFKIT_CHROMIUM overrides.
@@ -182,14 +144,16 @@ CHROMIUM_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 
 @pytest.fixture
 def plain_lighting(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Viewer pages without viser's environment map (``URDFKIT_VIEW_ENVIRONMENT=none``).
+    """Viewer pages lit as by default (``URDFKIT_VIEW_ENVIRONMENT=none``: a sky light).
 
-    Software WebGL prefilters it on every page, ~6 s of each page's first frame here
-    (docs/view.md); what these tests judge (controls, poses, the camera, tints) does not
-    depend on it. A test marked ``environment_map`` keeps the lighting users see.
+    A test marked ``environment_map`` gets viser's own environment map (``city``) instead:
+    software WebGL prefilters it on every page, ~6 s of each page's first frame here
+    (docs/view.md).
     """
     if request.node.get_closest_marker("environment_map") is None:
         monkeypatch.setenv("URDFKIT_VIEW_ENVIRONMENT", "none")
+    else:
+        monkeypatch.setenv("URDFKIT_VIEW_ENVIRONMENT", "city")
 
 
 def _chromium() -> Iterator[Any]:

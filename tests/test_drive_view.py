@@ -74,20 +74,65 @@ def test_the_run_is_paced_to_its_speed() -> None:
     assert last > 1.9 and wall >= last / 4.0
 
 
-def test_cli_streams_prints_json_and_serves_until_ctrl_c(served_run: Any) -> None:
-    code, out, err = served_run("drive", "--steer", "0.2", "--seconds", "3", "--view",
-                                "--no-wait", "--speed", "max", "--json")
-    assert code == 0, err  # the run finished clean: Ctrl-C only closed the page
-    plain = subprocess.run([sys.executable, "-m", "urdfkit", "drive", "--steer", "0.2",
-                            "--seconds", "3", "--json"], capture_output=True, text=True,
-                           timeout=120)
-    assert json.loads(out)["final_position"] == json.loads(plain.stdout)["final_position"]
+def _urdfkit(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:
+    """``urdfkit ARGS`` as a script runs it: no terminal on stdin, and a time limit."""
+    return subprocess.run([sys.executable, "-m", "urdfkit", *args], capture_output=True,
+                          text=True, timeout=timeout, stdin=subprocess.DEVNULL)
+
+
+def test_cli_no_wait_runs_prints_json_and_exits() -> None:
+    # --no-wait is for scripts: the run starts at once, and the command ends with it (it
+    # used to print its JSON and then serve the page until Ctrl-C, never exiting).
+    r = _urdfkit("drive", "--steer", "0.2", "--seconds", "3", "--view", "--no-wait",
+                 "--speed", "max", "--json")
+    assert r.returncode == 0, r.stderr
+    assert "its page at http://" in r.stderr and "is closed" in r.stderr, r.stderr
+    plain = _urdfkit("drive", "--steer", "0.2", "--seconds", "3", "--json")
+    assert json.loads(r.stdout)["final_position"] == json.loads(plain.stdout)["final_position"]
+
+
+def test_cli_without_a_terminal_says_it_waits_and_wait_timeout_ends_the_wait() -> None:
+    import re
+    import signal
+
+    # No page and no terminal: stderr says the wait has no end but a page, a signal or
+    # --wait-timeout, and it waits (a 1 s unpaced drive would be over long before 3 s).
+    proc = subprocess.Popen([sys.executable, "-m", "urdfkit", "drive", "--seconds", "1",
+                             "--view", "--speed", "max", "--json"], stdin=subprocess.DEVNULL,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    seen: list[str] = []
+    try:
+        assert _lines_until(proc, "waiting for a page", 120, seen), "".join(seen)
+        assert re.search(r"to connect to http://\S+ before the run starts; with no terminal, "
+                         r"only a page, a signal \(Ctrl-C\) or --wait-timeout ends the wait",
+                         seen[-1]), seen[-1]
+        time.sleep(3)
+        assert proc.poll() is None
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=30)
+        assert proc.returncode == 130 and out == ""
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    # --wait-timeout 2: after 2 s without a page the run starts unwatched, prints its JSON
+    # and the command ends (exit 0: the run is done and clean).
+    start = time.monotonic()
+    r = _urdfkit("drive", "--seconds", "1", "--view", "--speed", "max", "--json",
+                 "--wait-timeout", "2")
+    assert r.returncode == 0, r.stderr
+    assert time.monotonic() - start >= 2.0
+    assert "at most 2 s" in r.stderr and "no page connected in 2 s" in r.stderr, r.stderr
+    assert json.loads(r.stdout)["sim_time"] == pytest.approx(1.0, abs=0.01)
 
 
 @pytest.mark.parametrize(("args", "says"), [
     (["--view", "--gui"], "--view replaces --gui"),
     (["--view", "--speed", "0"], "--speed takes a positive factor or max"),
     (["--view", "--speed", "fast"], "--speed takes a positive factor or max"),
+    (["--wait-timeout", "2"], "--wait-timeout bounds --view's wait for a page; add --view"),
+    (["--view", "--no-wait", "--wait-timeout", "2"], "--no-wait waits for no page"),
+    (["--view", "--wait-timeout", "nan"], "--wait-timeout takes a number of seconds, got nan"),
 ])
 def test_cli_refuses_bad_view_options(args: list[str], says: str) -> None:
     r = subprocess.run([sys.executable, "-m", "urdfkit", "drive", *args], capture_output=True,
@@ -239,7 +284,7 @@ def test_the_page_names_the_template_not_its_cache_file() -> None:
     config = DriveConfig(seconds=0.1)
     with Scenario(config) as sc:
         assert "simplecar" in sc.car_file and sc.car_file != "simplecar"
-        stream = _run_view(sc, config, None, None, wait=False)
+        stream = _run_view(sc, config, None, None)
         try:
             m = stream.viewer.model
             assert m.file == "simplecar" and m.resolved.name == "simplecar"

@@ -55,15 +55,28 @@ def test_every_robot_ends_on_the_page_where_the_run_ends() -> None:
     assert len(stream.paths) == 2 and all(len(path) >= 2 for path in stream.paths)
 
 
-def test_cli_sim_view_prints_json_and_serves_until_ctrl_c(tmp_path: Path,
-                                                          served_run: Any) -> None:
+def test_cli_sim_view_no_wait_prints_json_and_exits(tmp_path: Path) -> None:
     out = tmp_path / "rows.jsonl"
-    code, stdout, err = served_run("sim", str(TWO_CARS), "--view", "--no-wait", "--speed",
-                                   "max", "--json", "-o", str(out))
-    assert code == 0, err
-    data = json.loads(stdout)
+    r = subprocess.run([sys.executable, "-m", "urdfkit", "sim", str(TWO_CARS), "--view",
+                        "--no-wait", "--speed", "max", "--json", "-o", str(out)],
+                       capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
+    assert r.returncode == 0, r.stderr
+    assert "is closed" in r.stderr
+    data = json.loads(r.stdout)
     assert data["steps"] == 720 and data["rows"] == 122
     assert len(out.read_text().splitlines()) == 122  # the rows file as without --view
+
+
+def test_cli_sim_view_wait_timeout_runs_unwatched_and_exits() -> None:
+    start = time.monotonic()
+    r = subprocess.run([sys.executable, "-m", "urdfkit", "sim", str(TWO_CARS), "--view",
+                        "--speed", "max", "--json", "--wait-timeout", "1.5"],
+                       capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
+    assert r.returncode == 0, r.stderr
+    assert time.monotonic() - start >= 1.5
+    assert "waiting for a page to connect to http://" in r.stderr
+    assert "no page connected in 1.5 s; the run starts unwatched" in r.stderr
+    assert json.loads(r.stdout)["steps"] == 720
 
 
 def test_cli_sim_view_refuses_gui_and_real_time() -> None:
@@ -109,7 +122,7 @@ def test_sim_view_readouts_show_the_first_robots_joints_as_the_run_leaves_them()
            "robots": [{"name": "north", "template": "simplecar",
                        "drive": [{"until": 1.0, "throttle": 10, "steer": 0.3}]}]}
     with Simulation(doc) as s:
-        stream = _sim_view(s, None, None, wait=False)
+        stream = _sim_view(s, None, None)
         viewer = stream.viewer
         try:
             s.run(sink=lambda _batch: stream.tick(s.t))
@@ -126,6 +139,55 @@ def test_sim_view_readouts_show_the_first_robots_joints_as_the_run_leaves_them()
     for name, value in shown.items():
         lo, hi = float(viewer.sliders[name].min), float(viewer.sliders[name].max)
         assert value == pytest.approx(min(max(raw[name], lo), hi), abs=1e-6), name
+
+
+def test_sim_view_readouts_are_the_followed_robots_joints() -> None:
+    """two_cars, following north: the sliders and the pose fields hold north's joints as raw
+    PyBullet has them at the end, not the parked car's (they did whichever car was followed);
+    following parked again, parked's, in the replay too."""
+    import re
+
+    from urdfkit.commands.simulating import _sim_view
+
+    with Simulation.from_file(str(TWO_CARS)) as s:
+        stream = _sim_view(s, None, None)
+        viewer = stream.viewer
+        try:
+            stream.camera.value = "follow north"
+            s.run(sink=lambda _batch: stream.tick(s.t))
+            stream.finish("**Done**")
+            bullet = s.bullet
+            raw = {name: {bullet.getJointInfo(b.body, j)[1].decode():
+                          bullet.getJointState(b.body, j)[0]
+                          for j in range(bullet.getNumJoints(b.body))}
+                   for name, b in s.bodies.items()}
+
+            def shown() -> tuple[dict[str, float], dict[str, float]]:
+                sliders = {name: float(sl.value) for name, sl in viewer.sliders.items()}
+                flags = viewer.joints_text.value.removeprefix("--joints ")
+                return sliders, {k: float(v) for k, v in
+                                 (pair.split("=") for pair in flags.split(","))}
+
+            north_sliders, north_flags = shown()
+            status = viewer.status.content
+            stream.camera.value = "follow parked"
+            stream.show_time(3.0)  # the replay's last frame, parked followed
+            parked_sliders, parked_flags = shown()
+        finally:
+            viewer.close()
+    wheel = "base_to_left_back_wheel"
+    # North drove 3 s at 10 rad/s; the parked car's wheels barely turned.
+    assert abs(raw["north"][wheel]) > 10 and abs(raw["parked"][wheel]) < 0.1
+    for robot, sliders, flags in (("north", north_sliders, north_flags),
+                                  ("parked", parked_sliders, parked_flags)):
+        # (the field prints six significant digits)
+        assert flags == pytest.approx({k: raw[robot][k] for k in flags}, rel=1e-5,
+                                      abs=1e-5), robot
+        for name, value in sliders.items():
+            lo, hi = float(viewer.sliders[name].min), float(viewer.sliders[name].max)
+            assert value == pytest.approx(min(max(raw[robot][name], lo), hi), abs=1e-6), \
+                (robot, name)
+    assert re.search(r"Joint readouts: north's", status), status
 
 
 def test_a_run_that_waited_for_a_page_is_paced_from_its_start() -> None:
@@ -157,7 +219,7 @@ def _sim_view_of(s: Simulation, pace: float | None) -> RunStream:
     """``sim --view``'s page for a simulation, not waiting for a browser."""
     from urdfkit.commands.simulating import _sim_view
 
-    stream: RunStream = _sim_view(s, pace, None, wait=False)
+    stream: RunStream = _sim_view(s, pace, None)
     return stream
 
 
@@ -185,10 +247,16 @@ def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
     with Simulation.from_file(str(TWO_CARS)) as s:
         started: list[RunStream] = []
         # sim --view's own page, waiting for a browser as the command does.
+        from urdfkit.commands.shared import wait_for_page
         from urdfkit.commands.simulating import _sim_view
 
-        waiter = threading.Thread(target=lambda: started.append(
-            _sim_view(s, 2.0, port, wait=True)), daemon=True)
+        def serve() -> None:
+            stream = _sim_view(s, 2.0, port)
+            started.append(stream)
+            wait_for_page("sim", stream.viewer, True)
+            started.append(stream)  # twice: a page came
+
+        waiter = threading.Thread(target=serve, daemon=True)
         waiter.start()
         time.sleep(1.0)
         assert waiter.is_alive() and s.step_count == 0  # unwatched: nothing has run
@@ -196,7 +264,8 @@ def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
         try:
             page.goto(f"http://127.0.0.1:{port}")
             waiter.join(60)
-            assert not waiter.is_alive() and started, "the page's connection did not start it"
+            assert not waiter.is_alive() and len(started) == 2, \
+                "the page's connection did not start it"
             stream = started[0]
             viewer = stream.viewer
             (client,) = viewer.server.get_clients().values()

@@ -30,12 +30,14 @@ from urdfkit.commands.shared import (
     UpOpt,
     UrdfOpt,
     ViewOpt,
+    WaitTimeoutOpt,
+    check_wait,
     command,
+    end_of_run,
     examples,
     library_defaults,
     parse_speed,
     say_streaming,
-    serve_until_interrupted,
     split_joints,
     wait_for_page,
 )
@@ -96,6 +98,7 @@ def drive(
     speed: SpeedOpt = "1",
     port: RunPortOpt = None,
     no_wait: NoWaitOpt = False,
+    wait_timeout: WaitTimeoutOpt = None,
 ) -> None:
     """Drive a car headless at a fixed throttle and steer, and report where it went.
 
@@ -107,6 +110,7 @@ def drive(
     pace = _check_drive_options(seconds=seconds, steps=steps, tutorial=tutorial,
                                 drivetrain=drivetrain, max_force=max_force, gui=gui, view=view,
                                 speed=speed, trajectory=trajectory, plot=plot, force=force)
+    check_wait(view, no_wait, wait_timeout)
     params = None
     if set_:
         from urdfkit.model.catalog import parse_assignments  # imports the builder: only when needed
@@ -126,7 +130,9 @@ def drive(
     with Scenario(config) as sc:
         _say_drivetrain(sc)
         said = list(sc.warnings)
-        stream = _run_view(sc, config, pace, port, wait=not no_wait) if view else None
+        stream = _run_view(sc, config, pace, port) if view else None
+        watched = stream is not None and wait_for_page("drive", stream.viewer, not no_wait,
+                                                       wait_timeout)
         result, written = _drive_run(sc, trajectory, force=force, stream=stream,
                                      quiet=as_json or view)
     if plot is not None:
@@ -134,7 +140,7 @@ def drive(
 
         written.append(write_plot(result, plot, force=force))
     _drive_report(result, written, said, as_json)
-    _drive_exit(result, stream)
+    _drive_exit(result, stream, watched)
 
 
 def use_library_defaults() -> None:
@@ -243,22 +249,21 @@ def _drive_report(result: Any, written: list[Any], said: list[str], as_json: boo
             show.wrote(path)
 
 
-def _drive_exit(result: Any, stream: Any) -> None:
-    """130 interrupted; with --view, the page served until Ctrl-C; 1 a suspect run."""
+def _drive_exit(result: Any, stream: Any, watched: bool) -> None:
+    """130 interrupted; with --view, a watched page served until Ctrl-C; 1 a suspect run."""
     if result.interrupted:
         if stream is not None:
             stream.viewer.close()
         show.interrupted("interrupted; the results cover the steps simulated")
         raise typer.Exit(130)
     if stream is not None:
-        serve_until_interrupted(stream.viewer, "the run is over; its page")
+        end_of_run("drive", stream.viewer, watched)
     if result.problems:  # the run is physically suspect: a finding, for CI
         raise typer.Exit(1)
 
 
-def _run_view(sc: Any, config: Any, pace: float | None, port: int | None,
-              wait: bool = True) -> Any:
-    """Start the page a run streams to (drive --view), say where it is, wait for a page."""
+def _run_view(sc: Any, config: Any, pace: float | None, port: int | None) -> Any:
+    """Start the page a run streams to (drive --view), and say where it is."""
     import math
 
     from urdfkit.draw.view import Viewer
@@ -278,7 +283,6 @@ def _run_view(sc: Any, config: Any, pace: float | None, port: int | None,
         stream = RunStream(viewer, sc.link_poses, pace, total, joints=joints)
         stream.push()
         say_streaming("drive", viewer, pace)
-        wait_for_page("drive", viewer, wait)
     except BaseException:
         viewer.close()
         raise

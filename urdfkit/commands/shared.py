@@ -141,13 +141,18 @@ UpOpt = Annotated[str, typer.Option(
 # drive --view and sim --view: the run streamed to a browser page (urdfkit/view.py).
 ViewOpt = Annotated[bool, typer.Option(
     "--view", help="Stream the run to a browser page (urdfkit view) while it simulates "
-    "headless; the page stays up after the run until Ctrl-C.")]
+    "headless; the run starts when a page connects, and the page stays up after the run "
+    "until Ctrl-C.")]
 SpeedOpt = Annotated[str, typer.Option(
     "--speed", metavar="FACTOR|max", help="With --view: simulated seconds per wall second "
     "(max: no pacing).")]
 NoWaitOpt = Annotated[bool, typer.Option(
     "--no-wait", help="With --view: start the run at once, not when the first page "
-    "connects (for scripts).")]
+    "connects, and end with it (for scripts).")]
+WaitTimeoutOpt = Annotated[float | None, typer.Option(
+    "--wait-timeout", min=0, metavar="SECONDS", help="With --view: wait at most SECONDS for "
+    "a page; none came, the run starts unwatched and the command ends with it.",
+    show_default="no limit")]
 RunPortOpt = Annotated[int | None, typer.Option(
     "--port", min=1, max=65535, help="With --view: the port to serve on.",
     show_default="a free one")]
@@ -178,19 +183,69 @@ def say_streaming(command: str, viewer: Any, pace: float | None) -> None:
     show.line(f"urdfkit {command}: {viewer.url} (the run streams there {pacing})", stderr=True)
 
 
-def wait_for_page(command: str, viewer: Any, wait: bool) -> None:
-    """Hold the run until a page has connected (``wait``), saying so on stderr.
+def check_wait(view: bool, no_wait: bool, wait_timeout: float | None) -> None:
+    """``--wait-timeout`` takes ``--view``, and not ``--no-wait`` (which waits for nothing)."""
+    import math
+
+    from urdfkit.core.errors import ParameterError
+
+    if wait_timeout is not None and not math.isfinite(wait_timeout):
+        raise ParameterError(f"`wait_timeout` takes a number of seconds, got {wait_timeout}",
+                             param="wait_timeout")
+    if wait_timeout is not None and not view:
+        raise ParameterError("`wait_timeout` bounds --view's wait for a page; add --view",
+                             param="wait_timeout")
+    if wait_timeout is not None and no_wait:
+        raise ParameterError("`no_wait` waits for no page: drop --wait-timeout",
+                             param="no_wait")
+
+
+def wait_for_page(command: str, viewer: Any, wait: bool, timeout: float | None = None) -> bool:
+    """Hold the run until a page has connected (``wait``), saying so on stderr; whether one has.
 
     A run streamed to nobody is over before anyone sees it: by default it starts when the
-    first page connects. ``--no-wait`` (``wait`` False) starts it at once.
+    first page connects. ``--no-wait`` (``wait`` False) starts it at once; ``--wait-timeout``
+    (``timeout``) starts it unwatched after that many seconds. Without a terminal, nothing
+    but a page, a signal or the timeout ends the wait: stderr says so. Interrupted, the page
+    is closed.
     """
+    import sys
+    import time
+
     if not wait:
-        return
-    show.line(f"urdfkit {command}: waiting for a page to connect to {viewer.url} before the "
-              "run starts (--no-wait starts it at once)", stderr=True)
-    while not viewer.wait_for_page(0.5):  # short waits: Ctrl-C is taken between them
-        pass
+        return False
+    head = f"urdfkit {command}: waiting for a page to connect to {viewer.url} before the run " \
+           "starts"
+    if timeout is not None:
+        show.line(f"{head} (at most {timeout:g} s; then it starts unwatched)", stderr=True)
+    elif sys.stdin is not None and sys.stdin.isatty():
+        show.line(f"{head} (--no-wait starts it at once)", stderr=True)
+    else:
+        show.line(f"{head}; with no terminal, only a page, a signal (Ctrl-C) or --wait-timeout "
+                  "ends the wait (--no-wait starts it at once)", stderr=True)
+    end = None if timeout is None else time.monotonic() + timeout
+    try:  # short waits: Ctrl-C is taken between them (and closes the page)
+        while not viewer.wait_for_page(0.5 if end is None else
+                                       max(0.0, min(0.5, end - time.monotonic()))):
+            if end is not None and time.monotonic() >= end:
+                show.line(f"urdfkit {command}: no page connected in {timeout:g} s; the run "
+                          "starts unwatched and the command ends with it", stderr=True)
+                return False
+    except BaseException:
+        viewer.close()
+        raise
     show.line(f"urdfkit {command}: a page connected; the run starts", stderr=True)
+    return True
+
+
+def end_of_run(command: str, viewer: Any, watched: bool) -> None:
+    """After a streamed run: a watched page stays until Ctrl-C; an unwatched one closes."""
+    if watched:
+        serve_until_interrupted(viewer, "the run is over; its page", command)
+        return
+    viewer.close()
+    show.line(f"urdfkit {command}: the run is over; its page at {viewer.url} is closed",
+              stderr=True)
 
 
 def serve_until_interrupted(viewer: Any, what: str, command: str = "drive") -> None:

@@ -14,11 +14,13 @@ from urdfkit.commands.shared import (
     RunPortOpt,
     SpeedOpt,
     ViewOpt,
+    WaitTimeoutOpt,
+    check_wait,
     command,
+    end_of_run,
     examples,
     parse_speed,
     say_streaming,
-    serve_until_interrupted,
     wait_for_page,
 )
 
@@ -51,6 +53,7 @@ def sim(
     speed: SpeedOpt = "1",
     port: RunPortOpt = None,
     no_wait: NoWaitOpt = False,
+    wait_timeout: WaitTimeoutOpt = None,
 ) -> None:
     """Simulate a scenario of one or more robots and record their observations.
 
@@ -66,12 +69,15 @@ def sim(
         return
     pace = _check_sim_options(scenario, config, gui=gui, real_time=real_time, view=view,
                               speed=speed)
+    check_wait(view, no_wait, wait_timeout)
     if out is not None:
         simulation.check_rows_output(out, force=force)  # fail before the run, not after it
     with simulation.Simulation.from_file(scenario, gui=gui) as s:
         for note in s.config.notes:
             show.warn(note)
-        stream = _sim_view(s, pace, port, wait=not no_wait) if view else None
+        stream = _sim_view(s, pace, port) if view else None
+        watched = stream is not None and wait_for_page("sim", stream.viewer, not no_wait,
+                                                       wait_timeout)
         result, written = _sim_run(s, out, force=force, real_time=real_time or gui,
                                    stream=stream)
     if stream is not None and result.interrupted:
@@ -95,7 +101,7 @@ def sim(
         show.interrupted("interrupted; the rows cover the steps simulated")
         raise typer.Exit(130)
     if stream is not None:
-        serve_until_interrupted(stream.viewer, "the run is over; its page", "sim")
+        end_of_run("sim", stream.viewer, watched)
 
 
 def _check_convert(config: str | None, run_options: bool) -> None:
@@ -170,7 +176,7 @@ def _sim_table(scenario: str, result: Any, summaries: list[Any], written: Any) -
         show.wrote(written, f"{result.row_count:,} rows")
 
 
-def _sim_view(s: Any, pace: float | None, port: int | None, wait: bool = True) -> Any:
+def _sim_view(s: Any, pace: float | None, port: int | None) -> Any:
     """Start the page a scenario streams to (sim --view): every robot, and say where."""
     from urdfkit.draw.view import Viewer
     from urdfkit.draw.view_stream import RunStream, joint_reader
@@ -190,13 +196,14 @@ def _sim_view(s: Any, pace: float | None, port: int | None, wait: bool = True) -
     try:
         for b in bodies[1:]:
             viewer.add_robot(b.loaded[0], inertia_from_file=b.loaded[1].inertia_from_file)
-        # The joint readouts show the first robot's run, as the page's sliders stand for it.
-        joints = joint_reader(s.bullet, bodies[0].body, viewer.model.joints)
+        # The joint readouts show the followed robot's joints (the first's by default).
+        models = [viewer.model, *(m for m, _ in viewer.extra)]
+        joints = [joint_reader(s.bullet, b.body, m.joints)
+                  for b, m in zip(bodies, models, strict=True)]
         stream = RunStream(viewer, s.link_poses, pace, s.total_steps * s.time_step,
                            robots=True, joints=joints, names=[b.name for b in bodies])
         stream.push()
         say_streaming("sim", viewer, pace)
-        wait_for_page("sim", viewer, wait)
     except BaseException:
         viewer.close()
         raise

@@ -246,67 +246,23 @@ def parse_joint_positions(items: Sequence[str] | None) -> dict[str, float]:
 # --------------------------------------------------------------------------- geometry
 
 
-def _normalize(v: Any) -> Any:
-    import numpy as np
-
-    n = float(np.linalg.norm(v))
-    return v / n if n > 0 else v
-
-
 def _basis(view: View) -> tuple[Any, Any, Any]:
     """(towards camera, right, up) unit vectors of a view."""
-    import numpy as np
+    from urdfkit.draw.framing import basis
 
-    d, up = VIEWS[view]
-    back = _normalize(np.array(d, dtype=float))
-    right = _normalize(np.cross(-back, np.array(up, dtype=float)))
-    true_up = np.cross(right, -back)
-    return back, right, true_up
-
-
-def _corners(lo: Any, hi: Any) -> Any:
-    import numpy as np
-
-    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
-                     for z in (lo[2], hi[2])], dtype=float)
+    return basis(*VIEWS[view])
 
 
 def frame_view(view: View, lo: Sequence[float], hi: Sequence[float], aspect: float,
                fov_deg: float = FOV_DEG, fill: float = FILL) -> tuple[Any, Any, Any]:
     """Place a camera so the box ``lo..hi`` fills the frame; return (eye, target, up).
 
-    For a corner at camera-space offset (x, y, z) from the target (z towards the camera), a
-    camera at distance d sees it at x / (d - z) on the image plane. Fitting needs
-    ``|x| <= (d - z) * tan(half fov) * fill``, so d = max over corners of z + |x| / (tan * fill),
-    and likewise for y. Two centring passes then move the target so the projected box sits in
-    the middle rather than wherever perspective pushed it.
+    :func:`urdfkit.draw.framing.fit_box` from the view's direction (the page's camera fits
+    the same way).
     """
-    import numpy as np
+    from urdfkit.draw.framing import fit_box
 
-    lo_a, hi_a = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
-    # A flat or point-like robot still needs a finite box to frame.
-    size = max(float(np.max(hi_a - lo_a)), 1e-3)
-    pad = np.maximum(hi_a - lo_a, size * 0.02) / 2
-    mid = (lo_a + hi_a) / 2
-    corners = _corners(mid - pad, mid + pad)
-    back, right, up = _basis(view)
-    tan_v = math.tan(math.radians(fov_deg) / 2) * fill
-    tan_h = tan_v * aspect
-    target = mid.copy()
-    dist = 0.0
-    for _ in range(3):
-        rel = corners - target
-        x, y, z = rel @ right, rel @ up, rel @ back
-        dist = float(np.max(np.maximum(z + np.abs(x) / tan_h, z + np.abs(y) / tan_v)))
-        depth = dist - z
-        u, v = x / depth, y / depth
-        # Shift the target so the projected extremes are symmetric about the centre.
-        du = (u.max() + u.min()) / 2
-        dv = (v.max() + v.min()) / 2
-        if abs(du) < 1e-6 and abs(dv) < 1e-6:
-            break
-        target = target + right * du * dist + up * dv * dist
-    return target + back * dist, target, up
+    return fit_box(_basis(view), lo, hi, aspect, fov_deg, fill)
 
 
 def view_fov(view: str) -> float:

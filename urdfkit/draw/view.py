@@ -7,31 +7,28 @@ Three parts:
   kinematics.
 - :class:`Viewer` (here) shows a :class:`ViewedRobot` with viser (a web server whose client
   ships in its wheel, so it works offline), and reloads it when the file or anything it read
-  changes; the page's text is written by view_page.py.
+  changes; the page's text is written by view_page.py, its cameras and lights are placed by
+  view_camera.py.
 - :class:`~urdfkit.draw.view_stream.RunStream` (view_stream.py) streams a simulated run to the page.
 """
 
 from __future__ import annotations
 
 import math
-import os
 import threading
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 from urdfkit.core.errors import EngineError, MissingDependencyError, UrdfkitError
 from urdfkit.draw import view_page as page
+from urdfkit.draw.view_camera import ASPECT, FIT, FOV_DEG, PageCameras, environment, fit, light
 from urdfkit.draw.view_model import SELECTED_RGB, TINTS, TOUCHING_RGB, Layer, Vec3, ViewedRobot
 from urdfkit.draw.view_stream import RunDisplay, add_shapes, wxyz
 
 #: The selection dropdown's entry for no link.
 NO_LINK = "(none)"
-#: The page's vertical field of view (degrees), set so the camera's fit is computed for it.
-FOV_DEG = 45.0
-#: Share of the canvas the robot's projected bounding box may fill when the camera fits it.
-FIT = 0.85
-#: The canvas's width over its height assumed before a page says its own (reset view).
-ASPECT = 1.4
+__all__ = ["ASPECT", "FIT", "FOV_DEG", "TINTS", "TOUCHING_RGB", "Viewer", "free_port"]
+
 #: How often the watcher looks at the files the robot was read from (s).
 POLL_SECONDS = 0.25
 
@@ -101,6 +98,8 @@ class Viewer(RunDisplay):
                  host: str = "127.0.0.1", port: int | None = None, watch: bool = True,
                  ground: float = 4.0, display: str | None = None,
                  stand_on_grid: bool = True) -> None:
+        #: The scene's lighting: ``none`` (a sky light) or viser's environment map's name.
+        self.lighting = environment()  # a bad URDFKIT_VIEW_ENVIRONMENT fails before anything
         self._load_args: dict[str, Any] = {
             "packages": packages, "package_paths": package_paths, "xacro_args": xacro_args,
             "inertia_from_file": inertia_from_file, "display": display}
@@ -139,11 +138,9 @@ class Viewer(RunDisplay):
         self.port = int(self.server.get_port())
         self.url = f"http://{'localhost' if host in ('127.0.0.1', '::1') else host}:{self.port}"
         self.server.scene.set_up_direction("+z")
-        if os.environ.get("URDFKIT_VIEW_ENVIRONMENT", "").lower() in ("0", "off", "none"):
-            # No image-based lighting: a browser without a GPU (software WebGL) prefilters
-            # the environment map on every page it opens, ~6 s of a first frame (Chromium
-            # with SwiftShader, measured); directional light only.
-            self.server.scene.configure_environment_map(hdri=None)
+        light(self.server, self.lighting)
+        #: Where each page's camera is, as urdfkit put it (view_camera.py).
+        self.cameras = PageCameras(self.server)
         # A sidebar beside the canvas, not a panel floating over the scene; wide enough that
         # joint names and the pose fields are not cut.
         self.server.gui.configure_theme(control_width="large")
@@ -156,6 +153,7 @@ class Viewer(RunDisplay):
                                                section_size=1.0, position=(0.0, 0.0, floor))
         self._connected = threading.Event()
         self.server.on_client_connect(self._client_connected)
+        self.server.on_client_disconnect(self.cameras.forget)
         self._static_gui()
         self._show_model()
         # Mimic joints to their leaders' zero pose (offsets included). Self-collisions are
@@ -304,27 +302,18 @@ class Viewer(RunDisplay):
         self.status.content = page.status(self.model, self.error)
 
     def _aim_camera(self) -> None:
-        """Fit the robot's bounds in the view: for new pages and the page's "Reset view"."""
-        eye, target, up = self.fit(*self.model.bounds(), ASPECT)
+        """Fit the robot's bounds in the view of pages to come, and of viser's "Reset View"."""
+        eye, target, _ = fit(self.model.bounds(), ASPECT)
         cam = self.server.initial_camera
         cam.fov = math.radians(FOV_DEG)
-        cam.look_at, cam.position, cam.up = target, eye, up
-
-    @staticmethod
-    def fit(lo: Vec3 | Any, hi: Vec3 | Any, aspect: float) -> tuple[Vec3, Vec3, Vec3]:
-        """Camera (eye, target, up) from render's iso direction that frames the box lo..hi.
-
-        The same fit as ``urdfkit render``'s (every corner inside :data:`FIT` of the view at
-        :data:`FOV_DEG`), so the page opens on the robot as the PNG shows it.
-        """
-        from urdfkit.draw.render import frame_view
-
-        eye, target, up = frame_view("iso", lo, hi, aspect, fov_deg=FOV_DEG, fill=FIT)
-        return (tuple(float(x) for x in eye), tuple(float(x) for x in target),  # type: ignore[return-value]
-                tuple(float(x) for x in up))
+        cam.look_at, cam.position, cam.up = target, eye, (0.0, 0.0, 1.0)
 
     def _client_connected(self, client: Any) -> None:
-        """A page connected: fit the camera to its own canvas, and release :meth:`wait_for_page`."""
+        """A page connected: fit the camera to its own canvas, and release :meth:`wait_for_page`.
+
+        Fitted again when its canvas changes size (the panel docking beside it narrows it
+        just after it connects), until its user moves the camera.
+        """
         import time
 
         try:
@@ -333,29 +322,13 @@ class Viewer(RunDisplay):
             while not client.camera.update_timestamp and time.monotonic() < end:
                 time.sleep(0.02)
             if client.camera.update_timestamp:
+                self.cameras.watch(client)
                 if self.aim_page is not None:
                     self.aim_page(client)
                 else:
-                    self.aim(client, self.model.bounds(), self.aspect(client))
+                    self.cameras.aim(client, lambda: self.model.bounds())
         finally:
             self._connected.set()
-
-    @staticmethod
-    def aspect(client: Any) -> float:
-        """A page's canvas width over height (:data:`ASPECT` until it has said)."""
-        try:
-            return float(client.camera.aspect) or ASPECT
-        except (AttributeError, AssertionError):
-            return ASPECT
-
-    def aim(self, client: Any, bounds: tuple[Any, Any], aspect: float = ASPECT) -> None:
-        """Point one page's camera at a box (the robot, or a run's whole path)."""
-        eye, target, up = self.fit(*bounds, aspect)
-        with self.server.atomic():  # position first: setting it moves look_at along
-            client.camera.fov = math.radians(FOV_DEG)
-            client.camera.up_direction = up
-            client.camera.position = eye
-            client.camera.look_at = target
 
     def wait_for_page(self, timeout: float | None = None) -> bool:
         """Block until a page has connected (or ``timeout`` seconds); whether one has."""
@@ -406,11 +379,13 @@ class Viewer(RunDisplay):
             self.joints_text.value = flags
             return now
 
-    def show_joint_values(self, values: Mapping[str, float]) -> None:
+    def show_joint_values(self, values: Mapping[str, float], joints: Any = None) -> None:
         """Show a run's joint positions (by name) on the sliders and in the pose fields.
 
         The robot on the page is posed by the run (:meth:`show_poses`); this keeps the
         readouts on the same values, without moving this viewer's own PyBullet body.
+        ``joints`` orders the pose fields (another robot's: ``sim --view`` following it);
+        the sliders, the first robot's, take the values of the joints of their names.
         """
         with self._lock:
             self._setting = True
@@ -421,7 +396,8 @@ class Viewer(RunDisplay):
                         s.value = min(max(float(value), float(s.min)), float(s.max))
             finally:
                 self._setting = False
-            joints = [j for j in self.model.joints if j.name in values]
+            joints = [j for j in (self.model.joints if joints is None else joints)
+                      if j.name in values]
             self.vector_text.value = repr([round(float(values[j.name]), 6) for j in joints])
             text = ",".join(f"{j.name}={round(float(values[j.name]), 6):g}" for j in joints)
             self.joints_text.value = f"--joints {text}" if text else ""
@@ -536,7 +512,8 @@ class Viewer(RunDisplay):
         """Load the file again; on success show it, keeping joint values by name.
 
         Returns whether the new robot is on show. A failure keeps the old one and sets
-        :attr:`error`; the next change of any file tried is retried.
+        :attr:`error`; the next change of any file tried is retried. Pages whose camera is
+        where urdfkit put it are framed on the new robot; a camera its user moved stays.
         """
         from urdfkit.core import deps
 
@@ -566,6 +543,9 @@ class Viewer(RunDisplay):
             self._show_model()
             old.close()
             self.set_joints(keep)
+            # A robot that grew (or shrank) is framed again where no one moved the camera.
+            self._aim_camera()
+            self.cameras.refit(self.server.get_clients().values())
             self.reloads += 1  # last: the count says the reload is complete
         return True
 

@@ -471,7 +471,17 @@ class ViewedRobot:
                     for a, b in out]
 
     def bounds(self) -> tuple[Vec3, Vec3]:
-        """The posed robot's box (union of getAABB over links), for the camera."""
+        """The posed robot's box, for the camera: getAABB over links, and the visual shapes.
+
+        PyBullet's boxes hold the collision shapes only: a link with visual shapes alone (an
+        arm sketched without ``<collision>``) adds a point, and a camera framed on that was
+        inside the arm. Each visual shape's own box, posed, counts too (planes aside).
+        """
+        import numpy as np
+
+        from urdfkit.draw.framing import corners
+        from urdfkit.model.spec import quat_to_matrix
+
         with self.lock:
             bullet = self.session.bullet
             lo, hi = [math.inf] * 3, [-math.inf] * 3
@@ -481,6 +491,16 @@ class ViewedRobot:
                         b[k] >= a[k] for k in range(3)):
                     lo = [min(lo[k], a[k]) for k in range(3)]
                     hi = [max(hi[k], b[k]) for k in range(3)]
+            for link, (pos, quat) in zip(self.links, self.link_poses(), strict=True):
+                for sh in link.visuals:
+                    v = np.asarray(sh.vertices, dtype=float)
+                    if sh.kind == "plane" or not len(v) or not np.all(np.isfinite(v)):
+                        continue
+                    box = corners(v.min(axis=0), v.max(axis=0))
+                    box = box @ np.asarray(quat_to_matrix(sh.quat)).T + np.asarray(sh.pos)
+                    box = box @ np.asarray(quat_to_matrix(quat)).T + np.asarray(pos)
+                    lo = [min(lo[k], float(box[:, k].min())) for k in range(3)]
+                    hi = [max(hi[k], float(box[:, k].max())) for k in range(3)]
             if not all(math.isfinite(x) for x in lo + hi):
                 return (-0.5, -0.5, -0.5), (0.5, 0.5, 0.5)
             return tuple(lo), tuple(hi)  # type: ignore[return-value]

@@ -66,6 +66,8 @@ class RunDisplay:
     extra: list[tuple[ViewedRobot, list[Any]]]
     #: Aims a page that connects (``aim_page(client)``); None: at the model's bounds.
     aim_page: Any
+    #: Each page's camera (:class:`~urdfkit.draw.view_camera.PageCameras`).
+    cameras: Any
     _lock: threading.RLock
     _nodes: dict[Layer, list[Any]]
     _frames: list[Any]
@@ -74,17 +76,8 @@ class RunDisplay:
         """Show or hide each layer as the page's checkboxes say."""
         raise NotImplementedError
 
-    def show_joint_values(self, values: Any) -> None:
-        """Show a run's joint positions (by name) on the page's readouts."""
-        raise NotImplementedError
-
-    def aim(self, client: Any, bounds: tuple[Any, Any], aspect: float = 1.4) -> None:
-        """Point one page's camera at a box."""
-        raise NotImplementedError
-
-    @staticmethod
-    def aspect(client: Any) -> float:
-        """A page's canvas width over height."""
+    def show_joint_values(self, values: Any, joints: Any = None) -> None:
+        """Show a run's joint positions (by name) on the page's readouts, in ``joints``' order."""
         raise NotImplementedError
 
     def add_robot(self, file: str, *, inertia_from_file: bool = False) -> int:
@@ -141,6 +134,9 @@ PATH_POINTS = 2000
 REPLAY_FRAMES = 4000
 #: The page's camera modes during and after a run.
 FOLLOW, WHOLE_PATH, FREE = "follow the robot", "frame the whole path", "free"
+#: Ground a followed robot is framed with on every side, in robot sizes (its largest side):
+#: the robot whole with its path around it, on a canvas of any shape.
+FOLLOW_MARGIN = 0.5
 
 
 def joint_reader(bullet: Any, body: int, joints: Sequence[Any]) -> Any:
@@ -169,16 +165,19 @@ class RunStream:
         speed: Simulated seconds per wall second; None for no pacing.
         total: The run's simulated duration (for the status line).
         robots: ``poses`` gives one list per robot.
-        joints: Returns the first robot's joint positions by name (the page's readouts), or
-            None.
+        joints: Returns a robot's joint positions by name (the page's readouts), or None;
+            with several robots, a list of them in the viewer's order: the readouts are the
+            followed robot's.
         names: The robots' names, in the viewer's order (``sim --view``): with more than one,
             the camera can follow any of them.
 
     Each sample's poses are kept (:attr:`frames_kept`), so once the run is over the page can
     replay it: a time slider puts the robot where the run had it at that time. The camera
     follows the robot (with several, the one chosen), frames every path, or is left alone
-    (a dropdown). The pacing starts with the run's first sample, not with the stream: a run
-    that waited for a page is paced from when it starts.
+    (a dropdown): followed, the robot is framed with :data:`FOLLOW_MARGIN` of ground around it,
+    at the distance that fits the page's canvas as it is now, from the direction the page's
+    user turned the camera to. The pacing starts with the run's first sample, not with the
+    stream: a run that waited for a page is paced from when it starts.
     """
 
     def __init__(self, viewer: RunDisplay, poses: Any, speed: float | None,
@@ -190,13 +189,16 @@ class RunStream:
         #: The robots the camera can follow by name (empty: one robot, "follow the robot").
         self.names = list(names) if names is not None and len(names) > 1 else []
         self.poses = poses if robots else (lambda: [poses()])
-        self.joints = joints
-        #: (t, every robot's link poses, joint positions) per sample, for the replay.
-        self.frames_kept: list[tuple[float, list[Any], dict[str, float]]] = []
+        #: Each robot's joint reader (None: no readouts for it).
+        self.joints: list[Any] = list(joints) if isinstance(joints, (list, tuple)) else [joints]
+        #: (t, every robot's link poses, every robot's joint positions) per sample, for the
+        #: replay.
+        self.frames_kept: list[tuple[float, list[Any], list[dict[str, float]]]] = []
         self._keep_stride = 1
         self._kept_seen = 0
         self.replay: Any = None
         self._aimed_at: tuple[float, float, float] | None = None
+        self._sizes: dict[int, float] = {}
         gui = viewer.server.gui
         follow = tuple(f"follow {n}" for n in self.names) or (FOLLOW,)
         with gui.add_folder("Run", order=0.5):
@@ -244,7 +246,7 @@ class RunStream:
         if self._kept_seen % self._keep_stride:
             return
         every = self.poses() if every is None else every
-        self.frames_kept.append((t, every, self.joints() if self.joints else {}))
+        self.frames_kept.append((t, every, [read() if read else {} for read in self.joints]))
         if len(self.frames_kept) > REPLAY_FRAMES:
             self.frames_kept = self.frames_kept[::2]
             self._keep_stride *= 2
@@ -272,8 +274,10 @@ class RunStream:
         every = self.poses()
         for k, poses in enumerate(every):
             self.viewer.show_poses(poses, robot=k)
-        if self.joints is not None:
-            self.viewer.show_joint_values(self.joints())
+        k = self.followed()
+        read = self.joints[k] if k < len(self.joints) else None
+        if read is not None:
+            self.viewer.show_joint_values(read(), self._model(k).joints)
         self.frames += 1
         paths = [self.path]
         if not self._seen:  # not fed drive samples: each robot's path from its base poses
@@ -294,7 +298,7 @@ class RunStream:
                 f"/run/path{k or ''}", segments, (230, 97, 0), thickness=3.0,
                 thickness_units="screen")
         if status is not None:
-            self.viewer.status.content = status
+            self.viewer.status.content = status + self._whose_joints()
         self._aim_all()
 
     def followed(self) -> int:
@@ -302,70 +306,75 @@ class RunStream:
         mode = self.camera.value
         return next((k for k, n in enumerate(self.names) if mode == f"follow {n}"), 0)
 
-    def _robot_box(self, poses: Sequence[Any], robot: int = 0) -> tuple[Any, Any]:
-        """A box around a robot's link frames, padded by the robot's size on the page."""
-        import numpy as np
+    def _model(self, robot: int) -> ViewedRobot:
+        return self.viewer.model if robot == 0 else self.viewer.extra[robot - 1][0]
 
-        pts = np.asarray([p[0] for p in poses], dtype=float)
-        model = self.viewer.model if robot == 0 else self.viewer.extra[robot - 1][0]
-        lo, hi = model.bounds()
-        pad = max(max(b - a for a, b in zip(lo, hi, strict=True)), 0.1) / 2
-        return pts.min(axis=0) - pad, pts.max(axis=0) + pad
+    def _whose_joints(self) -> str:
+        """With several robots, whose joints the readouts show."""
+        k = self.followed()
+        if not self.names or k >= len(self.joints) or self.joints[k] is None:
+            return ""
+        return f"\n\nJoint readouts: {self.names[k]}'s"
 
     def _aim_all(self, force: bool = False) -> None:
         """Move every page's camera as the Camera dropdown says (nothing when free)."""
-        import numpy as np
-
         mode = self.camera.value
         if mode == FREE:
             self._aimed_at = None
             return
-        k = self.followed()
-        base = tuple(float(x) for x in self.viewer.robot_pose(k)[0])
-        clients = list(self.viewer.server.get_clients().values())
-        if mode != WHOLE_PATH and self._aimed_at is not None and not force:
-            if base == self._aimed_at:
-                return
-            for client in clients:  # keep the user's own orbit, around the robot's base
-                try:
-                    cam = client.camera
-                    orbit = np.asarray(cam.position) - np.asarray(cam.look_at)
-                    with self.viewer.server.atomic():
-                        cam.position = np.asarray(base) + orbit  # (viser moves look_at too)
-                        cam.look_at = base
-                except AssertionError:  # a page that has not reported its camera yet
-                    continue
-        else:
-            box = self._box()
-            for client in clients:
-                try:
-                    self.viewer.aim(client, box, self.viewer.aspect(client))
-                except AssertionError:
-                    continue
+        base = tuple(float(x) for x in self.viewer.robot_pose(self.followed())[0])
+        if mode != WHOLE_PATH and base == self._aimed_at and not force:
+            return  # a still robot: the camera stays as its user turned it
+        for client in list(self.viewer.server.get_clients().values()):
+            try:
+                self._aim_page(client)
+            except AssertionError:  # a page that has not reported its camera yet
+                continue
         self._aimed_at = base  # type: ignore[assignment]
 
     def _camera_changed(self) -> None:
         """The Camera dropdown changed: aim now; in a replay, the status names the robot."""
+        if self.camera.value == FREE:
+            for client in list(self.viewer.server.get_clients().values()):
+                self.viewer.cameras.release(client)
         self._aim_all(force=True)
         if self._shown is not None:
             self.show_time(self._shown)
 
     def _box(self) -> tuple[Any, Any]:
-        """What the camera frames now: the followed robot, or with it every path."""
+        """What the camera frames now: the followed robot with ground around it, or every path."""
         import numpy as np
 
         k = self.followed()
-        lo, hi = self._robot_box(self._frames_now()[k], k)
-        if self.camera.value == WHOLE_PATH:
-            for path in (self.path, *self.paths):
-                if path:
-                    pts = np.asarray(path, dtype=float)
-                    lo, hi = np.minimum(lo, pts.min(axis=0)), np.maximum(hi, pts.max(axis=0))
+        pts = np.asarray([p[0] for p in self._frames_now()[k]], dtype=float)
+        size = self._size(k)
+        if self.camera.value != WHOLE_PATH:  # the shapes about the link frames, and a margin
+            pad = size / 2 + FOLLOW_MARGIN * size
+            return pts.min(axis=0) - pad, pts.max(axis=0) + pad
+        lo, hi = pts.min(axis=0) - size / 2, pts.max(axis=0) + size / 2
+        for path in (self.path, *self.paths):
+            if path:
+                got = np.asarray(path, dtype=float)
+                lo, hi = np.minimum(lo, got.min(axis=0)), np.maximum(hi, got.max(axis=0))
         return lo, hi
 
+    def _size(self, robot: int) -> float:
+        """A robot's largest side (at least 10 cm), as loaded: measured once."""
+        if robot not in self._sizes:
+            lo, hi = self._model(robot).bounds()
+            self._sizes[robot] = max(max(b - a for a, b in zip(lo, hi, strict=True)), 0.1)
+        return self._sizes[robot]
+
+    def _base(self) -> Vec3:
+        """Where the followed robot's base is on the page now."""
+        return self.viewer.robot_pose(self.followed())[0]
+
     def _aim_page(self, client: Any) -> None:
-        """A page that has just connected: framed as the Camera says (free: the robot)."""
-        self.viewer.aim(client, self._box(), self.viewer.aspect(client))
+        """Frame one page as the Camera says (a page just connected: free frames the robot)."""
+        if self.camera.value == WHOLE_PATH:
+            self.viewer.cameras.aim(client, self._box)
+        else:
+            self.viewer.cameras.follow(client, self._box, self._base)
 
     def _frames_now(self) -> list[Any]:
         """Every robot's link poses as the page shows them now."""
@@ -404,12 +413,13 @@ class RunStream:
         self._shown = at
         for r, poses in enumerate(every):
             self.viewer.show_poses(poses, robot=r)
-        if joints:
-            self.viewer.show_joint_values(joints)
         k = self.followed()
+        if k < len(joints) and joints[k]:
+            self.viewer.show_joint_values(joints[k], self._model(k).joints)
         x, y, z = self.viewer.robot_pose(k)[0]
         whose = f"{self.names[k]}'s base" if self.names else "base"
         self.viewer.status.content = (f"**Replay**: t = {at:.2f} s of {times[-1]:.2f}; {whose} "
-                                      f"at x {x:.3f}, y {y:.3f}, z {z:.3f} m\n\n{self.summary}")
+                                      f"at x {x:.3f}, y {y:.3f}, z {z:.3f} m\n\n{self.summary}"
+                                      f"{self._whose_joints()}")
         self._aim_all()
         return at, every
