@@ -1,4 +1,4 @@
-"""The exchange modules on their own: forward kinematics against an independent URDF library
+"""The formats modules on their own: forward kinematics against an independent URDF library
 (yourdfpy), rotations against PyBullet's, fused mass properties against a closed form."""
 
 from __future__ import annotations
@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from urdfkit.exchange.fk import link_frames
-from urdfkit.exchange.mjcf import combine, mat_to_quat
-from urdfkit.exchange.robot import Inertial, read_robot
+from urdfkit.formats.fk import link_frames
+from urdfkit.formats.mjcf import combine, mat_to_quat
+from urdfkit.formats.robot import Inertial, read_robot
 from urdfkit.sources.resolve import resolve
 
 

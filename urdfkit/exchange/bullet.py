@@ -9,7 +9,7 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-from urdfkit.exchange.robot import Inertial, Robot, read_inertial
+from urdfkit.formats.robot import Inertial, Robot, read_inertial
 
 
 def loaded_inertials(resolved: Any, *, inertia_from_file: bool) -> dict[str, Inertial]:

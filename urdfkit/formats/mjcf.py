@@ -17,9 +17,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import InputError, ParameterError
-from urdfkit.exchange.fk import fused, origin_matrix
-from urdfkit.exchange.mjcf_mesh import MeshAsset, mesh_asset, unusable
-from urdfkit.exchange.robot import Inertial, Joint, Link, Robot, Shape
+from urdfkit.formats.fk import fused, origin_matrix
+from urdfkit.formats.mjcf_mesh import MeshAsset, mesh_asset, unusable
+from urdfkit.formats.robot import Inertial, Joint, Link, Robot, Shape
 
 if TYPE_CHECKING:
     from lxml import etree
@@ -740,7 +740,7 @@ def write_export(export: Export, path: str | Path, *, force: bool = False,
     """Write the XML and its assets folder beside it, crash-safe; return the paths written.
 
     At every step the XML on disk, old or new, names only files that are there with the
-    bytes it expects (:mod:`urdfkit.exchange.mjcf_write`): mesh files are named by their
+    bytes it expects (:mod:`urdfkit.formats.mjcf_write`): mesh files are named by their
     content and only added until the new XML replaces the old one atomically; then the
     files it does not name are removed. Without ``force`` neither the XML nor a non-empty
     assets folder may exist. ``verify`` is handed the staged XML before it takes its place:
@@ -751,7 +751,7 @@ def write_export(export: Export, path: str | Path, *, force: bool = False,
             one line naming the file; nothing of this run is left.
     """
     from urdfkit.core.output import check_output
-    from urdfkit.exchange.mjcf_write import write_pair
+    from urdfkit.formats.mjcf_write import write_pair
 
     out = check_output(path, force=force, suffixes=(".xml",), what="the MJCF file")
     export.paths = write_pair(out, export.xml, export.assets, export.digests, export.asset_dir,
