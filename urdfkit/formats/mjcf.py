@@ -59,6 +59,9 @@ class ExportOptions:
             its mass properties, the ``<inertia>`` element, how it was made and why
             (:func:`urdfkit.exchange.bullet.zeroed_repairs`). Written only where the zero
             would leave a moving body MuJoCo refuses; each such link is said and listed.
+        geom_names: Name every geom ``g0``, ``g1`` ... and say in :attr:`Export.geom_links`
+            which link each comes from (an engine maps contacts back to links with it; a
+            fused body holds the geoms of several links).
     """
 
     fixed_base: bool = False
@@ -69,6 +72,7 @@ class ExportOptions:
     inertials: dict[str, Inertial] | None = None
     inertia_from_shapes: bool = False
     repairs: dict[str, tuple[Inertial, str, str, str]] | None = None
+    geom_names: bool = False
 
 
 @dataclass
@@ -91,6 +95,7 @@ class Export:
         asset_dir: The assets folder's name (beside the XML, the compiler's meshdir).
         notes: What was dropped, approximated or defaulted.
         bodies, sites: Link names written as bodies / as sites.
+        geom_links: With :attr:`ExportOptions.geom_names`, each geom's name and its link.
     """
 
     xml: bytes
@@ -102,6 +107,7 @@ class Export:
     paths: list[str] = field(default_factory=list)   # filled by write_export
     repaired: list[str] = field(default_factory=list)   # links given fix's tensor
     digests: dict[str, str] = field(default_factory=dict)   # asset name -> SHA-256 (hex)
+    geom_links: dict[str, str] = field(default_factory=dict)
 
 
 def num(x: float) -> str:
@@ -204,6 +210,7 @@ class _Writer:
         self.members: dict[str, list[str]] = {}
         self.locked: list[Any] = []
         self.repaired: list[str] = []
+        self.geom_links: dict[str, str] = {}
         self.root = etree.Element("mujoco", model=robot.name or "robot")
         self.compiler = etree.SubElement(self.root, "compiler", angle="radian",
                                          meshdir=asset_dir, autolimits="true")
@@ -324,6 +331,10 @@ class _Writer:
         if not self.shape_type(g, body, shape, link, visual):
             return
         _place(g, t)
+        if self.o.geom_names:
+            name = f"g{len(self.geom_links)}"
+            g.set("name", name)
+            self.geom_links[name] = link.name
         if visual:
             g.set("contype", "0")
             g.set("conaffinity", "0")
@@ -727,7 +738,7 @@ def export_mjcf(robot: Robot, options: ExportOptions | None = None,
     w.E.indent(w.root, space="  ")
     xml = w.E.tostring(w.root, xml_declaration=False, encoding="unicode").encode() + b"\n"
     return Export(xml, w.assets, asset_dir, w.notes, w.bodies, w.sites, digests=w.digests,
-                  repaired=w.repaired)
+                  repaired=w.repaired, geom_links=w.geom_links)
 
 
 def asset_dir_for(path: str | Path) -> str:
