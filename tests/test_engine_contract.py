@@ -1,0 +1,414 @@
+"""One contract, every engine: the same pendulum, box and car give the same physics.
+
+Each case runs on every engine through the seam's :class:`urdfkit.engine.api.Simulator` and is
+held to what physics says, not to the engine's own numbers: a compound pendulum's period, a
+free fall's time, a rolling wheel's distance. Every tolerance is stated beside its figure;
+docs/engines.md lists what each engine measured.
+
+``pybullet`` is raw PyBullet, through :class:`RawBullet` below, until
+``urdfkit/engine/pybullet.py`` is registered in :data:`urdfkit.engine.registry.ENGINES`; then
+the registered engine runs the same cases.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from urdfkit.core.errors import InputError, MissingDependencyError, ParameterError
+from urdfkit.engine.api import BaseState, ContactPoint, JointState, LoadSettings
+from urdfkit.engine.registry import ENGINES, open_engine
+
+ROBOTS = Path(__file__).parent / "fixtures" / "robots"
+PENDULUM = ROBOTS / "compound_pendulum.urdf"
+BOX = ROBOTS / "falling_box.urdf"
+SLED = ROBOTS / "sled.urdf"
+G = 9.81
+DT = 1.0 / 240.0
+ENGINE_NAMES = ["pybullet", "mujoco"]
+
+
+class RawBullet:
+    """The reference: what the contract asks of an engine, in raw PyBullet calls.
+
+    Stands in for ``engine/pybullet.py`` until that is registered (see the module).
+    """
+
+    name = "pybullet"
+
+    def __init__(self) -> None:
+        from urdfkit.engine.session import Session
+
+        self.session = Session()
+        self.p = self.session.bullet
+
+    def load(self, path: str, settings: LoadSettings, display: str | None = None) -> int:
+        from urdfkit.engine.session import LoadOptions
+
+        return self.session.load_urdf(path, LoadOptions(
+            fixed_base=settings.fixed_base, inertia_from_file=settings.inertia_from_file,
+            implicit_cylinder=settings.implicit_cylinder, self_collision=settings.self_collision,
+            base_position=settings.position, base_orientation=settings.orientation), display)
+
+    def set_gravity(self, gravity: Sequence[float]) -> None:
+        self.p.setGravity(*gravity)
+
+    def set_time_step(self, time_step: float) -> None:
+        self.p.setTimeStep(time_step)
+
+    def step(self) -> None:
+        self.p.stepSimulation()
+
+    def save(self) -> int:
+        return int(self.p.saveState())
+
+    def restore(self, state: int) -> None:
+        self.p.restoreState(state)
+
+    def joints(self, body: int) -> list[str]:
+        return [self.p.getJointInfo(body, i)[1].decode()
+                for i in range(self.p.getNumJoints(body))]
+
+    def joint_states(self, body: int, joints: Sequence[int]) -> list[JointState]:
+        return [JointState(s[0], s[1], tuple(s[2]), s[3])  # type: ignore[arg-type]
+                for s in self.p.getJointStates(body, list(joints))]
+
+    def reset_joint(self, body: int, joint: int, position: float, velocity: float = 0.0
+                    ) -> None:
+        self.p.resetJointState(body, joint, position, velocity)
+
+    def motors(self, body: int, joints: Sequence[int], mode: str, targets: Sequence[float],
+               forces: Sequence[float] | None = None) -> None:
+        if mode == "torque":
+            self.p.setJointMotorControlArray(body, list(joints), self.p.TORQUE_CONTROL,
+                                             forces=list(targets))
+            return
+        kind = {"velocity": self.p.VELOCITY_CONTROL, "position": self.p.POSITION_CONTROL}[mode]
+        key = "targetVelocities" if mode == "velocity" else "targetPositions"
+        self.p.setJointMotorControlArray(body, list(joints), kind, **{key: list(targets)},
+                                         forces=list(forces or [100000.0] * len(joints)))
+
+    def change_dynamics(self, body: int, link: int, **values: Any) -> None:
+        self.p.changeDynamics(body, link, **values)
+
+    def base_state(self, body: int) -> BaseState:
+        pos, orn = self.p.getBasePositionAndOrientation(body)
+        lin, ang = self.p.getBaseVelocity(body)
+        return BaseState(tuple(pos), tuple(orn), tuple(lin), tuple(ang))  # type: ignore[arg-type]
+
+    def contacts(self, body: int, link: int | None = None, other: int | None = None
+                 ) -> list[ContactPoint]:
+        kw: dict[str, int] = {"bodyA": body}
+        if other is not None:
+            kw["bodyB"] = other
+        return [ContactPoint(c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10],
+                             c[11], c[12], c[13]) for c in self.p.getContactPoints(**kw)
+                if link is None or c[3] == link]
+
+    def mass_matrix(self, body: int, positions: Sequence[float]) -> list[list[float]]:
+        return [list(row) for row in self.p.calculateMassMatrix(body, list(positions))]
+
+    def inverse_dynamics(self, body: int, positions: Sequence[float],
+                         velocities: Sequence[float], accelerations: Sequence[float]
+                         ) -> list[float]:
+        return list(self.p.calculateInverseDynamics(body, list(positions), list(velocities),
+                                                    list(accelerations)))
+
+    def close(self) -> None:
+        self.session.close()
+
+
+def _open(name: str) -> Any:
+    return open_engine(name) if name in ENGINES else RawBullet()
+
+
+@pytest.fixture(params=ENGINE_NAMES)
+def engine(request: pytest.FixtureRequest) -> Iterator[Any]:
+    e = _open(request.param)
+    try:
+        e.set_gravity((0.0, 0.0, -G))
+        e.set_time_step(DT)
+        yield e
+    finally:
+        e.close()
+
+
+def _free_pendulum(e: Any, angle: float) -> int:
+    """The pendulum at ``angle``, at rest, its motor and PyBullet's link damping off."""
+    body = e.load(str(PENDULUM), LoadSettings(fixed_base=True, inertia_from_file=True))
+    e.motors(body, [0], "velocity", [0.0], forces=[0.0])
+    for link in (-1, 0):
+        e.change_dynamics(body, link, linearDamping=0.0, angularDamping=0.0)
+    e.reset_joint(body, 0, angle)
+    return body
+
+
+def _period(small: float, amplitude: float) -> float:
+    """A pendulum's period at ``amplitude`` (rad): the small-swing period times 2 K(k) / pi,
+    k = sin(amplitude / 2), K by the arithmetic-geometric mean."""
+    a, b = 1.0, math.cos(amplitude / 2)
+    for _ in range(40):
+        a, b = (a + b) / 2, math.sqrt(a * b)
+    return small / a
+
+
+#: The pendulum (tests/fixtures/robots/compound_pendulum.urdf): I about the hinge, m, d.
+I_HINGE, MASS, D = 0.27, 1.0, 0.5
+
+
+def test_pendulum_swings_with_the_compound_pendulum_period(engine: Any) -> None:
+    """Released from 0.5 rad, the period is 2 pi sqrt(I / (m g d)) with its amplitude factor
+    (1.0159 at 0.5 rad), to 0.05 %, and the swing keeps its amplitude to 0.5 %."""
+    body = _free_pendulum(engine, 0.5)
+    crossings, peak, prev = [], 0.0, 0.5
+    for n in range(1, int(7.0 / DT)):
+        engine.step()
+        q = engine.joint_states(body, [0])[0].position
+        if prev > 0 >= q:  # downward through the bottom, interpolated within the step
+            crossings.append((n - 1 + prev / (prev - q)) * DT)
+        peak = max(peak, q) if n * DT > 5.0 else peak
+        prev = q
+    periods = [b - a for a, b in zip(crossings, crossings[1:], strict=False)]
+    small = 2 * math.pi * math.sqrt(I_HINGE / (MASS * G * D))
+    expected = _period(small, 0.5)
+    assert len(periods) >= 3
+    assert sum(periods) / len(periods) == pytest.approx(expected, rel=5e-4), (periods, expected)
+    assert peak == pytest.approx(0.5, rel=5e-3)
+
+
+def test_pendulum_mass_matrix_and_inverse_dynamics(engine: Any) -> None:
+    """M = I about the hinge; at rest at 0.5 rad gravity takes m g d sin(0.5) (1e-9)."""
+    body = _free_pendulum(engine, 0.0)
+    assert engine.mass_matrix(body, [0.3]) == [[pytest.approx(I_HINGE, rel=1e-9)]]
+    torque = engine.inverse_dynamics(body, [0.5], [0.0], [0.0])
+    assert torque == [pytest.approx(MASS * G * D * math.sin(0.5), rel=1e-9)]
+    accel = engine.inverse_dynamics(body, [0.0], [0.0], [2.0])
+    assert accel == [pytest.approx(2.0 * I_HINGE, rel=1e-9)]
+
+
+def test_the_engines_swing_the_same_pendulum() -> None:
+    """Both engines integrate a free swing alike: semi-implicit Euler at the same step, to
+    1e-9 rad over 2 s."""
+    traces = []
+    for name in ENGINE_NAMES:
+        e = _open(name)
+        try:
+            e.set_gravity((0.0, 0.0, -G))
+            e.set_time_step(DT)
+            body = _free_pendulum(e, 0.5)
+            trace = []
+            for _ in range(int(2.0 / DT)):
+                e.step()
+                trace.append(e.joint_states(body, [0])[0].position)
+            traces.append(trace)
+        finally:
+            e.close()
+    worst = max(abs(a - b) for a, b in zip(*traces, strict=True))
+    assert worst < 1e-9, worst
+
+
+def _ground(e: Any) -> int:
+    """pybullet_data's plane.urdf (lateral friction 1), as both engines load it."""
+    from urdfkit.sources.resolve import locate
+
+    return e.load(str(locate("plane.urdf")), LoadSettings(fixed_base=True), "plane.urdf")
+
+
+def test_a_dropped_box_hits_the_ground_after_sqrt_2h_over_g(engine: Any) -> None:
+    """The box's first contact is within 2 steps (8.3 ms) of sqrt(2 h / g); at rest, the
+    ground carries its weight to 1 %."""
+    ground = _ground(engine)
+    height = 0.5  # the box's underside above the ground
+    box = engine.load(str(BOX), LoadSettings(inertia_from_file=True,
+                                             position=(0.0, 0.0, height + 0.1)))
+    engine.change_dynamics(box, -1, linearDamping=0.0, angularDamping=0.0)
+    hit = None
+    for n in range(1, int(1.0 / DT)):
+        engine.step()
+        if any(c.distance <= 0 for c in engine.contacts(box, other=ground)):
+            hit = n * DT
+            break
+    assert hit is not None
+    assert abs(hit - math.sqrt(2 * height / G)) <= 2 * DT, (hit, math.sqrt(2 * height / G))
+    for _ in range(int(1.0 / DT)):
+        engine.step()
+    weight = sum(c.normal_force for c in engine.contacts(box, other=ground))
+    assert weight == pytest.approx(MASS * G, rel=1e-2)
+    assert all(c.normal[2] > 0.99 for c in engine.contacts(box, other=ground))  # B to A: up
+
+
+@pytest.fixture(scope="module")
+def car_urdf(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, float]:
+    """simplecar as `urdfkit build simplecar` writes it, and its wheels' radius."""
+    from lxml import etree
+
+    from urdfkit.model.catalog import build_template
+
+    path = build_template("simplecar").write(tmp_path_factory.mktemp("car") / "simplecar.urdf")
+    radii = {float(c.get("radius")) for c in etree.parse(str(path)).iter("cylinder")}
+    assert len(radii) == 1
+    return Path(path), radii.pop()
+
+
+def test_a_car_drives_wheel_speed_times_radius_times_time(engine: Any,
+                                                          car_urdf: tuple[Path, float]) -> None:
+    """simplecar's four wheels at 10 rad/s under a 10 N m cap, steering held at 0: after
+    2 s it has gone omega r t within 5 %, straight (1 cm), its wheels at speed (1 %) and never
+    past it by more than 1 % (a motor at its cap stops at its target)."""
+    path, radius = car_urdf
+    _ground(engine)
+    car = engine.load(str(path), LoadSettings(position=(0.0, 0.0, radius)))
+    names = engine.joints(car)
+    names = [j if isinstance(j, str) else j.name for j in names]
+    wheels = [i for i, n in enumerate(names) if "wheel" in n]
+    hinges = [i for i, n in enumerate(names) if "hinge" in n and "wheel" not in n]
+    assert len(wheels) == 4 and len(hinges) == 2, names
+    omega, seconds = 10.0, 2.0
+    engine.motors(car, wheels, "velocity", [omega] * 4, forces=[10.0] * 4)
+    engine.motors(car, hinges, "position", [0.0] * 2, forces=[100000.0] * 2)
+    top = 0.0
+    for _ in range(int(seconds / DT)):
+        engine.step()
+        top = max(top, *(s.velocity for s in engine.joint_states(car, wheels)))
+    assert top <= omega * 1.01
+    x, y, _ = engine.base_state(car).position
+    assert x == pytest.approx(omega * radius * seconds, rel=0.05)
+    assert abs(y) < 0.01
+    for s in engine.joint_states(car, wheels):
+        assert s.velocity == pytest.approx(omega, rel=0.01)
+
+
+def test_joint_order_is_pybullets(car_urdf: tuple[Path, float]) -> None:
+    """Every engine numbers simplecar's joints as PyBullet does (depth-first, file order)."""
+    path, _ = car_urdf
+    orders = []
+    for name in ENGINE_NAMES:
+        e = _open(name)
+        try:
+            body = e.load(str(path), LoadSettings())
+            orders.append([j if isinstance(j, str) else j.name for j in e.joints(body)])
+        finally:
+            e.close()
+    assert orders[0] == orders[1]
+
+
+def test_restore_steps_again_exactly(engine: Any) -> None:
+    """A saved state, restored mid-contact, steps as it did the first time."""
+    _ground(engine)
+    box = engine.load(str(BOX), LoadSettings(inertia_from_file=True,
+                                             position=(0.0, 0.0, 0.15)))
+    for _ in range(20):
+        engine.step()
+    state = engine.save()
+    runs = []
+    for _ in range(2):
+        engine.restore(state)
+        trace = []
+        for _ in range(30):
+            engine.step()
+            trace.append(engine.base_state(box).position)
+        runs.append(trace)
+    assert runs[0] == runs[1]
+
+
+# --------------------------------------------------------------------------- MuJoCo's own
+
+
+def test_mujoco_refuses_an_inertia_it_cannot_simulate_naming_the_link_and_fix(
+        tmp_path: Path) -> None:
+    """PyBullet zeroes a tensor that breaks the triangle inequality; MuJoCo refuses the moving
+    body it leaves: one error (exit code 2) naming the link and `urdfkit fix`."""
+    bad = tmp_path / "bad.urdf"
+    bad.write_text(PENDULUM.read_text().replace(
+        'ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.001"',
+        'ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.05"'))
+    e = open_engine("mujoco")
+    try:
+        with pytest.raises(InputError) as caught:
+            e.load(str(bad), LoadSettings(fixed_base=True, inertia_from_file=True), "bad.urdf")
+    finally:
+        e.close()
+    err = caught.value
+    assert err.exit_code == 2
+    assert "'arm'" in err.message and "urdfkit fix" in err.message, err.message
+    assert err.file == "bad.urdf"
+
+
+@pytest.mark.parametrize(("key", "value", "said"), [
+    ("contactStiffness", 1e4, "solref"), ("maxJointVelocity", 50.0, "velocity cap"),
+    ("restitution", 0.5, "bounce"), ("linearDamping", 0.04, "per-body velocity damping"),
+    ("lateralFricton", 0.5, "did you mean 'lateralFriction'")])
+def test_mujoco_names_what_it_cannot_carry(key: str, value: float, said: str) -> None:
+    e = open_engine("mujoco")
+    try:
+        body = e.load(str(BOX), LoadSettings())
+        with pytest.raises(ParameterError) as caught:
+            e.change_dynamics(body, -1, **{key: value})
+    finally:
+        e.close()
+    assert key in caught.value.message and said in caught.value.message
+
+
+def test_ground_friction_is_the_product_of_the_two(engine: Any) -> None:
+    """PyBullet multiplies two links' friction: a block of 0.5 (its default) on pybullet_data's
+    plane (1.0) slides with 0.5, where MuJoCo's own rule (the larger) would give 1.0 and hold
+    it. Pushed at 0.7 m g (a torque each step), the friction it slides with is 0.5 (5 %)."""
+    _ground(engine)
+    sled = engine.load(str(SLED), LoadSettings(fixed_base=True, inertia_from_file=True))
+    engine.motors(sled, [0, 1], "velocity", [0.0, 0.0], forces=[0.0, 0.0])
+    for link in (-1, 0, 1):
+        engine.change_dynamics(sled, link, linearDamping=0.0, angularDamping=0.0)
+    for _ in range(24):   # settle onto the ground
+        engine.step()
+    push = 0.7 * MASS * G
+    speeds = []
+    for _ in range(int(1.0 / DT)):
+        engine.motors(sled, [0], "torque", [push])
+        engine.step()
+        speeds.append(engine.joint_states(sled, [0])[0].velocity)
+    a, b = int(0.2 / DT), int(0.8 / DT)
+    accel = (speeds[b] - speeds[a]) / ((b - a) * DT)
+    friction = (push - (MASS + 0.001) * accel) / (MASS * G)
+    assert friction == pytest.approx(0.5, rel=0.05)
+
+
+def test_missing_mujoco_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "mujoco", None)  # `import mujoco` raises ImportError
+    with pytest.raises(MissingDependencyError) as caught:
+        open_engine("mujoco")
+    assert "pip install 'urdfkit[mujoco]'" in caught.value.message
+    assert "\n" not in caught.value.message
+
+
+def test_an_unknown_engine_is_named_with_the_closest() -> None:
+    with pytest.raises(ParameterError) as caught:
+        open_engine("mujuco")
+    assert "did you mean 'mujoco'" in caught.value.message
+
+
+def test_restore_with_motors_at_their_caps_steps_again_exactly(
+        engine: Any, car_urdf: tuple[Path, float]) -> None:
+    """Saved while its wheels' motors push at their caps, the car drives on as it did."""
+    path, radius = car_urdf
+    _ground(engine)
+    car = engine.load(str(path), LoadSettings(position=(0.0, 0.0, radius)))
+    engine.motors(car, [1, 3, 4, 5], "velocity", [30.0] * 4, forces=[2.0] * 4)
+    for _ in range(10):
+        engine.step()
+    state = engine.save()
+    runs = []
+    for _ in range(2):
+        engine.restore(state)
+        trace = []
+        for _ in range(60):
+            engine.step()
+            trace.append((engine.base_state(car).position,
+                          [s.velocity for s in engine.joint_states(car, [1, 3, 4, 5])]))
+        runs.append(trace)
+    assert runs[0] == runs[1]
+    assert all(s.applied == pytest.approx(2.0) for s in engine.joint_states(car, [4, 5]))
