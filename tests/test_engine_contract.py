@@ -28,6 +28,7 @@ ROBOTS = Path(__file__).parent / "fixtures" / "robots"
 PENDULUM = ROBOTS / "compound_pendulum.urdf"
 BOX = ROBOTS / "falling_box.urdf"
 SLED = ROBOTS / "sled.urdf"
+OFFSET = ROBOTS / "offset_base.urdf"
 G = 9.81
 DT = 1.0 / 240.0
 ENGINE_NAMES = ["pybullet", "mujoco"]
@@ -95,6 +96,15 @@ class RawBullet:
 
     def change_dynamics(self, body: int, link: int, **values: Any) -> None:
         self.p.changeDynamics(body, link, **values)
+
+    def reset_base(self, body: int, position: Sequence[float], orientation: Sequence[float]
+                   ) -> None:
+        self.p.resetBasePositionAndOrientation(body, position, orientation)
+        self.p.resetBaseVelocity(body, [0, 0, 0], [0, 0, 0])
+
+    def reset_base_velocity(self, body: int, linear: Sequence[float], angular: Sequence[float]
+                            ) -> None:
+        self.p.resetBaseVelocity(body, linear, angular)
 
     def base_state(self, body: int) -> BaseState:
         pos, orn = self.p.getBasePositionAndOrientation(body)
@@ -314,6 +324,46 @@ def test_restore_steps_again_exactly(engine: Any) -> None:
             trace.append(engine.base_state(box).position)
         runs.append(trace)
     assert runs[0] == runs[1]
+
+
+def test_the_base_is_its_inertial_frame_as_pybullet_has_it() -> None:
+    """base_state is the root's inertial frame (off the link frame, turned); reset_base and
+    reset_base_velocity set that frame; both engines agree to 1e-6 (PyBullet keeps float32
+    frames)."""
+    turn = (0.1, -0.2, 0.3, math.sqrt(1 - 0.14))
+    states = []
+    for name in ENGINE_NAMES:
+        e = _open(name)
+        try:
+            e.set_time_step(DT)   # no gravity: the body flies straight
+            body = e.load(str(OFFSET), LoadSettings(inertia_from_file=True,
+                                                    position=(1.0, 2.0, 3.0),
+                                                    orientation=turn))
+            e.change_dynamics(body, -1, linearDamping=0.0, angularDamping=0.0)
+            loaded = e.base_state(body)
+            e.reset_base(body, (0.5, -0.5, 2.0), (0.0, 0.0, 0.0, 1.0))
+            moved = e.base_state(body)
+            e.reset_base_velocity(body, (1.0, 0.0, 0.5), (0.0, 0.0, 2.0))
+            launched = e.base_state(body)
+            e.step()
+            flown = e.base_state(body)
+            states.append((loaded, moved, launched, flown))
+        finally:
+            e.close()
+    for (_, moved, launched, flown) in states:
+        assert moved.position == pytest.approx((0.5, -0.5, 2.0), abs=1e-6)
+        assert moved.orientation == pytest.approx((0.0, 0.0, 0.0, 1.0), abs=1e-6)
+        assert launched.linear == pytest.approx((1.0, 0.0, 0.5), abs=1e-6)
+        assert launched.angular == pytest.approx((0.0, 0.0, 2.0), abs=1e-6)
+        # MuJoCo moves the link frame's origin, and turns the body about it: the centre of
+        # mass strays from its straight line by w^2 |arm| dt^2 / 2 (4e-6 m here)
+        assert flown.position == pytest.approx((0.5 + DT, -0.5, 2.0 + 0.5 * DT), abs=1e-5)
+    a, b = states
+    for x, y in zip(a[:3], b[:3], strict=True):
+        assert x.position == pytest.approx(y.position, abs=1e-6)
+        assert x.orientation == pytest.approx(y.orientation, abs=1e-6)
+        assert x.linear == pytest.approx(y.linear, abs=1e-6)
+        assert x.angular == pytest.approx(y.angular, abs=1e-6)
 
 
 # --------------------------------------------------------------------------- MuJoCo's own

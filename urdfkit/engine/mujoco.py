@@ -406,23 +406,30 @@ class MuJoCoEngine:
 
     def base_state(self, body: int) -> BaseState:
         """The root's inertial frame (PyBullet's base pose) and its velocity, world."""
-        import numpy as np
+        from urdfkit.model.spec import quat_mul
 
-        from urdfkit.model.spec import quat_mul, quat_to_matrix
-
-        frames = self.link_frames(body)
         r, ids = self._body(body)
-        (p0, q0) = frames[0]
+        p0, q0, rot = self._root_frame(ids)
         offset, turn = r.root_offset()
-        rot = np.array(quat_to_matrix(q0))
-        p = np.array(p0) + rot @ np.array(offset)
+        p = _add(p0, _rotate(rot, offset))
         linear, angular = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
         if ids.free >= 0:
-            a = self._m.jnt_dofadr[self._m.body_jntadr[ids.root]]
-            v0 = np.array(self._d.qvel[a:a + 3])
-            w = rot @ np.array(self._d.qvel[a + 3:a + 6])   # a free joint's is local
-            linear, angular = _vec(v0 + np.cross(w, p - np.array(p0))), _vec(w)
-        return BaseState(_vec(p), quat_mul(q0, turn), linear, angular)
+            a = int(self._m.jnt_dofadr[self._m.body_jntadr[ids.root]])
+            qvel = self._d.qvel
+            w = _rotate(rot, (qvel[a + 3], qvel[a + 4], qvel[a + 5]))  # a free joint's: local
+            arm = (p[0] - p0[0], p[1] - p0[1], p[2] - p0[2])
+            linear = _add((qvel[a], qvel[a + 1], qvel[a + 2]), _cross(w, arm))
+            angular = w
+        return BaseState(p, quat_mul(q0, turn), linear, angular)
+
+    def _root_frame(self, ids: _Body) -> tuple[Vec3, Quat, Any]:
+        """The root link frame now: position, quaternion (x y z w), rotation matrix (3x3)."""
+        self._fresh_kinematics()
+        d = self._d
+        kind, i = ids.frames[0]
+        if kind == "body":
+            return _vec(d.xpos[i]), _xyzw(d.xquat[i]), d.xmat[i].reshape(3, 3)
+        return _vec(d.site_xpos[i]), self._mat_quat(d.site_xmat[i]), d.site_xmat[i].reshape(3, 3)
 
     def reset_base(self, body: int, position: Vec3, orientation: Quat) -> None:
         """Move the root's inertial frame there, at rest."""
@@ -453,21 +460,17 @@ class MuJoCoEngine:
 
     def reset_base_velocity(self, body: int, linear: Vec3, angular: Vec3) -> None:
         """Set the root's velocity: its inertial frame's linear velocity, and the angular."""
-        import numpy as np
-
-        from urdfkit.model.spec import quat_to_matrix
-
         m, d = self._world()
-        _, ids = self._body(body)
+        r, ids = self._body(body)
         if ids.free < 0:
             return  # a fixed base does not move (PyBullet's does not either)
-        state = self.base_state(body)
-        p0, q0 = self.link_frames(body)[0]
-        w = np.array(angular, dtype=float)
-        v0 = np.array(linear, dtype=float) - np.cross(w, np.array(state.position) - np.array(p0))
-        a = m.jnt_dofadr[m.body_jntadr[ids.root]]
-        d.qvel[a:a + 3] = v0
-        d.qvel[a + 3:a + 6] = np.array(quat_to_matrix(q0)).T @ w
+        _, _, rot = self._root_frame(ids)
+        arm = _rotate(rot, r.root_offset()[0])   # from the link frame to the inertial frame
+        w = (float(angular[0]), float(angular[1]), float(angular[2]))
+        cross = _cross(w, arm)
+        a = int(m.jnt_dofadr[m.body_jntadr[ids.root]])
+        d.qvel[a:a + 3] = (linear[0] - cross[0], linear[1] - cross[1], linear[2] - cross[2])
+        d.qvel[a + 3:a + 6] = _rotate(rot.T, w)
 
     def joint_states(self, body: int, joints: Sequence[int]) -> list[JointState]:
         """The state of these joints now; ``applied``: the motor's force in the last step.
@@ -917,9 +920,25 @@ class MuJoCoEngine:
 
 
 def _bad_count(mj: Any, d: Any) -> int:
+    """How often MuJoCo has found NaN or huge values (positions, velocities, accelerations)."""
     w = mj.mjtWarning
-    return sum(d.warning[int(k)].number for k in (w.mjWARN_BADQACC, w.mjWARN_BADQVEL,
-                                                  w.mjWARN_BADQPOS))
+    warning = d.warning
+    return int(warning[int(w.mjWARN_BADQACC)].number + warning[int(w.mjWARN_BADQVEL)].number
+               + warning[int(w.mjWARN_BADQPOS)].number)
+
+
+def _rotate(rot: Any, v: Sequence[float]) -> Vec3:
+    return (float(rot[0][0] * v[0] + rot[0][1] * v[1] + rot[0][2] * v[2]),
+            float(rot[1][0] * v[0] + rot[1][1] * v[1] + rot[1][2] * v[2]),
+            float(rot[2][0] * v[0] + rot[2][1] * v[1] + rot[2][2] * v[2]))
+
+
+def _add(a: Sequence[float], b: Sequence[float]) -> Vec3:
+    return (float(a[0] + b[0]), float(a[1] + b[1]), float(a[2] + b[2]))
+
+
+def _cross(a: Sequence[float], b: Sequence[float]) -> Vec3:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 def _vec(v: Any) -> Vec3:
