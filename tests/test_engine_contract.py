@@ -349,6 +349,33 @@ def test_joints_are_pybullets(name: str, car_urdf: tuple[Path, float]) -> None:
         assert a[-1] == pytest.approx(b[-1], abs=1e-12)   # the axis, normalised by each
 
 
+def test_contacts_name_the_links_and_carry_the_weight(engine: Any) -> None:
+    """r2d2 at rest touches the ground with its four wheels (links 2, 3, 6, 7: children of
+    fixed links, which MuJoCo fuses), which carry its weight (1e-3); a box stacked on another
+    rests on it, the normal from the lower box to the upper (B to A)."""
+    from lxml import etree
+
+    from urdfkit.sources.resolve import locate
+
+    ground = _ground(engine)
+    path = locate("r2d2.urdf")
+    mass = sum(float(m.get("value")) for m in etree.parse(str(path)).iter("mass"))
+    robot = engine.load(str(path), LoadSettings(position=(0.0, 0.0, 0.5)))
+    lower = engine.load(str(BOX), LoadSettings(position=(2.0, 0.0, 0.1)))
+    upper = engine.load(str(BOX), LoadSettings(position=(2.0, 0.0, 0.35)))
+    for _ in range(int(2.0 / DT)):
+        engine.step()
+    touching = engine.contacts(robot, other=ground)
+    assert sorted({c.link_a for c in touching}) == [2, 3, 6, 7]
+    assert {c.link_b for c in touching} == {-1} and {c.body_b for c in touching} == {ground}
+    assert sum(c.normal_force for c in touching) == pytest.approx(mass * G, rel=1e-3)
+    assert engine.contacts(robot, link=2, other=ground)
+    assert not engine.contacts(robot, link=0, other=ground)
+    stacked = engine.contacts(upper, other=lower)
+    assert sum(c.normal_force for c in stacked) == pytest.approx(MASS * G, rel=1e-3)
+    assert all(c.normal[2] > 0.99 and c.body_a == upper for c in stacked)
+
+
 def test_restore_steps_again_exactly(engine: Any) -> None:
     """A saved state, restored mid-contact, steps as it did the first time."""
     _ground(engine)
