@@ -313,6 +313,29 @@ def test_a_car_drives_wheel_speed_times_radius_times_time(engine: Any,
         assert s.velocity == pytest.approx(omega, rel=0.01)
 
 
+def test_default_motors_hold_what_no_motor_drives(engine: Any,
+                                                  car_urdf: tuple[Path, float]) -> None:
+    """PyBullet's default motor (velocity 0, 1 N m s per step) on every joint holds: a
+    pendulum left at 0.5 rad stays there (1e-4 rad over 1 s), and simplecar with only its
+    wheels driven keeps its steering straight against them (0.01 rad) and drives straight
+    (1 cm sideways in 2 m)."""
+    pendulum = engine.load(str(PENDULUM), LoadSettings(fixed_base=True, inertia_from_file=True))
+    engine.reset_joint(pendulum, 0, 0.5)
+    path, radius = car_urdf
+    _ground(engine)
+    car = engine.load(str(path), LoadSettings(position=(5.0, 0.0, radius)))
+    wheels = [j.index for j in engine.joints(car) if "wheel" in j.name]
+    hinges = [j.index for j in engine.joints(car) if j.name.endswith("hinge")]
+    engine.motors(car, wheels, "velocity", [10.0] * 4, forces=[10.0] * 4)
+    steer = 0.0
+    for _ in range(int(2.0 / DT)):
+        engine.step()
+        steer = max(steer, *(abs(s.position) for s in engine.joint_states(car, hinges)))
+    assert engine.joint_states(pendulum, [0])[0].position == pytest.approx(0.5, abs=1e-4)
+    assert steer < 0.01
+    assert abs(engine.base_state(car).position[1]) < 0.01
+
+
 @pytest.mark.parametrize("name", ["simplecar", "r2d2.urdf", "kuka_iiwa/model.urdf"])
 def test_joints_are_pybullets(name: str, car_urdf: tuple[Path, float]) -> None:
     """Every engine numbers joints and links as PyBullet does (depth-first, file order), with
@@ -538,6 +561,48 @@ def test_ground_friction_is_the_product_of_the_two(engine: Any) -> None:
     accel = (speeds[b] - speeds[a]) / ((b - a) * DT)
     friction = (push - (MASS + 0.001) * accel) / (MASS * G)
     assert friction == pytest.approx(0.5, rel=0.05)
+
+
+def test_mujoco_adds_a_body_mid_run_keeping_the_world_as_it_was() -> None:
+    """A body loaded after steps recompiles the world: the pendulum swings on from where it
+    was, its motor still driving it, its joint's changed damping still there."""
+    e = open_engine("mujoco")
+    try:
+        e.set_gravity((0.0, 0.0, -G))
+        e.set_time_step(DT)
+        body = _free_pendulum(e, 0.5)
+        e.change_dynamics(body, 0, jointDamping=0.01)
+        e.motors(body, [0], "velocity", [1.0], forces=[100.0])
+        for _ in range(24):
+            e.step()
+        before = e.joint_states(body, [0])[0]
+        e.load(str(BOX), LoadSettings(position=(3.0, 0.0, 0.5)))
+        assert e.joint_states(body, [0])[0] == before
+        e.step()
+        after = e.joint_states(body, [0])[0]
+        assert after.velocity == pytest.approx(1.0, abs=1e-3)
+        assert after.position == pytest.approx(before.position + DT, abs=1e-5)
+        assert e.joints(body)[0].damping == 0.01
+    finally:
+        e.close()
+
+
+def test_mujoco_says_when_the_run_diverges() -> None:
+    """A torque of 1e308 N m: MuJoCo's bad accelerations are an EngineError naming them, and
+    the state is left as it went (MuJoCo alone warns and starts over from its initial state,
+    where a run would silently go on)."""
+    from urdfkit.core.errors import EngineError
+
+    e = open_engine("mujoco")
+    try:
+        body = e.load(str(PENDULUM), LoadSettings(fixed_base=True, inertia_from_file=True))
+        e.reset_joint(body, 0, 0.5)
+        e.motors(body, [0], "torque", [1e308])
+        with pytest.raises(EngineError, match="diverged"):
+            e.step()
+        assert not math.isfinite(e.joint_states(body, [0])[0].velocity)
+    finally:
+        e.close()
 
 
 def test_missing_mujoco_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:

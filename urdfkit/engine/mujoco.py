@@ -15,15 +15,15 @@ time step, gravity) is kept here and applied again after each compile.
 
 Where it mirrors PyBullet, measured (docs/engines.md):
 
-- **The integrator** is ``implicitfast``: semi-implicit Euler, as PyBullet's, when nothing
-  depends on velocity (a free swing agrees with PyBullet's to 1e-9 rad over 2 s), with joint
-  damping and the motors' velocity feedback integrated implicitly, which keeps the stiff
-  motors stable at PyBullet's time steps.
+- **The integrator** is ``Euler``, MuJoCo's semi-implicit Euler, as PyBullet's (a free swing
+  agrees with PyBullet's to 1e-16 rad over 2 s), with joint damping integrated implicitly.
+  ``implicitfast`` would differ only for actuators, and the world has none: motors are
+  constraint rows.
 - **Motors** reach their velocity within a step under their force cap, as PyBullet's motor
-  rows do (:mod:`urdfkit.engine.mujoco_motors`); a position motor is PyBullet's
-  POSITION_CONTROL law. Every revolute and prismatic joint starts with PyBullet's default
-  motor: velocity 0 under one N m s of impulse per step. A torque acts for the next step only
-  (``qfrc_applied``).
+  rows do, solved with the contacts (:mod:`urdfkit.engine.mujoco_motors`); a position motor
+  is PyBullet's POSITION_CONTROL law. Every revolute and prismatic joint starts with
+  PyBullet's default motor: velocity 0 under one N m s of impulse per step. A torque acts for
+  the next step only (``qfrc_applied``).
 - **Contacts** are explicit pairs with PyBullet's combined friction (the product of the two
   lateral coefficients; MuJoCo would take the larger), between every two bodies, and within a
   robot only with ``self_collision``, never a link with its parent; the friction cone is
@@ -55,7 +55,7 @@ from urdfkit.engine.api import (
     Vec3,
 )
 from urdfkit.engine.mujoco_build import Loaded, Pair
-from urdfkit.engine.mujoco_motors import MAX_SETTLE, Motor, MotorBank
+from urdfkit.engine.mujoco_motors import Motor, MotorBank
 
 #: PyBullet's force cap when a motor is set without one (setJointMotorControl2's default).
 MOTOR_FORCE = 100000.0
@@ -111,7 +111,6 @@ class _Body:
     def __init__(self) -> None:
         self.joints: list[JointInfo] = []
         self.jnt: list[int] = []          # MuJoCo joint id per joint index, -1 fixed
-        self.act: dict[int, int] = {}     # actuator id per motor joint
         self.frames: list[tuple[str, int]] = []  # per link (root first): ("body"|"site", id)
         self.bodies: dict[str, int] = {}  # MuJoCo body id per body (by link name)
         self.root = -1                    # the root's MuJoCo body (-1: MuJoCo's world)
@@ -135,9 +134,9 @@ class MuJoCoEngine:
         self.notes: dict[int, list[str]] = {}
         self._spec: Any = mj.MjSpec()
         self._spec.modelname = "urdfkit"
-        self._spec.option.integrator = mj.mjtIntegrator.mjINT_IMPLICITFAST
-        # PyBullet's friction is a cone by default (enableConeFriction); MuJoCo's pyramid
-        # lifts a sliding box off the ground (4 mm measured) and brakes it 9 % too little
+        self._spec.option.integrator = mj.mjtIntegrator.mjINT_EULER
+        # PyBullet's friction is a cone by default (enableConeFriction); docs/engines.md
+        # measures MuJoCo's two against it
         self._spec.option.cone = mj.mjtCone.mjCONE_ELLIPTIC
         # a diverging run shows its NaNs (and step() says so) instead of starting over
         self._spec.option.disableflags |= mj.mjtDisableBit.mjDSBL_AUTORESET
@@ -155,7 +154,7 @@ class MuJoCoEngine:
         self._closed = False
         self._time_step = DEFAULT_TIME_STEP
         self._gravity: Vec3 = (0.0, 0.0, 0.0)
-        self._saved: list[tuple[int, Any, Any]] = []
+        self._saved: list[tuple[int, Any]] = []
         self._torques: dict[int, float] = {}
         self._bank: MotorBank | None = None
         self._kinematics = False
@@ -196,14 +195,6 @@ class MuJoCoEngine:
                                 geomname2=f"{p.robot_b}/{p.geom_b}", condim=condim,
                                 friction=friction)
             self._pairs.append(p)
-        for j in r.motors:
-            joint = f"{index}/{r.robot.joints[j].name}"
-            a = self._spec.add_actuator(name=joint, target=joint)
-            a.trntype = mj.mjtTrn.mjTRN_JOINT
-            a.gaintype = mj.mjtGain.mjGAIN_FIXED
-            a.biastype = mj.mjtBias.mjBIAS_AFFINE
-            a.forcelimited = mj.mjtLimited.mjLIMITED_TRUE
-            a.forcerange = [-1.0, 1.0]   # set with the gains after each compile
         self._assets.update(r.assets)
         self.notes[index] = r.notes
         self._stale = True
@@ -232,8 +223,6 @@ class MuJoCoEngine:
         Raises:
             EngineError: The simulation diverged (MuJoCo found NaN or huge values).
         """
-        import numpy as np
-
         from urdfkit.formats.mjwarn import mujoco_warnings
 
         m, d = self._world()
@@ -241,23 +230,15 @@ class MuJoCoEngine:
         bank = self._bank
         assert bank is not None
         h = self._time_step
-        want = bank.prepare(m, d, h)
-        snapshot = None
-        if len(bank.act):   # a step a motor's change-over undoes starts again from here
-            snapshot = np.empty(mj.mj_stateSize(m, self._state_sig()))
-            mj.mj_getState(m, d, snapshot, self._state_sig())
+        bank.bound(m, h)
+        for dof, torque in self._torques.items():
+            d.qfrc_applied[dof] = torque
         bad = _bad_count(mj, d)
         with mujoco_warnings(mj) as said:
-            for attempt in range(MAX_SETTLE + 1):
-                if attempt == MAX_SETTLE:
-                    bank.fallback(m, h)
-                for dof, torque in self._torques.items():
-                    d.qfrc_applied[dof] = torque
-                mj.mj_step(m, d)
-                changed = snapshot is not None and bank.settle(m, d, h, want)
-                if not changed or attempt == MAX_SETTLE:
-                    break
-                mj.mj_setState(m, d, snapshot, self._state_sig())
+            mj.mj_step1(m, d)       # positions, velocities, the constraint rows
+            bank.aim(m, d, h)       # each motor row asks for its velocity (mujoco_motors)
+            mj.mj_step2(m, d)       # forces, the solver, the integration
+        bank.record(m, d)
         for dof in self._torques:
             d.qfrc_applied[dof] = 0.0
         self._torques.clear()
@@ -270,8 +251,8 @@ class MuJoCoEngine:
     def save(self) -> int:
         """Keep the state now: time, positions, velocities, the solver's warm start.
 
-        And which motors are at their caps; the motors' targets are not kept (PyBullet's
-        restoreState keeps the targets set since: measured).
+        The motors' targets are not kept (PyBullet's restoreState keeps the targets set since:
+        measured).
         """
         import numpy as np
 
@@ -279,8 +260,7 @@ class MuJoCoEngine:
         sig = self._state_sig()
         state = np.empty(self._mj.mj_stateSize(m, sig))
         self._mj.mj_getState(m, d, state, sig)
-        assert self._bank is not None
-        self._saved.append((len(self._robots), state, self._bank.state.copy()))
+        self._saved.append((len(self._robots), state))
         return len(self._saved) - 1
 
     def restore(self, state: int) -> None:
@@ -293,14 +273,11 @@ class MuJoCoEngine:
         m, d = self._world()
         if not 0 <= state < len(self._saved):
             raise ParameterError(f"`state` {state} was not saved", param="state")
-        bodies, saved, motors = self._saved[state]
+        bodies, saved = self._saved[state]
         if bodies != len(self._robots):
             raise ParameterError(f"`state` {state} was saved with {bodies} bodies; the world "
                                  f"has {len(self._robots)} now", param="state")
         self._mj.mj_setState(m, d, saved, self._state_sig())
-        assert self._bank is not None
-        self._bank.state[:] = motors   # which motors were at their caps
-        self._bank.dirty = True
         self._torques.clear()
         self._kinematics = False
 
@@ -489,7 +466,7 @@ class MuJoCoEngine:
                 raise ParameterError(f"joint {info.name!r} is spherical: joint_states reads "
                                      "joints of one degree of freedom", param="joints")
             out.append(JointState(float(d.qpos[info.q_index]), float(d.qvel[info.v_index]),
-                                  (0.0,) * 6, self._applied(ids.act.get(j))))
+                                  (0.0,) * 6, self._applied(info.v_index)))
         return out
 
     def reset_joint(self, body: int, joint: int, position: float, velocity: float = 0.0
@@ -540,7 +517,7 @@ class MuJoCoEngine:
             r.motors[j] = Motor(mode, float(targets[k]),
                                 float(velocities[k]) if velocities is not None else 0.0, force)
             assert self._bank is not None
-            self._bank.set(ids.act[j], r.motors[j])
+            self._bank.set(info.v_index, r.motors[j])
 
     def change_dynamics(self, body: int, link: int, **values: float | Sequence[float]
                         ) -> None:
@@ -588,8 +565,6 @@ class MuJoCoEngine:
                 target.dynamics = old
                 self._apply_mass(body, target.body)
                 raise
-            if self._bank is not None:
-                self._bank.dirty = True   # the servos' gains follow the joints' inertia
         self._apply_joints()
         self._apply_pairs()
 
@@ -674,8 +649,15 @@ class MuJoCoEngine:
         self._stale = False
         self._scratch = mj.MjData(self._m)
         self._kinematics = False
+        # the motors' forces in the last step, by joint: the ids are remade below
+        applied = {(body, j): self._applied(info.v_index)
+                   for body, ids in enumerate(self._ids) for j, info in enumerate(ids.joints)
+                   if info.v_index >= 0}
         self._index()
         self._apply_all()
+        assert self._bank is not None
+        for (body, j), force in applied.items():
+            self._bank.applied[self._ids[body].joints[j].v_index] = force
 
     def _index(self) -> None:
         """Every robot's ids in the compiled world, and each geom's robot and link."""
@@ -700,8 +682,6 @@ class MuJoCoEngine:
             for i, j in enumerate(r.robot.joints):
                 jid = m.joint(prefix + j.name).id if j.moves else -1
                 ids.jnt.append(jid)
-                if i in r.motors:
-                    ids.act[i] = m.actuator(prefix + j.name).id
                 ids.joints.append(self._joint_info(r, i, jid, link_index))
             for g, owner in r.geom_links.items():
                 self._geom_owner[m.geom(prefix + g).id] = (index, link_index[owner])
@@ -743,21 +723,19 @@ class MuJoCoEngine:
         self._build_bank()
 
     def _build_bank(self) -> None:
-        """Every motor as MuJoCo actuators (see :mod:`urdfkit.engine.mujoco_motors`)."""
+        """Every motor as its joint's constraint row (see :mod:`urdfkit.engine.mujoco_motors`)."""
         import numpy as np
 
-        bank = MotorBank(np, self._m.nu)
+        bank = MotorBank(np, self._m.nv, int(self._mj.mjtConstraint.mjCNSTR_FRICTION_DOF))
         for r, ids in zip(self._robots, self._ids, strict=True):
             for j, motor in r.motors.items():
                 info = ids.joints[j]
-                bank.place(ids.act[j], info.v_index, info.q_index, motor)
+                bank.place(info.v_index, info.q_index, motor)
         self._bank = bank
 
-    def _applied(self, a: int | None) -> float:
-        """The force a motor applied in the last step (its implicit part included)."""
-        if a is None or self._bank is None:
-            return 0.0
-        return float(self._bank.applied[a])
+    def _applied(self, dof: int) -> float:
+        """The force a joint's motor applied in the last step."""
+        return 0.0 if self._bank is None else float(self._bank.applied[dof])
 
     def _apply_joints(self) -> None:
         """Joint damping and limits changed at run time, in the model and in :meth:`joints`."""

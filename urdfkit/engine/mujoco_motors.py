@@ -1,24 +1,22 @@
-"""PyBullet's joint motors on MuJoCo: a velocity target under a force cap, met within a step.
+"""PyBullet's joint motors on MuJoCo: a velocity asked of the step, under a force cap.
 
 PyBullet's VELOCITY_CONTROL and POSITION_CONTROL are rows of its constraint solver: each asks
-for a joint velocity at the end of the step (the target, or for a position motor
-``0.1 (q* - q) / dt + v*``, PyBullet's default gains) and gets it unless the impulse that
-takes exceeds ``cap * dt``, in which case the motor pushes with exactly its cap. MuJoCo's
-actuators are forces, and clamping one to a range happens before the step: a stiff velocity
-servo clamped at the start of a step overshoots its target by up to a step of full force
-(measured: simplecar's free wheels spun up to 29 rad/s for a 10 rad/s target).
+that the joint's velocity at the end of the step be the target (for a position motor,
+``0.1 (q* - q) / dt + v*``, PyBullet's default gains), with an impulse of at most
+``cap * dt`` either way, solved together with the contacts. MuJoCo's solver has such a row: a
+joint's friction loss, which asks for velocity 0 with a force of at most its ``frictionloss``.
+So each motor is its joint's friction-loss row, its bound the cap, made nearly hard
+(:data:`HARD`), and its reference acceleration set, between ``mj_step1`` and ``mj_step2``, to
+the one that reaches the target within the step (:meth:`MotorBank.aim`). The force cap is
+never exceeded, the motor pushes with exactly its cap when the target is out of reach, and the
+contacts see the motor's true force.
 
-So each motor here is, for each step, one of two things, as in the solution of PyBullet's
-bounded row:
-
-- **a servo** (not at its cap): a velocity actuator ``kv (v_des - v)`` with kv = STIFFNESS
-  times the joint's inertia per step, integrated implicitly (``implicitfast``), which leaves
-  ``1 / (1 + STIFFNESS)`` of the velocity error at the end of the step;
-- **at its cap**: a constant force of ``+cap`` or ``-cap``.
-
-After a step, a servo whose force (its implicit part included) exceeded its cap, or a capped
-motor that went past its target velocity, changes over and the step is taken again from the
-state before it (:meth:`MotorBank.settle`): an active-set solution of the same bounds.
+Measured against the stiff velocity actuators tried first (an implicit servo, its gain 100
+times the joint's inertia per step, capped by re-taking a step): those let MuJoCo's contact
+solver see forces up to 100 times the cap before the implicit step took them back, and
+simplecar with its steering left to PyBullet's default motors swung its hinges 0.24 rad in the
+first step (PyBullet: held, with 1 N m); a default motor holding a pendulum against gravity
+crept 0.36 mrad/s (here 0.004 mrad/s; PyBullet: 0).
 """
 
 from __future__ import annotations
@@ -26,21 +24,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-#: A servo's gain in units of its joint's inertia per step: kv = STIFFNESS * M_jj / dt. The
-#: velocity error left after a step is about 1 / (1 + STIFFNESS) of the error before it.
-STIFFNESS = 100.0
 #: PyBullet's default motor on every revolute and prismatic joint: velocity 0 with at most
 #: this impulse per step (N m s; measured: it caps at 240 N m at 1/240 s, 1000 at 1/1000).
 DEFAULT_MOTOR_IMPULSE = 1.0
 #: PyBullet's POSITION_CONTROL gains when none are given: positionGain, velocityGain.
 POSITION_GAIN, VELOCITY_GAIN = 0.1, 1.0
-#: How often a step is taken again at most while motors change over (a motor's state carries
-#: over to the next step, so that a motor at its cap for many steps costs none).
-MAX_SETTLE = 4
-#: A servo's force this far over its cap (relative) puts it at its cap.
-CAP_SLACK = 1e-9
+#: A motor row's impedance (MuJoCo's solimp: dmin, dmax, width, midpoint, power): 0.9999 of
+#: the way to its reference within the step, where MuJoCo's default (0.9) would leave a
+#: tenth of the velocity error.
+HARD = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 
-OFF, VELOCITY, POSITION = 0, 1, 2
+VELOCITY, POSITION = 1, 2
 
 
 @dataclass
@@ -58,125 +52,85 @@ class Motor:
 
 
 class MotorBank:
-    """Every motor of the world, as arrays over MuJoCo's actuators (one per motor).
+    """Every motor of the world, as arrays over MuJoCo's degrees of freedom.
 
     Attributes:
-        applied: Each actuator's force in the last step (N m or N), by actuator id.
+        applied: Each degree of freedom's motor force in the last step (N m or N).
     """
 
-    def __init__(self, np: Any, count: int) -> None:
+    def __init__(self, np: Any, nv: int, friction_row: int) -> None:
         self.np = np
-        self.act = np.zeros(0, dtype=np.int64)      # actuator ids of the motors on
-        self.dof = np.zeros(0, dtype=np.int64)
-        self.qpos = np.zeros(0, dtype=np.int64)
-        self.mode = np.zeros(count, dtype=np.int64)
-        self.target = np.zeros(count)
-        self.velocity = np.zeros(count)
-        self.force = np.full(count, np.nan)          # NaN: PyBullet's default motor
-        self.dofs = np.zeros(count, dtype=np.int64)
-        self.qadr = np.zeros(count, dtype=np.int64)
-        self.state = np.zeros(count, dtype=np.int64)  # -1, +1: at its cap; 0: a servo
-        self.applied = np.zeros(count)
-        #: The actuators' gains and ranges need writing (a motor, a state, the step or a
-        #: mass changed); each step writes only the servos' targets otherwise.
+        self.friction_row = friction_row   # MuJoCo's mjCNSTR_FRICTION_DOF
+        self.dofs = np.zeros(0, dtype=np.int64)      # the degrees of freedom with a motor
+        self.qadr = np.zeros(0, dtype=np.int64)
+        self.mode = np.zeros(nv, dtype=np.int64)
+        self.target = np.zeros(nv)
+        self.velocity = np.zeros(nv)
+        self.force = np.full(nv, np.nan)            # NaN: PyBullet's default motor
+        self.qpos_of = np.zeros(nv, dtype=np.int64)
+        self.want = np.zeros(nv)
+        self.applied = np.zeros(nv)
+        #: The rows' bounds need writing (a motor or the time step changed).
         self.dirty = True
         self._h = 0.0
 
-    def place(self, a: int, dof: int, qadr: int, motor: Motor) -> None:
-        """Actuator ``a`` drives the joint at ``dof`` (position at ``qadr``) as ``motor``."""
-        self.dofs[a] = dof
-        self.qadr[a] = qadr
-        self.set(a, motor)
+    def place(self, dof: int, qadr: int, motor: Motor) -> None:
+        """The joint at ``dof`` (its position at ``qadr``) has ``motor``."""
+        self.qpos_of[dof] = qadr
+        self.set(dof, motor)
 
-    def set(self, a: int, motor: Motor) -> None:
-        """Actuator ``a`` is ``motor`` from the next step on."""
-        self.mode[a] = VELOCITY if motor.mode == "velocity" else POSITION
-        self.target[a] = motor.target
-        self.velocity[a] = motor.velocity
-        self.force[a] = self.np.nan if motor.force is None else motor.force
-        self.state[a] = 0
-        self.dirty = True
-        on = self.np.flatnonzero(self.mode != OFF)
-        self.act = on
-        self.dof = self.dofs[on]
-        self.qpos = self.qadr[on]
-
-    def prepare(self, m: Any, d: Any, h: float) -> Any:
-        """Each motor's velocity for the end of this step, and the actuators set to reach it.
-
-        Returns the target velocities (by position in :attr:`act`).
-        """
+    def set(self, dof: int, motor: Motor) -> None:
+        """The motor at ``dof`` is ``motor`` from the next step on."""
         np = self.np
-        a = self.act
-        v = d.qvel[self.dof]
-        want = np.where(self.mode[a] == VELOCITY, self.target[a],
-                        POSITION_GAIN * (self.target[a] - d.qpos[self.qpos]) / h
-                        + (1 - VELOCITY_GAIN) * v + VELOCITY_GAIN * self.velocity[a])
-        if self.dirty or h != self._h:
-            self._write(m, h)
-        d.ctrl[a] = np.where(self.state[a] == 0, want, 0.0)
-        return want
+        self.mode[dof] = VELOCITY if motor.mode == "velocity" else POSITION
+        self.target[dof] = motor.target
+        self.velocity[dof] = motor.velocity
+        self.force[dof] = np.nan if motor.force is None else motor.force
+        self.dofs = np.flatnonzero(self.mode)
+        self.qadr = self.qpos_of[self.dofs]
+        self.dirty = True
 
     def caps(self, h: float) -> Any:
         """Each motor's force cap (its own, or PyBullet's default of one impulse per step)."""
-        f = self.force[self.act]
+        f = self.force[self.dofs]
         return self.np.where(self.np.isnan(f), DEFAULT_MOTOR_IMPULSE / h, f)
 
-    def _write(self, m: Any, h: float) -> None:
-        np = self.np
-        a = self.act
-        cap = self.caps(h)
-        kv = STIFFNESS * m.dof_M0[self.dof] / h
-        state = self.state[a]
-        servo = (state == 0) & (cap > 0)
-        m.actuator_gainprm[a, 0] = np.where(servo, kv, 0.0)
-        bias = np.zeros((len(a), 3))
-        bias[:, 0] = np.where(servo, 0.0, state * cap)
-        bias[:, 2] = np.where(servo, -kv, 0.0)
-        m.actuator_biasprm[a, :3] = bias
-        # a servo's force is not clamped by MuJoCo (settle() holds it to its cap)
-        big = np.where(servo, np.inf, cap)
-        m.actuator_forcerange[a, 0] = -big
-        m.actuator_forcerange[a, 1] = big
+    def bound(self, m: Any, h: float) -> None:
+        """Each motor's row: its cap as the joint's friction loss, made nearly hard."""
+        if not (self.dirty or h != self._h) or not len(self.dofs):
+            return
+        m.dof_frictionloss[self.dofs] = self.caps(h)
+        m.dof_solimp[self.dofs] = HARD
         self.dirty = False
         self._h = h
 
-    def fallback(self, m: Any, h: float) -> None:
-        """MuJoCo's own clamp on every servo, for a step taken :data:`MAX_SETTLE` times.
+    def aim(self, m: Any, d: Any, h: float) -> None:
+        """Each motor row's reference: the acceleration that brings its joint to its velocity.
 
-        A servo may then overshoot its target by up to a step at its cap, but never pushes
-        past its cap.
-        """
-        a = self.act
-        cap = self.caps(h)
-        m.actuator_forcerange[a, 0] = -cap
-        m.actuator_forcerange[a, 1] = cap
-        self.dirty = True
-
-    def settle(self, m: Any, d: Any, h: float, want: Any) -> bool:
-        """After a step: whether a motor changes over (and the step must be taken again).
-
-        ``want`` is what :meth:`prepare` returned for the step. Each motor's force in the step
-        is kept in :attr:`applied`.
+        Called between ``mj_step1`` (which makes the rows) and ``mj_step2`` (which solves
+        them).
         """
         np = self.np
-        a = self.act
-        cap = self.caps(h)
-        v1 = d.qvel[self.dof]
-        state = self.state[a]
-        kv = STIFFNESS * m.dof_M0[self.dof] / h
-        # implicitfast: a servo's force over the step is kv (want - v'), its implicit part in
-        force = np.where(state == 0, kv * (want - v1), state * cap)
-        force = np.where(cap > 0, force, 0.0)
-        self.applied[a] = np.clip(force, -cap, cap)  # past it only in a step settle redoes
-        over = (state == 0) & (np.abs(force) > cap * (1 + CAP_SLACK)) & (cap > 0)
-        past = (state != 0) & (state * (v1 - want) > 0)
-        if not (over.any() or past.any()):
-            return False
-        new = state.copy()
-        new[over] = np.sign(force[over])
-        new[past] = 0
-        self.state[a] = new
-        self._write(m, h)
-        d.ctrl[a] = np.where(new == 0, want, 0.0)
-        return True
+        dofs = self.dofs
+        if not len(dofs):
+            return
+        v = d.qvel[dofs]
+        self.want[dofs] = np.where(
+            self.mode[dofs] == VELOCITY, self.target[dofs],
+            POSITION_GAIN * (self.target[dofs] - d.qpos[self.qadr]) / h
+            + (1 - VELOCITY_GAIN) * v + VELOCITY_GAIN * self.velocity[dofs])
+        rows = self.rows(m, d)
+        if len(rows):
+            at = d.efc_id[rows]
+            d.efc_aref[rows] = (self.want[at] - d.qvel[at]) / h
+
+    def record(self, m: Any, d: Any) -> None:
+        """After the step: each motor's force in it."""
+        self.applied[:] = 0.0
+        rows = self.rows(m, d)
+        if len(rows):
+            self.applied[d.efc_id[rows]] = d.efc_force[rows]
+
+    def rows(self, m: Any, d: Any) -> Any:
+        """The constraint rows of the motors (MuJoCo's friction-loss rows of joints)."""
+        return self.np.flatnonzero(d.efc_type[:d.nefc] == self.friction_row)
