@@ -222,6 +222,16 @@ def test_pendulum_mass_matrix_and_inverse_dynamics(engine: Any) -> None:
     assert accel == [pytest.approx(2.0 * I_HINGE, rel=1e-9)]
 
 
+def test_change_dynamics_mass_and_inertia(engine: Any) -> None:
+    """A heavier arm (2 kg, I_cm 0.05 about the hinge's axis): M = 0.05 + 2 d^2, and gravity's
+    torque doubles (1e-9)."""
+    body = _free_pendulum(engine, 0.0)
+    engine.change_dynamics(body, 0, mass=2.0, localInertiaDiagonal=[0.05, 0.05, 0.002])
+    assert engine.mass_matrix(body, [0.0]) == [[pytest.approx(0.05 + 2.0 * D * D, rel=1e-9)]]
+    torque = engine.inverse_dynamics(body, [0.5], [0.0], [0.0])
+    assert torque == [pytest.approx(2.0 * G * D * math.sin(0.5), rel=1e-9)]
+
+
 def test_the_engines_swing_the_same_pendulum() -> None:
     """Both engines integrate a free swing alike: semi-implicit Euler at the same step, to
     1e-9 rad over 2 s."""
@@ -540,27 +550,39 @@ def test_mujoco_names_what_it_cannot_carry(key: str, value: float, said: str) ->
     assert key in caught.value.message and said in caught.value.message
 
 
-def test_ground_friction_is_the_product_of_the_two(engine: Any) -> None:
-    """PyBullet multiplies two links' friction: a block of 0.5 (its default) on pybullet_data's
-    plane (1.0) slides with 0.5, where MuJoCo's own rule (the larger) would give 1.0 and hold
-    it. Pushed at 0.7 m g (a torque each step), the friction it slides with is 0.5 (5 %)."""
-    _ground(engine)
+def _sliding_friction(engine: Any, push: float) -> float:
+    """The friction the sled's block slides with, pushed along at ``push`` m g (a torque on
+    its slide each step) from 0.2 to 0.8 s: (F - m a) / (m g)."""
     sled = engine.load(str(SLED), LoadSettings(fixed_base=True, inertia_from_file=True))
     engine.motors(sled, [0, 1], "velocity", [0.0, 0.0], forces=[0.0, 0.0])
     for link in (-1, 0, 1):
         engine.change_dynamics(sled, link, linearDamping=0.0, angularDamping=0.0)
     for _ in range(24):   # settle onto the ground
         engine.step()
-    push = 0.7 * MASS * G
     speeds = []
     for _ in range(int(1.0 / DT)):
-        engine.motors(sled, [0], "torque", [push])
+        engine.motors(sled, [0], "torque", [push * MASS * G])
         engine.step()
         speeds.append(engine.joint_states(sled, [0])[0].velocity)
     a, b = int(0.2 / DT), int(0.8 / DT)
     accel = (speeds[b] - speeds[a]) / ((b - a) * DT)
-    friction = (push - (MASS + 0.001) * accel) / (MASS * G)
-    assert friction == pytest.approx(0.5, rel=0.05)
+    return (push * MASS * G - (MASS + 0.001) * accel) / (MASS * G)
+
+
+def test_ground_friction_is_the_product_of_the_two(engine: Any) -> None:
+    """PyBullet multiplies two links' friction: a block of 0.5 (its default) on pybullet_data's
+    plane (1.0) slides with 0.5, where MuJoCo's own rule (the larger) would give 1.0 and hold
+    it. Pushed at 0.7 m g, the friction it slides with is 0.5 (5 %)."""
+    _ground(engine)
+    assert _sliding_friction(engine, 0.7) == pytest.approx(0.5, rel=0.05)
+
+
+def test_changed_ground_friction_is_the_product_too(engine: Any) -> None:
+    """The ground's friction set to 0.5 (changeDynamics on it): the block (0.5) now slides
+    with 0.25 (5 %), pushed at 0.5 m g."""
+    ground = _ground(engine)
+    engine.change_dynamics(ground, -1, lateralFriction=0.5)
+    assert _sliding_friction(engine, 0.5) == pytest.approx(0.25, rel=0.05)
 
 
 def test_mujoco_adds_a_body_mid_run_keeping_the_world_as_it_was() -> None:
