@@ -208,7 +208,7 @@ class MuJoCoEngine:
             self._m.opt.gravity[:] = self._gravity
 
     def set_time_step(self, time_step: float) -> None:
-        """The physics step, s (the motors' gains and default caps follow it)."""
+        """The physics step, s (the default motors' caps, one impulse per step, follow it)."""
         self._open()
         if not 0 < time_step <= 1:
             raise ParameterError(f"`time_step` must be in (0, 1], got {time_step!r}",

@@ -30,8 +30,8 @@ DEFAULT_MOTOR_IMPULSE = 1.0
 #: PyBullet's POSITION_CONTROL gains when none are given: positionGain, velocityGain.
 POSITION_GAIN, VELOCITY_GAIN = 0.1, 1.0
 #: A motor row's impedance (MuJoCo's solimp: dmin, dmax, width, midpoint, power): 0.9999 of
-#: the way to its reference within the step, where MuJoCo's default (0.9) would leave a
-#: tenth of the velocity error.
+#: the way to its reference within the step, MuJoCo's hardest (mjMAXIMP), where its default
+#: (0.9) would leave a tenth of the velocity error.
 HARD = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 
 VELOCITY, POSITION = 1, 2
