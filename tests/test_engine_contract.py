@@ -22,7 +22,7 @@ import pytest
 
 from urdfkit.core.errors import InputError, MissingDependencyError, ParameterError
 from urdfkit.engine.api import BaseState, ContactPoint, JointInfo, JointState, LoadSettings
-from urdfkit.engine.registry import ENGINES, open_engine
+from urdfkit.engine.registry import ENGINES, open_engine, preload
 
 ROBOTS = Path(__file__).parent / "fixtures" / "robots"
 PENDULUM = ROBOTS / "compound_pendulum.urdf"
@@ -652,6 +652,13 @@ def test_missing_mujoco_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None
         open_engine("mujoco")
     assert "pip install 'urdfkit[mujoco]'" in caught.value.message
     assert "\n" not in caught.value.message
+    with pytest.raises(MissingDependencyError, match=r"urdfkit\[mujoco\]"):
+        preload("mujoco")
+
+
+def test_mujoco_has_no_gui_and_says_so() -> None:
+    with pytest.raises(ParameterError, match="headless"):
+        open_engine("mujoco", gui=True)
 
 
 def test_an_unknown_engine_is_named_with_the_closest() -> None:

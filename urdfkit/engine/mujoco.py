@@ -93,16 +93,9 @@ def import_mujoco() -> Any:
     return mujoco
 
 
-def connect(gui: bool = False) -> MuJoCoEngine:
-    """A new MuJoCo world (the registry's way in: :func:`urdfkit.engine.registry.open_engine`).
-
-    Raises:
-        ParameterError: ``gui``: this engine runs headless.
-    """
-    if gui:
-        raise ParameterError("`gui`: the MuJoCo engine runs headless here (no viewer)",
-                             param="gui")
-    return MuJoCoEngine()
+def preload() -> None:
+    """Import mujoco now (the registry's :func:`~urdfkit.engine.registry.preload`)."""
+    import_mujoco()
 
 
 class _Body:
@@ -128,7 +121,10 @@ class MuJoCoEngine:
 
     name = "mujoco"
 
-    def __init__(self) -> None:
+    def __init__(self, gui: bool = False) -> None:
+        if gui:
+            raise ParameterError("`gui`: the MuJoCo engine runs headless here (no viewer)",
+                                 param="gui")
         mj = import_mujoco()
         self._mj = mj
         self.notes: dict[int, list[str]] = {}
