@@ -628,6 +628,28 @@ def test_mujoco_adds_a_body_mid_run_keeping_the_world_as_it_was() -> None:
         e.close()
 
 
+def test_mujoco_names_a_solver_setting_it_has_no_meaning_for() -> None:
+    """set_physics in PyBullet's terms: `solver_iterations` is named, not ignored; the cone
+    is MuJoCo's elliptic one or its pyramid; sorted pairs are what MuJoCo always does."""
+    e = open_engine("mujoco")
+    try:
+        body = e.load(str(BOX), LoadSettings())
+        e.set_physics(deterministic_pairs=True, cone_friction=False)
+        with pytest.raises(ParameterError, match="solver_iterations"):
+            e.set_physics(solver_iterations=50)
+        e.step()
+        e.load(str(BOX), LoadSettings(position=(1.0, 0.0, 0.0)))   # recompiled: still a pyramid
+        e.step()
+        import mujoco
+
+        assert e.world.m.opt.cone == mujoco.mjtCone.mjCONE_PYRAMIDAL
+        e.set_physics(cone_friction=True)
+        assert e.world.m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
+        assert e.base_state(body)
+    finally:
+        e.close()
+
+
 def test_mujoco_says_when_the_run_diverges() -> None:
     """A torque of 1e308 N m: MuJoCo's bad accelerations are an EngineError naming them, and
     the state is left as it went (MuJoCo alone warns and starts over from its initial state,

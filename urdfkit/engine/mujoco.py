@@ -139,6 +139,32 @@ class MuJoCoEngine:
         if w.m is not None:
             w.m.opt.timestep = w.time_step
 
+    def set_physics(self, *, deterministic_pairs: bool | None = None,
+                    solver_iterations: int | None = None,
+                    cone_friction: bool | None = None) -> None:
+        """The solver's settings, PyBullet's names; None leaves one as it is.
+
+        ``deterministic_pairs`` is what MuJoCo always does (a run replays exactly);
+        ``cone_friction`` False is MuJoCo's pyramid, True its elliptic cone (the default).
+
+        Raises:
+            ParameterError: ``solver_iterations``: MuJoCo solves each step to a tolerance by
+                Newton's method, where PyBullet's iteration count has no meaning.
+        """
+        w = self.world
+        w.open()
+        if solver_iterations is not None:
+            raise ParameterError(f"`solver_iterations` {solver_iterations!r}: MuJoCo solves "
+                                 "each step's constraints to a tolerance (Newton's method); "
+                                 "PyBullet's iteration count has no meaning there",
+                                 param="solver_iterations")
+        if cone_friction is not None:
+            cones = w.mj.mjtCone
+            w.spec.option.cone = cones.mjCONE_ELLIPTIC if cone_friction else \
+                cones.mjCONE_PYRAMIDAL
+            if w.m is not None:
+                w.m.opt.cone = w.spec.option.cone
+
     def step(self) -> None:
         """One physics step.
 
