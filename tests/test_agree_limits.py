@@ -60,7 +60,7 @@ def test_agree_on_limits_of_1e308_compares_every_row(tmp_path: Path) -> None:
 
 
 def test_the_frame_tolerances_stay_float32_sized() -> None:
-    from urdfkit.exchange.robot import read_robot
+    from urdfkit.formats.robot import read_robot
     from urdfkit.model.xmlio import load_xml
 
     robot = read_robot(load_xml(HUGE).getroot(), str(HUGE))

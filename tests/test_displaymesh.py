@@ -1,5 +1,5 @@
-"""The viewer's own convex hull and decimation (urdfkit.draw.displaymesh), against qhull (scipy)
-and geometry: no scipy at run time, the same hull."""
+"""The viewer's own convex hull (urdfkit.sources.hull) and decimation (urdfkit.draw.displaymesh),
+against qhull (scipy) and geometry: no scipy at run time, the same hull."""
 
 from __future__ import annotations
 
@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
-from urdfkit.draw.displaymesh import HULL_POINTS, convex_hull, decimate
+from urdfkit.draw.displaymesh import decimate
+from urdfkit.sources.hull import HULL_POINTS, convex_hull
 
 
 def _volume(v: np.ndarray, f: np.ndarray) -> float:

@@ -219,7 +219,7 @@ def test_never_overwrites_without_force(robot: Path, tmp_path: Path) -> None:
 
 
 def test_writer_numbers_round_trip_every_double(robot: Path, tmp_path: Path) -> None:
-    from urdfkit.exchange.mjcf import num
+    from urdfkit.formats.mjcf import num
 
     for x in (math.pi, 1 / 3, -2.9670597283903604, 1e-300, 0.1 + 0.2, -0.0):
         assert float(num(x)) == x

@@ -118,7 +118,7 @@ def leftovers(folder: Path) -> list[str]:
 
 KILLER = """
 import atexit, os, signal, sys
-import urdfkit.exchange.mjcf_write as files
+import urdfkit.formats.mjcf_write as files
 at, steps = int(sys.argv[1]), []
 def reached(step):
     steps.append(step)
@@ -288,7 +288,7 @@ def test_verify_on_a_file_mujoco_refuses_leaves_nothing(tmp_path: Path) -> None:
     one-line error naming the file the user asked for, and nothing is left."""
     from urdfkit.core.errors import InputError
     from urdfkit.exchange.agree import agree
-    from urdfkit.exchange.mjcf import Export, write_export
+    from urdfkit.formats.mjcf import Export, write_export
     from urdfkit.sources.resolve import resolve
 
     (tmp_path / "cube.obj").write_text(cube_obj(1.0))

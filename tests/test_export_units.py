@@ -1,4 +1,4 @@
-"""The exchange modules on their own: forward kinematics against an independent URDF library
+"""The formats modules on their own: forward kinematics against an independent URDF library
 (yourdfpy), rotations against PyBullet's, fused mass properties against a closed form."""
 
 from __future__ import annotations
@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from urdfkit.exchange.fk import link_frames
-from urdfkit.exchange.mjcf import combine, mat_to_quat
-from urdfkit.exchange.robot import Inertial, read_robot
+from urdfkit.formats.fk import link_frames
+from urdfkit.formats.mjcf import combine, mat_to_quat
+from urdfkit.formats.robot import Inertial, read_robot
 from urdfkit.sources.resolve import resolve
 
 
@@ -52,3 +52,31 @@ def test_two_point_masses_fuse_to_the_dumbbell_formula() -> None:
     m = combine([(point, left), (point, right)])
     assert m.mass == 2.0 and m.com.tolist() == [0, 0, 0]
     assert np.diag(m.tensor).tolist() == [0, 2, 2]
+
+
+def test_geom_names_say_each_geoms_link() -> None:
+    """With geom_names, every geom of the MJCF is named and Export.geom_links gives the link it
+    was written for, fused links included (r2d2's fixed links share their parent's body);
+    without it no geom is named (the goldens stay as they are)."""
+    from lxml import etree
+
+    from urdfkit.formats.fk import fused
+    from urdfkit.formats.mjcf import ExportOptions, export_mjcf
+
+    with resolve("r2d2.urdf") as r:
+        robot = read_robot(r.root, r.name)
+        named = export_mjcf(robot, ExportOptions(geom_names=True), "a")
+        plain = export_mjcf(robot, ExportOptions(), "a")
+    geoms = etree.fromstring(named.xml).iter("geom")
+    where = fused(robot, split_world=True)
+    seen, fused_in = 0, 0
+    for g in geoms:
+        body = g.getparent().get("name")
+        link = named.geom_links[g.get("name")]
+        assert where[link][0] == body  # the link's geoms are in the body it was fused into
+        seen += 1
+        fused_in += link != body
+    shapes = sum(len(link.visuals) + len(link.collisions) for link in robot.links.values())
+    assert seen == len(named.geom_links) == shapes
+    assert fused_in  # r2d2's fixed links' geoms sit in their parents' bodies
+    assert not [g for g in etree.fromstring(plain.xml).iter("geom") if g.get("name")]

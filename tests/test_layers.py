@@ -19,8 +19,9 @@ PACKAGE = Path(urdfkit.__file__).parent
 #: The floors, lowest first, and the folders on each: a module may import from its own floor
 #: or below, never above. The three capabilities (checks, motion, draw) share a floor: they
 #: may use each other (a sweep checks its robot, a plot reads a drive's trajectory), without
-#: cycles between modules.
-FLOOR_FOLDERS = [["core"], ["model"], ["sources"], ["engine"],
+#: cycles between modules. ``formats`` shares the engine's floor: an engine builds its model
+#: from the MJCF export.
+FLOOR_FOLDERS = [["core"], ["model"], ["sources"], ["engine", "formats"],
                  ["checks", "motion", "draw", "exchange"], ["commands"]]
 FLOORS: dict[str, int] = {name: n for n, names in enumerate(FLOOR_FOLDERS) for name in names}
 FOLDERS = [name for names in FLOOR_FOLDERS for name in names]

@@ -1,4 +1,4 @@
-"""The files an MJCF makes MuJoCo open (urdfkit/exchange/mjcf_files.py), checked first.
+"""The files an MJCF makes MuJoCo open (urdfkit/formats/mjcf_files.py), checked first.
 
 Each rule of where MuJoCo 4.0 looks is held against MuJoCo itself: the walk names the file,
 MuJoCo loads the layout, and the mesh or body it loaded is the one in that file. Then a FIFO
@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from urdfkit.core.errors import InputError
-from urdfkit.exchange.mjcf_files import MAX_MJCF_FILES, check_mjcf_files
+from urdfkit.formats.mjcf_files import MAX_MJCF_FILES, check_mjcf_files
 
 mujoco = pytest.importorskip("mujoco")  # in the test extra: CI never skips it
 
@@ -128,7 +128,7 @@ def test_what_mujoco_would_not_open_is_not_checked(tmp_path: Path) -> None:
     os.mkfifo(tmp_path / "pipe.png")
     os.mkfifo(tmp_path / "pipe.obj")
     assert check_mjcf_files(top) == []
-    from urdfkit.exchange.mjwarn import mujoco_warnings
+    from urdfkit.formats.mjwarn import mujoco_warnings
 
     with mujoco_warnings(mujoco) as said:  # not into ./MUJOCO_LOG.TXT
         assert mujoco.MjModel.from_xml_path(str(top)).nmesh == 1

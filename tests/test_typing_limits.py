@@ -102,8 +102,8 @@ def _plant(source: str) -> tuple[str, int, str]:
 TARGETS: list[tuple[str, str, str]] = [
     ("checks/rules_joints.py", "_joint_inertia", "jv"),
     ("checks/fix.py", "_Plan.carry_contacts", "link"),
-    ("exchange/mjcf.py", "_Writer.joint", "j"),
-    ("exchange/mjcf.py", "_Writer.fill", "body"),
+    ("formats/mjcf.py", "_Writer.joint", "j"),
+    ("formats/mjcf.py", "_Writer.fill", "body"),
     ("exchange/agree.py", "_Pybullet.__init__", "session"),
     ("commands/exporting.py", "_export_dict", "e"),
     ("model/robot.py", "_parse_joint", "el"),

@@ -1,4 +1,4 @@
-"""export, agree: a URDF written for MuJoCo, and proof that it agrees (urdfkit/exchange/)."""
+"""export, agree: a URDF written for MuJoCo (formats/), and proof that it agrees (exchange/)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 if TYPE_CHECKING:
-    from urdfkit.exchange.mjcf import Export
+    from urdfkit.formats.mjcf import Export
 
 from urdfkit.commands import present as show
 from urdfkit.commands.shared import (
@@ -174,9 +174,9 @@ def export(
     """
     from urdfkit.core.errors import ParameterError
     from urdfkit.core.output import check_output
-    from urdfkit.exchange.mjcf import ExportOptions, asset_dir_for, export_mjcf, write_export
-    from urdfkit.exchange.mjcf_write import check_asset_dir
-    from urdfkit.exchange.robot import read_robot
+    from urdfkit.formats.mjcf import ExportOptions, asset_dir_for, export_mjcf, write_export
+    from urdfkit.formats.mjcf_write import check_asset_dir
+    from urdfkit.formats.robot import read_robot
 
     if kind.lower() != "mjcf":
         raise ParameterError(f"unknown format {kind!r}: export writes mjcf", param="kind")

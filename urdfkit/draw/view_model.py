@@ -310,8 +310,8 @@ class ViewedRobot:
             vertices = np.asarray(mesh[0], dtype=float) * np.asarray(dims[:3], dtype=float)
             faces = np.asarray(mesh[1], dtype=np.int64)
             kind_name: ShapeKind = "mesh"
-            if collision:  # what PyBullet collides with: the hull (urdfkit.draw.displaymesh)
-                from urdfkit.draw.displaymesh import HULL_POINTS, convex_hull
+            if collision:  # what PyBullet collides with: the hull (urdfkit.sources.hull)
+                from urdfkit.sources.hull import HULL_POINTS, convex_hull
 
                 hull = convex_hull(vertices)
                 if hull is not None:

@@ -1,1 +1,1 @@
-"""Other engines' formats: the MJCF writer, its agreement with PyBullet, exact kinematics."""
+"""One engine against another: PyBullet's loaded inertia, and agree's row-by-row proof."""

@@ -8,7 +8,7 @@ matched to bodies or sites and joints to joints by name, and each comparison is 
   (1e-12 relative) and inertia about the centre of mass (1e-9 relative), bodies welded
   together (fixed links fused; MuJoCo's own welded bodies) compared as one;
 - kinematics: every matched link frame at seeded poses, against PyBullet's ``getLinkState``
-  (float32 inside: 1e-6) and against :mod:`urdfkit.exchange.fk` (1e-12);
+  (float32 inside: 1e-6) and against :mod:`urdfkit.formats.fk` (1e-12);
 - dynamics: the joint-space mass matrix and inverse-dynamics torques at those poses (1e-9
   relative), base fixed on both sides (the joint block of the floating model);
 - a free swing under gravity, MuJoCo set to PyBullet's integration (Euler, implicit damping
@@ -30,9 +30,9 @@ from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import EngineError, InputError, MissingDependencyError
 from urdfkit.exchange.agree_tree import match_models, tree_errors
-from urdfkit.exchange.fk import fused, link_frames
-from urdfkit.exchange.mjcf import combine
-from urdfkit.exchange.robot import Inertial, Robot
+from urdfkit.formats.fk import fused, link_frames
+from urdfkit.formats.mjcf import combine
+from urdfkit.formats.robot import Inertial, Robot
 
 if TYPE_CHECKING:
     from urdfkit.engine.session import Session
@@ -146,12 +146,12 @@ def load_mjcf(path: str | Path) -> tuple[Any, Any]:
     if why is not None:
         raise InputError("no such file" if why == "missing" else f"is {why}, not an MJCF "
                          "file", file=str(path))
-    from urdfkit.exchange.mjcf_files import check_mjcf_files
+    from urdfkit.formats.mjcf_files import check_mjcf_files
 
     check_mjcf_files(p)  # its includes, meshes, textures...: MuJoCo would block on a FIFO too
     import warnings
 
-    from urdfkit.exchange.mjwarn import mujoco_warnings
+    from urdfkit.formats.mjwarn import mujoco_warnings
 
     try:
         # MuJoCo's decoders warn through Python (an OBJ's texture coordinates dropped): kept
@@ -1378,8 +1378,8 @@ def agree(resolved: Any, model_path: str | Path, options: AgreeOptions | None = 
     import numpy as np
 
     from urdfkit.engine.session import Session
-    from urdfkit.exchange.mjwarn import mujoco_warnings
-    from urdfkit.exchange.robot import read_robot
+    from urdfkit.formats.mjwarn import mujoco_warnings
+    from urdfkit.formats.robot import read_robot
 
     o = options or AgreeOptions()
     robot = read_robot(resolved.root, resolved.name)

@@ -88,14 +88,14 @@ _MESH_BOXES: dict[tuple[str, tuple[float, ...]], Any] = {}
 def _mesh_points(path: str, scale: tuple[float, ...]) -> Any:
     """A mesh's vertices as PyBullet places them, scaled; None if none.
 
-    Read as export reads it (:func:`urdfkit.exchange.mjcf_mesh.mesh_asset`: the triangles
+    Read as export reads it (:func:`urdfkit.formats.mjcf_mesh.mesh_asset`: the triangles
     MuJoCo can take), and only the vertices those triangles use: a COLLADA file's arrays may
     hold more (tiago's torso_lift_collision_*.dae hold the same 154, each file's triangles 16
     to 74), and PyBullet's hull leaves out an OBJ's stray vertex.
     """
     import numpy as np
 
-    from urdfkit.exchange.mjcf_mesh import mesh_asset
+    from urdfkit.formats.mjcf_mesh import mesh_asset
 
     key = (path, scale)
     if key not in _MESH_BOXES:

@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from urdfkit.core.errors import ParameterError
-from urdfkit.exchange.fk import fused, link_frames, unit
-from urdfkit.exchange.robot import Robot
+from urdfkit.formats.fk import fused, link_frames, unit
+from urdfkit.formats.robot import Robot
 
 #: How far (m, and in the rotation matrix) a body's zero-pose frame may be from a link's for
 #: the two to be matched by the tree's shape (files written with 6 significant digits match).

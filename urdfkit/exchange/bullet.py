@@ -9,7 +9,7 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-from urdfkit.exchange.robot import Inertial, Robot, read_inertial
+from urdfkit.formats.robot import Inertial, Robot, read_inertial
 
 
 def loaded_inertials(resolved: Any, *, inertia_from_file: bool) -> dict[str, Inertial]:
@@ -19,27 +19,12 @@ def loaded_inertials(resolved: Any, *, inertia_from_file: bool) -> dict[str, Ine
     from the collision shapes' bounding boxes (a link without collision shapes gets a tiny
     sphere's, 6.7e-7 for 1 kg): ``export --inertia-from-shapes`` writes these.
     """
-    import numpy as np
+    from urdfkit.engine.inertials import link_tensor, loaded_dynamics
 
-    from urdfkit.engine.session import LoadOptions, Session
-    from urdfkit.model.spec import quat_to_matrix
-
-    with Session() as s:
-        body = s.load_urdf(resolved.load_path, LoadOptions(inertia_from_file=inertia_from_file),
-                           resolved.name)
-        b = s.bullet
-        names = {-1: b.getBodyInfo(body)[0].decode("utf-8", "replace")}
-        for i in range(b.getNumJoints(body)):
-            names[i] = b.getJointInfo(body, i)[12].decode("utf-8", "replace")
-        out = {}
-        for i, name in names.items():
-            d = b.getDynamicsInfo(body, i)
-            r = np.array(quat_to_matrix(d[4]))
-            t = r @ np.diag(d[2]) @ r.T
-            out[name] = Inertial(float(d[0]), (d[3][0], d[3][1], d[3][2]),
-                                 ((t[0, 0], t[0, 1], t[0, 2]), (t[1, 0], t[1, 1], t[1, 2]),
-                                  (t[2, 0], t[2, 1], t[2, 2])))
-    return out
+    loaded = loaded_dynamics(resolved.load_path, inertia_from_file=inertia_from_file,
+                             display=resolved.name)
+    return {name: Inertial(d.mass, d.inertial_position, link_tensor(d))
+            for name, d in loaded.items()}
 
 
 def zeroed_repairs(resolved: Any, robot: Robot, inertials: dict[str, Inertial]

@@ -17,9 +17,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import InputError, ParameterError
-from urdfkit.exchange.fk import fused, origin_matrix
-from urdfkit.exchange.mjcf_mesh import MeshAsset, mesh_asset, unusable
-from urdfkit.exchange.robot import Inertial, Joint, Link, Robot, Shape
+from urdfkit.formats.fk import fused, origin_matrix
+from urdfkit.formats.mjcf_mesh import MeshAsset, mesh_asset, unusable
+from urdfkit.formats.robot import Inertial, Joint, Link, Robot, Shape
 
 if TYPE_CHECKING:
     from lxml import etree
@@ -59,6 +59,9 @@ class ExportOptions:
             its mass properties, the ``<inertia>`` element, how it was made and why
             (:func:`urdfkit.exchange.bullet.zeroed_repairs`). Written only where the zero
             would leave a moving body MuJoCo refuses; each such link is said and listed.
+        geom_names: Name every geom ``g0``, ``g1`` ... and say in :attr:`Export.geom_links`
+            which link each comes from (an engine maps contacts back to links with it; a
+            fused body holds the geoms of several links).
     """
 
     fixed_base: bool = False
@@ -69,6 +72,7 @@ class ExportOptions:
     inertials: dict[str, Inertial] | None = None
     inertia_from_shapes: bool = False
     repairs: dict[str, tuple[Inertial, str, str, str]] | None = None
+    geom_names: bool = False
 
 
 @dataclass
@@ -91,6 +95,7 @@ class Export:
         asset_dir: The assets folder's name (beside the XML, the compiler's meshdir).
         notes: What was dropped, approximated or defaulted.
         bodies, sites: Link names written as bodies / as sites.
+        geom_links: With :attr:`ExportOptions.geom_names`, each geom's name and its link.
     """
 
     xml: bytes
@@ -102,6 +107,7 @@ class Export:
     paths: list[str] = field(default_factory=list)   # filled by write_export
     repaired: list[str] = field(default_factory=list)   # links given fix's tensor
     digests: dict[str, str] = field(default_factory=dict)   # asset name -> SHA-256 (hex)
+    geom_links: dict[str, str] = field(default_factory=dict)
 
 
 def num(x: float) -> str:
@@ -204,6 +210,7 @@ class _Writer:
         self.members: dict[str, list[str]] = {}
         self.locked: list[Any] = []
         self.repaired: list[str] = []
+        self.geom_links: dict[str, str] = {}
         self.root = etree.Element("mujoco", model=robot.name or "robot")
         self.compiler = etree.SubElement(self.root, "compiler", angle="radian",
                                          meshdir=asset_dir, autolimits="true")
@@ -324,6 +331,10 @@ class _Writer:
         if not self.shape_type(g, body, shape, link, visual):
             return
         _place(g, t)
+        if self.o.geom_names:
+            name = f"g{len(self.geom_links)}"
+            g.set("name", name)
+            self.geom_links[name] = link.name
         if visual:
             g.set("contype", "0")
             g.set("conaffinity", "0")
@@ -727,7 +738,7 @@ def export_mjcf(robot: Robot, options: ExportOptions | None = None,
     w.E.indent(w.root, space="  ")
     xml = w.E.tostring(w.root, xml_declaration=False, encoding="unicode").encode() + b"\n"
     return Export(xml, w.assets, asset_dir, w.notes, w.bodies, w.sites, digests=w.digests,
-                  repaired=w.repaired)
+                  repaired=w.repaired, geom_links=w.geom_links)
 
 
 def asset_dir_for(path: str | Path) -> str:
@@ -740,7 +751,7 @@ def write_export(export: Export, path: str | Path, *, force: bool = False,
     """Write the XML and its assets folder beside it, crash-safe; return the paths written.
 
     At every step the XML on disk, old or new, names only files that are there with the
-    bytes it expects (:mod:`urdfkit.exchange.mjcf_write`): mesh files are named by their
+    bytes it expects (:mod:`urdfkit.formats.mjcf_write`): mesh files are named by their
     content and only added until the new XML replaces the old one atomically; then the
     files it does not name are removed. Without ``force`` neither the XML nor a non-empty
     assets folder may exist. ``verify`` is handed the staged XML before it takes its place:
@@ -751,7 +762,7 @@ def write_export(export: Export, path: str | Path, *, force: bool = False,
             one line naming the file; nothing of this run is left.
     """
     from urdfkit.core.output import check_output
-    from urdfkit.exchange.mjcf_write import write_pair
+    from urdfkit.formats.mjcf_write import write_pair
 
     out = check_output(path, force=force, suffixes=(".xml",), what="the MJCF file")
     export.paths = write_pair(out, export.xml, export.assets, export.digests, export.asset_dir,

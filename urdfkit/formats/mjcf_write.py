@@ -1,7 +1,7 @@
 """An export's XML and assets folder, written so that a kill at any step leaves a sound pair.
 
 The assets folder holds files named by their content, ``stem_<8 hex digits of SHA-256>.stl``
-(:mod:`urdfkit.exchange.mjcf_mesh`): a name always means the same bytes. :func:`write_pair`:
+(:mod:`urdfkit.formats.mjcf_mesh`): a name always means the same bytes. :func:`write_pair`:
 
 1. refuses an assets path that is a symlink (never followed) or not a folder; creates the
    folder if need be (mode 0777 less the umask, as ``mkdir`` makes it); takes an exclusive

@@ -1,6 +1,6 @@
 """Mesh files MuJoCo 4.0 loads: every mesh read with urdfkit's readers before it is written.
 
-The MJCF writer (:mod:`urdfkit.exchange.mjcf`) never hands MuJoCo a file unread. Each mesh is
+The MJCF writer (:mod:`urdfkit.formats.mjcf`) never hands MuJoCo a file unread. Each mesh is
 parsed by :func:`urdfkit.sources.meshes.parse_mesh` (placed as PyBullet places it), and what
 MuJoCo 4.0.0 refuses was measured, file by file:
 
@@ -186,7 +186,7 @@ def unusable(asset: MeshAsset, scale: tuple[float, float, float], collides: bool
         return (f"its surface is {area:.3g} m^2 at scale {' '.join(map(repr, scale))} (MuJoCo "
                 "refuses under 1e-15: \"mesh surface area is too small\")")
     if collides:
-        from urdfkit.draw.displaymesh import spans_volume
+        from urdfkit.sources.hull import spans_volume
 
         if not spans_volume(points):
             return ("its vertices span no volume (flat), so MuJoCo cannot build the convex hull "

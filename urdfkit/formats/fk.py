@@ -11,7 +11,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from urdfkit.exchange.robot import Joint, Robot
+from urdfkit.formats.robot import Joint, Robot
 from urdfkit.model.spec import axis_angle_matrix, rpy_to_matrix
 
 

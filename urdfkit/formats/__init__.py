@@ -1,0 +1,1 @@
+"""Robots written for other engines: the URDF as PyBullet reads it, exact kinematics, MJCF."""
