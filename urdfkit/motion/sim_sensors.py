@@ -32,8 +32,7 @@ class Sensors:
 
     def keep_velocities(self, r: SimRobot) -> None:
         """Remember the joint velocities now, for the next measurement's accelerations."""
-        states = self.world.bullet.getJointStates(r.body, r.frame[0])
-        r.readings.previous_velocities = [st[1] for st in states]
+        r.readings.previous_velocities = self.world.engine.joint_vectors(r.body, r.frame[0])[1]
         r.readings.previous_step = self.world.step_count
 
     def fresh(self, r: SimRobot) -> Observation:
@@ -46,9 +45,9 @@ class Sensors:
     def measure(self, r: SimRobot) -> Observation:
         """The true observation now, in the measured joint frame."""
         world = self.world
-        p, step = world.bullet, world.step_count
-        pos, orn = p.getBasePositionAndOrientation(r.body)
-        lin, ang = p.getBaseVelocity(r.body)
+        engine, step = world.engine, world.step_count
+        base = engine.base_state(r.body)
+        pos, orn, lin, ang = base.position, base.orientation, base.linear, base.angular
         matrix = quat_to_matrix(orn)
         angles: dict[str, float] = {}
         velocities: dict[str, float] = {}
@@ -56,13 +55,11 @@ class Sensors:
         torques: dict[str, float] | None = None
         if r.active:
             indices, names, signs, offsets = r.frame
-            states = p.getJointStates(r.body, indices)
+            q, qd, applied = engine.joint_vectors(r.body, indices)
             if world.config.record.motor_torques:  # the joint's own frame, as applied
-                torques = {n: r.torques.get(n, st[3])
-                           for n, st in zip(names, states, strict=True)}
-            qd = [st[1] for st in states]
-            angles = {n: (st[0] - o) * s
-                      for n, st, s, o in zip(names, states, signs, offsets, strict=True)}
+                torques = {n: r.torques.get(n, a) for n, a in zip(names, applied, strict=True)}
+            angles = {n: (x - o) * s
+                      for n, x, s, o in zip(names, q, signs, offsets, strict=True)}
             velocities = {n: v * s for n, v, s in zip(names, qd, signs, strict=True)}
             readings = r.readings
             # Over the time since the velocities were last taken (one step, when recording).
@@ -89,19 +86,16 @@ class Sensors:
             joint_forces=forces, motor_torques=torques, link_poses=poses, feet=feet)
 
     def _forces(self, r: SimRobot) -> dict[str, list[float]]:
-        p = self.world.bullet
-        return {name: [float(x) for x in p.getJointState(r.body, index)[2]]
+        states = self.world.engine.joint_states
+        return {name: [float(x) for x in states(r.body, [index])[0].reaction]
                 for name, index in r.force_joints.items()}
 
     def _contacts(self, r: SimRobot) -> dict[str, dict[str, float]]:
-        p, ground = self.world.bullet, self.world.ground
+        engine, ground = self.world.engine, self.world.ground
         contacts = {}
         for link, index in r.contact_links.items():
-            if ground is not None:
-                points = p.getContactPoints(bodyA=r.body, linkIndexA=index, bodyB=ground)
-            else:
-                points = p.getContactPoints(bodyA=r.body, linkIndexA=index)
-            contacts[link] = {"normal_force": float(sum(pt[9] for pt in points)),
+            points = engine.contacts(r.body, index, ground)
+            contacts[link] = {"normal_force": float(sum(pt.normal_force for pt in points)),
                               "count": len(points)}
         return contacts
 
@@ -114,28 +108,29 @@ class Sensors:
 
     def _feet(self, r: SimRobot) -> dict[str, FootReading]:
         """Each foot's contact forces from everything but its own robot (world and local)."""
-        p = self.world.bullet
+        engine = self.world.engine
         out: dict[str, FootReading] = {}
         for label, index in r.feet.items():
             normal = [0.0, 0.0, 0.0]
             friction = [0.0, 0.0, 0.0]
             total = 0.0
             count = 0
-            for pt in p.getContactPoints(bodyA=r.body, linkIndexA=index):
-                if pt[2] == r.body:
+            for pt in engine.contacts(r.body, index):
+                if pt.body_b == r.body:
                     continue  # self-contact: not a ground reaction
                 count += 1
-                total += pt[9]
-                # contactNormalOnB points from B to A: the push on the foot (A). The lateral
+                total += pt.normal_force
+                # The normal points from B to A: the push on the foot (A). The lateral
                 # friction directions are those of the force on B (measured: a box sliding
                 # along +x reads +mu m g), so the foot feels their opposite.
                 for k in range(3):
-                    normal[k] += pt[9] * pt[7][k]
-                    friction[k] -= pt[10] * pt[11][k] + pt[12] * pt[13][k]
+                    normal[k] += pt.normal_force * pt.normal[k]
+                    friction[k] -= pt.friction1 * pt.direction1[k] + \
+                        pt.friction2 * pt.direction2[k]
             if index == -1:  # the URDF frame, not the centre of mass
                 orn = r.link_pose(next(k for k, v in r.links.items() if v == -1))[1]
             else:
-                orn = p.getLinkState(r.body, index, computeForwardKinematics=True)[5]
+                orn = list(engine.link_pose(r.body, index).orientation)
             local = rotate_back(quat_to_matrix(orn), normal)
             out[label] = {"contact": int(count > 0), "normal": total, "world": normal,
                           "local": list(local), "friction_world": friction}
