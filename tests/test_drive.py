@@ -326,14 +326,14 @@ def test_detects_racecar_wheels_and_hinges_with_rotated_joint_frames() -> None:
 def test_wheel_and_hinge_overrides_take_names_or_indices(simplecar_urdf: Path) -> None:
     with Session() as s:
         body = s.load_urdf(simplecar_urdf)
-        t = detect_drivetrain(PyBulletEngine(session=s), body, wheels=["base_to_left_back_wheel", "5"],
-                              hinges=[0])
+        engine = PyBulletEngine(session=s)
+        t = detect_drivetrain(engine, body, wheels=["base_to_left_back_wheel", "5"], hinges=[0])
         assert t.wheels == [4, 5] and t.hinges == [0]
         assert t.passive == [1, 2, 3]
         with pytest.raises(DrivetrainError, match="no joint named 'nope'"):
-            detect_drivetrain(PyBulletEngine(session=s), body, wheels=["nope"])
+            detect_drivetrain(engine, body, wheels=["nope"])
         with pytest.raises(DrivetrainError, match="no joint with index 9"):
-            detect_drivetrain(PyBulletEngine(session=s), body, wheels=[9])
+            detect_drivetrain(engine, body, wheels=[9])
 
 
 def test_a_model_without_wheels_is_an_error(simpleplane_urdf: Path) -> None:
