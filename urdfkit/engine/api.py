@@ -237,7 +237,11 @@ class Model(Protocol):
         ...
 
     def mass_matrix(self, body: int, positions: Sequence[float]) -> list[list[float]]:
-        """The joint-space mass matrix at ``positions`` (movable joints only)."""
+        """The joint-space mass matrix at ``positions`` (movable joints only).
+
+        A floating base's 6 coordinates come first, in the engine's order (PyBullet:
+        angular, then linear).
+        """
         ...
 
     def inverse_dynamics(self, body: int, positions: Sequence[float],
@@ -251,7 +255,8 @@ class Model(Protocol):
         """:meth:`mass_matrix` of a floating-base body with its root at this pose.
 
         The root's inertial frame, as :meth:`Simulator.base_pose` gives it; its 6
-        coordinates (linear, then angular) come first, as in :meth:`mass_matrix`.
+        coordinates come first, in the engine's order (PyBullet: linear, then angular,
+        unlike its :meth:`mass_matrix`).
         """
         ...
 
