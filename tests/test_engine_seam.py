@@ -38,7 +38,6 @@ ENGINE_PACKAGES = {"pybullet", "pybullet_utils", "pybullet_envs", "mujoco"}
 #: PyBullet through the session's importer, and why.
 IMPORTS_AN_ENGINE: dict[str, str] = {
     "exchange/agree.py": "loads the MJCF in MuJoCo beside PyBullet",
-    "motion/sweep_plan.py": "warms pybullet before forking the workers",
 }
 
 #: Modules outside engine/ that still call PyBullet's functions (through a session's bound
@@ -47,14 +46,14 @@ CALLS_PYBULLET: set[str] = {
     "checks/collisions.py", "draw/render.py", "draw/view_model.py", "draw/view_stream.py",
     "exchange/agree.py", "exchange/agree_contact.py", "exchange/bullet.py", "gym.py",
     "motion/drive.py",  # its own loop, sampler, ground and checks; detection is ported
-    "motion/sac.py",
 }
 
 #: The modules ported to the seam: no PyBullet but the escape hatch they hand out.
 PORTED = ["motion/simulation.py", "motion/sim_world.py", "motion/sim_robot.py",
           "motion/sim_control.py", "motion/sim_sensors.py", "motion/sim_dynamics.py",
           "motion/sim_episode.py", "motion/sim_record.py", "motion/vehicle.py",
-          "motion/vehicle_shapes.py", "motion/mimic.py", "motion/gazebo_load.py"]
+          "motion/vehicle_shapes.py", "motion/mimic.py", "motion/gazebo_load.py",
+          "motion/sac.py", "motion/sweep_plan.py"]
 
 
 def _outside_engine() -> list[Path]:

@@ -54,6 +54,13 @@ GEAR_ERP = 0.8
 _UNTRIED = "untried"
 
 
+def preload() -> None:
+    """Import pybullet now, quietly (:func:`~urdfkit.engine.session.import_pybullet`)."""
+    from urdfkit.engine.session import import_pybullet
+
+    import_pybullet()
+
+
 def _name(raw: bytes) -> str:
     return raw.decode("utf-8", "replace")
 

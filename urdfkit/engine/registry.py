@@ -1,7 +1,7 @@
 """The engines urdfkit can run on, by name, each imported only when it is opened.
 
 A third engine is one module of ``engine/`` implementing :class:`~urdfkit.engine.api.Simulator`
-and one entry here.
+(and a module-level ``preload()`` that imports the engine's package) and one entry here.
 """
 
 from __future__ import annotations
@@ -33,3 +33,15 @@ def open_engine(name: str = "pybullet", gui: bool = False) -> Simulator:
     module, cls = where.split(":")
     engine: Simulator = getattr(importlib.import_module(module), cls)(gui=gui)
     return engine
+
+
+def preload(name: str = "pybullet") -> None:
+    """Import engine ``name``'s package now: a process about to fork workers warms them once.
+
+    Raises:
+        ParameterError: an engine urdfkit does not know.
+    """
+    if name not in ENGINES:
+        raise ParameterError(f"`engine`: no engine named {name!r}; engines: "
+                             f"{', '.join(ENGINES)}", param="engine")
+    importlib.import_module(ENGINES[name].split(":")[0]).preload()
