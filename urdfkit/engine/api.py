@@ -325,7 +325,7 @@ class Simulator(Model, Protocol):
         ...
 
     def step(self) -> None:
-        """One physics step."""
+        """One physics step (an engine may make it a callable attribute: loops bind it)."""
         ...
 
     def save(self) -> int:
@@ -377,10 +377,10 @@ class Simulator(Model, Protocol):
         ...
 
     def joint_vectors(self, body: int, joints: Sequence[int]
-                      ) -> tuple[list[float], list[float], list[float]]:
+                      ) -> tuple[Sequence[float], Sequence[float], Sequence[float]]:
         """The positions, velocities and applied motor torques of these joints now.
 
-        :meth:`joint_states` as three lists, without a record per joint: the call the
+        :meth:`joint_states` as three sequences, without a record per joint: the call the
         measuring and control loops make every step.
         """
         ...

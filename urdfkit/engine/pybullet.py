@@ -16,7 +16,7 @@ joint states without a record per joint.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import EngineError
@@ -81,6 +81,10 @@ class PyBulletEngine:
 
     name = "pybullet"
     label = "PyBullet"
+    #: One physics step: ``stepSimulation`` bound to the client itself, so a loop that binds
+    #: ``step = engine.step`` pays what ``p.stepSimulation()`` does (a method here would add
+    #: a Python call to every step). Rebound to the closed client by :meth:`close`.
+    step: Callable[[], None]
 
     def __init__(self, gui: bool = False, *, session: Session | None = None) -> None:
         from urdfkit.engine.session import Session
@@ -91,12 +95,14 @@ class PyBulletEngine:
         self.error: type[Exception] = p.error
         self._modes = {"velocity": p.VELOCITY_CONTROL, "position": p.POSITION_CONTROL,
                        "torque": p.TORQUE_CONTROL}
+        self._torque = p.TORQUE_CONTROL
         self._gear, self._fixed = p.JOINT_GEAR, p.JOINT_FIXED
         #: Bodies :meth:`restore` moves apart (all but scenery), in load order.
         self._lifted: list[int] = []
         #: Per body, PyBullet's inverse-dynamics model: _UNTRIED, None (built: calls are
         #: bare) or why PyBullet refused to build it.
         self._models: dict[int, str | None] = {}
+        self.step = self.session.bullet.stepSimulation
 
     @property
     def bullet(self) -> Bullet:
@@ -110,6 +116,7 @@ class PyBulletEngine:
     def close(self) -> None:
         """Disconnect (safe to call twice)."""
         self.session.close()
+        self.step = self.session.bullet.stepSimulation  # fails, as every call now
 
     # ---- the world
 
@@ -156,10 +163,6 @@ class PyBulletEngine:
     def connected(self) -> bool:
         """``isConnected``: False once the GUI window is closed."""
         return bool(self.session.bullet.isConnected())
-
-    def step(self) -> None:
-        """``stepSimulation``."""
-        self.session.bullet.stepSimulation()
 
     def save(self) -> int:
         """``saveState``, then :func:`prime_resets` over every body but scenery."""
@@ -275,11 +278,17 @@ class PyBulletEngine:
                 for st in self.session.bullet.getJointStates(body, joints)]
 
     def joint_vectors(self, body: int, joints: Sequence[int]
-                      ) -> tuple[list[float], list[float], list[float]]:
-        """``getJointStates`` as positions, velocities and applied torques."""
+                      ) -> tuple[Sequence[float], Sequence[float], Sequence[float]]:
+        """``getJointStates`` as positions, velocities and applied torques.
+
+        Transposed in C (``zip``): three comprehensions cost the servo loop ~5k instructions
+        a step (callgrind).
+        """
         states = self.session.bullet.getJointStates(body, joints)
-        return ([st[0] for st in states], [st[1] for st in states],
-                [st[3] for st in states])
+        if not states:
+            return (), (), ()
+        q, qd, _, applied = zip(*states, strict=True)
+        return q, qd, applied
 
     def reset_joint(self, body: int, joint: int, position: float, velocity: float = 0.0
                     ) -> None:
@@ -301,11 +310,11 @@ class PyBulletEngine:
 
         A force cap not given is PyBullet's 100,000; a position target's velocity, 0.
         """
-        control = self._modes[mode]
         b = self.session.bullet
-        if mode == "torque":
-            b.setJointMotorControlArray(body, joints, control, forces=targets)
+        if mode == "torque":  # the servo's, every step
+            b.setJointMotorControlArray(body, joints, self._torque, forces=targets)
             return
+        control = self._modes[mode]
         values: dict[str, Sequence[float]] = {}
         if mode == "position":
             values["targetPositions"] = targets
