@@ -210,9 +210,10 @@ def test_joints_and_links_are_what_pybullet_loaded(engine: PyBulletEngine) -> No
     engine.set_joint_positions(body, [0.01, 0.02, 0.03], [0.1, 0.2, 0.3])
     q, qd, _ = engine.joint_vectors(body, [0, 1, 2])
     states = raw.getJointStates(body, [0, 1, 2])
-    assert (q, qd) == ([s[0] for s in states], [s[1] for s in states]) == \
+    assert (list(q), list(qd)) == ([s[0] for s in states], [s[1] for s in states]) == \
         ([0.01, 0.02, 0.03], [0.1, 0.2, 0.3])
-    assert [s.position for s in engine.joint_states(body, [0, 1, 2])] == q
+    assert [s.position for s in engine.joint_states(body, [0, 1, 2])] == list(q)
+    assert engine.joint_vectors(body, []) == ((), (), ())
 
 
 def test_a_continuous_joint_has_no_limits(engine: PyBulletEngine, simplecar_urdf: Path) -> None:
