@@ -208,12 +208,12 @@ def test_joints_and_links_are_what_pybullet_loaded(engine: PyBulletEngine) -> No
         assert (j.kind, j.lower, j.upper, j.limited) == ("prismatic", info[8], info[9], True)
     assert engine.link_names(body)[0] == raw.getBodyInfo(body)[0].decode()
     engine.set_joint_positions(body, [0.01, 0.02, 0.03], [0.1, 0.2, 0.3])
-    q, qd, _ = engine.joint_vectors(body, [0, 1, 2])
-    states = raw.getJointStates(body, [0, 1, 2])
-    assert (list(q), list(qd)) == ([s[0] for s in states], [s[1] for s in states]) == \
-        ([0.01, 0.02, 0.03], [0.1, 0.2, 0.3])
-    assert [s.position for s in engine.joint_states(body, [0, 1, 2])] == list(q)
-    assert engine.joint_vectors(body, []) == ((), (), ())
+    rows = engine.joint_rows(body, [0, 1, 2])
+    assert list(rows) == list(raw.getJointStates(body, [0, 1, 2]))
+    assert [(r[0], r[1]) for r in rows] == [(0.01, 0.1), (0.02, 0.2), (0.03, 0.3)]
+    assert [tuple(s.__dict__.values()) for s in engine.joint_states(body, [0, 1, 2])] == \
+        [tuple(r) for r in rows]  # the rows are the records' fields, in order
+    assert list(engine.joint_rows(body, [])) == []
 
 
 def test_a_continuous_joint_has_no_limits(engine: PyBulletEngine, simplecar_urdf: Path) -> None:
@@ -275,7 +275,7 @@ def test_a_coupled_follower_keeps_the_mimic_relation(engine: PyBulletEngine) -> 
     engine.motors(body, [0], "position", [0.015], forces=[20.0])
     for _ in range(240):
         engine.step()
-    left, right, thumb = engine.joint_vectors(body, [0, 1, 2])[0]
+    left, right, thumb = (r[0] for r in engine.joint_rows(body, [0, 1, 2]))
     assert left == pytest.approx(0.015, abs=1e-3)
     assert right == pytest.approx(-1 * left + 0.01, abs=1e-4)
     assert thumb == pytest.approx(left, abs=1e-4)
@@ -294,7 +294,7 @@ def test_a_held_base_stays_where_it_was_and_its_joints_still_move(
         engine.step()
     after = engine.base_pose(body)
     assert after[0] == pytest.approx(before[0], abs=1e-3)
-    assert abs(engine.joint_vectors(body, [0])[0][0] - 0.5) > 0.1  # it swung
+    assert abs(engine.joint_rows(body, [0])[0][0] - 0.5) > 0.1  # it swung
 
 
 @pytest.mark.parametrize("robot", [PENDULUM, str(ROBOTS / "panda_like.urdf")])

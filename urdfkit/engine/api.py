@@ -34,6 +34,9 @@ MotorMode = Literal["velocity", "position", "torque"]
 #: The joint kinds the seam knows, as URDF names them (PyBullet's continuous joints are
 #: revolute joints without limits: ``limited`` says which).
 JointKind = Literal["revolute", "prismatic", "spherical", "planar", "fixed"]
+#: One joint's state as a plain tuple: :class:`JointState`'s fields in its order (position,
+#: velocity, reaction wrench, applied motor torque). What :meth:`Simulator.joint_rows` gives.
+JointRow = tuple[float, float, Sequence[float], float]
 #: The collision shape kinds the seam knows (``other``: one it has no outline for).
 ShapeKind = Literal["sphere", "box", "cylinder", "capsule", "mesh", "plane", "other"]
 
@@ -376,12 +379,11 @@ class Simulator(Model, Protocol):
         """The state of these joints (by index) now."""
         ...
 
-    def joint_vectors(self, body: int, joints: Sequence[int]
-                      ) -> tuple[Sequence[float], Sequence[float], Sequence[float]]:
-        """The positions, velocities and applied motor torques of these joints now.
+    def joint_rows(self, body: int, joints: Sequence[int]) -> Sequence[JointRow]:
+        """:meth:`joint_states` as plain tuples (:data:`JointRow`), one per joint.
 
-        :meth:`joint_states` as three sequences, without a record per joint: the call the
-        measuring and control loops make every step.
+        The call the measuring and control loops make every step: no record per joint (an
+        engine may hand out its own tuples; PyBullet's ``getJointStates`` are these).
         """
         ...
 

@@ -138,11 +138,12 @@ class ServoControl:
             seen = self.sensors.observe(robot)
             return ({spec.name: (seen.motor_angles[spec.name], seen.motor_velocities[spec.name])
                      for spec in robot.servo}, seen.motor_accelerations)
-        q, qd, _ = self.engine.joint_vectors(robot.body, [j.index for j in robot.servo])
+        states = self.engine.joint_rows(robot.body, [j.index for j in robot.servo])
         state_of = {}
-        for spec, x, v in zip(robot.servo, q, qd, strict=True):
+        for spec, st in zip(robot.servo, states, strict=True):
             sign = robot.directions.get(spec.name, 1.0)
-            state_of[spec.name] = ((x - robot.offsets.get(spec.name, 0.0)) * sign, v * sign)
+            state_of[spec.name] = ((st[0] - robot.offsets.get(spec.name, 0.0)) * sign,
+                                   st[1] * sign)
         qdds = self.sensors.fresh(robot).motor_accelerations if m.inertia else {}
         return state_of, qdds
 

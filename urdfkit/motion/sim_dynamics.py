@@ -58,9 +58,9 @@ class Dynamics:
 
     def physical_state(self, robot: SimRobot) -> tuple[list[float], list[float]]:
         """The joints' positions and velocities now, physical (no offsets or directions)."""
-        q, qd, _ = self.world.engine.joint_vectors(robot.body,
-                                                   [j.index for j in self.joints(robot)])
-        return [float(x) for x in q], [float(v) for v in qd]
+        states = self.world.engine.joint_rows(robot.body,
+                                              [j.index for j in self.joints(robot)])
+        return [float(st[0]) for st in states], [float(st[1]) for st in states]
 
     def _fixed(self, robot: SimRobot, what: str) -> None:
         moving_base = robot.config.base != "fixed" and \

@@ -45,7 +45,7 @@ class Readings:
     history: deque[Observation]
     reports: deque[Observation] | None = None
     reported: tuple[int, Observation] | None = None
-    previous_velocities: Sequence[float] | None = None
+    previous_velocities: list[float] | None = None
     previous_step: int = -1
 
     def restart(self, rng: random.Random) -> None:

@@ -32,7 +32,8 @@ class Sensors:
 
     def keep_velocities(self, r: SimRobot) -> None:
         """Remember the joint velocities now, for the next measurement's accelerations."""
-        r.readings.previous_velocities = self.world.engine.joint_vectors(r.body, r.frame[0])[1]
+        states = self.world.engine.joint_rows(r.body, r.frame[0])
+        r.readings.previous_velocities = [st[1] for st in states]
         r.readings.previous_step = self.world.step_count
 
     def fresh(self, r: SimRobot) -> Observation:
@@ -55,11 +56,13 @@ class Sensors:
         torques: dict[str, float] | None = None
         if r.active:
             indices, names, signs, offsets = r.frame
-            q, qd, applied = engine.joint_vectors(r.body, indices)
+            states = engine.joint_rows(r.body, indices)
             if world.config.record.motor_torques:  # the joint's own frame, as applied
-                torques = {n: r.torques.get(n, a) for n, a in zip(names, applied, strict=True)}
-            angles = {n: (x - o) * s
-                      for n, x, s, o in zip(names, q, signs, offsets, strict=True)}
+                torques = {n: r.torques.get(n, st[3])
+                           for n, st in zip(names, states, strict=True)}
+            qd = [st[1] for st in states]
+            angles = {n: (st[0] - o) * s
+                      for n, st, s, o in zip(names, states, signs, offsets, strict=True)}
             velocities = {n: v * s for n, v, s in zip(names, qd, signs, strict=True)}
             readings = r.readings
             # Over the time since the velocities were last taken (one step, when recording).

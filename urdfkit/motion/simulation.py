@@ -358,10 +358,10 @@ class Simulation:
         velocity motors; for the servo model and torque commands, the torque it applied.
         """
         r = self.robot(robot)
-        applied = self.world.engine.joint_vectors(r.body, [j.index for j in r.active])[2]
+        states = self.world.engine.joint_rows(r.body, [j.index for j in r.active])
         # PyBullet reports 0 for a torque-controlled joint: the torque given is the answer.
-        return {j.name: r.torques.get(j.name, a)
-                for j, a in zip(r.active, applied, strict=True)}
+        return {j.name: r.torques.get(j.name, st[3])
+                for j, st in zip(r.active, states, strict=True)}
 
     def link_pose(self, robot: str, link: str) -> tuple[list[float], list[float]]:
         """World position and orientation (x, y, z, w) of a link's URDF frame."""
