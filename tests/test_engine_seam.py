@@ -263,6 +263,37 @@ def test_restore_replays_a_run_exactly_and_leaves_an_infinite_plane_in_place(
     assert engine.base_pose(plane)[0] == (0.0, 0.0, 0.0)
 
 
+BOX = """<robot name="box"><link name="box"><inertial><mass value="2"/>
+<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link></robot>"""
+
+
+def test_contacts_carry_a_resting_box_and_are_frozen_records(engine: PyBulletEngine,
+                                                             simpleplane_urdf: Path,
+                                                             tmp_path: Path) -> None:
+    import dataclasses
+
+    from urdfkit.engine.api import ContactPoint
+
+    (tmp_path / "box.urdf").write_text(BOX)
+    ground = engine.load(str(simpleplane_urdf), LoadSettings(fixed_base=True, scenery=True))
+    box = engine.load(str(tmp_path / "box.urdf"), LoadSettings(position=(0.0, 0.0, 0.2)))
+    engine.set_gravity((0.0, 0.0, -9.81))
+    for _ in range(480):
+        engine.step()
+    points = engine.contacts(box, -1, ground)
+    assert len(points) == 4  # the box's four bottom corners
+    assert sum(pt.normal_force for pt in points) == pytest.approx(2 * 9.81, rel=1e-3)
+    raw = engine.bullet.getContactPoints(bodyA=box, linkIndexA=-1, bodyB=ground)
+    for pt, row in zip(points, raw, strict=True):
+        assert pt == ContactPoint(*row[1:14])  # the same record the dataclass makes
+        assert (pt.body_a, pt.body_b) == (box, ground) and pt.normal[2] == pytest.approx(1.0)
+        assert hash(pt) == hash(ContactPoint(*row[1:14]))
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            pt.normal_force = 0.0  # type: ignore[misc]
+    assert engine.contacts(box, -1, box) == []
+
+
 def test_a_coupled_follower_keeps_the_mimic_relation(engine: PyBulletEngine) -> None:
     from urdfkit.motion.mimic import couple_mimics, mimic_relations
     from urdfkit.sources.resolve import open_input

@@ -89,9 +89,9 @@ class Sensors:
             joint_forces=forces, motor_torques=torques, link_poses=poses, feet=feet)
 
     def _forces(self, r: SimRobot) -> dict[str, list[float]]:
-        states = self.world.engine.joint_states
-        return {name: [float(x) for x in states(r.body, [index])[0].reaction]
-                for name, index in r.force_joints.items()}
+        rows = self.world.engine.joint_rows(r.body, list(r.force_joints.values()))
+        return {name: [float(x) for x in row[2]]
+                for name, row in zip(r.force_joints, rows, strict=True)}
 
     def _contacts(self, r: SimRobot) -> dict[str, dict[str, float]]:
         engine, ground = self.world.engine, self.world.ground
