@@ -139,6 +139,7 @@ def test_simplecar_velocity_export_drives_forward_in_mujoco(tmp_path: Path) -> N
     """At the wheel speeds `urdfkit drive` commands (throttle 10 rad/s, no steer)."""
     import numpy as np
 
+    from urdfkit.engine.pybullet import PyBulletEngine
     from urdfkit.engine.session import LoadOptions, Session
     from urdfkit.model.catalog import build_template
     from urdfkit.motion.drive import DriveConfig
@@ -149,7 +150,7 @@ def test_simplecar_velocity_export_drives_forward_in_mujoco(tmp_path: Path) -> N
     throttle = DriveConfig().throttle
     with Session() as s:
         body = s.load_urdf(car, LoadOptions())
-        train = detect_drivetrain(s.bullet, body)
+        train = detect_drivetrain(PyBulletEngine(session=s), body)
         speeds = train.wheel_speeds(throttle, 0.0)
         targets = {train.joint_names[w]: speeds[w] * train.wheel_signs.get(w, 1.0)
                    for w in train.wheels if w in speeds}

@@ -17,6 +17,7 @@ from typer.testing import CliRunner
 
 from urdfkit.cli import app
 from urdfkit.core.errors import ParameterError
+from urdfkit.engine.pybullet import PyBulletEngine
 from urdfkit.engine.session import LoadOptions, Session
 from urdfkit.model.catalog import build_template
 from urdfkit.motion.drive import DriveConfig, Scenario, builtin_file, drive
@@ -300,7 +301,7 @@ def test_racecar_from_pybullet_data_drives_forward_and_steers_left() -> None:
 def test_detects_the_tutorial_indices_of_simplecar(simplecar_urdf: Path) -> None:
     with Session() as s:
         body = s.load_urdf(simplecar_urdf)
-        t = detect_drivetrain(s.bullet, body)
+        t = detect_drivetrain(PyBulletEngine(session=s), body)
     # The tutorial's wheel_indices = [1, 3, 4, 5] and hinge_indices = [0, 2].
     assert t.wheels == [1, 3, 4, 5] and t.hinges == [0, 2] and t.passive == []
     assert t.hinge_limits == {0: (-0.5, 0.5), 2: (-0.5, 0.5)}
@@ -312,7 +313,7 @@ def test_detects_racecar_wheels_and_hinges_with_rotated_joint_frames() -> None:
 
     with open_input("racecar/racecar.urdf") as res, Session() as s:
         body = s.load_urdf(res.load_path)
-        t = detect_drivetrain(s.bullet, body)
+        t = detect_drivetrain(PyBulletEngine(session=s), body)
     assert t.wheels == [2, 3, 5, 7] and t.hinges == [4, 6]
     assert [t.joint_names[j] for j in t.hinges] == ["left_steering_hinge_joint",
                                                    "right_steering_hinge_joint"]
@@ -325,14 +326,14 @@ def test_detects_racecar_wheels_and_hinges_with_rotated_joint_frames() -> None:
 def test_wheel_and_hinge_overrides_take_names_or_indices(simplecar_urdf: Path) -> None:
     with Session() as s:
         body = s.load_urdf(simplecar_urdf)
-        t = detect_drivetrain(s.bullet, body, wheels=["base_to_left_back_wheel", "5"],
-                              hinges=[0])
+        engine = PyBulletEngine(session=s)
+        t = detect_drivetrain(engine, body, wheels=["base_to_left_back_wheel", "5"], hinges=[0])
         assert t.wheels == [4, 5] and t.hinges == [0]
         assert t.passive == [1, 2, 3]
         with pytest.raises(DrivetrainError, match="no joint named 'nope'"):
-            detect_drivetrain(s.bullet, body, wheels=["nope"])
+            detect_drivetrain(engine, body, wheels=["nope"])
         with pytest.raises(DrivetrainError, match="no joint with index 9"):
-            detect_drivetrain(s.bullet, body, wheels=[9])
+            detect_drivetrain(engine, body, wheels=[9])
 
 
 def test_a_model_without_wheels_is_an_error(simpleplane_urdf: Path) -> None:

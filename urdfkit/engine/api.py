@@ -10,14 +10,14 @@ suggest, since some engines (Pinocchio, Drake) give only the first:
   bodies, a physics step, motors, contacts, save and restore. What ``sim``, ``drive``,
   ``sweep`` and the Gymnasium environments run on.
 
-Every engine is one module of this folder (``engine/pybullet.py``, ``engine/mujoco.py``) and
-one entry of :data:`ENGINES`; nothing outside ``engine/`` imports an engine's package or calls
-its functions (tests/test_engine_seam.py). Indices are the engine's own, with PyBullet's
-conventions kept as the seam's: a body is an ``int``; link -1 is the root link; a link's index
-is its parent joint's; joints are numbered depth-first as the URDF lists them. Quaternions are
-``(x, y, z, w)``. A link *frame* is the URDF's frame of the link; its *inertial* frame is the
-``<inertial><origin>`` (PyBullet's base "position" is the root's inertial frame, not its link
-frame: :meth:`Simulator.base_state` says which it returns).
+Every engine is one module of this folder (``engine/pybullet.py``, ``engine/mujoco.py``) and one
+entry of :data:`urdfkit.engine.registry.ENGINES`; nothing outside ``engine/`` imports an
+engine's package or calls its functions (tests/test_engine_seam.py). Indices are the engine's
+own, with PyBullet's conventions kept as the seam's: a body is an ``int``; link -1 is the root
+link; a link's index is its parent joint's; joints are numbered depth-first as the URDF lists
+them. Quaternions are ``(x, y, z, w)``. A link *frame* is the URDF's frame of the link; its
+*inertial* frame is the ``<inertial><origin>`` (PyBullet's base "position" is the root's
+inertial frame, not its link frame: :meth:`Simulator.base_state` says which it returns).
 """
 
 from __future__ import annotations
@@ -34,6 +34,11 @@ MotorMode = Literal["velocity", "position", "torque"]
 #: The joint kinds the seam knows, as URDF names them (PyBullet's continuous joints are
 #: revolute joints without limits: ``limited`` says which).
 JointKind = Literal["revolute", "prismatic", "spherical", "planar", "fixed"]
+#: One joint's state as a plain tuple: :class:`JointState`'s fields in its order (position,
+#: velocity, reaction wrench, applied motor torque). What :meth:`Simulator.joint_rows` gives.
+JointRow = tuple[float, float, Sequence[float], float]
+#: The collision shape kinds the seam knows (``other``: one it has no outline for).
+ShapeKind = Literal["sphere", "box", "cylinder", "capsule", "mesh", "plane", "other"]
 
 
 @dataclass(frozen=True)
@@ -144,6 +149,40 @@ class ContactPoint:
 
 
 @dataclass(frozen=True)
+class LinkPose:
+    """One link's two world frames now: its inertial frame and its URDF link frame.
+
+    For the root the inertial frame is :meth:`Simulator.base_pose`'s; for another link both
+    come from one query (PyBullet's ``getLinkState`` with forward kinematics).
+    """
+
+    inertial_position: Vec3
+    inertial_orientation: Quat
+    position: Vec3
+    orientation: Quat
+
+
+@dataclass(frozen=True)
+class CollisionShape:
+    """One collision shape of a link (PyBullet's ``getCollisionShapeData``).
+
+    Attributes:
+        kind: What it is.
+        dimensions: ``box``: the full sizes x, y, z; ``sphere``: the radius first;
+            ``cylinder`` and ``capsule``: the length, then the radius; ``mesh``: the scale.
+        position, orientation: Its frame in the link's inertial frame.
+        vertices: A mesh's vertices in the link's inertial frame (empty when the engine
+            gives none); None for the other kinds.
+    """
+
+    kind: ShapeKind
+    dimensions: Sequence[float]
+    position: Vec3
+    orientation: Quat
+    vertices: Sequence[Vec3] | None = None
+
+
+@dataclass(frozen=True)
 class LoadSettings:
     """How a robot is loaded, in the engine's neutral terms.
 
@@ -154,6 +193,9 @@ class LoadSettings:
         implicit_cylinder: Collide with true cylinders, not meshes of them.
         self_collision: Let the robot's links collide (parent-child pairs excluded).
         position, orientation: Where the root link frame starts, world.
+        scenery: The world's ground (or a fixture): :meth:`Simulator.restore` leaves it
+            where it is. PyBullet's exact restore moves every other body apart once (an
+            infinite plane moved with them would still touch them).
     """
 
     fixed_base: bool = False
@@ -162,16 +204,19 @@ class LoadSettings:
     self_collision: bool = False
     position: Vec3 = (0.0, 0.0, 0.0)
     orientation: Quat = (0.0, 0.0, 0.0, 1.0)
+    scenery: bool = False
 
 
 class Model(Protocol):
     """A robot as an engine reads it: joints, links, kinematics and dynamics.
 
     Attributes:
-        name: The engine's name in :data:`ENGINES` (``"pybullet"``).
+        name: The engine's name in :data:`~urdfkit.engine.registry.ENGINES` (``"pybullet"``).
+        label: Its name as messages write it (``"PyBullet"``).
     """
 
     name: str
+    label: str
 
     def joints(self, body: int) -> list[JointInfo]:
         """Every joint of ``body``, fixed ones included, in the engine's order."""
@@ -195,7 +240,11 @@ class Model(Protocol):
         ...
 
     def mass_matrix(self, body: int, positions: Sequence[float]) -> list[list[float]]:
-        """The joint-space mass matrix at ``positions`` (movable joints only)."""
+        """The joint-space mass matrix at ``positions`` (movable joints only).
+
+        A floating base's 6 coordinates come first, in the engine's order (PyBullet:
+        angular, then linear).
+        """
         ...
 
     def inverse_dynamics(self, body: int, positions: Sequence[float],
@@ -204,13 +253,42 @@ class Model(Protocol):
         """The joint torques that give ``accelerations`` at this state, gravity included."""
         ...
 
+    def floating_mass_matrix(self, body: int, position: Vec3, orientation: Quat,
+                             positions: Sequence[float]) -> list[list[float]]:
+        """:meth:`mass_matrix` of a floating-base body with its root at this pose.
+
+        The root's inertial frame, as :meth:`Simulator.base_pose` gives it; its 6
+        coordinates come first, in the engine's order (PyBullet: linear, then angular,
+        unlike its :meth:`mass_matrix`).
+        """
+        ...
+
+    def jacobian(self, body: int, link: int, point: Vec3, positions: Sequence[float]
+                 ) -> tuple[list[list[float]], list[list[float]]]:
+        """The linear and angular Jacobians (3 x n each) of a point of a link at ``positions``.
+
+        ``point`` is in the link's URDF frame. The dynamics methods raise
+        :class:`urdfkit.core.errors.EngineError` when the engine cannot build its model of
+        the body, with why as a clause (a caller names the robot before it).
+        """
+        ...
+
     def close(self) -> None:
         """Release the engine (safe to call twice)."""
         ...
 
 
 class Simulator(Model, Protocol):
-    """A :class:`Model` that moves: a world of bodies stepped in time."""
+    """A :class:`Model` that moves: a world of bodies stepped in time.
+
+    Attributes:
+        gui: Whether the world shows in a window of the engine's own.
+        error: The exception the engine's calls raise when it fails (``pybullet.error``;
+            a closed window makes every call raise it).
+    """
+
+    gui: bool
+    error: type[Exception]
 
     def load(self, path: str, settings: LoadSettings, display: str | None = None) -> int:
         """Load a URDF that has passed the guard; its body id."""
@@ -224,20 +302,69 @@ class Simulator(Model, Protocol):
         """The physics step, s."""
         ...
 
+    def set_physics(self, *, deterministic_pairs: bool | None = None,
+                    solver_iterations: int | None = None,
+                    cone_friction: bool | None = None) -> None:
+        """The solver's settings; None leaves one as it is.
+
+        Args:
+            deterministic_pairs: Meet contacts in a sorted order, so a restore replays a
+                run exactly.
+            solver_iterations: Constraint solver iterations per step.
+            cone_friction: A friction cone (True) or its pyramid approximation.
+        """
+        ...
+
+    def require_state_queries(self, body: int, display: str) -> None:
+        """Refuse a body whose state the engine cannot report (PyBullet: 128 links or more).
+
+        Raises:
+            EngineError: naming ``display``.
+        """
+        ...
+
+    def connected(self) -> bool:
+        """Whether the engine still runs (False once its window is closed)."""
+        ...
+
     def step(self) -> None:
-        """One physics step."""
+        """One physics step (an engine may make it a callable attribute: loops bind it)."""
         ...
 
     def save(self) -> int:
-        """Keep the state now; an id for :meth:`restore`."""
+        """Keep the state now; an id for :meth:`restore`.
+
+        The world may be stepped and restored to it here, so that the first restore
+        continues as every later one does (PyBullet's contact bookkeeping differs after its
+        first step and reset); it is at the saved state when this returns.
+        """
         ...
 
     def restore(self, state: int) -> None:
-        """Back to a saved state, exactly as it was (contacts included)."""
+        """Back to a saved state, exactly as it was (contacts included).
+
+        Bodies loaded as ``scenery`` stay where they are while the engine drops what it
+        carried over (PyBullet moves the others apart once).
+        """
         ...
 
     def base_state(self, body: int) -> BaseState:
         """The root's inertial frame and velocity, world."""
+        ...
+
+    def base_pose(self, body: int) -> tuple[Vec3, Quat]:
+        """The root's inertial frame, world (:meth:`base_state` without the velocity)."""
+        ...
+
+    def link_pose(self, body: int, link: int) -> LinkPose:
+        """One link's inertial and URDF frames now, world (link -1: the root)."""
+        ...
+
+    def reset_base_frame(self, body: int, position: Vec3, orientation: Quat) -> None:
+        """Move the root's URDF link frame there, at rest.
+
+        :meth:`reset_base` places the inertial frame; a robot's start is its link frame.
+        """
         ...
 
     def reset_base(self, body: int, position: Vec3, orientation: Quat) -> None:
@@ -250,6 +377,14 @@ class Simulator(Model, Protocol):
 
     def joint_states(self, body: int, joints: Sequence[int]) -> list[JointState]:
         """The state of these joints (by index) now."""
+        ...
+
+    def joint_rows(self, body: int, joints: Sequence[int]) -> Sequence[JointRow]:
+        """:meth:`joint_states` as plain tuples (:data:`JointRow`), one per joint.
+
+        The call the measuring and control loops make every step: no record per joint (an
+        engine may hand out its own tuples; PyBullet's ``getJointStates`` are these).
+        """
         ...
 
     def reset_joint(self, body: int, joint: int, position: float, velocity: float = 0.0
@@ -281,4 +416,32 @@ class Simulator(Model, Protocol):
     def contacts(self, body: int, link: int | None = None, other: int | None = None
                  ) -> list[ContactPoint]:
         """The contact points of ``body`` (one link of it, or all) with ``other`` (or any)."""
+        ...
+
+    def enable_joint_force_sensor(self, body: int, joint: int) -> None:
+        """Measure the reaction wrench on a joint (:attr:`JointState.reaction`) from now on."""
+        ...
+
+    def hold_base(self, body: int) -> int:
+        """Hold the root where it is now, its joints still free; the constraint's id.
+
+        A fixed constraint to the world: simulation_and_control's rack.
+        """
+        ...
+
+    def couple_joints(self, body: int, leader: int, follower: int, multiplier: float,
+                      offset: float, max_force: float) -> int:
+        """Hold ``follower`` at ``multiplier * leader + offset`` (URDF's ``<mimic>``).
+
+        With up to ``max_force`` (N or N m); the coupling's id. The follower is not moved
+        onto the relation here.
+        """
+        ...
+
+    def collision_shapes(self, body: int, link: int) -> list[CollisionShape]:
+        """A link's collision shapes (link -1: the root), in the engine's order."""
+        ...
+
+    def aabb(self, body: int, link: int) -> tuple[Vec3, Vec3]:
+        """A link's axis-aligned bounding box now, world: its lower and upper corner."""
         ...

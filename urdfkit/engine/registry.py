@@ -16,10 +16,11 @@ if TYPE_CHECKING:
     from urdfkit.engine.api import Simulator
 
 #: Engine name to ``module:class``, the module imported on first use.
-ENGINES: dict[str, str] = {"mujoco": "urdfkit.engine.mujoco:MuJoCoEngine"}
+ENGINES: dict[str, str] = {"pybullet": "urdfkit.engine.pybullet:PyBulletEngine",
+                           "mujoco": "urdfkit.engine.mujoco:MuJoCoEngine"}
 
 
-def open_engine(name: str, gui: bool = False) -> Simulator:
+def open_engine(name: str = "pybullet", gui: bool = False) -> Simulator:
     """A new world in engine ``name``.
 
     Raises:
@@ -32,7 +33,7 @@ def open_engine(name: str, gui: bool = False) -> Simulator:
     return engine
 
 
-def preload(name: str) -> None:
+def preload(name: str = "pybullet") -> None:
     """Import engine ``name``'s package now: a process about to fork workers warms them once.
 
     Raises:

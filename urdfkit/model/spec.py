@@ -478,6 +478,19 @@ def rpy_to_quat(roll: float, pitch: float, yaw: float) -> tuple[float, float, fl
             cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
 
 
+def rpy_to_unit_quat(roll: float, pitch: float, yaw: float
+                     ) -> tuple[float, float, float, float]:
+    """:func:`rpy_to_quat` scaled to unit length: PyBullet's ``getQuaternionFromEuler``.
+
+    Bit for bit: PyBullet normalises the product (each part divided by the root of the sum
+    of squares, summed in order); the unscaled one differs from it in the last bit for about
+    a third of all angles (tests/test_engine_seam.py compares the two over random angles).
+    """
+    q = rpy_to_quat(roll, pitch, yaw)
+    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)
+
+
 def quat_to_matrix(q: Sequence[float]) -> Matrix3:
     """Rotation matrix of a unit quaternion (x, y, z, w), PyBullet's order."""
     x, y, z, w = q

@@ -62,6 +62,7 @@ from urdfkit.motion.vehicle_shapes import base_link_pose, lowest_point, set_base
 from urdfkit.sources.builtin import builtin_file as builtin_file  # re-exported: gym, sim, tests
 
 if TYPE_CHECKING:
+    from urdfkit.engine.pybullet import PyBulletEngine
     from urdfkit.model.gazebo import GazeboContact
     from urdfkit.motion.mimic import Mimic
 
@@ -294,6 +295,9 @@ class Scenario:
         #: The Gazebo contacts applied at load: {link: {lateralFriction, ...}}.
         self.gazebo_applied: dict[str, dict[str, float]] = {}
         self.session: Session | None = None
+        #: The world behind the engine seam, for the shared vehicle, mimic and Gazebo code;
+        #: this module's own loop still calls PyBullet through :attr:`session`.
+        self.engine: PyBulletEngine | None = None
         try:
             self._open()
         except BaseException:
@@ -338,8 +342,11 @@ class Scenario:
             return s.load_urdf(res.load_path, options, display=res.name)
 
     def _open(self) -> None:
+        from urdfkit.engine.pybullet import PyBulletEngine
+
         c = self.config
-        self.session = s = Session(gui=c.gui)
+        self.engine = engine = PyBulletEngine(session=Session(gui=c.gui))
+        self.session = s = engine.session
         p = s.bullet
         p.setGravity(0, 0, c.gravity)
         p.setTimeStep(c.time_step)
@@ -360,18 +367,18 @@ class Scenario:
         self.car_file = self._last_file
         s.require_state_queries(self.body, car)
         try:
-            self.drivetrain = train = detect_upright(p, self.body, upright, c.wheels,
+            self.drivetrain = train = detect_upright(engine, self.body, upright, c.wheels,
                                                      c.hinges, c.drivetrain)
         except DrivetrainError as e:
             raise DrivetrainError(e.message, file=car, param=e.param) from None
         if spawn != upright:  # the link frame, as loadURDF placed it
-            set_base_link_pose(p, self.body, start, spawn)
+            set_base_link_pose(engine, self.body, start, spawn)
         if c.gazebo_contacts:
             self._apply_gazebo()
         if c.mimic and self._mimics:
             from urdfkit.motion.mimic import couple_mimics
 
-            self.mimic_followers = couple_mimics(p, self.body, self._mimics)
+            self.mimic_followers = couple_mimics(engine, self.body, self._mimics)
         # The tutorial loads its plane as it is (a mass-0 box: static either way).
         self.plane = self._load(s, c.plane, "simpleplane", LoadOptions(
             fixed_base=not c.tutorial, implicit_cylinder=not c.tutorial), self._ground_params())
@@ -394,18 +401,17 @@ class Scenario:
         """Carry the file's Gazebo contact parameters over with changeDynamics."""
         from urdfkit.motion.gazebo_load import apply_gazebo_contacts
 
-        assert self.session is not None
-        self.gazebo_applied = apply_gazebo_contacts(self.session.bullet, self.body,
-                                                    self._gazebo)
+        assert self.engine is not None
+        self.gazebo_applied = apply_gazebo_contacts(self.engine, self.body, self._gazebo)
 
     def gazebo_differences(self) -> list[str]:
         """The file's Gazebo friction where PyBullet uses another, as a user reads it."""
-        if not self._gazebo or self.session is None:
+        if not self._gazebo or self.session is None or self.engine is None:
             return []
         from urdfkit.motion.gazebo_load import link_indices
 
         p = self.session.bullet
-        index = link_indices(p, self.body)
+        index = link_indices(self.engine, self.body)
         out = []
         for name, g in self._gazebo.items():
             mu = g.lateral_friction
@@ -527,12 +533,12 @@ class Scenario:
 
     def _rest_on_ground(self, start: tuple[float, float, float]) -> None:
         """Lower or raise the car until its lowest point is 1 mm above the ground's top."""
-        assert self.session is not None
-        p = self.session.bullet
-        lowest = lowest_point(p, self.body)  # the shapes' own, not the AABB's
+        assert self.engine is not None
+        engine = self.engine
+        lowest = lowest_point(engine, self.body)  # the shapes' own, not the AABB's
         top = self.ground_top if self.ground_top is not None else 0.0
-        pos, orn = base_link_pose(p, self.body)
-        set_base_link_pose(p, self.body,
+        pos, orn = base_link_pose(engine, self.body)
+        set_base_link_pose(engine, self.body,
                            (pos[0], pos[1], pos[2] + top + 0.001 - lowest), orn)
 
     def _check_start(self) -> None:
@@ -565,6 +571,9 @@ class Scenario:
 
     def close(self) -> None:
         """Disconnect and remove the temp folder."""
+        if self.engine is not None:
+            self.engine.close()  # and its session
+            self.engine = None
         if self.session is not None:
             self.session.close()
             self.session = None
@@ -580,9 +589,9 @@ class Scenario:
 
     def link_poses(self) -> list[tuple[Sequence[float], Sequence[float]]]:
         """Every URDF link frame's world pose now, base first (``(xyz, xyzw)``)."""
-        assert self.session is not None
+        assert self.session is not None and self.engine is not None
         p, body = self.session.bullet, self.body
-        out = [base_link_pose(p, body)]
+        out = [base_link_pose(self.engine, body)]
         for j in range(p.getNumJoints(body)):
             st = p.getLinkState(body, j, computeForwardKinematics=True)
             out.append((st[4], st[5]))
@@ -652,17 +661,17 @@ class Scenario:
             progress: Called as ``progress(done, total)`` after every sample.
             sink: Called with each trajectory sample as it is taken (to stream it to disk).
         """
-        assert self.session is not None
-        c, s, train = self.config, self.session, self.drivetrain
+        assert self.session is not None and self.engine is not None
+        c, s, train, engine = self.config, self.session, self.drivetrain, self.engine
         p, body = s.bullet, self.body
-        disable_default_motors(p, body, [j for j in train.passive if j not in self.held])
+        disable_default_motors(engine, body, [j for j in train.passive if j not in self.held])
         if self.held:
             held = list(self.held)
             p.setJointMotorControlArray(
                 body, held, p.POSITION_CONTROL,
                 targetPositions=[self.held[j][0] for j in held],
                 forces=[self.held[j][1] for j in held])
-        apply_drive(p, body, train, c.throttle, self.steer, c.max_force)
+        apply_drive(engine, body, train, c.throttle, self.steer, c.max_force)
         total, period, dt = c.total_steps, c.sample_period, c.time_step
         take = self._sampler()
         stats = Stats(SETTLED_FRACTION * total * dt)
@@ -871,8 +880,8 @@ class _GuiControls:
     """
 
     def __init__(self, sc: Scenario):
-        assert sc.session is not None
-        self.sc, self.p = sc, sc.session.bullet
+        assert sc.session is not None and sc.engine is not None
+        self.sc, self.p, self.engine = sc, sc.session.bullet, sc.engine
         lo, hi = sc.drivetrain.steer_range()
         lo, hi = max(lo, -1.0), min(hi, 1.0)
         top = max(20.0, abs(sc.config.throttle))
@@ -889,7 +898,7 @@ class _GuiControls:
                    p.readUserDebugParameter(self.steer_id))
             if now != self.last:
                 self.last = now
-                apply_drive(p, self.sc.body, self.sc.drivetrain, now[0], now[1],
+                apply_drive(self.engine, self.sc.body, self.sc.drivetrain, now[0], now[1],
                             self.sc.config.max_force)
             p.stepSimulation()
             self.next_tick += dt

@@ -1,7 +1,8 @@
 """URDF ``<mimic>`` honoured in PyBullet, which ignores it: a gear constraint per follower.
 
-A follower joint keeps ``q_follower = multiplier * q_leader + offset``. PyBullet's JOINT_GEAR
-constraint between the leader's and the follower's links holds
+A follower joint keeps ``q_follower = multiplier * q_leader + offset``: the engine couples the
+two joints (:meth:`~urdfkit.engine.api.Simulator.couple_joints`). In PyBullet that is a
+JOINT_GEAR constraint between the leader's and the follower's links, which holds
 ``q_leader + gearRatio * q_follower = relativePositionTarget``; with
 ``gearRatio = -1 / multiplier`` and ``relativePositionTarget = -offset / multiplier`` that is
 the mimic relation, offset included (the gear alone, target 0, ignores the offset).
@@ -11,8 +12,8 @@ thumb = left), the leader under a 20 N position motor tracking 0.015 sin(2 pi t)
 of 1/240 s, followers' motors off: the worst error is 0.035 mm with the gear, 3.7 mm when each
 follower's position motor is set to the relation every step (a step behind), 14.6 mm raw.
 The gear's default error reduction (0.2) leaves a sag under load: a 0.5 kg mast following at
-x 2 against gravity sits 0.37 mm off; at :data:`GEAR_ERP` 0.8 it is 0.010 mm, and the gripper
-in sim under step commands 0.009 mm worst.
+x 2 against gravity sits 0.37 mm off; at 0.8 (:data:`urdfkit.engine.pybullet.GEAR_ERP`) it is
+0.010 mm, and the gripper in sim under step commands 0.009 mm worst.
 """
 
 from __future__ import annotations
@@ -26,12 +27,10 @@ from urdfkit.model.spec import c_number
 if TYPE_CHECKING:
     from lxml import etree
 
-    from urdfkit.engine.session import Bullet
+    from urdfkit.engine.api import Simulator
 
 #: The gear's force when the follower's URDF gives no effort (N or N m).
 DEFAULT_MIMIC_FORCE = 1000.0
-#: The gear's error reduction per step.
-GEAR_ERP = 0.8
 
 
 @dataclass(frozen=True)
@@ -65,29 +64,24 @@ def mimic_relations(root: etree._Element) -> list[Mimic]:
     return out
 
 
-def couple_mimics(p: Bullet, body: int, mimics: list[Mimic]) -> dict[str, int]:
-    """A gear constraint per follower; {follower: constraint id}.
+def couple_mimics(engine: Simulator, body: int, mimics: list[Mimic]) -> dict[str, int]:
+    """A coupling (PyBullet: a gear constraint) per follower; {follower: its id}.
 
-    Followers are put on the relation first; joints PyBullet did not load (fixed, unknown)
+    Followers are put on the relation first; joints the engine did not load (fixed, unknown)
     are skipped.
     """
-    index = {p.getJointInfo(body, j)[1].decode("utf-8", "replace"): j
-             for j in range(p.getNumJoints(body))}
+    joints = engine.joints(body)
+    index = {j.name: j.index for j in joints}
     out = {}
     for m in mimics:
         f, lead = index.get(m.follower), index.get(m.leader)
         if f is None or lead is None or f == lead:
             continue
-        if p.getJointInfo(body, f)[2] == p.JOINT_FIXED or \
-                p.getJointInfo(body, lead)[2] == p.JOINT_FIXED:
+        if joints[f].kind == "fixed" or joints[lead].kind == "fixed":
             continue
-        q = p.getJointState(body, lead)[0]
-        p.resetJointState(body, f, m.multiplier * q + m.offset)
-        effort = p.getJointInfo(body, f)[10]
+        q = engine.joint_states(body, [lead])[0].position
+        engine.reset_joint(body, f, m.multiplier * q + m.offset)
+        effort = joints[f].effort
         force = effort if effort > 0 and math.isfinite(effort) else DEFAULT_MIMIC_FORCE
-        c = p.createConstraint(body, lead, body, f, p.JOINT_GEAR, [1, 0, 0], [0, 0, 0],
-                               [0, 0, 0])
-        p.changeConstraint(c, gearRatio=-1.0 / m.multiplier, maxForce=force,
-                           relativePositionTarget=-m.offset / m.multiplier, erp=GEAR_ERP)
-        out[m.follower] = c
+        out[m.follower] = engine.couple_joints(body, lead, f, m.multiplier, m.offset, force)
     return out

@@ -28,9 +28,12 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import InputError
+
+if TYPE_CHECKING:
+    from urdfkit.engine.api import JointKind
 
 #: The top-level sections of a simulation_and_control config.
 SECTIONS = ("sim", "robot_pybullet", "env_pybullet", "robot_pin")
@@ -105,7 +108,7 @@ class _Robot:
     joints: list[str]  # every joint, in PyBullet's index order
     active: list[str]  # the non-fixed ones: SimInterface's motors, in its order
     links: dict[str, str]  # child link -> joint
-    types: dict[str, int]
+    types: dict[str, JointKind]
 
 
 class _Reader:
@@ -216,24 +219,29 @@ def _resolve_urdf(reader: _Reader, where: str, name: object, base: Path) -> Path
 
 def _inspect(path: Path, display: str) -> _Robot:
     """Joint names and order as PyBullet indexes them (through urdfkit's guarded loader)."""
-    from urdfkit.engine.session import LoadOptions, Session
+    from urdfkit.engine.api import LoadSettings
+    from urdfkit.engine.registry import open_engine
     from urdfkit.sources.resolve import open_input
 
-    with open_input(str(path)) as resolved, Session() as s:
-        body = s.load_urdf(resolved.load_path, LoadOptions(fixed_base=True), display=display)
-        joints: list[str] = []
-        active: list[str] = []
-        links: dict[str, str] = {}
-        types: dict[str, int] = {}
-        for j in range(s.bullet.getNumJoints(body)):
-            info = s.bullet.getJointInfo(body, j)
-            name = info[1].decode("utf-8", "replace")
-            joints.append(name)
-            types[name] = info[2]
-            links[info[12].decode("utf-8", "replace")] = name
-            if info[2] != s.p.JOINT_FIXED:
-                active.append(name)
-        return _Robot(path, joints, active, links, types)
+    with open_input(str(path)) as resolved:
+        engine = open_engine("pybullet")
+        try:
+            body = engine.load(str(resolved.load_path), LoadSettings(fixed_base=True),
+                               display=display)
+            infos = engine.joints(body)
+        finally:
+            engine.close()
+    joints: list[str] = []
+    active: list[str] = []
+    links: dict[str, str] = {}
+    types: dict[str, JointKind] = {}
+    for info in infos:
+        joints.append(info.name)
+        types[info.name] = info.kind
+        links[info.link] = info.name
+        if info.kind != "fixed":
+            active.append(info.name)
+    return _Robot(path, joints, active, links, types)
 
 
 def convert(data: Mapping[str, object], *, source: str | Path | None = None) -> Imported:
@@ -327,7 +335,7 @@ def _load_robots(reader: _Reader, rp: Mapping[str, object], base: Path) -> list[
             robot = _inspect(path, f"{where} ({name})")
         except InputError as e:
             raise reader.fail(where, str(e)) from None
-        odd = [n for n in robot.active if robot.types[n] not in (0, 1)]
+        odd = [n for n in robot.active if robot.types[n] not in ("revolute", "prismatic")]
         if odd:
             raise reader.fail(where, f"joint {odd[0]!r} is neither revolute nor prismatic: "
                                      "SimInterface's motors need 1-DOF joints")

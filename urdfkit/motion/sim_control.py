@@ -4,8 +4,8 @@ A robot's command at time t is its override (``Simulation.set_drive``,
 ``set_joint_targets``), else its scenario segment (:meth:`SimRobot.command`). Two controllers
 apply it, both behind :class:`Controller`:
 
-- :class:`MotorControl`: PyBullet's own motors, set when the command changes (they persist),
-  torques every step (they last one);
+- :class:`MotorControl`: the engine's own motors, set when the command changes (they
+  persist), torques every step (they last one);
 - :class:`ServoControl`: the servo model, a torque law every step.
 """
 
@@ -18,7 +18,7 @@ from urdfkit.motion.sim_robot import SimRobot
 from urdfkit.motion.sim_state import Command
 
 if TYPE_CHECKING:
-    from urdfkit.engine.session import Bullet
+    from urdfkit.engine.api import Simulator
     from urdfkit.motion.scenario_models import Motor
     from urdfkit.motion.sim_dynamics import Dynamics
     from urdfkit.motion.sim_sensors import Sensors
@@ -32,10 +32,10 @@ class Controller(Protocol):
 
 
 class MotorControl:
-    """PyBullet's motors: a drive train's wheels and hinges, or joint targets."""
+    """The engine's motors: a drive train's wheels and hinges, or joint targets."""
 
-    def __init__(self, bullet: Bullet) -> None:
-        self.bullet = bullet
+    def __init__(self, engine: Simulator) -> None:
+        self.engine = engine
 
     def control(self, robot: SimRobot, t: float) -> None:
         """Set the motors when the command changes; re-apply torques every step."""
@@ -57,18 +57,18 @@ class MotorControl:
         assert train is not None
         vehicle = robot.config.vehicle
         max_force = vehicle.max_force if vehicle else 10.0
-        # Motors persist in PyBullet: set once per change of command.
-        apply_drive(self.bullet, robot.body, train, cmd.throttle,
+        # Motors persist: set once per change of command.
+        apply_drive(self.engine, robot.body, train, cmd.throttle,
                     clamp_steer(train, cmd.steer)[0], max_force)
         if robot.dry_friction:  # apply_drive frees the undriven wheels
             robot.free([i for i in train.free if i in robot.dry_friction])
 
     def _motors(self, robot: SimRobot, cmd: Command, *, torque: bool) -> None:
-        """PyBullet's own motors for a ``joints`` command (no servo model).
+        """The engine's own motors for a ``joints`` command (no servo model), joint by joint.
 
         ``torque``: the torque targets (every step), else the position and velocity ones.
         """
-        p = self.bullet
+        motors = self.engine.motors
         for name, target in cmd.targets.items():
             mode = cmd.mode_of(name)
             if (mode == "torque") != torque:
@@ -76,20 +76,17 @@ class MotorControl:
             spec = robot.joint(name)
             sign = robot.directions.get(name, 1.0)
             if mode == "torque":
-                p.setJointMotorControl2(robot.body, spec.index, p.TORQUE_CONTROL,
-                                        force=target * sign)
+                motors(robot.body, [spec.index], "torque", [target * sign])
                 robot.torques[name] = target * sign
                 continue
             force = cmd.max_force or (spec.effort if spec.effort > 0 else None)
-            limit = {} if force is None else {"force": force}
+            limit = None if force is None else [force]  # None: the engine's default cap
             if mode == "position":
-                p.setJointMotorControl2(robot.body, spec.index, p.POSITION_CONTROL,
-                                        targetPosition=robot.to_physical(name, target),
-                                        targetVelocity=cmd.velocities.get(name, 0.0) * sign,
-                                        **limit)
+                motors(robot.body, [spec.index], "position",
+                       [robot.to_physical(name, target)], forces=limit,
+                       velocities=[cmd.velocities.get(name, 0.0) * sign])
             else:
-                p.setJointMotorControl2(robot.body, spec.index, p.VELOCITY_CONTROL,
-                                        targetVelocity=target * sign, **limit)
+                motors(robot.body, [spec.index], "velocity", [target * sign], forces=limit)
 
 
 def _per_joint(value: float | dict[str, float], name: str) -> float:
@@ -113,8 +110,8 @@ class ServoControl:
     true one, as a real robot's servo does; ``qdd`` is the last measured acceleration.
     """
 
-    def __init__(self, bullet: Bullet, sensors: Sensors, dynamics: Dynamics) -> None:
-        self.bullet = bullet
+    def __init__(self, engine: Simulator, sensors: Sensors, dynamics: Dynamics) -> None:
+        self.engine = engine
         self.sensors = sensors
         self.dynamics = dynamics
 
@@ -141,7 +138,7 @@ class ServoControl:
             seen = self.sensors.observe(robot)
             return ({spec.name: (seen.motor_angles[spec.name], seen.motor_velocities[spec.name])
                      for spec in robot.servo}, seen.motor_accelerations)
-        states = self.bullet.getJointStates(robot.body, [j.index for j in robot.servo])
+        states = self.engine.joint_rows(robot.body, [j.index for j in robot.servo])
         state_of = {}
         for spec, st in zip(robot.servo, states, strict=True):
             sign = robot.directions.get(spec.name, 1.0)
@@ -151,7 +148,6 @@ class ServoControl:
         return state_of, qdds
 
     def _apply(self, robot: SimRobot, cmd: Command | None) -> None:
-        p = self.bullet
         m = robot.config.motor
         assert m is not None
         state_of, qdds = self._state(robot, m)
@@ -183,6 +179,5 @@ class ServoControl:
                 m.max_torque or (spec.effort if spec.effort > 0 else math.inf)
             tau = min(max(tau, -limit), limit)
             torques.append(tau * robot.directions.get(spec.name, 1.0))
-        p.setJointMotorControlArray(robot.body, [j.index for j in robot.servo],
-                                    p.TORQUE_CONTROL, forces=torques)
+        self.engine.motors(robot.body, [j.index for j in robot.servo], "torque", torques)
         robot.torques.update(zip((spec.name for spec in robot.servo), torques, strict=True))

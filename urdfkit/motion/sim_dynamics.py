@@ -2,32 +2,38 @@
 
 PyBullet builds the model its calculateMassMatrix, calculateInverseDynamics and
 calculateJacobian use once, at the first call, and never updates it: a mass changed later is
-ignored (measured on 3.2.7). So the dynamics run on a copy of the robot in a client of its
-own (a *shadow*, :class:`Shadows`), rebuilt after every ``set_mass``/``set_inertia``.
+ignored (measured on 3.2.7). So the dynamics run on a copy of the robot in a world of its own
+in the same engine (a *shadow*, :class:`Shadows`), rebuilt after every
+``set_mass``/``set_inertia``.
 
 PyBullet can refuse to build that model for a robot it loads and simulates (KUKA KR210's
-link_2 inertia; :func:`urdfkit.engine.session.dynamics_refusal` says why). Its calls then
-raise SystemError and print on fd 1: the first call on each shadow runs quiet and, when
-PyBullet refuses, every call on that shadow raises :class:`EngineError` saying why.
+link_2 inertia; :func:`urdfkit.engine.session.dynamics_refusal` says why): the engine's
+dynamics calls then raise :class:`EngineError` saying why, and every message here names the
+robot before it.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypeVar
 
 from urdfkit.core.errors import EngineError, ParameterError
-from urdfkit.engine.session import DYNAMICS_CALLS, LoadOptions, Session, dynamics_call
-from urdfkit.motion.sim_state import _FIXED, JointSpec
+from urdfkit.engine.registry import open_engine
+from urdfkit.motion.sim_state import JointSpec
 
 if TYPE_CHECKING:
     import numpy as np
 
-    from urdfkit.engine.session import Bullet
+    from urdfkit.engine.api import LoadSettings, Simulator
     from urdfkit.motion.sim_robot import MassValue, SimRobot
     from urdfkit.motion.sim_world import World
+
+T = TypeVar("T")
+
+#: What each dynamics call computes, for messages.
+MASS_MATRIX, INVERSE_DYNAMICS, JACOBIANS = "the mass matrix", "the inverse dynamics", "Jacobians"
 
 
 class Dynamics:
@@ -43,7 +49,7 @@ class Dynamics:
 
     def joints(self, robot: SimRobot) -> list[JointSpec]:
         """The joints the dynamics quantities are ordered by: the movable ones, 1-DOF."""
-        movable = [j for j in robot.joints if j.type != _FIXED]
+        movable = [j for j in robot.joints if j.kind != "fixed"]
         odd = [j.name for j in movable if not j.active]
         if odd:
             raise ParameterError(f"{robot.name}: the dynamics need 1-DOF joints; {odd[0]!r} "
@@ -52,51 +58,41 @@ class Dynamics:
 
     def physical_state(self, robot: SimRobot) -> tuple[list[float], list[float]]:
         """The joints' positions and velocities now, physical (no offsets or directions)."""
-        states = self.world.bullet.getJointStates(robot.body,
-                                                  [j.index for j in self.joints(robot)])
+        states = self.world.engine.joint_rows(robot.body,
+                                              [j.index for j in self.joints(robot)])
         return [float(st[0]) for st in states], [float(st[1]) for st in states]
 
     def _fixed(self, robot: SimRobot, what: str) -> None:
         moving_base = robot.config.base != "fixed" and \
-            self.world.bullet.getDynamicsInfo(robot.body, -1)[0] > 0
+            self.world.engine.dynamics(robot.body, -1).mass > 0
         if moving_base:
             raise ParameterError(f"{robot.name}: {what} needs a fixed base (PyBullet's "
                                  "calculateInverseDynamics does not take a floating one); "
                                  "use base = \"fixed\"", param="robot")
 
-    def model(self, robot: SimRobot) -> tuple[Bullet, int]:
-        """``(bullet, body)`` of the robot's dynamics model, as the robot is now."""
+    def model(self, robot: SimRobot) -> tuple[Simulator, int]:
+        """``(engine, body)`` of the robot's dynamics model, as the robot is now."""
         shadow = self._shadow(robot)
-        return shadow.session.bullet, shadow.body
+        return shadow.engine, shadow.body
 
     def _shadow(self, robot: SimRobot) -> Shadow:
         return self.shadows.model(robot.name, robot.loaded, self.world.config.physics.gravity,
-                                  robot.changes, robot.mass_version)
+                                  robot.changes, robot.mass_version, self.world.engine.name)
 
-    def call(self, robot: SimRobot, fn: str, *args: object, **kwargs: object) -> Any:
-        """PyBullet's ``fn`` (one of DYNAMICS_CALLS) on the robot's model, given ``args``.
+    def call(self, robot: SimRobot, what: str,
+             compute: Callable[[Simulator, int], T]) -> T:
+        """``compute(engine, body)`` on the robot's model; ``what`` it computes, for messages.
 
         Raises:
-            EngineError: PyBullet cannot build its inverse-dynamics model of the robot, or
-                the call failed; the message names the robot and says why.
+            EngineError: the engine cannot build its dynamics model of the robot, or the call
+                failed; the message names the robot and says why.
         """
         shadow = self._shadow(robot)
-        p, body = shadow.session.bullet, shadow.body
-        if shadow.proven:  # the motor's every-step path: the bare call
-            try:
-                return getattr(p, fn)(body, *args, **kwargs)
-            except (SystemError, p.error) as e:
-                raise EngineError(f"{_cannot(robot, fn)}: PyBullet's {fn} failed "
-                                  f"({e.__cause__ or e.__context__ or e})") from None
-        if shadow.refused is not None:
-            raise EngineError(f"{_cannot(robot, fn)}: {shadow.refused}")
-        try:  # the call that builds PyBullet's model: it may print
-            out = dynamics_call(p, fn, body, *args, **kwargs)
+        try:
+            return compute(shadow.engine, shadow.body)
         except EngineError as e:
-            shadow.refused = e.message
-            raise EngineError(f"{_cannot(robot, fn)}: {e.message}") from None
-        shadow.proven = True
-        return out
+            raise EngineError(f"{shadow.engine.label} cannot compute {what} of robot "
+                              f"{robot.name!r}: {e.message}") from None
 
     def mass_matrix(self, robot: SimRobot) -> np.ndarray:
         """The joint-space mass matrix M(q) now (PyBullet's calculateMassMatrix).
@@ -107,7 +103,7 @@ class Dynamics:
         import numpy as np
 
         q, _ = self.physical_state(robot)
-        return np.array(self.call(robot, "calculateMassMatrix", q))
+        return np.array(self.call(robot, MASS_MATRIX, lambda e, b: e.mass_matrix(b, q)))
 
     def coriolis_and_gravity(self, robot: SimRobot) -> np.ndarray:
         """C(q, qd) qd + g(q) now: the torques that hold the current motion."""
@@ -115,7 +111,9 @@ class Dynamics:
 
         self._fixed(robot, "coriolis_and_gravity")
         q, qd = self.physical_state(robot)
-        return np.array(self.call(robot, "calculateInverseDynamics", q, qd, [0.0] * len(q)))
+        zero = [0.0] * len(q)
+        return np.array(self.call(robot, INVERSE_DYNAMICS,
+                                  lambda e, b: e.inverse_dynamics(b, q, qd, zero)))
 
     def gravity_torques(self, robot: SimRobot) -> np.ndarray:
         """g(q) now: the torques that hold the robot still against gravity."""
@@ -124,7 +122,8 @@ class Dynamics:
         self._fixed(robot, "gravity_torques")
         q, _ = self.physical_state(robot)
         zero = [0.0] * len(q)
-        return np.array(self.call(robot, "calculateInverseDynamics", q, zero, zero))
+        return np.array(self.call(robot, INVERSE_DYNAMICS,
+                                  lambda e, b: e.inverse_dynamics(b, q, zero, zero)))
 
     def forward_dynamics(self, robot: SimRobot, tau: Sequence[float]) -> np.ndarray:
         """The joint accelerations ``tau`` would cause now, without contacts.
@@ -155,9 +154,9 @@ class Dynamics:
         if index is None or index == -1:
             raise ParameterError(f"`link`: {robot.name} has no moving link named {link!r}",
                                  param="link")
-        q, qd = self.physical_state(robot)
-        lin, ang = self.call(robot, "calculateJacobian", index, list(point), q, qd,
-                             [0.0] * len(q))
+        q, _ = self.physical_state(robot)
+        at = (float(point[0]), float(point[1]), float(point[2]))
+        lin, ang = self.call(robot, JACOBIANS, lambda e, b: e.jacobian(b, index, at, q))
         return np.vstack([np.array(lin), np.array(ang)])
 
     def times_mass_matrix(self, robot: SimRobot, vector: list[float]) -> list[float]:
@@ -175,7 +174,7 @@ class Dynamics:
         if measured:
             q = [(x - robot.offsets.get(j.name, 0.0)) * robot.directions.get(j.name, 1.0)
                  for x, j in zip(q, dyn, strict=True)]
-        matrix = self.call(robot, "calculateMassMatrix", q)
+        matrix = self.call(robot, MASS_MATRIX, lambda e, b: e.mass_matrix(b, q))
         skip = len(matrix) - len(dyn)  # a floating base's 6 coordinates come first
         where = {j.name: skip + k for k, j in enumerate(dyn)}
         rows = [where[spec.name] for spec in robot.servo]
@@ -191,17 +190,16 @@ class Dynamics:
                        skip: int, n: int, vector: list[float]) -> list[float]:
         """``M v`` as simulation_and_control computes it, to the last bit.
 
-        A floating base's matrix at the base's true pose (flags=1 takes position and
-        quaternion first; the quaternion's 4th row and column are zero and dropped), and
-        numpy's matrix product (whose rounding differs from an exact sum by an ulp or two).
+        A floating base's matrix at the base's true pose (not at the engine's default base
+        pose), and numpy's matrix product (whose rounding differs from an exact sum by an ulp
+        or two).
         """
         import numpy as np
 
         if skip:
-            pos, orn = self.world.bullet.getBasePositionAndOrientation(robot.body)
-            full = np.asarray(self.call(robot, "calculateMassMatrix", [*pos, *orn, *q],
-                                        flags=1))
-            full = np.delete(np.delete(full, 6, 0), 6, 1)
+            pos, orn = self.world.engine.base_pose(robot.body)
+            full = np.asarray(self.call(robot, MASS_MATRIX, lambda e, b: e.floating_mass_matrix(
+                b, pos, orn, q)))
         else:
             full = np.asarray(matrix)
         block = full[skip:, skip:][:n, :n]
@@ -210,32 +208,30 @@ class Dynamics:
 
 @dataclass
 class Shadow:
-    """One robot's dynamics model: its client, its body, and what PyBullet made of it.
+    """One robot's dynamics model: its world, its body, the robot's version it is of.
 
     Attributes:
-        session: The shadow's own PyBullet client.
+        engine: The shadow's own world, in the simulation's engine (which remembers whether
+            it could build its dynamics model of the body).
         body: The robot's body id in it.
         version: The robot's mass-change count it was built at.
-        proven: PyBullet has built its inverse-dynamics model of the body (a call worked).
-        refused: Why PyBullet refused to (None: not refused, or not tried yet).
     """
 
-    session: Session
+    engine: Simulator
     body: int
     version: int
-    proven: bool = False
-    refused: str | None = None
 
 
 class Shadows:
-    """One shadow client per robot, built at the first dynamics query, rebuilt when stale."""
+    """One shadow world per robot, built at the first dynamics query, rebuilt when stale."""
 
     def __init__(self) -> None:
         self.models: dict[str, Shadow] = {}
 
-    def model(self, name: str, loaded: tuple[str, LoadOptions], gravity: Sequence[float],
-              changes: Mapping[tuple[int, str], MassValue], version: int) -> Shadow:
-        """The robot's model: its URDF as loaded, its changes since.
+    def model(self, name: str, loaded: tuple[str, LoadSettings], gravity: Sequence[float],
+              changes: Mapping[tuple[int, str], MassValue], version: int,
+              engine: str = "pybullet") -> Shadow:
+        """The robot's model: its URDF as loaded, its changes since, in engine ``engine``.
 
         ``version`` counts the robot's mass changes: a model built at an older one is
         closed and built again.
@@ -245,31 +241,26 @@ class Shadows:
             self.stale(name)
             shadow = None
         if shadow is None:
-            s = Session()
+            world = open_engine(engine)
             try:
-                s.bullet.setGravity(*gravity)
-                body = s.load_urdf(loaded[0], loaded[1], display=name)
+                world.set_gravity((gravity[0], gravity[1], gravity[2]))
+                body = world.load(loaded[0], loaded[1], display=name)
                 for (link, key), value in changes.items():
-                    s.bullet.changeDynamics(body, link, **{key: value})
+                    world.change_dynamics(body, link, **{key: value})
             except BaseException:
-                s.close()
+                world.close()
                 raise
-            shadow = self.models[name] = Shadow(s, body, version)
+            shadow = self.models[name] = Shadow(world, body, version)
         return shadow
 
     def stale(self, name: str) -> None:
         """Close a robot's model: it is built again when next asked."""
         shadow = self.models.pop(name, None)
         if shadow is not None:
-            shadow.session.close()
+            shadow.engine.close()
 
     def close(self) -> None:
-        """Disconnect every shadow client (safe to call twice)."""
+        """Close every shadow world (safe to call twice)."""
         for shadow in self.models.values():
-            shadow.session.close()
+            shadow.engine.close()
         self.models.clear()
-
-
-def _cannot(robot: SimRobot, fn: str) -> str:
-    """The start of a refusal's message (made only when there is one)."""
-    return f"PyBullet cannot compute {DYNAMICS_CALLS[fn]} of robot {robot.name!r}"

@@ -1,6 +1,6 @@
 """Episodes: the start of one robot for one episode (``Simulation.reset(overrides=...)``).
 
-:func:`reset_plan` checks a robot's overrides and turns them into the PyBullet calls that
+:func:`reset_plan` checks a robot's overrides and turns them into the engine calls that
 start it there; ``Simulation.reset`` checks every robot's before it restores anything.
 """
 
@@ -55,13 +55,13 @@ def _joint_calls(r: SimRobot, joints: Mapping[str, object]) -> list[Callable[[],
             if isinstance(value, Mapping) else (value, 0.0)
         q = r.to_physical(name, _number(r, name, position))
         qd = _number(r, name, velocity) * r.directions.get(name, 1.0)
-        calls.append(functools.partial(r.bullet.resetJointState, r.body, spec.index, q, qd))
+        calls.append(functools.partial(r.engine.reset_joint, r.body, spec.index, q, qd))
     return calls
 
 
 def _pose_call(r: SimRobot, position: list[float] | None, rpy: list[float] | None,
                quat: list[float] | None) -> Callable[[], None]:
-    p, cfg = r.bullet, r.config
+    engine, cfg = r.engine, r.config
     if quat is None:
         quat = list(rpy_to_quat(*rpy)) if rpy is not None else \
             list(cfg.orientation_quat) if cfg.orientation_quat is not None else \
@@ -71,16 +71,15 @@ def _pose_call(r: SimRobot, position: list[float] | None, rpy: list[float] | Non
         raise ParameterError(f"`overrides`: {r.name}.orientation_quat must not be all "
                              "zeros", param="overrides")
     orn = quat_mul([v / norm for v in quat], UP_AXES[cfg.up])
-    at = position if position is not None else list(cfg.position)
-    if cfg.pose_frame == "link":
-        # resetBasePositionAndOrientation places the centre of mass.
-        dyn = p.getDynamicsInfo(r.body, -1)
-        at, orn = p.multiplyTransforms(at, orn, dyn[3], dyn[4])
-    return lambda: p.resetBasePositionAndOrientation(r.body, at, orn)
+    given = position if position is not None else list(cfg.position)
+    at = (given[0], given[1], given[2])
+    if cfg.pose_frame == "link":  # a reset of the base places its centre of mass
+        return functools.partial(engine.reset_base_frame, r.body, at, orn)
+    return functools.partial(engine.reset_base, r.body, at, orn)
 
 
 def reset_plan(r: SimRobot, changes: Mapping[str, object]) -> list[Callable[[], None]]:
-    """The PyBullet calls that start ``r`` as ``changes`` says, checked before any runs."""
+    """The engine calls that start ``r`` as ``changes`` says, checked before any runs."""
     for key in changes:
         if key not in OVERRIDE_KEYS:
             raise ParameterError(f"`overrides`: unknown key {key!r} for {r.name}; known "
@@ -103,5 +102,7 @@ def reset_plan(r: SimRobot, changes: Mapping[str, object]) -> list[Callable[[], 
     if lin is not None or ang is not None:
         velocity = (lin if lin is not None else list(r.config.base_velocity),
                     ang if ang is not None else list(r.config.base_angular_velocity))
-        calls.append(lambda: r.bullet.resetBaseVelocity(r.body, *velocity))
+        lin, ang = velocity
+        calls.append(functools.partial(r.engine.reset_base_velocity, r.body,
+                                       (lin[0], lin[1], lin[2]), (ang[0], ang[1], ang[2])))
     return calls

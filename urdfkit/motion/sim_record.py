@@ -43,15 +43,15 @@ class Recorder:
         summary = _Summary()
         record = self._recorder(rows, ideal, summary, sink, keep=keep)
         interrupted = False
-        p = world.bullet
+        engine = world.engine
         try:
             if world.step_count % every == 0:
                 record()
             self._loop(end, every, record, real_time)
         except KeyboardInterrupt:
             interrupted = True
-        except p.error:
-            if not world.session.gui or p.isConnected():
+        except engine.error:
+            if not engine.gui or engine.connected():
                 raise
             interrupted = True  # the GUI window was closed
         kept = min(len(rows), len(ideal))

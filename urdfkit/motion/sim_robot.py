@@ -1,7 +1,7 @@
 """One robot of a simulation: the typed handle :class:`~urdfkit.sim.Simulation` keeps per body.
 
-A :class:`SimRobot` knows its body as PyBullet loaded it (joints, links, the measured frame of
-offsets and directions), the command it is under, and changes its own physical parameters
+A :class:`SimRobot` knows its body as the engine loaded it (joints, links, the measured frame
+of offsets and directions), the command it is under, and changes its own physical parameters
 (the ``set_*`` setters). What its sensors last read is in :attr:`SimRobot.readings`
 (:class:`Readings`, kept by :class:`~urdfkit.motion.sim_sensors.Sensors`).
 """
@@ -20,7 +20,7 @@ from urdfkit.core.errors import ParameterError
 from urdfkit.motion.sim_state import Command, JointSpec, Observation
 
 if TYPE_CHECKING:
-    from urdfkit.engine.session import Bullet, LoadOptions
+    from urdfkit.engine.api import LoadSettings, Simulator
     from urdfkit.motion.scenario_models import RobotConfig
     from urdfkit.motion.vehicle import Drivetrain
 
@@ -64,14 +64,14 @@ class SimRobot:
     """A loaded robot: its joints and links, frames, command and physical parameters.
 
     Attributes:
-        bullet: PyBullet bound to the simulation's client.
+        engine: The simulation's world.
         name: The robot's name in the scenario.
         path: ``robots[i]``, for messages.
         config: Its scenario table.
-        body: PyBullet's body id.
-        joints: Every joint, in PyBullet's order.
+        body: The engine's body id.
+        joints: Every joint, in the engine's order.
         links: Link name to index (the root link is -1).
-        loaded: The file PyBullet loaded, and how (the dynamics models load it again).
+        loaded: The file the engine loaded, and how (the dynamics models load it again).
         readings: What its sensors keep (:class:`Readings`).
         offsets, directions: The measured frame: ``(q - offset) * direction``.
         train: The drive train of a ``drive`` robot.
@@ -87,14 +87,14 @@ class SimRobot:
         contact_links, force_joints, pose_links, feet: What ``record`` asks of this robot.
     """
 
-    bullet: Bullet
+    engine: Simulator
     name: str
     path: str
     config: RobotConfig
     body: int
     joints: list[JointSpec]
     links: dict[str, int]
-    loaded: tuple[str, LoadOptions]
+    loaded: tuple[str, LoadSettings]
     readings: Readings
     offsets: dict[str, float] = field(default_factory=dict)
     directions: dict[str, float] = field(default_factory=dict)
@@ -135,20 +135,23 @@ class SimRobot:
         raise KeyError(name)
 
     def to_physical(self, name: str, measured: float) -> float:
-        """A measured joint position as PyBullet's: ``measured * direction + offset``."""
+        """A measured joint position as the engine's: ``measured * direction + offset``."""
         return measured * self.directions.get(name, 1.0) + self.offsets.get(name, 0.0)
 
     def joint_limits(self, name: str) -> tuple[float, float, float, float]:
-        """The URDF's lower, upper, effort and velocity limits of a joint, as PyBullet read them."""
-        info = self.bullet.getJointInfo(self.body, self.joint(name).index)
-        return info[8], info[9], info[10], info[11]
+        """The URDF's lower, upper, effort and velocity limits of a joint, as loaded.
+
+        As the engine read them (PyBullet: a continuous joint's lower 0 and upper -1).
+        """
+        info = self.engine.joints(self.body)[self.joint(name).index]
+        return info.lower, info.upper, info.effort, info.velocity
 
     def link_mass(self, link: str) -> float:
         """A link's mass now, kg."""
-        return float(self.bullet.getDynamicsInfo(self.body, self.link_index(link))[0])
+        return float(self.engine.dynamics(self.body, self.link_index(link)).mass)
 
     def link_index(self, link: str) -> int:
-        """PyBullet's index of a link (-1: the root); ParameterError naming the link if none."""
+        """The engine's index of a link (-1: the root); ParameterError naming it if none."""
         if link not in self.links:
             from urdfkit.core.suggest import hint
 
@@ -167,39 +170,23 @@ class SimRobot:
     # ---- poses
 
     def base_position(self) -> list[float]:
-        """The base's centre of mass, world (PyBullet's base frame)."""
-        return list(self.bullet.getBasePositionAndOrientation(self.body)[0])
+        """The base's centre of mass, world (the engine's base pose)."""
+        return list(self.engine.base_pose(self.body)[0])
 
     def link_pose(self, link: str) -> tuple[list[float], list[float]]:
         """World position and orientation (x, y, z, w) of a link's URDF frame."""
-        p = self.bullet
         index = self.links.get(link)
         if index is None:
             from urdfkit.core.suggest import hint
 
             raise ParameterError(f"`link`: {self.name} has no link named {link!r}"
                                  f"{hint(link, self.links)}", param="link")
-        if index == -1:
-            pos, orn = p.getBasePositionAndOrientation(self.body)
-            dyn = p.getDynamicsInfo(self.body, -1)
-            inv = p.invertTransform(dyn[3], dyn[4])
-            pos, orn = p.multiplyTransforms(pos, orn, inv[0], inv[1])
-        else:
-            st = p.getLinkState(self.body, index, computeForwardKinematics=True)
-            pos, orn = st[4], st[5]
-        return list(pos), list(orn)
+        pose = self.engine.link_pose(self.body, index)
+        return list(pose.position), list(pose.orientation)
 
-    def link_frames(self) -> list[tuple[list[float], list[float]]]:
+    def link_frames(self) -> list[tuple[Sequence[float], Sequence[float]]]:
         """Every URDF link frame's world pose now, base first (``(xyz, xyzw)``)."""
-        p, body = self.bullet, self.body
-        pos, orn = p.getBasePositionAndOrientation(body)
-        local = p.getDynamicsInfo(body, -1)
-        inv = p.invertTransform(local[3], local[4])
-        poses = [p.multiplyTransforms(pos, orn, inv[0], inv[1])]
-        for j in range(p.getNumJoints(body)):
-            st = p.getLinkState(body, j, computeForwardKinematics=True)
-            poses.append((st[4], st[5]))
-        return poses
+        return list(self.engine.link_frames(self.body))
 
     # ---- commands and motors
 
@@ -221,19 +208,17 @@ class SimRobot:
         return None
 
     def free(self, indices: Sequence[int] | None = None) -> None:
-        """Switch PyBullet's velocity motors to their joints' dry friction (0: free).
+        """Switch the joints' velocity motors to their dry friction (0: free).
 
         A velocity motor with target 0 and a force limit is Coulomb friction: it holds the
         joint against up to that much torque and slows it by that much when it moves. It
-        works alongside TORQUE_CONTROL (the servo); PyBullet's position and velocity
-        commands use the same motor and replace it while they drive the joint.
+        works alongside torque commands (the servo); position and velocity commands use the
+        same motor and replace it while they drive the joint.
         """
-        p = self.bullet
         joints = [j.index for j in self.active] if indices is None else list(indices)
         if joints:
-            p.setJointMotorControlArray(
-                self.body, joints, p.VELOCITY_CONTROL, targetVelocities=[0.0] * len(joints),
-                forces=[self.dry_friction.get(j, 0.0) for j in joints])
+            self.engine.motors(self.body, joints, "velocity", [0.0] * len(joints),
+                               forces=[self.dry_friction.get(j, 0.0) for j in joints])
 
     def release(self) -> None:
         """Before a new command: free every joint the last one drove, forget its torques."""
@@ -244,7 +229,7 @@ class SimRobot:
             self.torques.clear()
 
     def motor_driven(self, spec: JointSpec) -> bool:
-        """Whether a PyBullet position or velocity command holds this joint's motor now."""
+        """Whether a position or velocity command (no servo) holds this joint's motor now."""
         cmd = self.applied
         if cmd is None or self.servo:
             return False
@@ -256,14 +241,17 @@ class SimRobot:
     # ---- setters: physical parameters
 
     def change(self, link: str | None, **values: float) -> None:
-        """Change the dynamics (changeDynamics) of one link, or of all if ``link`` is None."""
+        """Change the dynamics of one link, or of all if ``link`` is None.
+
+        By PyBullet's changeDynamics names (:meth:`~urdfkit.engine.api.Simulator.change_dynamics`).
+        """
         links = [self.link_index(link)] if link is not None else \
             [-1, *range(len(self.joints))]
         for index in links:
-            self.bullet.changeDynamics(self.body, index, **values)
+            self.engine.change_dynamics(self.body, index, **values)
 
     def _mass_change(self, index: int, values: Mapping[str, MassValue]) -> None:
-        self.bullet.changeDynamics(self.body, index, **values)
+        self.engine.change_dynamics(self.body, index, **values)
         for key, value in values.items():
             self.changes[(index, key)] = value
         self.mass_version += 1
@@ -275,8 +263,8 @@ class SimRobot:
         from the collision shapes (a link without any gets ~1e-6): not what "heavier" means.
         """
         index = self.link_index(link)
-        info = self.bullet.getDynamicsInfo(self.body, index)
-        old, diagonal = info[0], info[2]
+        info = self.engine.dynamics(self.body, index)
+        old, diagonal = info.mass, info.inertia
         self._mass_change(index, {"mass": float(mass)})
         if old > 0:
             self._mass_change(index, {"localInertiaDiagonal":
@@ -288,9 +276,9 @@ class SimRobot:
                           {"localInertiaDiagonal": [float(v) for v in diagonal]})
 
     def set_joint_damping(self, joint: str, damping: float) -> None:
-        """PyBullet's joint damping of one joint (N m s/rad)."""
+        """The joint damping of one joint (N m s/rad; PyBullet's ``jointDamping``)."""
         spec = self.joint_named(joint)
-        self.bullet.changeDynamics(self.body, spec.index, jointDamping=float(damping))
+        self.engine.change_dynamics(self.body, spec.index, jointDamping=float(damping))
 
     def set_joint_friction(self, joint: str, friction: float) -> None:
         """A joint's dry (Coulomb) friction, N m (N for a prismatic joint); 0 removes it.

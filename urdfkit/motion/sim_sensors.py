@@ -32,7 +32,7 @@ class Sensors:
 
     def keep_velocities(self, r: SimRobot) -> None:
         """Remember the joint velocities now, for the next measurement's accelerations."""
-        states = self.world.bullet.getJointStates(r.body, r.frame[0])
+        states = self.world.engine.joint_rows(r.body, r.frame[0])
         r.readings.previous_velocities = [st[1] for st in states]
         r.readings.previous_step = self.world.step_count
 
@@ -46,9 +46,9 @@ class Sensors:
     def measure(self, r: SimRobot) -> Observation:
         """The true observation now, in the measured joint frame."""
         world = self.world
-        p, step = world.bullet, world.step_count
-        pos, orn = p.getBasePositionAndOrientation(r.body)
-        lin, ang = p.getBaseVelocity(r.body)
+        engine, step = world.engine, world.step_count
+        base = engine.base_state(r.body)
+        pos, orn, lin, ang = base.position, base.orientation, base.linear, base.angular
         matrix = quat_to_matrix(orn)
         angles: dict[str, float] = {}
         velocities: dict[str, float] = {}
@@ -56,7 +56,7 @@ class Sensors:
         torques: dict[str, float] | None = None
         if r.active:
             indices, names, signs, offsets = r.frame
-            states = p.getJointStates(r.body, indices)
+            states = engine.joint_rows(r.body, indices)
             if world.config.record.motor_torques:  # the joint's own frame, as applied
                 torques = {n: r.torques.get(n, st[3])
                            for n, st in zip(names, states, strict=True)}
@@ -89,19 +89,16 @@ class Sensors:
             joint_forces=forces, motor_torques=torques, link_poses=poses, feet=feet)
 
     def _forces(self, r: SimRobot) -> dict[str, list[float]]:
-        p = self.world.bullet
-        return {name: [float(x) for x in p.getJointState(r.body, index)[2]]
-                for name, index in r.force_joints.items()}
+        rows = self.world.engine.joint_rows(r.body, list(r.force_joints.values()))
+        return {name: [float(x) for x in row[2]]
+                for name, row in zip(r.force_joints, rows, strict=True)}
 
     def _contacts(self, r: SimRobot) -> dict[str, dict[str, float]]:
-        p, ground = self.world.bullet, self.world.ground
+        engine, ground = self.world.engine, self.world.ground
         contacts = {}
         for link, index in r.contact_links.items():
-            if ground is not None:
-                points = p.getContactPoints(bodyA=r.body, linkIndexA=index, bodyB=ground)
-            else:
-                points = p.getContactPoints(bodyA=r.body, linkIndexA=index)
-            contacts[link] = {"normal_force": float(sum(pt[9] for pt in points)),
+            points = engine.contacts(r.body, index, ground)
+            contacts[link] = {"normal_force": float(sum(pt.normal_force for pt in points)),
                               "count": len(points)}
         return contacts
 
@@ -114,28 +111,29 @@ class Sensors:
 
     def _feet(self, r: SimRobot) -> dict[str, FootReading]:
         """Each foot's contact forces from everything but its own robot (world and local)."""
-        p = self.world.bullet
+        engine = self.world.engine
         out: dict[str, FootReading] = {}
         for label, index in r.feet.items():
             normal = [0.0, 0.0, 0.0]
             friction = [0.0, 0.0, 0.0]
             total = 0.0
             count = 0
-            for pt in p.getContactPoints(bodyA=r.body, linkIndexA=index):
-                if pt[2] == r.body:
+            for pt in engine.contacts(r.body, index):
+                if pt.body_b == r.body:
                     continue  # self-contact: not a ground reaction
                 count += 1
-                total += pt[9]
-                # contactNormalOnB points from B to A: the push on the foot (A). The lateral
+                total += pt.normal_force
+                # The normal points from B to A: the push on the foot (A). The lateral
                 # friction directions are those of the force on B (measured: a box sliding
                 # along +x reads +mu m g), so the foot feels their opposite.
                 for k in range(3):
-                    normal[k] += pt[9] * pt[7][k]
-                    friction[k] -= pt[10] * pt[11][k] + pt[12] * pt[13][k]
+                    normal[k] += pt.normal_force * pt.normal[k]
+                    friction[k] -= pt.friction1 * pt.direction1[k] + \
+                        pt.friction2 * pt.direction2[k]
             if index == -1:  # the URDF frame, not the centre of mass
                 orn = r.link_pose(next(k for k, v in r.links.items() if v == -1))[1]
             else:
-                orn = p.getLinkState(r.body, index, computeForwardKinematics=True)[5]
+                orn = list(engine.link_pose(r.body, index).orientation)
             local = rotate_back(quat_to_matrix(orn), normal)
             out[label] = {"contact": int(count > 0), "normal": total, "world": normal,
                           "local": list(local), "friction_world": friction}

@@ -13,11 +13,11 @@ from typing import TYPE_CHECKING, Literal
 from urdfkit.motion.scenario import OBSERVATION_FIELDS
 
 if TYPE_CHECKING:
+    from urdfkit.engine.api import JointKind
     from urdfkit.motion.scenario_models import Mode
 
-_REVOLUTE, _PRISMATIC, _FIXED = 0, 1, 4  # p.JOINT_* values
-#: Joint types with one degree of freedom: what getJointState can report.
-_ACTIVE = (_REVOLUTE, _PRISMATIC)
+#: Joint kinds with one degree of freedom: what the joint state queries report.
+_ACTIVE = ("revolute", "prismatic")
 
 
 # --------------------------------------------------------------------------- observations
@@ -132,23 +132,32 @@ def _copy_feet(feet: Mapping[str, Mapping[str, int | float | list[float]]]
 
 @dataclass
 class JointSpec:
-    """What the simulation needs to know of one joint of a loaded body."""
+    """What the simulation needs to know of one joint of a loaded body.
+
+    Attributes:
+        index: The engine's joint index.
+        name: The URDF's joint name.
+        kind: ``revolute`` (continuous ones too), ``prismatic``, ``spherical``, ``planar``
+            or ``fixed``, as the engine loaded it.
+        effort: The URDF's effort limit (0: none given).
+        child_link: The joint's child link.
+    """
 
     index: int
     name: str
-    type: int
+    kind: JointKind
     effort: float
     child_link: str
 
     @property
     def active(self) -> bool:
         """Whether the joint has one degree of freedom we measure and drive."""
-        return self.type in _ACTIVE
+        return self.kind in _ACTIVE
 
     @property
     def revolute(self) -> bool:
-        """Whether the joint turns (revolute or continuous; PyBullet's JOINT_REVOLUTE)."""
-        return self.type == _REVOLUTE
+        """Whether the joint turns (revolute or continuous)."""
+        return self.kind == "revolute"
 
 
 #: What a command drives: a car's wheels and hinges, or joints by target.

@@ -1,8 +1,8 @@
-"""The world of a simulation: the session, the ground, the robots as loaded, time, save/restore.
+"""The world of a simulation: the engine, the ground, the robots as loaded, time, save/restore.
 
-:class:`World` loads the ground and every robot of a scenario into its session, checks every
-joint and link name the scenario gives against what PyBullet loaded, and keeps the starting
-state for :meth:`World.restore`.
+:class:`World` loads the ground and every robot of a scenario into its engine
+(:class:`~urdfkit.engine.api.Simulator`), checks every joint and link name the scenario gives
+against what the engine loaded, and keeps the starting state for :meth:`World.restore`.
 """
 
 from __future__ import annotations
@@ -15,13 +15,17 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from urdfkit.core.errors import EngineError, InputError, ParameterError
-from urdfkit.engine.session import LoadOptions, Session, prime_resets, restore_clean
-from urdfkit.model.spec import UP_AXES, quat_mul
+from urdfkit.engine.api import LoadSettings
+from urdfkit.engine.registry import open_engine
+from urdfkit.model.spec import UP_AXES, quat_mul, rpy_to_unit_quat
 from urdfkit.motion.scenario import JOINT_NOISE_FIELDS
 from urdfkit.motion.sim_robot import SimRobot, new_readings
-from urdfkit.motion.sim_state import _FIXED, JointSpec, _first
+from urdfkit.motion.sim_state import JointSpec, _first
 
 if TYPE_CHECKING:
+    from urdfkit.engine.api import Simulator
+    from urdfkit.engine.pybullet import PyBulletEngine
+    from urdfkit.engine.session import Bullet, Session
     from urdfkit.motion.scenario_models import RobotConfig, ScenarioConfig
     from urdfkit.sources.resolve import Resolved
 
@@ -36,19 +40,24 @@ def robot_seed(seed: int, i: int) -> int:
 
 
 class World:
-    """One PyBullet client holding a scenario's ground and robots.
+    """One engine's world holding a scenario's ground and robots.
+
+    Args:
+        config: The scenario.
+        gui: Open the engine's own window.
+        engine: The engine's name (:data:`urdfkit.engine.registry.ENGINES`).
 
     Attributes:
         config: The scenario.
-        session: The PyBullet client of this world alone.
-        bullet: PyBullet bound to that client.
+        engine: The world of this simulation alone, in its engine.
         time_step: The physics step, s.
         step_count: Physics steps since the start (or the last restore).
         ground: The ground's body id (None: no ground).
         robots: The robots by name, in scenario order.
     """
 
-    def __init__(self, config: ScenarioConfig, *, gui: bool = False) -> None:
+    def __init__(self, config: ScenarioConfig, *, gui: bool = False,
+                 engine: str = "pybullet") -> None:
         self.config = config
         self.time_step: float = config.physics.time_step
         self.step_count = 0
@@ -57,8 +66,32 @@ class World:
         self._resolved: list[Resolved] = []
         self._start_state = -1
         self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-sim-")
-        self.session = Session(gui=gui)
-        self.bullet = self.session.bullet
+        self.engine: Simulator = open_engine(engine, gui=gui)
+
+    @property
+    def session(self) -> Session:
+        """The PyBullet session of this world (PyBullet only, as :attr:`bullet`)."""
+        return self._pybullet().session
+
+    @property
+    def bullet(self) -> Bullet:
+        """PyBullet bound to this world's client: the PyBullet-only escape hatch.
+
+        For what the engine seam does not cover (a camera image, a debug line); the
+        simulation itself calls only :attr:`engine`.
+
+        Raises:
+            ParameterError: the world runs on another engine.
+        """
+        return self._pybullet().bullet
+
+    def _pybullet(self) -> PyBulletEngine:
+        from urdfkit.engine.pybullet import PyBulletEngine
+
+        if not isinstance(self.engine, PyBulletEngine):
+            raise ParameterError(f"`bullet`: this simulation runs on {self.engine.label}, "
+                                 "not PyBullet", param="bullet")
+        return self.engine
 
     @property
     def t(self) -> float:
@@ -70,8 +103,8 @@ class World:
         return InputError(f"{path}: {message}", file=self.config.source)
 
     def close(self) -> None:
-        """Disconnect the client and remove temp files (safe to call twice)."""
-        self.session.close()
+        """Close the engine and remove temp files (safe to call twice)."""
+        self.engine.close()
         for r in self._resolved:
             r.close()
         self._resolved = []
@@ -81,22 +114,22 @@ class World:
 
     def setup(self) -> None:
         """The engine's settings, the ground, every robot where it starts, what is recorded."""
-        p = self.bullet
+        engine = self.engine
         ph = self.config.physics
-        p.setTimeStep(ph.time_step)
-        p.setGravity(*ph.gravity)
+        engine.set_time_step(ph.time_step)
+        engine.set_gravity(_vec3(ph.gravity))
         # Sorted overlapping pairs: without them the order the solver meets contacts in
         # depends on the engine's history, and a reset in place is not reproducible. A
         # simulation_and_control config turns them off, as SimInterface leaves them (else
         # its contacts are solved in another order and the runs part after a few steps).
-        p.setPhysicsEngineParameter(deterministicOverlappingPairs=int(ph.deterministic_pairs))
-        p.setPhysicsEngineParameter(numSolverIterations=ph.solver_iterations,
-                                    enableConeFriction=int(ph.cone_friction))
+        engine.set_physics(deterministic_pairs=ph.deterministic_pairs,
+                           solver_iterations=ph.solver_iterations,
+                           cone_friction=ph.cone_friction)
         if self.config.ground is not None:
             g = self.config.ground
             self.ground = self._load("ground", g.template, g.params, g.urdf,
-                                     LoadOptions(fixed_base=True,
-                                                 base_position=_vec3(g.position)))
+                                     LoadSettings(fixed_base=True, position=_vec3(g.position),
+                                                  scenery=True))
         for i, robot in enumerate(self.config.robots):
             r = self._add_robot(i, robot)
             self.robots[r.name] = r
@@ -109,19 +142,18 @@ class World:
                 ("angularDamping", _first(r.config.angular_damping, ph.angular_damping)))
                 if value is not None}
             if damping:
-                p.changeDynamics(r.body, -1, **damping)
+                engine.change_dynamics(r.body, -1, **damping)
 
     def save(self) -> None:
         """Keep the state now as the start :meth:`restore` returns to.
 
-        restoreState is ~100x cheaper than a new Simulation.
+        A restore is ~100x cheaper than a new Simulation (PyBullet's restoreState).
         """
-        self._start_state = self.bullet.saveState()
-        prime_resets(self.bullet, self._start_state, [r.body for r in self.robots.values()])
+        self._start_state = self.engine.save()
 
     def restore(self) -> None:
         """Back to the saved start, contacts and all; time starts over."""
-        restore_clean(self.bullet, self._start_state, [r.body for r in self.robots.values()])
+        self.engine.restore(self._start_state)
         self.step_count = 0
 
     def set_time_step(self, time_step: float) -> None:
@@ -129,27 +161,27 @@ class World:
         if not 0 < time_step <= 1:
             raise ParameterError(f"`time_step` must be in (0, 1], got {time_step!r}",
                                  param="time_step")
-        self.bullet.setTimeStep(time_step)
+        self.engine.set_time_step(time_step)
         self.time_step = float(time_step)
 
     def change_ground(self, **values: float) -> None:
-        """Set the ground's dynamics (changeDynamics): its friction, restitution."""
+        """Set the ground's dynamics (changeDynamics' names): its friction, restitution."""
         if self.ground is None:
             raise ParameterError("the scenario has no ground", param="robot")
-        self.bullet.changeDynamics(self.ground, -1, **values)
+        self.engine.change_dynamics(self.ground, -1, **values)
 
-    def link_poses(self) -> list[list[tuple[list[float], list[float]]]]:
+    def link_poses(self) -> list[list[tuple[Sequence[float], Sequence[float]]]]:
         """Every robot's URDF link frames' world poses now, base first (``(xyz, xyzw)``).
 
         Robots in the scenario's order; the base's pose is its link frame, not the inertial
-        frame ``getBasePositionAndOrientation`` reports.
+        frame the engine's base pose is.
         """
         return [r.link_frames() for r in self.robots.values()]
 
     # ---- loading
 
     def _load(self, path: str, template: str | None, params: Mapping[str, object],
-              urdf: str | None, options: LoadOptions) -> int:
+              urdf: str | None, settings: LoadSettings) -> int:
         from urdfkit.model.catalog import build_template
         from urdfkit.sources.resolve import open_input
 
@@ -175,7 +207,7 @@ class World:
             display = urdf
         resolved = open_input(name)
         self._resolved.append(resolved)
-        return self.session.load_urdf(resolved.load_path, options, display=display)
+        return self.engine.load(str(resolved.load_path), settings, display=display)
 
     def _add_robot(self, i: int, cfg: RobotConfig) -> SimRobot:
         path = f"robots[{i}]"
@@ -189,54 +221,52 @@ class World:
         self._place(r)
         return r
 
-    def _load_robot(self, path: str, cfg: RobotConfig) -> tuple[int, tuple[str, LoadOptions]]:
+    def _load_robot(self, path: str, cfg: RobotConfig) -> tuple[int, tuple[str, LoadSettings]]:
         """Load the robot's URDF where the scenario puts it; refuse a body too big to query."""
-        p = self.bullet
+        engine = self.engine
         if cfg.orientation_quat is not None:
             norm = math.sqrt(math.fsum(q * q for q in cfg.orientation_quat))
             orientation = tuple(q / norm for q in cfg.orientation_quat)
         else:
-            orientation = tuple(p.getQuaternionFromEuler(cfg.orientation_rpy or (0, 0, 0)))
+            orientation = rpy_to_unit_quat(*(cfg.orientation_rpy or (0.0, 0.0, 0.0)))
         # A Y-up (or X-up) model is first stood up, then turned as the scenario says.
-        orientation = quat_mul(orientation, UP_AXES[cfg.up])
-        options = LoadOptions(fixed_base=cfg.base == "fixed",
-                              inertia_from_file=cfg.inertia_from_file,
-                              implicit_cylinder=cfg.implicit_cylinder,
-                              self_collision=cfg.self_collision,
-                              base_position=_vec3(cfg.position), base_orientation=orientation)
-        body = self._load(path, cfg.template, cfg.params, cfg.urdf, options)
+        turn = quat_mul(orientation, UP_AXES[cfg.up])
+        settings = LoadSettings(fixed_base=cfg.base == "fixed",
+                                inertia_from_file=cfg.inertia_from_file,
+                                implicit_cylinder=cfg.implicit_cylinder,
+                                self_collision=cfg.self_collision,
+                                position=_vec3(cfg.position), orientation=turn)
+        body = self._load(path, cfg.template, cfg.params, cfg.urdf, settings)
         if cfg.pose_frame == "com":
-            # The pose is the base's centre of mass, as resetBasePositionAndOrientation takes it.
-            p.resetBasePositionAndOrientation(body, cfg.position, orientation)
-        loaded = (str(self._resolved[-1].load_path), options)
+            # The pose is the base's centre of mass, as the engine's base pose is.
+            engine.reset_base(body, _vec3(cfg.position), turn)
+        loaded = (str(self._resolved[-1].load_path), settings)
         if cfg.gazebo_contacts:  # before link_dynamics, which overrides them
             from urdfkit.motion.gazebo_load import apply_gazebo_contacts, contacts_to_apply
 
-            apply_gazebo_contacts(p, body, contacts_to_apply(self._resolved[-1].root))
+            apply_gazebo_contacts(engine, body, contacts_to_apply(self._resolved[-1].root))
         if cfg.mimic:  # PyBullet ignores <mimic>: a gear constraint per follower
             from urdfkit.motion.mimic import couple_mimics, mimic_relations
 
-            couple_mimics(p, body, mimic_relations(self._resolved[-1].root))
+            couple_mimics(engine, body, mimic_relations(self._resolved[-1].root))
         try:
-            # getBasePositionAndOrientation, getJointStates... all fail on 128+ link bodies.
-            self.session.require_state_queries(body, str(cfg.name))
+            # PyBullet's state queries all fail on 128+ link bodies.
+            engine.require_state_queries(body, str(cfg.name))
         except EngineError as e:
             raise self.error(path, str(e)) from None
         return body, loaded
 
     def _new_robot(self, i: int, path: str, cfg: RobotConfig, body: int,
-                   loaded: tuple[str, LoadOptions]) -> SimRobot:
-        """The robot's handle: its joints and links as PyBullet loaded them."""
-        p = self.bullet
-        joints: list[JointSpec] = []
-        for j in range(p.getNumJoints(body)):
-            info = p.getJointInfo(body, j)
-            joints.append(JointSpec(j, info[1].decode("utf-8", "replace"), info[2],
-                                    float(info[10]), info[12].decode("utf-8", "replace")))
-        links = {p.getBodyInfo(body)[0].decode("utf-8", "replace"): -1}
+                   loaded: tuple[str, LoadSettings]) -> SimRobot:
+        """The robot's handle: its joints and links as the engine loaded them."""
+        engine = self.engine
+        joints = [JointSpec(j.index, j.name, j.kind, j.effort, j.link)
+                  for j in engine.joints(body)]
+        links = {engine.link_names(body)[0]: -1}
         links.update({j.child_link: j.index for j in joints})
         readings = new_readings(robot_seed(self.config.seed, i), cfg.delay, cfg.history)
-        return SimRobot(p, str(cfg.name), path, cfg, body, joints, links, loaded, readings)
+        return SimRobot(engine, str(cfg.name), path, cfg, body, joints, links, loaded,
+                        readings)
 
     def _active_joint(self, r: SimRobot, where: str, name: str) -> JointSpec:
         """The movable joint ``name`` of ``r``; an error naming ``where`` otherwise."""
@@ -247,7 +277,7 @@ class World:
             raise self.error(where, f"no joint named {name!r} in {r.config.name}; active "
                                     f"joints: {known}") from None
         if not spec.active:
-            kind = "fixed" if spec.type == _FIXED else "not a 1-DOF joint"
+            kind = "fixed" if spec.kind == "fixed" else "not a 1-DOF joint"
             raise self.error(where, f"joint {name!r} is {kind} and cannot be moved")
         return spec
 
@@ -285,7 +315,7 @@ class World:
         v = cfg.vehicle
         # Detection judges axes in the base frame, at load time: before any step.
         try:
-            r.train = detect_upright(self.bullet, r.body, UP_AXES[cfg.up],
+            r.train = detect_upright(self.engine, r.body, UP_AXES[cfg.up],
                                      wheels=v.wheels if v else None,
                                      hinges=v.hinges if v else None)
         except ParameterError as e:
@@ -311,7 +341,7 @@ class World:
 
     def _place(self, r: SimRobot) -> None:
         """The start the config gives: joint friction, rack, link dynamics, initial joints."""
-        p = self.bullet
+        engine = self.engine
         cfg, path, body = r.config, r.path, r.body
         for name, friction in cfg.joint_friction.items():
             r.dry_friction[self._active_joint(r, f"{path}.joint_friction.{name}",
@@ -319,13 +349,12 @@ class World:
         # PyBullet holds every joint with a velocity motor (target 0) until told otherwise.
         r.free()
         if any(cfg.base_velocity) or any(cfg.base_angular_velocity):
-            p.resetBaseVelocity(body, cfg.base_velocity, cfg.base_angular_velocity)
+            engine.reset_base_velocity(body, _vec3(cfg.base_velocity),
+                                       _vec3(cfg.base_angular_velocity))
         if cfg.base == "on_rack":
             # Held in the air where it starts (simulation_and_control's rack): a fixed
             # constraint between the base and the world; its joints still move.
-            pos, orn = p.getBasePositionAndOrientation(body)
-            p.createConstraint(body, -1, -1, -1, p.JOINT_FIXED, [0, 0, 0], [0, 0, 0],
-                               pos, childFrameOrientation=orn)
+            engine.hold_base(body)
         for link, dyn in cfg.link_dynamics.items():
             if link not in r.links:
                 raise self.error(f"{path}.link_dynamics.{link}",
@@ -335,11 +364,11 @@ class World:
                 ("rollingFriction", dyn.rolling_friction),
                 ("spinningFriction", dyn.spinning_friction)) if value is not None}
             if values:
-                p.changeDynamics(body, r.links[link], **values)
+                engine.change_dynamics(body, r.links[link], **values)
         for name, init in cfg.initial_joints.items():
             spec = self._active_joint(r, f"{path}.initial_joints.{name}", name)
-            p.resetJointState(body, spec.index, r.to_physical(name, init.position),
-                              init.velocity * r.directions.get(name, 1.0))
+            engine.reset_joint(body, spec.index, r.to_physical(name, init.position),
+                               init.velocity * r.directions.get(name, 1.0))
 
     def _having_link(self, where: str, link: str) -> list[SimRobot]:
         """The robots with a link of that name; an error naming ``where`` if none has one."""
@@ -371,4 +400,4 @@ class World:
             for r in found:
                 index = r.joint(name).index
                 r.force_joints[name] = index
-                self.bullet.enableJointForceTorqueSensor(r.body, index, True)
+                self.engine.enable_joint_force_sensor(r.body, index)

@@ -3,18 +3,20 @@
 :class:`Simulation` is a facade over typed parts that meet through small interfaces
 (docs/architecture.md draws them):
 
-- :class:`~urdfkit.motion.sim_world.World`: the session, the ground, the robots as loaded,
-  time, save and restore;
+- :class:`~urdfkit.motion.sim_world.World`: the engine (:mod:`urdfkit.engine.api`), the
+  ground, the robots as loaded, time, save and restore;
 - :class:`~urdfkit.motion.sim_robot.SimRobot`, one per body: joints, frames, the command in
   force, setters, link poses (the handle :meth:`Simulation.robot` gives);
 - :class:`~urdfkit.motion.sim_control.Controller`: applies a robot's command every step
-  (PyBullet's motors, or the servo model);
+  (the engine's motors, or the servo model);
 - :class:`~urdfkit.motion.sim_sensors.Sensors`: measuring, noise, delay, history;
 - :class:`~urdfkit.motion.sim_dynamics.Dynamics`: mass matrix, inverse and forward dynamics,
   Jacobians, on shadow models;
 - :class:`~urdfkit.motion.sim_record.Recorder`: the run loop and the sinks rows go to.
 
-:mod:`urdfkit.sim` re-exports the public names.
+:mod:`urdfkit.sim` re-exports the public names. Every part calls the engine through the
+seam's :class:`~urdfkit.engine.api.Simulator`; :attr:`Simulation.bullet` (and
+:attr:`Simulation.session`) hand out PyBullet itself, for what the seam does not cover.
 """
 
 from __future__ import annotations
@@ -45,12 +47,13 @@ from urdfkit.motion.sim_writers import (
 if TYPE_CHECKING:
     import numpy as np
 
+    from urdfkit.engine.api import Simulator
     from urdfkit.engine.session import Bullet, Session
     from urdfkit.motion.scenario_models import Mode, ScenarioConfig
 
 
 class Simulation:
-    """A scenario running in its own PyBullet client.
+    """A scenario running in a world of its own (a PyBullet client).
 
     Args:
         config: A validated scenario (:func:`urdfkit.motion.scenario.load_scenario`) or the plain
@@ -73,8 +76,8 @@ class Simulation:
         self.sensors = Sensors(self.world)
         self.dynamics = Dynamics(self.world)
         self.recorder = Recorder(self.world, self.sensors, self.step)
-        motors = MotorControl(self.world.bullet)
-        servo = ServoControl(self.world.bullet, self.sensors, self.dynamics)
+        motors = MotorControl(self.world.engine)
+        servo = ServoControl(self.world.engine, self.sensors, self.dynamics)
         #: What applies each robot's command every step: the servo model, or PyBullet's motors.
         self.controllers: dict[str, Controller] = {}
         try:
@@ -129,13 +132,22 @@ class Simulation:
     # ---- the world
 
     @property
+    def engine(self) -> Simulator:
+        """The world of this simulation alone, behind the engine seam."""
+        return self.world.engine
+
+    @property
     def session(self) -> Session:
-        """The PyBullet client of this simulation alone."""
+        """The PyBullet client of this simulation alone (PyBullet only, as :attr:`bullet`)."""
         return self.world.session
 
     @property
     def bullet(self) -> Bullet:
-        """PyBullet bound to this simulation's client (``sim.bullet.getNumBodies()``)."""
+        """PyBullet bound to this simulation's client (``sim.bullet.getNumBodies()``).
+
+        The PyBullet-only escape hatch, for what the API does not cover (a camera image, a
+        debug line): the simulation itself calls only :attr:`engine`.
+        """
         return self.world.bullet
 
     @property
@@ -232,7 +244,7 @@ class Simulation:
         velocities, so the row's accelerations are over one step, as before.
         """
         world, sensors = self.world, self.sensors
-        step = world.bullet.stepSimulation
+        step = world.engine.step
         every = self.config.record.every
         robots = list(world.robots.values())
         delayed = [r for r in robots if r.config.delay > 0 or r.readings.reports is not None]
@@ -292,11 +304,12 @@ class Simulation:
               overrides: Mapping[str, Mapping[str, object]] | None = None) -> None:
         """Go back to the starting state in place, deterministically.
 
-        Positions, velocities and contacts come back through PyBullet's saveState and
-        restoreState; time, observation history, delays, commands and noise generators
-        (reseeded with ``seed``, default the scenario's) start over, so the same seed and the
-        same actions give the same observations. Changes made with the ``set_*`` methods
-        stay: they change the robot, not its state.
+        Positions, velocities and contacts come back through the engine's save and
+        restore (PyBullet's saveState and restoreState); time, observation history,
+        delays, commands and noise generators (reseeded with ``seed``, default the
+        scenario's) start over, so the same seed and the same actions give the same
+        observations. Changes made with the ``set_*`` methods stay: they change the
+        robot, not its state.
 
         Args:
             seed: Reseeds the noise; default: the scenario's ``seed``.
@@ -345,7 +358,7 @@ class Simulation:
         velocity motors; for the servo model and torque commands, the torque it applied.
         """
         r = self.robot(robot)
-        states = self.world.bullet.getJointStates(r.body, [j.index for j in r.active])
+        states = self.world.engine.joint_rows(r.body, [j.index for j in r.active])
         # PyBullet reports 0 for a torque-controlled joint: the torque given is the answer.
         return {j.name: r.torques.get(j.name, st[3])
                 for j, st in zip(r.active, states, strict=True)}
@@ -354,11 +367,11 @@ class Simulation:
         """World position and orientation (x, y, z, w) of a link's URDF frame."""
         return self.robot(robot).link_pose(link)
 
-    def link_poses(self) -> list[list[tuple[list[float], list[float]]]]:
+    def link_poses(self) -> list[list[tuple[Sequence[float], Sequence[float]]]]:
         """Every robot's URDF link frames' world poses now, base first (``(xyz, xyzw)``).
 
         Robots in the scenario's order; the base's pose is its link frame, not the inertial
-        frame ``getBasePositionAndOrientation`` reports.
+        frame the engine's base pose is (PyBullet's ``getBasePositionAndOrientation``).
         """
         return self.world.link_poses()
 

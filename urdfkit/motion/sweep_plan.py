@@ -593,9 +593,9 @@ def _local_rows(todo: Iterable[Job], count: int, jobs: int | None
     import multiprocessing
 
     from urdfkit.checks.check import worker_init
-    from urdfkit.engine.session import import_pybullet
+    from urdfkit.engine.registry import preload
 
-    import_pybullet()  # once, here: the forked workers inherit it, warm
+    preload("pybullet")  # once, here: the forked workers inherit it, warm
     context = multiprocessing.get_context("fork" if sys.platform.startswith("linux")
                                           else "spawn")
     # The with block terminates the workers on the way out (Ctrl-C included).

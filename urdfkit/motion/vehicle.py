@@ -1,6 +1,6 @@
 """Which joints of a loaded body are wheels and steering hinges, and how to drive them.
 
-Detection works on the body PyBullet loaded (so it sees exactly the joint indices the motors
+Detection works on the body the engine loaded (so it sees exactly the joint indices the motors
 are addressed by), in the **base frame**: the caller stands the body upright for it (see
 :func:`detect_drivetrain`), so a car spawned tilted is judged as the car it is.
 
@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from urdfkit.core.errors import ParameterError
 from urdfkit.model.spec import quat_to_matrix, rotate
@@ -56,7 +56,7 @@ from urdfkit.motion.vehicle_shapes import (
 )
 
 if TYPE_CHECKING:
-    from urdfkit.engine.session import Bullet
+    from urdfkit.engine.api import JointInfo, Simulator
 
 #: |axis . up| below this is "horizontal" (about 11 degrees of tilt allowed).
 HORIZONTAL_TOLERANCE = 0.2
@@ -77,9 +77,6 @@ PYBULLET_DEFAULT_FORCE = 100000.0
 
 #: How the wheels are driven (see docs/drive.md).
 DRIVETRAINS = ("differential", "rear", "locked")
-
-_REVOLUTE = 0  # p.JOINT_REVOLUTE
-_PRISMATIC = 1  # p.JOINT_PRISMATIC
 
 
 
@@ -319,9 +316,9 @@ class Drivetrain:
         }
 
 
-def _is_continuous(info: tuple[Any, ...]) -> bool:  # getJointInfo's
-    lower, upper = info[8], info[9]
-    return info[2] == _REVOLUTE and (lower > upper or upper - lower >= 2 * math.pi - 1e-6)
+def _is_continuous(info: JointInfo) -> bool:
+    return info.kind == "revolute" and (not info.limited
+                                        or info.upper - info.lower >= 2 * math.pi - 1e-6)
 
 
 def _pick(spec: Sequence[str | int], names: dict[int, str], movable: list[int],
@@ -352,7 +349,7 @@ def _pick(spec: Sequence[str | int], names: dict[int, str], movable: list[int],
     return out
 
 
-def detect_drivetrain(p: Bullet, body: int,
+def detect_drivetrain(engine: Simulator, body: int,
                       wheels: Sequence[str | int] | None = None,
                       hinges: Sequence[str | int] | None = None,
                       mode: str = "differential") -> Drivetrain:
@@ -363,7 +360,7 @@ def detect_drivetrain(p: Bullet, body: int,
     "vertical" and "touches the ground" are judged in the base frame.
 
     Args:
-        p: The pybullet module bound to the body's client (``Session.bullet``).
+        engine: The world the body is in.
         body: The body id.
         wheels: Joint names or indices to drive instead of the detected wheels.
         hinges: Joint names or indices to steer instead of the detected hinges.
@@ -375,7 +372,7 @@ def detect_drivetrain(p: Bullet, body: int,
     if mode not in DRIVETRAINS:
         raise DrivetrainError(f"`drivetrain` must be one of {', '.join(DRIVETRAINS)}, got "
                               f"{mode!r}", param="drivetrain")
-    scan = _Scan(p, body)
+    scan = _Scan(engine, body)
     names, movable, infos = scan.names, scan.movable, scan.infos
     wheel_list = _pick(wheels, names, movable, "wheels") if wheels is not None \
         else _find_wheels(scan)
@@ -397,9 +394,9 @@ def detect_drivetrain(p: Bullet, body: int,
     passive = [j for j in movable if j not in driven]
     in_base = (vdot(forward, scan.base_x), vdot(forward, scan.base_y))
     n = scan.n
-    link_names = {k: infos[k][12].decode("utf-8", "replace") for k in range(n)}
-    link_names[-1] = p.getBodyInfo(body)[0].decode("utf-8", "replace")
-    efforts = {j: float(infos[j][10]) for j in movable}
+    link_names = {k: infos[k].link for k in range(n)}
+    link_names[-1] = engine.link_names(body)[0]
+    efforts = {j: infos[j].effort for j in movable}
     caster_links = _caster_links(scan, wheel_list, casters)
     free = set(casters) | _caster_rollers(scan, caster_links, wheel_list, hinge_list)
     return Drivetrain(wheel_list, hinge_list, passive, names, hinge_limits, wheel_signs,
@@ -410,30 +407,29 @@ def detect_drivetrain(p: Bullet, body: int,
 class _Scan:
     """What detection reads of a body once: joints, their world axes and origins, shapes."""
 
-    def __init__(self, p: Bullet, body: int) -> None:
-        self.n = n = p.getNumJoints(body)
-        self.infos = infos = [p.getJointInfo(body, j) for j in range(n)]
-        self.names = {j: info[1].decode("utf-8", "replace") for j, info in enumerate(infos)}
+    def __init__(self, engine: Simulator, body: int) -> None:
+        self.infos = infos = engine.joints(body)
+        self.n = n = len(infos)
+        self.names = {j: info.name for j, info in enumerate(infos)}
         self.movable = movable = [j for j, info in enumerate(infos)
-                                  if info[2] in (_REVOLUTE, _PRISMATIC)]
-        states = {j: p.getLinkState(body, j, computeForwardKinematics=True) for j in movable}
-        self.origin = {j: tuple(states[j][4]) for j in movable}
+                                  if info.kind in ("revolute", "prismatic")]
+        states = {j: engine.link_pose(body, j) for j in movable}
+        self.origin: dict[int, Vec] = {j: (states[j].position[0], states[j].position[1],
+                                           states[j].position[2]) for j in movable}
         # getJointInfo's axis is in the child's inertial frame (measured: with inertia products
         # and URDF_USE_INERTIA_FROM_FILE a PR2 caster's vertical axis read 32 degrees off in the
         # link frame), so it turns with the link's centre-of-mass orientation, not its URDF
         # frame.
-        self.axes = {j: vunit(rotate(quat_to_matrix(states[j][1]), infos[j][13]))
+        self.axes = {j: vunit(rotate(quat_to_matrix(states[j].inertial_orientation),
+                                     infos[j].axis))
                      for j in movable}
-        base_pos, base_orn = p.getBasePositionAndOrientation(body)
-        dyn = p.getDynamicsInfo(body, -1)
-        inv_pos, inv_orn = p.invertTransform(dyn[3], dyn[4])
-        self.base_link, base_link_orn = p.multiplyTransforms(base_pos, base_orn, inv_pos,
-                                                             inv_orn)
+        base = engine.link_pose(body, -1)
+        self.base_link, base_link_orn = base.position, base.orientation
         base_rot = quat_to_matrix(base_link_orn)
         self.base_x = rotate(base_rot, (1.0, 0.0, 0.0))
         self.base_y = rotate(base_rot, (0.0, 1.0, 0.0))
-        self.link_points = {link: shape_points(p, body, link) for link in range(-1, n)}
-        self.lowest = lowest_point(p, body, self.link_points)
+        self.link_points = {link: shape_points(engine, body, link) for link in range(-1, n)}
+        self.lowest = lowest_point(engine, body, self.link_points)
         self._shapes: dict[int, tuple[float, float, Vec] | None] = {}
         self.forward: Vec = (1.0, 0.0, 0.0)
         self.left: Vec = (0.0, 1.0, 0.0)
@@ -446,11 +442,11 @@ class _Scan:
 
     def hinge_of(self, w: int, candidates: Sequence[int]) -> int | None:
         """The nearest joint above ``w`` (``w`` excluded) that is among ``candidates``."""
-        k = self.infos[w][16]
+        k = self.infos[w].parent
         while k >= 0:
             if k in candidates:
                 return k
-            k = self.infos[k][16]
+            k = self.infos[k].parent
         return None
 
     def face(self, forward: Vec) -> None:
@@ -504,7 +500,7 @@ def _find_hinges(scan: _Scan, wheel_list: list[int], named_wheels: bool
     """Steering hinges above the wheels, and casters: (wheels, hinges, casters)."""
     infos, axes = scan.infos, scan.axes
     verticals = [j for j in scan.movable if j not in set(wheel_list)
-                 and infos[j][2] == _REVOLUTE and abs(axes[j][2]) > VERTICAL_TOLERANCE]
+                 and infos[j].kind == "revolute" and abs(axes[j][2]) > VERTICAL_TOLERANCE]
     carrying = [j for j in verticals if any(scan.hinge_of(w, [j]) == j for w in wheel_list)]
     # A vertical joint that turns all the way round is a caster's swivel, not steering:
     # it and the wheels it carries roll free (unless the user named those wheels).
@@ -559,8 +555,8 @@ def _hinge_geometry(scan: _Scan, hinge_list: list[int]
         sign = -1.0 if scan.axes[j][2] < 0 else 1.0
         hinge_signs[j] = sign
         pivot[j] = scan.planar(scan.origin[j])
-        lower, upper = scan.infos[j][8], scan.infos[j][9]
-        if lower > upper:
+        lower, upper = scan.infos[j].lower, scan.infos[j].upper
+        if not scan.infos[j].limited:
             hinge_limits[j] = (-math.inf, math.inf)
         else:
             ends = sorted((lower * sign, upper * sign))
@@ -593,10 +589,10 @@ def _caster_rollers(scan: _Scan, caster_links: list[int], wheel_list: list[int],
     """
     carrying: set[int] = set()
     for w in wheel_list:
-        k = scan.infos[w][16]
+        k = scan.infos[w].parent
         while k >= 0:
             carrying.add(k)
-            k = scan.infos[k][16]
+            k = scan.infos[k].parent
     rollers: set[int] = set()
     for k in caster_links:
         j = k
@@ -605,7 +601,7 @@ def _caster_rollers(scan: _Scan, caster_links: list[int], wheel_list: list[int],
                 if not _is_continuous(scan.infos[j]) or j in wheel_list or j in hinge_list:
                     break
                 rollers.add(j)
-            j = scan.infos[j][16]
+            j = scan.infos[j].parent
     return rollers
 
 
@@ -632,7 +628,7 @@ def _forward(wheel_axes: list[Vec], base_x: Vec, base_y: Vec) -> Vec:
     return roll if vdot(roll, flat_y) > 0 else (-roll[0], -roll[1], 0.0)
 
 
-def detect_upright(p: Bullet, body: int, upright: Sequence[float],
+def detect_upright(engine: Simulator, body: int, upright: Sequence[float],
                    wheels: Sequence[str | int] | None = None,
                    hinges: Sequence[str | int] | None = None,
                    mode: str = "differential") -> Drivetrain:
@@ -641,18 +637,18 @@ def detect_upright(p: Bullet, body: int, upright: Sequence[float],
     A body spawned tilted (or upside down) is stood up where it is for detection, so its
     wheels are judged in its own frame, then put back exactly as it was.
     """
-    pos, orn = base_link_pose(p, body)  # the link frame is the one to stand up
+    pos, orn = base_link_pose(engine, body)  # the link frame is the one to stand up
     turned = any(abs(a - b) > 1e-12 for a, b in zip(orn, upright, strict=True))
     if turned:
-        set_base_link_pose(p, body, pos, list(upright))
+        set_base_link_pose(engine, body, pos, list(upright))
     try:
-        return detect_drivetrain(p, body, wheels, hinges, mode)
+        return detect_drivetrain(engine, body, wheels, hinges, mode)
     finally:
         if turned:
-            set_base_link_pose(p, body, pos, orn)
+            set_base_link_pose(engine, body, pos, orn)
 
 
-def disable_default_motors(p: Bullet, body: int, joints: Sequence[int]) -> None:
+def disable_default_motors(engine: Simulator, body: int, joints: Sequence[int]) -> None:
     """Switch off PyBullet's default velocity motors on ``joints``.
 
     PyBullet gives every revolute and prismatic joint a velocity motor with target 0 at load
@@ -661,18 +657,17 @@ def disable_default_motors(p: Bullet, body: int, joints: Sequence[int]) -> None:
     """
     if not joints:
         return
-    p.setJointMotorControlArray(body, list(joints), p.VELOCITY_CONTROL,
-                                targetVelocities=[0.0] * len(joints),
-                                forces=[0.0] * len(joints))
+    engine.motors(body, list(joints), "velocity", [0.0] * len(joints),
+                  forces=[0.0] * len(joints))
 
 
-def apply_drive(p: Bullet, body: int, train: Drivetrain, throttle: float,
+def apply_drive(engine: Simulator, body: int, train: Drivetrain, throttle: float,
                 steer: float, max_force: float | None, steer_force: float = STEER_FORCE
                 ) -> None:
     """Set the wheel and hinge motors once; PyBullet keeps them until they are changed.
 
     Args:
-        p: The pybullet module bound to the body's client (``Session.bullet``).
+        engine: The world the body is in.
         body: The body id.
         train: What :func:`detect_drivetrain` found.
         throttle: Wheel angular velocity, rad/s (positive = forward): see
@@ -686,18 +681,16 @@ def apply_drive(p: Bullet, body: int, train: Drivetrain, throttle: float,
     force = PYBULLET_DEFAULT_FORCE if max_force is None else max_force
     driven = [w for w in train.wheels if w in speeds]
     if driven:
-        p.setJointMotorControlArray(
-            body, driven, p.VELOCITY_CONTROL,
-            targetVelocities=[speeds[w] * train.wheel_signs.get(w, 1.0) for w in driven],
-            forces=[force] * len(driven))
-    disable_default_motors(p, body, train.free)
+        engine.motors(body, driven, "velocity",
+                      [speeds[w] * train.wheel_signs.get(w, 1.0) for w in driven],
+                      forces=[force] * len(driven))
+    disable_default_motors(engine, body, train.free)
     if train.hinges:
         angles = train.hinge_angles(steer) if train.mode != "locked" else \
             dict.fromkeys(train.hinges, steer)
-        p.setJointMotorControlArray(
-            body, train.hinges, p.POSITION_CONTROL,
-            targetPositions=[angles[h] * train.hinge_signs.get(h, 1.0) for h in train.hinges],
-            forces=[steer_force] * len(train.hinges))
+        engine.motors(body, train.hinges, "position",
+                      [angles[h] * train.hinge_signs.get(h, 1.0) for h in train.hinges],
+                      forces=[steer_force] * len(train.hinges))
 
 
 def clamp_steer(train: Drivetrain, steer: float) -> tuple[float, str | None]:

@@ -1,6 +1,6 @@
 """A body's shape as drive sees it: points on its collision shapes, its lowest point, roundness.
 
-Read from PyBullet (``getCollisionShapeData`` and link states), never from getAABB: the AABB of
+Read from the engine's collision shapes and link frames, never from the AABB: PyBullet's AABB of
 a base with inertia products turns with its inertial frame and grows (1.8 cm on a small robot).
 """
 
@@ -13,51 +13,46 @@ from typing import TYPE_CHECKING
 from urdfkit.model.spec import quat_to_matrix, rotate
 
 if TYPE_CHECKING:
-    from urdfkit.engine.session import Bullet
+    from urdfkit.engine.api import Simulator
 
 Vec = tuple[float, float, float]
 
 #: Sectors around a joint axis in which :func:`roundness` measures how far the shapes reach.
 ROUND_SECTORS = 12
-_SPHERE, _BOX, _CYLINDER, _MESH, _CAPSULE = 2, 3, 4, 5, 7  # p.GEOM_*
 
 
-def shape_points(p: Bullet, body: int, link: int) -> list[Vec]:
+def shape_points(engine: Simulator, body: int, link: int) -> list[Vec]:
     """Points outlining a link's collision shapes, in world coordinates.
 
     Meshes (and cylinders PyBullet turned into meshes) give their vertices; implicit
     cylinders, capsules, spheres and boxes are outlined from their dimensions.
     """
-    if link < 0:  # the base: getBasePositionAndOrientation is its inertial (COM) frame
-        pos_, orn_ = p.getBasePositionAndOrientation(body)
+    if link < 0:  # the base: its pose is its inertial (COM) frame
+        pos_, orn_ = engine.base_pose(body)
         com_pos, com_rot = tuple(pos_), quat_to_matrix(orn_)
     else:
-        st = p.getLinkState(body, link, computeForwardKinematics=True)
-        com_pos, com_rot = st[0], quat_to_matrix(st[1])
+        st = engine.link_pose(body, link)
+        com_pos, com_rot = st.inertial_position, quat_to_matrix(st.inertial_orientation)
     out: list[Vec] = []
-    for k, shape in enumerate(p.getCollisionShapeData(body, link)):
-        kind, dims, pos, orn = shape[2], shape[3], shape[5], shape[6]
+    for shape in engine.collision_shapes(body, link):
+        kind, dims, pos, orn = shape.kind, shape.dimensions, shape.position, shape.orientation
         local: list[Vec] = []
-        if kind == _MESH:
-            try:
-                count, verts = p.getMeshData(body, link, collisionShapeIndex=k)
-            except p.error:
-                count, verts = 0, []
-            if count:  # already in the link's inertial frame
-                out += [vadd(com_pos, rotate(com_rot, v)) for v in verts]
+        if kind == "mesh":
+            if shape.vertices:  # already in the link's inertial frame
+                out += [vadd(com_pos, rotate(com_rot, v)) for v in shape.vertices]
             continue
-        if kind == _SPHERE:
+        if kind == "sphere":
             r = dims[0]
             local = [(r * x, r * y, r * z) for x, y, z in _SPHERE_DIRECTIONS]
-        elif kind in (_CYLINDER, _CAPSULE):
+        elif kind in ("cylinder", "capsule"):
             length, r = dims[0], dims[1]
             local = [(r * math.cos(a), r * math.sin(a), z)
                      for a in (2 * math.pi * i / 24 for i in range(24))
                      for z in (-length / 2, length / 2)]
-            if kind == _CAPSULE:  # and its two half-spheres, beyond the cylinder's ends
+            if kind == "capsule":  # and its two half-spheres, beyond the cylinder's ends
                 local += [(r * x, r * y, r * z + math.copysign(length / 2, z))
                           for x, y, z in _SPHERE_DIRECTIONS]
-        elif kind == _BOX:
+        elif kind == "box":
             hx, hy, hz = (d / 2 for d in dims)
             local = [(sx * hx, sy * hy, sz * hz) for sx in (-1, 1) for sy in (-1, 1)
                      for sz in (-1, 1)]
@@ -68,48 +63,41 @@ def shape_points(p: Bullet, body: int, link: int) -> list[Vec]:
     return out
 
 
-def base_link_pose(p: Bullet, body: int) -> tuple[Sequence[float], Sequence[float]]:
-    """The base link frame's world pose (PyBullet reports the base's inertial frame).
+def base_link_pose(engine: Simulator, body: int) -> tuple[Sequence[float], Sequence[float]]:
+    """The base link frame's world pose (the engine's base pose is its inertial frame).
 
     With ``URDF_USE_INERTIA_FROM_FILE`` an ``<inertia>`` with products (ixy, ixz, iyz), or an
     ``<inertial><origin>``, puts the inertial frame elsewhere than the link frame: its pose is
     not the robot's.
     """
-    pos, orn = p.getBasePositionAndOrientation(body)
-    local = p.getDynamicsInfo(body, -1)
-    inv_pos, inv_orn = p.invertTransform(local[3], local[4])
-    return p.multiplyTransforms(pos, orn, inv_pos, inv_orn)
+    pose = engine.link_pose(body, -1)
+    return pose.position, pose.orientation
 
 
-def set_base_link_pose(p: Bullet, body: int, pos: Sequence[float],
+def set_base_link_pose(engine: Simulator, body: int, pos: Sequence[float],
                        orn: Sequence[float]) -> None:
-    """Place the base link frame.
-
-    ``resetBasePositionAndOrientation`` places the inertial frame; ``loadURDF`` the link frame.
-    """
-    local = p.getDynamicsInfo(body, -1)
-    com_pos, com_orn = p.multiplyTransforms(pos, orn, local[3], local[4])
-    p.resetBasePositionAndOrientation(body, com_pos, com_orn)
+    """Place the base link frame (the loader places it; a reset places the inertial frame)."""
+    engine.reset_base_frame(body, (pos[0], pos[1], pos[2]), (orn[0], orn[1], orn[2], orn[3]))
 
 
-def lowest_point(p: Bullet, body: int,
+def lowest_point(engine: Simulator, body: int,
                  points: dict[int, list[Vec]] | None = None) -> float:
     """The lowest z of the body's collision shapes, from the shapes themselves.
 
-    Not from ``getAABB``: a link whose ``<inertia>`` has products gets a rotated inertial
+    Not from the AABB: a link whose ``<inertia>`` has products gets a rotated inertial
     frame, and its AABB grows with it (1.8 cm below a small car's real corners), which would
     lift the start and disqualify the wheels as "above the robot's lowest point". A link
     without collision shapes does not count; a body with none falls back to the AABB.
     ``points`` (link index to :func:`shape_points`) saves measuring them again.
     """
-    n = p.getNumJoints(body)
+    n = len(engine.joints(body))
     if points is None:
-        points = {link: shape_points(p, body, link) for link in range(-1, n)}
+        points = {link: shape_points(engine, body, link) for link in range(-1, n)}
     zs = [pt[2] for pts in points.values() for pt in pts]
     finite = [z for z in zs if math.isfinite(z)]
     if finite:
         return min(finite)
-    return min(p.getAABB(body, link)[0][2] for link in range(-1, n))
+    return min(engine.aabb(body, link)[0][2] for link in range(-1, n))
 
 
 def _fibonacci_sphere(n: int) -> list[Vec]:
