@@ -690,8 +690,15 @@ def test_an_unknown_engine_is_named_with_the_closest() -> None:
 
 
 def test_restore_with_motors_at_their_caps_steps_again_exactly(
-        engine: Any, car_urdf: tuple[Path, float]) -> None:
+        engine: Any, car_urdf: tuple[Path, float], request: pytest.FixtureRequest) -> None:
     """Saved while its wheels' motors push at their caps, the car drives on as it did."""
+    if engine.name == "pybullet":
+        # Measured on PyBullet 3.2.7: the first step after each restore differs (a wheel at
+        # 27.53 rad/s after one restore, 26.86 after the next) though the bodies' state is the
+        # same: the motors' solver state is not in saveState, and restore_clean, which drops
+        # the contact manifolds, does not reach it. Strict: it fails once PyBullet replays.
+        request.applymarker(pytest.mark.xfail(strict=True, reason="PyBullet keeps its motor "
+                                              "rows' warm start across restoreState"))
     path, radius = car_urdf
     _ground(engine)
     car = engine.load(str(path), LoadSettings(position=(0.0, 0.0, radius)))

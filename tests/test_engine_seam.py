@@ -44,7 +44,7 @@ IMPORTS_AN_ENGINE: dict[str, str] = {
 #: client), each for its owner to port to the seam.
 CALLS_PYBULLET: set[str] = {
     "checks/collisions.py", "draw/render.py", "draw/view_model.py", "draw/view_stream.py",
-    "exchange/agree.py", "exchange/agree_contact.py", "exchange/bullet.py", "gym.py",
+    "exchange/agree.py", "exchange/agree_contact.py", "gym.py",
     "motion/drive.py",  # its own loop, sampler, ground and checks; detection is ported
 }
 

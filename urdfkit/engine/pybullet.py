@@ -426,8 +426,8 @@ class PyBulletEngine:
 
         Angular, then linear (measured on 3.2.7), with the base at PyBullet's default pose.
         """
-        out: list[list[float]] = self._dynamics("calculateMassMatrix", body, positions)
-        return out
+        rows = self._dynamics("calculateMassMatrix", body, positions)
+        return [list(row) for row in rows]
 
     def floating_mass_matrix(self, body: int, position: Vec3, orientation: Quat,
                              positions: Sequence[float]) -> list[list[float]]:
@@ -447,9 +447,8 @@ class PyBulletEngine:
                          velocities: Sequence[float],
                          accelerations: Sequence[float]) -> list[float]:
         """``calculateInverseDynamics`` (a fixed base only: PyBullet's limit)."""
-        out: list[float] = self._dynamics("calculateInverseDynamics", body, positions,
-                                          velocities, accelerations)
-        return out
+        return list(self._dynamics("calculateInverseDynamics", body, positions, velocities,
+                                   accelerations))
 
     def jacobian(self, body: int, link: int, point: Vec3, positions: Sequence[float]
                  ) -> tuple[list[list[float]], list[list[float]]]:
