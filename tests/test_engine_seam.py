@@ -233,6 +233,10 @@ def test_the_root_link_frame_is_the_urdf_frame_not_the_centre_of_mass(
     assert pose.inertial_position == pytest.approx((1.0, 2.0, 3.5), abs=1e-12)
     assert engine.base_pose(body)[0] == pose.inertial_position
     assert engine.link_frames(body)[0][0] == pose.position
+    assert engine.link_frame(body, -1) == (pose.position, pose.orientation)
+    arm = engine.link_pose(body, 0)
+    assert engine.link_frame(body, 0) == (arm.position, arm.orientation)
+    assert arm.inertial_position[2] == pytest.approx(arm.position[2] - 0.5)  # its bob, below
     engine.reset_base_frame(body, (0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 1.0))
     assert engine.base_pose(body)[0] == pytest.approx((0.0, 0.0, 1.5), abs=1e-6)
 

@@ -360,6 +360,13 @@ class Simulator(Model, Protocol):
         """One link's inertial and URDF frames now, world (link -1: the root)."""
         ...
 
+    def link_frame(self, body: int, link: int) -> tuple[Vec3, Quat]:
+        """One link's URDF frame now, world (link -1: the root).
+
+        :meth:`link_pose` without the record, for the rows that record feet and link poses.
+        """
+        ...
+
     def reset_base_frame(self, body: int, position: Vec3, orientation: Quat) -> None:
         """Move the root's URDF link frame there, at rest.
 

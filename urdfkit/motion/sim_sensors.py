@@ -133,7 +133,7 @@ class Sensors:
             if index == -1:  # the URDF frame, not the centre of mass
                 orn = r.link_pose(next(k for k, v in r.links.items() if v == -1))[1]
             else:
-                orn = list(engine.link_pose(r.body, index).orientation)
+                orn = list(engine.link_frame(r.body, index)[1])
             local = rotate_back(quat_to_matrix(orn), normal)
             out[label] = {"contact": int(count > 0), "normal": total, "world": normal,
                           "local": list(local), "friction_world": friction}

@@ -70,8 +70,7 @@ def base_link_pose(engine: Simulator, body: int) -> tuple[Sequence[float], Seque
     ``<inertial><origin>``, puts the inertial frame elsewhere than the link frame: its pose is
     not the robot's.
     """
-    pose = engine.link_pose(body, -1)
-    return pose.position, pose.orientation
+    return engine.link_frame(body, -1)
 
 
 def set_base_link_pose(engine: Simulator, body: int, pos: Sequence[float],
