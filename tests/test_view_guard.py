@@ -23,8 +23,6 @@ pytest.importorskip("viser", reason="urdfkit view needs viser (a core dependency
 
 from test_view import ARM  # noqa: E402
 
-from urdfkit.draw.view_guard import allowed  # noqa: E402
-
 
 @pytest.fixture
 def arm(tmp_path: Path) -> Path:
@@ -63,10 +61,9 @@ async def _session(port: int, origin: str | None, host: str = "localhost",
                    ) -> tuple[int | None, list[dict[str, Any]]]:
     """Connect as a page of ``origin`` under the Host name ``host``, send ``send`` (after a
     camera report), and gather what the server sends: (HTTP status if refused, messages)."""
+    import viser
     import websockets
     import websockets.exceptions
-
-    import viser
 
     got: list[dict[str, Any]] = []
     try:
@@ -123,6 +120,8 @@ def _labelled(messages: list[dict[str, Any]]) -> dict[str, str]:
 ])
 def test_allowed_is_the_page_own_origin_on_this_machine(host: str, origin: str | None,
                                                         bound: str, ok: bool) -> None:
+    from urdfkit.draw.view_guard import allowed
+
     assert allowed(host, origin, bound, 8080) is ok
 
 
@@ -205,3 +204,39 @@ def test_hostile_values_are_ignored_quietly(arm: Path, viewers: Any,
     assert not v.sliders["shoulder"].disabled
     assert v.vector_text.value == "[1.5, 0.085, 0.25]" != before["listed"]
     assert v.joints_text.value == "--joints shoulder=1.5,slide=0.085,spin=0.25"
+
+
+# --------------------------------------------------------------------------- bursts
+
+
+def test_a_burst_of_values_ends_on_the_last_one_everywhere(arm: Path, viewers: Any) -> None:
+    # A page's values as fast as a socket takes them (a page sends one per 50 ms; a busy
+    # server gets them in bunches): 60 to one slider, then 60 to another at once.
+    v = viewers(arm)
+    v.show_touching.value = True  # a move costs the self-collision pairs too
+    port = v.port
+    _, got = asyncio.run(_session(port, f"http://localhost:{port}"))
+    ids = _labelled(got)
+    shoulder = [round(0.02 * k, 4) for k in range(1, 61)]  # up to 1.2 rad
+    spin = [round(-0.05 * k, 4) for k in range(1, 61)]  # down to -3 rad
+    send = [{"type": "GuiUpdateMessage", "uuid": ids[name], "updates": {"value": x}}
+            for name, values in (("shoulder", shoulder), ("spin", spin)) for x in values]
+    _, answer = asyncio.run(_session(port, f"http://localhost:{port}", send=send, listen=3.0))
+    last = {"shoulder": shoulder[-1], "spin": spin[-1]}
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline and (
+            v.model.positions()["spin"] != pytest.approx(last["spin"])
+            or v.joints_text.value.split(",")[-1] != f"spin={last['spin']:g}"):
+        time.sleep(0.05)
+    time.sleep(0.5)
+    now = v.model.positions()
+    assert (now["shoulder"], now["spin"]) == pytest.approx((last["shoulder"], last["spin"]))
+    assert {k: s.value for k, s in v.sliders.items()} == pytest.approx(now)
+    assert v.joints_text.value == \
+        f"--joints shoulder={last['shoulder']:g},slide={now['slide']:g},spin={last['spin']:g}"
+    # And the page was never sent an older value of its own after its last one: it shows
+    # the last value it sent.
+    for name in ("shoulder", "spin"):
+        told = [m["updates"]["value"] for m in answer if m.get("type") == "GuiUpdateMessage"
+                and m.get("uuid") == ids[name] and "value" in m.get("updates", {})]
+        assert not told or told[-1] == pytest.approx(last[name]), (name, told[-5:])

@@ -202,6 +202,12 @@ def _same_kind(old: Any, new: Any) -> tuple[bool, Any]:
     return (True, new) if type(new) is type(old) else (False, None)
 
 
+#: How long a control several pages changed is left alone before every page is sent its
+#: value (:meth:`Gate._settle`), and how recent a change counts.
+SETTLE_SECONDS = 0.3
+CONTENDED_SECONDS = 3.0
+
+
 class Gate:
     """The one way in for the values pages send to controls: checked, then told in order.
 
@@ -223,8 +229,10 @@ class Gate:
 
     def __init__(self, server: Any) -> None:
         try:
+            import viser
             from viser import _messages
 
+            self._button = viser.GuiButtonHandle
             self._update = _messages.GuiUpdateMessage
             self._ws = server._websock_server
             self._inputs = server.gui._gui_input_handle_from_uuid
@@ -234,6 +242,8 @@ class Gate:
             raise GuardError(f"this viser cannot be guarded against hostile values ({e}); "
                              "urdfkit view is tested with viser 1.1") from None
         self._heard: dict[int, tuple[Any, Callable[[Any], None]]] = {}
+        #: Per control (by id): changes pages sent, and when each page last sent one.
+        self._busy: dict[str, tuple[int, dict[Any, float]]] = {}
         self._ws.register_handler(self._update, self._checked)
 
     def on_value(self, handle: Any, heard: Callable[[Any], None]) -> None:
@@ -247,6 +257,8 @@ class Gate:
         self._heard[id(handle)] = (handle, heard)
 
     async def _checked(self, client_id: Any, message: Any) -> None:
+        import asyncio
+
         updates = message.updates
         handle = self._inputs.get(message.uuid)
         if handle is None or not isinstance(updates, dict) or list(updates) != ["value"]:
@@ -258,9 +270,39 @@ class Gate:
         await self._viser(client_id, message)
         if value != updates["value"]:  # clamped: the sender is told too
             self._ws.queue_message(self._update(message.uuid, {"value": value}))
+        if not isinstance(handle, self._button):  # a click has no value to show
+            loop = asyncio.get_running_loop()
+            count, pages = self._busy.get(message.uuid, (0, {}))
+            pages[client_id] = loop.time()
+            self._busy[message.uuid] = count + 1, pages
+            loop.call_later(SETTLE_SECONDS, self._settle, message.uuid, count + 1)
         heard = self._heard.get(id(handle))
         if heard is not None and heard[0] is handle:
             heard[1](value)
+
+    def _settle(self, uuid: str, count: int) -> None:
+        """Once a control several pages changed is quiet, send every page its value.
+
+        viser sends a page's change to the other pages only, and a page sends its changes at
+        most every 50 ms, the last one late: a page that got another page's value in
+        between then sent its own older one, and kept showing the other's (two pages on one
+        slider: one showed 0.015, the robot held -0.033). Sent when the control has been
+        quiet :data:`SETTLE_SECONDS` and more than one page changed it in the last
+        :data:`CONTENDED_SECONDS` (a page's late value may come after a quiet spell). Not
+        sent when one page alone changed it: that page shows what it sent, and a value sent
+        back to it while it still moves the slider (its next keys not yet in) moved it back.
+        """
+        import asyncio
+
+        busy = self._busy.get(uuid)
+        if busy is None or busy[0] != count:
+            return  # not quiet yet: a later change set its own time
+        now = asyncio.get_running_loop().time()
+        pages = {k: t for k, t in busy[1].items() if now - t < CONTENDED_SECONDS}
+        self._busy[uuid] = count, pages
+        handle = self._inputs.get(uuid)
+        if handle is not None and len(pages) > 1:
+            self._ws.queue_message(self._update(uuid, {"value": handle.value}))
 
 
 # --------------------------------------------------------------------------- keys
