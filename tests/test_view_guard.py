@@ -147,6 +147,7 @@ def test_another_sites_page_and_a_rebinding_host_are_refused_with_no_data(
     request = urllib.request.Request(v.url, headers={"Host": f"evil.example:{port}"})
     with pytest.raises(urllib.error.HTTPError) as e:
         urllib.request.urlopen(request, timeout=10)
+    e.value.close()  # its socket
     assert e.value.code == 403
     with urllib.request.urlopen(v.url, timeout=10) as r:
         assert r.status == 200

@@ -459,9 +459,10 @@ class Viewer(RunDisplay):
                 return  # a slider of a robot since reloaded, a mimic joint, or a run on show
             if abs(self.model.positions()[name] - value) > 1e-12:
                 self.set_joints({name: value}, moved=name)
-            if abs(float(slider.value) - value) > 1e-12 and \
-                    not self.actions.waiting(("slider", name)):
-                slider.value = self.model.positions()[name]
+            # Written over (Reset to zero) after the page's value came: put it back, unless a
+            # newer value of the page's is waiting (checked on the loop, with no gap).
+            self.gate.set(slider, self.model.positions()[name],
+                          unless=functools.partial(self.actions.waiting, ("slider", name)))
 
     def set_joints(self, values: Mapping[str, float], touching: bool = True,
                    moved: str | None = None) -> dict[str, float]:
@@ -484,7 +485,7 @@ class Viewer(RunDisplay):
                 # in this thread, and finds its joint already there.
                 if s is not None and name != moved and (name in values or name in followers) \
                         and abs(float(s.value) - value) > 1e-12:
-                    s.value = value
+                    self.gate.set(s, value)
             self.update_poses()
             if touching:
                 self.update_touching()
@@ -555,8 +556,7 @@ class Viewer(RunDisplay):
                 raise KeyError(link)
             self.selected = link  # first: the menu's callback, run here, finds it selected
             want = NO_LINK if link is None else link
-            if self.select_link.value != want:
-                self.select_link.value = want
+            self.gate.set(self.select_link, want)
             self.recolour()
             if link is None:
                 self.selected_text.content = ""

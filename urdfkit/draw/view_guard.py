@@ -18,6 +18,7 @@ changed fails to start rather than serving unguarded.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import http
 import ipaddress
@@ -206,6 +207,8 @@ def _same_kind(old: Any, new: Any) -> tuple[bool, Any]:
 #: value (:meth:`Gate._settle`), and how recent a change counts.
 SETTLE_SECONDS = 0.3
 CONTENDED_SECONDS = 3.0
+#: The longest :meth:`Gate.set` waits for viser's event loop before setting the value itself.
+SET_TIMEOUT = 10.0
 
 
 class Gate:
@@ -234,6 +237,7 @@ class Gate:
 
             self._button = viser.GuiButtonHandle
             self._update = _messages.GuiUpdateMessage
+            self._loop = server._event_loop
             self._ws = server._websock_server
             self._inputs = server.gui._gui_input_handle_from_uuid
             self._viser = server.gui._handle_gui_updates
@@ -246,6 +250,53 @@ class Gate:
         self._busy: dict[str, tuple[int, dict[Any, float]]] = {}
         self._ws.register_handler(self._update, self._checked)
 
+    def set(self, handle: Any, value: Any, unless: Callable[[], bool] | None = None) -> None:
+        """Set a control's value from the server, on viser's event loop (waited for).
+
+        A page's value is applied there (the control's state set, then :meth:`on_value`
+        told) in one step: a value set from another thread could land in between, be sent to
+        the page after its own newer value, and stay on it (viser sends a page's change to
+        the other pages only): the page showed 0.0084, the robot held 0.168. Set on the loop,
+        it comes before or after a page's value, whole. ``unless()``, checked there, skips it.
+        """
+        import concurrent.futures
+
+        def write() -> None:
+            if (unless is None or not unless()) and handle.value != value:
+                handle.value = value
+                self._written(handle)
+
+        try:
+            on_loop = asyncio.get_running_loop() is self._loop
+        except RuntimeError:
+            on_loop = False
+        if on_loop or self._loop.is_closed():
+            write()
+            return
+        done: concurrent.futures.Future[None] = concurrent.futures.Future()
+
+        def run() -> None:
+            try:
+                write()
+                done.set_result(None)
+            except BaseException as e:  # noqa: BLE001 - handed to the waiting thread
+                done.set_exception(e)
+
+        try:
+            self._loop.call_soon_threadsafe(run)
+            done.result(timeout=SET_TIMEOUT)
+        except (RuntimeError, concurrent.futures.TimeoutError):  # the server has stopped
+            if not done.done():
+                write()
+
+    def _written(self, handle: Any) -> None:
+        """The server set a control (on the loop): a page's value after it gets settled."""
+        uuid = next((k for k, h in self._inputs.items() if h is handle), None)
+        if uuid is not None:
+            count, pages = self._busy.get(uuid, (0, {}))
+            pages[None] = self._loop.time()  # None: the server, as a page of its own
+            self._busy[uuid] = count, pages
+
     def on_value(self, handle: Any, heard: Callable[[Any], None]) -> None:
         """Call ``heard(value)`` with each value a page sends ``handle`` that gets in.
 
@@ -257,8 +308,6 @@ class Gate:
         self._heard[id(handle)] = (handle, heard)
 
     async def _checked(self, client_id: Any, message: Any) -> None:
-        import asyncio
-
         updates = message.updates
         handle = self._inputs.get(message.uuid)
         if handle is None or not isinstance(updates, dict) or list(updates) != ["value"]:
@@ -281,19 +330,20 @@ class Gate:
             heard[1](value)
 
     def _settle(self, uuid: str, count: int) -> None:
-        """Once a control several pages changed is quiet, send every page its value.
+        """Once a control several writers changed is quiet, send every page its value.
 
-        viser sends a page's change to the other pages only, and a page sends its changes at
-        most every 50 ms, the last one late: a page that got another page's value in
-        between then sent its own older one, and kept showing the other's (two pages on one
-        slider: one showed 0.015, the robot held -0.033). Sent when the control has been
-        quiet :data:`SETTLE_SECONDS` and more than one page changed it in the last
-        :data:`CONTENDED_SECONDS` (a page's late value may come after a quiet spell). Not
-        sent when one page alone changed it: that page shows what it sent, and a value sent
-        back to it while it still moves the slider (its next keys not yet in) moved it back.
+        The writers are pages, and the server (:meth:`set`). viser sends a page's change to
+        the other pages only, and a page may apply a value it got after its own newer change:
+        it sends its changes at most every 50 ms, the last one late, and applies what it gets
+        at its next frame (8 a second in software WebGL). Such a page kept showing another's
+        value, or the server's, over its own: two pages on one slider (one showed 0.015, the
+        robot held -0.033); keys pressed just after *Reset to zero* (the page showed 0, the
+        robot -0.126). Sent when the control has been quiet :data:`SETTLE_SECONDS` and more
+        than one writer changed it in the last :data:`CONTENDED_SECONDS` (a late value may
+        come after a quiet spell). Not sent when one page alone changed it: that page shows
+        what it sent, and a value sent back while it still moves the slider (its next keys
+        not yet in) moved it back.
         """
-        import asyncio
-
         busy = self._busy.get(uuid)
         if busy is None or busy[0] != count:
             return  # not quiet yet: a later change set its own time
