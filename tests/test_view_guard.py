@@ -182,6 +182,9 @@ def test_hostile_values_are_ignored_quietly(arm: Path, viewers: Any,
     send += [{"type": "GuiUpdateMessage", "uuid": ids["shoulder"], "updates": {"value": 7.0}},
              {"type": "GuiUpdateMessage", "uuid": ids["spin"], "updates": {"value": 0.25}}]
     _, answer = asyncio.run(_session(port, f"http://localhost:{port}", send=send))
+    # A page reporting a camera of no size, nowhere (its aspect is 1000 / 0): framed anyway.
+    bad_camera = {**CAMERA, "image_height": 0, "position": [math.nan] * 3, "fov": math.inf}
+    asyncio.run(_session(port, f"http://localhost:{port}", send=[bad_camera], listen=1.0))
     deadline = time.monotonic() + 10
     while v.model.positions()["spin"] != pytest.approx(0.25) and time.monotonic() < deadline:
         time.sleep(0.05)

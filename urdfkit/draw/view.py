@@ -9,6 +9,10 @@ Three parts:
   ships in its wheel, so it works offline), and reloads it when the file or anything it read
   changes; the page's text is written by view_page.py.
 - :class:`~urdfkit.draw.view_stream.RunStream` (view_stream.py) streams a simulated run to the page.
+
+The server is guarded (view_guard.py: only its own page, only sane values, no camera move from
+a slider's keys), and what pages do to the robot is applied in the order it arrives by one
+thread (view_queue.py).
 """
 
 from __future__ import annotations
