@@ -198,3 +198,43 @@ def settled(monkeypatch: pytest.MonkeyPatch) -> None:
 
     monkeypatch.setattr(deps, "RACY_NS", 0)
     monkeypatch.setattr(resultcache, "RACY_NS", 0)
+
+
+# --------------------------------------------------------------------------- viewers and pages
+
+
+@pytest.fixture
+def viewers() -> Iterator[Callable[..., Any]]:
+    """Start ``urdfkit view`` servers (``Viewer(path, **kwargs)``); each closed after the test."""
+    from urdfkit.draw.view import Viewer
+
+    started: list[Any] = []
+
+    def start(path: Path | str, **kwargs: Any) -> Any:
+        v = Viewer(str(path), **kwargs)
+        started.append(v)
+        return v
+
+    yield start
+    for v in started:
+        v.close()
+
+
+@pytest.fixture
+def open_view(module_chromium: Any) -> Iterator[Callable[..., Any]]:
+    """Open a viewer's page in Chromium and wait until it says "Connected"; closed after.
+
+    A page left open keeps drawing WebGL in software and starves the next tests of CPU.
+    """
+    opened: list[Any] = []
+
+    def open_page(url: str, width: int = 1000, height: int = 700) -> Any:
+        page = module_chromium.new_page(viewport={"width": width, "height": height})
+        opened.append(page)
+        page.goto(url)
+        page.get_by_text("Connected").wait_for(timeout=60000)
+        return page
+
+    yield open_page
+    for page in opened:
+        page.close()

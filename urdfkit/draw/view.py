@@ -10,11 +10,18 @@ Three parts:
   changes; the page's text is written by view_page.py, its cameras and lights are placed by
   view_camera.py.
 - :class:`~urdfkit.draw.view_stream.RunStream` (view_stream.py) streams a simulated run to the page.
+
+The server is guarded (view_guard.py: only its own page, only sane values, no camera move from
+a slider's keys), and what pages do to the robot is applied in the order it arrives by one
+thread (view_queue.py).
 """
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import math
+import os
 import threading
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -22,7 +29,9 @@ from typing import Any
 from urdfkit.core.errors import EngineError, MissingDependencyError, UrdfkitError
 from urdfkit.draw import view_page as page
 from urdfkit.draw.view_camera import ASPECT, FIT, FOV_DEG, PageCameras, environment, fit, light
+from urdfkit.draw.view_guard import Gate, GuardError, guarded_serve, keep_keys_off_camera
 from urdfkit.draw.view_model import SELECTED_RGB, TINTS, TOUCHING_RGB, Layer, Vec3, ViewedRobot
+from urdfkit.draw.view_queue import ActionQueue
 from urdfkit.draw.view_stream import RunDisplay, add_shapes, wxyz
 
 #: The selection dropdown's entry for no link.
@@ -44,9 +53,11 @@ def _viser() -> Any:
 SERVER_START_TIMEOUT = 60.0
 
 
-def _start_server(viser: Any, host: str, port: int) -> Any:
-    """``viser.ViserServer``, started in a thread of its own.
+def _start_server(viser: Any, host: str, port: int) -> tuple[Any, Gate]:
+    """``viser.ViserServer``, started in a thread of its own, guarded (view_guard.py).
 
+    It answers only its own page (other origins and Host names get a 403), checks every
+    value a page sends before applying it, and keeps a slider's arrow keys from the camera.
     Waited for at most :data:`SERVER_START_TIMEOUT` seconds (TimeoutError past it); its
     errors are re-raised here.
     """
@@ -54,8 +65,20 @@ def _start_server(viser: Any, host: str, port: int) -> Any:
 
     def start() -> None:
         try:
-            with _quiet():  # viser prints a banner with rich whatever `verbose` says
-                box["server"] = viser.ViserServer(host=host, port=port, verbose=False)
+            # viser prints a banner with rich whatever `verbose` says.
+            with _quiet(), guarded_serve(host) as guarded:
+                server = viser.ViserServer(host=host, port=port, verbose=False)
+            try:
+                if not guarded:  # bound some other way: never serve unguarded
+                    raise GuardError("this viser's server cannot be kept to its own page; "
+                                     "urdfkit view is tested with viser 1.1")
+                gate = Gate(server)
+                keep_keys_off_camera(server)
+            except GuardError:
+                with _quiet():
+                    server.stop()
+                raise
+            box["server"] = server, gate
         except BaseException as e:  # handed to the caller's thread
             box["error"] = e
 
@@ -109,7 +132,6 @@ class Viewer(RunDisplay):
         self.reloads = 0
         self._failed: dict[str, Any] | None = None
         self._lock = threading.RLock()
-        self._setting = False
         self._nodes: dict[Layer, list[Any]] = {}
         self._frames: list[Any] = []
         #: The page shows poses given from outside (a run, :meth:`show_poses`): the model's
@@ -126,7 +148,7 @@ class Viewer(RunDisplay):
         self.host = host
         self.port = free_port(host) if not port else port
         try:
-            self.server = _start_server(viser, host, self.port)
+            self.server, self.gate = _start_server(viser, host, self.port)
         except OSError as e:
             self.model.close()
             raise EngineError(f"cannot serve on {host}:{self.port}: {e.strerror or e}",
@@ -135,6 +157,9 @@ class Viewer(RunDisplay):
             self.model.close()
             raise EngineError(f"the server on {host}:{self.port} did not start within "
                               f"{SERVER_START_TIMEOUT:g} s", param="port") from None
+        except GuardError:
+            self.model.close()
+            raise
         self.port = int(self.server.get_port())
         self.url = f"http://{'localhost' if host in ('127.0.0.1', '::1') else host}:{self.port}"
         self.server.scene.set_up_direction("+z")
@@ -154,6 +179,8 @@ class Viewer(RunDisplay):
         self._connected = threading.Event()
         self.server.on_client_connect(self._client_connected)
         self.server.on_client_disconnect(self.cameras.forget)
+        #: What pages do to the robot, applied in the order the server got it.
+        self.actions = ActionQueue("urdfkit-view-actions", self._action_failed)
         self._static_gui()
         self._show_model()
         # Mimic joints to their leaders' zero pose (offsets included). Self-collisions are
@@ -171,6 +198,10 @@ class Viewer(RunDisplay):
     def _static_gui(self) -> None:
         gui = self.server.gui
         self.status = gui.add_markdown("", order=0)
+        # viser's own "Reset View" is in its settings menu; this one is where users look.
+        self.reset_view = gui.add_button("Reset view", order=0.1, hint=(
+            "Frame the robot again in this page's camera (a run: as the Camera menu says)"))
+        self.reset_view.on_click(lambda event: self.refit(event.client))
         with gui.add_folder("Show", order=1):
             self.show_visual = gui.add_checkbox("Visual", True)
             self.show_collision = gui.add_checkbox("Collision", False)
@@ -195,11 +226,12 @@ class Viewer(RunDisplay):
                 "Link", [NO_LINK], initial_value=NO_LINK,
                 hint="Or click a link in the scene, or a finding")
             self.selected_text = gui.add_markdown("")
-        self.select_link.on_update(lambda _event: self._dropdown_moved())
+        self.gate.on_value(self.select_link, lambda value: self.actions.put(
+            functools.partial(self._dropdown_moved, str(value)), key="select"))
         self.joints_folder = gui.add_folder("Joints", order=2)
         with self.joints_folder:
             self.reset_button = gui.add_button("Reset to zero")
-            self.reset_button.on_click(lambda _event: self.reset())
+            self.gate.on_value(self.reset_button, lambda _value: self.actions.put(self.reset))
             # Multiline: a long pose wraps instead of being cut at the field's edge.
             self.vector_text = gui.add_text("Python list", "[]", disabled=True, multiline=True)
             self.joints_text = gui.add_text("--joints", "", disabled=True, multiline=True)
@@ -243,7 +275,7 @@ class Viewer(RunDisplay):
                                                 wxyz=wxyz(quat)))
             for kind, mesh in add_shapes(scene, root, link, None):
                 # Clicking a link in the scene selects it (and its joint's row).
-                mesh.on_click(lambda _event, name=link.name: self.select(name))
+                mesh.on_click(self._clicked(link.name))
                 self._nodes[kind].append(mesh)
             self._nodes["frames"].append(scene.add_frame(
                 f"{root}/axes", axes_length=self.frame_size, axes_radius=size * 0.006))
@@ -273,10 +305,14 @@ class Viewer(RunDisplay):
                 hint = f"{j.urdf_type}, PyBullet joint {j.index}"
                 if j.mimic is not None:
                     hint += f"; mimics {j.mimic[0]} x {j.mimic[1]:g} + {j.mimic[2]:g}"
-                s = gui.add_slider(j.name, min=j.lower, max=max(j.upper, j.lower + step),
-                                   step=step, initial_value=min(max(now[j.name], j.lower), j.upper),
-                                   disabled=j.mimic is not None, hint=hint)
-                s.on_update(lambda _event, name=j.name: self._slider_moved(name))
+                hi = max(j.upper, j.lower + step)
+                s = gui.add_slider(j.name, min=j.lower, max=hi, step=step,
+                                   initial_value=min(max(now[j.name], j.lower), j.upper),
+                                   # A joint whose limits meet has nothing to slide.
+                                   disabled=j.mimic is not None or j.upper <= j.lower,
+                                   hint=hint)
+                s.precision = page.box_digits(j.lower, hi, step)
+                self.gate.on_value(s, functools.partial(self._slid, j.name, s))
                 self.sliders[j.name] = s
                 self._gui.append(s)
 
@@ -292,14 +328,25 @@ class Viewer(RunDisplay):
                 links = m.finding_links(f)
                 if not links:
                     continue
-                where = f"line {f.line}" if f.line is not None else f.file
-                button = gui.add_button(f"{f.code} {where}: {links[0]}", hint=f.text[:300],
+                where = f"line {f.line}" if f.line is not None else os.path.basename(f.file)
+                button = gui.add_button(page.finding_button(f.code, where, links[0]),
+                                        hint=f"{links[0]}: {f.text}"[:300],
                                         color="red" if f.level == "error" else "yellow")
-                button.on_click(lambda _event, name=links[0]: self.select(name))
+                self.gate.on_value(button, self._selects(links[0]))
                 self._gui.append(button)
 
     def _refresh_status(self) -> None:
         self.status.content = page.status(self.model, self.error)
+
+    def refit(self, client: Any) -> None:
+        """Frame one page's camera again, as when it connected (the Reset view button)."""
+        if client is None:
+            return
+        with contextlib.suppress(AssertionError):  # a page that has not said its camera yet
+            if self.aim_page is not None:
+                self.aim_page(client)
+            else:
+                self.cameras.aim(client, lambda: self.model.bounds())
 
     def _aim_camera(self) -> None:
         """Fit the robot's bounds in the view of pages to come, and of viser's "Reset View"."""
@@ -350,27 +397,71 @@ class Viewer(RunDisplay):
 
     # ------------------------------------------------------------------ moving
 
-    def _slider_moved(self, name: str) -> None:
-        if self._setting:
-            return
-        self.set_joints({name: float(self.sliders[name].value)})
+    # What a page does to the robot goes through the gate (the value it sent, as it arrived)
+    # into the queue of actions (applied in that order, view_queue.py).
 
-    def set_joints(self, values: Mapping[str, float], touching: bool = True
-                   ) -> dict[str, float]:
-        """Move joints (by name) in PyBullet and update the scene; return the new positions.
+    def _slid(self, name: str, handle: Any, value: Any) -> None:
+        self.actions.put(functools.partial(self._slider_moved, name, handle, float(value)),
+                         key=("slider", name))
 
-        ``touching=False`` leaves the self-collision highlight as it was.
+    def _selects(self, link: str) -> Any:
+        """What a finding's button does when a page clicks it: select its link."""
+        return lambda _value: self.actions.put(functools.partial(self.select, link),
+                                               key="select")
+
+    def _clicked(self, link: str) -> Any:
+        """A link's click callback (scene clicks come from pages only): select it."""
+        async def clicked(_event: Any) -> None:
+            self.actions.put(functools.partial(self.select, link), key="select")
+
+        return clicked
+
+    def _action_failed(self, e: Exception) -> None:
+        self.error = f"internal error (a bug in urdfkit): {type(e).__name__}: {e}"
+        self._refresh_status()
+
+    def _slider_moved(self, name: str, handle: Any, value: float) -> None:
+        """A page set a joint's slider to ``value``: move the joint there.
+
+        The slider is not written back while a newer value of the page's is queued: a move
+        applied late once put an old value back over a newer one (the page showed one value,
+        the robot another). It is written when something else (Reset to zero) wrote over it
+        after the page's value arrived.
         """
         with self._lock:
+            slider = self.sliders.get(name)
+            if slider is None or slider is not handle or slider.disabled or \
+                    self.external_poses or not math.isfinite(value):
+                return  # a slider of a robot since reloaded, a mimic joint, or a run on show
+            if abs(self.model.positions()[name] - value) > 1e-12:
+                self.set_joints({name: value}, moved=name)
+            # Written over (Reset to zero) after the page's value came: put it back, unless a
+            # newer value of the page's is waiting (checked on the loop, with no gap).
+            self.gate.set(slider, self.model.positions()[name],
+                          unless=functools.partial(self.actions.waiting, ("slider", name)))
+
+    def set_joints(self, values: Mapping[str, float], touching: bool = True,
+                   moved: str | None = None) -> dict[str, float]:
+        """Move joints (by name) in PyBullet and update the scene; return the new positions.
+
+        Values are kept within each joint's limits (a value that is not finite is ignored).
+        ``touching=False`` leaves the self-collision highlight as it was; ``moved`` names the
+        slider the value came from, which is left as it is.
+        """
+        with self._lock:
+            limits = {j.name: (j.lower, j.upper) for j in self.model.joints}
+            values = {k: min(max(float(v), limits[k][0]), limits[k][1])
+                      for k, v in values.items() if k in limits and math.isfinite(float(v))}
             now = self.model.set_positions(values)
-            self._setting = True
-            try:
-                for name, value in now.items():
-                    s = self.sliders.get(name)
-                    if s is not None and abs(float(s.value) - value) > 1e-12:
-                        s.value = value
-            finally:
-                self._setting = False
+            followers = {j.name for j in self.model.joints if j.mimic is not None}
+            for name, value in now.items():
+                s = self.sliders.get(name)
+                # Only the joints set here and their mimics: another slider may hold a value
+                # a page just sent, its own call still to come. A slider's callback runs here,
+                # in this thread, and finds its joint already there.
+                if s is not None and name != moved and (name in values or name in followers) \
+                        and abs(float(s.value) - value) > 1e-12:
+                    self.gate.set(s, value)
             self.update_poses()
             if touching:
                 self.update_touching()
@@ -388,14 +479,10 @@ class Viewer(RunDisplay):
         the sliders, the first robot's, take the values of the joints of their names.
         """
         with self._lock:
-            self._setting = True
-            try:
-                for name, value in values.items():
-                    s = self.sliders.get(name)
-                    if s is not None:
-                        s.value = min(max(float(value), float(s.min)), float(s.max))
-            finally:
-                self._setting = False
+            for name, value in values.items():  # the sliders are disabled: nothing follows
+                s = self.sliders.get(name)
+                if s is not None and math.isfinite(float(value)):
+                    s.value = min(max(float(value), float(s.min)), float(s.max))
             joints = [j for j in (self.model.joints if joints is None else joints)
                       if j.name in values]
             self.vector_text.value = repr([round(float(values[j.name]), 6) for j in joints])
@@ -429,11 +516,12 @@ class Viewer(RunDisplay):
                         if tuple(h.color) != tuple(want):
                             h.color = want
 
-    def _dropdown_moved(self) -> None:
-        if self._setting:
-            return
-        value = str(self.select_link.value)
-        self.select(None if value == NO_LINK else value)
+    def _dropdown_moved(self, value: str) -> None:
+        """A page chose ``value`` in the Selection menu: select it."""
+        link = None if value == NO_LINK else value
+        with self._lock:
+            if link is None or link in {lk.name for lk in self.model.links}:
+                self.select(link)
 
     def select(self, link: str | None) -> None:
         """Select a link (None: none): highlight it, show its joint's row and its findings.
@@ -445,14 +533,9 @@ class Viewer(RunDisplay):
             m = self.model
             if link is not None and link not in {lk.name for lk in m.links}:
                 raise KeyError(link)
-            self.selected = link
-            self._setting = True
-            try:
-                want = NO_LINK if link is None else link
-                if self.select_link.value != want:
-                    self.select_link.value = want
-            finally:
-                self._setting = False
+            self.selected = link  # first: the menu's callback, run here, finds it selected
+            want = NO_LINK if link is None else link
+            self.gate.set(self.select_link, want)
             self.recolour()
             if link is None:
                 self.selected_text.content = ""
@@ -553,6 +636,7 @@ class Viewer(RunDisplay):
         """Stop watching and serving, and disconnect PyBullet."""
         self._stop.set()
         self._watcher.join(timeout=5)
+        self.actions.stop()
         with _quiet():
             self.server.stop()
         self.model.close()

@@ -2,15 +2,71 @@
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Sequence
 
 from urdfkit.draw.view_model import COLLISION_RGB, SELECTED_RGB, TINTS, TOUCHING_RGB, ViewedRobot
 
+#: Characters a slider's number box shows whole: viser's box is 3 rem wide ("-2.0944" fits,
+#: "-0.09985" is cut; measured in Chromium with the page's fonts).
+BOX_CHARS = 7
+
+
+def box_digits(lo: float, hi: float, step: float) -> int:
+    """Decimals a slider shows: two significant digits of its step, as many as its box shows.
+
+    viser shows (and the page rounds a slider's values to) enough decimals for the slider's
+    ends and step: 7 for a joint at +-2.0943951 rad, more than its box shows ("3.00000" of a
+    replay whose last time is 3.0000000000000013 s).
+    """
+    whole = max(len(str(int(abs(x)))) + (x < 0) for x in (lo, hi))
+    need = 1 - math.floor(math.log10(step)) if step > 0 else 0
+    return max(0, min(BOX_CHARS - whole - 1, need))
+
+
+#: Lets a long name break anywhere: a joint name longer than the panel is wide wraps, never cut.
+WRAP = "overflow-wrap:anywhere"
+
 
 def md(text: str) -> str:
-    """Text safe inside markdown (no tables or emphasis broken by names)."""
-    return re.sub(r"([\\`*_|<>\[\]])", r"\\\1", text)
+    """Text safe inside markdown, wrapping anywhere (no table, emphasis or HTML made by names).
+
+    viser renders raw HTML in markdown (scripts included), so ``<`` is escaped like the
+    characters markdown uses; the span lets a name with no spaces wrap in the panel.
+    """
+    return f'<span style="{WRAP}">{_escape(text)}</span>'
+
+
+def _escape(text: str) -> str:
+    return re.sub(r"([\\`*_|<>\[\]&#!])", r"\\\1", text)
+
+
+def code(text: str) -> str:
+    r"""Text shown as code (a file, a command), escaped as :func:`md` and wrapping anywhere.
+
+    A markdown code span shows its text as it is, backslashes included (a path's ``_``
+    escaped for markdown showed as ``kuka\_iiwa``), and cannot wrap a long path: an HTML
+    ``code`` element's text is markdown, escaped as any other.
+    """
+    return f'<code style="{WRAP}">{_escape(text)}</code>'
+
+
+#: Characters a finding's button shows on its one line in the docked panel (measured in
+#: Chromium: 40 of "U604 line 12: ..." fit).
+BUTTON_CHARS = 38
+
+
+def finding_button(code: str, where: str, link: str) -> str:
+    """A finding button's label, ``U604 line 12: upper_arm``, on one line.
+
+    A button does not wrap: a link name too long for it keeps its end (where names of one
+    robot differ: ``left_arm_link_7``, ``right_arm_link_7``) after an ellipsis; the button's
+    hint has it whole.
+    """
+    head = f"{code} {where}: "
+    room = max(BUTTON_CHARS - len(head), 12)
+    return head + (link if len(link) <= room else "\u2026" + link[-(room - 1):])
 
 
 def status(m: ViewedRobot, error: str | None) -> str:
@@ -39,20 +95,20 @@ def legend() -> str:
 def findings(m: ViewedRobot) -> str:
     """Each finding once: the file's, and those on no link (a button stands for the others)."""
     shown = [f for f in m.findings if f.level in ("error", "warning")]
-    lines = [f"In `{md(m.file)}`:"] if shown else []
+    lines = [f"In {code(m.file)}:"] if shown else []
     on_links = 0
     for f in shown:
         if m.finding_links(f):
             on_links += 1
             continue
         where = f.file if f.line is None else f"{f.file}:{f.line}"
-        lines.append(f"- **{f.level} {f.code}** `{where}`: {md(f.text)}")
+        lines.append(f"- **{f.level} {f.code}** {code(where)}: {md(f.text)}")
     if on_links:
         lines.append(f"- {on_links} on links, below: a button selects its link and shows "
                      "the finding")
     hidden = len(m.findings) - len(shown)
     if hidden:
-        lines.append(f"- and {hidden} note(s): `urdfkit check {m.file}`")
+        lines.append(f"- and {hidden} note(s): {code('urdfkit check ' + m.file)}")
     lines += [f"- note: {md(n)}" for n in m.notes]
     return "\n".join(lines) or "No errors or warnings."
 
@@ -81,7 +137,7 @@ def selection(m: ViewedRobot, link: str) -> str:
     for f in m.findings:
         if f.level in TINTS and link in m.finding_links(f):
             where = f.file if f.line is None else f"{f.file}:{f.line}"
-            lines.append(f"- **{f.level} {f.code}** `{where}`: {md(f.text)}")
+            lines.append(f"- **{f.level} {f.code}** {code(where)}: {md(f.text)}")
     return "\n\n".join(lines[:2]) + ("\n\n" + "\n".join(lines[2:]) if lines[2:] else "")
 
 

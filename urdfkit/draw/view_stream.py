@@ -8,6 +8,7 @@ from typing import Any
 
 from urdfkit.core.errors import EngineError
 from urdfkit.draw.view_model import Layer, Vec3, ViewedRobot
+from urdfkit.draw.view_page import box_digits
 
 
 def wxyz(q: Sequence[float]) -> tuple[float, float, float, float]:
@@ -399,6 +400,9 @@ class RunStream:
             self.replay = self.viewer.server.gui.add_slider(
                 "Time (s)", min=0.0, max=end, step=end / 100, initial_value=end,
                 hint="Put the robot where the run had it at this simulated time")
+            # A run's last time is a sum of steps (3.0000000000000013 s): viser would show it
+            # to 7 decimals, in a box that shows 5 characters of them.
+            self.replay.precision = box_digits(0.0, end, end / 100)
         self.replay.on_update(lambda _event: self.show_time(float(self.replay.value)))
 
     def show_time(self, t: float) -> tuple[float, list[Any]]:
