@@ -144,6 +144,7 @@ def _margins(mask: Any) -> tuple[float, float, float, float]:
 # --------------------------------------------------------------------------- following a run
 
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 def test_the_followed_car_is_whole_with_its_path_at_the_start_middle_and_end(
         module_chromium: Any) -> None:
     """drive --view's follow camera, on canvases that change shape under it.
@@ -250,6 +251,7 @@ def _brightness(page: Any, viewer: Viewer) -> tuple[float, float]:
     return float(np.percentile(light, 5)), float(np.median(light))
 
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 def test_a_white_robot_is_light_on_every_side_without_the_environment_map(
         module_chromium: Any, tmp_path: Path) -> None:
     """The default lighting (no environment map): every side of a white arm is light.
@@ -277,6 +279,7 @@ def test_a_white_robot_is_light_on_every_side_without_the_environment_map(
         assert dark > 110 and middle > 160, (where, dark, middle)
 
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 @pytest.mark.environment_map
 def test_a_white_robot_is_light_with_the_environment_map(module_chromium: Any,
                                                          tmp_path: Path) -> None:
@@ -340,6 +343,7 @@ def test_a_robot_drawn_without_collision_shapes_is_framed_whole(module_chromium:
     assert arm.sum() > 2000 and min(_margins(arm)) > 0.05, _margins(arm)
 
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 def test_a_reloaded_robot_that_grew_is_framed_again_unless_the_camera_was_moved(
         module_chromium: Any, tmp_path: Path) -> None:
     """The arm rewritten three times as long is refitted on a page whose camera is urdfkit's:

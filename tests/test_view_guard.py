@@ -161,6 +161,7 @@ HOSTILE: list[Any] = [math.nan, math.inf, -math.inf, 1e308, -1e308, "abc", "1.5"
                       [1, 2], {"a": 1}, 1, "x" * 10000]
 
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 def test_hostile_values_are_ignored_quietly(arm: Path, viewers: Any,
                                             capfd: pytest.CaptureFixture[str]) -> None:
     v = viewers(arm)
@@ -213,6 +214,7 @@ def test_hostile_values_are_ignored_quietly(arm: Path, viewers: Any,
 # --------------------------------------------------------------------------- bursts
 
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 def test_a_burst_of_values_ends_on_the_last_one_everywhere(arm: Path, viewers: Any) -> None:
     # A page's values as fast as a socket takes them (a page sends one per 50 ms; a busy
     # server gets them in bunches): 60 to one slider, then 60 to another at once.

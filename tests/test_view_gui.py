@@ -106,6 +106,7 @@ def _agree(v: Any, path: Path, pages: list[Any]) -> None:
 # --------------------------------------------------------------------------- item 1
 
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 def test_fast_keys_and_drags_on_a_fresh_page_leave_page_and_robot_agreeing(
         open_view: Any, viewers: Any) -> None:
     import pybullet_data
@@ -227,6 +228,7 @@ def _page_state(page: Any) -> tuple[bool, bool, str]:
             page.get_by_label("Link", exact=True).input_value())
 
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 def test_two_pages_show_one_robot_in_one_state(open_view: Any, viewers: Any,
                                                arm: Path) -> None:
     v = viewers(arm)
@@ -381,6 +383,7 @@ BOXES = """() => Object.fromEntries([...document.querySelectorAll('label[for]')]
 }))"""
 
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 def test_number_boxes_show_their_values_whole(open_view: Any, viewers: Any) -> None:
     import pybullet_data
 
