@@ -10,6 +10,7 @@ what it skips (comments, namespaced elements, opaque subtrees, shapes after the 
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import pybullet_data
@@ -34,6 +35,21 @@ DATA = Path(pybullet_data.getDataPath())
 FIXTURES = Path(__file__).parent / "fixtures"
 
 
+#: A whole token as C's strtod reads one (PyBullet reads numbers with atof): decimal, inf, nan;
+#: Python's float() also takes "1_0" and other scripts' digits, which C reads otherwise.
+_DEC = re.compile(r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf|infinity|nan)",
+                  re.IGNORECASE)
+_HEX = re.compile(r"[+-]?0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)(?:[pP][+-]?[0-9]+)?")
+
+
+def _c_float(token: str) -> float:
+    if _DEC.fullmatch(token):
+        return float(token)
+    if _HEX.fullmatch(token):
+        return float.fromhex(token)
+    raise ValueError(token)
+
+
 def oracle_findings(root: etree._Element) -> list[tuple[str, str, etree._Element]]:
     """U401/U402/U801/U802 as (code, message, element), by the plain recursive rule."""
     out: list[tuple[str, str, etree._Element]] = []
@@ -44,12 +60,17 @@ def oracle_findings(root: etree._Element) -> list[tuple[str, str, etree._Element
             n = NUMERIC.get((tag, attr))
             if n is not None:
                 try:
-                    vals = [float(x) for x in text.split()]
+                    vals = [_c_float(x) for x in text.split()]
                 except ValueError:
                     vals = None
                 if vals is None or not all(math.isfinite(v) for v in vals):
                     out.append(("U401", f"<{tag} {attr}={text!r}>: expected "
                                 f"{'a finite number' if n == 1 else f'{n} finite numbers'}", el))
+                elif any(_HEX.fullmatch(x) for x in text.split()):
+                    read = " ".join(f"{v:.17g}" for v in vals)
+                    out.append(("U401", f"<{tag} {attr}={text!r}>: C hexadecimal notation; "
+                                f"PyBullet reads {read}, but urdfdom (ROS), Python and most URDF "
+                                f"readers refuse it: write {read}", el))
                 elif len(vals) != n:
                     out.append(("U402", f"<{tag} {attr}={text!r}>: expected {n} numbers, "
                                 f"got {len(vals)}", el))
