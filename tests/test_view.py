@@ -87,18 +87,9 @@ def arm(tmp_path: Path) -> Path:
 
 
 @pytest.fixture
-def viewer_of() -> Iterator[Callable[..., Viewer]]:
-    """Start viewers on free ports; every one is closed after the test."""
-    started: list[Viewer] = []
-
-    def start(path: Path, **kwargs: Any) -> Viewer:
-        v = Viewer(str(path), **kwargs)
-        started.append(v)
-        return v
-
-    yield start
-    for v in started:
-        v.close()
+def viewer_of(viewers: Callable[..., Viewer]) -> Callable[..., Viewer]:
+    """Start viewers on free ports; every one is closed after the test (conftest's)."""
+    return viewers
 
 
 def _raw_link_state(path: Path, joints: dict[str, float], link: str,
