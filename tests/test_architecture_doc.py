@@ -8,7 +8,8 @@ from pathlib import Path
 import urdfkit
 
 PACKAGE = Path(urdfkit.__file__).parent
-DOC = PACKAGE.parent / "docs" / "architecture.md"
+#: In the checkout: the tests' own folder's parent, wherever urdfkit is installed.
+DOC = Path(__file__).resolve().parent.parent / "docs" / "architecture.md"
 
 
 def _listed() -> set[str]:
