@@ -325,6 +325,7 @@ def test_a_bad_environment_name_is_refused(monkeypatch: pytest.MonkeyPatch,
 # --------------------------------------------------------------------------- live reload
 
 
+@pytest.mark.slow  # a long browser test (7-10 s): CI's slow step runs it
 def test_a_robot_drawn_without_collision_shapes_is_framed_whole(module_chromium: Any,
                                                                  tmp_path: Path) -> None:
     """The white arm has visual shapes only: PyBullet's boxes (collision shapes) hold none of

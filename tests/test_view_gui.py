@@ -192,6 +192,7 @@ def _hold(page: Any, key: str, seconds: float = 0.6) -> None:
     page.keyboard.up(key)
 
 
+@pytest.mark.slow  # a long browser test (7-10 s): CI's slow step runs it
 def test_arrow_keys_on_a_slider_move_the_slider_not_the_camera(
         open_view: Any, viewers: Any, arm: Path) -> None:
     v = viewers(arm)
@@ -354,6 +355,7 @@ def test_findings_name_the_file_as_it_is(open_view: Any, viewers: Any, tmp_path:
 # --------------------------------------------------------------------------- item 9
 
 
+@pytest.mark.slow  # a long browser test (7-10 s): CI's slow step runs it
 def test_reset_view_frames_the_robot_again(open_view: Any, viewers: Any, arm: Path) -> None:
     v = viewers(arm)
     page = open_view(v.url)
