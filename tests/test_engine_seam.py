@@ -43,9 +43,8 @@ IMPORTS_AN_ENGINE: dict[str, str] = {
 #: Modules outside engine/ that still call PyBullet's functions (through a session's bound
 #: client), each for its owner to port to the seam.
 CALLS_PYBULLET: set[str] = {
-    "checks/collisions.py", "draw/render.py", "draw/view_model.py", "draw/view_stream.py",
+    "checks/collisions.py", "draw/render.py", "draw/view_model.py",
     "exchange/agree.py", "exchange/agree_contact.py", "gym.py",
-    "motion/drive.py",  # its own loop, sampler, ground and checks; detection is ported
 }
 
 #: The modules ported to the seam: no PyBullet but the escape hatch they hand out.

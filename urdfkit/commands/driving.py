@@ -11,6 +11,7 @@ from urdfkit.commands.shared import (
     AllOpt,
     ArgOpt,
     DrivetrainOpt,
+    EngineOpt,
     ForceOpt,
     JsonOpt,
     MaxForceOpt,
@@ -99,6 +100,7 @@ def drive(
     port: RunPortOpt = None,
     no_wait: NoWaitOpt = False,
     wait_timeout: WaitTimeoutOpt = None,
+    engine: EngineOpt = FROM_LIBRARY,
 ) -> None:
     """Drive a car headless at a fixed throttle and steer, and report where it went.
 
@@ -126,7 +128,7 @@ def drive(
         steer=steer, drivetrain=drivetrain, tutorial=tutorial, keep_trajectory=plot is not None,
         wheels=split_joints(wheels), hinges=split_joints(hinges), sample_every=sample_every,
         gui=gui, guard=not no_guard, package_paths=package_path, up=up, limp=limp,
-        gazebo_contacts=gazebo_contacts, mimic=not no_mimic, **given)
+        gazebo_contacts=gazebo_contacts, mimic=not no_mimic, engine=engine, **given)
     with Scenario(config) as sc:
         _say_drivetrain(sc)
         said = list(sc.warnings)
@@ -203,7 +205,8 @@ def _say_drivetrain(sc: Any) -> None:
         [t.link_names.get(k, str(k)) for k in t.caster_links]
     show.note(f"{sc.model}: wheels {names(t.wheels)}; hinges {names(t.hinges)}; "
               f"casters {', '.join(casters) or 'none'}; held {names(list(sc.held))}; "
-              f"limp {names(sc.limp)}; drivetrain {t.mode} ({t.steering} steering)")
+              f"limp {names(sc.limp)}; drivetrain {t.mode} ({t.steering} steering)"
+              + ("" if sc.config.engine == "pybullet" else f"; engine {sc.engine.label}"))
     if sc.gazebo_applied:
         show.note("Gazebo contacts applied: " + "; ".join(
             f"{k} " + ", ".join(f"{n} {v:g}" for n, v in vals.items())
@@ -278,8 +281,7 @@ def _run_view(sc: Any, config: Any, pace: float | None, port: int | None) -> Any
                     port=port, watch=False, ground=float(max(4, math.ceil(2 * reach + 2))),
                     display=display, stand_on_grid=False)
     try:
-        session = sc.session
-        joints = joint_reader(session.bullet, sc.body, viewer.model.joints)
+        joints = joint_reader(sc.engine, sc.body, viewer.model.joints)
         stream = RunStream(viewer, sc.link_poses, pace, total, joints=joints)
         stream.push()
         say_streaming("drive", viewer, pace)

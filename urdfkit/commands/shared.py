@@ -136,6 +136,10 @@ UrdfOpt = Annotated[str | None, typer.Option(
     show_default="the built-in simplecar")]
 PlaneOpt = Annotated[str | None, typer.Option(
     help="Ground to drive on.", show_default="the built-in simpleplane")]
+# drive, sim: the physics engine (urdfkit/engine/registry.py); sim's default is the scenario's.
+EngineOpt = Annotated[str, typer.Option(
+    "--engine", metavar="pybullet|mujoco", help="The physics engine: mujoco runs the MJCF "
+    "export in memory (needs urdfkit\\[mujoco]; docs/engines.md).")]
 UpOpt = Annotated[str, typer.Option(
     "--up", metavar="z|y|x", help="The car's up axis: y stands up a Y-up model.")]
 # drive --view and sim --view: the run streamed to a browser page (urdfkit/view.py).

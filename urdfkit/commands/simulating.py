@@ -54,6 +54,10 @@ def sim(
     port: RunPortOpt = None,
     no_wait: NoWaitOpt = False,
     wait_timeout: WaitTimeoutOpt = None,
+    engine: Annotated[str | None, typer.Option(
+        "--engine", metavar="pybullet|mujoco", help="The physics engine instead of the "
+        "scenario's physics.engine: mujoco runs the MJCF export in memory (needs "
+        "urdfkit\\[mujoco]; docs/engines.md).", show_default="the scenario's")] = None,
 ) -> None:
     """Simulate a scenario of one or more robots and record their observations.
 
@@ -72,7 +76,11 @@ def sim(
     check_wait(view, no_wait, wait_timeout)
     if out is not None:
         simulation.check_rows_output(out, force=force)  # fail before the run, not after it
-    with simulation.Simulation.from_file(scenario, gui=gui) as s:
+    if engine is not None:
+        from urdfkit.engine.registry import check
+
+        check(engine)
+    with simulation.Simulation.from_file(scenario, gui=gui, engine=engine) as s:
         for note in s.config.notes:
             show.warn(note)
         stream = _sim_view(s, pace, port) if view else None
@@ -87,7 +95,8 @@ def sim(
     summaries = simulation.summarize(result)
     if as_json:
         data: dict[str, Any] = {
-            "scenario": scenario, "time_step": result.time_step, "steps": result.steps,
+            "scenario": scenario, "engine": s.engine.name,
+            "time_step": result.time_step, "steps": result.steps,
             "duration": result.steps * result.time_step, "rows": result.row_count,
             "robots": [x.to_dict() for x in summaries],
             "out": None if written is None else str(written),
@@ -96,7 +105,8 @@ def sim(
             data["observations"] = rows
         show.print_json(data)
     else:
-        _sim_table(scenario, result, summaries, written)
+        on = "" if s.engine.name == "pybullet" else f" on {s.engine.label}"
+        _sim_table(scenario + on, result, summaries, written)
     if result.interrupted:
         show.interrupted("interrupted; the rows cover the steps simulated")
         raise typer.Exit(130)
@@ -198,7 +208,7 @@ def _sim_view(s: Any, pace: float | None, port: int | None) -> Any:
             viewer.add_robot(b.loaded[0], inertia_from_file=b.loaded[1].inertia_from_file)
         # The joint readouts show the followed robot's joints (the first's by default).
         models = [viewer.model, *(m for m, _ in viewer.extra)]
-        joints = [joint_reader(s.bullet, b.body, m.joints)
+        joints = [joint_reader(s.engine, b.body, m.joints)
                   for b, m in zip(bodies, models, strict=True)]
         stream = RunStream(viewer, s.link_poses, pace, s.total_steps * s.time_step,
                            robots=True, joints=joints, names=[b.name for b in bodies])

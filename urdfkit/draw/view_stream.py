@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import threading
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import EngineError
 from urdfkit.draw.view_model import Layer, Vec3, ViewedRobot
 from urdfkit.draw.view_page import box_digits
+
+if TYPE_CHECKING:
+    from urdfkit.engine.api import Simulator
 
 
 def wxyz(q: Sequence[float]) -> tuple[float, float, float, float]:
@@ -140,13 +143,18 @@ FOLLOW, WHOLE_PATH, FREE = "follow the robot", "frame the whole path", "free"
 FOLLOW_MARGIN = 0.5
 
 
-def joint_reader(bullet: Any, body: int, joints: Sequence[Any]) -> Any:
+def joint_reader(engine: Simulator, body: int, joints: Sequence[Any]
+                 ) -> Callable[[], dict[str, float]]:
     """A function returning a run's joint positions by name (``joints``: the viewer's).
 
-    ``bullet`` is the run's session's bound pybullet (:class:`~urdfkit.engine.session.Bullet`).
+    ``engine`` is the run's world (any engine: indices are PyBullet's on every one).
     """
+    indices = [j.index for j in joints]
+    names = [j.name for j in joints]
+
     def read() -> dict[str, float]:
-        return {j.name: float(bullet.getJointState(body, j.index)[0]) for j in joints}
+        rows = engine.joint_rows(body, indices) if indices else ()
+        return {name: float(row[0]) for name, row in zip(names, rows, strict=True)}
     return read
 
 

@@ -425,6 +425,16 @@ class Simulator(Model, Protocol):
         """The contact points of ``body`` (one link of it, or all) with ``other`` (or any)."""
         ...
 
+    def closest_points(self, body: int, other: int, distance: float,
+                       link: int | None = None, other_link: int | None = None
+                       ) -> list[ContactPoint]:
+        """The points of ``body`` and ``other`` (one link of either) within ``distance``.
+
+        PyBullet's ``getClosestPoints``: ``distance`` < 0 is how deep they are inside each
+        other; no step is needed.
+        """
+        ...
+
     def enable_joint_force_sensor(self, body: int, joint: int) -> None:
         """Measure the reaction wrench on a joint (:attr:`JointState.reaction`) from now on."""
         ...

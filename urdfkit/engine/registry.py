@@ -33,6 +33,15 @@ def open_engine(name: str = "pybullet", gui: bool = False) -> Simulator:
     return engine
 
 
+def check(name: str) -> None:
+    """Refuse an engine urdfkit does not have, before anything is opened.
+
+    Raises:
+        ParameterError: No engine of that name (the closest names said).
+    """
+    _where(name)
+
+
 def preload(name: str = "pybullet") -> None:
     """Import engine ``name``'s package now: a process about to fork workers warms them once.
 

@@ -514,10 +514,30 @@ def axis_angle_matrix(axis: Sequence[float], angle: float) -> Matrix3:
             (t * x * z - s * y, t * y * z + s * x, t * z * z + c))
 
 
+def euler_from_quat(q: Sequence[float]) -> Vec3:
+    """Roll, pitch, yaw of a quaternion (x, y, z, w): PyBullet's ``getEulerFromQuaternion``.
+
+    Bit for bit (its formula, in its order; tests/test_engine_seam.py compares the two over
+    random quaternions), for what reports as PyBullet did (drive's trajectories, on every
+    engine). Within 0.0045 rad of a pitch of +-pi/2 the pitch is +-pi/2, roll 0 and yaw takes
+    the sum (:func:`quat_to_rpy` is exact there).
+    """
+    x, y, z, w = q
+    sqx, sqy, sqz, squ = x * x, y * y, z * z, w * w
+    sarg = -2 * (x * z - w * y)
+    if sarg <= -0.99999:
+        return (0.0, -0.5 * math.pi, 2 * math.atan2(x, -y))
+    if sarg >= 0.99999:
+        return (0.0, 0.5 * math.pi, 2 * math.atan2(-x, y))
+    return (math.atan2(2 * (y * z + w * x), squ - sqx - sqy + sqz), math.asin(sarg),
+            math.atan2(2 * (x * y + w * z), squ + sqx - sqy - sqz))
+
+
 def quat_to_rpy(q: Sequence[float]) -> Vec3:
     """Roll, pitch, yaw (URDF's fixed-axis X-Y-Z convention) of a quaternion (x, y, z, w).
 
-    The same result as ``p.getEulerFromQuaternion``, without needing a PyBullet client.
+    PyBullet's ``getEulerFromQuaternion`` to 1e-6 and exact near a pitch of +-pi/2, where
+    PyBullet's (:func:`euler_from_quat`) snaps to +-pi/2 (r2d2's -1.57075 reads -pi/2 there).
     """
     x, y, z, w = q
     roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))

@@ -38,8 +38,18 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from urdfkit.core.errors import ParameterError, UrdfkitError
-from urdfkit.engine.session import LoadOptions, Session, quiet_stdout
-from urdfkit.model.spec import MAX_STEPS, UP_AXES, finite, quat_mul
+from urdfkit.engine.api import LoadSettings
+from urdfkit.engine.registry import check as check_engine
+from urdfkit.engine.registry import open_engine
+from urdfkit.engine.session import quiet_stdout
+from urdfkit.model.spec import (
+    MAX_STEPS,
+    UP_AXES,
+    euler_from_quat,
+    finite,
+    quat_mul,
+    rpy_to_unit_quat,
+)
 from urdfkit.motion.drive_result import (
     SETTLED_FRACTION,
     DriveResult,
@@ -62,7 +72,8 @@ from urdfkit.motion.vehicle_shapes import base_link_pose, lowest_point, set_base
 from urdfkit.sources.builtin import builtin_file as builtin_file  # re-exported: gym, sim, tests
 
 if TYPE_CHECKING:
-    from urdfkit.engine.pybullet import PyBulletEngine
+    from urdfkit.engine.api import Simulator
+    from urdfkit.engine.session import Session
     from urdfkit.model.gazebo import GazeboContact
     from urdfkit.motion.mimic import Mimic
 
@@ -137,6 +148,8 @@ class DriveConfig:
             stiffness and damping from kp/kd (both given); see :mod:`urdfkit.model.gazebo`.
         mimic: Honour ``<mimic>`` (a gear constraint per follower, :mod:`urdfkit.motion.mimic`);
             False: raw PyBullet, which ignores it.
+        engine: The physics engine (:data:`urdfkit.engine.registry.ENGINES`): ``pybullet``,
+            or ``mujoco`` (the export, in memory: docs/engines.md).
     """
 
     urdf: str | None = None
@@ -166,6 +179,7 @@ class DriveConfig:
     limp: bool = False
     gazebo_contacts: bool = False
     mimic: bool = True
+    engine: str = "pybullet"
 
     def check(self) -> None:
         """Refuse values that would make the run meaningless (exit 2 in the CLI)."""
@@ -206,8 +220,7 @@ class DriveConfig:
         if self.base_position is not None:
             self.base_position = tuple(  # type: ignore[assignment]
                 _finite("base_position", v) for v in self.base_position)
-        if self.tutorial:
-            self.drivetrain, self.max_force = "locked", None
+        self._check_engine()
         self.gravity = _finite("gravity", self.gravity)
         if self.up not in UP_AXES:
             raise ParameterError(f"`up` must be one of {', '.join(UP_AXES)}, got {self.up!r}",
@@ -219,6 +232,14 @@ class DriveConfig:
         if self.template_params and self.urdf is not None:
             raise ParameterError("`template_params` are for the built-in simplecar; a `urdf` "
                                  "file takes `xacro_args`", param="template_params")
+
+    def _check_engine(self) -> None:
+        check_engine(self.engine)
+        if self.tutorial:
+            if self.engine != "pybullet":
+                raise ParameterError(f"`tutorial` reproduces PyBullet's tutorial loop; it has "
+                                     f"no meaning on {self.engine}", param="tutorial")
+            self.drivetrain, self.max_force = "locked", None
 
     @property
     def total_steps(self) -> int:
@@ -270,7 +291,7 @@ PROBE_LIMIT = 60.0
 class Scenario:
     """A loaded car on a plane, ready to drive: open it, look at what was detected, run it.
 
-    Use it as a context manager so the PyBullet client and temp files always go away::
+    Use it as a context manager so the engine's world and temp files always go away::
 
         with Scenario(DriveConfig(throttle=10, steer=0.2)) as sc:
             print(sc.drivetrain.wheels)
@@ -294,10 +315,8 @@ class Scenario:
         self.mimic_followers: dict[str, int] = {}
         #: The Gazebo contacts applied at load: {link: {lateralFriction, ...}}.
         self.gazebo_applied: dict[str, dict[str, float]] = {}
-        self.session: Session | None = None
-        #: The world behind the engine seam, for the shared vehicle, mimic and Gazebo code;
-        #: this module's own loop still calls PyBullet through :attr:`session`.
-        self.engine: PyBulletEngine | None = None
+        #: The world behind the engine seam (PyBullet's or MuJoCo's: ``config.engine``).
+        self.engine: Simulator | None = None
         try:
             self._open()
         except BaseException:
@@ -316,12 +335,28 @@ class Scenario:
         path.write_bytes(build_template(name, params).to_bytes())
         return path
 
-    def _load(self, s: Session, name: str | None, builtin: str, options: LoadOptions,
+    @property
+    def session(self) -> Session | None:
+        """The PyBullet client of a PyBullet run (None once closed): the escape hatch.
+
+        Raises:
+            ParameterError: the run is on another engine.
+        """
+        from urdfkit.engine.pybullet import PyBulletEngine
+
+        if self.engine is None:
+            return None
+        if not isinstance(self.engine, PyBulletEngine):
+            raise ParameterError(f"`session`: this drive runs on {self.engine.name}, not "
+                                 "PyBullet", param="session")
+        return self.engine.session
+
+    def _load(self, engine: Simulator, name: str | None, builtin: str, settings: LoadSettings,
               params: Mapping[str, str] | None = None) -> int:
         if name is None:
             path = self._builtin(builtin, params)
             self._last_file = str(path)
-            return s.load_urdf(path, options, display=builtin)
+            return engine.load(str(path), settings, display=builtin)
         from urdfkit.sources.resolve import open_input
 
         self._last_file = name
@@ -339,20 +374,16 @@ class Scenario:
 
                 self._gazebo = contacts_to_apply(res.root)
                 self._mimics = mimic_relations(res.root)
-            return s.load_urdf(res.load_path, options, display=res.name)
+            return engine.load(str(res.load_path), settings, display=res.name)
 
     def _open(self) -> None:
-        from urdfkit.engine.pybullet import PyBulletEngine
-
         c = self.config
-        self.engine = engine = PyBulletEngine(session=Session(gui=c.gui))
-        self.session = s = engine.session
-        p = s.bullet
-        p.setGravity(0, 0, c.gravity)
-        p.setTimeStep(c.time_step)
+        self.engine = engine = open_engine(c.engine, gui=c.gui)
+        engine.set_gravity((0.0, 0.0, c.gravity))
+        engine.set_time_step(c.time_step)
         car = c.urdf or "simplecar"
         upright = UP_AXES[c.up]
-        spawn = quat_mul(p.getQuaternionFromEuler(c.base_rpy), upright)
+        spawn = quat_mul(rpy_to_unit_quat(*c.base_rpy), upright)
         start = c.base_position or (TUTORIAL_START if c.tutorial else (0.0, 0.0, 0.0))
         # The tutorial's load: no flags. Otherwise implicit cylinders (smooth wheels) and the
         # file's own inertia; see the module docstring.
@@ -360,12 +391,12 @@ class Scenario:
                                             "URDF_USE_INERTIA_FROM_FILE"]
         # The car is loaded first (as the tutorial does), standing up where it starts; it is
         # turned to its spawn tilt only after its wheels are found in its own frame.
-        self.body = self._load(s, c.urdf, "simplecar", LoadOptions(
-            base_position=start, base_orientation=upright, inertia_from_file=not c.tutorial,
+        self.body = self._load(engine, c.urdf, "simplecar", LoadSettings(
+            position=start, orientation=upright, inertia_from_file=not c.tutorial,
             implicit_cylinder=not c.tutorial), c.template_params)
         #: The car's file, for a viewer to load the same robot (the built-in one's build).
         self.car_file = self._last_file
-        s.require_state_queries(self.body, car)
+        engine.require_state_queries(self.body, car)
         try:
             self.drivetrain = train = detect_upright(engine, self.body, upright, c.wheels,
                                                      c.hinges, c.drivetrain)
@@ -380,8 +411,9 @@ class Scenario:
 
             self.mimic_followers = couple_mimics(engine, self.body, self._mimics)
         # The tutorial loads its plane as it is (a mass-0 box: static either way).
-        self.plane = self._load(s, c.plane, "simpleplane", LoadOptions(
-            fixed_base=not c.tutorial, implicit_cylinder=not c.tutorial), self._ground_params())
+        self.plane = self._load(engine, c.plane, "simpleplane", LoadSettings(
+            fixed_base=not c.tutorial, implicit_cylinder=not c.tutorial, scenery=True),
+            self._ground_params())
         self.ground_top, self.ground_bounds = self._ground()
         if c.base_position is None and not c.tutorial:
             self._rest_on_ground(start)
@@ -406,22 +438,22 @@ class Scenario:
 
     def gazebo_differences(self) -> list[str]:
         """The file's Gazebo friction where PyBullet uses another, as a user reads it."""
-        if not self._gazebo or self.session is None or self.engine is None:
+        if not self._gazebo or self.engine is None:
             return []
         from urdfkit.motion.gazebo_load import link_indices
 
-        p = self.session.bullet
-        index = link_indices(self.engine, self.body)
+        engine = self.engine
+        index = link_indices(engine, self.body)
         out = []
         for name, g in self._gazebo.items():
             mu = g.lateral_friction
             if mu is None or name not in index:
                 continue
-            used = p.getDynamicsInfo(self.body, index[name])[1]
+            used = engine.dynamics(self.body, index[name]).lateral_friction
             if abs(used - mu) > 1e-9 * max(1.0, mu):
                 given = " ".join(f"{k} {v:g}" for k, v in g.given().items()
                                  if k in ("mu1", "mu2"))
-                out.append(f"{name} {given}, PyBullet uses {used:g}")
+                out.append(f"{name} {given}, {self._engine_label()} uses {used:g}")
         return out
 
     def _warn_phantom_mass(self) -> None:
@@ -433,10 +465,10 @@ class Scenario:
         """
         if not self._phantom:
             return
-        assert self.session is not None
-        p = self.session.bullet
-        total = sum(p.getDynamicsInfo(self.body, k)[0]
-                    for k in range(-1, p.getNumJoints(self.body)))
+        assert self.engine is not None
+        engine = self.engine
+        total = sum(engine.dynamics(self.body, k).mass
+                    for k in range(-1, len(engine.joints(self.body))))
         made_up = float(len(self._phantom))
         if total > 0 and made_up >= 0.1 * total:
             names = ", ".join(self._phantom[:5]) + (", ..." if len(self._phantom) > 5 else "")
@@ -454,16 +486,16 @@ class Scenario:
         ``--steer 0.5`` yawed 0.13 rad while its drive unit turned, and the run blamed wheel
         slip.
         """
-        assert self.session is not None
-        p, train = self.session.bullet, self.drivetrain
+        assert self.engine is not None
+        joints, train = self.engine.joints(self.body), self.drivetrain
         free = set(train.casters)
         swivels: dict[int, list[str]] = {}
         for w in train.wheels:
-            k = p.getJointInfo(self.body, w)[16]
+            k = joints[w].parent
             while k >= 0:
                 if k in free and k not in train.wheels:
                     swivels.setdefault(k, []).append(train.joint_names[w])
-                k = p.getJointInfo(self.body, k)[16]
+                k = joints[k].parent
         if swivels:
             named = ", ".join(train.joint_names[k] for k in swivels)
             wheels = ", ".join(w for ws in swivels.values() for w in ws)
@@ -480,8 +512,8 @@ class Scenario:
         once; held by a position motor at its start angle with the URDF's effort it stays as
         it was loaded. Casters always roll free; ``limp`` frees the rest too.
         """
-        assert self.session is not None
-        p, train = self.session.bullet, self.drivetrain
+        assert self.engine is not None
+        train = self.drivetrain
         casters = set(train.casters)
         geared = set(self.mimic_followers)  # moved by their leaders' gears, not held
         candidates = [j for j in train.passive if j not in casters
@@ -490,12 +522,12 @@ class Scenario:
         self.limp: list[int] = list(candidates) if self.config.limp else []
         if self.config.limp or not candidates:
             return
-        states = p.getJointStates(self.body, candidates)
+        states = self.engine.joint_states(self.body, candidates)
         weak = []
         for j, st in zip(candidates, states, strict=True):
             force = train.efforts.get(j, 0.0)
             if force > 0 and math.isfinite(force):
-                self.held[j] = (st[0], force)
+                self.held[j] = (st.position, force)
             else:
                 self.limp.append(j)
                 weak.append(train.joint_names[j])
@@ -523,9 +555,8 @@ class Scenario:
 
     def _ground(self) -> tuple[float | None, tuple[float, float, float, float] | None]:
         """The ground's top z and its x-y extent (None where unbounded, as a GEOM_PLANE)."""
-        assert self.session is not None
-        p = self.session.bullet
-        lo, hi = p.getAABB(self.plane, -1)
+        assert self.engine is not None
+        lo, hi = self.engine.aabb(self.plane, -1)
         top = hi[2] if abs(hi[2]) < 1e6 else None
         bounds = (lo[0], hi[0], lo[1], hi[1]) if max(map(abs, (*lo[:2], *hi[:2]))) < 1e6 \
             else None
@@ -543,11 +574,11 @@ class Scenario:
 
     def _check_start(self) -> None:
         """A static base, or a start inside the ground, make the run meaningless: say so."""
-        assert self.session is not None
-        p = self.session.bullet
+        assert self.engine is not None
+        engine = self.engine
         self.problems = []
-        self.static_base = p.getDynamicsInfo(self.body, -1)[0] == 0
-        root = p.getBodyInfo(self.body)[0].decode("utf-8", "replace")
+        self.static_base = engine.dynamics(self.body, -1).mass == 0
+        root = engine.link_names(self.body)[0]
         if self.static_base and root == "world":
             # PyBullet gives a link named `world` without <inertial> mass 0, not 1 kg
             # (measured on 3.2.7: with a mass of its own it falls like any other).
@@ -558,8 +589,8 @@ class Scenario:
         elif self.static_base:
             self.problems.append("static base: the root link has mass 0, so PyBullet fixes it "
                                  "where it is loaded and the car cannot move; give it a mass")
-        points = p.getClosestPoints(self.body, self.plane, 0.0)
-        depth = min((pt[8] for pt in points), default=0.0)
+        points = engine.closest_points(self.body, self.plane, 0.0)
+        depth = min((pt.distance for pt in points), default=0.0)
         if depth < -0.005:
             if self.config.tutorial:  # the tutorial's own start: reproduced, and said
                 self.warnings.append(f"the tutorial's start is {-depth * 1000:.0f} mm inside "
@@ -572,11 +603,8 @@ class Scenario:
     def close(self) -> None:
         """Disconnect and remove the temp folder."""
         if self.engine is not None:
-            self.engine.close()  # and its session
+            self.engine.close()
             self.engine = None
-        if self.session is not None:
-            self.session.close()
-            self.session = None
         if self._tmp is not None:
             self._tmp.cleanup()
             self._tmp = None
@@ -589,40 +617,33 @@ class Scenario:
 
     def link_poses(self) -> list[tuple[Sequence[float], Sequence[float]]]:
         """Every URDF link frame's world pose now, base first (``(xyz, xyzw)``)."""
-        assert self.session is not None and self.engine is not None
-        p, body = self.session.bullet, self.body
-        out = [base_link_pose(self.engine, body)]
-        for j in range(p.getNumJoints(body)):
-            st = p.getLinkState(body, j, computeForwardKinematics=True)
-            out.append((st[4], st[5]))
-        return out
+        assert self.engine is not None
+        return list(self.engine.link_frames(self.body))
 
     def _sampler(self) -> Callable[[float], tuple[float, ...]]:
-        assert self.session is not None
-        p, body = self.session.bullet, self.body
+        assert self.engine is not None
+        engine, body = self.engine, self.body
         joints = self.drivetrain.wheels + self.drivetrain.hinges
-        pose, velocity = p.getBasePositionAndOrientation, p.getBaseVelocity
-        euler, states = p.getEulerFromQuaternion, p.getJointStates
-        # The base link frame's pose and velocity, not the inertial frame's PyBullet reports:
+        state, frame, states = engine.base_state, engine.link_frame, engine.joint_rows
+        # The base link frame's pose and velocity, not the inertial frame the engine reports:
         # with inertia products or an <inertial><origin> they differ (a yaw of -0.16 rad at
-        # rest). The local inertial pose is fixed for the run: inverted once.
-        local = p.getDynamicsInfo(body, -1)
-        inv_pos, inv_orn = p.invertTransform(local[3], local[4])
-        compose = p.multiplyTransforms
-        offset = any(abs(x) > 0 for x in inv_pos) or any(abs(x) > 0 for x in inv_orn[:3])
+        # rest).
+        local = engine.dynamics(body, -1)
+        offset = any(abs(x) > 0 for x in local.inertial_position) or \
+            any(abs(x) > 0 for x in local.inertial_orientation[:3])
 
         def sample(t: float) -> tuple[float, ...]:
-            com, com_orn = pose(body)
-            lin, ang = velocity(body)
+            base = state(body)
+            com, com_orn, lin, ang = base.position, base.orientation, base.linear, base.angular
             if offset:
-                pos, orn = compose(com, com_orn, inv_pos, inv_orn)
+                pos, orn = frame(body, -1)
                 r = (pos[0] - com[0], pos[1] - com[1], pos[2] - com[2])
                 lin = (lin[0] + ang[1] * r[2] - ang[2] * r[1],
                        lin[1] + ang[2] * r[0] - ang[0] * r[2],
                        lin[2] + ang[0] * r[1] - ang[1] * r[0])
             else:
                 pos, orn = com, com_orn
-            row = [t, *pos, *euler(orn), *lin]
+            row = [t, *pos, *euler_from_quat(orn), *lin]
             if joints:
                 for st in states(body, joints):
                     row += (st[0], st[1])
@@ -644,11 +665,17 @@ class Scenario:
             "limp": [{"index": j, "name": self.drivetrain.joint_names[j]} for j in self.limp],
             "load_flags": self.flags, "time_step": c.time_step, "gravity": c.gravity,
             "link_damping": {"linear": PYBULLET_LINK_DAMPING,
-                             "angular": PYBULLET_LINK_DAMPING, "note": "PyBullet's default"},
+                             "angular": PYBULLET_LINK_DAMPING, "note": "PyBullet's default"}
+            if c.engine == "pybullet" else
+            {"linear": 0.0, "angular": 0.0, "note": f"{self._engine_label()} has none"},
             "tutorial": c.tutorial,
             "gazebo_contacts": self.gazebo_applied,
             "mimic": sorted(self.mimic_followers),
+            "engine": c.engine,
         }
+
+    def _engine_label(self) -> str:
+        return self.engine.label if self.engine is not None else self.config.engine
 
     def run(self, progress: ProgressFn | None = None,
             sink: Callable[[tuple[float, ...]], None] | None = None) -> DriveResult:
@@ -661,16 +688,13 @@ class Scenario:
             progress: Called as ``progress(done, total)`` after every sample.
             sink: Called with each trajectory sample as it is taken (to stream it to disk).
         """
-        assert self.session is not None and self.engine is not None
-        c, s, train, engine = self.config, self.session, self.drivetrain, self.engine
-        p, body = s.bullet, self.body
+        assert self.engine is not None
+        c, train, engine, body = self.config, self.drivetrain, self.engine, self.body
         disable_default_motors(engine, body, [j for j in train.passive if j not in self.held])
         if self.held:
             held = list(self.held)
-            p.setJointMotorControlArray(
-                body, held, p.POSITION_CONTROL,
-                targetPositions=[self.held[j][0] for j in held],
-                forces=[self.held[j][1] for j in held])
+            engine.motors(body, held, "position", [self.held[j][0] for j in held],
+                          forces=[self.held[j][1] for j in held])
         apply_drive(engine, body, train, c.throttle, self.steer, c.max_force)
         total, period, dt = c.total_steps, c.sample_period, c.time_step
         take = self._sampler()
@@ -689,20 +713,20 @@ class Scenario:
                 sink(row)
 
         sample(0.0)
-        step = p.stepSimulation
+        step = engine.step
         done = 0
         interrupted = False
         gui = _GuiControls(self) if c.gui else None
         start = time.perf_counter()
-        with quiet_stdout() as out:
+        with quiet_stdout():  # what the engine prints (PyBullet's C code, on fd 1)
             try:
                 while done < total:
                     n = min(period, total - done)
                     if gui is not None:
-                        n = gui.steps(n)
+                        n, open_ = gui.steps(n)
+                        interrupted = not open_  # the window was closed
                     else:
-                        # The hot loop: nothing but the physics step (bound to the client
-                        # once, above).
+                        # The hot loop: nothing but the physics step (bound once, above).
                         for _ in range(n):
                             step()
                     done += n
@@ -710,14 +734,11 @@ class Scenario:
                         sample(done * dt)
                     if progress is not None:
                         progress(done, total)
+                    if interrupted:
+                        break
             except KeyboardInterrupt:
                 interrupted = True
-            except p.error:
-                if gui is None:
-                    raise
-                interrupted = True  # the GUI window was closed
         wall = time.perf_counter() - start
-        s.diagnostics.extend(out.lines)
         assert stats.last is not None
         if stats.last[0] != done * dt:
             sample(done * dt)
@@ -880,32 +901,36 @@ class _GuiControls:
     """
 
     def __init__(self, sc: Scenario):
-        assert sc.session is not None and sc.engine is not None
-        self.sc, self.p, self.engine = sc, sc.session.bullet, sc.engine
+        from urdfkit.engine.pybullet_gui import Sliders
+
+        assert sc.engine is not None
+        self.sc, self.engine = sc, sc.engine
         lo, hi = sc.drivetrain.steer_range()
         lo, hi = max(lo, -1.0), min(hi, 1.0)
         top = max(20.0, abs(sc.config.throttle))
-        self.steer_id = self.p.addUserDebugParameter("Steering", lo, hi, sc.steer)
-        self.throttle_id = self.p.addUserDebugParameter("Throttle", -top, top,
-                                                        sc.config.throttle)
-        self.last = (sc.config.throttle, sc.steer)
+        self.sliders = Sliders(sc.engine, [("Steering", lo, hi, sc.steer),
+                                           ("Throttle", -top, top, sc.config.throttle)])
+        self.last: tuple[float, ...] = (sc.steer, sc.config.throttle)
         self.next_tick = time.perf_counter()
 
-    def steps(self, n: int) -> int:
-        p, dt = self.p, self.sc.config.time_step
-        for _ in range(n):
-            now = (p.readUserDebugParameter(self.throttle_id),
-                   p.readUserDebugParameter(self.steer_id))
+    def steps(self, n: int) -> tuple[int, bool]:
+        """Up to ``n`` steps at real time; how many were taken, and whether the window is open."""
+        dt = self.sc.config.time_step
+        for i in range(n):
+            now = self.sliders.read()
+            if now is None:
+                return i, False
             if now != self.last:
                 self.last = now
-                apply_drive(self.engine, self.sc.body, self.sc.drivetrain, now[0], now[1],
+                apply_drive(self.engine, self.sc.body, self.sc.drivetrain, now[1], now[0],
                             self.sc.config.max_force)
-            p.stepSimulation()
+            if not self.sliders.step():
+                return i, False
             self.next_tick += dt
             delay = self.next_tick - time.perf_counter()
             if delay > 0:
                 time.sleep(delay)
-        return n
+        return n, True
 
 
 def drive(config: DriveConfig, progress: ProgressFn | None = None) -> DriveResult:

@@ -12,7 +12,14 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 # This module is the lazy import itself: scenario.py imports it only when a scenario is read.
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator  # noqa: TID253
+from pydantic import (  # noqa: TID253
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    field_validator,
+    model_validator,
+)
 
 
 class ConfigModel(BaseModel):
@@ -29,8 +36,10 @@ non_negative = Annotated[float, Field(ge=0)]
 
 
 class Physics(ConfigModel):
-    """The engine: time step, gravity, solver, damping (``physics``)."""
+    """The engine: which, time step, gravity, solver, damping (``physics``)."""
 
+    # urdfkit/engine/registry.py's ENGINES: "pybullet", or "mujoco" (the export, in memory).
+    engine: str = "pybullet"
     time_step: Annotated[float, Field(gt=0, le=1)] = 1.0 / 240.0
     gravity: vec3 = Field(default_factory=lambda: [0.0, 0.0, -9.81])
     solver_iterations: Annotated[int, Field(ge=1)] = 50
@@ -41,6 +50,18 @@ class Physics(ConfigModel):
     # PyBullet's deterministicOverlappingPairs: contacts met in a sorted order, so a
     # reset in place replays the same run. simulation_and_control leaves it off.
     deterministic_pairs: bool = True
+
+    @field_validator("engine")
+    @classmethod
+    def _known_engine(cls, name: str) -> str:
+        from urdfkit.core.errors import ParameterError
+        from urdfkit.engine.registry import check
+
+        try:
+            check(name)
+        except ParameterError as e:
+            raise ValueError(e.message.removeprefix("`engine`: ")) from None
+        return name
 
 
 class Ground(ConfigModel):

@@ -45,7 +45,8 @@ class World:
     Args:
         config: The scenario.
         gui: Open the engine's own window.
-        engine: The engine's name (:data:`urdfkit.engine.registry.ENGINES`).
+        engine: The engine's name (:data:`urdfkit.engine.registry.ENGINES`); default: the
+            scenario's ``physics.engine``.
 
     Attributes:
         config: The scenario.
@@ -57,7 +58,7 @@ class World:
     """
 
     def __init__(self, config: ScenarioConfig, *, gui: bool = False,
-                 engine: str = "pybullet") -> None:
+                 engine: str | None = None) -> None:
         self.config = config
         self.time_step: float = config.physics.time_step
         self.step_count = 0
@@ -66,7 +67,7 @@ class World:
         self._resolved: list[Resolved] = []
         self._start_state = -1
         self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-sim-")
-        self.engine: Simulator = open_engine(engine, gui=gui)
+        self.engine: Simulator = open_engine(engine or config.physics.engine, gui=gui)
 
     @property
     def session(self) -> Session:
@@ -122,9 +123,16 @@ class World:
         # depends on the engine's history, and a reset in place is not reproducible. A
         # simulation_and_control config turns them off, as SimInterface leaves them (else
         # its contacts are solved in another order and the runs part after a few steps).
-        engine.set_physics(deterministic_pairs=ph.deterministic_pairs,
-                           solver_iterations=ph.solver_iterations,
-                           cone_friction=ph.cone_friction)
+        # An iteration count only when the scenario gives one: PyBullet's default is the
+        # scenario's (50), and MuJoCo, which has none, names the key given.
+        given = ph.model_fields_set
+        try:
+            engine.set_physics(deterministic_pairs=ph.deterministic_pairs,
+                               solver_iterations=ph.solver_iterations
+                               if "solver_iterations" in given else None,
+                               cone_friction=ph.cone_friction)
+        except ParameterError as e:
+            raise self.error(f"physics.{e.param or 'engine'}", e.message) from None
         if self.config.ground is not None:
             g = self.config.ground
             self.ground = self._load("ground", g.template, g.params, g.urdf,
@@ -142,7 +150,11 @@ class World:
                 ("angularDamping", _first(r.config.angular_damping, ph.angular_damping)))
                 if value is not None}
             if damping:
-                engine.change_dynamics(r.body, -1, **damping)
+                try:
+                    engine.change_dynamics(r.body, -1, **damping)
+                except ParameterError as e:
+                    raise self.error(f"{r.path}.linear_damping, angular_damping (or "
+                                     "physics')", e.message) from None
 
     def save(self) -> None:
         """Keep the state now as the start :meth:`restore` returns to.

@@ -60,6 +60,8 @@ class Simulation:
             dict of one, which is validated here.
         base_dir: Where relative ``urdf`` paths of a dict ``config`` are resolved.
         gui: Open PyBullet's GUI window to watch the run (needs a display).
+        engine: The physics engine (:data:`urdfkit.engine.registry.ENGINES`) instead of the
+            scenario's ``physics.engine``.
 
     Raises:
         InputError: the scenario is invalid, or names a joint or link a robot lacks, or
@@ -68,11 +70,12 @@ class Simulation:
     """
 
     def __init__(self, config: ScenarioConfig | Mapping[str, object], *,
-                 base_dir: str | Path | None = None, gui: bool = False):
+                 base_dir: str | Path | None = None, gui: bool = False,
+                 engine: str | None = None):
         if isinstance(config, Mapping):
             config = parse_scenario(config, base_dir=base_dir)
         self.config = config
-        self.world = World(config, gui=gui)
+        self.world = World(config, gui=gui, engine=engine)
         self.sensors = Sensors(self.world)
         self.dynamics = Dynamics(self.world)
         self.recorder = Recorder(self.world, self.sensors, self.step)
@@ -108,13 +111,14 @@ class Simulation:
                                    "viscous_friction and stiffness to 0)") from None
 
     @classmethod
-    def from_file(cls, path: str | Path, *, gui: bool = False) -> Simulation:
+    def from_file(cls, path: str | Path, *, gui: bool = False, engine: str | None = None
+                  ) -> Simulation:
         """Load and validate a ``.json`` or ``.toml`` scenario and set it up.
 
         A simulation_and_control config is imported (:mod:`urdfkit.motion.sac`); what the import
         had to say is in ``simulation.config.notes``.
         """
-        return cls(load_scenario(path), gui=gui)
+        return cls(load_scenario(path), gui=gui, engine=engine)
 
     # ---- lifecycle
 

@@ -1,0 +1,56 @@
+"""PyBullet's GUI window as a control panel: sliders read while a run steps (drive --gui).
+
+PyBullet only: its GUI client draws debug sliders (``addUserDebugParameter``) beside the
+scene. Closing the window ends the run: every call then fails with ``pybullet.error``, which
+:class:`Sliders` turns into a plain answer (``None``, ``False``) rather than an exception.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from urdfkit.core.errors import ParameterError
+
+if TYPE_CHECKING:
+    from urdfkit.engine.api import Simulator
+
+
+class Sliders:
+    """Named sliders in an engine's GUI window, and its physics step.
+
+    Args:
+        engine: A PyBullet world opened with ``gui=True``.
+        sliders: ``(label, lowest, highest, start)`` for each slider, top to bottom.
+
+    Raises:
+        ParameterError: the engine is not PyBullet's GUI.
+    """
+
+    def __init__(self, engine: Simulator,
+                 sliders: Sequence[tuple[str, float, float, float]]) -> None:
+        from urdfkit.engine.pybullet import PyBulletEngine
+
+        if not isinstance(engine, PyBulletEngine) or not engine.gui:
+            raise ParameterError("`gui`: sliders need PyBullet's GUI window", param="gui")
+        self._bullet = engine.bullet
+        self._error = engine.session.p.error
+        self._step = engine.bullet.stepSimulation
+        self._ids = [self._bullet.addUserDebugParameter(label, lo, hi, start)
+                     for label, lo, hi, start in sliders]
+
+    def read(self) -> tuple[float, ...] | None:
+        """Every slider's value now, in the order given; None once the window is closed."""
+        read = self._bullet.readUserDebugParameter
+        try:
+            return tuple(float(read(i)) for i in self._ids)
+        except self._error:
+            return None
+
+    def step(self) -> bool:
+        """One physics step; False (and no step) once the window is closed."""
+        try:
+            self._step()
+        except self._error:
+            return False
+        return True
