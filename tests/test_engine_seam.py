@@ -44,7 +44,7 @@ IMPORTS_AN_ENGINE: dict[str, str] = {
 #: client), each for its owner to port to the seam.
 CALLS_PYBULLET: set[str] = {
     "checks/collisions.py", "draw/render.py", "draw/view_model.py",
-    "exchange/agree.py", "exchange/agree_contact.py", "gym.py",
+    "exchange/agree.py", "exchange/agree_contact.py",
 }
 
 #: The modules ported to the seam: no PyBullet but the escape hatch they hand out.

@@ -23,10 +23,10 @@ def test_simple_driving_refuses_an_action_that_is_not_two_real_numbers(action: o
     env = SimpleDrivingEnv()
     try:
         env.reset(seed=0)
-        before = env._p.getBasePositionAndOrientation(env.car)
+        before = env.engine.base_pose(env.car)
         with pytest.raises(ValueError, match="two numbers|finite"):
             env.step(action)
-        after = env._p.getBasePositionAndOrientation(env.car)
+        after = env.engine.base_pose(env.car)
         assert before == after  # refused before anything reached PyBullet
     finally:
         env.close()

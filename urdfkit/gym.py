@@ -32,7 +32,10 @@ except ImportError as e:  # pragma: no cover - the [gym] extra installs it
     raise MissingDependencyError("urdfkit.gym needs gymnasium: pip install 'urdfkit[gym]'") \
         from e
 
-from urdfkit.engine.session import LoadOptions, Session, prime_resets, restore_clean
+from urdfkit.engine.api import Camera, LoadSettings
+from urdfkit.engine.registry import check as check_engine
+from urdfkit.engine.registry import open_engine
+from urdfkit.model.spec import quat_to_matrix
 
 if TYPE_CHECKING:
     from urdfkit.motion.scenario_models import Mode, Randomize, RobotConfig
@@ -49,6 +52,18 @@ _HINGES = (0, 2)
 _WHEELS = (1, 3, 4, 5)
 #: simpleplane as the tutorial has it: a 20 x 20 x 0.01 m box (the template's default is a plane).
 TUTORIAL_GROUND = {"shape": "box"}
+#: The goal marker: a green post, 1 m tall and 1 m across, seen by the cameras and touched by
+#: nothing (no collision shape); fixed where each episode's goal is.
+GOAL_MARKER = """<?xml version="1.0"?>
+<robot name="goal">
+  <link name="goal">
+    <visual>
+      <geometry><cylinder radius="0.5" length="1.0"/></geometry>
+      <material name="goal"><color rgba="0 0.925 0 1"/></material>
+    </visual>
+  </link>
+</robot>
+"""
 
 
 def _real(action: object) -> None:
@@ -129,13 +144,20 @@ class SimpleDrivingEnv(gym.Env):
     id truncates at 250 steps (8.3 s), the tutorial's training length.
 
     Args:
-        render_mode: ``"rgb_array"`` (TinyRenderer frames) or ``"human"`` (PyBullet's GUI,
-            paced to real time).
+        render_mode: ``"rgb_array"`` (the engine's off-screen frames) or ``"human"``
+            (PyBullet's GUI, paced to real time).
         camera: ``"chase"`` (the tutorial's camera on the car, looking ahead) or
             ``"overview"`` (the arena from above).
         width, height: Frame size of ``rgb_array``.
-        implicit_cylinder: Roll on true cylinders (``URDF_USE_IMPLICIT_CYLINDER``); off by
-            default, as in the tutorial: it costs about 1.35x per physics step.
+        implicit_cylinder: Roll on true cylinders (``URDF_USE_IMPLICIT_CYLINDER``); on
+            PyBullet off by default, as in the tutorial: it costs about 1.35x per physics
+            step. MuJoCo's cylinders are true ones (True only).
+        engine: The physics engine (:data:`urdfkit.engine.registry.ENGINES`): ``pybullet``,
+            or ``mujoco`` (docs/engines.md).
+
+    Attributes:
+        engine: The environment's world, behind the engine seam (:mod:`urdfkit.engine.api`).
+        car, goal_marker: Their body ids in it.
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 30}
@@ -152,7 +174,9 @@ class SimpleDrivingEnv(gym.Env):
 
     def __init__(self, render_mode: RenderMode | None = None, *,
                  camera: Literal["chase", "overview"] = "chase",
-                 width: int = 320, height: int = 240, implicit_cylinder: bool = False):
+                 width: int = 320, height: int = 240, implicit_cylinder: bool | None = None,
+                 engine: str = "pybullet"):
+        check_engine(engine)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(f"render_mode must be one of "
                                  f"{', '.join(self.metadata['render_modes'])} or None, got "
@@ -176,11 +200,12 @@ class SimpleDrivingEnv(gym.Env):
         self.observation_space = spaces.Box(
             np.array([-edge, -edge, -1, -1, -5, -5, -9, -9], dtype=np.float32),
             np.array([edge, edge, 1, 1, 5, 5, 9, 9], dtype=np.float32))
-        self._session = Session(gui=_gui(render_mode))
+        self.engine = open_engine(engine, gui=_gui(render_mode))
         try:
-            self._setup(implicit_cylinder)
+            self._setup(implicit_cylinder if implicit_cylinder is not None
+                        else engine != "pybullet")
         except BaseException:
-            self._session.close()
+            self.close()
             raise
         self.goal = (0.0, 0.0)
         self._speed = 0.0
@@ -189,39 +214,34 @@ class SimpleDrivingEnv(gym.Env):
         self._last_frame = 0.0
 
     def _setup(self, implicit_cylinder: bool) -> None:
+        import tempfile
+
         from urdfkit.motion.drive import builtin_file
 
-        s = self._session
-        p = s.bullet
-        self._p = p
-        p.setTimeStep(self.TIME_STEP)
+        e = self.engine
+        e.set_time_step(self.TIME_STEP)
         # Sorted overlapping pairs: the solver meets contacts in the same order after every
         # reset (PyBullet's default does not, and single-step episodes then differ).
-        p.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
-        p.setGravity(0, 0, self.GRAVITY)
+        e.set_physics(deterministic_pairs=True)
+        e.set_gravity((0.0, 0.0, self.GRAVITY))
+        self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-gym-")
+        folder = Path(self._tmp.name)
         # The tutorial's own ground, a box centred on its origin (drive's default is the slab).
         plane, car = builtin_file("simpleplane", TUTORIAL_GROUND), builtin_file("simplecar")
-        if plane is None or car is None:  # no writable cache: build into a temp folder
-            import tempfile
-
+        if plane is None or car is None:  # no writable cache: build into the temp folder
             from urdfkit.model.catalog import build_template
 
-            self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-gym-")
-            plane = build_template("simpleplane", TUTORIAL_GROUND).write(
-                Path(self._tmp.name) / "plane.urdf")
-            car = build_template("simplecar").write(Path(self._tmp.name) / "car.urdf")
-        s.load_urdf(plane, LoadOptions(fixed_base=True), display="simpleplane")
-        self.car = s.load_urdf(car, LoadOptions(
-            base_position=(0.0, 0.0, 0.1), inertia_from_file=True,
+            plane = build_template("simpleplane", TUTORIAL_GROUND).write(folder / "plane.urdf")
+            car = build_template("simplecar").write(folder / "car.urdf")
+        marker = folder / "goal.urdf"
+        marker.write_text(GOAL_MARKER, encoding="utf-8")
+        e.load(str(plane), LoadSettings(fixed_base=True, scenery=True), display="simpleplane")
+        self.car = e.load(str(car), LoadSettings(
+            position=(0.0, 0.0, 0.1), inertia_from_file=True,
             implicit_cylinder=implicit_cylinder), display="simplecar")
-        # The goal marker: a green post, seen by the cameras, touched by nothing.
-        shape = p.createVisualShape(p.GEOM_CYLINDER, radius=0.5, length=1.0,
-                                    rgbaColor=[0.0, 0.925, 0.0, 1.0])
-        self.goal_marker = p.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1,
-                                             baseVisualShapeIndex=shape,
-                                             basePosition=[0.0, 0.0, 0.5])
-        self._start = p.saveState()
-        prime_resets(p, self._start, [self.car])
+        self.goal_marker = e.load(str(marker), LoadSettings(
+            fixed_base=True, position=(0.0, 0.0, 0.5), scenery=True), display="goal")
+        self._start = e.save()  # and primed: the first episode is like every later one
 
     # ---- the Gymnasium API
 
@@ -235,8 +255,8 @@ class SimpleDrivingEnv(gym.Env):
         _open(self)
         super().reset(seed=seed)
         self._ended = self._warned_end = False
-        p = self._p
-        restore_clean(p, self._start, [self.car])
+        e = self.engine
+        e.restore(self._start)
         goal = (options or {}).get("goal")
         if goal is not None:
             gx, gy = _finite_pair(goal)
@@ -247,7 +267,7 @@ class SimpleDrivingEnv(gym.Env):
             gx = rng.uniform(5, 9) if rng.integers(2) else -rng.uniform(5, 9)
             gy = rng.uniform(5, 9) if rng.integers(2) else -rng.uniform(5, 9)
         self.goal = (float(gx), float(gy))
-        p.resetBasePositionAndOrientation(self.goal_marker, [gx, gy, 0.5], [0, 0, 0, 1])
+        e.reset_base(self.goal_marker, (float(gx), float(gy), 0.5), (0.0, 0.0, 0.0, 1.0))
         self._speed = 0.0
         self._steer = None
         obs = self._observe()
@@ -267,22 +287,17 @@ class SimpleDrivingEnv(gym.Env):
         _after_end(self)
         throttle = min(max(throttle, 0.0), 1.0)
         steer = max(min(steer, 0.6), -0.6)
-        p, car = self._p, self.car
-        # The bound calls read as attributes, then called: CPython 3.11 caches an attribute
-        # load but not a method call on an instance (p.f(...)): ~270 instructions a call.
-        motors = p.setJointMotorControlArray
+        e, car = self.engine, self.car
         if steer != self._steer:  # position motors persist: set on change
-            motors(car, _HINGES, p.POSITION_CONTROL, targetPositions=[steer, steer])
+            e.motors(car, _HINGES, "position", [steer, steer])
             self._steer = steer
         v = self._speed
         v += self.TIME_STEP * (self.C_THROTTLE * throttle - v * (v * self.C_DRAG
                                                                  + self.C_ROLLING))
         self._speed = v = max(v, 0.0)
         force = self.WHEEL_FORCE
-        motors(car, _WHEELS, p.VELOCITY_CONTROL, targetVelocities=[v, v, v, v],
-               forces=[force, force, force, force])
-        step = p.stepSimulation
-        step()
+        e.motors(car, _WHEELS, "velocity", [v, v, v, v], forces=[force, force, force, force])
+        e.step()
         obs = self._observe()
         x, y = float(obs[0]), float(obs[1])
         gx, gy = self.goal
@@ -298,16 +313,14 @@ class SimpleDrivingEnv(gym.Env):
             reward = self.GOAL_BONUS
         else:
             terminated = False
-        if self.render_mode == "human" and self._session.gui:
+        if self.render_mode == "human" and self.engine.gui:
             self._follow_in_gui(x, y)
         self._ended = terminated
         return obs, reward, terminated, False, {"distance": distance, "is_success": reached}
 
     def _observe(self) -> np.ndarray:
-        p, car = self._p, self.car
-        pose, velocity = p.getBasePositionAndOrientation, p.getBaseVelocity  # as in step()
-        pos, (qx, qy, qz, qw) = pose(car)
-        lin = velocity(car)[0]
+        base = self.engine.base_state(self.car)
+        pos, (qx, qy, qz, qw), lin = base.position, base.orientation, base.linear
         # cos and sin of PyBullet's yaw, atan2(b, a), without the angle.
         a = qw * qw + qx * qx - qy * qy - qz * qz
         b = 2.0 * (qx * qy + qw * qz)
@@ -320,29 +333,23 @@ class SimpleDrivingEnv(gym.Env):
         """An ``rgb_array`` frame (height x width x 3, uint8); None in ``human`` mode."""
         if self.render_mode != "rgb_array":
             return None
-        p = self._p
-        pos, orn = p.getBasePositionAndOrientation(self.car)
+        pos, orn = self.engine.base_pose(self.car)
         if self.camera == "chase":
             # The tutorial's camera: at the car, 0.2 m up, looking along its heading.
-            m = p.getMatrixFromQuaternion(orn)
-            ahead = (m[0], m[3], m[6])
-            up = (m[2], m[5], m[8])
+            m = quat_to_matrix(orn)
+            ahead, up = (m[0][0], m[1][0], m[2][0]), (m[0][2], m[1][2], m[2][2])
             eye = (pos[0], pos[1], 0.2)
-            view = p.computeViewMatrix(eye, [e + f for e, f in zip(eye, ahead, strict=True)],
-                                       up)
-            fov = 80.0
+            camera = Camera(eye, (eye[0] + ahead[0], eye[1] + ahead[1], eye[2] + ahead[2]), up,
+                            fov=80.0)
         else:
-            view = p.computeViewMatrix((0.0, -13.0, 17.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
-            fov = 60.0
-        proj = p.computeProjectionMatrixFOV(fov, self.width / self.height, 0.01, 100.0)
-        image = p.getCameraImage(self.width, self.height, view, proj,
-                                 renderer=p.ER_TINY_RENDERER)[2]
-        return np.asarray(image, dtype=np.uint8).reshape(self.height, self.width, 4)[
-            :, :, :3].copy()
+            camera = Camera((0.0, -13.0, 17.0), (0.0, 0.0, 0.0))
+        return _frame(self.engine.camera_image(camera, self.width, self.height),
+                      self.width, self.height)
 
     def _follow_in_gui(self, x: float, y: float) -> None:
-        p = self._p
-        p.resetDebugVisualizerCamera(4.0, -40.0, -35.0, [x, y, 0.0])
+        from urdfkit.engine.pybullet_gui import follow
+
+        follow(self.engine, 4.0, -40.0, -35.0, (x, y, 0.0))
         wait = self._last_frame + self.TIME_STEP - time.perf_counter()
         if wait > 0:
             time.sleep(wait)
@@ -351,7 +358,8 @@ class SimpleDrivingEnv(gym.Env):
     def close(self) -> None:
         """Disconnect the client (safe to call twice); reset or step after it is an error."""
         self._closed = True
-        self._session.close()
+        if "engine" in self.__dict__:
+            self.engine.close()
         tmp = self.__dict__.pop("_tmp", None)
         if tmp is not None:
             tmp.cleanup()
@@ -396,6 +404,9 @@ class ScenarioEnv(gym.Env):
             velocities, plus the base pose and velocities for a floating base.
         action_bounds: Per action name (joint, ``throttle`` or ``steer``), ``(low, high)``
             instead of the defaults.
+        engine: The physics engine instead of the scenario's ``physics.engine``
+            (``pybullet``, ``mujoco``); not with a :class:`~urdfkit.sim.Simulation`, which
+            has its own.
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 30}
@@ -409,7 +420,7 @@ class ScenarioEnv(gym.Env):
                  observation: Literal["flat", "dict"] = "flat",
                  fields: Sequence[str] | None = None,
                  action_bounds: Mapping[str, tuple[float, float]] | None = None,
-                 width: int = 320, height: int = 240):
+                 width: int = 320, height: int = 240, engine: str | None = None):
         from urdfkit.sim import OBSERVATION_FIELDS, Simulation
 
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -430,16 +441,21 @@ class ScenarioEnv(gym.Env):
             if fn is not None and not callable(fn):
                 raise ParameterError(f"{name} must be a callable taking the observation",
                                      param=name)
+        if engine is not None:
+            check_engine(engine)
         gui = _gui(render_mode)
         if isinstance(scenario, Simulation):
-            if gui and not scenario.session.gui:
+            if engine is not None and engine != scenario.engine.name:
+                raise ParameterError(f"engine={engine!r}: the Simulation given runs on "
+                                     f"{scenario.engine.name}", param="engine")
+            if gui and not scenario.engine.gui:
                 raise ParameterError("render_mode='human' needs a Simulation made with "
                                      "gui=True", param="render_mode")
             self.sim = scenario
         elif isinstance(scenario, Mapping):
-            self.sim = Simulation(scenario, gui=gui)
+            self.sim = Simulation(scenario, gui=gui, engine=engine)
         else:
-            self.sim = Simulation.from_file(scenario, gui=gui)
+            self.sim = Simulation.from_file(scenario, gui=gui, engine=engine)
         try:
             self.robot = self._pick_robot(robot)
             self._build_action_space(dict(action_bounds or {}))
@@ -713,19 +729,20 @@ class ScenarioEnv(gym.Env):
         """An ``rgb_array`` frame looking at the robot (height x width x 3, uint8)."""
         if self.render_mode != "rgb_array":
             return None
-        p = self.sim.bullet
-        target = self.sim.robot(self.robot).base_position()
-        view = p.computeViewMatrixFromYawPitchRoll(target, 2.0, 45.0, -30.0, 0.0, 2)
-        proj = p.computeProjectionMatrixFOV(60.0, self.width / self.height, 0.01, 100.0)
-        image = p.getCameraImage(self.width, self.height, view, proj,
-                                 renderer=p.ER_TINY_RENDERER)[2]
-        return np.asarray(image, dtype=np.uint8).reshape(self.height, self.width, 4)[
-            :, :, :3].copy()
+        x, y, z = self.sim.robot(self.robot).base_position()
+        camera = Camera.orbit((x, y, z), 2.0, 45.0, -30.0)
+        return _frame(self.sim.engine.camera_image(camera, self.width, self.height),
+                      self.width, self.height)
 
     def close(self) -> None:
         """Close the simulation (safe to call twice); reset or step after it is an error."""
         self._closed = True
         self.sim.close()
+
+
+def _frame(rgb: bytes, width: int, height: int) -> np.ndarray:
+    """An engine's RGB bytes as Gymnasium's frame: height x width x 3, uint8, writable."""
+    return np.frombuffer(rgb, dtype=np.uint8).reshape(height, width, 3).copy()
 
 
 def _values(value: dict[str, float] | list[float]) -> list[float]:

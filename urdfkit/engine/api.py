@@ -183,6 +183,42 @@ class CollisionShape:
 
 
 @dataclass(frozen=True)
+class Camera:
+    """A pinhole camera for :meth:`Simulator.camera_image`, world coordinates.
+
+    Attributes:
+        eye: Where it is.
+        target: The point it looks at.
+        up: Which way is up in the picture.
+        fov: The vertical field of view, degrees.
+        near, far: The clipping distances, m.
+    """
+
+    eye: Vec3
+    target: Vec3
+    up: Vec3 = (0.0, 0.0, 1.0)
+    fov: float = 60.0
+    near: float = 0.01
+    far: float = 100.0
+
+    @classmethod
+    def orbit(cls, target: Vec3, distance: float, yaw: float, pitch: float,
+              fov: float = 60.0) -> Camera:
+        """Looking at ``target`` from ``distance`` away, from ``yaw`` and ``pitch`` degrees.
+
+        Turned ``yaw`` about +Z and tilted ``pitch`` (negative: from above), as PyBullet's
+        ``computeViewMatrixFromYawPitchRoll`` (its view matrix to float32's precision).
+        """
+        import math
+
+        y, p = math.radians(yaw), math.radians(pitch)
+        eye = (target[0] + distance * math.cos(p) * math.sin(y),
+               target[1] - distance * math.cos(p) * math.cos(y),
+               target[2] - distance * math.sin(p))
+        return cls(eye, target, fov=fov)
+
+
+@dataclass(frozen=True)
 class LoadSettings:
     """How a robot is loaded, in the engine's neutral terms.
 
@@ -461,4 +497,12 @@ class Simulator(Model, Protocol):
 
     def aabb(self, body: int, link: int) -> tuple[Vec3, Vec3]:
         """A link's axis-aligned bounding box now, world: its lower and upper corner."""
+        ...
+
+    def camera_image(self, camera: Camera, width: int, height: int) -> bytes:
+        """What ``camera`` sees now: ``height`` rows of ``width`` RGB pixels, top row first.
+
+        Off screen (PyBullet's TinyRenderer; MuJoCo's renderer, which needs OpenGL: EGL
+        headless).
+        """
         ...

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from urdfkit.core.errors import EngineError
 from urdfkit.engine.api import (
     BaseState,
+    Camera,
     CollisionShape,
     ContactPoint,
     JointInfo,
@@ -449,6 +450,19 @@ class PyBulletEngine:
         """``getAABB``."""
         lo, hi = self.session.bullet.getAABB(body, link)
         return lo, hi
+
+    def camera_image(self, camera: Camera, width: int, height: int) -> bytes:
+        """``getCameraImage`` with the TinyRenderer, its RGB without alpha."""
+        import numpy as np
+
+        b = self.session.bullet
+        view = b.computeViewMatrix(camera.eye, camera.target, camera.up)
+        proj = b.computeProjectionMatrixFOV(camera.fov, width / height, camera.near,
+                                            camera.far)
+        image = b.getCameraImage(width, height, view, proj,
+                                 renderer=self.session.p.ER_TINY_RENDERER)[2]
+        rgba = np.asarray(image, dtype=np.uint8).reshape(height, width, 4)
+        return rgba[:, :, :3].tobytes()
 
     # ---- dynamics
 

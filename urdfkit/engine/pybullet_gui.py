@@ -1,4 +1,7 @@
-"""PyBullet's GUI window as a control panel: sliders read while a run steps (drive --gui).
+"""PyBullet's GUI window as a control panel: sliders, and a camera that follows.
+
+Sliders are read while a run steps (drive --gui); the camera follows the Gymnasium car in its
+``human`` mode.
 
 PyBullet only: its GUI client draws debug sliders (``addUserDebugParameter``) beside the
 scene. Closing the window ends the run: every call then fails with ``pybullet.error``, which
@@ -54,3 +57,15 @@ class Sliders:
         except self._error:
             return False
         return True
+
+
+def follow(engine: Simulator, distance: float, yaw: float, pitch: float,
+           target: tuple[float, float, float]) -> None:
+    """Point the GUI window's camera at ``target`` (``resetDebugVisualizerCamera``).
+
+    Nothing on an engine without PyBullet's window.
+    """
+    from urdfkit.engine.pybullet import PyBulletEngine
+
+    if isinstance(engine, PyBulletEngine) and engine.gui:
+        engine.bullet.resetDebugVisualizerCamera(distance, yaw, pitch, list(target))
