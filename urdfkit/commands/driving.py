@@ -360,6 +360,7 @@ def sweep(
     package: PackageOpt = None,
     package_path: PackagePathOpt = None,
     up: UpOpt = FROM_LIBRARY,
+    engine: EngineOpt = FROM_LIBRARY,
 ) -> None:
     """Run many drives or scenario runs, one row of results per point.
 
@@ -377,7 +378,7 @@ def sweep(
             "throttle": throttle, "steer": steer, "drivetrain": drivetrain, "seconds": seconds,
             "steps": steps, "time_step": time_step, "max_force": max_force, "urdf": urdf,
             "plane": plane, "template_params": set_, "xacro_args": arg, "packages": package,
-            "package_paths": package_path, "up": up})
+            "package_paths": package_path, "up": up, "engine": engine})
     run = sweep_run.SweepRun(request)  # every option and point checked before any runs
     outcome = _sweep_run(run, as_json)
     _sweep_report(outcome, as_json, show_all, rows=out is None)

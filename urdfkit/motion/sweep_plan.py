@@ -51,7 +51,9 @@ KINDS: tuple[SweepKind, ...] = ("drive", "sim")
 BACKENDS: tuple[Backend, ...] = ("local", "ray")
 #: Drive options a sweep may vary (DriveConfig fields; the rest are files and switches).
 DRIVE_OPTIONS = ("throttle", "steer", "seconds", "steps", "time_step", "max_force",
-                 "drivetrain", "gravity", "urdf", "plane", "up")
+                 "drivetrain", "gravity", "urdf", "plane", "up", "engine")
+#: A sim sweep's short names for scenario key paths (``engine``: each point's engine).
+SIM_ALIASES = {"engine": "physics.engine"}
 #: The most points one sweep may have: a typo such as 0:1:1e9 must not plan forever.
 MAX_POINTS = 1_000_000
 
@@ -417,7 +419,7 @@ def _sim_point(document: Mapping[str, object], base_dir: str, source: str,
 
     edited = copy.deepcopy(dict(document))
     for name, value in values.items():
-        set_path(edited, name, value)
+        set_path(edited, SIM_ALIASES.get(name, name), value)
     try:
         parse_scenario(edited, source=source, base_dir=base_dir)
     except InputError as e:

@@ -19,9 +19,9 @@ from urdfkit.motion import sweep_plan as sweeping
 #: The drive options a drive sweep holds fixed for every point, in the order messages list them.
 FIXED_DRIVE = ("throttle", "steer", "drivetrain", "seconds", "steps", "time_step", "max_force",
                "urdf", "plane", "template_params", "xacro_args", "packages", "package_paths",
-               "up")
+               "up", "engine")
 #: Of those, the ones whose "not given" is DriveConfig's default value; the rest are None.
-VALUED_DRIVE = ("throttle", "steer", "drivetrain", "time_step", "up")
+VALUED_DRIVE = ("throttle", "steer", "drivetrain", "time_step", "up", "engine")
 
 
 def drive_defaults() -> dict[str, object]:
