@@ -388,6 +388,19 @@ class PyBulletEngine:
             return []
         return [_contact_point(pt[1:14]) for pt in found]
 
+    def closest_points(self, body: int, other: int, distance: float, link: int | None = None,
+                       other_link: int | None = None) -> list[ContactPoint]:
+        """``getClosestPoints`` of ``body`` (``linkIndexA``) and ``other`` (``linkIndexB``)."""
+        links: dict[str, int] = {}
+        if link is not None:
+            links["linkIndexA"] = link
+        if other_link is not None:
+            links["linkIndexB"] = other_link
+        found = self.session.bullet.getClosestPoints(body, other, distance, **links)
+        if not found:
+            return []
+        return [_contact_point(pt[1:14]) for pt in found]
+
     def enable_joint_force_sensor(self, body: int, joint: int) -> None:
         """``enableJointForceTorqueSensor``."""
         self.session.bullet.enableJointForceTorqueSensor(body, joint, True)
