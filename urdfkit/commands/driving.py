@@ -443,8 +443,10 @@ def _drive_summary(r: Any, said: list[str]) -> None:
         ("drivetrain", f"{sim['drivetrain']}, {sim['steering']} steering; wheel force "
                        f"{force}"),
         ("load flags", flags),
-        ("simulated", f"{r.sim_time:.3f} s in {r.steps:,} steps of {r.time_step:.5g} s; link "
-                      f"damping {sim['link_damping']['linear']:g} (PyBullet's default)"),
+        ("simulated", f"{r.sim_time:.3f} s in {r.steps:,} steps of {r.time_step:.5g} s"
+                      + ("" if sim["engine"] == "pybullet" else f" on {sim['engine']}")
+                      + f"; link damping {sim['link_damping']['linear']:g} "
+                      f"({sim['link_damping']['note']})"),
         ("wall time", f"{r.wall_time:.3f} s (real-time factor {r.real_time_factor:.1f}x)"),
     ])
     # Every warning shows in text too, not only in JSON: those found by the run itself (a

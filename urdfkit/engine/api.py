@@ -461,13 +461,13 @@ class Simulator(Model, Protocol):
         """The contact points of ``body`` (one link of it, or all) with ``other`` (or any)."""
         ...
 
-    def closest_points(self, body: int, other: int, distance: float,
-                       link: int | None = None, other_link: int | None = None
-                       ) -> list[ContactPoint]:
-        """The points of ``body`` and ``other`` (one link of either) within ``distance``.
+    def closest_points(self, body: int, other: int, distance: float, link: int | None = None,
+                       other_link: int | None = None) -> list[ContactPoint]:
+        """The points of ``body`` and ``other`` nearer than ``distance`` now.
 
-        PyBullet's ``getClosestPoints``: ``distance`` < 0 is how deep they are inside each
-        other; no step is needed.
+        PyBullet's ``getClosestPoints``, of one link of each or of all. Fields as
+        :meth:`contacts` fills them, A ``body``: a negative ``distance`` is a penetration; no
+        forces. Measured at the positions now, not in the last step.
         """
         ...
 

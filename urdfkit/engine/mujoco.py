@@ -38,32 +38,27 @@ said in docs/engines.md with what it costs on the contract cases.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import EngineError, MissingDependencyError, ParameterError
+from urdfkit.engine import mujoco_bodies as bodies
 from urdfkit.engine.api import (
     BaseState,
+    Camera,
+    CollisionShape,
     ContactPoint,
     JointInfo,
+    JointRow,
     JointState,
     LinkDynamics,
+    LinkPose,
     LoadSettings,
     MotorMode,
     Quat,
     Vec3,
 )
 from urdfkit.engine.mujoco_motors import Motor
-from urdfkit.engine.mujoco_world import (
-    World,
-    add,
-    bad_count,
-    cross,
-    rotate,
-    unit_quat,
-    vec3,
-    wxyz,
-    xyzw,
-)
+from urdfkit.engine.mujoco_world import World, bad_count
 
 #: PyBullet's force cap when a motor is set without one (setJointMotorControl2's default).
 MOTOR_FORCE = 100000.0
@@ -71,6 +66,12 @@ MOTOR_FORCE = 100000.0
 
 def import_mujoco() -> Any:
     """mujoco, or an error saying how to install it."""
+    import os
+    import sys
+
+    if sys.platform.startswith("linux") and "MUJOCO_GL" not in os.environ \
+            and not os.environ.get("DISPLAY"):
+        os.environ["MUJOCO_GL"] = "egl"  # headless: pictures through EGL (mujoco_render)
     try:
         import mujoco
     except ImportError as e:
@@ -99,6 +100,11 @@ class MuJoCoEngine:
     """
 
     name = "mujoco"
+    label = "MuJoCo"
+    #: No window of its own: the engine runs headless.
+    gui = False
+    #: What its calls raise when it fails (a closed world, a diverged run).
+    error: type[Exception] = EngineError
 
     def __init__(self, gui: bool = False) -> None:
         if gui:
@@ -106,6 +112,7 @@ class MuJoCoEngine:
                                  param="gui")
         self.world = World(import_mujoco())
         self.notes = self.world.notes
+        self._renderers: dict[tuple[int, int, int], Any] = {}
 
     def load(self, path: str, settings: LoadSettings, display: str | None = None) -> int:
         """Load a guarded URDF: its export attached to the world, compiled when next needed.
@@ -165,6 +172,17 @@ class MuJoCoEngine:
             if w.m is not None:
                 w.m.opt.cone = w.spec.option.cone
 
+    def require_state_queries(self, body: int, display: str) -> None:
+        """Nothing to refuse: MuJoCo reports the state of a body of any size.
+
+        (PyBullet cannot past 127 links.) An unknown body is a ParameterError.
+        """
+        self.world.body(body)
+
+    def connected(self) -> bool:
+        """Whether the world is still open (it has no window to be closed)."""
+        return not self.world.closed
+
     def step(self) -> None:
         """One physics step.
 
@@ -186,7 +204,14 @@ class MuJoCoEngine:
         with mujoco_warnings(mj) as said:
             mj.mj_step1(m, d)       # positions, velocities, the constraint rows
             bank.aim(m, d, h)       # each motor row asks for its velocity (mujoco_motors)
-            mj.mj_step2(m, d)       # forces, the solver, the integration
+            if w.sensors:           # joint force/torque sensors: at the step's start state
+                from urdfkit.engine.mujoco_reactions import measure
+
+                before = d.qvel.copy()
+                mj.mj_step2(m, d)
+                measure(w, m, d, before)
+            else:
+                mj.mj_step2(m, d)   # forces, the solver, the integration
         bank.record(m, d)
         for dof in w.torques:
             d.qfrc_applied[dof] = 0.0
@@ -236,6 +261,9 @@ class MuJoCoEngine:
         """Release the world (safe to call twice)."""
         w = self.world
         w.closed = True
+        for renderer in self._renderers.values():
+            renderer.close()
+        self._renderers.clear()
         w.m = w.d = w.scratch = None
         w.spec = None
         w.robots = []
@@ -256,130 +284,52 @@ class MuJoCoEngine:
     def set_joint_positions(self, body: int, positions: Sequence[float],
                             velocities: Sequence[float] | None = None) -> None:
         """Put every movable joint (in :meth:`joints` order) at these values."""
-        w = self.world
-        m, d = w.compiled()
-        moving = w.movable(body)
-        if len(positions) != len(moving) or (velocities is not None
-                                             and len(velocities) != len(moving)):
-            raise ParameterError(f"`positions` needs {len(moving)} values, one per movable "
-                                 f"joint of body {body}", param="positions")
-        for k, j in enumerate(moving):
-            d.qpos[j.q_index] = positions[k]
-            d.qvel[j.v_index] = velocities[k] if velocities is not None else 0.0
-        w.kinematics = False
+        bodies.set_joint_positions(self.world, body, positions, velocities)
 
     def link_frames(self, body: int) -> list[tuple[Vec3, Quat]]:
         """Every link frame's world pose now, the root first (position, quaternion x y z w)."""
-        w = self.world
-        w.fresh_kinematics()
-        d = w.d
-        _, ids = w.body(body)
-        out = []
-        for kind, i in ids.frames:
-            if kind == "body":
-                out.append((vec3(d.xpos[i]), xyzw(d.xquat[i])))
-            else:
-                out.append((vec3(d.site_xpos[i]), w.mat_quat(d.site_xmat[i])))
-        return out
+        return bodies.link_frames(self.world, body)
+
+    def link_frame(self, body: int, link: int) -> tuple[Vec3, Quat]:
+        """One link's URDF frame now, world (link -1: the root)."""
+        return bodies.link_frame(self.world, body, link)
+
+    def link_pose(self, body: int, link: int) -> LinkPose:
+        """One link's inertial and URDF frames now, world (link -1: the root)."""
+        return bodies.link_pose(self.world, body, link)
 
     def base_state(self, body: int) -> BaseState:
         """The root's inertial frame (PyBullet's base pose) and its velocity, world."""
-        from urdfkit.model.spec import quat_mul
+        return bodies.base_state(self.world, body)
 
-        w = self.world
-        r, ids = w.body(body)
-        p0, q0, rot = w.root_frame(ids)
-        offset, turn = r.root_offset()
-        p = add(p0, rotate(rot, offset))
-        linear, angular = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
-        if ids.free >= 0:
-            a = int(w.m.jnt_dofadr[w.m.body_jntadr[ids.root]])
-            qvel = w.d.qvel
-            spin = rotate(rot, (qvel[a + 3], qvel[a + 4], qvel[a + 5]))  # a free joint's: local
-            arm = (p[0] - p0[0], p[1] - p0[1], p[2] - p0[2])
-            linear = add((qvel[a], qvel[a + 1], qvel[a + 2]), cross(spin, arm))
-            angular = spin
-        return BaseState(p, quat_mul(q0, turn), linear, angular)
+    def base_pose(self, body: int) -> tuple[Vec3, Quat]:
+        """The root's inertial frame (PyBullet's base pose), world."""
+        return bodies.base_pose(self.world, body)
 
     def reset_base(self, body: int, position: Vec3, orientation: Quat) -> None:
         """Move the root's inertial frame there, at rest."""
-        import numpy as np
+        bodies.reset_base(self.world, body, position, orientation)
 
-        from urdfkit.model.spec import quat_mul, quat_to_matrix
-
-        w = self.world
-        m, d = w.compiled()
-        r, ids = w.body(body)
-        offset, turn = r.root_offset()
-        inverse = (-turn[0], -turn[1], -turn[2], turn[3])
-        q = quat_mul(unit_quat(orientation), inverse)
-        p = np.array(position, dtype=float) - np.array(quat_to_matrix(q)) @ np.array(offset)
-        if ids.free >= 0:
-            a = ids.free
-            d.qpos[a:a + 3] = p
-            d.qpos[a + 3:a + 7] = wxyz(q)
-            v = w.m.jnt_dofadr[w.m.body_jntadr[ids.root]]
-            d.qvel[v:v + 6] = 0.0
-        elif ids.root >= 0:
-            w.root_poses[body] = (vec3(p), q)
-            m.body_pos[ids.root] = p
-            m.body_quat[ids.root] = wxyz(q)
-        else:
-            raise ParameterError(f"body {body}'s root is MuJoCo's world; it cannot move",
-                                 param="body")
-        w.kinematics = False
+    def reset_base_frame(self, body: int, position: Vec3, orientation: Quat) -> None:
+        """Move the root's URDF link frame there, at rest."""
+        bodies.reset_base_frame(self.world, body, position, orientation)
 
     def reset_base_velocity(self, body: int, linear: Vec3, angular: Vec3) -> None:
         """Set the root's velocity: its inertial frame's linear velocity, and the angular."""
-        w = self.world
-        m, d = w.compiled()
-        r, ids = w.body(body)
-        if ids.free < 0:
-            return  # a fixed base does not move (PyBullet's does not either)
-        _, _, rot = w.root_frame(ids)
-        arm = rotate(rot, r.root_offset()[0])   # from the link frame to the inertial frame
-        spin = (float(angular[0]), float(angular[1]), float(angular[2]))
-        swing = cross(spin, arm)
-        a = int(m.jnt_dofadr[m.body_jntadr[ids.root]])
-        d.qvel[a:a + 3] = (linear[0] - swing[0], linear[1] - swing[1], linear[2] - swing[2])
-        d.qvel[a + 3:a + 6] = rotate(rot.T, spin)
+        bodies.reset_base_velocity(self.world, body, linear, angular)
 
     def joint_states(self, body: int, joints: Sequence[int]) -> list[JointState]:
-        """The state of these joints now; ``applied``: the motor's force in the last step.
+        """The state of these joints now; ``applied``: the motor's force in the last step."""
+        return bodies.joint_states(self.world, body, joints)
 
-        ``reaction`` is zeros: this engine measures no joint reactions.
-        """
-        w = self.world
-        m, d = w.compiled()
-        r, ids = w.body(body)
-        out = []
-        for j in joints:
-            info = w.joint(r, ids, j)
-            if info.kind == "fixed":
-                out.append(JointState(0.0, 0.0, (0.0,) * 6, 0.0))
-                continue
-            if info.kind == "spherical":
-                raise ParameterError(f"joint {info.name!r} is spherical: joint_states reads "
-                                     "joints of one degree of freedom", param="joints")
-            out.append(JointState(float(d.qpos[info.q_index]), float(d.qvel[info.v_index]),
-                                  (0.0,) * 6, w.applied(info.v_index)))
-        return out
+    def joint_rows(self, body: int, joints: Sequence[int]) -> Sequence[JointRow]:
+        """:meth:`joint_states` as plain tuples (``reaction``: see the sensor below)."""
+        return bodies.joint_rows(self.world, body, joints)
 
     def reset_joint(self, body: int, joint: int, position: float, velocity: float = 0.0
                     ) -> None:
         """Put one joint at a position and velocity (a fixed joint: nothing to do)."""
-        w = self.world
-        m, d = w.compiled()
-        r, ids = w.body(body)
-        info = w.joint(r, ids, joint)
-        if info.kind == "fixed":
-            return
-        if info.kind == "spherical":
-            raise ParameterError(f"joint {info.name!r} is spherical: reset_joint sets joints "
-                                 "of one degree of freedom", param="joint")
-        d.qpos[info.q_index] = position
-        d.qvel[info.v_index] = velocity
-        w.kinematics = False
+        bodies.reset_joint(self.world, body, joint, position, velocity)
 
     def motors(self, body: int, joints: Sequence[int], mode: MotorMode,
                targets: Sequence[float], forces: Sequence[float] | None = None,
@@ -416,10 +366,24 @@ class MuJoCoEngine:
             w.bank.set(info.v_index, r.motors[j])
 
     def mass_matrix(self, body: int, positions: Sequence[float]) -> list[list[float]]:
-        """The joint-space mass matrix at ``positions``: the movable joints' block."""
+        """The joint-space mass matrix at ``positions`` (a floating base's 6 first)."""
         from urdfkit.engine.mujoco_query import mass_matrix
 
         return mass_matrix(self.world, body, positions)
+
+    def floating_mass_matrix(self, body: int, position: Vec3, orientation: Quat,
+                             positions: Sequence[float]) -> list[list[float]]:
+        """The mass matrix with the root's inertial frame at this pose (linear first)."""
+        from urdfkit.engine.mujoco_query import floating_mass_matrix
+
+        return floating_mass_matrix(self.world, body, position, orientation, positions)
+
+    def jacobian(self, body: int, link: int, point: Vec3, positions: Sequence[float]
+                 ) -> tuple[list[list[float]], list[list[float]]]:
+        """The linear and angular Jacobians of a point of a link (the URDF frame's)."""
+        from urdfkit.engine.mujoco_query import jacobian
+
+        return jacobian(self.world, body, link, point, positions)
 
     def inverse_dynamics(self, body: int, positions: Sequence[float],
                          velocities: Sequence[float],
@@ -450,3 +414,55 @@ class MuJoCoEngine:
         from urdfkit.engine.mujoco_query import contacts
 
         return contacts(self.world, body, link, other)
+
+    def closest_points(self, body: int, other: int, distance: float, link: int | None = None,
+                       other_link: int | None = None) -> list[ContactPoint]:
+        """Points of ``body`` and ``other`` nearer than ``distance`` (negative: sunk in)."""
+        from urdfkit.engine.mujoco_query import closest_points
+
+        return closest_points(self.world, body, other, distance, link, other_link)
+
+    def enable_joint_force_sensor(self, body: int, joint: int) -> None:
+        """Measure the wrench on a joint from the next step on (mujoco_reactions)."""
+        r, ids = self.world.body(body)
+        self.world.joint(r, ids, joint)
+        self.world.sensors.add((body, joint))
+
+    def hold_base(self, body: int) -> int:
+        """A weld of the root to the world where it is now; its id (mujoco_constraints)."""
+        from urdfkit.engine.mujoco_constraints import hold_base
+
+        return hold_base(self.world, body)
+
+    def couple_joints(self, body: int, leader: int, follower: int, multiplier: float,
+                      offset: float, max_force: float) -> int:
+        """A joint equality, follower = multiplier * leader + offset; its id."""
+        from urdfkit.engine.mujoco_constraints import couple_joints
+
+        return couple_joints(self.world, body, leader, follower, multiplier, offset, max_force)
+
+    def collision_shapes(self, body: int, link: int) -> list[CollisionShape]:
+        """A link's collision shapes, PyBullet's getCollisionShapeData (mujoco_shapes)."""
+        from urdfkit.engine.mujoco_shapes import collision_shapes
+
+        return collision_shapes(self.world, body, link)
+
+    def aabb(self, body: int, link: int) -> tuple[Vec3, Vec3]:
+        """A link's axis-aligned bounding box now, world (mujoco_shapes)."""
+        from urdfkit.engine.mujoco_shapes import aabb
+
+        return aabb(self.world, body, link)
+
+    def camera_image(self, camera: Camera, width: int, height: int) -> bytes:
+        """What ``camera`` sees now, RGB rows top first (mujoco_render; +Z up)."""
+        from urdfkit.engine.mujoco_render import camera_image
+
+        return camera_image(self.world, self._renderers, camera, width, height)
+
+
+if TYPE_CHECKING:
+    from urdfkit.engine.api import Simulator
+
+    def _is_a_simulator(engine: MuJoCoEngine) -> Simulator:
+        """Never called: mypy checks here that the class keeps the whole protocol."""
+        return engine

@@ -60,6 +60,8 @@ class Loaded:
         collisions: The collision geoms: (name, link, body), in the export's order.
         static: The MuJoCo bodies welded to the world (by link name).
         parents: Each moving body's parent body (by link name).
+        placed: Each collision geom's pose in its MuJoCo body as the export wrote it
+            (MuJoCo moves a mesh's geom to the mesh's own centre when it compiles).
         motors: By joint index, every revolute and prismatic joint's motor.
         notes: What the export dropped, approximated or defaulted, and what the engine
             left out, one line each.
@@ -75,6 +77,7 @@ class Loaded:
     collisions: list[tuple[str, str, str]]
     static: set[str]
     parents: dict[str, str]
+    placed: dict[str, tuple[Vec3, Quat]] = field(default_factory=dict)
     motors: dict[int, Motor] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
 
@@ -132,11 +135,14 @@ def prepare(mujoco: Any, path: str, settings: LoadSettings, display: str | None)
     notes += _drop_mimics(mujoco, spec)
     where = fused(robot, split_world=True)
     collisions = []
+    placed: dict[str, tuple[Vec3, Quat]] = {}
     for g in spec.geoms:
         if g.group == COLLISION_GROUP:
             g.contype = 0  # every contact is an explicit pair (see pairs)
             g.conaffinity = 0
             collisions.append((g.name, e.geom_links[g.name], where[e.geom_links[g.name]][0]))
+            w, x, y, z = (float(v) for v in g.quat)
+            placed[g.name] = ((float(g.pos[0]), float(g.pos[1]), float(g.pos[2])), (x, y, z, w))
     links = [Link(robot.root, where[robot.root][0], where[robot.root][1], loaded[robot.root])]
     links += [Link(j.child, where[j.child][0], where[j.child][1], loaded[j.child])
               for j in robot.joints]
@@ -153,7 +159,7 @@ def prepare(mujoco: Any, path: str, settings: LoadSettings, display: str | None)
     motors = {i: Motor() for i, j in enumerate(robot.joints)
               if j.type in ("revolute", "continuous", "prismatic")}
     return Loaded(robot, name, settings, spec, assets, links, e.geom_links, collisions, static,
-                  parents, motors, notes)
+                  parents, placed, motors, notes)
 
 
 def _parse(mujoco: Any, xml: bytes, assets: dict[str, bytes], name: str) -> Any:

@@ -66,7 +66,8 @@ class World:
         self.ids: list[Ids] = []
         self.pairs: list[Pair] = []
         self.pair_ids: list[int] = []
-        self.geom_owner: dict[int, tuple[int, int]] = {}
+        self.geom_owner: dict[int, tuple[int, int]] = {}   # every geom's robot and link
+        self.colliders: dict[int, tuple[int, int]] = {}    # the collision geoms' alone
         self.m: Any = None
         self.d: Any = None
         self.scratch: Any = None
@@ -83,6 +84,13 @@ class World:
         self.damping: dict[tuple[int, int], float] = {}
         self.limits: dict[tuple[int, int], tuple[float, float]] = {}
         self.root_poses: dict[int, tuple[Vec3, Quat]] = {}   # static roots moved by reset_base
+        #: The joints with a force/torque sensor (body, joint), and what each measured in the
+        #: last step (urdfkit/engine/mujoco_reactions.py).
+        self.sensors: set[tuple[int, int]] = set()
+        self.reactions: dict[tuple[int, int], tuple[float, ...]] = {}
+        self.sensed: tuple[Any, Any, Any] | None = None   # frames at the last measured step
+        self.held: Any = None   # the joints' own constraint forces in it, once read
+        self.constraints = 0   # how many user constraints (holds, couplings) were made
 
     def add(self, r: Loaded, settings: LoadSettings) -> int:
         """Attach a prepared robot where ``settings`` puts it, with its contact pairs."""
@@ -110,6 +118,11 @@ class World:
         self.notes[index] = r.notes
         self.stale = True
         return index
+
+    def new_constraint(self) -> int:
+        """The next user constraint's id (PyBullet's ids: one count for every kind)."""
+        self.constraints += 1
+        return self.constraints - 1
 
     def open(self) -> None:
         """Refuse a closed world."""
@@ -148,6 +161,8 @@ class World:
         self.stale = False
         self.scratch = mj.MjData(self.m)
         self.kinematics = False
+        self.sensed = None          # the data is new: no step measured in it
+        self.reactions.clear()
         # the motors' forces in the last step, by joint: the ids are remade below
         applied = {(body, j): self.applied(info.v_index)
                    for body, ids in enumerate(self.ids) for j, info in enumerate(ids.joints)
@@ -163,6 +178,7 @@ class World:
         m, mj = self.m, self.mj
         self.ids = []
         self.geom_owner = {}
+        self.colliders = {}
         for index, r in enumerate(self.robots):
             ids = Ids()
             prefix = f"{index}/"
@@ -184,6 +200,8 @@ class World:
                 ids.joints.append(self.joint_info(r, i, jid, link_index))
             for g, owner in r.geom_links.items():
                 self.geom_owner[m.geom(prefix + g).id] = (index, link_index[owner])
+            for g, owner, _ in r.collisions:
+                self.colliders[m.geom(prefix + g).id] = (index, link_index[owner])
             self.ids.append(ids)
         self.pair_ids = [m.pair(f"pair{k}").id for k in range(len(self.pairs))]
 
@@ -377,15 +395,14 @@ class World:
         flags = self.mj.mjtState
         return int(getattr(flags, _STATE[0])) | int(getattr(flags, _STATE[1]))
 
-    def root_frame(self, ids: Ids) -> tuple[Vec3, Quat, Any]:
-        """The root link frame now: position, quaternion (x y z w), rotation matrix (3x3)."""
+    def frame_of(self, ids: Ids, k: int) -> tuple[Vec3, Quat, Any]:
+        """Link frame ``k`` (0: the root) now: position, quaternion (x y z w), matrix (3x3)."""
         self.fresh_kinematics()
         d = self.d
-        kind, i = ids.frames[0]
+        kind, i = ids.frames[k]
         if kind == "body":
             return vec3(d.xpos[i]), xyzw(d.xquat[i]), d.xmat[i].reshape(3, 3)
         return vec3(d.site_xpos[i]), self.mat_quat(d.site_xmat[i]), d.site_xmat[i].reshape(3, 3)
-
 
 def bad_count(mj: Any, d: Any) -> int:
     """How often MuJoCo has found NaN or huge values (positions, velocities, accelerations)."""

@@ -389,17 +389,18 @@ class PyBulletEngine:
             return []
         return [_contact_point(pt[1:14]) for pt in found]
 
-    def closest_points(self, body: int, other: int, distance: float,
-                       link: int | None = None, other_link: int | None = None
-                       ) -> list[ContactPoint]:
-        """``getClosestPoints``: the points of the two within ``distance`` (< 0: inside)."""
-        b = self.session.bullet
-        if link is None and other_link is None:
-            found = b.getClosestPoints(body, other, distance)
-        else:
-            found = b.getClosestPoints(body, other, distance, -1 if link is None else link,
-                                       -1 if other_link is None else other_link)
-        return [_contact_point(pt[1:14]) for pt in found or ()]
+    def closest_points(self, body: int, other: int, distance: float, link: int | None = None,
+                       other_link: int | None = None) -> list[ContactPoint]:
+        """``getClosestPoints`` of ``body`` (``linkIndexA``) and ``other`` (``linkIndexB``)."""
+        links: dict[str, int] = {}
+        if link is not None:
+            links["linkIndexA"] = link
+        if other_link is not None:
+            links["linkIndexB"] = other_link
+        found = self.session.bullet.getClosestPoints(body, other, distance, **links)
+        if not found:
+            return []
+        return [_contact_point(pt[1:14]) for pt in found]
 
     def enable_joint_force_sensor(self, body: int, joint: int) -> None:
         """``enableJointForceTorqueSensor``."""
