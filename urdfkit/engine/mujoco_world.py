@@ -219,7 +219,9 @@ class World:
             q_index=int(m.jnt_qposadr[jid]) if jid >= 0 else -1,
             v_index=int(m.jnt_dofadr[jid]) if jid >= 0 else -1,
             damping=j.damping, friction=j.friction, lower=j.lower, upper=j.upper,
-            limited=j.limited, effort=j.effort, velocity=j.velocity, link=j.child,
+            # as PyBullet reports it: a continuous joint's <limit> too, though not enforced
+            limited=kind in ("revolute", "prismatic") and j.lower <= j.upper,
+            effort=j.effort, velocity=j.velocity, link=j.child,
             axis=unit(j.axis) if j.moves and j.type != "spherical" else (0.0, 0.0, 0.0),
             parent=link_index[j.parent])
 

@@ -3,10 +3,10 @@
 What PyBullet 3.2.7 does with a URDF, measured, is what this reads (the facts are in
 docs/export.md): joints in its depth-first order, a link without ``<inertial>`` weighing 1 kg
 with unit inertia (``URDF_USE_INERTIA_FROM_FILE``), the inertial ``rpy`` applied to the tensor,
-``continuous`` unlimited, a revolute or prismatic joint limited only when lower <= upper, a
-``floating`` joint loaded as fixed, ``<mimic>`` ignored (kept here: MuJoCo can mean it),
-lateral friction 0.5 unless ``<contact>`` says otherwise, and the first shape of a
-``<geometry>`` the one used.
+``continuous`` unlimited (its ``<limit>`` reported, not enforced), a revolute or prismatic
+joint limited only when lower <= upper, a ``floating`` joint loaded as fixed, ``<mimic>``
+ignored (kept here: MuJoCo can mean it), lateral friction 0.5 unless ``<contact>`` says
+otherwise, and the first shape of a ``<geometry>`` the one used.
 """
 
 from __future__ import annotations
@@ -293,10 +293,9 @@ def _joint(el: Any) -> Joint:
     # PyBullet's defaults when <limit> leaves them out: lower 0, upper -1 (unlimited; measured)
     lower = _scalar(limit, "lower", 0.0)
     upper = _scalar(limit, "upper", -1.0)
-    if kind == "continuous":
-        limited, lower, upper = False, 0.0, -1.0
-    else:
-        limited = kind in ("revolute", "prismatic") and lower <= upper
+    # A continuous joint is never limited, but PyBullet reports the <limit> it was given
+    # (racecar's right steering hinge: getJointInfo says -1, 1; it turns past them, measured)
+    limited = kind in ("revolute", "prismatic") and lower <= upper
     dyn = el.find("dynamics")
     mimic_el = el.find("mimic")
     mimic = None

@@ -434,7 +434,8 @@ class Scenario:
         from urdfkit.motion.gazebo_load import apply_gazebo_contacts
 
         assert self.engine is not None
-        self.gazebo_applied = apply_gazebo_contacts(self.engine, self.body, self._gazebo)
+        self.gazebo_applied = apply_gazebo_contacts(self.engine, self.body, self._gazebo,
+                                                    self.warnings)
 
     def gazebo_differences(self) -> list[str]:
         """The file's Gazebo friction where PyBullet uses another, as a user reads it."""

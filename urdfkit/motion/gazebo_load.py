@@ -27,10 +27,18 @@ def contacts_to_apply(root: etree._Element) -> dict[str, GazeboContact]:
     return {k: g for k, g in gazebo_contacts(root).items() if g.pybullet()}
 
 
-def apply_gazebo_contacts(engine: Simulator, body: int,
-                          contacts: dict[str, GazeboContact]) -> dict[str, dict[str, float]]:
-    """Set each link's dynamics as its Gazebo block says; {link: the values set}."""
+def apply_gazebo_contacts(engine: Simulator, body: int, contacts: dict[str, GazeboContact],
+                          notes: list[str] | None = None) -> dict[str, dict[str, float]]:
+    """Set each link's dynamics as its Gazebo block says; {link: the values set}.
+
+    What the engine cannot carry (MuJoCo has no contact spring for kp/kd) is left out, the
+    rest applied, and one line each goes to ``notes``.
+    """
+    from urdfkit.core.errors import ParameterError
+
     index, applied = link_indices(engine, body), {}
+    refused: list[str] = []
+    why = ""
     for name, g in contacts.items():
         if name not in index:
             continue
@@ -38,8 +46,19 @@ def apply_gazebo_contacts(engine: Simulator, body: int,
         if g.lateral_friction is not None:
             values["lateralFriction"] = g.lateral_friction
         if g.kp is not None and g.kd is not None:
-            values.update(contactStiffness=g.kp, contactDamping=g.kd)
+            spring = {"contactStiffness": g.kp, "contactDamping": g.kd}
+            try:
+                engine.change_dynamics(body, index[name], **spring)
+                values.update(spring)
+            except ParameterError as e:
+                refused.append(f"{name} kp {g.kp:g} kd {g.kd:g}")
+                why = e.message.partition(": ")[2]
+        if "lateralFriction" in values:
+            engine.change_dynamics(body, index[name], lateralFriction=values["lateralFriction"])
         if values:
-            engine.change_dynamics(body, index[name], **values)
             applied[name] = values
+    if refused and notes is not None:
+        shown = "; ".join(refused[:4]) + ("; ..." if len(refused) > 4 else "")
+        notes.append(f"<gazebo> contact stiffness not applied on {engine.label} ({shown}): "
+                     f"{why}")
     return applied

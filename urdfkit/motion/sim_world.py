@@ -256,7 +256,8 @@ class World:
         if cfg.gazebo_contacts:  # before link_dynamics, which overrides them
             from urdfkit.motion.gazebo_load import apply_gazebo_contacts, contacts_to_apply
 
-            apply_gazebo_contacts(engine, body, contacts_to_apply(self._resolved[-1].root))
+            apply_gazebo_contacts(engine, body, contacts_to_apply(self._resolved[-1].root),
+                                  self.config.notes)
         if cfg.mimic:  # PyBullet ignores <mimic>: a gear constraint per follower
             from urdfkit.motion.mimic import couple_mimics, mimic_relations
 
