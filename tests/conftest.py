@@ -13,6 +13,11 @@ from urdfkit.model.catalog import build_template
 
 TESTS = Path(__file__).parent
 
+# Tests import mujoco themselves, before urdfkit's engine would choose EGL for a headless
+# MuJoCo picture (urdfkit/engine/mujoco.py: import_mujoco): choose it as the engine does.
+if not os.environ.get("DISPLAY"):
+    os.environ.setdefault("MUJOCO_GL", "egl")
+
 
 @pytest.fixture(scope="session", autouse=True)
 def private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:

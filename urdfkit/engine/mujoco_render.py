@@ -40,8 +40,8 @@ def camera_image(w: World, renderers: dict[tuple[int, int, int], Any], camera: C
         except Exception as e:  # noqa: BLE001 - whatever the GL backend raises, said once
             raise EngineError(f"MuJoCo cannot draw here: no OpenGL ({type(e).__name__}: "
                               f"{str(e).splitlines()[0] if str(e) else 'no context'}); "
-                              "headless, MUJOCO_GL=egl or osmesa needs Mesa's libEGL or "
-                              "libOSMesa") from None
+                              "headless, set MUJOCO_GL=egl (Mesa's libEGL) or osmesa before "
+                              "mujoco is first imported") from None
         renderers[key] = renderer
     eye, target = camera.eye, camera.target
     ahead = [t - e for t, e in zip(target, eye, strict=True)]
@@ -53,6 +53,10 @@ def camera_image(w: World, renderers: dict[tuple[int, int, int], Any], camera: C
     view.azimuth = math.degrees(math.atan2(ahead[1], ahead[0]))
     view.elevation = math.degrees(math.asin(max(-1.0, min(1.0, ahead[2] / distance))))
     m.vis.global_.fovy = camera.fov
+    # the export has no lights: MuJoCo's headlight alone, brighter than its default (0.1
+    # ambient, 0.4 diffuse), lights faces turned from the camera too
+    m.vis.headlight.ambient[:] = (0.4, 0.4, 0.4)
+    m.vis.headlight.diffuse[:] = (0.6, 0.6, 0.6)
     renderer.update_scene(d, camera=view)
     image: Any = renderer.render()
     return bytes(image.tobytes())

@@ -132,7 +132,8 @@ class World:
                                if "solver_iterations" in given else None,
                                cone_friction=ph.cone_friction)
         except ParameterError as e:
-            raise self.error(f"physics.{e.param or 'engine'}", e.message) from None
+            raise self.error(f"physics.{e.param or 'engine'}",
+                             f"{e.message}; drop it to run on {engine.label}") from None
         if self.config.ground is not None:
             g = self.config.ground
             self.ground = self._load("ground", g.template, g.params, g.urdf,
