@@ -49,12 +49,15 @@ def _streamed(config: DriveConfig, speed: float | None) -> tuple[object, RunStre
     return result, stream, wall
 
 
-def test_the_page_ends_where_drive_json_ends() -> None:
-    config = DriveConfig(throttle=10, steer=0.2, seconds=3)
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_the_page_ends_where_drive_json_ends(engine: str) -> None:
+    if engine == "mujoco":
+        pytest.importorskip("mujoco")
+    config = DriveConfig(throttle=10, steer=0.2, seconds=3, engine=engine)
     result, stream, _ = _streamed(config, None)
     (base_pos, _), (wheel_pos, _), raw_wheel = stream.final  # type: ignore[attr-defined]
-    plain = drive(DriveConfig(throttle=10, steer=0.2, seconds=3))
-    # The same run (PyBullet is deterministic): streaming changes nothing it simulates...
+    plain = drive(DriveConfig(throttle=10, steer=0.2, seconds=3, engine=engine))
+    # The same run (each engine is deterministic): streaming changes nothing it simulates...
     assert result.final_position == pytest.approx(plain.final_position, abs=1e-9)  # type: ignore[attr-defined]
     # ...and the page's base and wheel frames are where the run's session has them.
     assert base_pos == pytest.approx(plain.final_position, abs=1e-6)

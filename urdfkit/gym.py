@@ -242,6 +242,8 @@ class SimpleDrivingEnv(gym.Env):
         self.goal_marker = e.load(str(marker), LoadSettings(
             fixed_base=True, position=(0.0, 0.0, 0.5), scenery=True), display="goal")
         self._start = e.save()  # and primed: the first episode is like every later one
+        # bound once: a step is short (~80 us), and each lookup shows in it
+        self._motors, self._step, self._base = e.motors, e.step, e.base_state
 
     # ---- the Gymnasium API
 
@@ -287,17 +289,17 @@ class SimpleDrivingEnv(gym.Env):
         _after_end(self)
         throttle = min(max(throttle, 0.0), 1.0)
         steer = max(min(steer, 0.6), -0.6)
-        e, car = self.engine, self.car
+        motors, car = self._motors, self.car
         if steer != self._steer:  # position motors persist: set on change
-            e.motors(car, _HINGES, "position", [steer, steer])
+            motors(car, _HINGES, "position", [steer, steer])
             self._steer = steer
         v = self._speed
         v += self.TIME_STEP * (self.C_THROTTLE * throttle - v * (v * self.C_DRAG
                                                                  + self.C_ROLLING))
         self._speed = v = max(v, 0.0)
         force = self.WHEEL_FORCE
-        e.motors(car, _WHEELS, "velocity", [v, v, v, v], forces=[force, force, force, force])
-        e.step()
+        motors(car, _WHEELS, "velocity", [v, v, v, v], forces=[force, force, force, force])
+        self._step()
         obs = self._observe()
         x, y = float(obs[0]), float(obs[1])
         gx, gy = self.goal
@@ -319,7 +321,7 @@ class SimpleDrivingEnv(gym.Env):
         return obs, reward, terminated, False, {"distance": distance, "is_success": reached}
 
     def _observe(self) -> np.ndarray:
-        base = self.engine.base_state(self.car)
+        base = self._base(self.car)
         pos, (qx, qy, qz, qw), lin = base.position, base.orientation, base.linear
         # cos and sin of PyBullet's yaw, atan2(b, a), without the angle.
         a = qw * qw + qx * qx - qy * qy - qz * qz

@@ -131,8 +131,7 @@ class PyBulletEngine:
         p = self.session.p
         self.gui = self.session.gui
         self.error: type[Exception] = p.error
-        self._modes = {"velocity": p.VELOCITY_CONTROL, "position": p.POSITION_CONTROL,
-                       "torque": p.TORQUE_CONTROL}
+        self._velocity, self._position = p.VELOCITY_CONTROL, p.POSITION_CONTROL
         self._torque = p.TORQUE_CONTROL
         self._gear, self._fixed = p.JOINT_GEAR, p.JOINT_FIXED
         #: Bodies :meth:`restore` moves apart (all but scenery), in load order.
@@ -140,7 +139,15 @@ class PyBulletEngine:
         #: Per body, PyBullet's inverse-dynamics model: _UNTRIED, None (built: calls are
         #: bare) or why PyBullet refused to build it.
         self._models: dict[int, str | None] = {}
-        self.step = self.session.bullet.stepSimulation
+        self._bind()
+
+    def _bind(self) -> None:
+        """The calls a loop makes every step, bound to the client once (as :attr:`step`)."""
+        b = self.session.bullet
+        self.step = b.stepSimulation
+        self._motor_array = b.setJointMotorControlArray
+        self._base_pose = b.getBasePositionAndOrientation
+        self._base_velocity = b.getBaseVelocity
 
     @property
     def bullet(self) -> Bullet:
@@ -154,7 +161,7 @@ class PyBulletEngine:
     def close(self) -> None:
         """Disconnect (safe to call twice)."""
         self.session.close()
-        self.step = self.session.bullet.stepSimulation  # fails, as every call now
+        self._bind()  # to the closed client: every call fails now
 
     # ---- the world
 
@@ -257,9 +264,8 @@ class PyBulletEngine:
 
     def base_state(self, body: int) -> BaseState:
         """``getBasePositionAndOrientation`` and ``getBaseVelocity``."""
-        b = self.session.bullet
-        pos, orn = b.getBasePositionAndOrientation(body)
-        lin, ang = b.getBaseVelocity(body)
+        pos, orn = self._base_pose(body)
+        lin, ang = self._base_velocity(body)
         return _base_state((pos, orn, lin, ang))
 
     def base_pose(self, body: int) -> tuple[Vec3, Quat]:
@@ -355,21 +361,27 @@ class PyBulletEngine:
 
         A force cap not given is PyBullet's 100,000; a position target's velocity, 0.
         """
-        b = self.session.bullet
+        # Each form spelt out, as in contacts(): a loop that sets motors every step (the
+        # Gymnasium car's) pays no dict of keywords.
+        motors = self._motor_array
         if mode == "torque":  # the servo's, every step
-            b.setJointMotorControlArray(body, joints, self._torque, forces=targets)
-            return
-        control = self._modes[mode]
-        values: dict[str, Sequence[float]] = {}
-        if mode == "position":
-            values["targetPositions"] = targets
-            if velocities is not None:
-                values["targetVelocities"] = velocities
+            motors(body, joints, self._torque, forces=targets)
+        elif mode == "velocity":
+            if forces is None:
+                motors(body, joints, self._velocity, targetVelocities=targets)
+            else:
+                motors(body, joints, self._velocity, targetVelocities=targets, forces=forces)
+        elif velocities is None:
+            if forces is None:
+                motors(body, joints, self._position, targetPositions=targets)
+            else:
+                motors(body, joints, self._position, targetPositions=targets, forces=forces)
+        elif forces is None:
+            motors(body, joints, self._position, targetPositions=targets,
+                   targetVelocities=velocities)
         else:
-            values["targetVelocities"] = targets
-        if forces is not None:
-            values["forces"] = forces
-        b.setJointMotorControlArray(body, joints, control, **values)
+            motors(body, joints, self._position, targetPositions=targets,
+                   targetVelocities=velocities, forces=forces)
 
     def contacts(self, body: int, link: int | None = None, other: int | None = None
                  ) -> list[ContactPoint]:
