@@ -543,7 +543,7 @@ class Scenario:
 
     def _check_start(self) -> None:
         """A static base, or a start inside the ground, make the run meaningless: say so."""
-        assert self.session is not None
+        assert self.session is not None and self.engine is not None
         p = self.session.bullet
         self.problems = []
         self.static_base = p.getDynamicsInfo(self.body, -1)[0] == 0
@@ -558,8 +558,8 @@ class Scenario:
         elif self.static_base:
             self.problems.append("static base: the root link has mass 0, so PyBullet fixes it "
                                  "where it is loaded and the car cannot move; give it a mass")
-        points = p.getClosestPoints(self.body, self.plane, 0.0)
-        depth = min((pt[8] for pt in points), default=0.0)
+        points = self.engine.closest_points(self.body, self.plane, 0.0)
+        depth = min((pt.distance for pt in points), default=0.0)
         if depth < -0.005:
             if self.config.tutorial:  # the tutorial's own start: reproduced, and said
                 self.warnings.append(f"the tutorial's start is {-depth * 1000:.0f} mm inside "
