@@ -365,7 +365,8 @@ def test_default_motors_hold_what_no_motor_drives(engine: Any,
     assert abs(engine.base_state(car).position[1]) < 0.01
 
 
-@pytest.mark.parametrize("name", ["simplecar", "r2d2.urdf", "kuka_iiwa/model.urdf"])
+@pytest.mark.parametrize("name", ["simplecar", "r2d2.urdf", "kuka_iiwa/model.urdf",
+                                  "mir_like", "turned_arm"])
 def test_joints_are_pybullets(name: str, car_urdf: tuple[Path, float]) -> None:
     """Every engine numbers joints and links as PyBullet does (depth-first, file order), with
     PyBullet's kinds (a continuous joint is revolute without limits), limits, dynamics, axes
@@ -373,13 +374,16 @@ def test_joints_are_pybullets(name: str, car_urdf: tuple[Path, float]) -> None:
 
     PyBullet's getJointInfo gives a continuous joint the bounds its <limit> writes (r2d2's
     head_swivel: -0.38 to 0) but never holds it there (measured: driven to 2 rad): the seam
-    says it has no limits, and its bounds are not compared.
+    says it has no limits, and its bounds are not compared. The axis is in the child link's
+    inertial frame, as getJointInfo gives it: mir_like's wheels and turned_arm's links have
+    turned <inertial> frames.
     """
     from lxml import etree
 
     from urdfkit.sources.resolve import locate
 
-    path = car_urdf[0] if name == "simplecar" else locate(name)
+    path = car_urdf[0] if name == "simplecar" else ROBOTS / f"{name}.urdf" \
+        if "/" not in name and not name.endswith(".urdf") else locate(name)
     continuous = {j.get("name") for j in etree.parse(str(path)).iter("joint")
                   if j.get("type") == "continuous"}
     tables = []
@@ -398,7 +402,14 @@ def test_joints_are_pybullets(name: str, car_urdf: tuple[Path, float]) -> None:
     assert [row[:-1] for row in tables[0]] == [row[:-1] for row in tables[1]]
     assert not [j for j in tables[1] if j[1] in continuous and j[2] != "revolute"]
     for a, b in zip(tables[0], tables[1], strict=True):
-        assert a[-1] == pytest.approx(b[-1], abs=1e-12)   # the axis, normalised by each
+        # the axis, in the child's inertial frame; PyBullet keeps the file's length
+        # (turned_arm's (0, 1, 0.3)), MuJoCo a unit vector: the direction is compared
+        assert _direction(a[-1]) == pytest.approx(_direction(b[-1]), abs=1e-12)
+
+
+def _direction(v: Sequence[float]) -> list[float]:
+    n = math.sqrt(sum(x * x for x in v))
+    return [x / n for x in v] if n else list(v)
 
 
 def test_contacts_name_the_links_and_carry_the_weight(engine: Any) -> None:
@@ -1236,3 +1247,34 @@ def test_mimic_joints_follow_on_every_engine(engine: Any) -> None:
     assert reach > 0.01 and worst < 1e-4, (reach, worst)
     if engine.name == "mujoco":
         assert any("no force bound" in note for note in engine.notes[body])
+
+
+@pytest.mark.parametrize("name", ["simplecar", "husky/husky.urdf", "mir_like"])
+def test_drive_finds_the_same_drivetrain_on_every_engine(name: str,
+                                                         car_urdf: tuple[Path, float]) -> None:
+    """urdfkit/motion/vehicle.py's detection (joints, link poses, collision shapes, AABBs
+    through the seam) finds the same wheels, hinges and passive joints on both engines, the
+    same radii and contact points to 1e-6 (PyBullet's frames are float32), and the same
+    lowest point. mir_like's wheels have turned <inertial> frames."""
+    from urdfkit.motion.vehicle import detect_drivetrain
+    from urdfkit.motion.vehicle_shapes import lowest_point
+    from urdfkit.sources.resolve import locate
+
+    path = car_urdf[0] if name == "simplecar" else ROBOTS / f"{name}.urdf" \
+        if "/" not in name else locate(name)
+    found = []
+    for engine_name in ENGINE_NAMES:
+        e = _open(engine_name)
+        try:
+            body = e.load(str(path), LoadSettings(position=(0.0, 0.0, 0.3)))
+            found.append((detect_drivetrain(e, body), lowest_point(e, body)))
+        finally:
+            e.close()
+    (a, low_a), (b, low_b) = found
+    assert (a.wheels, a.hinges, a.passive, a.casters) == (b.wheels, b.hinges, b.passive,
+                                                          b.casters)
+    assert a.wheels
+    for j in a.wheels:
+        assert a.radius[j] == pytest.approx(b.radius[j], abs=1e-6)
+        assert a.contact[j] == pytest.approx(b.contact[j], abs=1e-6)
+    assert low_a == pytest.approx(low_b, abs=1e-6)

@@ -55,7 +55,8 @@ class JointInfo:
         lower, upper: The limits; ``limited`` False where the joint has none.
         effort, velocity: The URDF's effort and velocity limits (0: none given).
         link: The child link's name.
-        axis: The joint axis in the child link's frame.
+        axis: The joint axis in the child link's inertial frame, as PyBullet's getJointInfo
+            gives it (the link frame's axes unless the ``<inertial>`` is turned).
         parent: The parent link's index (-1: the root).
     """
 

@@ -209,8 +209,11 @@ class World:
                    ) -> JointInfo:
         """Joint ``i`` of a robot as the seam records it, MuJoCo's state indices in."""
         from urdfkit.formats.fk import unit
+        from urdfkit.model.spec import quat_to_matrix, rotate_back
 
         j = r.robot.joints[i]
+        # PyBullet's axis is in the child's inertial frame (its link frame in Bullet)
+        turn = quat_to_matrix(r.links[i + 1].dynamics.inertial_orientation)
         kind = {"continuous": "revolute", "revolute": "revolute", "prismatic": "prismatic",
                 "spherical": "spherical"}.get(j.type, "fixed")
         m = self.m
@@ -220,7 +223,8 @@ class World:
             v_index=int(m.jnt_dofadr[jid]) if jid >= 0 else -1,
             damping=j.damping, friction=j.friction, lower=j.lower, upper=j.upper,
             limited=j.limited, effort=j.effort, velocity=j.velocity, link=j.child,
-            axis=unit(j.axis) if j.moves and j.type != "spherical" else (0.0, 0.0, 0.0),
+            axis=rotate_back(turn, unit(j.axis)) if j.moves and j.type != "spherical"
+            else (0.0, 0.0, 0.0),
             parent=link_index[j.parent])
 
     def apply_all(self) -> None:
