@@ -268,7 +268,11 @@ class Model(Protocol):
                  ) -> tuple[list[list[float]], list[list[float]]]:
         """The linear and angular Jacobians (3 x n each) of a point of a link at ``positions``.
 
-        ``point`` is in the link's URDF frame. The dynamics methods raise
+        ``point`` is from the link's URDF frame's origin along the link's inertial frame's axes,
+        as PyBullet's calculateJacobian takes it (measured on 3.2.7; the URDF frame's axes
+        unless the ``<inertial>`` is turned). A floating base's 6 columns come first, as
+        :meth:`mass_matrix`'s coordinates; the rows are in the root's inertial frame (PyBullet
+        computes with the base at the origin, unturned). The dynamics methods raise
         :class:`urdfkit.core.errors.EngineError` when the engine cannot build its model of
         the body, with why as a clause (a caller names the robot before it).
         """
