@@ -992,7 +992,9 @@ def test_floating_mass_matrix_is_pybullets() -> None:
 
 def test_the_jacobian_moves_the_point(engine: Any) -> None:
     """J dq is how far a link's point moves when the joints move by dq (central differences
-    of link_frame, 1e-6), in the root's inertial frame: turned_arm fixed, its root turned."""
+    of link_frame over 1e-5 rad: to 1e-6 on MuJoCo; PyBullet's float32 frames leave 1e-2),
+    in the root's inertial frame, the point along the link's inertial axes: turned_arm
+    fixed, its root turned."""
     import numpy as np
 
     from urdfkit.model.spec import quat_to_matrix
