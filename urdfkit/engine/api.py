@@ -52,10 +52,13 @@ class JointInfo:
         q_index, v_index: Its first position and velocity index in the engine's state
             vectors, -1 for a fixed joint.
         damping, friction: The URDF's ``<dynamics>`` (N m s/rad; N m).
-        lower, upper: The limits; ``limited`` False where the joint has none.
+        lower, upper: The limits; ``limited`` False where the joint has none. As PyBullet
+            reports them: a continuous joint with a ``<limit>`` has its bounds (limited),
+            though no engine holds it there.
         effort, velocity: The URDF's effort and velocity limits (0: none given).
         link: The child link's name.
-        axis: The joint axis in the child link's frame.
+        axis: The joint axis in the child link's inertial frame, as PyBullet's getJointInfo
+            gives it (the link frame's axes unless the ``<inertial>`` is turned).
         parent: The parent link's index (-1: the root).
     """
 
@@ -303,7 +306,11 @@ class Model(Protocol):
                  ) -> tuple[list[list[float]], list[list[float]]]:
         """The linear and angular Jacobians (3 x n each) of a point of a link at ``positions``.
 
-        ``point`` is in the link's URDF frame. The dynamics methods raise
+        ``point`` is from the link's URDF frame's origin along the link's inertial frame's axes,
+        as PyBullet's calculateJacobian takes it (measured on 3.2.7; the URDF frame's axes
+        unless the ``<inertial>`` is turned). A floating base's 6 columns come first, as
+        :meth:`mass_matrix`'s coordinates; the rows are in the root's inertial frame (PyBullet
+        computes with the base at the origin, unturned). The dynamics methods raise
         :class:`urdfkit.core.errors.EngineError` when the engine cannot build its model of
         the body, with why as a clause (a caller names the robot before it).
         """

@@ -31,8 +31,15 @@ Where it mirrors PyBullet, measured (docs/engines.md):
 - **Indices** are PyBullet's: joints in its depth-first order, link ``i`` the child of joint
   ``i``, -1 the root; a fixed link fused into its parent's body keeps its index and frame.
 
-What cannot be the same (the contact model, the friction cone, the solver, link damping) is
-said in docs/engines.md with what it costs on the contract cases.
+- **The rest of the seam** is each in a part: frames, resets and joint states
+  (:mod:`~urdfkit.engine.mujoco_bodies`), closest points, Jacobians and mass matrices in
+  PyBullet's coordinates (:mod:`~urdfkit.engine.mujoco_query`), collision shapes and boxes
+  (:mod:`~urdfkit.engine.mujoco_shapes`), a held base and geared joints as equalities
+  (:mod:`~urdfkit.engine.mujoco_constraints`), PyBullet's joint force/torque sensor
+  (:mod:`~urdfkit.engine.mujoco_reactions`).
+
+What cannot be the same (the contact model, the friction cone, the solver, link damping, an
+uncapped coupling) is said in docs/engines.md with what it costs on the contract cases.
 """
 
 from __future__ import annotations

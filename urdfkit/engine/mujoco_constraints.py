@@ -6,7 +6,7 @@ world where it is now, PyBullet's ``JOINT_FIXED`` constraint; :func:`couple_join
 equality, ``follower = offset + multiplier * leader`` (its ``polycoef``), PyBullet's
 ``JOINT_GEAR``. Both are made as hard as MuJoCo allows, as the motors are
 (:data:`~urdfkit.engine.mujoco_motors.HARD`, and the shortest time constant MuJoCo takes: two
-steps): held against gravity, a base sags 7e-8 m; a follower lags its leader by what
+steps): a base held while its arm swings moves 8.5e-8 m in 1 s; a follower lags by what
 docs/engines.md measures.
 
 What cannot be the same: a MuJoCo equality has no force bound, so ``couple_joints``'s

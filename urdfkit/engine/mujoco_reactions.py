@@ -139,8 +139,8 @@ def _fused(w: World, m: Any, d: Any, np: Any, body: int, child: Link, point: Any
         if link.name not in below:
             continue
         if link.body != child.body:
-            if link.body == link.name:   # a body hanging from the fused links
-                total += d.cfrc_int[ids.bodies[link.name]]
+            if link.body == link.name and r.parents.get(link.name) == child.body:
+                total += d.cfrc_int[ids.bodies[link.name]]   # a body hanging from them
             continue
         dyn = link.dynamics
         if dyn.mass <= 0:

@@ -209,8 +209,11 @@ class World:
                    ) -> JointInfo:
         """Joint ``i`` of a robot as the seam records it, MuJoCo's state indices in."""
         from urdfkit.formats.fk import unit
+        from urdfkit.model.spec import quat_to_matrix, rotate_back
 
         j = r.robot.joints[i]
+        # PyBullet's axis is in the child's inertial frame (its link frame in Bullet)
+        turn = quat_to_matrix(r.links[i + 1].dynamics.inertial_orientation)
         kind = {"continuous": "revolute", "revolute": "revolute", "prismatic": "prismatic",
                 "spherical": "spherical"}.get(j.type, "fixed")
         m = self.m
@@ -222,7 +225,8 @@ class World:
             # as PyBullet reports it: a continuous joint's <limit> too, though not enforced
             limited=kind in ("revolute", "prismatic") and j.lower <= j.upper,
             effort=j.effort, velocity=j.velocity, link=j.child,
-            axis=unit(j.axis) if j.moves and j.type != "spherical" else (0.0, 0.0, 0.0),
+            axis=rotate_back(turn, unit(j.axis)) if j.moves and j.type != "spherical"
+            else (0.0, 0.0, 0.0),
             parent=link_index[j.parent])
 
     def apply_all(self) -> None:

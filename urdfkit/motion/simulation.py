@@ -416,7 +416,8 @@ class Simulation:
                  ) -> np.ndarray:
         """The 6 x n Jacobian (linear rows, then angular) of a point of a link now (numpy).
 
-        ``point`` is in the link's URDF frame (the joint frame): PyBullet 3.2.7's
+        ``point`` is from the link's URDF frame's origin (the joint), along the link's inertial
+        frame's axes (the URDF frame's unless its ``<inertial>`` is turned): PyBullet 3.2.7's
         calculateJacobian takes it so, whatever its docs say of the centre of mass (measured:
         the point (0, 0, 0) of a pendulum's bob link is on the hinge, J = 0).
         """
