@@ -375,9 +375,9 @@ def test_joints_are_pybullets(name: str, car_urdf: tuple[Path, float]) -> None:
     PyBullet's getJointInfo gives a continuous joint the bounds its <limit> writes (r2d2's
     head_swivel: -0.38 to 0; racecar's right steering hinge: -1 to 1) but never holds it
     there (measured: driven to 2 rad). Every engine reports them so (drive's detection reads
-    them: racecar's right hinge is a hinge, not a caster), and none holds them. The axis is in the child link's
-    inertial frame, as getJointInfo gives it: mir_like's wheels and turned_arm's links have
-    turned <inertial> frames.
+    them: racecar's right hinge is a hinge, not a caster), and none holds them. The axis is
+    in the child link's inertial frame, as getJointInfo gives it: mir_like's wheels and
+    turned_arm's links have turned <inertial> frames.
     """
     from lxml import etree
 
