@@ -66,6 +66,7 @@ from urdfkit.engine.api import (
 )
 from urdfkit.engine.mujoco_motors import Motor
 from urdfkit.engine.mujoco_world import World, bad_count
+from urdfkit.formats.mjwarn import listen, stop_listening
 
 #: PyBullet's force cap when a motor is set without one (setJointMotorControl2's default).
 MOTOR_FORCE = 100000.0
@@ -120,6 +121,8 @@ class MuJoCoEngine:
         self.world = World(import_mujoco())
         self.notes = self.world.notes
         self._renderers: dict[tuple[int, int, int], Any] = {}
+        #: What MuJoCo warns while this engine is open, one line each (cleared every step).
+        self._said = listen(self.world.mj)
 
     def load(self, path: str, settings: LoadSettings, display: str | None = None) -> int:
         """Load a guarded URDF: its export attached to the world, compiled when next needed.
@@ -196,8 +199,6 @@ class MuJoCoEngine:
         Raises:
             EngineError: The simulation diverged (MuJoCo found NaN or huge values).
         """
-        from urdfkit.formats.mjwarn import mujoco_warnings
-
         w = self.world
         m, d = w.compiled()
         mj = w.mj
@@ -205,26 +206,30 @@ class MuJoCoEngine:
         assert bank is not None
         h = w.time_step
         bank.bound(m, h)
-        for dof, torque in w.torques.items():
-            d.qfrc_applied[dof] = torque
-        bad = bad_count(mj, d)
-        with mujoco_warnings(mj) as said:
-            mj.mj_step1(m, d)       # positions, velocities, the constraint rows
-            bank.aim(m, d, h)       # each motor row asks for its velocity (mujoco_motors)
-            if w.sensors:           # joint force/torque sensors: at the step's start state
-                from urdfkit.engine.mujoco_reactions import measure
+        if w.torques:
+            for dof, torque in w.torques.items():
+                d.qfrc_applied[dof] = torque
+        said = self._said
+        said.clear()
+        mj.mj_step1(m, d)       # positions, velocities, the constraint rows
+        bank.aim(m, d, h)       # each motor row asks for its velocity (mujoco_motors)
+        if w.sensors:           # joint force/torque sensors: at the step's start state
+            from urdfkit.engine.mujoco_reactions import measure
 
-                before = d.qvel.copy()
-                mj.mj_step2(m, d)
-                measure(w, m, d, before)
-            else:
-                mj.mj_step2(m, d)   # forces, the solver, the integration
+            before = d.qvel.copy()
+            mj.mj_step2(m, d)
+            measure(w, m, d, before)
+        else:
+            mj.mj_step2(m, d)   # forces, the solver, the integration
         bank.record(m, d)
-        for dof in w.torques:
-            d.qfrc_applied[dof] = 0.0
-        w.torques.clear()
+        if w.torques:
+            for dof in w.torques:
+                d.qfrc_applied[dof] = 0.0
+            w.torques.clear()
         w.kinematics = False
-        if bad_count(mj, d) != bad:
+        bad = bad_count(mj, d)
+        if bad != w.bad:
+            w.bad = bad
             raise EngineError("MuJoCo's simulation diverged" + (f": {said[0]}" if said else
                                                                 "") + " (a smaller time step, "
                               "or smaller forces, may help)")
@@ -267,6 +272,8 @@ class MuJoCoEngine:
     def close(self) -> None:
         """Release the world (safe to call twice)."""
         w = self.world
+        if not w.closed:
+            stop_listening(w.mj)
         w.closed = True
         for renderer in self._renderers.values():
             renderer.close()

@@ -73,6 +73,12 @@ class MotorBank:
         #: The rows' bounds need writing (a motor or the time step changed).
         self.dirty = True
         self._h = 0.0
+        #: Every motor a velocity motor: what each asks is its target, set once.
+        self._velocities_only = True
+        #: The motor rows of the step being taken (first row, count, their dofs).
+        self._rows: tuple[int, int, Any] = (0, 0, None)
+        #: The rows' dofs and what each asks, kept while the rows and the motors stay.
+        self._cached: tuple[int, int, Any, Any] | None = None
 
     def place(self, dof: int, qadr: int, motor: Motor) -> None:
         """The joint at ``dof`` (its position at ``qadr``) has ``motor``."""
@@ -88,6 +94,14 @@ class MotorBank:
         self.force[dof] = np.nan if motor.force is None else motor.force
         self.dofs = np.flatnonzero(self.mode)
         self.qadr = self.qpos_of[self.dofs]
+        # a velocity motor asks for its target, set here once; a position motor's ask is
+        # worked out every step (aim)
+        velocity = self.dofs[self.mode[self.dofs] == VELOCITY]
+        self.want[velocity] = self.target[velocity]
+        self._positions = self.dofs[self.mode[self.dofs] == POSITION]
+        self._position_qadr = self.qpos_of[self._positions]
+        self._velocities_only = not len(self._positions)
+        self._cached = None
         self.dirty = True
 
     def caps(self, h: float) -> Any:
@@ -110,27 +124,45 @@ class MotorBank:
         Called between ``mj_step1`` (which makes the rows) and ``mj_step2`` (which solves
         them).
         """
-        np = self.np
-        dofs = self.dofs
-        if not len(dofs):
+        if not len(self.dofs):
+            self._rows = (0, 0, None)
             return
-        v = d.qvel[dofs]
-        self.want[dofs] = np.where(
-            self.mode[dofs] == VELOCITY, self.target[dofs],
-            POSITION_GAIN * (self.target[dofs] - d.qpos[self.qadr]) / h
-            + (1 - VELOCITY_GAIN) * v + VELOCITY_GAIN * self.velocity[dofs])
-        rows = self.rows(m, d)
-        if len(rows):
-            at = d.efc_id[rows]
-            d.efc_aref[rows] = (self.want[at] - d.qvel[at]) / h
+        if not self._velocities_only:
+            p = self._positions
+            self.want[p] = (POSITION_GAIN * (self.target[p] - d.qpos[self._position_qadr]) / h
+                            + (1 - VELOCITY_GAIN) * d.qvel[p] + VELOCITY_GAIN * self.velocity[p])
+        first, count = self.rows(m, d)
+        if not count:
+            self._rows = (0, 0, None)
+            return
+        end = first + count
+        cached = self._cached
+        if cached is not None and cached[:2] == (first, count):
+            at = cached[2]   # the same rows as the last step
+            want = cached[3] if self._velocities_only else self.want[at]
+        else:
+            at = d.efc_id[first:end].copy()
+            want = self.want[at]
+            self._cached = (first, count, at, want)
+            self.applied[:] = 0.0   # a joint no longer among the rows pushed with nothing
+        d.efc_aref[first:end] = (want - d.qvel[at]) / h
+        self._rows = (first, count, at)
 
     def record(self, m: Any, d: Any) -> None:
-        """After the step: each motor's force in it."""
-        self.applied[:] = 0.0
-        rows = self.rows(m, d)
-        if len(rows):
-            self.applied[d.efc_id[rows]] = d.efc_force[rows]
+        """After the step: each motor's force in it (the rows :meth:`aim` found)."""
+        first, count, at = self._rows
+        if count:
+            self.applied[at] = d.efc_force[first:first + count]
+        else:
+            self.applied[:] = 0.0
 
-    def rows(self, m: Any, d: Any) -> Any:
-        """The constraint rows of the motors (MuJoCo's friction-loss rows of joints)."""
-        return self.np.flatnonzero(d.efc_type[:d.nefc] == self.friction_row)
+    def rows(self, m: Any, d: Any) -> tuple[int, int]:
+        """The motors' constraint rows (the joints' friction-loss rows): first, how many.
+
+        MuJoCo puts the friction-loss rows right after the equality rows (``ne`` of them),
+        ``nf`` in all; the world has no tendons, whose friction would be among them.
+        """
+        if m.ntendon:  # not built by the export; searched for, should a model have them
+            rows = self.np.flatnonzero(d.efc_type[:d.nefc] == self.friction_row)
+            return (int(rows[0]), len(rows)) if len(rows) else (0, 0)
+        return int(d.ne), int(d.nf)

@@ -91,6 +91,8 @@ class World:
         self.sensed: tuple[Any, Any, Any] | None = None   # frames at the last measured step
         self.held: Any = None   # the joints' own constraint forces in it, once read
         self.constraints = 0   # how many user constraints (holds, couplings) were made
+        #: MuJoCo's count of NaN or huge values found, after the last step (bad_count).
+        self.bad = 0
 
     def add(self, r: Loaded, settings: LoadSettings) -> int:
         """Attach a prepared robot where ``settings`` puts it, with its contact pairs."""
@@ -159,6 +161,7 @@ class World:
                               f"{first}") from None
         self.compiled_bodies = len(self.robots)
         self.stale = False
+        self.bad = bad_count(mj, self.d)   # a recompile carries the data's warnings over
         self.scratch = mj.MjData(self.m)
         self.kinematics = False
         self.sensed = None          # the data is new: no step measured in it
@@ -410,12 +413,16 @@ class World:
             return vec3(d.xpos[i]), xyzw(d.xquat[i]), d.xmat[i].reshape(3, 3)
         return vec3(d.site_xpos[i]), self.mat_quat(d.site_xmat[i]), d.site_xmat[i].reshape(3, 3)
 
+_BAD: list[int] = []
+
+
 def bad_count(mj: Any, d: Any) -> int:
     """How often MuJoCo has found NaN or huge values (positions, velocities, accelerations)."""
-    w = mj.mjtWarning
+    if not _BAD:  # the warnings' indices, looked up once
+        w = mj.mjtWarning
+        _BAD.extend(int(k) for k in (w.mjWARN_BADQACC, w.mjWARN_BADQVEL, w.mjWARN_BADQPOS))
     warning = d.warning
-    return int(warning[int(w.mjWARN_BADQACC)].number + warning[int(w.mjWARN_BADQVEL)].number
-               + warning[int(w.mjWARN_BADQPOS)].number)
+    return int(warning[_BAD[0]].number + warning[_BAD[1]].number + warning[_BAD[2]].number)
 
 
 def rotate(rot: Any, v: Sequence[float]) -> Vec3:

@@ -19,10 +19,7 @@ def mujoco_warnings(mujoco: Any) -> Iterator[list[str]]:
     said: list[str] = []
 
     def keep(message: str) -> None:
-        # one line each ("flex 'f' is not rigid ...\nElement name 'f', id 0": the element in
-        # brackets), as urdfkit's warnings are
-        first, *rest = message.strip().splitlines() or [""]
-        said.append(first + (f" ({'; '.join(r.strip() for r in rest)})" if rest else ""))
+        said.append(one_line(message))
 
     previous = mujoco.get_mju_user_warning()
     mujoco.set_mju_user_warning(keep)
@@ -30,3 +27,40 @@ def mujoco_warnings(mujoco: Any) -> Iterator[list[str]]:
         yield said
     finally:
         mujoco.set_mju_user_warning(previous)
+
+
+def one_line(message: str) -> str:
+    """A MuJoCo warning as one line, as urdfkit's warnings are.
+
+    A second line (``Element name 'f', id 0``) goes in brackets after the first.
+    """
+    first, *rest = message.strip().splitlines() or [""]
+    return first + (f" ({'; '.join(r.strip() for r in rest)})" if rest else "")
+
+
+#: What MuJoCo warned while a :func:`listen` is open, one line each (its users clear it).
+_SAID: list[str] = []
+#: How many listeners are open, and the handler before the first.
+_LISTENERS: dict[str, Any] = {"open": 0, "previous": None}
+
+
+def listen(mujoco: Any) -> list[str]:
+    """Keep what MuJoCo warns from now until :func:`stop_listening`, in the list returned.
+
+    For a loop that would pay :func:`mujoco_warnings` at every step (a MuJoCo engine's
+    step): the handler is set once, while any listener is open, and the one before it put
+    back when the last closes. The list is shared: a step clears it before it steps.
+    """
+    if _LISTENERS["open"] == 0:
+        _LISTENERS["previous"] = mujoco.get_mju_user_warning()
+        mujoco.set_mju_user_warning(lambda message: _SAID.append(one_line(message)))
+    _LISTENERS["open"] += 1
+    return _SAID
+
+
+def stop_listening(mujoco: Any) -> None:
+    """One :func:`listen` less; the last puts the handler before them back."""
+    _LISTENERS["open"] -= 1
+    if _LISTENERS["open"] == 0:
+        mujoco.set_mju_user_warning(_LISTENERS["previous"])
+        _LISTENERS["previous"] = None
