@@ -35,7 +35,8 @@ BENCH = Path(__file__).resolve().parent
 sys.path.insert(0, str(BENCH))
 
 #: Section modules under bench/, each with ``cases(ctx) -> list[Case]``.
-SECTIONS = ["inspect_bench", "build_bench", "output_bench", "check_cli_bench", "export_bench"]
+SECTIONS = ["inspect_bench", "build_bench", "output_bench", "check_cli_bench", "export_bench",
+            "engine_bench"]
 
 
 @dataclass
