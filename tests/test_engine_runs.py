@@ -175,6 +175,25 @@ def test_sim_names_a_key_mujoco_has_no_meaning_for() -> None:
     assert len(out.output.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize(("change", "key", "said"), [
+    ({"link_dynamics": {"arm": {"restitution": 0.5}}}, "robots[0].link_dynamics.arm",
+     "do not bounce"),
+    ({"linear_damping": 0.1}, "robots[0].linear_damping", "no per-body velocity damping"),
+])
+def test_sim_names_a_robot_key_mujoco_cannot_carry(tmp_path: Path, change: dict[str, object],
+                                                   key: str, said: str) -> None:
+    document = json.loads((EXAMPLES / "pendulum_servo.json").read_text())
+    document["physics"] = {"engine": "mujoco"}
+    document["robots"][0]["urdf"] = str(EXAMPLES / "pendulum.urdf")
+    document["robots"][0].update(change)
+    scenario = tmp_path / "p.json"
+    scenario.write_text(json.dumps(document))
+    out = CliRunner().invoke(app, ["sim", str(scenario)])
+    assert out.exit_code == 2, out.output
+    line, = out.output.strip().splitlines()
+    assert str(scenario) in line and key in line and said in line
+
+
 def test_sim_json_names_its_engine(tmp_path: Path) -> None:
     scenario = tmp_path / "p.json"
     document = json.loads((EXAMPLES / "pendulum_servo.json").read_text())

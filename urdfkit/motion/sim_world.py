@@ -378,7 +378,10 @@ class World:
                 ("rollingFriction", dyn.rolling_friction),
                 ("spinningFriction", dyn.spinning_friction)) if value is not None}
             if values:
-                engine.change_dynamics(body, r.links[link], **values)
+                try:
+                    engine.change_dynamics(body, r.links[link], **values)
+                except ParameterError as e:
+                    raise self.error(f"{path}.link_dynamics.{link}", e.message) from None
         for name, init in cfg.initial_joints.items():
             spec = self._active_joint(r, f"{path}.initial_joints.{name}", name)
             engine.reset_joint(body, spec.index, r.to_physical(name, init.position),
