@@ -99,7 +99,7 @@ def test_the_gym_tutorial_env_keeps_the_tutorials_box() -> None:
     env = SimpleDrivingEnv()
     try:
         env.reset(seed=0)
-        p = env._p
+        p = env.engine.bullet  # type: ignore[attr-defined]  # PyBullet's escape hatch
         grounds = [b for b in range(p.getNumBodies())
                    if p.getBodyInfo(b)[1].decode() == "simpleplane"]
         assert len(grounds) == 1
