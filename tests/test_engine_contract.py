@@ -22,6 +22,7 @@ import pytest
 
 from urdfkit.core.errors import InputError, MissingDependencyError, ParameterError
 from urdfkit.engine.api import BaseState, ContactPoint, JointInfo, JointState, LoadSettings
+from urdfkit.engine.mujoco import MuJoCoEngine
 from urdfkit.engine.registry import ENGINES, open_engine, preload
 
 ROBOTS = Path(__file__).parent / "fixtures" / "robots"
@@ -1325,3 +1326,55 @@ def test_the_joint_force_sensor_sums_a_fused_link_and_what_hangs_from_it(engine:
         want = np.concatenate([turn[j].T @ force, turn[j].T @ moment])
         worst = max(worst, float(np.abs(np.array(states[j].reaction) - want).max()))
     assert worst < (1e-9 if engine.name == "mujoco" else 2e-3), worst
+
+
+# --------------------------------------------------------------------------- the contract can fail
+
+
+class _StrongGravity(MuJoCoEngine):
+    """A tampered engine: gravity 1 % too strong (a pendulum's period 0.5 % short)."""
+
+    def set_gravity(self, gravity: tuple[float, float, float]) -> None:
+        super().set_gravity((gravity[0] * 1.01, gravity[1] * 1.01, gravity[2] * 1.01))
+
+
+class _SlowMotors(MuJoCoEngine):
+    """A tampered engine: velocity motors reach 90 % of their target."""
+
+    def motors(self, body: int, joints: Any, mode: Any, targets: Any, forces: Any = None,
+               velocities: Any = None) -> None:
+        if mode == "velocity":
+            targets = [0.9 * t for t in targets]
+        super().motors(body, joints, mode, targets, forces, velocities)
+
+
+class _Sticky(MuJoCoEngine):
+    """A tampered engine: every link loaded with friction 1 (not PyBullet's 0.5)."""
+
+    def load(self, path: str, settings: LoadSettings, display: str | None = None) -> int:
+        body = super().load(path, settings, display)
+        for link in range(-1, len(self.joints(body))):
+            super().change_dynamics(body, link, lateralFriction=1.0)
+        return body
+
+
+@pytest.mark.parametrize(("tampered", "test"), [
+    (_StrongGravity, test_pendulum_swings_with_the_compound_pendulum_period),
+    (_StrongGravity, test_a_dropped_box_hits_the_ground_after_sqrt_2h_over_g),
+    (_SlowMotors, test_a_car_drives_wheel_speed_times_radius_times_time),
+    (_Sticky, test_ground_friction_is_the_product_of_the_two),
+])
+def test_the_contract_fails_a_tampered_engine(tampered: type[MuJoCoEngine], test: Any,
+                                              car_urdf: tuple[Path, float]) -> None:
+    """Each contract test fails on an engine with one thing wrong: they can fail."""
+    e = tampered()
+    e.set_gravity((0.0, 0.0, -G))
+    e.set_time_step(DT)
+    try:
+        with pytest.raises(AssertionError):
+            if "car_urdf" in test.__code__.co_varnames[:test.__code__.co_argcount]:
+                test(e, car_urdf)
+            else:
+                test(e)
+    finally:
+        e.close()
