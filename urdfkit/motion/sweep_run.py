@@ -93,6 +93,10 @@ def _sim_base(request: SweepRequest) -> object:
         raise ParameterError("sweep sim needs the scenario file: urdfkit sweep sim "
                              "scenario.toml --vary PATH=VALUES", param="kind")
     changed = [name for name, given in _given(request.drive).items() if given]
+    if changed == ["engine"]:
+        raise ParameterError(f"`engine`: a sim sweep runs on its scenario's physics.engine; "
+                             f"for every point on {request.drive['engine']}: `vary` "
+                             f"engine={request.drive['engine']}", param="engine")
     if changed:
         raise ParameterError(f"{', '.join(f'`{n}`' for n in changed)}: drive options; a sim "
                              "sweep varies the scenario's keys (`vary` "
