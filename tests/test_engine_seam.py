@@ -36,15 +36,12 @@ ENGINE_PACKAGES = {"pybullet", "pybullet_utils", "pybullet_envs", "mujoco"}
 
 #: Modules outside engine/ that still import an engine's package (lazily counts), or
 #: PyBullet through the session's importer, and why.
-IMPORTS_AN_ENGINE: dict[str, str] = {
-    "exchange/agree.py": "loads the MJCF in MuJoCo beside PyBullet",
-}
+IMPORTS_AN_ENGINE: dict[str, str] = {}
 
 #: Modules outside engine/ that still call PyBullet's functions (through a session's bound
 #: client), each for its owner to port to the seam.
 CALLS_PYBULLET: set[str] = {
     "checks/collisions.py", "draw/render.py", "draw/view_model.py",
-    "exchange/agree.py", "exchange/agree_contact.py",
 }
 
 #: The modules ported to the seam: no PyBullet but the escape hatch they hand out.
