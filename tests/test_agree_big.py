@@ -72,7 +72,10 @@ def test_every_state_query_fails_from_128_joints_at_every_index(
 
 
 def test_a_joint_past_128_coordinates_reads_0_and_any_reset_zeroes_it(
-        bullet: Any, load: Callable[..., int]) -> None:
+        bullet: Any, load: Callable[..., int], tmp_path: Path) -> None:
+    from urdfkit.engine.api import LoadSettings
+    from urdfkit.engine.pybullet import PyBulletEngine
+
     body = load(123)  # 122 revolute joints: the last one's qIndex is 7 + 121 = 128
     assert [bullet.getJointInfo(body, i)[3] for i in (120, 121)] == [127, 128]
 
@@ -88,9 +91,15 @@ def test_a_joint_past_128_coordinates_reads_0_and_any_reset_zeroes_it(
     bullet.resetJointState(body, 5, 0.2)
     bullet.resetJointState(body, 5, 0.0)  # another joint, and back: joint 121 is at 0 again
     assert sphere(121) == pytest.approx(rest, abs=1e-12)
-    info = [bullet.getJointInfo(body, i) for i in range(bullet.getNumJoints(body))]
-    assert "from joint j122 on" in unreadable_state(info)
-    assert unreadable_state(info[:121]) == ""
+    engine = PyBulletEngine()  # the same chain's joints as agree reads them
+    try:
+        joints = engine.joints(engine.load(str(tmp_path / "chain123.urdf"),
+                                           LoadSettings(fixed_base=True)))
+    finally:
+        engine.close()
+    assert [j.q_index for j in joints[120:]] == [127, 128]
+    assert "from joint j122 on" in unreadable_state(joints)
+    assert unreadable_state(joints[:121]) == ""
 
 
 def _agree(tmp_path: Path, links: int, fixed_every: int = 0) -> dict[str, dict]:
@@ -132,7 +141,7 @@ def test_pybullets_dynamics_are_wrong_past_128_degrees_of_freedom(
         bullet: Any, load: Callable[..., int], tmp_path: Path) -> None:
     import numpy as np
 
-    from urdfkit.exchange.agree import load_mjcf
+    from urdfkit.engine.mujoco_file import open_mjcf
 
     rows = _agree(tmp_path, 131)  # 130 revolute joints
     row = rows["mass matrix, inverse dynamics"]
@@ -142,7 +151,8 @@ def test_pybullets_dynamics_are_wrong_past_128_degrees_of_freedom(
     body = load(131)
     q = [0.3] * 130
     ours = np.array(bullet.calculateMassMatrix(body, q))
-    _, fixed = load_mjcf(tmp_path / "chain.xml")
+    with open_mjcf(tmp_path / "chain.xml") as mjcf:
+        fixed = mjcf.fixed
     d = mujoco.MjData(fixed)
     d.qpos[:] = q
     mujoco.mj_forward(fixed, d)

@@ -12,7 +12,7 @@ import pytest
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
-from urdfkit.exchange.agree import pybullet_frame_tolerances, sample_range
+from urdfkit.exchange.agree_poses import pybullet_frame_tolerances, sample_range
 
 mujoco = pytest.importorskip("mujoco")  # in the test extra: CI never skips it
 runner = CliRunner()

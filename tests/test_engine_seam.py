@@ -36,15 +36,12 @@ ENGINE_PACKAGES = {"pybullet", "pybullet_utils", "pybullet_envs", "mujoco"}
 
 #: Modules outside engine/ that still import an engine's package (lazily counts), or
 #: PyBullet through the session's importer, and why.
-IMPORTS_AN_ENGINE: dict[str, str] = {
-    "exchange/agree.py": "loads the MJCF in MuJoCo beside PyBullet",
-}
+IMPORTS_AN_ENGINE: dict[str, str] = {}
 
 #: Modules outside engine/ that still call PyBullet's functions (through a session's bound
 #: client), each for its owner to port to the seam.
 CALLS_PYBULLET: set[str] = {
     "checks/collisions.py", "draw/render.py", "draw/view_model.py",
-    "exchange/agree.py", "exchange/agree_contact.py",
 }
 
 #: The modules ported to the seam: no PyBullet but the escape hatch they hand out.
@@ -393,3 +390,59 @@ def test_simulation_runs_on_the_engine_and_hands_out_pybullet_as_an_escape_hatch
         assert shadow is not sim.engine and shadow.name == sim.engine.name
     with pytest.raises(Exception, match="Not connected"):
         sim.bullet.getNumBodies()
+
+
+def test_a_meshs_file_and_a_links_vertices_are_what_pybullet_loaded(
+        engine: PyBulletEngine) -> None:
+    """What agree reads of PyBullet's meshes: the file it read, every vertex it keeps."""
+    from urdfkit.sources.resolve import open_input
+
+    with open_input("r2d2.urdf") as res:
+        body = engine.load(str(res.load_path), LoadSettings(fixed_base=True))
+    raw = engine.bullet
+    meshes = 0
+    for link in range(-1, raw.getNumJoints(body)):
+        for shape, row in zip(engine.collision_shapes(body, link),
+                              raw.getCollisionShapeData(body, link), strict=True):
+            want = row[4].decode() if shape.kind == "mesh" else ""
+            assert shape.file == want
+            meshes += shape.kind == "mesh"
+            assert not want or Path(want).is_file()
+        try:
+            count, vertices = raw.getMeshData(body, link, -1)
+        except raw.error:
+            count, vertices = 0, []
+        assert engine.collision_vertices(body, link) == (list(vertices) if count else [])
+    assert meshes and any(engine.collision_vertices(body, k)
+                          for k in range(raw.getNumJoints(body)))
+
+
+def test_a_body_out_of_every_contact_falls_through_the_ground_and_can_be_removed(
+        engine: PyBulletEngine, simpleplane_urdf: Path, tmp_path: Path) -> None:
+    (tmp_path / "box.urdf").write_text(BOX)
+    engine.load(str(simpleplane_urdf), LoadSettings(fixed_base=True, scenery=True))
+    engine.set_gravity((0.0, 0.0, -9.81))
+    kept = engine.load(str(tmp_path / "box.urdf"), LoadSettings(position=(0.0, 0.0, 0.2)))
+    ghost = engine.load(str(tmp_path / "box.urdf"), LoadSettings(position=(1.0, 0.0, 0.2)))
+    engine.set_collision_filter(ghost, -1, 0, 0)
+    for _ in range(240):
+        engine.step()
+    assert engine.base_pose(kept)[0][2] == pytest.approx(0.1, abs=2e-3)  # it rests
+    assert engine.base_pose(ghost)[0][2] < -1.0  # it fell through
+    engine.remove_body(ghost)
+    assert engine.bullet.getNumBodies() == 2
+    # PyBullet hands a removed body's id on: nothing the engine knew of it may stay, as
+    # a refused inverse-dynamics model (KR210's asymmetric link_2) would
+    from urdfkit.core.errors import EngineError
+
+    refused = engine.load(str(ROBOTS / "id_asymmetric.urdf"), LoadSettings(fixed_base=True))
+    moving = sum(1 for j in engine.joints(refused) if j.kind != "fixed")
+    with pytest.raises(EngineError):
+        engine.mass_matrix(refused, [0.0] * moving)
+    engine.remove_body(refused)
+    again = engine.load(PENDULUM, LoadSettings(fixed_base=True, inertia_from_file=True))
+    assert again == refused
+    assert len(engine.mass_matrix(again, [0.2])) == 1
+    assert PyBulletEngine.load_flags(LoadSettings(inertia_from_file=True,
+                                                  self_collision=True)) == [
+        "URDF_USE_INERTIA_FROM_FILE", "URDF_USE_IMPLICIT_CYLINDER", "URDF_USE_SELF_COLLISION"]

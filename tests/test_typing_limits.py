@@ -104,7 +104,7 @@ TARGETS: list[tuple[str, str, str]] = [
     ("checks/fix.py", "_Plan.carry_contacts", "link"),
     ("formats/mjcf.py", "_Writer.joint", "j"),
     ("formats/mjcf.py", "_Writer.fill", "body"),
-    ("exchange/agree.py", "_Pybullet.__init__", "session"),
+    ("exchange/agree_sides.py", "PyBulletSide.__init__", "engine"),
     ("commands/exporting.py", "_export_dict", "e"),
     ("model/robot.py", "_parse_joint", "el"),
     ("sources/references.py", "label", "el"),

@@ -176,6 +176,9 @@ class CollisionShape:
         position, orientation: Its frame in the link's inertial frame.
         vertices: A mesh's vertices in the link's inertial frame (empty when the engine
             gives none); None for the other kinds.
+        file: A mesh's file as the engine read it (PyBullet's resolved path, which
+            ``agree`` reads the mesh from); empty for the other kinds, or where the engine
+            read none (MuJoCo's in-memory export).
     """
 
     kind: ShapeKind
@@ -183,6 +186,7 @@ class CollisionShape:
     position: Vec3
     orientation: Quat
     vertices: Sequence[Vec3] | None = None
+    file: str = ""
 
 
 @dataclass(frozen=True)

@@ -456,8 +456,49 @@ class PyBulletEngine:
                 except self.error:
                     count, verts = 0, []
                 vertices = verts if count else ()
-            out.append(CollisionShape(kind, shape[3], shape[5], shape[6], vertices))
+            out.append(CollisionShape(kind, shape[3], shape[5], shape[6], vertices,
+                                      _name(shape[4]) if kind == "mesh" else ""))
         return out
+
+    def collision_vertices(self, body: int, link: int) -> list[Vec3]:
+        """``getMeshData(body, link, -1)``: every collision vertex PyBullet keeps for a link.
+
+        In the link's inertial frame, all its collision shapes' at once (measured: the files'
+        placed vertices exactly, an OBJ's stray vertex left out); empty where PyBullet gives
+        none or refuses (it raises plain errors on a link without a mesh).
+        """
+        try:
+            count, vertices = self.session.bullet.getMeshData(body, link, -1)
+        except Exception:  # noqa: BLE001 - PyBullet raises plain errors; no data, no vertices
+            return []
+        return list(vertices) if count else []
+
+    def set_collision_filter(self, body: int, link: int, group: int, mask: int) -> None:
+        """``setCollisionFilterGroupMask``: group and mask 0 take the link out of every contact.
+
+        PyBullet only (not in the seam's protocol): ``agree`` swings a robot with contacts off.
+        """
+        self.session.bullet.setCollisionFilterGroupMask(body, link, group, mask)
+
+    def remove_body(self, body: int) -> None:
+        """``removeBody`` (PyBullet only, not in the seam's protocol).
+
+        What the engine kept of the body goes with it: PyBullet gives its id to the next.
+        """
+        self.session.bullet.removeBody(body)
+        self._models.pop(body, None)
+        if body in self._lifted:
+            self._lifted.remove(body)
+
+    @staticmethod
+    def load_flags(settings: LoadSettings) -> list[str]:
+        """The ``loadURDF`` flags :meth:`load` sets for ``settings``, by name (``URDF_*``)."""
+        from urdfkit.engine.session import LoadOptions
+
+        return LoadOptions(fixed_base=settings.fixed_base,
+                           inertia_from_file=settings.inertia_from_file,
+                           implicit_cylinder=settings.implicit_cylinder,
+                           self_collision=settings.self_collision).flag_names()
 
     def aabb(self, body: int, link: int) -> tuple[Vec3, Vec3]:
         """``getAABB``."""

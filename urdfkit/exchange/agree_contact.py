@@ -1,7 +1,9 @@
 """Collision geometry and contact parameters: PyBullet's shapes against MuJoCo's geoms.
 
-PyBullet's side is what it loaded (``getCollisionShapeData``: kind, dimensions, the shape's
-frame in the link's inertial frame; ``getDynamicsInfo``: friction), not the file. Both sides
+PyBullet's side is what it loaded, through the engine seam (``collision_shapes``, PyBullet's
+``getCollisionShapeData``: kind, dimensions, the shape's frame in the link's inertial frame;
+``dynamics``, its ``getDynamicsInfo``: friction), not the file; MuJoCo's is the file's
+collision geoms (:meth:`~urdfkit.engine.mujoco_file.MjcfFile.geoms`). Both sides
 are placed in the world at the zero pose, base at the origin, and each PyBullet shape takes the
 nearest unused MuJoCo collision geom (``contype`` or ``conaffinity`` set) of the same kind in
 the body its link is welded to. A shape nothing matches is missing, a geom left over is extra,
@@ -12,6 +14,7 @@ Contact parameters are compared per matched pair: friction (sliding, torsional, 
 contact dimension that makes MuJoCo use the last two, that the geom meets MuJoCo's default
 geoms (a ground), and that its priority makes MuJoCo take the robot's friction against a
 ground, as PyBullet multiplies it by a ground's 1.0 (MuJoCo takes the larger of two equals).
+:func:`collisions` writes the rows.
 """
 
 from __future__ import annotations
@@ -19,7 +22,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+from urdfkit.exchange.agree_sides import Sides
+from urdfkit.formats.fk import fused, link_frames
+
+if TYPE_CHECKING:
+    from urdfkit.engine.mujoco_file import Geom
+    from urdfkit.engine.pybullet import PyBulletEngine
 
 #: Sizes and places of primitives (m); measured 1.7e-16 at worst on r2d2, racecar, husky.
 TOL_SHAPE = 1e-9
@@ -32,9 +42,6 @@ TOL_MESH = 1e-6
 #: which a misread file fails by far (jaxon's repeated COLLADA ids: 0.43).
 TOL_BULLET_HULL = 1e-3
 TOL_FRICTION = 1e-12
-#: PyBullet's geometry codes (GEOM_*) -> MuJoCo's geom type names.
-_PB_KIND = {2: "sphere", 3: "box", 4: "cylinder", 5: "mesh", 6: "plane", 7: "capsule"}
-_MJ_KIND = {0: "plane", 2: "sphere", 3: "capsule", 5: "cylinder", 6: "box", 7: "mesh"}
 
 
 @dataclass
@@ -120,28 +127,29 @@ def _why_skipped(kind: str, size: tuple[float, ...], scale: tuple[float, ...],
     return ""
 
 
-def pybullet_shapes(b: Any, body: int, link_index: dict[str, int], zero: dict[str, Any],
-                    group: dict[str, str], static: set[str]) -> tuple[list[Shape], list[str]]:
+def pybullet_shapes(engine: PyBulletEngine, body: int, link_index: dict[str, int],
+                    zero: dict[str, Any], group: dict[str, str], static: set[str]
+                    ) -> tuple[list[Shape], list[str]]:
     """PyBullet's collision shapes at the zero pose, and those MuJoCo cannot hold (said)."""
     shapes: list[Shape] = []
     skipped: list[str] = []
     for link, i in link_index.items():
         if link not in zero:
             continue
-        d = b.getDynamicsInfo(body, i)
-        at = zero[link] @ _transform(d[3], d[4])
-        for s in b.getCollisionShapeData(body, i):
-            kind = _PB_KIND.get(int(s[2]))
-            dims = tuple(float(x) for x in s[3])
-            if kind is None:
-                skipped.append(f"{link}: PyBullet geometry {int(s[2])}")
+        d = engine.dynamics(body, i)
+        at = zero[link] @ _transform(d.inertial_position, d.inertial_orientation)
+        for s in engine.collision_shapes(body, i):
+            kind = s.kind
+            dims = tuple(float(x) for x in s.dimensions)
+            if kind == "other":
+                skipped.append(f"{link}: a PyBullet geometry of no kind MuJoCo has")
                 continue
             scale = dims if kind == "mesh" else (1.0, 1.0, 1.0)
             why = _why_skipped(kind, dims, scale, group[link] in static)
             if why:
                 skipped.append(f"{link}: {why}")
                 continue
-            frame = at @ _transform(s[5], s[6])
+            frame = at @ _transform(s.position, s.orientation)
             size: tuple[float, ...] = ()
             box = None
             if kind == "sphere":
@@ -151,7 +159,7 @@ def pybullet_shapes(b: Any, body: int, link_index: dict[str, int], zero: dict[st
             elif kind in ("cylinder", "capsule"):
                 size = (dims[1], dims[0] / 2)
             elif kind == "mesh":
-                pts = _mesh_points(s[4].decode("utf-8", "replace"), scale)
+                pts = _mesh_points(s.file, scale)
                 if pts is None:
                     skipped.append(f"{link}: a mesh urdfkit's readers find no vertices in")
                     continue
@@ -161,13 +169,15 @@ def pybullet_shapes(b: Any, body: int, link_index: dict[str, int], zero: dict[st
     return shapes, skipped
 
 
-def pybullet_mesh_boxes(b: Any, body: int, link_index: dict[str, int], zero: dict[str, Any],
-                        shapes: list[Shape], skipped: list[str]) -> dict[str, Any]:
+def pybullet_mesh_boxes(engine: PyBulletEngine, body: int, link_index: dict[str, int],
+                        zero: dict[str, Any], shapes: list[Shape], skipped: list[str]
+                        ) -> dict[str, Any]:
     """PyBullet's own vertices of each link whose collision shapes are all meshes, as a box.
 
-    ``getMeshData(body, link, -1)`` gives every collision vertex PyBullet keeps for a link, in
-    its inertial frame (measured: it matches the files' placed vertices exactly, and leaves out
-    an OBJ's stray vertex): a check of urdfkit's mesh reading by PyBullet itself.
+    ``getMeshData(body, link, -1)`` (:meth:`~urdfkit.engine.pybullet.PyBulletEngine.\
+collision_vertices`) gives every collision vertex PyBullet keeps for a link, in its inertial
+    frame (measured: it matches the files' placed vertices exactly, and leaves out an OBJ's
+    stray vertex): a check of urdfkit's mesh reading by PyBullet itself.
     """
     import numpy as np
 
@@ -178,14 +188,11 @@ def pybullet_mesh_boxes(b: Any, body: int, link_index: dict[str, int], zero: dic
     for link, k in kinds.items():
         if k != {"mesh"} or any(x.startswith(f"{link}: ") for x in skipped):
             continue
-        try:
-            n, vertices = b.getMeshData(body, link_index[link], -1)
-        except Exception:  # noqa: BLE001 - PyBullet raises plain errors; no data, no box
+        vertices = engine.collision_vertices(body, link_index[link])
+        if not vertices:
             continue
-        if not n:
-            continue
-        d = b.getDynamicsInfo(body, link_index[link])
-        at = zero[link] @ _transform(d[3], d[4])
+        d = engine.dynamics(body, link_index[link])
+        at = zero[link] @ _transform(d.inertial_position, d.inertial_orientation)
         world = np.asarray(vertices, dtype=float) @ at[:3, :3].T + at[:3, 3]
         out[link] = (world.min(axis=0), world.max(axis=0))
     return out
@@ -210,32 +217,14 @@ def _union_errors(pairs: list[tuple[Shape, int, float]], geoms: list[tuple[int, 
     return errors
 
 
-def mujoco_geoms(mj: Any, m: Any, d: Any, keep_world: bool) -> list[tuple[int, Shape]]:
-    """MuJoCo's collision geoms at ``d``'s pose: (geom id, shape; ``link`` empty)."""
-    import numpy as np
+def mujoco_geoms(geoms: list[Geom], keep_world: bool) -> list[tuple[int, Shape]]:
+    """MuJoCo's collision geoms as shapes (``link`` empty): (geom id, shape).
 
-    out = []
-    for g in range(m.ngeom):
-        if not (int(m.geom_contype[g]) or int(m.geom_conaffinity[g])):
-            continue  # a visual
-        kind = _MJ_KIND.get(int(m.geom_type[g]), f"type {int(m.geom_type[g])}")
-        if int(m.geom_bodyid[g]) == 0 and not keep_world:
-            continue  # the world's own geoms: a ground, not the robot
-        frame = np.eye(4)
-        frame[:3, :3] = d.geom_xmat[g].reshape(3, 3)
-        frame[:3, 3] = d.geom_xpos[g]
-        size = tuple(float(x) for x in m.geom_size[g])
-        box = None
-        if kind == "mesh":
-            k = int(m.geom_dataid[g])
-            start, n = int(m.mesh_vertadr[k]), int(m.mesh_vertnum[k])
-            pts = np.asarray(m.mesh_vert[start:start + n], dtype=float)
-            world = pts @ frame[:3, :3].T + frame[:3, 3]
-            box = (world.min(axis=0), world.max(axis=0))
-        size = {"sphere": size[:1], "box": size, "cylinder": size[:2], "capsule": size[:2]
-                }.get(kind, ())
-        out.append((g, Shape("", kind, size, frame, box)))
-    return out
+    The world's own geoms (a ground) are left out unless ``keep_world`` (the URDF's root is
+    ``world``).
+    """
+    return [(g.index, Shape("", g.kind, g.size, g.frame, g.box)) for g in geoms
+            if g.body != 0 or keep_world]
 
 
 def _corners(s: Shape) -> Any:
@@ -312,18 +301,20 @@ def compare(pb_shapes: list[Shape], geoms: list[tuple[int, Shape]], body_weld: A
     return pairs, missing, extra
 
 
-def contact_errors(b: Any, body: int, link_index: dict[str, int], m: Any,
-                   pairs: list[tuple[Shape, int, float]], geom_name: dict[int, str]) -> list[str]:
+def contact_errors(engine: PyBulletEngine, body: int, link_index: dict[str, int],
+                   pairs: list[tuple[Shape, int, float]], geoms: dict[int, Geom]) -> list[str]:
     """Friction, contact dimension, what the geom meets, and priority: one line a link."""
     out: list[str] = []
     seen: set[str] = set()
     for s, g, _ in pairs:
         if s.link in seen:
             continue
-        d = b.getDynamicsInfo(body, link_index[s.link])
-        lateral, rolling, spinning = float(d[1]), float(d[6]), float(d[7])
-        slide, torsion, roll = (float(x) for x in m.geom_friction[g])
-        condim = int(m.geom_condim[g])
+        d = engine.dynamics(body, link_index[s.link])
+        lateral = float(d.lateral_friction)
+        rolling, spinning = float(d.rolling_friction), float(d.spinning_friction)
+        geom = geoms[g]
+        slide, torsion, roll = geom.friction
+        condim = geom.condim
         said = []
         if not abs(slide - lateral) <= TOL_FRICTION:  # (a NaN fails too)
             said.append(f"friction {slide:g}, PyBullet's lateral {lateral:g}")
@@ -335,42 +326,81 @@ def contact_errors(b: Any, body: int, link_index: dict[str, int], m: Any,
         if not abs(got_roll - rolling) <= TOL_FRICTION:
             said.append(f"rolling friction {got_roll:g} (condim {condim}), PyBullet's "
                         f"{rolling:g}")
-        if not (int(m.geom_contype[g]) & 1 or int(m.geom_conaffinity[g]) & 1):
+        if not (geom.contype & 1 or geom.conaffinity & 1):
             said.append("meets no default geom (contype and conaffinity without bit 1): it "
                         "falls through a ground")
-        if int(m.geom_priority[g]) <= 0:
-            said.append(f"priority {int(m.geom_priority[g])}: against a ground MuJoCo takes the "
+        if geom.priority <= 0:
+            said.append(f"priority {geom.priority}: against a ground MuJoCo takes the "
                         "larger friction, PyBullet the product")
         if said:
             seen.add(s.link)
-            out.append(f"{s.link} ({geom_name.get(g, g)}): " + "; ".join(said))
+            out.append(f"{s.link} ({geom.name}): " + "; ".join(said))
     return out
 
 
-def collision_verdict(mj: Any, m: Any, b: Any, body: int, link_index: dict[str, int],
-                      zero: dict[str, Any], group: dict[str, str], image: dict[str, int],
-                      static: set[str], keep_world: bool) -> Verdict:
-    """Collision geometry and contact parameters of both engines, compared."""
-    d = mj.MjData(m)
-    d.qpos[:] = m.qpos0
-    mj.mj_kinematics(m, d)
-    def owner(g: int) -> str:
-        b = int(m.geom_bodyid[g])
-        return mj.mj_id2name(m, mj.mjtObj.mjOBJ_BODY, b) or f"body {b}"
+def collision_verdict(engine: PyBulletEngine, body: int, link_index: dict[str, int],
+                      all_geoms: list[Geom], zero: dict[str, Any], group: dict[str, str],
+                      image: dict[str, int], static: set[str], keep_world: bool) -> Verdict:
+    """Collision geometry and contact parameters of both engines, compared.
 
-    names = {g: mj.mj_id2name(m, mj.mjtObj.mjOBJ_GEOM, g) or f"geom {g} of {owner(g)}"
-             for g in range(m.ngeom)}
-    shapes, skipped = pybullet_shapes(b, body, link_index, zero, group, static)
-    geoms = mujoco_geoms(mj, m, d, keep_world)
+    PyBullet's through ``engine`` (its load ``body``), MuJoCo's the file's collision geoms
+    (:meth:`~urdfkit.engine.mujoco_file.MjcfFile.geoms`).
+    """
+    by_id = {g.index: g for g in all_geoms}
+    names = {g.index: g.name for g in all_geoms}
+    shapes, skipped = pybullet_shapes(engine, body, link_index, zero, group, static)
+    geoms = mujoco_geoms(all_geoms, keep_world)
     pairs, missing, extra = compare(
-        shapes, geoms, lambda g: m.body_weldid[int(m.geom_bodyid[g])], image, names,
-        lambda g: int(m.geom_bodyid[g]) == 0)
+        shapes, geoms, lambda g: by_id[g].weld, image, names, lambda g: by_id[g].body == 0)
     prim = [(e, f"{s.link} ({s.kind})") for s, _, e in pairs if s.kind != "mesh"]
     mesh = [(e / _extent(s), f"{s.link} ({s.kind})") for s, _, e in pairs if s.kind == "mesh"]
-    hull = _union_errors(pairs, geoms, pybullet_mesh_boxes(b, body, link_index, zero, shapes,
-                                                           skipped))
+    hull = _union_errors(pairs, geoms, pybullet_mesh_boxes(engine, body, link_index, zero,
+                                                           shapes, skipped))
     return Verdict(max(prim, key=lambda x: x[0]) if prim else None,
                    max(mesh, key=lambda x: x[0]) if mesh else None,
                    max(hull, key=lambda x: x[0]) if hull else None, missing, extra, skipped,
-                   contact_errors(b, body, link_index, m, pairs, names), len(pairs),
+                   contact_errors(engine, body, link_index, pairs, by_id), len(pairs),
                    len({s.link for s in shapes}))
+
+
+def collisions(s: Sides) -> None:
+    """The contact rows: collision shapes, meshes, contact parameters, what MuJoCo cannot hold."""
+    robot, res = s.robot, s.result
+    where = fused(robot)
+    group = {n: g for n, (g, _) in where.items()}
+    static = {robot.root} if (s.options.fixed_base or robot.root == "world"
+                              or robot.links[robot.root].inertial.mass == 0) else set()
+    v = collision_verdict(s.pb.engine, s.pb.body, s.pb.link_index, s.mjcf.geoms(),
+                          link_frames(robot, {}), group, s.weld_image(where, s.mjcf.tree.weld),
+                          static, keep_world=robot.root == "world")
+    lost = ([f"missing in the MJCF: {', '.join(v.missing[:3])}"
+             f"{' ...' if len(v.missing) > 3 else ''}"] if v.missing else []) + \
+        ([f"extra in the MJCF: {', '.join(v.extra[:3])}{' ...' if len(v.extra) > 3 else ''}"]
+         if v.extra else [])
+    if not v.pairs and not lost:
+        res.add("contacts", "collision shapes", None, None, "",
+                "no collision shapes on either side", status="info")
+        return _said_skipped(s, v.skipped)
+    if lost or v.shape_error is not None:
+        worst, at = v.shape_error or (0.0, "")
+        res.add("contacts", "collision shapes", math.inf if lost else worst, TOL_SHAPE, "m",
+                "; ".join(x for x in [*lost, at] if x))
+    if v.mesh_error is not None:
+        res.add("contacts", "collision meshes", v.mesh_error[0], TOL_MESH, "relative",
+                v.mesh_error[1])
+    if v.hull_error is not None:
+        res.add("contacts", "collision meshes vs PyBullet's own vertices",
+                v.hull_error[0], TOL_BULLET_HULL, "relative", f"{v.hull_error[1]} "
+                "(getMeshData: Bullet's hull points lie up to ~2e-4 off the file's, measured)")
+    res.add("contacts", "contact parameters", float(len(v.contact)), 0.0, "links",
+            "; ".join(v.contact[:2]) + (" ..." if len(v.contact) > 2 else "")
+            or f"friction, condim, priority of {v.pairs} geoms")
+    _said_skipped(s, v.skipped)
+
+
+def _said_skipped(s: Sides, skipped: list[str]) -> None:
+    if skipped:
+        s.result.add(
+            "contacts", "shapes MuJoCo cannot hold", float(len(skipped)), None, "known",
+            "; ".join(skipped[:3]) + (" ..." if len(skipped) > 3 else "")
+            + " (left out by export)", status="known")

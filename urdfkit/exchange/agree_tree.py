@@ -17,11 +17,14 @@ detached from the chassis and welded to the world fails here, naming the wheel.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import ParameterError
 from urdfkit.formats.fk import fused, link_frames, unit
 from urdfkit.formats.robot import Robot
+
+if TYPE_CHECKING:
+    from urdfkit.engine.mujoco_file import Tree
 
 #: How far (m, and in the rotation matrix) a body's zero-pose frame may be from a link's for
 #: the two to be matched by the tree's shape (files written with 6 significant digits match).
@@ -57,28 +60,15 @@ def parse_map(items: list[str] | None) -> dict[str, str]:
 
 
 class _Model:
-    """MuJoCo's names, tree and zero-pose frames of one compiled model."""
+    """A compiled model's tree (:class:`~urdfkit.engine.mujoco_file.Tree`), walked."""
 
-    def __init__(self, mj: Any, m: Any) -> None:
-        import numpy as np
-
-        self.m = m
-        obj = mj.mjtObj
-        self.joint = {mj.mj_id2name(m, obj.mjOBJ_JOINT, i) or "": i for i in range(m.njnt)}
-        self.body = {mj.mj_id2name(m, obj.mjOBJ_BODY, i) or "": i for i in range(1, m.nbody)}
-        self.site = {mj.mj_id2name(m, obj.mjOBJ_SITE, i) or "": i for i in range(m.nsite)}
-        self.joint.pop("", None)
-        self.body.pop("", None)
-        self.site.pop("", None)
-        d = mj.MjData(m)
-        mj.mj_kinematics(m, d)
-        self.xpos, self.xmat = np.array(d.xpos), np.array(d.xmat).reshape(-1, 3, 3)
-        self.xaxis = np.array(d.xaxis)
-        self.kind = {int(mj.mjtJoint.mjJNT_HINGE): "hinge", int(mj.mjtJoint.mjJNT_SLIDE): "slide",
-                     int(mj.mjtJoint.mjJNT_BALL): "ball", int(mj.mjtJoint.mjJNT_FREE): "free"}
+    def __init__(self, tree: Tree) -> None:
+        self.t = tree
+        self.joint, self.body, self.site = tree.joints, tree.bodies, tree.sites
+        self.xpos, self.xmat, self.xaxis = tree.xpos, tree.xmat, tree.xaxis
 
     def children(self, b: int) -> list[int]:
-        return [i for i in range(1, self.m.nbody) if int(self.m.body_parentid[i]) == b]
+        return [i for i in range(1, len(self.t.parent)) if self.t.parent[i] == b]
 
     def below(self, b: int) -> list[int]:
         """Bodies under ``b``: its children, and theirs through bodies that do not move."""
@@ -86,13 +76,12 @@ class _Model:
         while todo:
             c = todo.pop(0)
             out.append(c)
-            if not int(self.m.body_jntnum[c]):
+            if not self.t.body_joints[c]:
                 todo.extend(self.children(c))
         return out
 
     def joints_of(self, b: int) -> list[int]:
-        start, n = int(self.m.body_jntadr[b]), int(self.m.body_jntnum[b])
-        return list(range(start, start + n)) if n > 0 else []
+        return self.t.body_joints[b]
 
 
 def _close(a: Any, b: Any) -> float:
@@ -101,14 +90,14 @@ def _close(a: Any, b: Any) -> float:
     return float(max(np.abs(a[:3, 3] - b[:3, 3]).max(), np.abs(a[:3, :3] - b[:3, :3]).max()))
 
 
-def match_models(mj: Any, fixed: Any, robot: Robot, movable: list[str],
+def match_models(fixed: Tree, robot: Robot, movable: list[str],
                  name_map: dict[str, str]) -> Matching:
     """Match the URDF's links and movable joints to the (base-welded) MuJoCo model's.
 
     Raises:
         ParameterError: A ``name_map`` name the URDF or the MJCF does not have.
     """
-    model = _Model(mj, fixed)
+    model = _Model(fixed)
     out = Matching()
     links = set(robot.links)
     movable_set = set(movable)
@@ -160,7 +149,7 @@ def _mj_body_of(out: Matching, model: _Model, link: str) -> int | None:
     if link in out.bodies:
         return out.bodies[link]
     if link in out.sites:
-        return int(model.m.site_bodyid[out.sites[link]])
+        return model.t.site_body[out.sites[link]]
     return None
 
 
@@ -225,7 +214,7 @@ def _match_one_side(model: _Model, j: Any, axis: Any, movable: set[str], out: Ma
             taken_j.add(ks[0])
             out.pairs.append((j.name, _joint_name(model, ks[0]), "structure"))
         return
-    b = int(model.m.jnt_bodyid[out.joints[j.name]])  # the joint is matched: its body is
+    b = model.t.joint_body[out.joints[j.name]]  # the joint is matched: its body is
     if b not in taken_b:
         out.bodies[j.child] = b
         taken_b.add(b)
@@ -238,7 +227,7 @@ def _joints_like(model: _Model, b: int, kind: str, axis: Any) -> list[int]:
 
     out = []
     for k in model.joints_of(b):
-        if model.kind.get(int(model.m.jnt_type[k])) != _KINDS[kind]:
+        if model.t.joint_kind[k] != _KINDS[kind]:
             continue
         if axis is not None and float(np.abs(model.xaxis[k] - axis).max()) > FRAME_TOL:
             continue
@@ -254,7 +243,7 @@ def _joint_name(model: _Model, k: int) -> str:
     return next((n for n, i in model.joint.items() if i == k), f"joint {k}")
 
 
-def tree_errors(mj: Any, written: Any, fixed: Any, robot: Robot, match: Matching
+def tree_errors(written: Tree, fixed: Tree, robot: Robot, match: Matching
                 ) -> tuple[list[str], int]:
     """What differs in the body tree (one line each, naming the body), and groups compared.
 
@@ -262,8 +251,8 @@ def tree_errors(mj: Any, written: Any, fixed: Any, robot: Robot, match: Matching
     ``fixed`` the same with its free joints removed, whose joint ids ``match`` holds (the
     bodies' ids are the same in both).
     """
-    model = _Model(mj, written)
-    m = written
+    model = _Model(written)
+    weld, up = written.weld, written.parent
     where = fused(robot)
     group = {link: body for link, (body, _) in where.items()}
     parent: dict[str, str | None] = {robot.root: None}
@@ -276,7 +265,7 @@ def tree_errors(mj: Any, written: Any, fixed: Any, robot: Robot, match: Matching
         if b is None and link == robot.root == "world":
             b = 0  # MuJoCo's world body
         if b is not None:
-            weld_of.setdefault(group[link], set()).add(int(m.body_weldid[b]))
+            weld_of.setdefault(group[link], set()).add(weld[b])
     errors: list[str] = []
     image: dict[str, int] = {}
     for g, welds in weld_of.items():
@@ -295,14 +284,14 @@ def tree_errors(mj: Any, written: Any, fixed: Any, robot: Robot, match: Matching
         p = parent.get(g)
         if p is None or p not in image:
             continue
-        got = int(m.body_weldid[int(m.body_parentid[w])]) if w else 0
+        got = weld[up[w]] if w else 0
         if w and got != image[p]:
             errors.append(f"{g}: hangs from {_weld_name(model, got)} in MuJoCo, from {p} in "
                           "PyBullet")
     for name, k in match.joints.items():
         j = next(j for j in robot.joints if j.name == name)
-        b = int(fixed.jnt_bodyid[k])
-        if group[j.child] in image and int(m.body_weldid[b]) != image[group[j.child]]:
+        b = fixed.joint_body[k]
+        if group[j.child] in image and weld[b] != image[group[j.child]]:
             errors.append(f"joint {name}: moves {_body_name(model, b)} in MuJoCo, "
                           f"{j.child} in PyBullet")
     return errors, len(image)

@@ -9,27 +9,30 @@ the exact forward-kinematics row and the dynamics rows still cover every joint a
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
 from urdfkit.model.spec import MAX_STATE_COORDINATES
 
+if TYPE_CHECKING:
+    from urdfkit.engine.api import JointInfo
 
-def unreadable_state(info: Sequence[Sequence[Any]]) -> str:
-    """Why PyBullet cannot report this body's state, from its ``getJointInfo`` rows, or "".
 
-    See :data:`urdfkit.model.spec.MAX_STATE_COORDINATES` for what was measured.
+def unreadable_state(joints: Sequence[JointInfo]) -> str:
+    """Why PyBullet cannot report this body's state, from its joints, or "".
+
+    ``joints`` are the body's, as :meth:`urdfkit.engine.api.Model.joints` gives them. See
+    :data:`urdfkit.model.spec.MAX_STATE_COORDINATES` for what was measured.
     """
     limit = MAX_STATE_COORDINATES
-    if len(info) >= limit:
+    if len(joints) >= limit:
         return (f"PyBullet's state queries stop at {limit} links: getLinkState, getJointState "
-                f"and getBasePositionAndOrientation raise on this body of {len(info) + 1}")
-    past = next((row for row in info if row[3] >= limit or row[4] >= limit), None)
+                f"and getBasePositionAndOrientation raise on this body of {len(joints) + 1}")
+    past = next((j for j in joints if j.q_index >= limit or j.v_index >= limit), None)
     if past is None:
         return ""
-    name = past[1].decode("utf-8", "replace") if isinstance(past[1], bytes) else str(past[1])
     return (f"PyBullet's state queries hold {limit} coordinates, the base's 7 first: from "
-            f"joint {name} on this body's joints lie past them (getJointState reads them as "
-            "0; resetting any joint sets them back to 0)")
+            f"joint {past.name} on this body's joints lie past them (getJointState reads them "
+            "as 0; resetting any joint sets them back to 0)")
 
 
 def unreliable_dynamics(dofs: int) -> str:
