@@ -37,13 +37,16 @@ from urdfkit.engine.api import (
     JointKind,
     JointRow,
     JointState,
+    Light,
     LinkDynamics,
     LinkPose,
     LoadSettings,
     MotorMode,
+    Picture,
     Quat,
     ShapeKind,
     Vec3,
+    VisualShape,
 )
 
 if TYPE_CHECKING:
@@ -58,6 +61,7 @@ JOINT_KINDS: dict[int, JointKind] = {0: "revolute", 1: "prismatic", 2: "spherica
 #: ``getCollisionShapeData``'s geometry codes (``p.GEOM_*``) as the seam's shape kinds.
 SHAPE_KINDS: dict[int, ShapeKind] = {2: "sphere", 3: "box", 4: "cylinder", 5: "mesh",
                                      6: "plane", 7: "capsule"}
+_MESH = 5
 #: A mimic gear's error reduction per step (PyBullet's default, 0.2, leaves a sag under load:
 #: a 0.5 kg mast following at x 2 against gravity sat 0.37 mm off; at 0.8, 0.010 mm;
 #: urdfkit/motion/mimic.py has the measurements).
@@ -346,6 +350,10 @@ class PyBulletEngine:
         """``resetJointState``."""
         self.session.bullet.resetJointState(body, joint, position, velocity)
 
+    def reset_spherical_joint(self, body: int, joint: int, orientation: Quat) -> None:
+        """``resetJointStateMultiDof`` (which zeroes the joint's velocity: measured)."""
+        self.session.bullet.resetJointStateMultiDof(body, joint, list(orientation))
+
     def set_joint_positions(self, body: int, positions: Sequence[float],
                             velocities: Sequence[float] | None = None) -> None:
         """``resetJointState`` of every movable joint, in :meth:`joints` order."""
@@ -456,8 +464,20 @@ class PyBulletEngine:
                 except self.error:
                     count, verts = 0, []
                 vertices = verts if count else ()
-            out.append(CollisionShape(kind, shape[3], shape[5], shape[6], vertices))
+            out.append(CollisionShape(kind, shape[3], shape[5], shape[6], vertices,
+                                      _name(shape[4]) if kind == "mesh" else ""))
         return out
+
+    def visual_shapes(self, body: int) -> list[VisualShape]:
+        """``getVisualShapeData``, quiet (what PyBullet prints goes to the diagnostics)."""
+        from urdfkit.engine.session import quiet_stdout
+
+        with quiet_stdout() as out:
+            rows = self.session.bullet.getVisualShapeData(body)
+        self.session.diagnostics.extend(out.lines)
+        return [VisualShape(int(v[1]), SHAPE_KINDS.get(v[2], "other"), v[3],
+                            _name(v[4]) if v[2] == _MESH else "", v[5], v[6], v[7])
+                for v in rows]
 
     def aabb(self, body: int, link: int) -> tuple[Vec3, Vec3]:
         """``getAABB``."""
@@ -476,6 +496,34 @@ class PyBulletEngine:
                                  renderer=self.session.p.ER_TINY_RENDERER)[2]
         rgba = np.asarray(image, dtype=np.uint8).reshape(height, width, 4)
         return rgba[:, :, :3].tobytes()
+
+    def picture(self, camera: Camera, width: int, height: int, light: Light | None = None
+                ) -> Picture:
+        """``getCameraImage`` with the TinyRenderer: RGB, segmentation mask, matrices.
+
+        The matrices are ``computeViewMatrix``'s and ``computeProjectionMatrixFOV``'s. PyBullet
+        computes the matrices in float32; they are handed out as it gives them, so
+        that what is drawn over the picture meets what PyBullet drew.
+        """
+        import numpy as np
+
+        b = self.session.bullet
+        view = b.computeViewMatrix(camera.eye, camera.target, camera.up)
+        proj = b.computeProjectionMatrixFOV(camera.fov, width / height, camera.near,
+                                            camera.far)
+        renderer = self.session.p.ER_TINY_RENDERER
+        if light is None:
+            shot = b.getCameraImage(width, height, view, proj, renderer=renderer)
+        else:
+            shot = b.getCameraImage(
+                width, height, view, proj, renderer=renderer,
+                lightDirection=list(light.direction), shadow=int(light.shadows),
+                lightAmbientCoeff=light.ambient, lightDiffuseCoeff=light.diffuse,
+                lightSpecularCoeff=light.specular)
+        rgba = np.asarray(shot[2], dtype=np.uint8).reshape(height, width, 4)
+        bodies = np.asarray(shot[4]).astype("<i4").tobytes()
+        return Picture(width, height, rgba[:, :, :3].tobytes(), bodies, tuple(view),
+                       tuple(proj))
 
     # ---- dynamics
 
