@@ -152,6 +152,7 @@ class PyBulletEngine:
         self._motor_array = b.setJointMotorControlArray
         self._base_pose = b.getBasePositionAndOrientation
         self._base_velocity = b.getBaseVelocity
+        self._closest = b.getClosestPoints
 
     @property
     def bullet(self) -> Bullet:
@@ -411,13 +412,20 @@ class PyBulletEngine:
 
     def closest_points(self, body: int, other: int, distance: float, link: int | None = None,
                        other_link: int | None = None) -> list[ContactPoint]:
-        """``getClosestPoints`` of ``body`` (``linkIndexA``) and ``other`` (``linkIndexB``)."""
-        links: dict[str, int] = {}
-        if link is not None:
-            links["linkIndexA"] = link
-        if other_link is not None:
-            links["linkIndexB"] = other_link
-        found = self.session.bullet.getClosestPoints(body, other, distance, **links)
+        """``getClosestPoints`` of ``body`` (``linkIndexA``) and ``other`` (``linkIndexB``).
+
+        Bound once, each form spelt out, two links by position: collisions asks for every
+        link pair in every pose (r2d2's 91 pairs: 2.5 us a pair here, 2.3 us the bare call;
+        a dict of keywords cost 0.55 us more).
+        """
+        closest = self._closest
+        if link is None:
+            found = closest(body, other, distance) if other_link is None else \
+                closest(body, other, distance, linkIndexB=other_link)
+        elif other_link is None:
+            found = closest(body, other, distance, linkIndexA=link)
+        else:
+            found = closest(body, other, distance, link, other_link)
         if not found:
             return []
         return [_contact_point(pt[1:14]) for pt in found]
