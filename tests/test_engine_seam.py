@@ -43,7 +43,7 @@ IMPORTS_AN_ENGINE: dict[str, str] = {
 #: Modules outside engine/ that still call PyBullet's functions (through a session's bound
 #: client), each for its owner to port to the seam.
 CALLS_PYBULLET: set[str] = {
-    "draw/render.py", "draw/view_model.py",
+    "draw/render.py",
     "exchange/agree.py", "exchange/agree_contact.py",
 }
 
@@ -52,7 +52,7 @@ PORTED = ["motion/simulation.py", "motion/sim_world.py", "motion/sim_robot.py",
           "motion/sim_control.py", "motion/sim_sensors.py", "motion/sim_dynamics.py",
           "motion/sim_episode.py", "motion/sim_record.py", "motion/vehicle.py",
           "motion/vehicle_shapes.py", "motion/mimic.py", "motion/gazebo_load.py",
-          "motion/sac.py", "motion/sweep_plan.py"]
+          "motion/sac.py", "motion/sweep_plan.py", "draw/view_model.py"]
 
 
 def _outside_engine() -> list[Path]:
