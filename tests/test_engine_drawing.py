@@ -225,3 +225,34 @@ def test_a_spherical_joint_turns_its_child(engine: Any, tmp_path: Path) -> None:
         assert at == pytest.approx((0.0, 0.0, 0.5), abs=1e-6)
         dot = abs(sum(a * b for a, b in zip(turn, q, strict=True)))
         assert dot == pytest.approx(1.0, abs=1e-6)
+
+
+def test_drawing_collision_shapes_is_pybullets_alone(tmp_path: Path) -> None:
+    """render --collision's load: PyBullet draws the <collision> shapes in the colour given
+    (the cube's red visual is not drawn); MuJoCo is refused, naming the option."""
+    from urdfkit.core.errors import ParameterError
+    from urdfkit.engine.pybullet_render import load_drawing_collisions
+
+    path = _file(tmp_path, "cube.urdf", CUBE.replace(
+        '<collision><geometry><box size="0.2 0.2 0.2"/>',
+        '<collision><geometry><sphere radius="0.1"/>'))
+    e = open_engine("pybullet")
+    try:
+        body = load_drawing_collisions(e, path, LoadSettings(fixed_base=True), "cube",
+                                       (0.0, 0.0, 1.0, 1.0))
+        assert [(s.kind, s.rgba) for s in e.visual_shapes(body)] == \
+            [("sphere", (0.0, 0.0, 1.0, 1.0))]
+        rgb, bodies = _arrays(e.picture(Camera((0.6, -0.6, 0.4), (0.0, 0.0, 0.0), fov=40.0,
+                                               near=0.1, far=3.0), W, H))
+        blue = rgb[bodies == body]
+        assert len(blue) > 100 and np.all(blue[:, 2] > blue[:, 0] + 20)
+    finally:
+        e.close()
+    m = open_engine("mujoco")
+    try:
+        with pytest.raises(ParameterError, match="`collision`: drawing the collision shapes "
+                                                 "needs PyBullet's TinyRenderer, not MuJoCo"):
+            load_drawing_collisions(m, path, LoadSettings(fixed_base=True), "cube",
+                                    (0.0, 0.0, 1.0, 1.0))
+    finally:
+        m.close()

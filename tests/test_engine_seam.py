@@ -43,7 +43,6 @@ IMPORTS_AN_ENGINE: dict[str, str] = {
 #: Modules outside engine/ that still call PyBullet's functions (through a session's bound
 #: client), each for its owner to port to the seam.
 CALLS_PYBULLET: set[str] = {
-    "draw/render.py",
     "exchange/agree.py", "exchange/agree_contact.py",
 }
 

@@ -405,8 +405,10 @@ def test_visual_bounds_match_pybullet_aabb(tmp_path: Path) -> None:
     """Our box around primitive visuals equals PyBullet's getAABB of identical collisions."""
     from lxml import etree
 
-    from urdfkit.draw.render import _visual_bounds, link_frames
+    from urdfkit.draw.render import _visual_bounds
     from urdfkit.engine.session import LoadOptions, Session
+    from urdfkit.formats.fk import link_frames
+    from urdfkit.formats.robot import read_robot
 
     shapes = ['<box size="0.4 0.1 0.2"/>', '<cylinder radius="0.1" length="0.5"/>',
               '<sphere radius="0.15"/>']
@@ -427,8 +429,9 @@ def test_visual_bounds_match_pybullet_aabb(tmp_path: Path) -> None:
         body = s.load_urdf(path, LoadOptions(fixed_base=True))
         s.p.resetJointState(body, 1, 0.6, physicsClientId=s.client)
         root = etree.parse(str(path)).getroot()
-        frames = link_frames(root, ["j1", "j2"], ((0, 0, 0), (0, 0, 0, 1)), {"j2": 0.6})
-        ours = [_visual_bounds(root, {f"l{i}": frames[i]}) for i in range(3)]
+        frames = link_frames(read_robot(root, str(path)), {"j2": 0.6})
+        ours = [_visual_bounds(root, {f"l{i}": (frames[f"l{i}"][:3, 3], frames[f"l{i}"][:3, :3])})
+                for i in range(3)]
         boxes = [s.p.getAABB(body, link, physicsClientId=s.client) for link in (-1, 0, 1)]
     # Bullet bounds a shape in a turned link by turning the shape's own box, so its AABB is
     # exact only where the link frame is not rotated (l0) and loose elsewhere; it also pads
@@ -479,36 +482,41 @@ def test_a_white_robot_keeps_its_shape_on_the_white_background(tmp_path: Path) -
 
 
 @pytest.mark.parametrize("name", ["kuka_iiwa/model.urdf", "r2d2.urdf", "humanoid/humanoid.urdf",
-                                  "quadruped/minitaur.urdf", "franka_panda/panda.urdf"])
-def test_link_frames_equal_getlinkstate(name: str, pb) -> None:
-    # Forward kinematics from the file, no state query (which fails from 128 links): every
-    # frame must equal getLinkState's URDF link frame, posed and turned.
-    import pybullet_data
-
+                                  "quadruped/minitaur.urdf", "franka_panda/panda.urdf",
+                                  "bicycle/bike.urdf", "quadruped/microtaur/microtaur.urdf",
+                                  "husky/husky.urdf"])
+def test_link_frames_equal_getlinkstate(name: str) -> None:
+    """Forward kinematics from the file, no state query (which fails from 128 links): every
+    frame must equal getLinkState's URDF link frame, posed and turned (1e-6: PyBullet reports
+    link states rounded to float32). bike, microtaur and husky hold attributes that are not
+    plain numbers, read as PyBullet reads them (render's own kinematics, before it used
+    formats/fk.py, read them as 0 and put microtaur's links 2 m off)."""
     from urdfkit.draw.render import link_frames
-    from urdfkit.model.spec import UP_AXES
-    from urdfkit.model.xmlio import parse_xml, read_bytes
+    from urdfkit.engine.api import LoadSettings
+    from urdfkit.engine.pybullet import PyBulletEngine
+    from urdfkit.model.spec import UP_AXES, quat_to_matrix
+    from urdfkit.sources.resolve import open_input
 
-    p, c = pb
-    path = os.path.join(pybullet_data.getDataPath(), name)
-    base = ((0.3, -0.2, 0.1), UP_AXES["y"])
-    body = p.loadURDF(path, base[0], base[1], useFixedBase=True, physicsClientId=c)
+    settings = LoadSettings(fixed_base=True, position=(0.3, -0.2, 0.1), orientation=UP_AXES["y"])
     rng = np.random.default_rng(3)
-    names, positions = [], {}
-    for j in range(p.getNumJoints(body, physicsClientId=c)):
-        info = p.getJointInfo(body, j, physicsClientId=c)
-        names.append(info[1].decode())
-        if info[2] in (p.JOINT_REVOLUTE, p.JOINT_PRISMATIC):
-            positions[names[-1]] = float(rng.uniform(-1, 1))
-            p.resetJointState(body, j, positions[names[-1]], physicsClientId=c)
-    frames = link_frames(parse_xml(read_bytes(Path(path)), path).getroot(), names, base, positions)
-    assert len(frames) == len(names) + 1
-    for j, (pos, rot) in enumerate(frames[1:]):
-        st = p.getLinkState(body, j, computeForwardKinematics=True, physicsClientId=c)
-        # PyBullet reports link states rounded to ~1e-7 (float32 on the way out).
-        assert np.allclose(pos, st[4], atol=1e-6), (name, j)
-        assert np.allclose(rot, np.reshape(p.getMatrixFromQuaternion(st[5]), (3, 3)),
-                           atol=1e-6), (name, j)
+    e = PyBulletEngine()
+    try:
+        with open_input(name, guard=False) as res:
+            body = e.load(str(res.load_path), settings)
+            joints = e.joints(body)
+            positions = {}
+            for j in joints:
+                if j.kind in ("revolute", "prismatic"):
+                    positions[j.name] = float(rng.uniform(-1, 1))
+                    e.bullet.resetJointState(body, j.index, positions[j.name])
+            frames = link_frames(res, joints, settings, positions)
+        assert len(frames) == len(joints) + 1
+        for j, (pos, rot) in enumerate(frames[1:]):
+            st = e.bullet.getLinkState(body, j, computeForwardKinematics=True)
+            assert np.allclose(pos, st[4], atol=1e-6), (name, j)
+            assert np.allclose(rot, np.array(quat_to_matrix(st[5])), atol=1e-6), (name, j)
+    finally:
+        e.close()
 
 
 def test_render_draws_a_body_of_130_links(tmp_path: Path) -> None:
