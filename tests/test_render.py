@@ -347,11 +347,21 @@ def test_cli_render_pybullet_data_name_default_output(tmp_path: Path,
     assert (tmp_path / "r2d2.png").is_file()
 
 
+_TWO = ("<robot name='x'><link name='a'><visual><geometry><box size='.1 .1 .1'/></geometry>"
+        "</visual></link><link name='b'/><joint name='j' type='revolute'><parent link='a'/>"
+        "<child link='b'/>{}<limit lower='-1' upper='1' effort='1' velocity='1'/></joint>"
+        "</robot>")
+
+
 @pytest.mark.parametrize("content, expect", [
     (None, "no such file"),
     ("<robot name='x'><link name='a'>", "not well-formed XML"),
     ("<robot name='x'><link name='a'/><link name='b'/></robot>", "root links"),
     ("", "empty"),
+    # PyBullet puts link b at NaN; the link frames cannot be drawn (check: U401, U305)
+    (_TWO.format("<origin xyz='nan 0 0'/><axis xyz='0 0 1'/>"),
+     "<origin xyz='nan 0 0'> is not a finite vector; no frame can be placed with it"),
+    (_TWO.format("<axis xyz='0 0 0'/>"), "joint 'j' has a zero axis"),
 ])
 def test_cli_render_bad_files(tmp_path: Path, content: str | None, expect: str) -> None:
     bad = tmp_path / "bad.urdf"
@@ -517,6 +527,44 @@ def test_link_frames_equal_getlinkstate(name: str) -> None:
             assert np.allclose(rot, np.array(quat_to_matrix(st[5])), atol=1e-6), (name, j)
     finally:
         e.close()
+
+
+def test_a_planar_joint_is_drawn_where_pybullet_puts_its_child(tmp_path: Path) -> None:
+    """A planar joint (which the MJCF export refuses) holds its child at its origin, as
+    PyBullet does at rest; the revolute joint below it turns the link after it."""
+    from urdfkit.draw.render import link_frames
+    from urdfkit.engine.api import LoadSettings
+    from urdfkit.engine.pybullet import PyBulletEngine
+    from urdfkit.model.spec import quat_to_matrix
+    from urdfkit.sources.resolve import open_input
+
+    box = "<visual><geometry><box size='0.1 0.1 0.1'/></geometry></visual>"
+    path = tmp_path / "planar.urdf"
+    path.write_text(
+        f"<robot name='p'><link name='a'>{box}</link><link name='b'>{box}</link>"
+        f"<link name='c'>{box}</link><joint name='slide' type='planar'><parent link='a'/>"
+        "<child link='b'/><origin xyz='0.1 0 0.2' rpy='0 0 0.3'/><axis xyz='0 0 1'/></joint>"
+        "<joint name='turn' type='revolute'><parent link='b'/><child link='c'/>"
+        "<origin xyz='0 0 0.15' rpy='0.2 0 0'/><axis xyz='0 0 1'/>"
+        "<limit lower='-2' upper='2' effort='1' velocity='1'/></joint></robot>")
+    settings = LoadSettings(fixed_base=True)
+    e = PyBulletEngine()
+    try:
+        with open_input(str(path)) as res:
+            body = e.load(str(res.load_path), settings)
+            joints = e.joints(body)
+            assert [j.kind for j in joints] == ["planar", "revolute"]
+            e.reset_joint(body, 1, 0.8)
+            frames = link_frames(res, joints, settings, {"turn": 0.8})
+        for j, (pos, rot) in enumerate(frames[1:]):
+            st = e.bullet.getLinkState(body, j, computeForwardKinematics=True)
+            assert np.allclose(pos, st[4], atol=1e-6) and \
+                np.allclose(rot, np.array(quat_to_matrix(st[5])), atol=1e-6), j
+    finally:
+        e.close()
+    result = CliRunner().invoke(app, ["render", str(path), "--frames", "--joints", "turn=0.8",
+                                      "-o", str(tmp_path / "p.png"), "--size", "160x120"])
+    assert result.exit_code == 0, result.output
 
 
 def test_render_draws_a_body_of_130_links(tmp_path: Path) -> None:
