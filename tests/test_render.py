@@ -347,11 +347,21 @@ def test_cli_render_pybullet_data_name_default_output(tmp_path: Path,
     assert (tmp_path / "r2d2.png").is_file()
 
 
+_TWO = ("<robot name='x'><link name='a'><visual><geometry><box size='.1 .1 .1'/></geometry>"
+        "</visual></link><link name='b'/><joint name='j' type='revolute'><parent link='a'/>"
+        "<child link='b'/>{}<limit lower='-1' upper='1' effort='1' velocity='1'/></joint>"
+        "</robot>")
+
+
 @pytest.mark.parametrize("content, expect", [
     (None, "no such file"),
     ("<robot name='x'><link name='a'>", "not well-formed XML"),
     ("<robot name='x'><link name='a'/><link name='b'/></robot>", "root links"),
     ("", "empty"),
+    # PyBullet puts link b at NaN; the link frames cannot be drawn (check: U401, U305)
+    (_TWO.format("<origin xyz='nan 0 0'/><axis xyz='0 0 1'/>"),
+     "<origin xyz='nan 0 0'> is not a finite vector; no frame can be placed with it"),
+    (_TWO.format("<axis xyz='0 0 0'/>"), "joint 'j' has a zero axis"),
 ])
 def test_cli_render_bad_files(tmp_path: Path, content: str | None, expect: str) -> None:
     bad = tmp_path / "bad.urdf"
@@ -405,8 +415,10 @@ def test_visual_bounds_match_pybullet_aabb(tmp_path: Path) -> None:
     """Our box around primitive visuals equals PyBullet's getAABB of identical collisions."""
     from lxml import etree
 
-    from urdfkit.draw.render import _visual_bounds, link_frames
+    from urdfkit.draw.render import _visual_bounds
     from urdfkit.engine.session import LoadOptions, Session
+    from urdfkit.formats.fk import link_frames
+    from urdfkit.formats.robot import read_robot
 
     shapes = ['<box size="0.4 0.1 0.2"/>', '<cylinder radius="0.1" length="0.5"/>',
               '<sphere radius="0.15"/>']
@@ -427,8 +439,9 @@ def test_visual_bounds_match_pybullet_aabb(tmp_path: Path) -> None:
         body = s.load_urdf(path, LoadOptions(fixed_base=True))
         s.p.resetJointState(body, 1, 0.6, physicsClientId=s.client)
         root = etree.parse(str(path)).getroot()
-        frames = link_frames(root, ["j1", "j2"], ((0, 0, 0), (0, 0, 0, 1)), {"j2": 0.6})
-        ours = [_visual_bounds(root, {f"l{i}": frames[i]}) for i in range(3)]
+        frames = link_frames(read_robot(root, str(path)), {"j2": 0.6})
+        ours = [_visual_bounds(root, {f"l{i}": (frames[f"l{i}"][:3, 3], frames[f"l{i}"][:3, :3])})
+                for i in range(3)]
         boxes = [s.p.getAABB(body, link, physicsClientId=s.client) for link in (-1, 0, 1)]
     # Bullet bounds a shape in a turned link by turning the shape's own box, so its AABB is
     # exact only where the link frame is not rotated (l0) and loose elsewhere; it also pads
@@ -479,36 +492,79 @@ def test_a_white_robot_keeps_its_shape_on_the_white_background(tmp_path: Path) -
 
 
 @pytest.mark.parametrize("name", ["kuka_iiwa/model.urdf", "r2d2.urdf", "humanoid/humanoid.urdf",
-                                  "quadruped/minitaur.urdf", "franka_panda/panda.urdf"])
-def test_link_frames_equal_getlinkstate(name: str, pb) -> None:
-    # Forward kinematics from the file, no state query (which fails from 128 links): every
-    # frame must equal getLinkState's URDF link frame, posed and turned.
-    import pybullet_data
-
+                                  "quadruped/minitaur.urdf", "franka_panda/panda.urdf",
+                                  "bicycle/bike.urdf", "quadruped/microtaur/microtaur.urdf",
+                                  "husky/husky.urdf"])
+def test_link_frames_equal_getlinkstate(name: str) -> None:
+    """Forward kinematics from the file, no state query (which fails from 128 links): every
+    frame must equal getLinkState's URDF link frame, posed and turned (1e-6: PyBullet reports
+    link states rounded to float32). bike, microtaur and husky hold attributes that are not
+    plain numbers, read as PyBullet reads them (render's own kinematics, before it used
+    formats/fk.py, read them as 0 and put microtaur's links 2 m off)."""
     from urdfkit.draw.render import link_frames
-    from urdfkit.model.spec import UP_AXES
-    from urdfkit.model.xmlio import parse_xml, read_bytes
+    from urdfkit.engine.api import LoadSettings
+    from urdfkit.engine.pybullet import PyBulletEngine
+    from urdfkit.model.spec import UP_AXES, quat_to_matrix
+    from urdfkit.sources.resolve import open_input
 
-    p, c = pb
-    path = os.path.join(pybullet_data.getDataPath(), name)
-    base = ((0.3, -0.2, 0.1), UP_AXES["y"])
-    body = p.loadURDF(path, base[0], base[1], useFixedBase=True, physicsClientId=c)
+    settings = LoadSettings(fixed_base=True, position=(0.3, -0.2, 0.1), orientation=UP_AXES["y"])
     rng = np.random.default_rng(3)
-    names, positions = [], {}
-    for j in range(p.getNumJoints(body, physicsClientId=c)):
-        info = p.getJointInfo(body, j, physicsClientId=c)
-        names.append(info[1].decode())
-        if info[2] in (p.JOINT_REVOLUTE, p.JOINT_PRISMATIC):
-            positions[names[-1]] = float(rng.uniform(-1, 1))
-            p.resetJointState(body, j, positions[names[-1]], physicsClientId=c)
-    frames = link_frames(parse_xml(read_bytes(Path(path)), path).getroot(), names, base, positions)
-    assert len(frames) == len(names) + 1
-    for j, (pos, rot) in enumerate(frames[1:]):
-        st = p.getLinkState(body, j, computeForwardKinematics=True, physicsClientId=c)
-        # PyBullet reports link states rounded to ~1e-7 (float32 on the way out).
-        assert np.allclose(pos, st[4], atol=1e-6), (name, j)
-        assert np.allclose(rot, np.reshape(p.getMatrixFromQuaternion(st[5]), (3, 3)),
-                           atol=1e-6), (name, j)
+    e = PyBulletEngine()
+    try:
+        with open_input(name, guard=False) as res:
+            body = e.load(str(res.load_path), settings)
+            joints = e.joints(body)
+            positions = {}
+            for j in joints:
+                if j.kind in ("revolute", "prismatic"):
+                    positions[j.name] = float(rng.uniform(-1, 1))
+                    e.bullet.resetJointState(body, j.index, positions[j.name])
+            frames = link_frames(res, joints, settings, positions)
+        assert len(frames) == len(joints) + 1
+        for j, (pos, rot) in enumerate(frames[1:]):
+            st = e.bullet.getLinkState(body, j, computeForwardKinematics=True)
+            assert np.allclose(pos, st[4], atol=1e-6), (name, j)
+            assert np.allclose(rot, np.array(quat_to_matrix(st[5])), atol=1e-6), (name, j)
+    finally:
+        e.close()
+
+
+def test_a_planar_joint_is_drawn_where_pybullet_puts_its_child(tmp_path: Path) -> None:
+    """A planar joint (which the MJCF export refuses) holds its child at its origin, as
+    PyBullet does at rest; the revolute joint below it turns the link after it."""
+    from urdfkit.draw.render import link_frames
+    from urdfkit.engine.api import LoadSettings
+    from urdfkit.engine.pybullet import PyBulletEngine
+    from urdfkit.model.spec import quat_to_matrix
+    from urdfkit.sources.resolve import open_input
+
+    box = "<visual><geometry><box size='0.1 0.1 0.1'/></geometry></visual>"
+    path = tmp_path / "planar.urdf"
+    path.write_text(
+        f"<robot name='p'><link name='a'>{box}</link><link name='b'>{box}</link>"
+        f"<link name='c'>{box}</link><joint name='slide' type='planar'><parent link='a'/>"
+        "<child link='b'/><origin xyz='0.1 0 0.2' rpy='0 0 0.3'/><axis xyz='0 0 1'/></joint>"
+        "<joint name='turn' type='revolute'><parent link='b'/><child link='c'/>"
+        "<origin xyz='0 0 0.15' rpy='0.2 0 0'/><axis xyz='0 0 1'/>"
+        "<limit lower='-2' upper='2' effort='1' velocity='1'/></joint></robot>")
+    settings = LoadSettings(fixed_base=True)
+    e = PyBulletEngine()
+    try:
+        with open_input(str(path)) as res:
+            body = e.load(str(res.load_path), settings)
+            joints = e.joints(body)
+            assert [j.kind for j in joints] == ["planar", "revolute"]
+            e.reset_joint(body, 1, 0.8)
+            frames = link_frames(res, joints, settings, {"turn": 0.8})
+        for j, (pos, rot) in enumerate(frames[1:]):
+            st = e.bullet.getLinkState(body, j, computeForwardKinematics=True)
+            assert np.allclose(pos, st[4], atol=1e-6) and \
+                np.allclose(rot, np.array(quat_to_matrix(st[5])), atol=1e-6), j
+    finally:
+        e.close()
+    result = CliRunner().invoke(app, ["render", str(path), "--frames", "--joints", "turn=0.8",
+                                      "-o", str(tmp_path / "p.png"), "--size", "160x120"])
+    assert result.exit_code == 0, result.output
 
 
 def test_render_draws_a_body_of_130_links(tmp_path: Path) -> None:

@@ -4,12 +4,13 @@ A robot whose links interpenetrate at its start pose jitters or explodes the mom
 collision is turned on (``URDF_USE_SELF_COLLISION``): the solver pushes the pair apart every
 step. This module finds those pairs the way PyBullet sees them:
 
-- The robot is loaded with a fixed base and nothing is simulated. Each pose is set with
-  ``resetJointState`` (which updates the link colliders at once), and every pair of links
-  that both have collision shapes is measured with ``getClosestPoints(body, body, margin,
-  linkA, linkB)``: the signed distance of the two links' collision shapes, negative when they
-  interpenetrate. That query ignores collision filters, so it reports a pair whether or not a
-  user later disables it.
+- The robot is loaded with a fixed base and nothing is simulated, on PyBullet through the
+  engine seam (:mod:`urdfkit.engine.api`). Each pose is set with ``reset_joint``
+  (``resetJointState``, which updates the link colliders at once), and every pair of links
+  that both have collision shapes is measured with ``closest_points(body, body, margin,
+  linkA, linkB)`` (``getClosestPoints``): the signed distance of the two links' collision
+  shapes, negative when they interpenetrate. That query ignores collision filters, so it
+  reports a pair whether or not a user later disables it.
 - A link and its parent are never tested: PyBullet's multibody collider skips parent-child
   pairs (``btMultiBodyLinkCollider::checkCollideWithOverride``) unless a user loads with
   ``URDF_USE_SELF_COLLISION_INCLUDE_PARENT``. They are counted and said to be skipped.
@@ -33,8 +34,7 @@ from typing import Any
 from lxml import etree
 
 from urdfkit.core.errors import InputError, ParameterError
-from urdfkit.engine.joints import JointInfo, base_link_name, joint_table, pose_joints
-from urdfkit.engine.session import Bullet, LoadOptions, Session
+from urdfkit.engine.api import JointInfo, LoadSettings, Simulator
 from urdfkit.model.spec import atof, ignored_shape, numbers
 from urdfkit.model.xmlio import children, line_of
 from urdfkit.sources.resolve import Resolved
@@ -202,45 +202,53 @@ def self_collisions(resolved: Resolved, *, joints: Mapping[str, float] | None = 
     pinned = dict(joints or {})
     read_as = _refuse_non_finite(resolved)
     _refuse_mimic_cycles(resolved)
-    with Session() as s:
-        bullet = s.bullet
+    from urdfkit.engine.joints import pose_by_name
+    from urdfkit.engine.registry import open_engine
+
+    engine = open_engine("pybullet")
+    try:
         # Without URDF_USE_SELF_COLLISION, getClosestPoints(body, body, 0, a, b) finds nothing
         # even for links 10 mm deep in each other (PyBullet 3.2.7).
-        body = s.load_urdf(resolved.load_path, LoadOptions(fixed_base=True, self_collision=True),
+        body = engine.load(str(resolved.load_path),
+                           LoadSettings(fixed_base=True, self_collision=True),
                            display=resolved.name)
-        s.require_state_queries(body, resolved.name)
-        table = joint_table(s, body, resolved.root)
-        names = [base_link_name(s, body)] + [j.link_name for j in table]
+        engine.require_state_queries(body, resolved.name)
+        table = engine.joints(body)
+        names = engine.link_names(body)
+        continuous = {el.get("name", "") for el in children(resolved.root, "joint")
+                      if el.get("type") == "continuous"}
         warnings: list[str] = list(read_as)
-        pose_joints(bullet, body, table, pinned, warnings, resolved.name)
-        sampler = _Sampler(table, resolved.root, pinned, warnings)
-        sampler.follow(bullet, body, sampler.start())  # mimic joints follow at the start too
-        shaped = [i for i in range(-1, len(table))
-                  if s.call("getCollisionShapeData", body, i)]
+        pose_by_name(engine, body, table, pinned, warnings, resolved.name,
+                     unlimited=continuous)
+        sampler = _Sampler(table, resolved.root, pinned, warnings, continuous)
+        sampler.follow(engine, body, sampler.start())  # mimic joints follow at the start too
+        shaped = [i for i in range(-1, len(table)) if engine.collision_shapes(body, i)]
         without = [names[i + 1] for i in range(-1, len(table)) if i not in set(shaped)]
         tested: list[tuple[int, int]] = []
         adjacent: list[tuple[str, str]] = []
         for k, a in enumerate(shaped):
             for b in shaped[k + 1:]:
-                if table[b].parent_index == a:
+                if table[b].parent == a:
                     adjacent.append((names[a + 1], names[b + 1]))
                 else:
                     tested.append((a, b))
         rng = np.random.default_rng(seed)
         closest: dict[tuple[int, int], float] = {}
         hits: dict[tuple[int, int], int] = {}
-        closest_points = bullet.getClosestPoints  # bound once, outside the loop
+        closest_points = engine.closest_points  # bound once, outside the loop
         for pose in range(samples + 1):
             if pose:
-                sampler.pose(bullet, body, rng)
+                sampler.pose(engine, body, rng)
             for a, b in tested:
                 points = closest_points(body, body, margin, a, b)
                 if not points:
                     continue
-                d = min(x[8] for x in points)
+                d = min(x.distance for x in points)
                 if d <= margin:
                     hits[(a, b)] = hits.get((a, b), 0) + 1
                     closest[(a, b)] = min(d, closest.get((a, b), math.inf))
+    finally:
+        engine.close()
     concave = _concave_links(resolved, packages)
     pairs = [Pair(names[a + 1], names[b + 1], a, b, closest[(a, b)], n,
                   [x for x in (names[a + 1], names[b + 1]) if x in concave])
@@ -324,12 +332,13 @@ class _Sampler:
     """Draws joint positions within limits; pinned joints stay, mimic joints follow."""
 
     def __init__(self, table: Sequence[JointInfo], root: etree._Element,
-                 pinned: Mapping[str, float], warnings: list[str]):
+                 pinned: Mapping[str, float], warnings: list[str], continuous: set[str]):
         self.free: list[tuple[int, float, float]] = []  # (index, low, high) of 1-DOF joints
         self.spherical: list[int] = []
         self.mimic: list[tuple[int, int, float, float]] = []  # (index, leader, mult, offset)
-        index = {j.joint_name: j.joint_index for j in table}
+        index = {j.name: j.index for j in table}
         self.pinned = {index[name]: value for name, value in pinned.items() if name in index}
+        types = {el.get("name"): el.get("type") for el in children(root, "joint")}
         leaders = {}
         for el in children(root, "joint"):
             m = el.find("mimic")
@@ -341,36 +350,37 @@ class _Sampler:
                 except ValueError:
                     continue
         for j in self._leaders_first(table, leaders):
-            if j.joint_name in pinned or not j.movable:
+            if j.name in pinned or j.kind == "fixed":
                 continue
-            if j.joint_name in leaders:
-                self.mimic.append((j.joint_index, *leaders[j.joint_name]))
-            elif j.joint_type == "SPHERICAL":
-                self.spherical.append(j.joint_index)
-            elif j.limited and math.isfinite(j.joint_upper_limit - j.joint_lower_limit):
-                self.free.append((j.joint_index, j.joint_lower_limit, j.joint_upper_limit))
-            elif j.joint_type == "REVOLUTE":
-                if j.limited:  # limits of 1e308 or inf: no range to draw from but a turn
-                    warnings.append(f"joint {j.joint_name}: limits {j.joint_lower_limit:g}.."
-                                    f"{j.joint_upper_limit:g} span more than any number can "
-                                    "hold; sampled over one turn (-pi..pi)")
-                self.free.append((j.joint_index, -math.pi, math.pi))
+            limited = j.limited and j.name not in continuous
+            if j.name in leaders:
+                self.mimic.append((j.index, *leaders[j.name]))
+            elif j.kind == "spherical":
+                self.spherical.append(j.index)
+            elif limited and math.isfinite(j.upper - j.lower):
+                self.free.append((j.index, j.lower, j.upper))
+            elif j.kind == "revolute":
+                if limited:  # limits of 1e308 or inf: no range to draw from but a turn
+                    warnings.append(f"joint {j.name}: limits {j.lower:g}..{j.upper:g} span "
+                                    "more than any number can hold; sampled over one turn "
+                                    "(-pi..pi)")
+                self.free.append((j.index, -math.pi, math.pi))
             else:
-                warnings.append(f"joint {j.joint_name}: a {j.urdf_type or j.joint_type.lower()} "
-                                "joint without finite limits has no range to sample; held at 0")
+                warnings.append(f"joint {j.name}: a {types.get(j.name) or j.kind} joint "
+                                "without finite limits has no range to sample; held at 0")
 
     @staticmethod
     def _leaders_first(table: Sequence[JointInfo],
                        leaders: Mapping[Any, tuple[int, float, float]]) -> list[JointInfo]:
         """The joints with every mimic after the joint it follows (chains: A <- B <- C)."""
-        by_index = {j.joint_index: j for j in table}
+        by_index = {j.index: j for j in table}
         depth: dict[str, int] = {}
         for j in table:
-            n, name = 0, j.joint_name
+            n, name = 0, j.name
             while name in leaders and n <= len(table):
-                name, n = by_index[leaders[name][0]].joint_name, n + 1
-            depth[j.joint_name] = n
-        return sorted(table, key=lambda j: depth[j.joint_name])
+                name, n = by_index[leaders[name][0]].name, n + 1
+            depth[j.name] = n
+        return sorted(table, key=lambda j: depth[j.name])
 
     def start(self) -> dict[int, float]:
         """Every leader's position at the start pose: pinned, else 0."""
@@ -378,23 +388,24 @@ class _Sampler:
         return {leader: self.pinned.get(leader, 0.0) for _, leader, _, _ in self.mimic
                 if leader not in followers}
 
-    def follow(self, bullet: Bullet, body: int, values: dict[int, float]) -> None:
+    def follow(self, engine: Simulator, body: int, values: dict[int, float]) -> None:
         """Set each mimic joint from its leader's position in ``values``."""
         for i, leader, mult, offset in self.mimic:  # leaders first: a chain follows through
             if leader in values:
                 values[i] = mult * values[leader] + offset
-                bullet.resetJointState(body, i, values[i])
+                engine.reset_joint(body, i, values[i])
 
-    def pose(self, bullet: Bullet, body: int, rng: Any) -> None:
+    def pose(self, engine: Simulator, body: int, rng: Any) -> None:
         values: dict[int, float] = dict(self.pinned)
         for i, low, high in self.free:
             values[i] = float(rng.uniform(low, high))
-            bullet.resetJointState(body, i, values[i])
+            engine.reset_joint(body, i, values[i])
         for i in self.spherical:
             q = rng.normal(size=4)
             q = q / (float((q * q).sum()) ** 0.5 or 1.0)  # uniform over rotations
-            bullet.resetJointStateMultiDof(body, i, [float(x) for x in q])
-        self.follow(bullet, body, values)
+            engine.reset_spherical_joint(body, i, (float(q[0]), float(q[1]), float(q[2]),
+                                                   float(q[3])))
+        self.follow(engine, body, values)
 
 
 def _concave_links(resolved: Resolved, packages: Mapping[str, Path] | None) -> set[str]:

@@ -1,18 +1,22 @@
 """``urdfkit render``: draw a robot headless to a PNG with PyBullet's TinyRenderer.
 
-The robot is loaded in a DIRECT session and drawn with ``getCameraImage(renderer=
-ER_TINY_RENDERER)``, PyBullet's CPU rasteriser: no GPU, no display, no OpenGL context, so it
-works the same on a laptop and on a CI machine.
+The robot is loaded in PyBullet (DIRECT) through the engine seam (:mod:`urdfkit.engine.api`)
+and drawn with its ``picture``: ``getCameraImage(renderer=ER_TINY_RENDERER)``, PyBullet's CPU
+rasteriser: no GPU, no display, no OpenGL context, so it works the same on a laptop and on a
+CI machine.
 
 What TinyRenderer does and does not do, measured on PyBullet 3.2.7, decides the design:
 
 - It draws *visual* shapes only. Loading with ``URDF_IGNORE_VISUAL_SHAPES`` makes PyBullet
   build the visual shapes from the ``<collision>`` elements instead (r2d2's base then draws
   with the collision radius 0.17, not the visual 0.2), all white. That is the honest way to
-  show collision geometry, so ``collision=True`` loads that way and recolours every shape.
+  show collision geometry, so ``collision=True`` loads that way and recolours every shape
+  (PyBullet's alone: :func:`urdfkit.engine.pybullet_render.load_drawing_collisions`).
 - It ignores ``addUserDebugLine`` (those are GUI-only; the image does not change by a single
-  pixel). Ground grid, link frames and joint axes are therefore projected here with the same
-  view and projection matrices and drawn with Pillow.
+  pixel). Ground grid, link frames and joint axes are therefore projected here with the view
+  and projection matrices the picture was drawn with and drawn with Pillow; the link frames
+  are the file's forward kinematics (:func:`urdfkit.formats.fk.link_frames`), which needs no
+  state query (those fail from 128 links).
 - It does not antialias. We render at :data:`SUPERSAMPLE` times the size and average each
   block of pixels down, which costs about 0.25 s at 800x600 and makes edges and lines smooth.
 - The segmentation mask tells robot pixels from background exactly, so the drawn grid can go
@@ -34,7 +38,8 @@ from typing import Any, Literal
 
 from urdfkit.core.errors import EngineError, InputError, MissingDependencyError, ParameterError
 from urdfkit.draw import style
-from urdfkit.engine.joints import JointInfo, pose_joints
+from urdfkit.engine.api import Camera as EngineCamera
+from urdfkit.engine.api import JointInfo, Light, LoadSettings, Simulator
 from urdfkit.model.spec import UP_AXES, UpAxis, attr_vec, rpy_to_matrix, vector
 
 #: The views, as (direction from target to camera, camera up vector). URDF: x forward, z up.
@@ -77,9 +82,6 @@ FILL = 0.82
 COLLISION_COLOR = style.SECONDARY
 #: Joint-axis arrows (``frames=True``).
 JOINT_AXIS_COLOR = style.END
-
-# PyBullet joint types (p.JOINT_*), spelled here so that reading them needs no import.
-_JOINT_FIXED = 4
 
 
 @dataclass(frozen=True)
@@ -270,14 +272,6 @@ def view_fov(view: str) -> float:
     return ORTHO_FOV_DEG if view in ORTHO_VIEWS else FOV_DEG
 
 
-def _matrices(p: Any, eye: Any, target: Any, up: Any, aspect: float, near: float,
-              far: float, fov_deg: float = FOV_DEG) -> tuple[list[float], list[float]]:
-    view = p.computeViewMatrix([float(c) for c in eye], [float(c) for c in target],
-                               [float(c) for c in up])
-    proj = p.computeProjectionMatrixFOV(fov_deg, aspect, near, far)
-    return list(view), list(proj)
-
-
 class Projector:
     """Project world points to pixels exactly as TinyRenderer does (column-major matrices)."""
 
@@ -340,7 +334,7 @@ def _nice_step(span: float, lines: int = 10) -> float:
 class _Scene:
     """A loaded, posed robot and what the drawing needs to know about it."""
 
-    s: Any
+    engine: Simulator
     body: int
     lo: Any
     hi: Any
@@ -349,58 +343,53 @@ class _Scene:
     plane: int | None = None
 
 
-def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) -> _Scene:
+def _load(resolved: Any, engine: Simulator, o: RenderOptions, warnings: list[str]) -> _Scene:
     import numpy as np
 
-    from urdfkit.engine.session import LoadOptions
+    from urdfkit.engine.joints import pose_by_name
+    from urdfkit.model.spec import quat_to_matrix
 
-    p, bullet = session.p, session.bullet
     # Fixed base: nothing is simulated, and the robot must stay exactly where it is posed.
-    opts = LoadOptions(fixed_base=True, base_orientation=UP_AXES[o.up])
+    settings = LoadSettings(fixed_base=True, orientation=UP_AXES[o.up])
     if o.collision:
-        # Make TinyRenderer draw the collision shapes: with this flag PyBullet builds the
-        # visual shapes from <collision> (see the module docstring).
-        opts.extra_flags = p.URDF_IGNORE_VISUAL_SHAPES
-    body = session.load_urdf(resolved.load_path, opts, display=resolved.name)
+        # Make TinyRenderer draw the collision shapes (see the module docstring).
+        from urdfkit.engine.pybullet_render import load_drawing_collisions
+
+        body = load_drawing_collisions(engine, str(resolved.load_path), settings,
+                                       resolved.name, (*COLLISION_COLOR, 1.0))
+    else:
+        body = engine.load(str(resolved.load_path), settings, display=resolved.name)
     try:
-        n = bullet.getNumJoints(body)
-        infos = [bullet.getJointInfo(body, j) for j in range(n)]
-        by_name = {i[1].decode("utf-8"): i for i in infos}
-        positions = pose_joints(bullet, body, [JointInfo.from_pybullet(i) for i in infos],
-                                o.joints, warnings, resolved.name)
-        if o.collision:
-            for link in range(-1, n):
-                session.call("changeVisualShape", body, link, rgbaColor=[*COLLISION_COLOR, 1.0])
+        joints = engine.joints(body)
+        positions = pose_by_name(engine, body, joints, o.joints, warnings, resolved.name)
         lo = np.full(3, np.inf)
         hi = np.full(3, -np.inf)
-        for link in range(-1, n):
-            a, b = bullet.getAABB(body, link)
-            a, b = np.array(a), np.array(b)
+        for link in range(-1, len(joints)):
+            box = engine.aabb(body, link)
+            a, b = np.array(box[0]), np.array(box[1])
             # A link without collision shapes reports an empty or inverted box; skip it.
             if np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(b >= a):
                 lo, hi = np.minimum(lo, a), np.maximum(hi, b)
-        frames = link_frames(resolved.root, list(by_name),
-                             (opts.base_position, opts.base_orientation), positions)
+        frames = link_frames(resolved, joints, settings, positions)
         for pos, _ in frames:
             lo, hi = np.minimum(lo, pos), np.maximum(hi, pos)
         if not o.collision:
             # getAABB only knows collision shapes; a link with visuals only (common in
             # hand-written files) would fall outside the frame. Bound its visuals too.
-            names = [bullet.getBodyInfo(body)[0].decode("utf-8")]
-            names += [i[12].decode("utf-8") for i in infos]
+            names = engine.link_names(body)
             v_lo, v_hi = _visual_bounds(resolved.root, dict(zip(names, frames, strict=True)))
             lo, hi = np.minimum(lo, v_lo), np.maximum(hi, v_hi)
         axes = []
-        for j, info in enumerate(infos):
-            if info[2] == _JOINT_FIXED or info[2] not in (0, 1):
+        for j in joints:
+            if j.kind not in ("revolute", "prismatic"):
                 continue
-            pos, rot = frames[j + 1]
-            # PyBullet's axis is in the child's inertial frame: turn it into the link frame.
-            local = bullet.getDynamicsInfo(body, j)[4]
-            inertial = np.array(p.getMatrixFromQuaternion(local), dtype=float).reshape(3, 3)
-            axes.append((pos, rot @ inertial @ np.array(info[13], dtype=float)))
-    except p.error as e:
-        raise EngineError(f"PyBullet cannot report this body's state ({e})",
+            pos, rot = frames[j.index + 1]
+            # The engine's axis is in the child's inertial frame: turn it into the link frame.
+            local = engine.dynamics(body, j.index).inertial_orientation
+            inertial = np.array(quat_to_matrix(local), dtype=float)
+            axes.append((pos, rot @ inertial @ np.array(j.axis, dtype=float)))
+    except engine.error as e:
+        raise EngineError(f"{engine.label} cannot report this body's state ({e})",
                           file=resolved.name) from None
     extent = float(np.max(hi - lo)) if np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) \
         else math.inf
@@ -408,7 +397,7 @@ def _load(resolved: Any, session: Any, o: RenderOptions, warnings: list[str]) ->
         raise InputError(f"the robot spans {extent:.3g} m as loaded, too large to frame and "
                          f"draw (at most {MAX_EXTENT:g} m); check its sizes and origins "
                          "(urdfkit check)", file=resolved.name)
-    return _Scene(session, body, lo, hi, frames, axes)
+    return _Scene(engine, body, lo, hi, frames, axes)
 
 
 def _visual_bounds(root: Any, frames: Mapping[str, tuple[Any, Any]]) -> tuple[Any, Any]:
@@ -465,65 +454,56 @@ def _half_extent(geometry: Any, rot: Any) -> Any:
     return None
 
 
-def link_frames(root: Any, joint_names: Sequence[str],
-                base: tuple[Sequence[float], Sequence[float]],
+def link_frames(resolved: Any, joints: Sequence[JointInfo], settings: LoadSettings,
                 positions: Mapping[str, float]) -> list[tuple[Any, Any]]:
-    """World pose (position, 3x3 rotation) of every URDF link frame, base first (link -1).
+    """World pose (position, 3x3 rotation) of every link frame, root first, in ``joints``' order.
 
-    Forward kinematics from the file, with no PyBullet state query, so it works on bodies of
-    128 links or more, where getLinkState and getBasePositionAndOrientation fail: ``base`` is
-    the pose the body was loaded at (PyBullet places the root link frame there),
-    ``joint_names`` PyBullet's joint order (link j is joint j's child), ``positions`` the joint
-    positions set by name (others 0). Each link frame is its parent's times the joint's
-    ``<origin>`` times the motion along its ``<axis>``. Equal to getLinkState's worldLinkFrame
+    :func:`urdfkit.formats.fk.link_frames` of the file, with no state query, so it works on
+    bodies of 128 links or more, where getLinkState fails: the root's link frame where the body
+    was loaded (``settings``), each joint at its position in ``positions`` (others 0), link
+    ``j`` the child of ``joints[j]``. Equal to getLinkState's worldLinkFrame
     (tests/test_render.py).
     """
     import numpy as np
 
-    from urdfkit.model.spec import axis_angle_matrix, quat_to_matrix
+    from urdfkit.formats.fk import link_frames as forward
+    from urdfkit.formats.robot import read_robot
+    from urdfkit.model.spec import quat_to_matrix
 
-    joints = {j.get("name"): j for j in root.iterchildren("joint")}
-    children = {(c.get("link") if (c := j.find("child")) is not None else None)
-                for j in joints.values()}
-    base_link = next((link.get("name") for link in root.iterchildren("link")
-                      if link.get("name") not in children), None)
-    frames: dict[str | None, tuple[Any, Any]] = {
-        base_link: (np.array(base[0], dtype=float), np.array(quat_to_matrix(base[1])))}
-    out = [frames[base_link]]
-    for name in joint_names:
-        j = joints[name]
-        parent, child = j.find("parent"), j.find("child")
-        ppos, prot = frames[parent.get("link") if parent is not None else None]
-        origin = j.find("origin")
-        xyz = np.array(attr_vec(origin, "xyz", 3, (0, 0, 0)))
-        rot = prot @ np.array(rpy_to_matrix(attr_vec(origin, "rpy", 3, (0, 0, 0))))  # type: ignore[arg-type]
-        pos = ppos + prot @ xyz
-        q = positions.get(name, 0.0)
-        axis = attr_vec(j.find("axis"), "xyz", 3, (1, 0, 0)) or (1.0, 0.0, 0.0)
-        if q and j.get("type") in ("revolute", "continuous"):
-            rot = rot @ np.array(axis_angle_matrix(axis, q))
-        elif q and j.get("type") == "prismatic":
-            unit = np.array(axis) / (np.linalg.norm(axis) or 1.0)
-            pos = pos + rot @ (unit * q)
-        frames[child.get("link") if child is not None else None] = (pos, rot)
-        out.append((pos, rot))
-    return out
+    robot = read_robot(resolved.root, resolved.name, planar=True)
+    base = np.eye(4)
+    base[:3, :3] = quat_to_matrix(settings.orientation)
+    base[:3, 3] = settings.position
+    frames = forward(robot, positions, base)
+    return [(frames[name][:3, 3], frames[name][:3, :3])
+            for name in [robot.root] + [j.link for j in joints]]
 
 
 def _add_plane(scene: _Scene) -> int:
-    """A ground slab under the robot in the style's ground colour, to catch its shadow."""
+    """A ground slab under the robot in the style's ground colour, to catch its shadow.
+
+    A box that is seen and does not collide, written as a URDF and loaded as scenery (the
+    picture is PyBullet's createVisualShape and createMultiBody of it to the pixel, measured
+    on r2d2, kuka_iiwa and racecar in four views).
+    """
+    import tempfile
+
     import numpy as np
 
-    s = scene.s
     size = float(np.max(scene.hi - scene.lo))
-    half = [float(max(scene.hi[0] - scene.lo[0], scene.hi[1] - scene.lo[1])) * 1.5 + size] * 2
+    half = float(max(scene.hi[0] - scene.lo[0], scene.hi[1] - scene.lo[1])) * 1.5 + size
     thick = size * 0.01
     centre = (scene.lo + scene.hi) / 2
-    shape = s.call("createVisualShape", s.p.GEOM_BOX, halfExtents=[*half, thick],
-                   rgbaColor=[*style.GROUND, 1.0])
-    return int(s.call("createMultiBody", baseMass=0, baseVisualShapeIndex=shape,
-                      basePosition=[float(centre[0]), float(centre[1]),
-                                    float(scene.lo[2]) - thick]))
+    rgba = " ".join(repr(float(x)) for x in (*style.GROUND, 1.0))
+    urdf = (f'<robot name="ground"><link name="ground"><visual><geometry><box size="'
+            f'{2 * half!r} {2 * half!r} {2 * thick!r}"/></geometry><material name="ground">'
+            f'<color rgba="{rgba}"/></material></visual></link></robot>')
+    with tempfile.TemporaryDirectory(prefix="urdfkit-ground-") as folder:
+        path = Path(folder) / "ground.urdf"
+        path.write_text(urdf, "utf-8")
+        return scene.engine.load(str(path), LoadSettings(
+            fixed_base=True, scenery=True, position=(float(centre[0]), float(centre[1]),
+                                                     float(scene.lo[2]) - thick)))
 
 
 def _shoot(scene: _Scene, view: View, width: int, height: int, o: RenderOptions,
@@ -534,7 +514,6 @@ def _shoot(scene: _Scene, view: View, width: int, height: int, o: RenderOptions,
     Image = _pillow()
     from PIL import ImageDraw
 
-    p = scene.s.p
     aspect = width / height
     fov = view_fov(view)
     eye, target, up = frame_view(view, scene.lo, scene.hi, aspect, fov_deg=fov)
@@ -542,18 +521,17 @@ def _shoot(scene: _Scene, view: View, width: int, height: int, o: RenderOptions,
     radius = float(np.linalg.norm(scene.hi - scene.lo)) / 2
     near = max(dist - 3 * radius, dist * 0.02)
     far = dist + 8 * radius + 1.0
-    view_m, proj_m = _matrices(p, eye, target, up, aspect, near, far, fov)
     back, right, _ = _basis(view)
     # Light from over the viewer's left shoulder, so faces turned to the camera are lit.
     light = back + up * 0.9 - right * 0.6
-    _, _, rgba, _, seg = scene.s.call(
-        "getCameraImage", width, height, view_m, proj_m, renderer=p.ER_TINY_RENDERER,
-        lightDirection=[float(x) for x in light], shadow=1 if scene.plane is not None else 0,
-        lightAmbientCoeff=0.55, lightDiffuseCoeff=0.5, lightSpecularCoeff=0.05)
-    rgb = np.reshape(np.asarray(rgba, dtype=np.uint8), (height, width, 4))[:, :, :3]
-    seg = np.reshape(np.asarray(seg), (height, width))
+    shot = scene.engine.picture(
+        EngineCamera(_floats(eye), _floats(target), _floats(up), fov, near, far), width, height,
+        Light(_floats(light), ambient=0.55, diffuse=0.5, specular=0.05,
+              shadows=scene.plane is not None))
+    rgb = np.frombuffer(shot.rgb, dtype=np.uint8).reshape(height, width, 3)
+    seg = np.frombuffer(shot.bodies, dtype="<i4").reshape(height, width)
     robot = seg == scene.body
-    proj = Projector(view_m, proj_m, width, height, near)
+    proj = Projector(shot.view, shot.projection, width, height, near)
 
     canvas = Image.new("RGB", (width, height), style.rgb255(style.BACKGROUND))
     if scene.plane is not None:
@@ -575,6 +553,10 @@ def _shoot(scene: _Scene, view: View, width: int, height: int, o: RenderOptions,
                     tuple(float(x) for x in target), tuple(float(x) for x in up),  # type: ignore[arg-type]
                     fov, (0, 0, 0, 0))
     return canvas, camera, bool(robot.any())
+
+
+def _floats(v: Any) -> tuple[float, float, float]:
+    return float(v[0]), float(v[1]), float(v[2])
 
 
 def _outlined(rgb: Any, robot: Any, scale: int) -> Any:
@@ -669,7 +651,7 @@ def render(resolved: Any, options: RenderOptions | None = None) -> Rendering:
     """
     import numpy as np
 
-    from urdfkit.engine.session import Session
+    from urdfkit.engine.registry import open_engine
 
     o = options or RenderOptions()
     Image = _pillow()
@@ -683,8 +665,9 @@ def render(resolved: Any, options: RenderOptions | None = None) -> Rendering:
     out = Image.new("RGB", (o.width * ss, o.height * ss), style.rgb255(style.BACKGROUND))
     cameras: list[Camera] = []
     visible = False
-    with Session() as s:
-        scene = _load(resolved, s, o, warnings)
+    engine = open_engine("pybullet")
+    try:
+        scene = _load(resolved, engine, o, warnings)
         if not np.all(np.isfinite(scene.lo)):
             raise EngineError("nothing to draw: no link has a shape", file=resolved.name)
         if o.ground == "plane":
@@ -697,6 +680,8 @@ def render(resolved: Any, options: RenderOptions | None = None) -> Rendering:
             out.paste(img, (left * ss, top * ss))
             cam.panel = (left, top, panel_w, panel_h)
             cameras.append(cam)
+    finally:
+        engine.close()
     if not visible:
         warnings.append("no shape of the robot is visible in the picture"
                         + ("" if o.collision else "; try --collision"))

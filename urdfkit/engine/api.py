@@ -176,9 +176,9 @@ class CollisionShape:
         position, orientation: Its frame in the link's inertial frame.
         vertices: A mesh's vertices in the link's inertial frame (empty when the engine
             gives none); None for the other kinds.
-        file: A mesh's file as the engine read it (PyBullet's resolved path, which
-            ``agree`` reads the mesh from); empty for the other kinds, or where the engine
-            read none (MuJoCo's in-memory export).
+        filename: A mesh's file as the engine read it ("" for the other kinds, and where the
+            engine has no file to name: a cylinder PyBullet made a mesh of, a mesh MuJoCo's
+            export converted).
     """
 
     kind: ShapeKind
@@ -186,7 +186,31 @@ class CollisionShape:
     position: Vec3
     orientation: Quat
     vertices: Sequence[Vec3] | None = None
-    file: str = ""
+    filename: str = ""
+
+
+@dataclass(frozen=True)
+class VisualShape:
+    """One visual shape of a body, what pictures draw (PyBullet's ``getVisualShapeData``).
+
+    Attributes:
+        link: Its link (-1: the root).
+        kind: What it is.
+        dimensions: As :attr:`CollisionShape.dimensions`: a box's full sizes, a sphere's
+            radius first, a cylinder's or capsule's length, then its radius, a mesh's scale.
+        filename: A mesh's file as the engine read it ("" as for :class:`CollisionShape`).
+        position, orientation: Its frame in the link's URDF frame (not the inertial frame,
+            unlike a collision shape's).
+        rgba: Its colour, 0..1, as the engine holds it (PyBullet's material rules applied).
+    """
+
+    link: int
+    kind: ShapeKind
+    dimensions: Sequence[float]
+    filename: str
+    position: Vec3
+    orientation: Quat
+    rgba: tuple[float, float, float, float]
 
 
 @dataclass(frozen=True)
@@ -223,6 +247,46 @@ class Camera:
                target[1] - distance * math.cos(p) * math.cos(y),
                target[2] - distance * math.sin(p))
         return cls(eye, target, fov=fov)
+
+
+@dataclass(frozen=True)
+class Light:
+    """The one directional light of a :meth:`Simulator.picture`.
+
+    Attributes:
+        direction: Towards the light from the scene, world (any length).
+        ambient, diffuse, specular: How much each term lights, 0..1 (PyBullet's defaults).
+        shadows: Whether shapes cast shadows.
+    """
+
+    direction: Vec3
+    ambient: float = 0.6
+    diffuse: float = 0.35
+    specular: float = 0.05
+    shadows: bool = False
+
+
+@dataclass(frozen=True)
+class Picture:
+    """What a :meth:`Simulator.picture` saw, and how to find a world point in it.
+
+    Attributes:
+        width, height: Its size in pixels.
+        rgb: ``height`` rows of ``width`` RGB pixels, top row first.
+        bodies: The body drawn at each pixel, in the same order, a little-endian int32
+            each (``numpy.frombuffer(bodies, "<i4")``); -1 where none is.
+        view, projection: The view and projection matrices it was drawn with, 16 numbers
+            each, column-major (OpenGL's): a world point ``p`` is at clip coordinates
+            ``c = projection @ view @ (p, 1)``, pixel ``((c_x / c_w + 1) width / 2,
+            (1 - c_y / c_w) height / 2)`` from the top left corner.
+    """
+
+    width: int
+    height: int
+    rgb: bytes
+    bodies: bytes
+    view: tuple[float, ...]
+    projection: tuple[float, ...]
 
 
 @dataclass(frozen=True)
@@ -516,4 +580,21 @@ class Simulator(Model, Protocol):
         Off screen (PyBullet's TinyRenderer; MuJoCo's renderer, which needs OpenGL: EGL
         headless).
         """
+        ...
+
+    def picture(self, camera: Camera, width: int, height: int, light: Light | None = None
+                ) -> Picture:
+        """What ``camera`` sees now, which body each pixel shows, and the matrices it used.
+
+        As :meth:`camera_image`, lit by ``light`` (None: the engine's own light), with the
+        camera's ``near`` and ``far``.
+        """
+        ...
+
+    def visual_shapes(self, body: int) -> list[VisualShape]:
+        """Every visual shape of ``body``, by link (the root first), in the engine's order."""
+        ...
+
+    def reset_spherical_joint(self, body: int, joint: int, orientation: Quat) -> None:
+        """Put a spherical joint at an orientation (x, y, z, w), at rest."""
         ...

@@ -22,9 +22,9 @@ shape this module:
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from lxml import etree
 
@@ -37,6 +37,10 @@ from urdfkit.model.spec import (
     quat_to_rpy,
 )
 from urdfkit.model.xmlio import children
+
+if TYPE_CHECKING:
+    from urdfkit.engine import api
+    from urdfkit.engine.api import Simulator
 
 #: The 17 ``getJointInfo`` fields, in tuple order, as the Quickstart Guide names them.
 JOINT_INFO_FIELDS = (
@@ -233,34 +237,59 @@ def pose_joints(bullet: Bullet, body: int, joints: Sequence[JointInfo],
     Raises:
         ParameterError: an unknown name, a fixed joint, or a multi-DOF joint.
     """
-    from urdfkit.core.errors import ParameterError
+    rows = {j.joint_name: (j.joint_index, j.joint_type, j.limited, j.joint_lower_limit,
+                           j.joint_upper_limit) for j in joints}
+    return _pose(rows, values, lambda i, v: bullet.resetJointState(body, i, v), warnings, file)
 
-    by_name = {j.joint_name: j for j in joints}
-    movable = [j.joint_name for j in joints if j.movable]
-    positions: dict[str, float] = {}
+
+def pose_by_name(engine: Simulator, body: int, joints: Sequence[api.JointInfo],
+                 values: Mapping[str, float], warnings: list[str], file: str, *,
+                 unlimited: Collection[str] = ()) -> dict[str, float]:
+    """:func:`pose_joints` on any engine: the seam's joint records, ``reset_joint``.
+
+    A joint named in ``unlimited`` has no limits to warn of: a URDF ``continuous`` joint,
+    whose ``<limit>`` PyBullet reports (:attr:`api.JointInfo.limited` is True for it).
+    """
+    rows = {j.name: (j.index, j.kind.upper(), j.limited and j.name not in unlimited, j.lower,
+                     j.upper) for j in joints}
+    return _pose(rows, values, lambda i, v: engine.reset_joint(body, i, v), warnings, file)
+
+
+def _pose(joints: Mapping[str, tuple[int, str, bool, float, float]],
+          values: Mapping[str, float], reset: Callable[[int, float], None],
+          warnings: list[str], file: str) -> dict[str, float]:
+    """Check each name and value, then ``reset`` it.
+
+    ``joints`` maps each name to (index, PyBullet's type name, limited, lower, upper).
+    """
     import math
 
+    from urdfkit.core.errors import ParameterError
+
+    movable = [name for name, j in joints.items() if j[1] != "FIXED"]
+    positions: dict[str, float] = {}
     for name, value in values.items():
         if not math.isfinite(value):
             raise ParameterError(f"`joints` {name}: {value!r} is not a finite number",
                                  file=file, param="joints")
-        info = by_name.get(name)
+        info = joints.get(name)
         if info is None:
             from urdfkit.core.suggest import hint
 
             known = ", ".join(movable) or "none"
             raise ParameterError(f"`joints`: no joint named {name!r}{hint(name, movable)} "
                                  f"(movable joints: {known})", file=file, param="joints")
-        if info.joint_type == "FIXED":
+        index, kind, limited, lower, upper = info
+        if kind == "FIXED":
             raise ParameterError(f"`joints` {name}: a fixed joint cannot move", file=file,
                                  param="joints")
-        if info.joint_type not in ("REVOLUTE", "PRISMATIC"):
-            raise ParameterError(f"`joints` {name}: {info.joint_type.lower()} joints take more "
+        if kind not in ("REVOLUTE", "PRISMATIC"):
+            raise ParameterError(f"`joints` {name}: {kind.lower()} joints take more "
                                  "than one position; only revolute, continuous and prismatic "
                                  "joints can be posed", file=file, param="joints")
-        if info.limited and not info.joint_lower_limit <= value <= info.joint_upper_limit:
+        if limited and not lower <= value <= upper:
             warnings.append(f"joint {name}: {value:g} is beyond its limits "
-                            f"[{info.joint_lower_limit:g}, {info.joint_upper_limit:g}]")
-        bullet.resetJointState(body, info.joint_index, value)
+                            f"[{lower:g}, {upper:g}]")
+        reset(index, value)
         positions[name] = value
     return positions

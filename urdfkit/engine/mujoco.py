@@ -57,12 +57,15 @@ from urdfkit.engine.api import (
     JointInfo,
     JointRow,
     JointState,
+    Light,
     LinkDynamics,
     LinkPose,
     LoadSettings,
     MotorMode,
+    Picture,
     Quat,
     Vec3,
+    VisualShape,
 )
 from urdfkit.engine.mujoco_motors import Motor
 from urdfkit.engine.mujoco_world import World, bad_count
@@ -472,6 +475,23 @@ class MuJoCoEngine:
         from urdfkit.engine.mujoco_render import camera_image
 
         return camera_image(self.world, self._renderers, camera, width, height)
+
+    def picture(self, camera: Camera, width: int, height: int, light: Light | None = None
+                ) -> Picture:
+        """What ``camera`` sees now, each pixel's body, the matrices (mujoco_render)."""
+        from urdfkit.engine.mujoco_render import picture
+
+        return picture(self.world, self._renderers, camera, width, height, light)
+
+    def visual_shapes(self, body: int) -> list[VisualShape]:
+        """The visual geoms of ``body`` as PyBullet's visual shapes (mujoco_shapes)."""
+        from urdfkit.engine.mujoco_shapes import visual_shapes
+
+        return visual_shapes(self.world, body)
+
+    def reset_spherical_joint(self, body: int, joint: int, orientation: Quat) -> None:
+        """Put a ball joint at an orientation, at rest."""
+        bodies.reset_spherical_joint(self.world, body, joint, orientation)
 
 
 if TYPE_CHECKING:

@@ -177,6 +177,20 @@ def reset_joint(w: World, body: int, joint: int, position: float, velocity: floa
     w.kinematics = False
 
 
+def reset_spherical_joint(w: World, body: int, joint: int, orientation: Quat) -> None:
+    """Put a ball joint at an orientation (x, y, z, w), at rest."""
+    d = w.compiled()[1]
+    r, ids = w.body(body)
+    info = w.joint(r, ids, joint)
+    if info.kind != "spherical":
+        raise ParameterError(f"joint {info.name!r} is {info.kind}, not spherical",
+                             param="joint")
+    x, y, z, s = orientation
+    d.qpos[info.q_index:info.q_index + 4] = (s, x, y, z)
+    d.qvel[info.v_index:info.v_index + 3] = 0.0
+    w.kinematics = False
+
+
 def set_joint_positions(w: World, body: int, positions: Sequence[float],
                         velocities: Sequence[float] | None) -> None:
     """Put every movable joint (in joint order) at these values."""

@@ -10,6 +10,7 @@ PyBullet's combined friction. :mod:`urdfkit.engine.mujoco` holds the engine itse
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from urdfkit.core.errors import InputError, ParameterError
@@ -17,8 +18,8 @@ from urdfkit.engine.api import LinkDynamics, LoadSettings, Quat, Vec3
 from urdfkit.engine.mujoco_motors import Motor
 from urdfkit.formats.robot import Robot
 
-#: The export's group of collision geoms (``formats.mjcf.COLLISION_GROUP``).
-COLLISION_GROUP = 3
+#: The export's groups of visual and collision geoms (``formats.mjcf``'s).
+VISUAL_GROUP, COLLISION_GROUP = 2, 3
 #: Bullet's clamp on a combined friction coefficient (btManifoldResult).
 MAX_FRICTION = 10.0
 #: The export's codes for what MuJoCo refuses in a link's mass properties; ``urdfkit fix``
@@ -60,11 +61,14 @@ class Loaded:
         collisions: The collision geoms: (name, link, body), in the export's order.
         static: The MuJoCo bodies welded to the world (by link name).
         parents: Each moving body's parent body (by link name).
-        placed: Each collision geom's pose in its MuJoCo body as the export wrote it
-            (MuJoCo moves a mesh's geom to the mesh's own centre when it compiles).
+        placed: Each collision and visual geom's pose in its MuJoCo body as the export
+            wrote it (MuJoCo moves a mesh's geom to the mesh's own centre when it compiles).
         motors: By joint index, every revolute and prismatic joint's motor.
         notes: What the export dropped, approximated or defaulted, and what the engine
             left out, one line each.
+        visuals: The visual geoms: (name, link), in the export's order.
+        mesh_files: Each mesh (by its unprefixed name) and the file it was read from, ""
+            where the export converted it (a DAE, an STL it repaired).
     """
 
     robot: Robot
@@ -80,6 +84,8 @@ class Loaded:
     placed: dict[str, tuple[Vec3, Quat]] = field(default_factory=dict)
     motors: dict[int, Motor] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    visuals: list[tuple[str, str]] = field(default_factory=list)
+    mesh_files: dict[str, str] = field(default_factory=dict)
 
     def link(self, index: int) -> Link:
         """Link ``index`` (-1: the root), or a ParameterError naming the range."""
@@ -135,14 +141,21 @@ def prepare(mujoco: Any, path: str, settings: LoadSettings, display: str | None)
     notes += _drop_mimics(mujoco, spec)
     where = fused(robot, split_world=True)
     collisions = []
+    visuals = []
     placed: dict[str, tuple[Vec3, Quat]] = {}
     for g in spec.geoms:
         if g.group == COLLISION_GROUP:
             g.contype = 0  # every contact is an explicit pair (see pairs)
             g.conaffinity = 0
             collisions.append((g.name, e.geom_links[g.name], where[e.geom_links[g.name]][0]))
-            w, x, y, z = (float(v) for v in g.quat)
-            placed[g.name] = ((float(g.pos[0]), float(g.pos[1]), float(g.pos[2])), (x, y, z, w))
+        elif g.group == VISUAL_GROUP:
+            visuals.append((g.name, e.geom_links[g.name]))
+        else:
+            continue
+        w, x, y, z = (float(v) for v in g.quat)
+        placed[g.name] = ((float(g.pos[0]), float(g.pos[1]), float(g.pos[2])), (x, y, z, w))
+    read = {k: str(v) for k, v in e.assets.items() if not isinstance(v, bytes)}
+    mesh_files = {mesh.name: read.get(Path(mesh.file).name, "") for mesh in spec.meshes}
     links = [Link(robot.root, where[robot.root][0], where[robot.root][1], loaded[robot.root])]
     links += [Link(j.child, where[j.child][0], where[j.child][1], loaded[j.child])
               for j in robot.joints]
@@ -159,7 +172,7 @@ def prepare(mujoco: Any, path: str, settings: LoadSettings, display: str | None)
     motors = {i: Motor() for i, j in enumerate(robot.joints)
               if j.type in ("revolute", "continuous", "prismatic")}
     return Loaded(robot, name, settings, spec, assets, links, e.geom_links, collisions, static,
-                  parents, placed, motors, notes)
+                  parents, placed, motors, notes, visuals, mesh_files)
 
 
 def _parse(mujoco: Any, xml: bytes, assets: dict[str, bytes], name: str) -> Any:

@@ -4,7 +4,12 @@
 as a :class:`~urdfkit.engine.api.CollisionShape`, its frame in the link's inertial frame
 (PyBullet's link frame), a box by its full sizes, a sphere by its radius (three times, as
 PyBullet writes it), a cylinder or capsule by its length and radius, a mesh by its scale with
-its vertices. :func:`aabb` is ``getAABB``: the world box around the link's collision geoms
+its vertices and the file it was read from. :func:`visual_shapes` is ``getVisualShapeData``:
+the visual geoms the same way (a sphere by its radius once), each in its link's URDF frame,
+with the colour the export wrote (MuJoCo's grey where it wrote none; PyBullet's is white, and
+PyBullet lets a later ``<visual>`` reuse a material named in an earlier one, which the export
+does not). A link without ``<visual>`` has none here; PyBullet lists its collision shapes as
+what it draws. :func:`aabb` is ``getAABB``: the world box around the link's collision geoms
 now.
 """
 
@@ -12,7 +17,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from urdfkit.engine.api import CollisionShape, ShapeKind, Vec3
+from urdfkit.engine.api import CollisionShape, ShapeKind, Vec3, VisualShape
 from urdfkit.engine.mujoco_world import World, vec3
 
 #: PyBullet's AABB of a plane: all of space.
@@ -29,7 +34,6 @@ def collision_shapes(w: World, body: int, link: int) -> list[CollisionShape]:
     r, _ = w.body(body)
     target = r.link(link)
     mj = w.mj
-    types = mj.mjtGeom
     # the link's inertial frame in its MuJoCo body
     dyn = target.dynamics
     frame = np.asarray(target.frame, dtype=float)
@@ -40,35 +44,67 @@ def collision_shapes(w: World, body: int, link: int) -> list[CollisionShape]:
         if owner != target.name:
             continue
         g = m.geom(f"{body}/{name}")
-        kind = int(g.type[0])
-        size = [float(x) for x in g.size]
         at, turn = r.placed[name]
         shape_rot = rot.T @ np.array(quat_to_matrix(turn))
         position = vec3(rot.T @ (np.array(at) - origin))
         orientation = _quat(mj, np, shape_rot)
+        shape, dims, filename = _kind(w, r, body, g)
         vertices: list[Vec3] | None = None
-        dims: tuple[float, ...]
-        shape: ShapeKind
-        if kind == types.mjGEOM_BOX:
-            shape, dims = "box", (2 * size[0], 2 * size[1], 2 * size[2])
-        elif kind == types.mjGEOM_SPHERE:
-            shape, dims = "sphere", (size[0],) * 3
-        elif kind in (types.mjGEOM_CYLINDER, types.mjGEOM_CAPSULE):
-            shape = "cylinder" if kind == types.mjGEOM_CYLINDER else "capsule"
-            dims = (2 * size[1], size[0], 0.0)
-        elif kind == types.mjGEOM_PLANE:
-            shape, dims = "plane", (0.0, 0.0, 1.0)
-        elif kind == types.mjGEOM_MESH:
-            mesh = int(g.dataid[0])
-            shape, dims = "mesh", tuple(float(x) for x in m.mesh_scale[mesh])
+        if shape == "mesh":
             # MuJoCo's vertices are about the mesh's own centre, where its geom now sits
             geom_rot = np.array(quat_to_matrix((*g.quat[1:], g.quat[0])))
-            local = hull(m, np, mesh) @ geom_rot.T + g.pos
+            local = hull(m, np, int(g.dataid[0])) @ geom_rot.T + g.pos
             vertices = [vec3(v) for v in (local - origin) @ rot]
-        else:
-            shape, dims = "other", tuple(size)
-        out.append(CollisionShape(shape, dims, position, orientation, vertices))
+        out.append(CollisionShape(shape, dims, position, orientation, vertices, filename))
     return out
+
+
+def visual_shapes(w: World, body: int) -> list[VisualShape]:
+    """A body's visual geoms, by link (the root first), each in its link's URDF frame."""
+    import numpy as np
+
+    from urdfkit.model.spec import quat_to_matrix
+
+    m, _ = w.compiled()
+    r, _ = w.body(body)
+    index = {r.robot.root: -1} | {j.child: i for i, j in enumerate(r.robot.joints)}
+    out = []
+    for name, owner in r.visuals:
+        link = index[owner]
+        frame = np.asarray(r.link(link).frame, dtype=float)  # the link frame in its body
+        at, turn = r.placed[name]
+        g = m.geom(f"{body}/{name}")
+        shape, dims, filename = _kind(w, r, body, g)
+        if shape == "sphere":  # getVisualShapeData's: the radius, then zeros
+            dims = (dims[0], 0.0, 0.0)
+        rot = frame[:3, :3].T @ np.array(quat_to_matrix(turn))
+        position = vec3(frame[:3, :3].T @ (np.array(at) - frame[:3, 3]))
+        rgba = tuple(float(x) for x in g.rgba)
+        out.append(VisualShape(link, shape, dims, filename, position, _quat(w.mj, np, rot),
+                               (rgba[0], rgba[1], rgba[2], rgba[3])))
+    out.sort(key=lambda v: v.link)  # stable: each link's in the export's order
+    return out
+
+
+def _kind(w: World, r: Any, body: int, g: Any) -> tuple[ShapeKind, tuple[float, ...], str]:
+    """A compiled geom's kind, its dimensions as PyBullet writes them, a mesh's file."""
+    m, types = w.m, w.mj.mjtGeom
+    kind = int(g.type[0])
+    size = [float(x) for x in g.size]
+    if kind == types.mjGEOM_BOX:
+        return "box", (2 * size[0], 2 * size[1], 2 * size[2]), ""
+    if kind == types.mjGEOM_SPHERE:
+        return "sphere", (size[0],) * 3, ""
+    if kind in (types.mjGEOM_CYLINDER, types.mjGEOM_CAPSULE):
+        return ("cylinder" if kind == types.mjGEOM_CYLINDER else "capsule",
+                (2 * size[1], size[0], 0.0), "")
+    if kind == types.mjGEOM_PLANE:
+        return "plane", (0.0, 0.0, 1.0), ""
+    if kind == types.mjGEOM_MESH:
+        mesh = int(g.dataid[0])
+        name = m.mesh(mesh).name.removeprefix(f"{body}/")
+        return "mesh", tuple(float(x) for x in m.mesh_scale[mesh]), r.mesh_files.get(name, "")
+    return "other", tuple(size), ""
 
 
 def aabb(w: World, body: int, link: int) -> tuple[Vec3, Vec3]:

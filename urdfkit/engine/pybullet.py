@@ -37,13 +37,16 @@ from urdfkit.engine.api import (
     JointKind,
     JointRow,
     JointState,
+    Light,
     LinkDynamics,
     LinkPose,
     LoadSettings,
     MotorMode,
+    Picture,
     Quat,
     ShapeKind,
     Vec3,
+    VisualShape,
 )
 
 if TYPE_CHECKING:
@@ -58,6 +61,7 @@ JOINT_KINDS: dict[int, JointKind] = {0: "revolute", 1: "prismatic", 2: "spherica
 #: ``getCollisionShapeData``'s geometry codes (``p.GEOM_*``) as the seam's shape kinds.
 SHAPE_KINDS: dict[int, ShapeKind] = {2: "sphere", 3: "box", 4: "cylinder", 5: "mesh",
                                      6: "plane", 7: "capsule"}
+_MESH = 5
 #: A mimic gear's error reduction per step (PyBullet's default, 0.2, leaves a sag under load:
 #: a 0.5 kg mast following at x 2 against gravity sat 0.37 mm off; at 0.8, 0.010 mm;
 #: urdfkit/motion/mimic.py has the measurements).
@@ -159,6 +163,7 @@ class PyBulletEngine:
         self._motor_array = b.setJointMotorControlArray
         self._base_pose = b.getBasePositionAndOrientation
         self._base_velocity = b.getBaseVelocity
+        self._closest = b.getClosestPoints
 
     @property
     def bullet(self) -> Bullet:
@@ -176,15 +181,20 @@ class PyBulletEngine:
 
     # ---- the world
 
-    def load(self, path: str, settings: LoadSettings, display: str | None = None) -> int:
-        """Load a guarded URDF (:meth:`Session.load_urdf`, its flags from ``settings``)."""
+    def load(self, path: str, settings: LoadSettings, display: str | None = None, *,
+             flags: int = 0) -> int:
+        """Load a guarded URDF (:meth:`Session.load_urdf`, its flags from ``settings``).
+
+        ``flags``: further ``p.URDF_*`` flags, PyBullet's own (render's
+        ``URDF_IGNORE_VISUAL_SHAPES``: :mod:`urdfkit.engine.pybullet_render`).
+        """
         from urdfkit.engine.session import LoadOptions
 
         body = self.session.load_urdf(path, LoadOptions(
             fixed_base=settings.fixed_base, inertia_from_file=settings.inertia_from_file,
             implicit_cylinder=settings.implicit_cylinder,
             self_collision=settings.self_collision, base_position=settings.position,
-            base_orientation=settings.orientation), display=display)
+            base_orientation=settings.orientation, extra_flags=flags), display=display)
         if not settings.scenery:
             self._lifted.append(body)
         if self._removed:
@@ -359,6 +369,10 @@ class PyBulletEngine:
         """``resetJointState``."""
         self.session.bullet.resetJointState(body, joint, position, velocity)
 
+    def reset_spherical_joint(self, body: int, joint: int, orientation: Quat) -> None:
+        """``resetJointStateMultiDof`` (which zeroes the joint's velocity: measured)."""
+        self.session.bullet.resetJointStateMultiDof(body, joint, list(orientation))
+
     def set_joint_positions(self, body: int, positions: Sequence[float],
                             velocities: Sequence[float] | None = None) -> None:
         """``resetJointState`` of every movable joint, in :meth:`joints` order."""
@@ -416,13 +430,20 @@ class PyBulletEngine:
 
     def closest_points(self, body: int, other: int, distance: float, link: int | None = None,
                        other_link: int | None = None) -> list[ContactPoint]:
-        """``getClosestPoints`` of ``body`` (``linkIndexA``) and ``other`` (``linkIndexB``)."""
-        links: dict[str, int] = {}
-        if link is not None:
-            links["linkIndexA"] = link
-        if other_link is not None:
-            links["linkIndexB"] = other_link
-        found = self.session.bullet.getClosestPoints(body, other, distance, **links)
+        """``getClosestPoints`` of ``body`` (``linkIndexA``) and ``other`` (``linkIndexB``).
+
+        Bound once, each form spelt out, two links by position: collisions asks for every
+        link pair in every pose (r2d2's 91 pairs: 2.5 us a pair here, 2.3 us the bare call;
+        a dict of keywords cost 0.55 us more).
+        """
+        closest = self._closest
+        if link is None:
+            found = closest(body, other, distance) if other_link is None else \
+                closest(body, other, distance, linkIndexB=other_link)
+        elif other_link is None:
+            found = closest(body, other, distance, linkIndexA=link)
+        else:
+            found = closest(body, other, distance, link, other_link)
         if not found:
             return []
         return [_contact_point(pt[1:14]) for pt in found]
@@ -516,6 +537,17 @@ class PyBulletEngine:
                            implicit_cylinder=settings.implicit_cylinder,
                            self_collision=settings.self_collision).flag_names()
 
+    def visual_shapes(self, body: int) -> list[VisualShape]:
+        """``getVisualShapeData``, quiet (what PyBullet prints goes to the diagnostics)."""
+        from urdfkit.engine.session import quiet_stdout
+
+        with quiet_stdout() as out:
+            rows = self.session.bullet.getVisualShapeData(body)
+        self.session.diagnostics.extend(out.lines)
+        return [VisualShape(int(v[1]), SHAPE_KINDS.get(v[2], "other"), v[3],
+                            _name(v[4]) if v[2] == _MESH else "", v[5], v[6], v[7])
+                for v in rows]
+
     def aabb(self, body: int, link: int) -> tuple[Vec3, Vec3]:
         """``getAABB``."""
         lo, hi = self.session.bullet.getAABB(body, link)
@@ -533,6 +565,39 @@ class PyBulletEngine:
                                  renderer=self.session.p.ER_TINY_RENDERER)[2]
         rgba = np.asarray(image, dtype=np.uint8).reshape(height, width, 4)
         return rgba[:, :, :3].tobytes()
+
+    def picture(self, camera: Camera, width: int, height: int, light: Light | None = None
+                ) -> Picture:
+        """``getCameraImage`` with the TinyRenderer: RGB, segmentation mask, matrices.
+
+        The matrices are ``computeViewMatrix``'s and ``computeProjectionMatrixFOV``'s. PyBullet
+        computes the matrices in float32; they are handed out as it gives them, so
+        that what is drawn over the picture meets what PyBullet drew.
+        """
+        import numpy as np
+
+        b = self.session.bullet
+        view = b.computeViewMatrix(camera.eye, camera.target, camera.up)
+        proj = b.computeProjectionMatrixFOV(camera.fov, width / height, camera.near,
+                                            camera.far)
+        renderer = self.session.p.ER_TINY_RENDERER
+        shoot = self.session.call  # quiet: a picture may go to stdout (render -o -)
+        if light is None:
+            shot = shoot("getCameraImage", width, height, view, proj, renderer=renderer)
+        else:
+            shot = shoot(
+                "getCameraImage", width, height, view, proj, renderer=renderer,
+                lightDirection=list(light.direction), shadow=int(light.shadows),
+                lightAmbientCoeff=light.ambient, lightDiffuseCoeff=light.diffuse,
+                lightSpecularCoeff=light.specular)
+        from PIL import Image
+
+        # Pillow drops the alpha in a third of the time numpy's strided copy takes (5 against
+        # 16 ms at 1600x1200, render's supersampled 800x600)
+        rgba = np.ascontiguousarray(shot[2], dtype=np.uint8)
+        rgb = Image.frombuffer("RGBA", (width, height), rgba, "raw", "RGBA", 0, 1).convert("RGB")
+        bodies = np.ascontiguousarray(shot[4], dtype="<i4").tobytes()
+        return Picture(width, height, rgb.tobytes(), bodies, tuple(view), tuple(proj))
 
     # ---- dynamics
 

@@ -159,7 +159,7 @@ def pybullet_shapes(engine: PyBulletEngine, body: int, link_index: dict[str, int
             elif kind in ("cylinder", "capsule"):
                 size = (dims[1], dims[0] / 2)
             elif kind == "mesh":
-                pts = _mesh_points(s.file, scale)
+                pts = _mesh_points(s.filename, scale)
                 if pts is None:
                     skipped.append(f"{link}: a mesh urdfkit's readers find no vertices in")
                     continue

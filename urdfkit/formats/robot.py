@@ -182,8 +182,8 @@ def _vec3(el: Any, attr: str, default: Vec = (0.0, 0.0, 0.0)) -> Vec:
         return default
     out = (values[0], values[1], values[2])
     if not all(map(math.isfinite, out)):
-        raise InputError(f"<{el.tag} {attr}={text[:60]!r}> is not a finite vector; MuJoCo "
-                         "cannot place anything with it", line=line_of(el))
+        raise InputError(f"<{el.tag} {attr}={text[:60]!r}> is not a finite vector; no frame "
+                         "can be placed with it", line=line_of(el))
     _ODD.append((el, attr, out))
     return out
 
@@ -319,15 +319,23 @@ def _non_finite(text: str | None) -> bool:
     return x is not None and not math.isfinite(x)
 
 
-def read_robot(root: Any, file: str) -> Robot:
+def read_robot(root: Any, file: str, *, planar: bool = False) -> Robot:
     """The robot of a guarded ``<robot>`` element (:class:`urdfkit.sources.resolve.Resolved`).
 
+    Args:
+        root: The ``<robot>`` element.
+        file: The file as the user named it (for messages).
+        planar: Read planar joints (forward kinematics holds them at their origin, as every
+            multi-dof joint), where the MJCF export must refuse them.
+
     Raises:
-        InputError: A joint type MuJoCo has no counterpart for here (planar), with its line.
+        InputError: A joint type MuJoCo has no counterpart for here (planar, unless
+            ``planar``), a moving joint with a zero axis, a vector that is not finite; with
+            its line.
     """
     _ODD.clear()
     try:
-        robot = _read(root, file)
+        robot = _read(root, file, planar)
     except InputError as e:
         if e.file is None:
             e.file = file
@@ -340,12 +348,12 @@ def read_robot(root: Any, file: str) -> Robot:
     return robot
 
 
-def _read(root: Any, file: str) -> Robot:
+def _read(root: Any, file: str, planar: bool = False) -> Robot:
     materials = {m.get("name"): m for m in root.iterfind("material") if m.get("name")}
     links = {el.get("name", ""): _link(el, materials) for el in root.iterfind("link")}
     joints = [_joint(el) for el in root.iterfind("joint")]
     for j in joints:
-        if j.type == "planar":
+        if j.type == "planar" and not planar:
             raise InputError(f"joint {j.name!r} is planar; export does not map planar joints "
                              "to MuJoCo yet (two slides and a hinge)", file=file, line=j.line)
         norm = math.sqrt(sum(a * a for a in j.axis))
