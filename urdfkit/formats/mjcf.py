@@ -161,31 +161,22 @@ class _Mass:
 def combine(parts: list[tuple[Inertial, Any]]) -> _Mass:
     """Mass properties of rigidly joined links: (inertial, link frame in the body) each.
 
-    Exact: masses add, the centre of mass is their weighted mean, and each tensor is rotated
-    into the body's axes and moved to the common centre by the parallel-axis theorem.
+    Each link's centre and tensor are placed in the body's axes, then joined by
+    :func:`urdfkit.model.massprops.combine` (the parallel-axis theorem).
     """
     import numpy as np
 
+    from urdfkit.model.massprops import combine as join
+
     with np.errstate(all="ignore"):  # huge values overflow: check_mass refuses the result
-        return _combine(parts)
-
-
-def _combine(parts: list[tuple[Inertial, Any]]) -> _Mass:
-    import numpy as np
-
-    total = sum(i.mass for i, _ in parts)
-    coms = [t[:3, :3] @ np.array(i.com) + t[:3, 3] for i, t in parts]
-    if total > 0:
-        com = sum(i.mass * c for (i, _), c in zip(parts, coms, strict=True)) / total
-    else:
-        com = coms[0]
-    tensor = np.zeros((3, 3))
-    for (i, t), c in zip(parts, coms, strict=True):
-        r = t[:3, :3]
-        tensor += r @ np.array(i.tensor) @ r.T
-        d = c - com
-        tensor += i.mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
-    return _Mass(float(total), com, (tensor + tensor.T) / 2)
+        placed = []
+        for i, t in parts:
+            r = t[:3, :3]
+            com = r @ np.array(i.com) + t[:3, 3]
+            tensor = r @ np.array(i.tensor) @ r.T
+            placed.append((i.mass, com.tolist(), tensor.tolist()))
+    total = join(placed)
+    return _Mass(float(total.mass), np.array(total.com), np.array(total.tensor))
 
 
 class _Writer:
