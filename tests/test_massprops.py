@@ -6,14 +6,18 @@ through it."""
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 from lxml import etree
+from typer.testing import CliRunner
 
 from urdfkit.builder import Box, Inertial, Origin
 from urdfkit.checks.rules_mass import link_solid
+from urdfkit.cli import app
 from urdfkit.formats.fk import origin_matrix
 from urdfkit.formats.mjcf import combine as fuse
 from urdfkit.formats.robot import Inertial as LoadedInertial
@@ -102,6 +106,23 @@ def test_checks_collision_solid_of_two_halves_is_the_box() -> None:
     assert np.array(solid.com) == pytest.approx(AT, abs=1e-15)
     whole = _whole(volume)   # per unit density: the volume is the mass
     _close(solid.tensor, whole, float(np.abs(whole).max()))
+
+
+def test_check_measures_a_link_of_two_halves_against_the_whole_box(tmp_path: Path) -> None:
+    # The whole 1.6 x 0.5 x 0.2 box of 3 kg has the trace 3 (2.56 + 0.25 + 0.04) / 6; the file
+    # says a twentieth of each moment, and check says so (U605), through the one combination.
+    whole = [float(x) / 20 for x in np.diag(_box(MASS, (2 * A, B, C)))]
+    path = tmp_path / "halves.urdf"
+    path.write_text(
+        f'<robot name="r"><link name="base"><inertial><mass value="{MASS}"/><inertia '
+        f'ixx="{whole[0]!r}" iyy="{whole[1]!r}" izz="{whole[2]!r}" ixy="0" ixz="0" iyz="0"/>'
+        '</inertial>' + "".join(
+            f'<collision><origin xyz="{s * A / 2} 0 0"/><geometry><box size="{A} {B} {C}"/>'
+            '</geometry></collision>' for s in (-1, 1)) + '</link></robot>')
+    r = CliRunner().invoke(app, ["check", str(path), "--json", "--no-cache"])
+    said = [f["message"] for f in json.loads(r.stdout)["findings"] if f["code"] == "U605"]
+    assert len(said) == 1 and "is 0.05 times what its collision shapes and mass 3 kg imply" \
+        in said[0], said
 
 
 def test_the_builders_inertia_from_two_halves_is_the_box() -> None:
