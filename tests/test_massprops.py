@@ -20,7 +20,7 @@ from urdfkit.checks.rules_mass import link_solid
 from urdfkit.cli import app
 from urdfkit.formats.fk import origin_matrix
 from urdfkit.formats.mjcf import combine as fuse
-from urdfkit.formats.robot import Inertial as LoadedInertial
+from urdfkit.formats.robot import LoadedInertial
 from urdfkit.model.massprops import combine
 from urdfkit.model.spec import rpy_to_matrix
 

@@ -15,7 +15,7 @@ from typing import Any
 from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.engine.api import LinkDynamics, LoadSettings, Quat, Vec3
 from urdfkit.engine.mujoco_motors import Motor
-from urdfkit.formats.robot import Robot
+from urdfkit.formats.robot import LoadedRobot
 
 #: The export's group of collision geoms (``formats.mjcf.COLLISION_GROUP``).
 COLLISION_GROUP = 3
@@ -27,7 +27,7 @@ FIXABLE_INERTIA = ("U602", "U603", "U604", "U608")
 
 
 @dataclass
-class Link:
+class WorldLink:
     """One URDF link in the world.
 
     Attributes:
@@ -67,12 +67,12 @@ class Loaded:
             left out, one line each.
     """
 
-    robot: Robot
+    robot: LoadedRobot
     display: str
     settings: LoadSettings
     spec: Any
     assets: dict[str, bytes]
-    links: list[Link]
+    links: list[WorldLink]
     geom_links: dict[str, str]
     collisions: list[tuple[str, str, str]]
     static: set[str]
@@ -81,7 +81,7 @@ class Loaded:
     motors: dict[int, Motor] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
 
-    def link(self, index: int) -> Link:
+    def link(self, index: int) -> WorldLink:
         """Link ``index`` (-1: the root), or a ParameterError naming the range."""
         if not -1 <= index < len(self.links) - 1:
             raise ParameterError(f"`link` {index} is not a link of {self.display} (it has -1 "
@@ -105,7 +105,7 @@ def prepare(mujoco: Any, path: str, settings: LoadSettings, display: str | None)
     from urdfkit.engine.inertials import link_tensor, loaded_dynamics
     from urdfkit.formats.fk import fused
     from urdfkit.formats.mjcf import ExportOptions, export_mjcf
-    from urdfkit.formats.robot import Inertial, read_robot
+    from urdfkit.formats.robot import LoadedInertial, read_robot
     from urdfkit.sources.resolve import resolve
 
     name = display or str(path)
@@ -119,7 +119,7 @@ def prepare(mujoco: Any, path: str, settings: LoadSettings, display: str | None)
                                  param="implicit_cylinder")
         loaded = loaded_dynamics(resolved.load_path, inertia_from_file=settings.inertia_from_file,
                                  display=name)
-        inertials = {n: Inertial(d.mass, d.inertial_position, link_tensor(d))
+        inertials = {n: LoadedInertial(d.mass, d.inertial_position, link_tensor(d))
                      for n, d in loaded.items()}
         try:
             e = export_mjcf(robot, ExportOptions(
@@ -143,8 +143,8 @@ def prepare(mujoco: Any, path: str, settings: LoadSettings, display: str | None)
             collisions.append((g.name, e.geom_links[g.name], where[e.geom_links[g.name]][0]))
             w, x, y, z = (float(v) for v in g.quat)
             placed[g.name] = ((float(g.pos[0]), float(g.pos[1]), float(g.pos[2])), (x, y, z, w))
-    links = [Link(robot.root, where[robot.root][0], where[robot.root][1], loaded[robot.root])]
-    links += [Link(j.child, where[j.child][0], where[j.child][1], loaded[j.child])
+    links = [WorldLink(robot.root, where[robot.root][0], where[robot.root][1], loaded[robot.root])]
+    links += [WorldLink(j.child, where[j.child][0], where[j.child][1], loaded[j.child])
               for j in robot.joints]
     root_mass = loaded[robot.root].mass
     static = {robot.root} if settings.fixed_base or root_mass == 0 or robot.root == "world" \

@@ -32,7 +32,7 @@ from urdfkit.core.errors import EngineError, InputError, MissingDependencyError
 from urdfkit.exchange.agree_tree import match_models, tree_errors
 from urdfkit.formats.fk import fused, link_frames
 from urdfkit.formats.mjcf import combine
-from urdfkit.formats.robot import Inertial, Robot
+from urdfkit.formats.robot import LoadedInertial, LoadedRobot
 
 if TYPE_CHECKING:
     from urdfkit.engine.session import Session
@@ -270,11 +270,11 @@ class _Pybullet:
         return frame(*self.b.getBasePositionAndOrientation(body)) @ np.linalg.inv(
             frame(d[3], d[4]))
 
-    def inertial(self, link: str) -> Inertial:
+    def inertial(self, link: str) -> LoadedInertial:
         """A link's mass properties as PyBullet loaded them (floating load), link frame."""
         return self.inertials[link]
 
-    def _inertial(self, index: int) -> Inertial:
+    def _inertial(self, index: int) -> LoadedInertial:
         import numpy as np
 
         from urdfkit.model.spec import quat_to_matrix
@@ -282,8 +282,8 @@ class _Pybullet:
         d = self.b.getDynamicsInfo(self.free, index)
         r = np.array(quat_to_matrix(d[4]))
         tensor = r @ np.diag(d[2]) @ r.T
-        return Inertial(float(d[0]), tuple(d[3]),
-                        tuple(map(tuple, tensor)))  # type: ignore[arg-type]
+        return LoadedInertial(float(d[0]), tuple(d[3]),
+                              tuple(map(tuple, tensor)))  # type: ignore[arg-type]
 
     def pose(self, q: dict[str, float]) -> None:
         for i, name in zip(self.one, self.one_names, strict=True):
@@ -321,7 +321,7 @@ class _Pybullet:
         return out
 
 
-def pybullet_frame_tolerances(robot: Robot) -> dict[str, float]:
+def pybullet_frame_tolerances(robot: LoadedRobot) -> dict[str, float]:
     """Each link frame's tolerance against PyBullet's ``getLinkState``: float32 inside.
 
     A float32 rounding is 2^-24 relative; each transform on the way from the root rounds a
@@ -355,7 +355,7 @@ def sample_range(j: Any) -> tuple[float, float]:
     return max(j.lower, near - reach), min(j.upper, near + reach)
 
 
-def _sample(robot: Robot, names: list[str], rng: Any) -> dict[str, float]:
+def _sample(robot: LoadedRobot, names: list[str], rng: Any) -> dict[str, float]:
     q = {}
     joints = {j.name: j for j in robot.joints}
     for n in names:
@@ -396,7 +396,7 @@ def _frame_error(a: Any, b: Any) -> tuple[float, float]:
 
 
 class _Compare:
-    def __init__(self, robot: Robot, model_path: str, session: Any,
+    def __init__(self, robot: LoadedRobot, model_path: str, session: Any,
                  load_path: str, options: AgreeOptions) -> None:
         import mujoco
 
@@ -602,7 +602,7 @@ class _Compare:
         where = fused(robot)
         zero = link_frames(robot, {})
         # PyBullet: each body group (fixed links fused), in the world at the zero pose
-        groups: dict[str, list[tuple[Inertial, Any]]] = {}
+        groups: dict[str, list[tuple[LoadedInertial, Any]]] = {}
         for link, (body, _) in where.items():
             if link in self.pb.link_index:
                 groups.setdefault(body, []).append((self.pb.inertial(link), zero[link]))
@@ -629,8 +629,8 @@ class _Compare:
                 if not (body == robot.root == "world" and combine(parts).mass == 0):
                     missing.append(body)  # (a massless `world` is MuJoCo's world body)
                 continue
-            ours, theirs = combine(parts), combine(weld.get(image[body], []) or
-                                                   [(Inertial(0.0, (0, 0, 0), _ZERO3), np.eye(4))])
+            ours, theirs = combine(parts), combine(
+                weld.get(image[body], []) or [(LoadedInertial(0.0, (0, 0, 0), _ZERO3), np.eye(4))])
             mass.append((abs(ours.mass - theirs.mass) / max(ours.mass, theirs.mass, 1e-300),
                          body))
             if ours.mass <= 0:
@@ -680,7 +680,7 @@ class _Compare:
                     "the dynamics and the swing are not compared",
                     status="known")
 
-    def _mujoco_weld_groups(self, d: Any) -> tuple[dict[int, list[tuple[Inertial, Any]]],
+    def _mujoco_weld_groups(self, d: Any) -> tuple[dict[int, list[tuple[LoadedInertial, Any]]],
                                                     list[tuple[float, str]]]:
         """MuJoCo's bodies' mass properties by weld group (as written), placed by ``d``.
 
@@ -690,7 +690,7 @@ class _Compare:
         import numpy as np
 
         mj, m = self.mj, self.fixed
-        weld: dict[int, list[tuple[Inertial, Any]]] = {}
+        weld: dict[int, list[tuple[LoadedInertial, Any]]] = {}
         snapped: list[tuple[float, str]] = []
         for b in range(1, m.nbody):
             # the inertial frame as the MJCF gives it (body_ipos, body_iquat): MuJoCo's
@@ -701,8 +701,8 @@ class _Compare:
             t = np.eye(4)
             t[:3, :3] = d.xmat[b].reshape(3, 3) @ turn.reshape(3, 3)
             t[:3, 3] = d.xpos[b] + d.xmat[b].reshape(3, 3) @ m.body_ipos[b]
-            own = Inertial(float(m.body_mass[b]), (0.0, 0.0, 0.0),
-                           tuple(map(tuple, np.diag(m.body_inertia[b]))))  # type: ignore[arg-type]
+            own = LoadedInertial(float(m.body_mass[b]), (0.0, 0.0, 0.0),
+                                 tuple(map(tuple, np.diag(m.body_inertia[b]))))  # type: ignore[arg-type]
             if int(m.body_sameframe[b]):
                 sim = d.ximat[b].reshape(3, 3)
                 full = t[:3, :3] @ np.diag(m.body_inertia[b]) @ t[:3, :3].T

@@ -21,7 +21,7 @@ from typing import Any
 
 from urdfkit.core.errors import ParameterError
 from urdfkit.formats.fk import fused, link_frames, unit
-from urdfkit.formats.robot import Robot
+from urdfkit.formats.robot import LoadedRobot
 
 #: How far (m, and in the rotation matrix) a body's zero-pose frame may be from a link's for
 #: the two to be matched by the tree's shape (files written with 6 significant digits match).
@@ -101,7 +101,7 @@ def _close(a: Any, b: Any) -> float:
     return float(max(np.abs(a[:3, 3] - b[:3, 3]).max(), np.abs(a[:3, :3] - b[:3, :3]).max()))
 
 
-def match_models(mj: Any, fixed: Any, robot: Robot, movable: list[str],
+def match_models(mj: Any, fixed: Any, robot: LoadedRobot, movable: list[str],
                  name_map: dict[str, str]) -> Matching:
     """Match the URDF's links and movable joints to the (base-welded) MuJoCo model's.
 
@@ -164,7 +164,7 @@ def _mj_body_of(out: Matching, model: _Model, link: str) -> int | None:
     return None
 
 
-def _match_by_shape(model: _Model, robot: Robot, movable: set[str], out: Matching) -> None:
+def _match_by_shape(model: _Model, robot: LoadedRobot, movable: set[str], out: Matching) -> None:
     """Match what names did not by the tree's shape and the zero-pose frames."""
     import numpy as np
 
@@ -254,7 +254,7 @@ def _joint_name(model: _Model, k: int) -> str:
     return next((n for n, i in model.joint.items() if i == k), f"joint {k}")
 
 
-def tree_errors(mj: Any, written: Any, fixed: Any, robot: Robot, match: Matching
+def tree_errors(mj: Any, written: Any, fixed: Any, robot: LoadedRobot, match: Matching
                 ) -> tuple[list[str], int]:
     """What differs in the body tree (one line each, naming the body), and groups compared.
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 from urdfkit.model.spec import Matrix3, Vec3, axis_angle_matrix, matmul, rotate, rpy_to_matrix
 
 if TYPE_CHECKING:
-    from urdfkit.formats.robot import Joint, Robot
+    from urdfkit.formats.robot import LoadedJoint, LoadedRobot
 
 #: A link's frame: its rotation (the link's axes in the world's) and its origin.
 Frame = tuple[Matrix3, Vec3]
@@ -48,7 +48,7 @@ def child_frame(parent: Frame, xyz: Sequence[float], rpy: Sequence[float]) -> Fr
     return matmul(rot, rpy_to_matrix(rpy)), (pos[0] + o[0], pos[1] + o[1], pos[2] + o[2])
 
 
-def moved(frame: Frame, joint: Joint, q: float) -> Frame:
+def moved(frame: Frame, joint: LoadedJoint, q: float) -> Frame:
     """A 1-dof joint's child frame (at q = 0: ``frame``) at position ``q`` (rad or m)."""
     if q == 0:
         return frame
@@ -62,7 +62,7 @@ def moved(frame: Frame, joint: Joint, q: float) -> Frame:
     return frame
 
 
-def frames(robot: Robot, q: Mapping[str, float], base: Frame = WORLD) -> dict[str, Frame]:
+def frames(robot: LoadedRobot, q: Mapping[str, float], base: Frame = WORLD) -> dict[str, Frame]:
     """Every link's frame at joint positions ``q`` (missing joints at 0), the root's ``base``.
 
     Spherical joints count as fixed here (``agree`` poses 1-dof joints only).
@@ -76,7 +76,7 @@ def frames(robot: Robot, q: Mapping[str, float], base: Frame = WORLD) -> dict[st
     return out
 
 
-def link_frames(robot: Robot, q: Mapping[str, float], base: Any = None) -> dict[str, Any]:
+def link_frames(robot: LoadedRobot, q: Mapping[str, float], base: Any = None) -> dict[str, Any]:
     """:func:`frames` as 4x4 transforms (numpy); ``base`` the root's (identity by default)."""
     import numpy as np
 
@@ -94,7 +94,7 @@ def link_frames(robot: Robot, q: Mapping[str, float], base: Any = None) -> dict[
     return out
 
 
-def fused(robot: Robot, split_world: bool = False) -> dict[str, tuple[str, Any]]:
+def fused(robot: LoadedRobot, split_world: bool = False) -> dict[str, tuple[str, Any]]:
     """Each link's body after fixed links are fused: (body link, the link's frame in it).
 
     A body is the root link or the child of a joint that moves; a link under a fixed joint
