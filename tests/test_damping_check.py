@@ -7,13 +7,20 @@ import json
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from urdfkit.checks.rules_joints import _zero_pose_tree
 from urdfkit.cli import app
+from urdfkit.formats.fk import link_frames
+from urdfkit.formats.robot import read_robot
+from urdfkit.model.index import Doc
+from urdfkit.sources.resolve import resolve
 
 runner = CliRunner()
-STIFF = Path(__file__).parent / "fixtures" / "robots" / "stiff_damping.urdf"
+ROBOTS = Path(__file__).parent / "fixtures" / "robots"
+STIFF = ROBOTS / "stiff_damping.urdf"
 
 
 def _u311(path: Path) -> list[dict]:
@@ -136,3 +143,31 @@ def test_a_damped_joint_without_a_child_is_a_finding_not_a_crash(tmp_path: Path)
     assert "U201" in {f["code"] for f in json.loads(r.stdout)["findings"]}
     r = runner.invoke(app, ["fix", str(path), "--diff"])
     assert r.exit_code in (0, 1), r.output
+
+
+@pytest.mark.parametrize("name", [
+    "kuka_iiwa/model.urdf", "r2d2.urdf", "quadruped/minitaur.urdf", "xarm/xarm6_robot.urdf",
+    "laikago/laikago.urdf", "franka_panda/panda.urdf", str(ROBOTS / "coupled_damping.urdf"),
+    str(ROBOTS / "turned_arm.urdf"), str(ROBOTS / "ur_like.urdf"),
+    str(ROBOTS / "panda_like.urdf")])
+def test_u311_places_every_link_where_formats_fk_does(name: str) -> None:
+    """The zero-pose mass matrix U311 judges puts each link at urdfkit.formats.fk's frame (the
+    one forward kinematics, which tests/test_export_units.py holds to yourdfpy at 1e-12)."""
+    with resolve(name) as r:
+        robot = read_robot(r.root, r.name)
+        doc = Doc(r.root)
+    links = {lv.name: lv for lv in doc.links if lv.name is not None}
+    below: dict[str, list] = {}
+    for jv in doc.joints:
+        parent = jv.parent.get("link") if jv.parent is not None else None
+        if parent is not None and jv.child is not None:
+            below.setdefault(parent, []).append(jv)
+    tree = _zero_pose_tree(doc, links, below)
+    assert tree is not None
+    _, order, frames, _ = tree
+    fk = link_frames(robot, {})
+    assert sorted(order) == sorted(fk) == sorted(robot.links)
+    for link in order:
+        rot, pos = frames[link]
+        assert np.array(rot) == pytest.approx(fk[link][:3, :3], abs=1e-12), link
+        assert np.array(pos) == pytest.approx(fk[link][:3, 3], abs=1e-12), link

@@ -10,7 +10,7 @@ import pytest
 
 from urdfkit.formats.fk import link_frames
 from urdfkit.formats.mjcf import combine, mat_to_quat
-from urdfkit.formats.robot import Inertial, read_robot
+from urdfkit.formats.robot import LoadedInertial, read_robot
 from urdfkit.sources.resolve import resolve
 
 
@@ -46,7 +46,7 @@ def test_quaternions_agree_with_pybullet() -> None:
 
 def test_two_point_masses_fuse_to_the_dumbbell_formula() -> None:
     # two 1 kg points 2 m apart on x: centre between them, I_yy = I_zz = 2 * 1 * 1^2
-    point = Inertial(1.0, (0.0, 0.0, 0.0), ((0.0, 0, 0), (0, 0.0, 0), (0, 0, 0.0)))
+    point = LoadedInertial(1.0, (0.0, 0.0, 0.0), ((0.0, 0, 0), (0, 0.0, 0), (0, 0, 0.0)))
     left, right = np.eye(4), np.eye(4)
     left[0, 3], right[0, 3] = -1.0, 1.0
     m = combine([(point, left), (point, right)])

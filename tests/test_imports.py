@@ -78,3 +78,37 @@ def test_installed_console_script_help() -> None:
     assert proc.returncode == 0
     for command in ("joints", "links", "tree", "info"):
         assert command in proc.stdout
+
+
+COMPOUND_DAMPED = """<robot name="compound">
+  <link name="base">
+    <inertial><mass value="3"/>
+      <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.006" iyz="0" izz="0.007"/></inertial>
+    <collision><origin xyz="-0.4 0 0"/><geometry><box size="0.8 0.5 0.2"/></geometry></collision>
+    <collision><origin xyz="0.4 0 0" rpy="0 0 0.3"/><geometry><box size="0.8 0.5 0.2"/></geometry>
+    </collision>
+  </link>
+  <link name="finger">
+    <inertial><mass value="0.01"/>
+      <inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial>
+    <collision><geometry><box size="0.02 0.02 0.02"/></geometry></collision>
+  </link>
+  <joint name="hinge" type="revolute">
+    <parent link="base"/><child link="finger"/><origin xyz="0.8 0 0.1" rpy="0.2 0 0"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
+    <dynamics damping="0.1"/>
+  </joint>
+</robot>
+"""
+
+
+def test_check_of_damped_joints_and_compound_links_imports_no_numpy(tmp_path: Path) -> None:
+    """U311 places links with urdfkit.formats.fk and check joins a link's collision solids with
+    urdfkit.model.massprops, both plain Python: numpy (~65 ms to import) stays out of check
+    unless a mesh is read or U311's Gershgorin bound passes 2."""
+    path = tmp_path / "compound.urdf"
+    path.write_text(COMPOUND_DAMPED)
+    proc, modules = loaded_modules("check", str(path), "--json", "--no-cache")
+    codes = {f["code"] for f in json.loads(proc.stdout)["findings"]}
+    assert {"U311", "U605"} <= codes, codes  # the damping judged; base against its two boxes
+    assert "numpy" not in modules

@@ -7,7 +7,7 @@ on the mass matrix at the zero pose).
 from __future__ import annotations
 
 import math
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 from lxml import etree
 
@@ -24,6 +24,9 @@ from urdfkit.model.spec import attr_float as _num
 from urdfkit.model.spec import attr_vec as _vec
 from urdfkit.sources.guard import RuleReport
 from urdfkit.sources.references import label
+
+if TYPE_CHECKING:  # formats.fk is imported where a damped joint needs it
+    from urdfkit.formats.fk import Frame
 
 
 def rule_mimic(root: etree._Element, r: RuleReport) -> None:
@@ -175,18 +178,21 @@ Chain = list[tuple[int, tuple[float, ...], tuple[float, ...], bool]]
 
 
 def _zero_pose_tree(doc: Doc, links: dict[str, LinkView], below: dict[str, list[Any]]
-                    ) -> tuple[list[str], list[str], dict[str, Any], dict[str, Chain]] | None:
+                    ) -> tuple[list[str], list[str], dict[str, Frame], dict[str, Chain]] | None:
     """The tree at the zero pose, or None when it does not read.
 
     Returns the moving joints' names, the links root first, each link's frame (rotation,
-    origin) and the moving joints above it (index, axis, a point on it, prismatic). It does not
-    read with not one root, a loop, a missing link or a bad number.
+    origin: :func:`urdfkit.formats.fk.child_frame` composes it) and the moving joints above it
+    (index, axis, a point on it, prismatic). It does not read with not one root, a loop, a
+    missing link or a bad number.
     """
+    from urdfkit.formats.fk import WORLD, child_frame
+
     children = {jv.child.get("link") for jv in doc.joints if jv.child is not None}
     roots = [n for n in links if n not in children]
     if len(roots) != 1:
         return None
-    frame: dict[str, Any] = {roots[0]: (_IDENTITY, (0.0, 0.0, 0.0))}
+    frame: dict[str, Frame] = {roots[0]: WORLD}
     chain: dict[str, Chain] = {roots[0]: []}
     names: list[str] = []
     order: list[str] = []
@@ -194,13 +200,13 @@ def _zero_pose_tree(doc: Doc, links: dict[str, LinkView], below: dict[str, list[
     while stack:
         name = stack.pop()
         order.append(name)
-        rot, pos = frame[name]
+        here = frame[name]
         for jv in below.get(name, ()):
             child = jv.child.get("link") if jv.child is not None else None
-            placed = _child_frame(jv, rot, pos)
-            if child is None or child in frame or child not in links or placed is None:
+            origin = _origin(jv)
+            if child is None or child in frame or child not in links or origin is None:
                 return None
-            crot, cpos = frame[child] = placed
+            crot, cpos = frame[child] = child_frame(here, *origin)
             chain[child] = list(chain[name])
             if jv.type in ("revolute", "continuous", "prismatic"):
                 axis = _unit_axis(jv)
@@ -327,15 +333,11 @@ def _link_inertia(lv: LinkView, rot: Matrix3, pos: tuple[float, ...]
             matmul(rot, rpy_to_matrix(rpy)), tensor)
 
 
-def _child_frame(jv: Any, rot: Matrix3, pos: tuple[float, ...]
-                 ) -> tuple[Matrix3, tuple[float, ...]] | None:
-    """The frame of joint ``jv``'s child link at q = 0, its parent's being (rot, pos)."""
+def _origin(jv: Any) -> tuple[tuple[float, ...], tuple[float, ...]] | None:
+    """Joint ``jv``'s ``<origin>`` (xyz, rpy), or None when a number does not read (U401)."""
     xyz = _vec(jv.origin, "xyz", 3, (0.0, 0.0, 0.0))
     rpy = _vec(jv.origin, "rpy", 3, (0.0, 0.0, 0.0))
-    if xyz is None or rpy is None:
-        return None
-    return (matmul(rot, rpy_to_matrix(rpy)),
-            tuple(p + o for p, o in zip(pos, rotate(rot, xyz), strict=True)))
+    return None if xyz is None or rpy is None else (xyz, rpy)
 
 
 def _unit_axis(jv: Any) -> tuple[float, ...] | None:
@@ -355,21 +357,23 @@ def _joint_inertia(jv: JointView, links: dict[str, LinkView], below: dict[str, l
     The sum stops once it passes ``enough`` while no link's term was negative (only an
     invalid tensor gives one): the caller only asks whether it stays under.
     """
+    from urdfkit.formats.fk import WORLD, child_frame
+
     a = _unit_axis(jv)
     if a is None:
         return None
     prismatic = jv.type == "prismatic"
     # frames relative to the joint's own (its child link's frame at q = 0)
-    todo: list[tuple[str | None, Matrix3, tuple[float, ...]]] = [
-        (jv.child.get("link") if jv.child is not None else None, _IDENTITY, (0.0, 0.0, 0.0))]
+    todo: list[tuple[str | None, Frame]] = [
+        (jv.child.get("link") if jv.child is not None else None, WORLD)]
     seen: set[str] = set()
     total = 0.0
     while todo:
-        name, rot, pos = todo.pop()
+        name, here = todo.pop()
         if name is None or name in seen or name not in links:
             return None
         seen.add(name)
-        body = _link_inertia(links[name], rot, pos)
+        body = _link_inertia(links[name], *here)
         if body is None:
             return None
         mass, com, frame, tensor = body
@@ -386,9 +390,9 @@ def _joint_inertia(jv: JointView, links: dict[str, LinkView], below: dict[str, l
         elif total > enough:
             return total
         for child in below.get(name, ()):
-            placed = _child_frame(child, rot, pos)
-            if placed is None:
+            origin = _origin(child)
+            if origin is None:
                 return None
             todo.append((child.child.get("link") if child.child is not None else None,
-                         *placed))
+                         child_frame(here, *origin)))
     return total

@@ -16,6 +16,7 @@ from typing import Any, cast
 from lxml import etree
 
 from urdfkit.model.index import Doc, LinkView, collision_parts
+from urdfkit.model.massprops import combine
 from urdfkit.model.spec import (
     SHAPES,
     SOLIDS,
@@ -360,39 +361,14 @@ def _solid(link: etree._Element, r: RuleReport | None,
 def _combine(parts: list[tuple[float, tuple[float, ...], Matrix3, float]]
              ) -> tuple[float, tuple[float, float, float], Matrix3, float] | None:
     """Parts (volume, centre, tensor per unit density, size) as one solid's fields."""
-    if len(parts) == 1:  # the common case: sum() of one term is 0.0 plus the term
-        volume, centre, _, _ = parts[0]
-        total = 0.0 + volume
-        if not 0 < total < math.inf:
-            return None
-        cx = (0.0 + volume * centre[0]) / total
-        cy = (0.0 + volume * centre[1]) / total
-        cz = (0.0 + volume * centre[2]) / total
-    else:
-        total = sum(p[0] for p in parts)
-        if not parts or not 0 < total < math.inf:
-            return None
-        cx = sum(v * c[0] for v, c, _, _ in parts) / total
-        cy = sum(v * c[1] for v, c, _, _ in parts) / total
-        cz = sum(v * c[2] for v, c, _, _ in parts) / total
-    # Parallel axes: each part's tensor moved from its centre to the common one.
-    xx = xy = xz = yx = yy = yz = zx = zy = zz = 0.0
-    for volume, centre, t, _ in parts:
-        dx, dy, dz = centre[0] - cx, centre[1] - cy, centre[2] - cz
-        d2 = dx * dx + dy * dy + dz * dz
-        (t00, t01, t02), (t10, t11, t12), (t20, t21, t22) = t
-        xx += t00 + volume * (d2 - dx * dx)
-        xy += t01 + volume * (0.0 - dx * dy)
-        xz += t02 + volume * (0.0 - dx * dz)
-        yx += t10 + volume * (0.0 - dy * dx)
-        yy += t11 + volume * (d2 - dy * dy)
-        yz += t12 + volume * (0.0 - dy * dz)
-        zx += t20 + volume * (0.0 - dz * dx)
-        zy += t21 + volume * (0.0 - dz * dy)
-        zz += t22 + volume * (d2 - dz * dz)
-    if not all(map(math.isfinite, (xx, xy, xz, yx, yy, yz, zx, zy, zz))):
+    if not parts:
         return None
-    return (total, (cx, cy, cz), ((xx, xy, xz), (yx, yy, yz), (zx, zy, zz)),
+    joined = combine([(volume, centre, tensor) for volume, centre, tensor, _ in parts])
+    if not 0 < joined.mass < math.inf:
+        return None
+    if not all(map(math.isfinite, (*joined.tensor[0], *joined.tensor[1], *joined.tensor[2]))):
+        return None
+    return (joined.mass, joined.com, joined.tensor,
             parts[0][3] if len(parts) == 1 else max(p[3] for p in parts))
 
 

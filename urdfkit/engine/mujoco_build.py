@@ -16,7 +16,7 @@ from typing import Any
 from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.engine.api import LinkDynamics, LoadSettings, Quat, Vec3
 from urdfkit.engine.mujoco_motors import Motor
-from urdfkit.formats.robot import Robot
+from urdfkit.formats.robot import LoadedRobot
 
 #: The export's groups of visual and collision geoms (``formats.mjcf``'s).
 VISUAL_GROUP, COLLISION_GROUP = 2, 3
@@ -28,7 +28,7 @@ FIXABLE_INERTIA = ("U602", "U603", "U604", "U608")
 
 
 @dataclass
-class Link:
+class WorldLink:
     """One URDF link in the world.
 
     Attributes:
@@ -71,12 +71,12 @@ class Loaded:
             where the export converted it (a DAE, an STL it repaired).
     """
 
-    robot: Robot
+    robot: LoadedRobot
     display: str
     settings: LoadSettings
     spec: Any
     assets: dict[str, bytes]
-    links: list[Link]
+    links: list[WorldLink]
     geom_links: dict[str, str]
     collisions: list[tuple[str, str, str]]
     static: set[str]
@@ -87,7 +87,7 @@ class Loaded:
     visuals: list[tuple[str, str]] = field(default_factory=list)
     mesh_files: dict[str, str] = field(default_factory=dict)
 
-    def link(self, index: int) -> Link:
+    def link(self, index: int) -> WorldLink:
         """Link ``index`` (-1: the root), or a ParameterError naming the range."""
         if not -1 <= index < len(self.links) - 1:
             raise ParameterError(f"`link` {index} is not a link of {self.display} (it has -1 "
@@ -111,7 +111,7 @@ def prepare(mujoco: Any, path: str, settings: LoadSettings, display: str | None)
     from urdfkit.engine.inertials import link_tensor, loaded_dynamics
     from urdfkit.formats.fk import fused
     from urdfkit.formats.mjcf import ExportOptions, export_mjcf
-    from urdfkit.formats.robot import Inertial, read_robot
+    from urdfkit.formats.robot import LoadedInertial, read_robot
     from urdfkit.sources.resolve import resolve
 
     name = display or str(path)
@@ -125,7 +125,7 @@ def prepare(mujoco: Any, path: str, settings: LoadSettings, display: str | None)
                                  param="implicit_cylinder")
         loaded = loaded_dynamics(resolved.load_path, inertia_from_file=settings.inertia_from_file,
                                  display=name)
-        inertials = {n: Inertial(d.mass, d.inertial_position, link_tensor(d))
+        inertials = {n: LoadedInertial(d.mass, d.inertial_position, link_tensor(d))
                      for n, d in loaded.items()}
         try:
             e = export_mjcf(robot, ExportOptions(
@@ -156,8 +156,8 @@ def prepare(mujoco: Any, path: str, settings: LoadSettings, display: str | None)
         placed[g.name] = ((float(g.pos[0]), float(g.pos[1]), float(g.pos[2])), (x, y, z, w))
     read = {k: str(v) for k, v in e.assets.items() if not isinstance(v, bytes)}
     mesh_files = {mesh.name: read.get(Path(mesh.file).name, "") for mesh in spec.meshes}
-    links = [Link(robot.root, where[robot.root][0], where[robot.root][1], loaded[robot.root])]
-    links += [Link(j.child, where[j.child][0], where[j.child][1], loaded[j.child])
+    links = [WorldLink(robot.root, where[robot.root][0], where[robot.root][1], loaded[robot.root])]
+    links += [WorldLink(j.child, where[j.child][0], where[j.child][1], loaded[j.child])
               for j in robot.joints]
     root_mass = loaded[robot.root].mass
     static = {robot.root} if settings.fixed_base or root_mass == 0 or robot.root == "world" \

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from urdfkit.engine.mujoco_build import Link, Loaded
+from urdfkit.engine.mujoco_build import Loaded, WorldLink
 from urdfkit.engine.mujoco_world import Ids, World
 
 
@@ -109,7 +109,7 @@ def _wrench(w: World, m: Any, d: Any, np: Any, body: int, j: int, held: Any
     return (*(rot.T @ force).tolist(), *(rot.T @ torque).tolist())
 
 
-def _inertial(w: World, np: Any, ids: Ids, link: Link) -> tuple[Any, Any]:
+def _inertial(w: World, np: Any, ids: Ids, link: WorldLink) -> tuple[Any, Any]:
     """A link's inertial frame in the world at the step: its origin and rotation."""
     from urdfkit.model.spec import quat_to_matrix
 
@@ -124,7 +124,7 @@ def _inertial(w: World, np: Any, ids: Ids, link: Link) -> tuple[Any, Any]:
     return origin, rot
 
 
-def _fused(w: World, m: Any, d: Any, np: Any, body: int, child: Link, point: Any) -> Any:
+def _fused(w: World, m: Any, d: Any, np: Any, body: int, child: WorldLink, point: Any) -> Any:
     """The wrench on a fused link's subtree, about ``point`` in world axes.
 
     Its links' motion, less the contacts on their geoms, plus the bodies that hang from them.

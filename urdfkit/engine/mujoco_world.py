@@ -306,11 +306,11 @@ class World:
 
         from urdfkit.engine.inertials import link_tensor
         from urdfkit.formats.mjcf import combine
-        from urdfkit.formats.robot import Inertial
+        from urdfkit.formats.robot import LoadedInertial
 
         r, ids = self.robots[body], self.ids[body]
-        parts = [(Inertial(x.dynamics.mass, x.dynamics.inertial_position,
-                           link_tensor(x.dynamics)), x.frame)
+        parts = [(LoadedInertial(x.dynamics.mass, x.dynamics.inertial_position,
+                                 link_tensor(x.dynamics)), x.frame)
                  for x in r.links if x.body == name]
         total = combine(parts)
         moments, axes = np.linalg.eigh(total.tensor)

@@ -15,7 +15,7 @@ from typing import Any
 from urdfkit.exchange.agree_report import TOL_DYNAMICS, TOL_FK, TOL_PYBULLET_FRAME, worst
 from urdfkit.exchange.agree_sides import Sides
 from urdfkit.formats.fk import link_frames
-from urdfkit.formats.robot import Robot
+from urdfkit.formats.robot import LoadedRobot
 
 #: How far from the point of its range nearest zero a limited joint is sampled: a turn each
 #: way (a revolute pose repeats past it), a metre along a prismatic one. Real ranges fit
@@ -24,7 +24,7 @@ from urdfkit.formats.robot import Robot
 SAMPLE_REACH = {"revolute": 2 * math.pi, "prismatic": 1.0}
 
 
-def pybullet_frame_tolerances(robot: Robot) -> dict[str, float]:
+def pybullet_frame_tolerances(robot: LoadedRobot) -> dict[str, float]:
     """Each link frame's tolerance against PyBullet's ``getLinkState``: float32 inside.
 
     A float32 rounding is 2^-24 relative; each transform on the way from the root rounds a
@@ -51,7 +51,7 @@ def sample_range(j: Any) -> tuple[float, float]:
     return max(j.lower, near - reach), min(j.upper, near + reach)
 
 
-def _sample(robot: Robot, names: list[str], rng: Any) -> dict[str, float]:
+def _sample(robot: LoadedRobot, names: list[str], rng: Any) -> dict[str, float]:
     q = {}
     joints = {j.name: j for j in robot.joints}
     for n in names:

@@ -18,7 +18,7 @@ from urdfkit.core.errors import EngineError
 from urdfkit.engine.api import JointInfo, LoadSettings
 from urdfkit.exchange.agree_report import Agreement, AgreeOptions
 from urdfkit.exchange.agree_tree import Matching, match_models
-from urdfkit.formats.robot import Inertial, Robot
+from urdfkit.formats.robot import LoadedInertial, LoadedRobot
 
 if TYPE_CHECKING:
     from urdfkit.engine.mujoco_file import MjcfFile
@@ -89,7 +89,7 @@ class PyBulletSide:
         self._inertials = {n: self._inertial(free, i) for n, i in self.link_index.items()}
         engine.remove_body(free)
 
-    def _inertial(self, body: int, index: int) -> Inertial:
+    def _inertial(self, body: int, index: int) -> LoadedInertial:
         import numpy as np
 
         from urdfkit.model.spec import quat_to_matrix
@@ -97,10 +97,10 @@ class PyBulletSide:
         d = self.engine.dynamics(body, index)
         r = np.array(quat_to_matrix(d.inertial_orientation))
         tensor = r @ np.diag(d.inertia) @ r.T
-        return Inertial(float(d.mass), d.inertial_position,
+        return LoadedInertial(float(d.mass), d.inertial_position,
                         tuple(map(tuple, tensor)))  # type: ignore[arg-type]
 
-    def inertial(self, link: str) -> Inertial:
+    def inertial(self, link: str) -> LoadedInertial:
         """A link's mass properties as PyBullet loaded them (floating load), link frame."""
         return self._inertials[link]
 
@@ -194,7 +194,7 @@ class Sides:
             the masses' rows).
     """
 
-    robot: Robot
+    robot: LoadedRobot
     options: AgreeOptions
     pb: PyBulletSide
     mjcf: MjcfFile
@@ -251,7 +251,7 @@ class Sides:
         return self.options.fixed_base or self.robot.root == "world" or root.inertial.mass == 0
 
 
-def sides(robot: Robot, mjcf: MjcfFile, engine: PyBulletEngine, load_path: str,
+def sides(robot: LoadedRobot, mjcf: MjcfFile, engine: PyBulletEngine, load_path: str,
           model_path: str, options: AgreeOptions) -> Sides:
     """The URDF loaded in ``engine``, matched with ``mjcf``; no rows yet.
 

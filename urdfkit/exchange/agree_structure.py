@@ -17,7 +17,7 @@ from urdfkit.exchange.agree_sides import Sides
 from urdfkit.exchange.agree_tree import tree_errors
 from urdfkit.formats.fk import fused, link_frames
 from urdfkit.formats.mjcf import combine
-from urdfkit.formats.robot import Inertial
+from urdfkit.formats.robot import LoadedInertial
 
 _ZERO3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
@@ -187,7 +187,7 @@ def masses(s: Sides) -> None:
     where = fused(robot)
     zero = link_frames(robot, {})
     # PyBullet: each body group (fixed links fused), in the world at the zero pose
-    groups: dict[str, list[tuple[Inertial, Any]]] = {}
+    groups: dict[str, list[tuple[LoadedInertial, Any]]] = {}
     for link, (body, _) in where.items():
         if link in s.pb.link_index:
             groups.setdefault(body, []).append((s.pb.inertial(link), zero[link]))
@@ -210,8 +210,8 @@ def masses(s: Sides) -> None:
             if not (body == robot.root == "world" and combine(parts).mass == 0):
                 missing.append(body)  # (a massless `world` is MuJoCo's world body)
             continue
-        ours, theirs = combine(parts), combine(weld.get(image[body], []) or
-                                               [(Inertial(0.0, (0, 0, 0), _ZERO3), np.eye(4))])
+        nothing = [(LoadedInertial(0.0, (0, 0, 0), _ZERO3), np.eye(4))]
+        ours, theirs = combine(parts), combine(weld.get(image[body], []) or nothing)
         mass.append((abs(ours.mass - theirs.mass) / max(ours.mass, theirs.mass, 1e-300), body))
         if ours.mass <= 0:
             continue
@@ -261,7 +261,7 @@ def masses(s: Sides) -> None:
                 status="known")
 
 
-def _mujoco_weld_groups(s: Sides) -> tuple[dict[int, list[tuple[Inertial, Any]]],
+def _mujoco_weld_groups(s: Sides) -> tuple[dict[int, list[tuple[LoadedInertial, Any]]],
                                            list[tuple[float, str]]]:
     """MuJoCo's bodies' mass properties by weld group (as written), placed at qpos 0.
 
@@ -270,12 +270,12 @@ def _mujoco_weld_groups(s: Sides) -> tuple[dict[int, list[tuple[Inertial, Any]]]
     """
     import numpy as np
 
-    weld: dict[int, list[tuple[Inertial, Any]]] = {}
+    weld: dict[int, list[tuple[LoadedInertial, Any]]] = {}
     snapped: list[tuple[float, str]] = []
     for b in s.mjcf.bodies():
         if b.snapped is not None:
             snapped.append((b.snapped, b.name))
-        own = Inertial(b.mass, (0.0, 0.0, 0.0),
+        own = LoadedInertial(b.mass, (0.0, 0.0, 0.0),
                        tuple(map(tuple, np.diag(b.inertia))))  # type: ignore[arg-type]
         # grouped as written: a body with a free joint of its own that no link matches
         # (a second robot, a loose box) is a group of its own, said as extra

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import ParameterError
 from urdfkit.formats.fk import fused, link_frames, unit
-from urdfkit.formats.robot import Robot
+from urdfkit.formats.robot import LoadedRobot
 
 if TYPE_CHECKING:
     from urdfkit.engine.mujoco_file import Tree
@@ -90,7 +90,7 @@ def _close(a: Any, b: Any) -> float:
     return float(max(np.abs(a[:3, 3] - b[:3, 3]).max(), np.abs(a[:3, :3] - b[:3, :3]).max()))
 
 
-def match_models(fixed: Tree, robot: Robot, movable: list[str],
+def match_models(fixed: Tree, robot: LoadedRobot, movable: list[str],
                  name_map: dict[str, str]) -> Matching:
     """Match the URDF's links and movable joints to the (base-welded) MuJoCo model's.
 
@@ -153,7 +153,7 @@ def _mj_body_of(out: Matching, model: _Model, link: str) -> int | None:
     return None
 
 
-def _match_by_shape(model: _Model, robot: Robot, movable: set[str], out: Matching) -> None:
+def _match_by_shape(model: _Model, robot: LoadedRobot, movable: set[str], out: Matching) -> None:
     """Match what names did not by the tree's shape and the zero-pose frames."""
     import numpy as np
 
@@ -243,7 +243,7 @@ def _joint_name(model: _Model, k: int) -> str:
     return next((n for n, i in model.joint.items() if i == k), f"joint {k}")
 
 
-def tree_errors(written: Tree, fixed: Tree, robot: Robot, match: Matching
+def tree_errors(written: Tree, fixed: Tree, robot: LoadedRobot, match: Matching
                 ) -> tuple[list[str], int]:
     """What differs in the body tree (one line each, naming the body), and groups compared.
 

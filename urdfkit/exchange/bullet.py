@@ -9,10 +9,10 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-from urdfkit.formats.robot import Inertial, Robot, read_inertial
+from urdfkit.formats.robot import LoadedInertial, LoadedRobot, read_inertial
 
 
-def loaded_inertials(resolved: Any, *, inertia_from_file: bool) -> dict[str, Inertial]:
+def loaded_inertials(resolved: Any, *, inertia_from_file: bool) -> dict[str, LoadedInertial]:
     """Each link's mass properties as PyBullet loads them, in the link frame.
 
     Without ``inertia_from_file`` PyBullet discards the file's ``<inertia>`` and computes one
@@ -23,12 +23,12 @@ def loaded_inertials(resolved: Any, *, inertia_from_file: bool) -> dict[str, Ine
 
     loaded = loaded_dynamics(resolved.load_path, inertia_from_file=inertia_from_file,
                              display=resolved.name)
-    return {name: Inertial(d.mass, d.inertial_position, link_tensor(d))
+    return {name: LoadedInertial(d.mass, d.inertial_position, link_tensor(d))
             for name, d in loaded.items()}
 
 
-def zeroed_repairs(resolved: Any, robot: Robot, inertials: dict[str, Inertial]
-                   ) -> dict[str, tuple[Inertial, str, str, str]]:
+def zeroed_repairs(resolved: Any, robot: LoadedRobot, inertials: dict[str, LoadedInertial]
+                   ) -> dict[str, tuple[LoadedInertial, str, str, str]]:
     """The links PyBullet simulates with a singular tensor, each with what ``fix`` writes.
 
     PyBullet sets a tensor that breaks the triangle inequality to zero ("Bad inertia tensor
@@ -65,8 +65,8 @@ def zeroed_repairs(resolved: Any, robot: Robot, inertials: dict[str, Inertial]
 
     report = RuleReport(resolved.name, resolved.source.absolute().parent)
     elements = {el.get("name", ""): el for el in resolved.root.iterchildren("link")}
-    out: dict[str, tuple[Inertial, str, str, str]] = {}
-    boxes: dict[str, Inertial] = {}
+    out: dict[str, tuple[LoadedInertial, str, str, str]] = {}
+    boxes: dict[str, LoadedInertial] = {}
     for name in zeroed:
         given = robot.links[name].inertial
         if name not in elements:

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 from urdfkit.core.errors import InputError, ParameterError
 from urdfkit.formats.fk import fused, origin_matrix
 from urdfkit.formats.mjcf_mesh import MeshAsset, mesh_asset, unusable
-from urdfkit.formats.robot import Inertial, Joint, Link, Robot, Shape
+from urdfkit.formats.robot import LoadedInertial, LoadedJoint, LoadedLink, LoadedRobot, LoadedShape
 
 if TYPE_CHECKING:
     from lxml import etree
@@ -69,9 +69,9 @@ class ExportOptions:
     actuators: str = "motor"
     gain: float | None = None
     ground: bool = False
-    inertials: dict[str, Inertial] | None = None
+    inertials: dict[str, LoadedInertial] | None = None
     inertia_from_shapes: bool = False
-    repairs: dict[str, tuple[Inertial, str, str, str]] | None = None
+    repairs: dict[str, tuple[LoadedInertial, str, str, str]] | None = None
     geom_names: bool = False
 
 
@@ -158,40 +158,31 @@ class _Mass:
     tensor: Any
 
 
-def combine(parts: list[tuple[Inertial, Any]]) -> _Mass:
+def combine(parts: list[tuple[LoadedInertial, Any]]) -> _Mass:
     """Mass properties of rigidly joined links: (inertial, link frame in the body) each.
 
-    Exact: masses add, the centre of mass is their weighted mean, and each tensor is rotated
-    into the body's axes and moved to the common centre by the parallel-axis theorem.
+    Each link's centre and tensor are placed in the body's axes, then joined by
+    :func:`urdfkit.model.massprops.combine` (the parallel-axis theorem).
     """
     import numpy as np
 
+    from urdfkit.model.massprops import combine as join
+
     with np.errstate(all="ignore"):  # huge values overflow: check_mass refuses the result
-        return _combine(parts)
-
-
-def _combine(parts: list[tuple[Inertial, Any]]) -> _Mass:
-    import numpy as np
-
-    total = sum(i.mass for i, _ in parts)
-    coms = [t[:3, :3] @ np.array(i.com) + t[:3, 3] for i, t in parts]
-    if total > 0:
-        com = sum(i.mass * c for (i, _), c in zip(parts, coms, strict=True)) / total
-    else:
-        com = coms[0]
-    tensor = np.zeros((3, 3))
-    for (i, t), c in zip(parts, coms, strict=True):
-        r = t[:3, :3]
-        tensor += r @ np.array(i.tensor) @ r.T
-        d = c - com
-        tensor += i.mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
-    return _Mass(float(total), com, (tensor + tensor.T) / 2)
+        placed = []
+        for i, t in parts:
+            r = t[:3, :3]
+            com = r @ np.array(i.com) + t[:3, 3]
+            tensor = r @ np.array(i.tensor) @ r.T
+            placed.append((i.mass, com.tolist(), tensor.tolist()))
+    total = join(placed)
+    return _Mass(float(total.mass), np.array(total.com), np.array(total.tensor))
 
 
 class _Writer:
     """Builds one document; see :func:`export_mjcf`."""
 
-    def __init__(self, robot: Robot, options: ExportOptions, asset_dir: str) -> None:
+    def __init__(self, robot: LoadedRobot, options: ExportOptions, asset_dir: str) -> None:
         from lxml import etree
 
         self.E = etree
@@ -221,7 +212,7 @@ class _Writer:
     def note(self, kind: str, message: str, line: int | None = None) -> None:
         self.notes.append(Note(kind, message, line))
 
-    def inertial(self, link: Link) -> Inertial:
+    def inertial(self, link: LoadedLink) -> LoadedInertial:
         if link.name in self.repaired and self.o.repairs:
             return self.o.repairs[link.name][0]
         if self.o.inertials is not None and link.name in self.o.inertials:
@@ -230,7 +221,7 @@ class _Writer:
 
     # ------------------------------------------------------------------ meshes
 
-    def mesh(self, shape: Shape, visual: bool, link: Link) -> str | None:
+    def mesh(self, shape: LoadedShape, visual: bool, link: LoadedLink) -> str | None:
         """The asset name of a mesh shape (added on first use), None when it is left out."""
         assert shape.filename is not None
         asset = self.mesh_file(Path(shape.filename), shape.line)
@@ -288,7 +279,7 @@ class _Writer:
 
     # ------------------------------------------------------------------ geoms
 
-    def sized(self, shape: Shape, visual: bool, link: Link) -> bool:
+    def sized(self, shape: LoadedShape, visual: bool, link: LoadedLink) -> bool:
         """Whether the shape has a size in every dimension (a mesh's scale nonzero).
 
         MuJoCo refuses a geom whose size is not positive ("size 0 must be positive in
@@ -323,7 +314,8 @@ class _Writer:
                       + ("" if visual else " it collides with") + ")", shape.line)
         return ok
 
-    def geom(self, body: etree._Element, shape: Shape, at: Any, visual: bool, link: Link) -> None:
+    def geom(self, body: etree._Element, shape: LoadedShape, at: Any, visual: bool,
+             link: LoadedLink) -> None:
         if not self.sized(shape, visual, link):
             return
         t = at @ origin_matrix(shape.xyz, shape.rpy)
@@ -363,8 +355,8 @@ class _Writer:
                 g.set("condim", "4")
         body.append(g)
 
-    def shape_type(self, g: etree._Element, body: etree._Element, shape: Shape, link: Link,
-                   visual: bool) -> bool:
+    def shape_type(self, g: etree._Element, body: etree._Element, shape: LoadedShape,
+                   link: LoadedLink, visual: bool) -> bool:
         """Set the geom's type and size (or mesh); False when it cannot be written."""
         if shape.kind == "box":
             g.set("type", "box")
@@ -582,7 +574,7 @@ class _Writer:
             raise InputError(f"{what}: PyBullet zeroes it and MuJoCo refuses the body it "
                              f"leaves ({hint})", file=self.robot.file, line=line)
 
-    def joint(self, body: etree._Element, j: Joint) -> None:
+    def joint(self, body: etree._Element, j: LoadedJoint) -> None:
         E = self.E
         if j.odd_limit:
             raise InputError(f"joint {j.name!r}: <limit {j.odd_limit}>: PyBullet loads a bound "
@@ -699,7 +691,7 @@ class _Writer:
                                        directional="true"))
 
 
-def export_mjcf(robot: Robot, options: ExportOptions | None = None,
+def export_mjcf(robot: LoadedRobot, options: ExportOptions | None = None,
                 asset_dir: str = "robot_assets") -> Export:
     """The MJCF of ``robot`` and the meshes it needs (nothing is written here).
 

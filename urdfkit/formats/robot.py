@@ -7,6 +7,11 @@ with unit inertia (``URDF_USE_INERTIA_FROM_FILE``), the inertial ``rpy`` applied
 joint limited only when lower <= upper, a ``floating`` joint loaded as fixed, ``<mimic>``
 ignored (kept here: MuJoCo can mean it), lateral friction 0.5 unless ``<contact>`` says
 otherwise, and the first shape of a ``<geometry>`` the one used.
+
+Its records are named for that: :class:`LoadedRobot`, :class:`LoadedLink`, :class:`LoadedJoint`,
+:class:`LoadedInertial`, :class:`LoadedShape` hold what PyBullet loads, its defaults filled in
+and nothing to edit; ``Robot``, ``Link``, ``Joint`` and ``Inertial`` are the builder's
+(:mod:`urdfkit.model.robot`), the file as written, checked where set and written back.
 """
 
 from __future__ import annotations
@@ -42,7 +47,7 @@ DEFAULT_INERTIA = (1.0, 1.0, 1.0)
 
 
 @dataclass
-class Inertial:
+class LoadedInertial:
     """A link's mass properties in its own frame.
 
     Attributes:
@@ -62,7 +67,7 @@ class Inertial:
 
 
 @dataclass
-class Shape:
+class LoadedShape:
     """One ``<visual>`` or ``<collision>``: its shape, placed in the link frame."""
 
     kind: str                     # box, cylinder, sphere, capsule, mesh, plane
@@ -78,13 +83,13 @@ class Shape:
 
 
 @dataclass
-class Link:
+class LoadedLink:
     """A link: mass properties, shapes and contact parameters."""
 
     name: str
-    inertial: Inertial
-    visuals: list[Shape] = field(default_factory=list)
-    collisions: list[Shape] = field(default_factory=list)
+    inertial: LoadedInertial
+    visuals: list[LoadedShape] = field(default_factory=list)
+    collisions: list[LoadedShape] = field(default_factory=list)
     lateral_friction: float = DEFAULT_LATERAL_FRICTION
     rolling_friction: float = 0.0
     spinning_friction: float = 0.0
@@ -93,7 +98,7 @@ class Link:
 
 
 @dataclass
-class Joint:
+class LoadedJoint:
     """A joint as PyBullet loads it (``type`` the URDF word; floating already made fixed)."""
 
     name: str
@@ -123,7 +128,7 @@ class Joint:
 
 
 @dataclass
-class Robot:
+class LoadedRobot:
     """A URDF as PyBullet loads it.
 
     Attributes:
@@ -136,13 +141,13 @@ class Robot:
 
     name: str
     root: str
-    links: dict[str, Link]
-    joints: list[Joint]
+    links: dict[str, LoadedLink]
+    joints: list[LoadedJoint]
     file: str
     #: Attributes that were not plain numbers, and what PyBullet reads in them.
     warnings: list[str] = field(default_factory=list)
 
-    def movable(self) -> list[Joint]:
+    def movable(self) -> list[LoadedJoint]:
         """The joints with degrees of freedom, in PyBullet's order."""
         return [j for j in self.joints if j.moves]
 
@@ -155,7 +160,7 @@ def _scalar(el: Any, attr: str, default: float) -> float:
 
     biped2d_pybullet's ``lower="-1.57."`` is -1.57 to PyBullet (its getJointInfo): read as
     the default 0 it exported a range of 0 to 1.57. A bound that is not finite stays the
-    default here (:attr:`Joint.odd_limit` says it).
+    default here (:attr:`LoadedJoint.odd_limit` says it).
     """
     x = attr_float(el, attr, None)
     if x is not None:
@@ -188,13 +193,13 @@ def _vec3(el: Any, attr: str, default: Vec = (0.0, 0.0, 0.0)) -> Vec:
     return out
 
 
-def _inertial(link: Any, name: str) -> Inertial:
+def _inertial(link: Any, name: str) -> LoadedInertial:
     el = link.find("inertial")
     if el is None:
         d = DEFAULT_INERTIA
-        return Inertial(DEFAULT_MASS, (0.0, 0.0, 0.0),
-                        ((d[0], 0.0, 0.0), (0.0, d[1], 0.0), (0.0, 0.0, d[2])), given=False,
-                        line=line_of(link))
+        return LoadedInertial(DEFAULT_MASS, (0.0, 0.0, 0.0),
+                              ((d[0], 0.0, 0.0), (0.0, d[1], 0.0), (0.0, 0.0, d[2])), given=False,
+                              line=line_of(link))
     origin = el.find("origin")
     mass = attr_float(el.find("mass"), "value", 0.0) or 0.0
     i = el.find("inertia")
@@ -209,10 +214,10 @@ def _inertial(link: Any, name: str) -> Inertial:
         # exactly symmetric: the products above differ in the last bit
         tensor = tuple(tuple((tensor[a][b] + tensor[b][a]) / 2 for b in range(3))
                        for a in range(3))  # type: ignore[assignment]
-    return Inertial(mass, _vec3(origin, "xyz"), tensor, line=line_of(el))
+    return LoadedInertial(mass, _vec3(origin, "xyz"), tensor, line=line_of(el))
 
 
-def read_inertial(link: Any) -> Inertial:
+def read_inertial(link: Any) -> LoadedInertial:
     """A ``<link>`` element's mass properties, as :func:`read_robot` reads them."""
     return _inertial(link, link.get("name", ""))
 
@@ -232,7 +237,7 @@ def _rgba(visual: Any, materials: dict[str, Any]) -> tuple[tuple[float, ...] | N
     return rgba, name, texture
 
 
-def _shape(el: Any, materials: dict[str, Any]) -> Shape | None:
+def _shape(el: Any, materials: dict[str, Any]) -> LoadedShape | None:
     shape = used_shape(el.find("geometry"))
     if shape is None:
         return None
@@ -248,7 +253,7 @@ def _shape(el: Any, materials: dict[str, Any]) -> Shape | None:
         size = ()
     else:
         return None  # cdf: nothing MuJoCo reads
-    out = Shape(kind, size, _vec3(origin, "xyz"), _vec3(origin, "rpy"), line=line_of(el))
+    out = LoadedShape(kind, size, _vec3(origin, "xyz"), _vec3(origin, "rpy"), line=line_of(el))
     if kind == "mesh":
         out.filename = shape.get("filename")
         out.scale = _vec3(shape, "scale", (1.0, 1.0, 1.0))
@@ -259,9 +264,9 @@ def _shape(el: Any, materials: dict[str, Any]) -> Shape | None:
     return out
 
 
-def _link(el: Any, materials: dict[str, Any]) -> Link:
+def _link(el: Any, materials: dict[str, Any]) -> LoadedLink:
     name = el.get("name", "")
-    link = Link(name, _inertial(el, name), line=line_of(el))
+    link = LoadedLink(name, _inertial(el, name), line=line_of(el))
     for tag, into in (("visual", link.visuals), ("collision", link.collisions)):
         for v in el.iterfind(tag):
             s = _shape(v, materials)
@@ -284,7 +289,7 @@ def _link(el: Any, materials: dict[str, Any]) -> Link:
     return link
 
 
-def _joint(el: Any) -> Joint:
+def _joint(el: Any) -> LoadedJoint:
     declared = el.get("type", "")
     kind = "fixed" if declared == "floating" else declared
     origin = el.find("origin")
@@ -304,7 +309,7 @@ def _joint(el: Any) -> Joint:
                  attr_float(mimic_el, "offset", 0.0) or 0.0)
     odd = [f'{a}="{limit.get(a)}"' for a in ("lower", "upper")
            if limit is not None and _non_finite(limit.get(a))]
-    return Joint(
+    return LoadedJoint(
         el.get("name", ""), kind, el.find("parent").get("link", ""),
         el.find("child").get("link", ""), _vec3(origin, "xyz"), _vec3(origin, "rpy"), axis,
         limited, lower, upper, _scalar(limit, "effort", 0.0), _scalar(limit, "velocity", 0.0),
@@ -319,7 +324,7 @@ def _non_finite(text: str | None) -> bool:
     return x is not None and not math.isfinite(x)
 
 
-def read_robot(root: Any, file: str, *, planar: bool = False) -> Robot:
+def read_robot(root: Any, file: str, *, planar: bool = False) -> LoadedRobot:
     """The robot of a guarded ``<robot>`` element (:class:`urdfkit.sources.resolve.Resolved`).
 
     Args:
@@ -348,7 +353,7 @@ def read_robot(root: Any, file: str, *, planar: bool = False) -> Robot:
     return robot
 
 
-def _read(root: Any, file: str, planar: bool = False) -> Robot:
+def _read(root: Any, file: str, planar: bool = False) -> LoadedRobot:
     materials = {m.get("name"): m for m in root.iterfind("material") if m.get("name")}
     links = {el.get("name", ""): _link(el, materials) for el in root.iterfind("link")}
     joints = [_joint(el) for el in root.iterfind("joint")]
@@ -363,8 +368,8 @@ def _read(root: Any, file: str, planar: bool = False) -> Robot:
     roots = [n for n in links if n not in children]
     if len(roots) != 1:  # the guard refuses these first; kept for --no-guard callers
         raise InputError(f"the robot has {len(roots)} root links, not one", file=file)
-    below: dict[str, list[Joint]] = {}
+    below: dict[str, list[LoadedJoint]] = {}
     for j in joints:
         below.setdefault(j.parent, []).append(j)
     ordered = depth_first(roots[0], below, lambda j: j.child)
-    return Robot(root.get("name", ""), roots[0], links, ordered, file)
+    return LoadedRobot(root.get("name", ""), roots[0], links, ordered, file)

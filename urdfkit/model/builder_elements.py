@@ -17,6 +17,7 @@ from typing import Any, ClassVar
 from lxml import etree
 
 from urdfkit.core.errors import ModelError
+from urdfkit.model.massprops import combine
 from urdfkit.model.spec import (
     JOINT_TYPES,
     LIMITED_JOINT_TYPES,
@@ -416,21 +417,16 @@ class Inertial(_Element):
         shapes = list(shapes)
         if not shapes:
             raise ModelError("cannot derive inertia: the link has no shapes")
-        volumes = [g.volume for g, _ in shapes]
-        total = sum(volumes)
-        com = tuple(sum(v * o.xyz[i] for v, (_, o) in zip(volumes, shapes, strict=True)) / total
-                    for i in range(3))
-        acc = [[0.0] * 3 for _ in range(3)]
-        for v, (geom, origin) in zip(volumes, shapes, strict=True):
-            m = mass * v / total
-            tensor = geom.inertia(m).rotated(origin.rotation).matrix
-            d = [origin.xyz[i] - com[i] for i in range(3)]
-            d2 = sum(x * x for x in d)
-            for i in range(3):
-                for j in range(3):
-                    acc[i][j] += tensor[i][j] + m * ((d2 if i == j else 0.0) - d[i] * d[j])
-        return cls(mass=mass, inertia=Inertia.from_matrix(acc),  # type: ignore[arg-type]
-                   origin=Origin(xyz=com))  # type: ignore[arg-type]
+        # the solid at unit density (volumes as masses), then scaled to ``mass``
+        solid = combine([(geom.volume, origin.xyz, matmul(matmul(
+            origin.rotation, geom.inertia(geom.volume).matrix), transpose(origin.rotation)))
+            for geom, origin in shapes])
+        scale = mass / solid.mass
+        (a, b, c), (d, e, f), (g, h, i) = solid.tensor
+        tensor = ((a * scale, b * scale, c * scale), (d * scale, e * scale, f * scale),
+                  (g * scale, h * scale, i * scale))
+        return cls(mass=mass, inertia=Inertia.from_matrix(tensor),
+                   origin=Origin(xyz=solid.com))
 
 
 @dataclass(eq=False)
