@@ -33,11 +33,11 @@ import math
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from urdfkit.core.errors import ParameterError, UrdfkitError
+from urdfkit.core.errors import ParameterError
 from urdfkit.engine.api import LoadSettings
 from urdfkit.engine.registry import check as check_engine
 from urdfkit.engine.registry import open_engine
@@ -50,6 +50,14 @@ from urdfkit.model.spec import (
     quat_mul,
     rpy_to_unit_quat,
 )
+from urdfkit.motion.drive_advice import (
+    free_swivels,
+    gazebo_differences,
+    phantom_mass,
+    simulated,
+    start_problems,
+    yaw_shortfall,
+)
 from urdfkit.motion.drive_result import (
     SETTLED_FRACTION,
     DriveResult,
@@ -60,8 +68,6 @@ from urdfkit.motion.drive_result import (
 )
 from urdfkit.motion.vehicle import (
     DRIVETRAINS,
-    PYBULLET_DEFAULT_FORCE,
-    STEER_FORCE,
     DrivetrainError,
     apply_drive,
     clamp_steer,
@@ -80,8 +86,6 @@ if TYPE_CHECKING:
 #: Default simulated samples per second in the trajectory (and for the statistics): enough
 #: for a smooth path and a good circle fit, cheap enough to cost nothing next to the physics.
 SAMPLES_PER_SECOND = 10
-#: PyBullet's linear and angular damping of every link (drive does not change it).
-PYBULLET_LINK_DAMPING = 0.04
 #: The tutorial's start: the car's base 0.1 m up, loaded before the plane.
 TUTORIAL_START = (0.0, 0.0, 0.1)
 #: The built-in ground is at least this size (m), and larger when the run needs it.
@@ -284,10 +288,6 @@ def drive_to_file(scenario: Scenario, path: str | Path, *, force: bool = False,
 ProgressFn = Callable[[int, int], None]
 
 
-#: The longest run (simulated s) repeated at more force to test the advice to raise it.
-PROBE_LIMIT = 60.0
-
-
 class Scenario:
     """A loaded car on a plane, ready to drive: open it, look at what was detected, run it.
 
@@ -308,8 +308,10 @@ class Scenario:
         self.static_base = False
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
         self._last_file = ""
-        self._phantom: list[str] | None = None
-        self._gazebo: dict[str, GazeboContact] = {}
+        #: The car's links without <inertial> (PyBullet gives each 1 kg), its root aside.
+        self.links_without_inertial: list[str] | None = None
+        #: The file's Gazebo contact parameters, by link (``--gazebo-contacts`` applies them).
+        self.gazebo: dict[str, GazeboContact] = {}
         self._mimics: list[Mimic] = []
         #: Mimic followers geared to their leaders: {joint name: constraint id}.
         self.mimic_followers: dict[str, int] = {}
@@ -363,16 +365,18 @@ class Scenario:
         with open_input(name, packages=self.config.packages, xacro_args=self.config.xacro_args,
                         guard=self.config.guard, package_paths=self.config.package_paths) as res:
             self.warnings.extend(res.warnings)
-            if self._phantom is None:  # the car, loaded first: links PyBullet gives 1 kg
-                # Not the root: mass 0 would fix the base in place, so fix never gives it
-                # that, and the advice below would be wrong for it (kobuki's base_footprint).
+            if self.links_without_inertial is None:  # the car, loaded first
+                # Links PyBullet gives 1 kg. Not the root: mass 0 would fix the base in
+                # place, so fix never gives it that, and the advice would be wrong for it
+                # (kobuki's base_footprint).
                 children = {c.get("link") for c in res.root.iterfind("joint/child")}
-                self._phantom = [el.get("name", "") for el in res.root.iterchildren("link")
-                                 if el.find("inertial") is None and el.get("name") in children]
+                self.links_without_inertial = [
+                    el.get("name", "") for el in res.root.iterchildren("link")
+                    if el.find("inertial") is None and el.get("name") in children]
                 from urdfkit.motion.gazebo_load import contacts_to_apply
                 from urdfkit.motion.mimic import mimic_relations
 
-                self._gazebo = contacts_to_apply(res.root)
+                self.gazebo = contacts_to_apply(res.root)
                 self._mimics = mimic_relations(res.root)
             return engine.load(str(res.load_path), settings, display=res.name)
 
@@ -417,12 +421,14 @@ class Scenario:
         self.ground_top, self.ground_bounds = self._ground()
         if c.base_position is None and not c.tutorial:
             self._rest_on_ground(start)
-        self._check_start()
+        self.static_base, self.problems, start_said = start_problems(self)
+        self.warnings.extend(start_said)
         self.steer, note = clamp_steer(train, c.steer)
         if note:
             self.warnings.append(note)
-        self._warn_phantom_mass()
-        self._warn_free_swivels()
+        for found in (phantom_mass(self), free_swivels(self)):
+            if found is not None:
+                self.warnings.append(found)
         self._plan_holds()
         self.columns = list(BASE_COLUMNS)
         for j in train.wheels + train.hinges:
@@ -434,77 +440,8 @@ class Scenario:
         from urdfkit.motion.gazebo_load import apply_gazebo_contacts
 
         assert self.engine is not None
-        self.gazebo_applied = apply_gazebo_contacts(self.engine, self.body, self._gazebo,
+        self.gazebo_applied = apply_gazebo_contacts(self.engine, self.body, self.gazebo,
                                                     self.warnings)
-
-    def gazebo_differences(self) -> list[str]:
-        """The file's Gazebo friction where PyBullet uses another, as a user reads it."""
-        if not self._gazebo or self.engine is None:
-            return []
-        from urdfkit.motion.gazebo_load import link_indices
-
-        engine = self.engine
-        index = link_indices(engine, self.body)
-        out = []
-        for name, g in self._gazebo.items():
-            mu = g.lateral_friction
-            if mu is None or name not in index:
-                continue
-            used = engine.dynamics(self.body, index[name]).lateral_friction
-            if abs(used - mu) > 1e-9 * max(1.0, mu):
-                given = " ".join(f"{k} {v:g}" for k, v in g.given().items()
-                                 if k in ("mu1", "mu2"))
-                out.append(f"{name} {given}, {self._engine_label()} uses {used:g}")
-        return out
-
-    def _warn_phantom_mass(self) -> None:
-        """Say when PyBullet's 1 kg for each link without <inertial> is much of the robot.
-
-        Frames (camera, IMU, sensor links) usually have no <inertial>; PyBullet makes each a
-        1 kg body. On a small robot that is most of its weight, high up: a TurtleBot-sized base
-        with five such frames (5 of 8.55 kg) tips over in raw PyBullet with its motors off.
-        """
-        if not self._phantom:
-            return
-        assert self.engine is not None
-        engine = self.engine
-        total = sum(engine.dynamics(self.body, k).mass
-                    for k in range(-1, len(engine.joints(self.body))))
-        made_up = float(len(self._phantom))
-        if total > 0 and made_up >= 0.1 * total:
-            names = ", ".join(self._phantom[:5]) + (", ..." if len(self._phantom) > 5 else "")
-            self.warnings.append(
-                f"PyBullet gives the {len(self._phantom)} link(s) without <inertial> 1 kg each "
-                f"({names}): {made_up:g} of the {total:.4g} kg simulated; if they are frames, "
-                "`urdfkit fix` gives them mass 0")
-
-    def _warn_free_swivels(self) -> None:
-        """Say so when driven wheels hang from a swivel left free (a caster's).
-
-        Naming only the wheels of a base whose wheels all sit on swivels (youBot's, Toyota
-        HSR's drive unit on ``base_roll_joint``) leaves the swivels rolling free: the unit
-        turns under the body, and the body's path and yaw are not the wheels'. HSR at
-        ``--steer 0.5`` yawed 0.13 rad while its drive unit turned, and the run blamed wheel
-        slip.
-        """
-        assert self.engine is not None
-        joints, train = self.engine.joints(self.body), self.drivetrain
-        free = set(train.casters)
-        swivels: dict[int, list[str]] = {}
-        for w in train.wheels:
-            k = joints[w].parent
-            while k >= 0:
-                if k in free and k not in train.wheels:
-                    swivels.setdefault(k, []).append(train.joint_names[w])
-                k = joints[k].parent
-        if swivels:
-            named = ", ".join(train.joint_names[k] for k in swivels)
-            wheels = ", ".join(w for ws in swivels.values() for w in ws)
-            them = "it" if len(swivels) == 1 else "them"
-            self.warnings.append(
-                f"the driven wheels {wheels} hang from free swivel(s) {named}, which turn "
-                "under the base as the wheels push: the base's path and yaw are not the "
-                f"wheels'; give {named} to --hinges to hold {them}")
 
     def _plan_holds(self) -> None:
         """Which passive joints hold their start angle, with what force, and which go limp.
@@ -573,34 +510,6 @@ class Scenario:
         set_base_link_pose(engine, self.body,
                            (pos[0], pos[1], pos[2] + top + 0.001 - lowest), orn)
 
-    def _check_start(self) -> None:
-        """A static base, or a start inside the ground, make the run meaningless: say so."""
-        assert self.engine is not None
-        engine = self.engine
-        self.problems = []
-        self.static_base = engine.dynamics(self.body, -1).mass == 0
-        root = engine.link_names(self.body)[0]
-        if self.static_base and root == "world":
-            # PyBullet gives a link named `world` without <inertial> mass 0, not 1 kg
-            # (measured on 3.2.7: with a mass of its own it falls like any other).
-            self.problems.append("static base: the root link is named `world`, and PyBullet "
-                                 "gives a `world` link without <inertial> mass 0, which fixes it "
-                                 "where it is loaded: the car cannot move; drop the `world` link "
-                                 "and its joint (build without the world frame) to drive it")
-        elif self.static_base:
-            self.problems.append("static base: the root link has mass 0, so PyBullet fixes it "
-                                 "where it is loaded and the car cannot move; give it a mass")
-        points = engine.closest_points(self.body, self.plane, 0.0)
-        depth = min((pt.distance for pt in points), default=0.0)
-        if depth < -0.005:
-            if self.config.tutorial:  # the tutorial's own start: reproduced, and said
-                self.warnings.append(f"the tutorial's start is {-depth * 1000:.0f} mm inside "
-                                     "the ground (the contact pushes the car out at once)")
-            else:
-                self.problems.append(f"started inside the ground: {-depth * 1000:.0f} mm deep "
-                                     "(the contact pushes it out with a jolt); leave "
-                                     "`base_position` unset to rest it on the ground")
-
     def close(self) -> None:
         """Disconnect and remove the temp folder."""
         if self.engine is not None:
@@ -651,32 +560,6 @@ class Scenario:
             return tuple(row)
 
         return sample
-
-    def simulated(self) -> dict[str, object]:
-        """What this run simulates, beyond the robot: for the summary and JSON."""
-        c = self.config
-        return {
-            "drivetrain": self.drivetrain.mode, "steering": self.drivetrain.steering,
-            # N m; PyBullet's default when no cap is given (the tutorial's).
-            "wheel_force": PYBULLET_DEFAULT_FORCE if c.max_force is None else c.max_force,
-            "wheel_force_default": c.max_force is None,
-            "hinge_force": STEER_FORCE if self.drivetrain.hinges else None,
-            "held": [{"index": j, "name": self.drivetrain.joint_names[j],
-                      "angle": round(a, 6), "force": f} for j, (a, f) in self.held.items()],
-            "limp": [{"index": j, "name": self.drivetrain.joint_names[j]} for j in self.limp],
-            "load_flags": self.flags, "time_step": c.time_step, "gravity": c.gravity,
-            "link_damping": {"linear": PYBULLET_LINK_DAMPING,
-                             "angular": PYBULLET_LINK_DAMPING, "note": "PyBullet's default"}
-            if c.engine == "pybullet" else
-            {"linear": 0.0, "angular": 0.0, "note": f"{self._engine_label()} has none"},
-            "tutorial": c.tutorial,
-            "gazebo_contacts": self.gazebo_applied,
-            "mimic": sorted(self.mimic_followers),
-            "engine": c.engine,
-        }
-
-    def _engine_label(self) -> str:
-        return self.engine.label if self.engine is not None else self.config.engine
 
     def run(self, progress: ProgressFn | None = None,
             sink: Callable[[tuple[float, ...]], None] | None = None) -> DriveResult:
@@ -761,11 +644,11 @@ class Scenario:
             share = rate / self.steer
             if share < 0.9:
                 (problems if share < 0.1 else warnings).append(
-                    _yaw_shortfall(self, rate, share, sim_time))
+                    yaw_shortfall(self, rate, share, sim_time))
         slipping = [m for m in problems + warnings
                     if m.startswith(("wheels slipping", "stuck", "skid steering turns",
                                      "differential steering turns"))]
-        differ = self.gazebo_differences() if slipping else []
+        differ = gazebo_differences(self) if slipping else []
         if differ:
             shown = "; ".join(differ[:4]) + ("; ..." if len(differ) > 4 else "")
             warnings.append(f"the file's <gazebo> gives {shown}: --gazebo-contacts applies "
@@ -784,114 +667,8 @@ class Scenario:
             throttle=c.throttle, steer=self.steer, interrupted=interrupted,
             drivetrain=self.drivetrain, trajectory=traj,
             warnings=warnings + problems, expected_radius=expected, yaw_rate=rate,
-            radius_note=note, simulated=self.simulated(), samples=stats.count,
+            radius_note=note, simulated=simulated(self), samples=stats.count,
             problems=problems)
-
-
-def _yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> str:
-    """Why the base turns slower than commanded, and advice that was tried before it is said.
-
-    The same drive (same duration, so the same settled half) is run again over what a user
-    would reach: ten and a hundred times the wheel force (capped at PyBullet's default), then,
-    if no force helps, up to three times the yaw rate (capped where the inner wheels would
-    stop: 2 v / track). Advice is given only when its run turns clearly faster (1.5x); it
-    names the option as the command line spells it. More yaw rate is then searched for the
-    command that turns within 10% of what was asked (:func:`_aim`). At most three re-runs and
-    :data:`AIM_RUNS` more, only when this warning is printed; runs over :data:`PROBE_LIMIT` s
-    are not repeated.
-    """
-    c, train = sc.config, sc.drivetrain
-    kind = "skid steering" if train.steering == "skid" else "differential steering"
-    # round first: a share of -3e-5 is said "0%", not "-0%"
-    said = (f"{kind} turns at {rate:.3g} rad/s, {round(share, 2) + 0.0:.0%} of the "
-            f"{sc.steer:g} commanded")
-    force = PYBULLET_DEFAULT_FORCE if c.max_force is None else c.max_force
-    if not 0 < sim_time <= PROBE_LIMIT:
-        return (f"{said}; not measured at more force (the run is over {PROBE_LIMIT:g} s): "
-                "the wheels slip sideways, or the motors are too weak")
-
-    def probe(**changes: float | None) -> float | None:
-        cfg = replace(c, keep_trajectory=False, gui=False, steps=None, seconds=sim_time,
-                      **changes)  # type: ignore[arg-type]
-        try:
-            with Scenario(cfg, probe=True) as run:
-                return run.run().yaw_rate
-        except UrdfkitError:
-            return None
-
-    def better(r: float | None) -> bool:
-        return r is not None and abs(r) > 1.5 * abs(rate) and \
-            abs(r - rate) > 0.05 * abs(sc.steer)
-
-    def shown(r: float | None) -> str:
-        return "failed" if r is None else f"{r:.3g} rad/s"
-
-    tried: list[str] = []
-    for factor in (10.0, 100.0):
-        higher = min(force * factor, PYBULLET_DEFAULT_FORCE) if force > 0 else factor
-        if higher <= force or (tried and tried[-1].startswith(f"--max-force {higher:g}:")):
-            break
-        r = probe(max_force=higher)
-        if better(r):
-            assert r is not None
-            return (f"{said}; with --max-force {higher:g} it turns at {r:.3g} rad/s "
-                    f"({r / sc.steer:.0%}): run with --max-force {higher:g}")
-        tried.append(f"--max-force {higher:g}: {shown(r)}")
-    widest = 2.0 * abs(c.throttle) * train.reference_radius / train.track \
-        if train.track > 0 else math.inf
-    more = math.copysign(min(3.0 * abs(sc.steer), widest), sc.steer)
-    if abs(more) > 1.2 * abs(sc.steer):
-        r = probe(steer=more)
-        if better(r):
-            assert r is not None
-            first = f"more wheel force does not help ({'; '.join(tried)})" if tried \
-                else "at PyBullet's default wheel force"
-            return f"{said}; {first}: the wheels slip sideways, and " + _aim(
-                lambda x: probe(steer=x), sc.steer, (sc.steer, rate), (more, r), widest)
-        tried.append(f"--steer {more:.3g}: {shown(r)}")
-    return (f"{said}; neither more force nor more yaw rate turns it faster "
-            f"({'; '.join(tried)}): the wheels slip sideways")
-
-
-#: How close advice must land to the yaw rate asked for to be advised as reaching it.
-AIM = 0.1
-#: Re-runs the search for that command may take (beyond the first at more yaw rate).
-AIM_RUNS = 4
-
-
-def _aim(measure: Callable[[float], float | None], asked: float, start: tuple[float, float],
-         more: tuple[float, float], widest: float) -> str:
-    """The ``--steer`` to command for the yaw rate ``asked``, found by running it.
-
-    A skid-steered base turns slower than commanded, and not in proportion: three times the
-    command may turn it faster than asked (r2d2 at --throttle 5: --steer 0.9 turns at 0.5
-    rad/s for 0.3 asked). From the two runs made (``start``, the user's, and ``more``), the
-    secant method picks the next command, rounded to the three digits the advice prints,
-    and runs it, up to :data:`AIM_RUNS` times, until one lands within :data:`AIM` of
-    ``asked`` (capped at ``widest``, where the inner wheels stop). The advice names that
-    command and what it measured; if none lands, the nearest, and says it missed.
-    """
-    runs = [start, more]
-    for _ in range(AIM_RUNS):
-        (s0, r0), (s1, r1) = runs[-2], runs[-1]
-        if abs(r1 - asked) <= AIM * abs(asked) or r1 == r0:
-            break
-        s = s1 + (asked - r1) * (s1 - s0) / (r1 - r0)
-        s = math.copysign(min(abs(s), widest), asked) if s * asked > 0 else s1 / 2
-        s = float(f"{s:.3g}")
-        if any(s == x for x, _ in runs):
-            break
-        r = measure(s)
-        if r is None:
-            break
-        runs.append((s, r))
-    s, r = min(runs[1:], key=lambda x: abs(x[1] - asked))
-    if abs(r - asked) <= AIM * abs(asked):
-        return (f"--steer {s:.3g} turns at {r:.3g} rad/s ({r / asked:.0%} of the {asked:g} "
-                f"asked): command more yaw rate (--steer {s:.3g})")
-    tried = "; ".join(f"--steer {x:.3g}: {y:.3g} rad/s" for x, y in runs[1:])
-    return (f"no command tried turns within {AIM:.0%} of the {asked:g} asked ({tried}); "
-            f"--steer {s:.3g} comes nearest, at {r:.3g} rad/s ({r / asked:.0%})")
 
 
 class _GuiControls:
