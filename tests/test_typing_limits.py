@@ -101,7 +101,7 @@ def _plant(source: str) -> tuple[str, int, str]:
 #: parameters were ``Any`` (an lxml element, a Joint, an Export, a Session).
 TARGETS: list[tuple[str, str, str]] = [
     ("checks/rules_joints.py", "_joint_inertia", "jv"),
-    ("checks/fix.py", "_Plan.carry_contacts", "link"),
+    ("checks/fix_plan.py", "_Plan.carry_contacts", "link"),
     ("formats/mjcf.py", "_Writer.joint", "j"),
     ("formats/mjcf.py", "_Writer.fill", "body"),
     ("exchange/agree_sides.py", "PyBulletSide.__init__", "engine"),

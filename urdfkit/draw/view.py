@@ -7,8 +7,9 @@ Three parts:
   kinematics.
 - :class:`Viewer` (here) shows a :class:`ViewedRobot` with viser (a web server whose client
   ships in its wheel, so it works offline), and reloads it when the file or anything it read
-  changes; the page's text is written by view_page.py, its cameras and lights are placed by
-  view_camera.py.
+  changes (view_watch.py watches the files); the robot's scene nodes are drawn by
+  view_scene.py, its sidebar controls added by view_panel.py, the page's text written by
+  view_page.py, its cameras and lights placed by view_camera.py.
 - :class:`~urdfkit.draw.view_stream.RunStream` (view_stream.py) streams a simulated run to the page.
 
 The server is guarded (view_guard.py: only its own page, only sane values, no camera move from
@@ -21,25 +22,25 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
-import os
 import threading
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from urdfkit.core.errors import EngineError, MissingDependencyError, UrdfkitError
+from urdfkit.core.errors import EngineError, MissingDependencyError
 from urdfkit.draw import view_page as page
-from urdfkit.draw.view_camera import ASPECT, FIT, FOV_DEG, PageCameras, environment, fit, light
+from urdfkit.draw import view_panel as panel
+from urdfkit.draw.view_camera import ASPECT, FIT, FOV_DEG, PageCameras, environment, light
 from urdfkit.draw.view_guard import Gate, GuardError, guarded_serve, keep_keys_off_camera
 from urdfkit.draw.view_model import SELECTED_RGB, TINTS, TOUCHING_RGB, Layer, Vec3, ViewedRobot
 from urdfkit.draw.view_queue import ActionQueue
-from urdfkit.draw.view_stream import RunDisplay, add_shapes, wxyz
+from urdfkit.draw.view_scene import RobotScene
+from urdfkit.draw.view_stream import RunDisplay
+from urdfkit.draw.view_watch import POLL_SECONDS, WatchedFile
 
 #: The selection dropdown's entry for no link.
 NO_LINK = "(none)"
-__all__ = ["ASPECT", "FIT", "FOV_DEG", "TINTS", "TOUCHING_RGB", "Viewer", "free_port"]
-
-#: How often the watcher looks at the files the robot was read from (s).
-POLL_SECONDS = 0.25
+__all__ = ["ASPECT", "FIT", "FOV_DEG", "NO_LINK", "POLL_SECONDS", "SELECTED_RGB", "TINTS",
+           "TOUCHING_RGB", "Viewer", "free_port"]
 
 
 def _viser() -> Any:
@@ -50,6 +51,9 @@ def _viser() -> Any:
     return viser
 
 
+#: Seconds the web server may take to start. viser waits on its server thread without a time
+#: limit, and that thread dies silently on anything but a port in use: a hang, never a
+#: message. Bounded here.
 SERVER_START_TIMEOUT = 60.0
 
 
@@ -92,6 +96,31 @@ def _start_server(viser: Any, host: str, port: int) -> tuple[Any, Gate]:
     return box["server"]
 
 
+def _serve(viser: Any, host: str, port: int) -> tuple[Any, Gate]:
+    """:func:`_start_server`, its failure to listen said as an EngineError about ``port``."""
+    try:
+        return _start_server(viser, host, port)
+    except OSError as e:
+        raise EngineError(f"cannot serve on {host}:{port}: {e.strerror or e}",
+                          param="port") from None
+    except TimeoutError:
+        raise EngineError(f"the server on {host}:{port} did not start within "
+                          f"{SERVER_START_TIMEOUT:g} s", param="port") from None
+
+
+def _page(server: Any, lighting: str, ground: float, floor: float) -> Any:
+    """Set up the page: z up, its lights, the sidebar, and the grid (returned) at ``floor``."""
+    server.scene.set_up_direction("+z")
+    light(server, lighting)
+    # A sidebar beside the canvas, not a panel floating over the scene; wide enough that
+    # joint names and the pose fields are not cut.
+    server.gui.configure_theme(control_width="large")
+    server.gui.main_panel.dock_right()
+    return server.scene.add_grid("/ground", width=ground, height=ground,
+                                 cell_size=0.1 if ground <= 4.0 else 0.5, section_size=1.0,
+                                 position=(0.0, 0.0, floor))
+
+
 def free_port(host: str) -> int:
     """A TCP port nothing listens on now."""
     import socket
@@ -123,17 +152,15 @@ class Viewer(RunDisplay):
                  stand_on_grid: bool = True) -> None:
         #: The scene's lighting: ``none`` (a sky light) or viser's environment map's name.
         self.lighting = environment()  # a bad URDFKIT_VIEW_ENVIRONMENT fails before anything
-        self._load_args: dict[str, Any] = {
+        #: The file on show, loaded again when it changes.
+        self.source = WatchedFile(file, {
             "packages": packages, "package_paths": package_paths, "xacro_args": xacro_args,
-            "inertia_from_file": inertia_from_file, "display": display}
+            "inertia_from_file": inertia_from_file, "display": display})
         self.file = file
-        self.model = ViewedRobot(file, **self._load_args)  # a bad file fails here, before serving
+        self.model = self.source.load()  # a bad file fails here, before serving
         self.error: str | None = None
         self.reloads = 0
-        self._failed: dict[str, Any] | None = None
         self._lock = threading.RLock()
-        self._nodes: dict[Layer, list[Any]] = {}
-        self._frames: list[Any] = []
         #: The page shows poses given from outside (a run, :meth:`show_poses`): the model's
         #: own joints no longer move the scene, even from a late slider callback.
         self.external_poses = False
@@ -148,34 +175,20 @@ class Viewer(RunDisplay):
         self.host = host
         self.port = free_port(host) if not port else port
         try:
-            self.server, self.gate = _start_server(viser, host, self.port)
-        except OSError as e:
-            self.model.close()
-            raise EngineError(f"cannot serve on {host}:{self.port}: {e.strerror or e}",
-                              param="port") from None
-        except TimeoutError:
-            self.model.close()
-            raise EngineError(f"the server on {host}:{self.port} did not start within "
-                              f"{SERVER_START_TIMEOUT:g} s", param="port") from None
-        except GuardError:
+            self.server, self.gate = _serve(viser, host, self.port)
+        except (EngineError, GuardError):
             self.model.close()
             raise
         self.port = int(self.server.get_port())
         self.url = f"http://{'localhost' if host in ('127.0.0.1', '::1') else host}:{self.port}"
-        self.server.scene.set_up_direction("+z")
-        light(self.server, self.lighting)
         #: Where each page's camera is, as urdfkit put it (view_camera.py).
         self.cameras = PageCameras(self.server)
-        # A sidebar beside the canvas, not a panel floating over the scene; wide enough that
-        # joint names and the pose fields are not cut.
-        self.server.gui.configure_theme(control_width="large")
-        self.server.gui.main_panel.dock_right()
         # The robot stands where `render` stands it: its lowest point on the grid (a run's
         # ground is its own plane at z = 0).
         floor = self.model.bounds()[0][2] if stand_on_grid else 0.0
-        self.grid = self.server.scene.add_grid("/ground", width=ground, height=ground,
-                                               cell_size=0.1 if ground <= 4.0 else 0.5,
-                                               section_size=1.0, position=(0.0, 0.0, floor))
+        self.grid = _page(self.server, self.lighting, ground, floor)
+        #: The robot's nodes in the scene.
+        self.scene = RobotScene(self.server.scene)
         self._connected = threading.Event()
         self.server.on_client_connect(self._client_connected)
         self.server.on_client_disconnect(self.cameras.forget)
@@ -186,12 +199,10 @@ class Viewer(RunDisplay):
         # Mimic joints to their leaders' zero pose (offsets included). Self-collisions are
         # first measured by the watcher, so their second load does not delay the first draw.
         self.set_joints(self.zero(), touching=False)
-        self._aim_camera()
-        self._stop = threading.Event()
+        self.cameras.initial(self.model.bounds())
         # A run on show (drive --view) is not reloaded under it: no watcher then.
-        self._watcher = threading.Thread(target=self._watch if watch else lambda: None,
-                                         name="urdfkit-view-watch", daemon=True)
-        self._watcher.start()
+        self.source.watch(watch, self._measure_touching, lambda: self.model.depends,
+                          self.reload, self._report)
 
     # ------------------------------------------------------------------ the page
 
@@ -240,100 +251,30 @@ class Viewer(RunDisplay):
 
     def _show_model(self) -> None:
         """Put the model's shapes and controls on the page (replacing the previous ones)."""
-        for h in self._frames + self._gui:  # a link's frame takes its shapes with it
+        self.scene.clear()
+        for h in self._gui:
             h.remove()
-        self._nodes = {"visual": [], "collision": [], "frames": [], "inertia": []}
-        self._frames, self._gui, self.sliders = [], [], {}
-        self._draw_links()
+        self._gui = []
+        self.scene.draw(self.model, self._clicked)
         self.apply_toggles()
         listed, flags = self.model.joint_vector()
         self.vector_text.value, self.joints_text.value = listed, flags
-        self._add_sliders()
-        self._add_findings()
+        gui = self.server.gui
+        with self.joints_folder:
+            self.sliders = panel.add_sliders(gui, self.model, lambda name, s: self.gate.on_value(
+                s, functools.partial(self._slid, name, s)))
+        self._gui += self.sliders.values()
+        with self.findings_folder:
+            self._gui += panel.add_findings(gui, self.model, lambda button, link:
+                                            self.gate.on_value(button, self._selects(link)))
         names = [lk.name for lk in self.model.links]
         self.select_link.options = [NO_LINK, *names]
         if self.selected not in names:
             self.selected = None
         self.select(self.selected)
         with self.table_folder:
-            self._gui.append(self.server.gui.add_markdown(page.joint_table(self.model)))
+            self._gui.append(gui.add_markdown(page.joint_table(self.model)))
         self._refresh_status()
-
-    def _draw_links(self) -> None:
-        """Each link's frame, shapes, axes, joint axis, centre of mass and inertia box."""
-        import numpy as np
-
-        from urdfkit.model.spec import quat_to_matrix, rotate
-
-        scene, m = self.server.scene, self.model
-        size = max(max(hi - lo for lo, hi in zip(*m.bounds(), strict=True)), 0.05)
-        self.frame_size = size * 0.15  # the axes a link frame is drawn with: the robot's scale
-        by_index = {j.link: j for j in m.joints}
-        for link, (pos, quat) in zip(m.links, m.link_poses(), strict=True):
-            root = f"/robot/link{link.index + 1}"
-            self._frames.append(scene.add_frame(root, show_axes=False, position=pos,
-                                                wxyz=wxyz(quat)))
-            for kind, mesh in add_shapes(scene, root, link, None):
-                # Clicking a link in the scene selects it (and its joint's row).
-                mesh.on_click(self._clicked(link.name))
-                self._nodes[kind].append(mesh)
-            self._nodes["frames"].append(scene.add_frame(
-                f"{root}/axes", axes_length=self.frame_size, axes_radius=size * 0.006))
-            joint = by_index.get(link.index)
-            if joint is not None:  # PyBullet's axis is in the inertial frame: into the link's
-                axis = np.asarray(rotate(quat_to_matrix(link.inertial_quat), joint.axis),
-                                  dtype=float)
-                points = np.array([[-axis, axis]], dtype=np.float32) * size * 0.2
-                self._nodes["frames"].append(scene.add_line_segments(
-                    f"{root}/joint_axis", points, (204, 121, 167), thickness=size * 0.006))
-            self._nodes["inertia"].append(scene.add_frame(
-                f"{root}/com", show_axes=False, position=link.inertial_pos,
-                wxyz=wxyz(link.inertial_quat)))
-            self._nodes["inertia"].append(scene.add_icosphere(
-                f"{root}/com/dot", radius=size * 0.012, color=(20, 20, 20)))
-            if link.inertia_box is not None:
-                self._nodes["inertia"].append(scene.add_box(
-                    f"{root}/com/box", dimensions=link.inertia_box, color=(0, 114, 178),
-                    opacity=0.35))
-
-    def _add_sliders(self) -> None:
-        """One slider per movable joint (mimic joints shown, not movable)."""
-        gui, now = self.server.gui, self.model.positions()
-        with self.joints_folder:
-            for j in self.model.joints:
-                step = (j.upper - j.lower) / 1000 if j.upper > j.lower else 0.001
-                hint = f"{j.urdf_type}, PyBullet joint {j.index}"
-                if j.mimic is not None:
-                    hint += f"; mimics {j.mimic[0]} x {j.mimic[1]:g} + {j.mimic[2]:g}"
-                hi = max(j.upper, j.lower + step)
-                s = gui.add_slider(j.name, min=j.lower, max=hi, step=step,
-                                   initial_value=min(max(now[j.name], j.lower), j.upper),
-                                   # A joint whose limits meet has nothing to slide.
-                                   disabled=j.mimic is not None or j.upper <= j.lower,
-                                   hint=hint)
-                s.precision = page.box_digits(j.lower, hi, step)
-                self.gate.on_value(s, functools.partial(self._slid, j.name, s))
-                self.sliders[j.name] = s
-                self._gui.append(s)
-
-    def _add_findings(self) -> None:
-        """Each finding once: a button for one about a link, the text of the others.
-
-        The button selects the link, whose panel then shows the finding's text.
-        """
-        gui, m = self.server.gui, self.model
-        with self.findings_folder:
-            self._gui.append(gui.add_markdown(page.findings(m)))
-            for f in (f for f in m.findings if f.level in TINTS):
-                links = m.finding_links(f)
-                if not links:
-                    continue
-                where = f"line {f.line}" if f.line is not None else os.path.basename(f.file)
-                button = gui.add_button(page.finding_button(f.code, where, links[0]),
-                                        hint=f"{links[0]}: {f.text}"[:300],
-                                        color="red" if f.level == "error" else "yellow")
-                self.gate.on_value(button, self._selects(links[0]))
-                self._gui.append(button)
 
     def _refresh_status(self) -> None:
         self.status.content = page.status(self.model, self.error)
@@ -343,17 +284,14 @@ class Viewer(RunDisplay):
         if client is None:
             return
         with contextlib.suppress(AssertionError):  # a page that has not said its camera yet
-            if self.aim_page is not None:
-                self.aim_page(client)
-            else:
-                self.cameras.aim(client, lambda: self.model.bounds())
+            self._aim(client)
 
-    def _aim_camera(self) -> None:
-        """Fit the robot's bounds in the view of pages to come, and of viser's "Reset View"."""
-        eye, target, _ = fit(self.model.bounds(), ASPECT)
-        cam = self.server.initial_camera
-        cam.fov = math.radians(FOV_DEG)
-        cam.look_at, cam.position, cam.up = target, eye, (0.0, 0.0, 1.0)
+    def _aim(self, client: Any) -> None:
+        """Frame one page: as a run on show says, else on the model's bounds."""
+        if self.aim_page is not None:
+            self.aim_page(client)
+        else:
+            self.cameras.aim(client, lambda: self.model.bounds())
 
     def _client_connected(self, client: Any) -> None:
         """A page connected: fit the camera to its own canvas, and release :meth:`wait_for_page`.
@@ -361,19 +299,8 @@ class Viewer(RunDisplay):
         Fitted again when its canvas changes size (the panel docking beside it narrows it
         just after it connects), until its user moves the camera.
         """
-        import time
-
         try:
-            # The page reports its camera (and so its canvas's aspect) just after connecting.
-            end = time.monotonic() + 5.0
-            while not client.camera.update_timestamp and time.monotonic() < end:
-                time.sleep(0.02)
-            if client.camera.update_timestamp:
-                self.cameras.watch(client)
-                if self.aim_page is not None:
-                    self.aim_page(client)
-                else:
-                    self.cameras.aim(client, lambda: self.model.bounds())
+            self.cameras.connected(client, self._aim)
         finally:
             self._connected.set()
 
@@ -384,16 +311,13 @@ class Viewer(RunDisplay):
     def apply_toggles(self) -> None:
         """Show or hide each layer as the Show checkboxes say."""
         with self._lock:
-            want = {"visual": self.show_visual.value, "collision": self.show_collision.value,
-                    "frames": self.show_frames.value, "inertia": self.show_inertia.value}
-            for kind, handles in self._nodes.items():
-                for h in handles:
-                    h.visible = bool(want[kind])
+            self.scene.show({"visual": self.show_visual.value,
+                             "collision": self.show_collision.value,
+                             "frames": self.show_frames.value, "inertia": self.show_inertia.value})
 
     def visible(self, kind: Layer) -> bool:
         """Whether a layer (visual, collision, frames, inertia) is shown."""
-        handles = self._nodes.get(kind, [])
-        return bool(handles) and all(h.visible for h in handles)
+        return self.scene.visible(kind)
 
     # ------------------------------------------------------------------ moving
 
@@ -417,8 +341,7 @@ class Viewer(RunDisplay):
         return clicked
 
     def _action_failed(self, e: Exception) -> None:
-        self.error = f"internal error (a bug in urdfkit): {type(e).__name__}: {e}"
-        self._refresh_status()
+        self._report(f"internal error (a bug in urdfkit): {type(e).__name__}: {e}")
 
     def _slider_moved(self, name: str, handle: Any, value: float) -> None:
         """A page set a joint's slider to ``value``: move the joint there.
@@ -479,42 +402,21 @@ class Viewer(RunDisplay):
         the sliders, the first robot's, take the values of the joints of their names.
         """
         with self._lock:
-            for name, value in values.items():  # the sliders are disabled: nothing follows
-                s = self.sliders.get(name)
-                if s is not None and math.isfinite(float(value)):
-                    s.value = min(max(float(value), float(s.min)), float(s.max))
-            joints = [j for j in (self.model.joints if joints is None else joints)
-                      if j.name in values]
-            self.vector_text.value = repr([round(float(values[j.name]), 6) for j in joints])
-            text = ",".join(f"{j.name}={round(float(values[j.name]), 6):g}" for j in joints)
-            self.joints_text.value = f"--joints {text}" if text else ""
+            panel.show_values(self.sliders, self.vector_text, self.joints_text, values,
+                              self.model.joints if joints is None else joints)
 
     def update_poses(self) -> None:
         """Move every link node to the pose PyBullet reports (not while a run is shown)."""
         if self.external_poses:
             return
         with self._lock, self.server.atomic():
-            for frame, (pos, quat) in zip(self._frames, self.model.link_poses(), strict=True):
-                frame.position = pos
-                frame.wxyz = wxyz(quat)
+            self.scene.move(self.model.link_poses())
 
     def recolour(self) -> None:
         """Each link's colour: selected, touching, its findings' tint (asked), or its own."""
         with self._lock:
             hit = {name for a, b, _ in self.touching for name in (a, b)}
-            tint = bool(self.tint_findings.value)
-            for link, k in zip(self.model.links, range(len(self.model.links)), strict=True):
-                base = TINTS.get(link.level or "") if tint else None
-                layers: tuple[tuple[Layer, Any], ...] = (("visual", link.visuals),
-                                                         ("collision", link.collisions))
-                for kind, shapes in layers:
-                    handles = [h for h in self._nodes.get(kind, [])
-                               if h.name.startswith(f"/robot/link{k}/")]
-                    for h, sh in zip(handles, shapes, strict=True):
-                        want = SELECTED_RGB if link.name == self.selected else \
-                            TOUCHING_RGB if link.name in hit else (base or sh.rgb)
-                        if tuple(h.color) != tuple(want):
-                            h.color = want
+            self.scene.recolour(self.model, self.selected, hit, bool(self.tint_findings.value))
 
     def _dropdown_moved(self, value: str) -> None:
         """A page chose ``value`` in the Selection menu: select it."""
@@ -559,37 +461,25 @@ class Viewer(RunDisplay):
 
     def link_pose(self, name: str) -> tuple[Vec3, tuple[float, float, float, float]]:
         """A link node's pose in the scene: (position, wxyz)."""
-        for link, frame in zip(self.model.links, self._frames, strict=True):
-            if link.name == name:
-                return (tuple(float(x) for x in frame.position),  # type: ignore[return-value]
-                        tuple(float(x) for x in frame.wxyz))
-        raise KeyError(name)
+        return self.scene.link_pose(self.model, name)
 
     def nodes(self, kind: Layer, link: str) -> list[Any]:
         """The scene handles of one layer of one link (for tests and tools)."""
-        index = next(i for i, lk in enumerate(self.model.links) if lk.name == link)
-        prefix = f"/robot/link{index}/"
-        return [h for h in self._nodes.get(kind, []) if h.name.startswith(prefix)]
+        return self.scene.of(self.model, kind, link)
 
     # ------------------------------------------------------------------ reloading
 
-    def _watch(self) -> None:
-        from urdfkit.core import deps
-
+    def _measure_touching(self) -> None:
+        """The first measure of self-collisions (on the watcher's thread): its failure said."""
         try:
             self.update_touching()
         except Exception as e:  # noqa: BLE001 - the server outlives a probe that fails
-            self.error = f"self-collisions not measured: {e}"
-            self._refresh_status()
-        while not self._stop.wait(POLL_SECONDS):
-            recorded = self._failed if self._failed is not None else self.model.depends
-            try:
-                if deps.unchanged(recorded):
-                    continue
-                self.reload()
-            except Exception as e:  # noqa: BLE001 - the server outlives any bad file
-                self.error = f"{type(e).__name__}: {e}"
-                self._refresh_status()
+            self._report(f"self-collisions not measured: {e}")
+
+    def _report(self, error: str) -> None:
+        """Show an error in the page's status (:attr:`error`)."""
+        self.error = error
+        self._refresh_status()
 
     def reload(self) -> bool:
         """Load the file again; on success show it, keeping joint values by name.
@@ -598,44 +488,27 @@ class Viewer(RunDisplay):
         :attr:`error`; the next change of any file tried is retried. Pages whose camera is
         where urdfkit put it are framed on the new robot; a camera its user moved stays.
         """
-        from urdfkit.core import deps
-
-        kept = self.model.positions()
-        try:
-            model = ViewedRobot(self.file, **self._load_args)
-        except Exception as e:  # noqa: BLE001 - any failure keeps the last good robot
-            self.error = str(e) if isinstance(e, UrdfkitError) else \
-                f"internal error (a bug in urdfkit): {type(e).__name__}: {e}"
-            # Not retried until a file changes again: a bad file is not loaded 4 times a second.
-            with deps.record() as recorded:  # what the failed attempt depends on
-                deps.note(self.file)
-                for path in self.model.depends:
-                    deps.note(path)
-            self._failed = recorded
-            self._refresh_status()
+        loaded = self.source.reload(self.model)
+        if isinstance(loaded, str):
+            self._report(loaded)
             return False
-        names = {j.name for j in model.joints}
-        keep = {k: v for k, v in kept.items() if k in names}
-        # The joints are set before the new robot is published: a reader that sees the new
-        # model (or the new count) never sees it at zero.
-        model.set_positions(keep)
+        model, keep = loaded
         with self._lock:
             old, self.model = self.model, model
-            self._failed = None
+            self.source.failed = None
             self.error = None
             self._show_model()
             old.close()
             self.set_joints(keep)
             # A robot that grew (or shrank) is framed again where no one moved the camera.
-            self._aim_camera()
+            self.cameras.initial(self.model.bounds())
             self.cameras.refit(self.server.get_clients().values())
             self.reloads += 1  # last: the count says the reload is complete
         return True
 
     def close(self) -> None:
         """Stop watching and serving, and disconnect PyBullet."""
-        self._stop.set()
-        self._watcher.join(timeout=5)
+        self.source.stop()
         self.actions.stop()
         with _quiet():
             self.server.stop()

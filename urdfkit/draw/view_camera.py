@@ -131,6 +131,28 @@ class PageCameras:
         self._lock = threading.RLock()
         self._aimed: dict[int, _Aimed] = {}
 
+    def initial(self, box: Box) -> None:
+        """Fit ``box`` in the view of pages to come, and of viser's "Reset View"."""
+        eye, target, _ = fit(box, ASPECT)
+        cam = self.server.initial_camera
+        cam.fov = math.radians(FOV_DEG)
+        cam.look_at, cam.position, cam.up = target, eye, (0.0, 0.0, 1.0)
+
+    def connected(self, client: Any, aim: Callable[[Any], None]) -> None:
+        """A page connected: once it reports its camera, watch it and ``aim(client)``.
+
+        The page reports its camera (and so its canvas's aspect) just after connecting: waited
+        for at most 5 s; a page that says nothing by then is left as it is.
+        """
+        import time
+
+        end = time.monotonic() + 5.0
+        while not client.camera.update_timestamp and time.monotonic() < end:
+            time.sleep(0.02)
+        if client.camera.update_timestamp:
+            self.watch(client)
+            aim(client)
+
     def watch(self, client: Any) -> None:
         """Refit a page when its canvas changes size (its user not having moved it)."""
         client.camera.on_update(lambda camera: self._reported(camera.client))

@@ -7,48 +7,12 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import EngineError
-from urdfkit.draw.view_model import Layer, Vec3, ViewedRobot
+from urdfkit.draw.view_model import Vec3, ViewedRobot
 from urdfkit.draw.view_page import box_digits
+from urdfkit.draw.view_scene import RobotScene, add_shapes, wxyz
 
 if TYPE_CHECKING:
     from urdfkit.engine.api import Simulator
-
-
-def wxyz(q: Sequence[float]) -> tuple[float, float, float, float]:
-    """A PyBullet quaternion (x, y, z, w) as viser takes it (w, x, y, z)."""
-    return (float(q[3]), float(q[0]), float(q[1]), float(q[2]))
-
-
-#: Seconds the web server may take to start. viser waits on its server thread without a time
-#: limit, and that thread dies silently on anything but a port in use: a hang, never a
-#: message. Bounded here.
-
-
-#: How much larger collision shapes are drawn than they are (see :func:`add_shapes`).
-COLLISION_INFLATE = 1.005
-
-
-def add_shapes(scene: Any, root: str, link: Any, tint: tuple[int, int, int] | None
-                ) -> list[tuple[Layer, Any]]:
-    """A link's visual and collision meshes under its frame ``root``: (kind, handle) pairs."""
-    out: list[tuple[Layer, Any]] = []
-    layers: tuple[tuple[Layer, Any], ...] = (("visual", link.visuals),
-                                             ("collision", link.collisions))
-    for kind, shapes in layers:
-        for k, sh in enumerate(shapes):
-            vertices = sh.vertices
-            if kind == "collision" and len(vertices):
-                # A collision box on its visual box would z-fight (both drawn, the faces
-                # flicker): drawn 0.5% larger about its middle, the pair shows as one.
-                mid = (vertices.max(axis=0) + vertices.min(axis=0)) / 2
-                vertices = mid + (vertices - mid) * COLLISION_INFLATE
-            out.append((kind, scene.add_mesh_simple(
-                f"{root}/{kind}{k}", vertices, sh.faces, color=tint or sh.rgb,
-                opacity=None if sh.opacity >= 1 else sh.opacity,
-                # No shadow pass: it doubles the first draw in software WebGL.
-                cast_shadow=False, receive_shadow=False,
-                position=sh.pos, wxyz=wxyz(sh.quat))))
-    return out
 
 
 class RunDisplay:
@@ -72,9 +36,9 @@ class RunDisplay:
     aim_page: Any
     #: Each page's camera (:class:`~urdfkit.draw.view_camera.PageCameras`).
     cameras: Any
+    #: The robot's nodes in the scene (the shapes of the robots added here join its layers).
+    scene: RobotScene
     _lock: threading.RLock
-    _nodes: dict[Layer, list[Any]]
-    _frames: list[Any]
 
     def apply_toggles(self) -> None:
         """Show or hide each layer as the page's checkboxes say."""
@@ -99,7 +63,7 @@ class RunDisplay:
                 frames.append(scene.add_frame(root, show_axes=False, position=pos,
                                               wxyz=wxyz(quat)))
                 for kind, mesh in add_shapes(scene, root, link, None):
-                    self._nodes[kind].append(mesh)
+                    self.scene.nodes[kind].append(mesh)
             self.extra.append((m, frames))
             self.apply_toggles()
         return k
@@ -113,7 +77,7 @@ class RunDisplay:
         were added with :meth:`add_robot`.
         """
         self.external_poses = True
-        frames = self._frames if robot == 0 else self.extra[robot - 1][1]
+        frames = self.scene.frames if robot == 0 else self.extra[robot - 1][1]
         if len(poses) != len(frames):
             raise EngineError(f"the run has {len(poses)} links, the view {len(frames)}")
         with self._lock, self.server.atomic():
@@ -123,7 +87,7 @@ class RunDisplay:
 
     def robot_pose(self, robot: int, link: int = 0) -> tuple[Vec3, tuple[float, ...]]:
         """A link node's pose in the scene, by robot number and link position (base 0)."""
-        frame = (self._frames if robot == 0 else self.extra[robot - 1][1])[link]
+        frame = (self.scene.frames if robot == 0 else self.extra[robot - 1][1])[link]
         return (tuple(float(x) for x in frame.position),  # type: ignore[return-value]
                 tuple(float(x) for x in frame.wxyz))
 
@@ -390,7 +354,7 @@ class RunStream:
         out = []
         n = 1 + len(self.viewer.extra)
         for k in range(n):
-            frames = self.viewer._frames if k == 0 else self.viewer.extra[k - 1][1]
+            frames = self.viewer.scene.frames if k == 0 else self.viewer.extra[k - 1][1]
             out.append([(tuple(float(x) for x in f.position), None) for f in frames])
         return out
 

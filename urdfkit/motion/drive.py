@@ -33,11 +33,11 @@ import math
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from urdfkit.core.errors import ParameterError
+from urdfkit.core.errors import ParameterError, UrdfkitError
 from urdfkit.engine.api import LoadSettings
 from urdfkit.engine.registry import check as check_engine
 from urdfkit.engine.registry import open_engine
@@ -51,10 +51,10 @@ from urdfkit.model.spec import (
     rpy_to_unit_quat,
 )
 from urdfkit.motion.drive_advice import (
+    PYBULLET_LINK_DAMPING,
     free_swivels,
     gazebo_differences,
     phantom_mass,
-    simulated,
     start_problems,
     yaw_shortfall,
 )
@@ -68,6 +68,8 @@ from urdfkit.motion.drive_result import (
 )
 from urdfkit.motion.vehicle import (
     DRIVETRAINS,
+    PYBULLET_DEFAULT_FORCE,
+    STEER_FORCE,
     DrivetrainError,
     apply_drive,
     clamp_steer,
@@ -421,12 +423,14 @@ class Scenario:
         self.ground_top, self.ground_bounds = self._ground()
         if c.base_position is None and not c.tutorial:
             self._rest_on_ground(start)
-        self.static_base, self.problems, start_said = start_problems(self)
+        self.static_base, self.problems, start_said = start_problems(
+            engine, self.body, self.plane, c.tutorial)
         self.warnings.extend(start_said)
         self.steer, note = clamp_steer(train, c.steer)
         if note:
             self.warnings.append(note)
-        for found in (phantom_mass(self), free_swivels(self)):
+        for found in (phantom_mass(engine, self.body, self.links_without_inertial),
+                      free_swivels(engine, self.body, train)):
             if found is not None:
                 self.warnings.append(found)
         self._plan_holds()
@@ -529,6 +533,18 @@ class Scenario:
         """Every URDF link frame's world pose now, base first (``(xyz, xyzw)``)."""
         assert self.engine is not None
         return list(self.engine.link_frames(self.body))
+
+    def _probe_yaw(self, sim_time: float) -> Callable[..., float | None]:
+        """The same drive again with some options changed: its yaw rate (None: it failed)."""
+        def probe(**changes: float | None) -> float | None:
+            cfg = replace(self.config, keep_trajectory=False, gui=False, steps=None,
+                          seconds=sim_time, **changes)  # type: ignore[arg-type]
+            try:
+                with Scenario(cfg, probe=True) as run:
+                    return run.run().yaw_rate
+            except UrdfkitError:
+                return None
+        return probe
 
     def _sampler(self) -> Callable[[float], tuple[float, ...]]:
         assert self.engine is not None
@@ -644,11 +660,13 @@ class Scenario:
             share = rate / self.steer
             if share < 0.9:
                 (problems if share < 0.1 else warnings).append(
-                    yaw_shortfall(self, rate, share, sim_time))
+                    yaw_shortfall(train, self.steer, c.throttle, c.max_force, rate, share,
+                                  sim_time, self._probe_yaw(sim_time)))
         slipping = [m for m in problems + warnings
                     if m.startswith(("wheels slipping", "stuck", "skid steering turns",
                                      "differential steering turns"))]
-        differ = gazebo_differences(self) if slipping else []
+        differ = gazebo_differences(self.engine, self.body, self.gazebo) \
+            if slipping and self.engine is not None else []
         if differ:
             shown = "; ".join(differ[:4]) + ("; ..." if len(differ) > 4 else "")
             warnings.append(f"the file's <gazebo> gives {shown}: --gazebo-contacts applies "
@@ -709,6 +727,31 @@ class _GuiControls:
             if delay > 0:
                 time.sleep(delay)
         return n, True
+
+
+def simulated(sc: Scenario) -> dict[str, object]:
+    """What a run simulates, beyond the robot: for the summary and JSON."""
+    c = sc.config
+    label = sc.engine.label if sc.engine is not None else c.engine
+    return {
+        "drivetrain": sc.drivetrain.mode, "steering": sc.drivetrain.steering,
+        # N m; PyBullet's default when no cap is given (the tutorial's).
+        "wheel_force": PYBULLET_DEFAULT_FORCE if c.max_force is None else c.max_force,
+        "wheel_force_default": c.max_force is None,
+        "hinge_force": STEER_FORCE if sc.drivetrain.hinges else None,
+        "held": [{"index": j, "name": sc.drivetrain.joint_names[j],
+                  "angle": round(a, 6), "force": f} for j, (a, f) in sc.held.items()],
+        "limp": [{"index": j, "name": sc.drivetrain.joint_names[j]} for j in sc.limp],
+        "load_flags": sc.flags, "time_step": c.time_step, "gravity": c.gravity,
+        "link_damping": {"linear": PYBULLET_LINK_DAMPING,
+                         "angular": PYBULLET_LINK_DAMPING, "note": "PyBullet's default"}
+        if c.engine == "pybullet" else
+        {"linear": 0.0, "angular": 0.0, "note": f"{label} has none"},
+        "tutorial": c.tutorial,
+        "gazebo_contacts": sc.gazebo_applied,
+        "mimic": sorted(sc.mimic_followers),
+        "engine": c.engine,
+    }
 
 
 def drive(config: DriveConfig, progress: ProgressFn | None = None) -> DriveResult:

@@ -1,6 +1,4 @@
-"""What ``drive`` says beside its numbers: what it simulated, what it found, its advice.
-
-:func:`simulated`: the settings a run simulated with (the summary's and the JSON's).
+"""What ``drive`` says beside its numbers: what it found, and the advice it measures first.
 
 Found at load: a static base or a start inside the ground (:func:`start_problems`), frames
 PyBullet gives 1 kg (:func:`phantom_mass`), driven wheels on a swivel left free
@@ -13,14 +11,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from urdfkit.core.errors import UrdfkitError
-from urdfkit.motion.vehicle import PYBULLET_DEFAULT_FORCE, STEER_FORCE
+from urdfkit.motion.vehicle import PYBULLET_DEFAULT_FORCE
 
 if TYPE_CHECKING:
-    from urdfkit.motion.drive import Scenario
+    from urdfkit.engine.api import Simulator
+    from urdfkit.model.gazebo import GazeboContact
+    from urdfkit.motion.vehicle import Drivetrain
 
 #: PyBullet's linear and angular damping of every link (drive does not change it).
 PYBULLET_LINK_DAMPING = 0.04
@@ -28,43 +26,17 @@ PYBULLET_LINK_DAMPING = 0.04
 PROBE_LIMIT = 60.0
 
 
-def simulated(sc: Scenario) -> dict[str, object]:
-    """What a run simulates, beyond the robot: for the summary and JSON."""
-    c = sc.config
-    label = sc.engine.label if sc.engine is not None else c.engine
-    return {
-        "drivetrain": sc.drivetrain.mode, "steering": sc.drivetrain.steering,
-        # N m; PyBullet's default when no cap is given (the tutorial's).
-        "wheel_force": PYBULLET_DEFAULT_FORCE if c.max_force is None else c.max_force,
-        "wheel_force_default": c.max_force is None,
-        "hinge_force": STEER_FORCE if sc.drivetrain.hinges else None,
-        "held": [{"index": j, "name": sc.drivetrain.joint_names[j],
-                  "angle": round(a, 6), "force": f} for j, (a, f) in sc.held.items()],
-        "limp": [{"index": j, "name": sc.drivetrain.joint_names[j]} for j in sc.limp],
-        "load_flags": sc.flags, "time_step": c.time_step, "gravity": c.gravity,
-        "link_damping": {"linear": PYBULLET_LINK_DAMPING,
-                         "angular": PYBULLET_LINK_DAMPING, "note": "PyBullet's default"}
-        if c.engine == "pybullet" else
-        {"linear": 0.0, "angular": 0.0, "note": f"{label} has none"},
-        "tutorial": c.tutorial,
-        "gazebo_contacts": sc.gazebo_applied,
-        "mimic": sorted(sc.mimic_followers),
-        "engine": c.engine,
-    }
-
-
-def start_problems(sc: Scenario) -> tuple[bool, list[str], list[str]]:
+def start_problems(engine: Simulator, body: int, ground: int, tutorial: bool
+                   ) -> tuple[bool, list[str], list[str]]:
     """A static base, or a start inside the ground, make the run meaningless: say so.
 
     Whether the base is static, the problems, and the warnings (the tutorial's own start,
     reproduced, is a warning).
     """
-    assert sc.engine is not None
-    engine = sc.engine
     problems: list[str] = []
     warnings: list[str] = []
-    static_base = engine.dynamics(sc.body, -1).mass == 0
-    root = engine.link_names(sc.body)[0]
+    static_base = engine.dynamics(body, -1).mass == 0
+    root = engine.link_names(body)[0]
     if static_base and root == "world":
         # PyBullet gives a link named `world` without <inertial> mass 0, not 1 kg
         # (measured on 3.2.7: with a mass of its own it falls like any other).
@@ -75,10 +47,10 @@ def start_problems(sc: Scenario) -> tuple[bool, list[str], list[str]]:
     elif static_base:
         problems.append("static base: the root link has mass 0, so PyBullet fixes it where it "
                         "is loaded and the car cannot move; give it a mass")
-    points = engine.closest_points(sc.body, sc.plane, 0.0)
+    points = engine.closest_points(body, ground, 0.0)
     depth = min((pt.distance for pt in points), default=0.0)
     if depth < -0.005:
-        if sc.config.tutorial:  # the tutorial's own start: reproduced, and said
+        if tutorial:  # the tutorial's own start: reproduced, and said
             warnings.append(f"the tutorial's start is {-depth * 1000:.0f} mm inside the "
                             "ground (the contact pushes the car out at once)")
         else:
@@ -88,41 +60,37 @@ def start_problems(sc: Scenario) -> tuple[bool, list[str], list[str]]:
     return static_base, problems, warnings
 
 
-def gazebo_differences(sc: Scenario) -> list[str]:
+def gazebo_differences(engine: Simulator, body: int, gazebo: dict[str, GazeboContact]
+                       ) -> list[str]:
     """The file's Gazebo friction where the engine uses another, as a user reads it."""
-    if not sc.gazebo or sc.engine is None:
+    if not gazebo:
         return []
     from urdfkit.motion.gazebo_load import link_indices
 
-    engine = sc.engine
-    index = link_indices(engine, sc.body)
+    index = link_indices(engine, body)
     out = []
-    for name, g in sc.gazebo.items():
+    for name, g in gazebo.items():
         mu = g.lateral_friction
         if mu is None or name not in index:
             continue
-        used = engine.dynamics(sc.body, index[name]).lateral_friction
+        used = engine.dynamics(body, index[name]).lateral_friction
         if abs(used - mu) > 1e-9 * max(1.0, mu):
             given = " ".join(f"{k} {v:g}" for k, v in g.given().items()
                              if k in ("mu1", "mu2"))
-            out.append(f"{name} {given}, {sc.engine.label} uses {used:g}")
+            out.append(f"{name} {given}, {engine.label} uses {used:g}")
     return out
 
 
-def phantom_mass(sc: Scenario) -> str | None:
+def phantom_mass(engine: Simulator, body: int, frames: list[str] | None) -> str | None:
     """What to say when PyBullet's 1 kg for each link without <inertial> is much of the robot.
 
     Frames (camera, IMU, sensor links) usually have no <inertial>; PyBullet makes each a
     1 kg body. On a small robot that is most of its weight, high up: a TurtleBot-sized base
     with five such frames (5 of 8.55 kg) tips over in raw PyBullet with its motors off.
     """
-    if not sc.links_without_inertial:
+    if not frames:
         return None
-    assert sc.engine is not None
-    engine = sc.engine
-    total = sum(engine.dynamics(sc.body, k).mass
-                for k in range(-1, len(engine.joints(sc.body))))
-    frames = sc.links_without_inertial
+    total = sum(engine.dynamics(body, k).mass for k in range(-1, len(engine.joints(body))))
     made_up = float(len(frames))
     if total > 0 and made_up >= 0.1 * total:
         names = ", ".join(frames[:5]) + (", ..." if len(frames) > 5 else "")
@@ -133,7 +101,7 @@ def phantom_mass(sc: Scenario) -> str | None:
     return None
 
 
-def free_swivels(sc: Scenario) -> str | None:
+def free_swivels(engine: Simulator, body: int, train: Drivetrain) -> str | None:
     """What to say when driven wheels hang from a swivel left free (a caster's).
 
     Naming only the wheels of a base whose wheels all sit on swivels (youBot's, Toyota
@@ -142,8 +110,7 @@ def free_swivels(sc: Scenario) -> str | None:
     ``--steer 0.5`` yawed 0.13 rad while its drive unit turned, and the run blamed wheel
     slip.
     """
-    assert sc.engine is not None
-    joints, train = sc.engine.joints(sc.body), sc.drivetrain
+    joints = engine.joints(body)
     free = set(train.casters)
     swivels: dict[int, list[str]] = {}
     for w in train.wheels:
@@ -163,7 +130,9 @@ def free_swivels(sc: Scenario) -> str | None:
     return None
 
 
-def yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> str:
+def yaw_shortfall(train: Drivetrain, steer: float, throttle: float, max_force: float | None,
+                  rate: float, share: float, sim_time: float,
+                  probe: Callable[..., float | None]) -> str:
     """Why the base turns slower than commanded, and advice that was tried before it is said.
 
     The same drive (same duration, so the same settled half) is run again over what a user
@@ -173,32 +142,21 @@ def yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> s
     names the option as the command line spells it. More yaw rate is then searched for the
     command that turns within 10% of what was asked (:func:`_aim`). At most three re-runs and
     :data:`AIM_RUNS` more, only when this warning is printed; runs over :data:`PROBE_LIMIT` s
-    are not repeated.
+    are not repeated. ``probe(**changes)`` runs the same drive with some of its options
+    changed (``max_force``, ``steer``) and gives its yaw rate (None: it failed).
     """
-    c, train = sc.config, sc.drivetrain
     kind = "skid steering" if train.steering == "skid" else "differential steering"
     # round first: a share of -3e-5 is said "0%", not "-0%"
     said = (f"{kind} turns at {rate:.3g} rad/s, {round(share, 2) + 0.0:.0%} of the "
-            f"{sc.steer:g} commanded")
-    force = PYBULLET_DEFAULT_FORCE if c.max_force is None else c.max_force
+            f"{steer:g} commanded")
+    force = PYBULLET_DEFAULT_FORCE if max_force is None else max_force
     if not 0 < sim_time <= PROBE_LIMIT:
         return (f"{said}; not measured at more force (the run is over {PROBE_LIMIT:g} s): "
                 "the wheels slip sideways, or the motors are too weak")
 
-    from urdfkit.motion.drive import Scenario
-
-    def probe(**changes: float | None) -> float | None:
-        cfg = replace(c, keep_trajectory=False, gui=False, steps=None, seconds=sim_time,
-                      **changes)  # type: ignore[arg-type]
-        try:
-            with Scenario(cfg, probe=True) as run:
-                return run.run().yaw_rate
-        except UrdfkitError:
-            return None
-
     def better(r: float | None) -> bool:
         return r is not None and abs(r) > 1.5 * abs(rate) and \
-            abs(r - rate) > 0.05 * abs(sc.steer)
+            abs(r - rate) > 0.05 * abs(steer)
 
     def shown(r: float | None) -> str:
         return "failed" if r is None else f"{r:.3g} rad/s"
@@ -212,19 +170,19 @@ def yaw_shortfall(sc: Scenario, rate: float, share: float, sim_time: float) -> s
         if better(r):
             assert r is not None
             return (f"{said}; with --max-force {higher:g} it turns at {r:.3g} rad/s "
-                    f"({r / sc.steer:.0%}): run with --max-force {higher:g}")
+                    f"({r / steer:.0%}): run with --max-force {higher:g}")
         tried.append(f"--max-force {higher:g}: {shown(r)}")
-    widest = 2.0 * abs(c.throttle) * train.reference_radius / train.track \
+    widest = 2.0 * abs(throttle) * train.reference_radius / train.track \
         if train.track > 0 else math.inf
-    more = math.copysign(min(3.0 * abs(sc.steer), widest), sc.steer)
-    if abs(more) > 1.2 * abs(sc.steer):
+    more = math.copysign(min(3.0 * abs(steer), widest), steer)
+    if abs(more) > 1.2 * abs(steer):
         r = probe(steer=more)
         if better(r):
             assert r is not None
             first = f"more wheel force does not help ({'; '.join(tried)})" if tried \
                 else "at PyBullet's default wheel force"
             return f"{said}; {first}: the wheels slip sideways, and " + _aim(
-                lambda x: probe(steer=x), sc.steer, (sc.steer, rate), (more, r), widest)
+                lambda x: probe(steer=x), steer, (steer, rate), (more, r), widest)
         tried.append(f"--steer {more:.3g}: {shown(r)}")
     return (f"{said}; neither more force nor more yaw rate turns it faster "
             f"({'; '.join(tried)}): the wheels slip sideways")
