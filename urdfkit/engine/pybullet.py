@@ -27,27 +27,22 @@ import dataclasses
 from collections.abc import Callable, Iterable, Sequence
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from urdfkit.core.errors import EngineError
 from urdfkit.engine.api import (
     BaseState,
-    Camera,
-    CollisionShape,
     ContactPoint,
     JointInfo,
     JointKind,
     JointRow,
     JointState,
-    Light,
     LinkDynamics,
     LinkPose,
     LoadSettings,
     MotorMode,
-    Picture,
     Quat,
-    ShapeKind,
     Vec3,
-    VisualShape,
 )
+from urdfkit.engine.pybullet_dynamics import STALE_MODELS, Dynamics
+from urdfkit.engine.pybullet_shapes import Shapes, text
 
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
@@ -58,16 +53,11 @@ if TYPE_CHECKING:
 #: revolute one without limits).
 JOINT_KINDS: dict[int, JointKind] = {0: "revolute", 1: "prismatic", 2: "spherical",
                                      3: "planar", 4: "fixed"}
-#: ``getCollisionShapeData``'s geometry codes (``p.GEOM_*``) as the seam's shape kinds.
-SHAPE_KINDS: dict[int, ShapeKind] = {2: "sphere", 3: "box", 4: "cylinder", 5: "mesh",
-                                     6: "plane", 7: "capsule"}
-_MESH = 5
 #: A mimic gear's error reduction per step (PyBullet's default, 0.2, leaves a sag under load:
 #: a 0.5 kg mast following at x 2 against gravity sat 0.37 mm off; at 0.8, 0.010 mm;
 #: urdfkit/motion/mimic.py has the measurements).
 GEAR_ERP = 0.8
 
-_UNTRIED = "untried"
 R = TypeVar("R", bound="DataclassInstance")
 
 
@@ -96,15 +86,6 @@ _joint_state = _maker(JointState)
 _contact_point = _maker(ContactPoint)
 
 
-#: Why a body loaded after a ``removeBody`` gets no dynamics: PyBullet keeps each body's
-#: inverse-dynamics model by the body's place in memory, and a new body can take a removed
-#: one's place and its model (measured on 3.2.7: kuka_iiwa loaded after a removed pendulum
-#: got the pendulum's model: a dimension error, and PyBullet's SystemError).
-STALE_MODELS = ("PyBullet may give a body loaded after a removeBody the removed body's "
-                "inverse-dynamics model (it keeps them by place in memory): its dynamics "
-                "are not asked of this engine; load it into a fresh one")
-
-
 def preload() -> None:
     """Import pybullet now, quietly (:func:`~urdfkit.engine.session.import_pybullet`)."""
     from urdfkit.engine.session import import_pybullet
@@ -112,11 +93,7 @@ def preload() -> None:
     import_pybullet()
 
 
-def _name(raw: bytes) -> str:
-    return raw.decode("utf-8", "replace")
-
-
-class PyBulletEngine:
+class PyBulletEngine(Shapes, Dynamics):
     """A PyBullet physics client behind the seam (DIRECT, or its GUI window).
 
     Args:
@@ -259,19 +236,19 @@ class PyBulletEngine:
         kind = JOINT_KINDS.get(info[2], "fixed")
         lower, upper = float(info[8]), float(info[9])
         return JointInfo(
-            index=int(info[0]), name=_name(info[1]), kind=kind, q_index=int(info[3]),
+            index=int(info[0]), name=text(info[1]), kind=kind, q_index=int(info[3]),
             v_index=int(info[4]), damping=float(info[6]), friction=float(info[7]),
             lower=lower, upper=upper,
             # PyBullet's continuous joints read lower 0, upper -1: no limits.
             limited=kind in ("revolute", "prismatic") and lower <= upper,
-            effort=float(info[10]), velocity=float(info[11]), link=_name(info[12]),
+            effort=float(info[10]), velocity=float(info[11]), link=text(info[12]),
             axis=(info[13][0], info[13][1], info[13][2]), parent=int(info[16]))
 
     def link_names(self, body: int) -> list[str]:
         """``getBodyInfo``'s root name, then each joint's child link."""
         b = self.session.bullet
-        return [_name(b.getBodyInfo(body)[0])] + [
-            _name(b.getJointInfo(body, j)[12]) for j in range(b.getNumJoints(body))]
+        return [text(b.getBodyInfo(body)[0])] + [
+            text(b.getJointInfo(body, j)[12]) for j in range(b.getNumJoints(body))]
 
     def dynamics(self, body: int, link: int) -> LinkDynamics:
         """``getDynamicsInfo``."""
@@ -474,39 +451,6 @@ class PyBulletEngine:
                            relativePositionTarget=-offset / multiplier, erp=GEAR_ERP)
         return int(c)
 
-    def collision_shapes(self, body: int, link: int) -> list[CollisionShape]:
-        """``getCollisionShapeData``; a mesh's vertices from ``getMeshData``.
-
-        A cylinder PyBullet turned into a mesh (no implicit cylinders) is a mesh here too.
-        """
-        b = self.session.bullet
-        out: list[CollisionShape] = []
-        for k, shape in enumerate(b.getCollisionShapeData(body, link)):
-            kind = SHAPE_KINDS.get(shape[2], "other")
-            vertices: Sequence[Vec3] | None = None
-            if kind == "mesh":
-                try:
-                    count, verts = b.getMeshData(body, link, collisionShapeIndex=k)
-                except self.error:
-                    count, verts = 0, []
-                vertices = verts if count else ()
-            out.append(CollisionShape(kind, shape[3], shape[5], shape[6], vertices,
-                                      _name(shape[4]) if kind == "mesh" else ""))
-        return out
-
-    def collision_vertices(self, body: int, link: int) -> list[Vec3]:
-        """``getMeshData(body, link, -1)``: every collision vertex PyBullet keeps for a link.
-
-        In the link's inertial frame, all its collision shapes' at once (measured: the files'
-        placed vertices exactly, an OBJ's stray vertex left out); empty where PyBullet gives
-        none or refuses (it raises plain errors on a link without a mesh).
-        """
-        try:
-            count, vertices = self.session.bullet.getMeshData(body, link, -1)
-        except Exception:  # noqa: BLE001 - PyBullet raises plain errors; no data, no vertices
-            return []
-        return list(vertices) if count else []
-
     def set_collision_filter(self, body: int, link: int, group: int, mask: int) -> None:
         """``setCollisionFilterGroupMask``: group and mask 0 take the link out of every contact.
 
@@ -536,141 +480,6 @@ class PyBulletEngine:
                            inertia_from_file=settings.inertia_from_file,
                            implicit_cylinder=settings.implicit_cylinder,
                            self_collision=settings.self_collision).flag_names()
-
-    def visual_shapes(self, body: int) -> list[VisualShape]:
-        """``getVisualShapeData``, quiet (what PyBullet prints goes to the diagnostics)."""
-        from urdfkit.engine.session import quiet_stdout
-
-        with quiet_stdout() as out:
-            rows = self.session.bullet.getVisualShapeData(body)
-        self.session.diagnostics.extend(out.lines)
-        return [VisualShape(int(v[1]), SHAPE_KINDS.get(v[2], "other"), v[3],
-                            _name(v[4]) if v[2] == _MESH else "", v[5], v[6], v[7])
-                for v in rows]
-
-    def aabb(self, body: int, link: int) -> tuple[Vec3, Vec3]:
-        """``getAABB``."""
-        lo, hi = self.session.bullet.getAABB(body, link)
-        return lo, hi
-
-    def camera_image(self, camera: Camera, width: int, height: int) -> bytes:
-        """``getCameraImage`` with the TinyRenderer, its RGB without alpha."""
-        import numpy as np
-
-        b = self.session.bullet
-        view = b.computeViewMatrix(camera.eye, camera.target, camera.up)
-        proj = b.computeProjectionMatrixFOV(camera.fov, width / height, camera.near,
-                                            camera.far)
-        image = b.getCameraImage(width, height, view, proj,
-                                 renderer=self.session.p.ER_TINY_RENDERER)[2]
-        rgba = np.asarray(image, dtype=np.uint8).reshape(height, width, 4)
-        return rgba[:, :, :3].tobytes()
-
-    def picture(self, camera: Camera, width: int, height: int, light: Light | None = None
-                ) -> Picture:
-        """``getCameraImage`` with the TinyRenderer: RGB, segmentation mask, matrices.
-
-        The matrices are ``computeViewMatrix``'s and ``computeProjectionMatrixFOV``'s. PyBullet
-        computes the matrices in float32; they are handed out as it gives them, so
-        that what is drawn over the picture meets what PyBullet drew.
-        """
-        import numpy as np
-
-        b = self.session.bullet
-        view = b.computeViewMatrix(camera.eye, camera.target, camera.up)
-        proj = b.computeProjectionMatrixFOV(camera.fov, width / height, camera.near,
-                                            camera.far)
-        renderer = self.session.p.ER_TINY_RENDERER
-        shoot = self.session.call  # quiet: a picture may go to stdout (render -o -)
-        if light is None:
-            shot = shoot("getCameraImage", width, height, view, proj, renderer=renderer)
-        else:
-            shot = shoot(
-                "getCameraImage", width, height, view, proj, renderer=renderer,
-                lightDirection=list(light.direction), shadow=int(light.shadows),
-                lightAmbientCoeff=light.ambient, lightDiffuseCoeff=light.diffuse,
-                lightSpecularCoeff=light.specular)
-        from PIL import Image
-
-        # Pillow drops the alpha in a third of the time numpy's strided copy takes (5 against
-        # 16 ms at 1600x1200, render's supersampled 800x600)
-        rgba = np.ascontiguousarray(shot[2], dtype=np.uint8)
-        rgb = Image.frombuffer("RGBA", (width, height), rgba, "raw", "RGBA", 0, 1).convert("RGB")
-        bodies = np.ascontiguousarray(shot[4], dtype="<i4").tobytes()
-        return Picture(width, height, rgb.tobytes(), bodies, tuple(view), tuple(proj))
-
-    # ---- dynamics
-
-    def mass_matrix(self, body: int, positions: Sequence[float]) -> list[list[float]]:
-        """``calculateMassMatrix``: a floating base's 6 coordinates first.
-
-        Angular, then linear (measured on 3.2.7), with the base at PyBullet's default pose.
-        """
-        rows = self._dynamics("calculateMassMatrix", body, positions)
-        return [list(row) for row in rows]
-
-    def floating_mass_matrix(self, body: int, position: Vec3, orientation: Quat,
-                             positions: Sequence[float]) -> list[list[float]]:
-        """``calculateMassMatrix`` with ``flags=1``: the base's pose before the joints.
-
-        PyBullet then gives 7 base rows and columns, linear then angular, and a 7th that is
-        the identity's (the quaternion's 4th part); the 6 kept are the first three and the
-        angular three. A root without ``<inertial>``, which PyBullet simulates at 1 kg, counts
-        0 kg here (measured on 3.2.7: quadruped_like's linear diagonal reads 13.72 kg of the
-        14.72 its links hold; with ``flags=0`` it reads 14.72).
-        """
-        full: list[list[float]] = self._dynamics(
-            "calculateMassMatrix", body, [*position, *orientation, *positions], flags=1)
-        return [row[:6] + row[7:] for k, row in enumerate(full) if k != 6]
-
-    def inverse_dynamics(self, body: int, positions: Sequence[float],
-                         velocities: Sequence[float],
-                         accelerations: Sequence[float]) -> list[float]:
-        """``calculateInverseDynamics`` (a fixed base only: PyBullet's limit)."""
-        return list(self._dynamics("calculateInverseDynamics", body, positions, velocities,
-                                   accelerations))
-
-    def jacobian(self, body: int, link: int, point: Vec3, positions: Sequence[float]
-                 ) -> tuple[list[list[float]], list[list[float]]]:
-        """``calculateJacobian`` at rest.
-
-        The velocities do not change PyBullet's Jacobian (bit for bit the same at any,
-        measured on three robots, a floating one among them).
-        """
-        zero = [0.0] * len(positions)
-        lin, ang = self._dynamics("calculateJacobian", body, link, list(point), positions,
-                                  zero, zero)
-        return lin, ang
-
-    def _dynamics(self, fn: str, body: int, *args: Any, **kwargs: Any) -> Any:
-        """One of the three dynamics calls on ``body``'s inverse-dynamics model.
-
-        PyBullet builds that model at the first call and may refuse (and print): the first
-        call runs quiet (:func:`dynamics_call`); after one worked, calls are bare; after a
-        refusal, every call raises why.
-
-        Raises:
-            EngineError: with why as a clause.
-        """
-        state = self._models.get(body, _UNTRIED)
-        if state is None:  # the motor's every-step path: the bare call
-            b = self.session.bullet
-            try:
-                return getattr(b, fn)(body, *args, **kwargs)
-            except (SystemError, self.error) as e:
-                raise EngineError(f"PyBullet's {fn} failed "
-                                  f"({e.__cause__ or e.__context__ or e})") from None
-        if state is not _UNTRIED:
-            raise EngineError(state)
-        from urdfkit.engine.session import dynamics_call
-
-        try:  # the call that builds PyBullet's model: it may print
-            out = dynamics_call(self.session.bullet, fn, body, *args, **kwargs)
-        except EngineError as e:
-            self._models[body] = e.message
-            raise EngineError(e.message) from None
-        self._models[body] = None
-        return out
 
 
 if TYPE_CHECKING:
