@@ -205,6 +205,7 @@ def _car_pixels(page: Any) -> int:
     return int((crop.max(axis=2) < 50).sum())
 
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 def test_drive_view_waits_for_the_page_follows_the_car_and_replays(
         chromium: Any, tmp_path: Path) -> None:
     import csv

@@ -225,6 +225,7 @@ def _sim_view_of(s: Simulation, pace: float | None) -> RunStream:
 
 # --------------------------------------------------------------------------- in a browser
 
+@pytest.mark.slow  # a long browser test (10-30 s): CI's slow step runs it
 def test_sim_view_in_a_browser_waits_follows_the_chosen_robot_and_replays(
         chromium: Any) -> None:
     """two_cars on the page in headless Chromium (tests/conftest.py's ``chromium``).
