@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -21,15 +20,6 @@ pytest.importorskip("mujoco")
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 WHEEL_RADIUS, WHEELBASE = 0.1, 0.4  # simplecar's defaults
-
-
-@pytest.fixture(autouse=True, scope="module")
-def _private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
-    folder = tmp_path_factory.mktemp("cache")
-    mp = pytest.MonkeyPatch()
-    mp.setenv("URDFKIT_CACHE_DIR", str(folder))
-    yield folder
-    mp.undo()
 
 
 @pytest.fixture(scope="module")
