@@ -111,7 +111,7 @@ def _robot(page: Any, viewer: Viewer) -> tuple[Any, Any, Any]:
         viewer.apply_toggles()
         return _still(page)
 
-    for _ in range(4):
+    for _ in range(10):  # a loaded machine's software WebGL can take several tries
         shown = _still(page)
         try:
             hidden = show(False)
