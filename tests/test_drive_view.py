@@ -94,6 +94,7 @@ def test_cli_no_wait_runs_prints_json_and_exits() -> None:
     assert json.loads(r.stdout)["final_position"] == json.loads(plain.stdout)["final_position"]
 
 
+@pytest.mark.slow  # 8 s of waiting by design: CI's slow step runs it
 def test_cli_without_a_terminal_says_it_waits_and_wait_timeout_ends_the_wait() -> None:
     import re
     import signal

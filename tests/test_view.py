@@ -518,6 +518,7 @@ def test_selecting_a_link_highlights_it_and_shows_its_joint_row(tmp_path: Path,
         v.select("no_such_link")
 
 
+@pytest.mark.slow  # a long browser test (7-10 s): CI's slow step runs it
 def test_clicking_a_finding_and_choosing_a_link_in_the_page_select_it(
         page_of: Any, tmp_path: Path, viewer_of: Any) -> None:
     path = tmp_path / "bad.urdf"
@@ -598,6 +599,7 @@ def _projected_share(camera: Any, lo: Any, hi: Any) -> tuple[float, float]:
     return (max(xs) - min(xs)) / 2, (max(ys) - min(ys)) / 2
 
 
+@pytest.mark.slow  # a long browser test (7-10 s): CI's slow step runs it
 @pytest.mark.environment_map  # the colours as users see them: viser's own lighting
 def test_kuka_in_its_own_colours_with_a_legend_filling_the_view(page_of: Any,
                                                                 viewer_of: Any) -> None:
