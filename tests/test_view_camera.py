@@ -361,8 +361,10 @@ def test_a_reloaded_robot_that_grew_is_framed_again_unless_the_camera_was_moved(
         for p in (page, other):
             p.goto(viewer.url)
             p.get_by_text("Connected").wait_for(timeout=60000)
+        # viser counts a page as connected at its first camera report, which software
+        # WebGL on a loaded machine can send well after the page shows "Connected"
+        assert _wait(lambda: len(viewer.server.get_clients()) == 2, 60)
         clients = sorted(viewer.server.get_clients().values(), key=lambda c: c.client_id)
-        assert len(clients) == 2
         mine, theirs = clients
         _, before, _ = _robot(page, viewer)
         assert min(_margins(before)) > 0.05  # the short arm is whole
@@ -435,42 +437,3 @@ def _inside(camera: Any, lo: Any, hi: Any) -> bool:
         if depth <= 0 or abs(rel @ right / depth) > tan_h or abs(rel @ up / depth) > tan_v:
             return False
     return True
-
-
-def test_a_page_slow_to_report_its_camera_is_aimed_when_it_does(
-        monkeypatch: pytest.MonkeyPatch) -> None:
-    """A page that reports its camera only after the 5 s a connection waits for it (software
-    WebGL on a loaded machine: a page reloaded in CI's slow step) is aimed at its first report;
-    it used to be left on the file's pose."""
-    from urdfkit.draw.view_camera import PageCameras
-
-    class Camera:
-        update_timestamp = 0.0
-        client: Any = None
-
-        def __init__(self) -> None:
-            self.callbacks: list[Any] = []
-
-        def on_update(self, fn: Any) -> None:
-            self.callbacks.append(fn)
-
-    class Client:
-        client_id = 7
-
-        def __init__(self) -> None:
-            self.camera = Camera()
-            self.camera.client = self
-
-    clock = iter(float(t) for t in range(0, 10_000, 3))  # each reading 3 s after the last
-    monkeypatch.setattr(time, "monotonic", lambda: next(clock))
-    monkeypatch.setattr(time, "sleep", lambda _s: None)
-    client, aimed = Client(), []
-    PageCameras(server=None).connected(client, aimed.append)
-    assert aimed == []  # nothing reported within the wait: not aimed yet
-    client.camera.update_timestamp = 1.0
-    for fn in list(client.camera.callbacks):  # the page's first report
-        fn(client.camera)
-    assert aimed == [client]
-    for fn in list(client.camera.callbacks):  # later reports do not aim it again
-        fn(client.camera)
-    assert aimed == [client]

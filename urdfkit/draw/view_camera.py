@@ -142,30 +142,16 @@ class PageCameras:
         """A page connected: once it reports its camera, watch it and ``aim(client)``.
 
         The page reports its camera (and so its canvas's aspect) just after connecting: waited
-        for here for at most 5 s. A page slower than that (software WebGL on a loaded machine)
-        is watched and aimed when its first report comes; it used to be left on the file's
-        pose.
+        for at most 5 s; a page that says nothing by then is left as it is.
         """
         import time
 
         end = time.monotonic() + 5.0
         while not client.camera.update_timestamp and time.monotonic() < end:
             time.sleep(0.02)
-        done = threading.Event()
-
-        def first(_camera: Any = None) -> None:
-            with self._lock:
-                if done.is_set():
-                    return
-                done.set()
+        if client.camera.update_timestamp:
             self.watch(client)
             aim(client)
-
-        if not client.camera.update_timestamp:
-            client.camera.on_update(first)  # its first report, however late
-            if not client.camera.update_timestamp:
-                return
-        first()
 
     def watch(self, client: Any) -> None:
         """Refit a page when its canvas changes size (its user not having moved it)."""
