@@ -446,15 +446,19 @@ def test_restore_steps_again_exactly(engine: Any) -> None:
     for _ in range(20):
         engine.step()
     state = engine.save()
-    runs = []
-    for _ in range(2):
-        engine.restore(state)
-        trace = []
-        for _ in range(30):
-            engine.step()
-            trace.append(engine.base_state(box).position)
-        runs.append(trace)
+    runs = [_replayed(engine, state, 30, lambda: engine.base_state(box).position)
+            for _ in range(2)]
     assert runs[0] == runs[1]
+
+
+def _replayed(engine: Any, state: int, steps: int, read: Any) -> list[Any]:
+    """``read()`` after each of ``steps`` steps from the saved ``state``."""
+    engine.restore(state)
+    trace = []
+    for _ in range(steps):
+        engine.step()
+        trace.append(read())
+    return trace
 
 
 def test_the_base_is_its_inertial_frame_as_pybullet_has_it() -> None:
@@ -716,15 +720,9 @@ def test_restore_with_motors_at_their_caps_steps_again_exactly(
     for _ in range(10):
         engine.step()
     state = engine.save()
-    runs = []
-    for _ in range(2):
-        engine.restore(state)
-        trace = []
-        for _ in range(60):
-            engine.step()
-            trace.append((engine.base_state(car).position,
-                          [s.velocity for s in engine.joint_states(car, [1, 3, 4, 5])]))
-        runs.append(trace)
+    runs = [_replayed(engine, state, 60, lambda: (
+        engine.base_state(car).position,
+        [s.velocity for s in engine.joint_states(car, [1, 3, 4, 5])])) for _ in range(2)]
     assert runs[0] == runs[1]
     assert all(s.applied == pytest.approx(2.0) for s in engine.joint_states(car, [4, 5]))
 
