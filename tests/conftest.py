@@ -243,3 +243,16 @@ def open_view(module_chromium: Any) -> Iterator[Callable[..., Any]]:
     yield open_page
     for page in opened:
         page.close()
+
+
+def wait_until(cond: Callable[[], Any], seconds: float = 20.0) -> bool:
+    """Whether ``cond()`` came true within ``seconds`` (asked every 0.05 s, and once more at
+    the end): the page and server tests' one wait."""
+    import time
+
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.05)
+    return bool(cond())

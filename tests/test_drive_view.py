@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from conftest import wait_until as _wait_for
 
 #: One worker runs every page and server test (pytest-xdist --dist loadgroup): two Chromiums
 #: drawing WebGL in software on 2 cores starve each other.
@@ -272,13 +273,6 @@ def test_drive_view_waits_for_the_page_follows_the_car_and_replays(
             proc.communicate()
 
 
-def _wait_for(cond: Any, seconds: float) -> bool:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.2)
-    return bool(cond())
 
 
 def test_the_page_names_the_template_not_its_cache_file() -> None:

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from conftest import wait_until as _wait_for
 
 #: One worker runs every page and server test (pytest-xdist --dist loadgroup): two Chromiums
 #: drawing WebGL in software on 2 cores starve each other.
@@ -384,10 +385,3 @@ def _all_in_view(view: Any, points: list[Any]) -> bool:
     return True
 
 
-def _wait_for(cond: Any, seconds: float) -> bool:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.1)
-    return bool(cond())

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from conftest import wait_until as _wait
 
 #: One worker runs every page and server test (pytest-xdist --dist loadgroup): two Chromiums
 #: drawing WebGL in software on 2 cores starve each other.
@@ -127,13 +128,6 @@ def _plain(markdown: str) -> str:
     return re.sub(r"\\(.)", r"\1", re.sub(r"<[^>]+>", "", markdown))
 
 
-def _wait(cond: Callable[[], bool], seconds: float = 10.0) -> bool:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.05)
-    return cond()
 
 
 # --------------------------------------------------------------------------- the server

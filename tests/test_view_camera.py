@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from conftest import wait_until as _wait
 
 #: One worker runs every page and server test (pytest-xdist --dist loadgroup): two Chromiums
 #: drawing WebGL in software on 2 cores starve each other.
@@ -393,13 +394,6 @@ def test_a_reloaded_robot_that_grew_is_framed_again_unless_the_camera_was_moved(
         viewer.close()
 
 
-def _wait(cond: Any, seconds: float) -> bool:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.1)
-    return bool(cond())
 
 
 def _settled(camera: Any, seconds: float = 60) -> Any:

@@ -11,11 +11,11 @@ from __future__ import annotations
 import math
 import re
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import pytest
+from conftest import wait_until as _wait
 
 pytestmark = [pytest.mark.xdist_group("browser"), pytest.mark.usefixtures("plain_lighting")]
 
@@ -31,13 +31,6 @@ def arm(tmp_path: Path) -> Path:
     return path
 
 
-def _wait(cond: Callable[[], bool], seconds: float = 20.0) -> bool:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        if cond():
-            return True
-        time.sleep(0.1)
-    return cond()
 
 
 #: Each labelled slider's value as the page holds it (``aria-valuenow`` of its thumb).
