@@ -36,6 +36,7 @@ from urdfkit.engine.api import Camera, LoadSettings
 from urdfkit.engine.registry import check as check_engine
 from urdfkit.engine.registry import open_engine
 from urdfkit.model.spec import quat_to_matrix
+from urdfkit.motion.stepping import StepLoop
 
 if TYPE_CHECKING:
     from urdfkit.motion.scenario_models import Mode, Randomize, RobotConfig
@@ -208,7 +209,7 @@ class SimpleDrivingEnv(gym.Env):
             self.close()
             raise
         self.goal = (0.0, 0.0)
-        self._speed = 0.0
+        self._speed = self._throttle = self._steer_asked = 0.0
         self._steer: float | None = None
         self._previous_distance = 0.0
         self._last_frame = 0.0
@@ -242,8 +243,11 @@ class SimpleDrivingEnv(gym.Env):
         self.goal_marker = e.load(str(marker), LoadSettings(
             fixed_base=True, position=(0.0, 0.0, 0.5), scenery=True), display="goal")
         self._start = e.save()  # and primed: the first episode is like every later one
+        #: The one step loop (:mod:`urdfkit.motion.stepping`), with the car's controller.
+        self._loop = StepLoop(e, self.TIME_STEP)
+        self._controls = (self._control,)
         # bound once: a step is short (~80 us), and each lookup shows in it
-        self._motors, self._step, self._base = e.motors, e.step, e.base_state
+        self._motors, self._base = e.motors, e.base_state
 
     # ---- the Gymnasium API
 
@@ -272,6 +276,7 @@ class SimpleDrivingEnv(gym.Env):
         e.reset_base(self.goal_marker, (float(gx), float(gy), 0.5), (0.0, 0.0, 0.0, 1.0))
         self._speed = 0.0
         self._steer = None
+        self._loop.step_count = 0
         obs = self._observe()
         self._previous_distance = math.hypot(obs[0] - gx, obs[1] - gy)
         if self.render_mode == "human":
@@ -287,19 +292,9 @@ class SimpleDrivingEnv(gym.Env):
         _open(self)
         throttle, steer = _finite_pair(action)
         _after_end(self)
-        throttle = min(max(throttle, 0.0), 1.0)
-        steer = max(min(steer, 0.6), -0.6)
-        motors, car = self._motors, self.car
-        if steer != self._steer:  # position motors persist: set on change
-            motors(car, _HINGES, "position", [steer, steer])
-            self._steer = steer
-        v = self._speed
-        v += self.TIME_STEP * (self.C_THROTTLE * throttle - v * (v * self.C_DRAG
-                                                                 + self.C_ROLLING))
-        self._speed = v = max(v, 0.0)
-        force = self.WHEEL_FORCE
-        motors(car, _WHEELS, "velocity", [v, v, v, v], forces=[force, force, force, force])
-        self._step()
+        self._throttle = min(max(throttle, 0.0), 1.0)
+        self._steer_asked = max(min(steer, 0.6), -0.6)
+        self._loop.step(1, self._controls)
         obs = self._observe()
         x, y = float(obs[0]), float(obs[1])
         gx, gy = self.goal
@@ -319,6 +314,22 @@ class SimpleDrivingEnv(gym.Env):
             self._follow_in_gui(x, y)
         self._ended = terminated
         return obs, reward, terminated, False, {"distance": distance, "is_success": reached}
+
+    def _control(self, t: float) -> None:
+        """The car's controller: hinges at the steering angle, wheels at the throttle's speed.
+
+        The wheel speed the throttle builds up is integrated over the coming step.
+        """
+        motors, car, steer = self._motors, self.car, self._steer_asked
+        if steer != self._steer:  # position motors persist: set on change
+            motors(car, _HINGES, "position", [steer, steer])
+            self._steer = steer
+        v = self._speed
+        v += self.TIME_STEP * (self.C_THROTTLE * self._throttle - v * (v * self.C_DRAG
+                                                                       + self.C_ROLLING))
+        self._speed = v = max(v, 0.0)
+        force = self.WHEEL_FORCE
+        motors(car, _WHEELS, "velocity", [v, v, v, v], forces=[force, force, force, force])
 
     def _observe(self) -> np.ndarray:
         base = self._base(self.car)

@@ -5,7 +5,7 @@ Sliders are read while a run steps (drive --gui); the camera follows the Gymnasi
 
 PyBullet only: its GUI client draws debug sliders (``addUserDebugParameter``) beside the
 scene. Closing the window ends the run: every call then fails with ``pybullet.error``, which
-:class:`Sliders` turns into a plain answer (``None``, ``False``) rather than an exception.
+:meth:`Sliders.read` turns into a plain answer (``None``) rather than an exception.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 
 
 class Sliders:
-    """Named sliders in an engine's GUI window, and its physics step.
+    """Named sliders in an engine's GUI window.
 
     Args:
         engine: A PyBullet world opened with ``gui=True``.
@@ -38,7 +38,6 @@ class Sliders:
             raise ParameterError("`gui`: sliders need PyBullet's GUI window", param="gui")
         self._bullet = engine.bullet
         self._error = engine.session.p.error
-        self._step = engine.bullet.stepSimulation
         self._ids = [self._bullet.addUserDebugParameter(label, lo, hi, start)
                      for label, lo, hi, start in sliders]
 
@@ -49,14 +48,6 @@ class Sliders:
             return tuple(float(read(i)) for i in self._ids)
         except self._error:
             return None
-
-    def step(self) -> bool:
-        """One physics step; False (and no step) once the window is closed."""
-        try:
-            self._step()
-        except self._error:
-            return False
-        return True
 
 
 def follow(engine: Simulator, distance: float, yaw: float, pitch: float,

@@ -66,6 +66,7 @@ from urdfkit.motion.drive_result import (
     Trajectory,
     trajectory_format,
 )
+from urdfkit.motion.stepping import Closed, StepLoop
 from urdfkit.motion.vehicle import (
     DRIVETRAINS,
     PYBULLET_DEFAULT_FORCE,
@@ -612,33 +613,17 @@ class Scenario:
             if sink is not None:
                 sink(row)
 
-        sample(0.0)
-        step = engine.step
-        done = 0
-        interrupted = False
+        loop = StepLoop(engine, dt)
         gui = _GuiControls(self) if c.gui else None
+        controls = () if gui is None else (gui.control,)
         start = time.perf_counter()
         with quiet_stdout():  # what the engine prints (PyBullet's C code, on fd 1)
-            try:
-                while done < total:
-                    n = min(period, total - done)
-                    if gui is not None:
-                        n, open_ = gui.steps(n)
-                        interrupted = not open_  # the window was closed
-                    else:
-                        # The hot loop: nothing but the physics step (bound once, above).
-                        for _ in range(n):
-                            step()
-                    done += n
-                    if done % period == 0 or done == total:
-                        sample(done * dt)
-                    if progress is not None:
-                        progress(done, total)
-                    if interrupted:
-                        break
-            except KeyboardInterrupt:
-                interrupted = True
+            interrupted = loop.run(
+                total, period, lambda: sample(loop.t), progress=progress, start=True,
+                last=True, real_time=gui is not None,
+                step=None if gui is None else lambda n: loop.step(n, controls))
         wall = time.perf_counter() - start
+        done = loop.step_count
         assert stats.last is not None
         if stats.last[0] != done * dt:
             sample(done * dt)
@@ -690,10 +675,10 @@ class Scenario:
 
 
 class _GuiControls:
-    """The tutorial's Steering and Throttle sliders, read every step, applied on change.
+    """The tutorial's Steering and Throttle sliders: a controller, read before every step.
 
-    Runs at real time so a person can drive; the run ends at the configured duration or
-    when the window is closed.
+    The run paces itself to real time so a person can drive; it ends at the configured duration
+    or when the window is closed.
     """
 
     def __init__(self, sc: Scenario):
@@ -707,26 +692,16 @@ class _GuiControls:
         self.sliders = Sliders(sc.engine, [("Steering", lo, hi, sc.steer),
                                            ("Throttle", -top, top, sc.config.throttle)])
         self.last: tuple[float, ...] = (sc.steer, sc.config.throttle)
-        self.next_tick = time.perf_counter()
 
-    def steps(self, n: int) -> tuple[int, bool]:
-        """Up to ``n`` steps at real time; how many were taken, and whether the window is open."""
-        dt = self.sc.config.time_step
-        for i in range(n):
-            now = self.sliders.read()
-            if now is None:
-                return i, False
-            if now != self.last:
-                self.last = now
-                apply_drive(self.engine, self.sc.body, self.sc.drivetrain, now[1], now[0],
-                            self.sc.config.max_force)
-            if not self.sliders.step():
-                return i, False
-            self.next_tick += dt
-            delay = self.next_tick - time.perf_counter()
-            if delay > 0:
-                time.sleep(delay)
-        return n, True
+    def control(self, t: float) -> None:
+        """Apply the sliders when they moved; :class:`Closed` once the window is closed."""
+        now = self.sliders.read()
+        if now is None:
+            raise Closed
+        if now != self.last:
+            self.last = now
+            apply_drive(self.engine, self.sc.body, self.sc.drivetrain, now[1], now[0],
+                        self.sc.config.max_force)
 
 
 def simulated(sc: Scenario) -> dict[str, object]:

@@ -1,12 +1,12 @@
-"""Recording: the run loop, its rows and where they go.
+"""Recording: a run's rows and where they go.
 
-:class:`Recorder` steps a simulation to an end, taking a row per robot every
-``record.every`` steps, and hands each batch to a sink (a file, a viewer) as it comes.
+:class:`Recorder` runs a simulation to an end on the world's step loop
+(:mod:`urdfkit.motion.stepping`), taking a row per robot every ``record.every`` steps, and
+hands each batch to a sink (a file, a viewer) as it comes.
 """
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
@@ -42,37 +42,12 @@ class Recorder:
         ideal: list[Observation] = []
         summary = _Summary()
         record = self._recorder(rows, ideal, summary, sink, keep=keep)
-        interrupted = False
-        engine = world.engine
-        try:
-            if world.step_count % every == 0:
-                record()
-            self._loop(end, every, record, real_time)
-        except KeyboardInterrupt:
-            interrupted = True
-        except engine.error:
-            if not engine.gui or engine.connected():
-                raise
-            interrupted = True  # the GUI window was closed
+        interrupted = world.loop.run(end, every, record, step=self.step, real_time=real_time,
+                                     start=True)
         kept = min(len(rows), len(ideal))
         whole = kept - kept % max(1, len(world.robots))
         return SimResult(rows[:whole], ideal[:whole], world.time_step, world.step_count,
                          interrupted, summary.rows, summary.robots())
-
-    def _loop(self, end: int, every: int, record: Callable[[], None], real_time: bool) -> None:
-        world, step = self.world, self.step
-        # Real time: at most a 60th of a second of simulated time between two waits.
-        chunk = max(1, round(1 / 60 / world.time_step)) if real_time else end
-        start_wall, start_step = time.perf_counter(), world.step_count
-        while world.step_count < end:
-            step(min(every - world.step_count % every, end - world.step_count, chunk))
-            if world.step_count % every == 0:
-                record()
-            if real_time:
-                ahead = start_wall + (world.step_count - start_step) * world.time_step \
-                    - time.perf_counter()
-                if ahead > 0:
-                    time.sleep(ahead)
 
     def _recorder(self, rows: list[Observation], ideal: list[Observation], summary: _Summary,
                   sink: Sink | None, *, keep: bool) -> Callable[[], None]:

@@ -21,6 +21,7 @@ from urdfkit.model.spec import UP_AXES, quat_mul, rpy_to_unit_quat
 from urdfkit.motion.scenario import JOINT_NOISE_FIELDS
 from urdfkit.motion.sim_robot import SimRobot, new_readings
 from urdfkit.motion.sim_state import JointSpec, _first
+from urdfkit.motion.stepping import StepLoop
 
 if TYPE_CHECKING:
     from urdfkit.engine.api import Simulator
@@ -51,8 +52,7 @@ class World:
     Attributes:
         config: The scenario.
         engine: The world of this simulation alone, in its engine.
-        time_step: The physics step, s.
-        step_count: Physics steps since the start (or the last restore).
+        loop: Its step loop, which counts the steps (``time_step``, ``step_count``).
         ground: The ground's body id (None: no ground).
         robots: The robots by name, in scenario order.
     """
@@ -60,14 +60,24 @@ class World:
     def __init__(self, config: ScenarioConfig, *, gui: bool = False,
                  engine: str | None = None) -> None:
         self.config = config
-        self.time_step: float = config.physics.time_step
-        self.step_count = 0
         self.ground: int | None = None
         self.robots: dict[str, SimRobot] = {}
         self._resolved: list[Resolved] = []
         self._start_state = -1
         self._tmp = tempfile.TemporaryDirectory(prefix="urdfkit-sim-")
         self.engine: Simulator = open_engine(engine or config.physics.engine, gui=gui)
+        #: The one step loop (:mod:`urdfkit.motion.stepping`): the world's clock.
+        self.loop = StepLoop(self.engine, config.physics.time_step)
+
+    @property
+    def time_step(self) -> float:
+        """The physics step, s."""
+        return self.loop.time_step
+
+    @property
+    def step_count(self) -> int:
+        """Physics steps since the start (or the last restore)."""
+        return self.loop.step_count
 
     @property
     def session(self) -> Session:
@@ -167,7 +177,7 @@ class World:
     def restore(self) -> None:
         """Back to the saved start, contacts and all; time starts over."""
         self.engine.restore(self._start_state)
-        self.step_count = 0
+        self.loop.step_count = 0
 
     def set_time_step(self, time_step: float) -> None:
         """The physics time step, s (times already recorded keep theirs)."""
@@ -175,7 +185,7 @@ class World:
             raise ParameterError(f"`time_step` must be in (0, 1], got {time_step!r}",
                                  param="time_step")
         self.engine.set_time_step(time_step)
-        self.time_step = float(time_step)
+        self.loop.time_step = float(time_step)
 
     def change_ground(self, **values: float) -> None:
         """Set the ground's dynamics (changeDynamics' names): its friction, restitution."""

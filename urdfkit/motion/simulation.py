@@ -21,6 +21,7 @@ seam's :class:`~urdfkit.engine.api.Simulator`; :attr:`Simulation.bullet` (and
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -247,32 +248,29 @@ class Simulation(RobotPhysics):
         (``observe``, a recorded row); the step before a recorded row keeps the joint
         velocities, so the row's accelerations are over one step, as before.
         """
-        world, sensors = self.world, self.sensors
-        step = world.engine.step
+        world, sensors, loop = self.world, self.sensors, self.world.loop
         every = self.config.record.every
         robots = list(world.robots.values())
         delayed = [r for r in robots if r.config.delay > 0 or r.readings.reports is not None]
         lazy = [r for r in robots if r not in delayed and r.active]
         # Robots with nothing to command (no schedule, override, servo or standing command)
         # cost nothing per step.
-        controlled = [(r, self.controllers[r.name]) for r in robots
-                      if r.override is not None or r.applied is not None or r.servo
-                      or r.config.drive or r.config.joints]
-        for _ in range(n):
-            if controlled:  # the time only when a controller reads it
-                t = world.step_count * world.time_step
-                for r, controller in controlled:
-                    controller.control(r, t)
-            step()
-            world.step_count += 1
+        controls = [functools.partial(self.controllers[r.name].control, r) for r in robots
+                    if r.override is not None or r.applied is not None or r.servo
+                    or r.config.drive or r.config.joints]
+
+        def measure() -> None:
             for r in delayed:
                 r.readings.history.append(sensors.measure(r))
                 if r.readings.reports is not None:
                     sensors.report(r)
             # The step before a row (unless a row is taken now, which keeps them anyway).
-            if lazy and (world.step_count + 1) % every == 0 and world.step_count % every:
+            count = loop.step_count
+            if lazy and (count + 1) % every == 0 and count % every:
                 for r in lazy:
                     sensors.keep_velocities(r)
+
+        loop.step(n, controls, measure if delayed or lazy else None)
 
     def observe(self, robot: str | None = None, *, ideal: bool = False
                 ) -> Observation | dict[str, Observation]:
