@@ -44,8 +44,8 @@ def steps_cost(env, n: int) -> tuple[float, int]:
 
 def bodies(env) -> int:
     """How many bodies the env's world holds (a car, a goal and a plane after a reset)."""
-    if hasattr(env, "_p"):  # urdfkit's: pybullet bound to its client
-        return env._p.getNumBodies()
+    if hasattr(env, "engine"):  # urdfkit's: PyBullet through the engine's escape hatch
+        return env.engine.bullet.getNumBodies()
     return env.p.getNumBodies(physicsClientId=env.client)  # the tutorial's
 
 
