@@ -269,8 +269,11 @@ def _read(path: str, display: str, no_exec: bool = False,
 def check_file(display: str, path: str | Path,
                packages: Mapping[str, Path] | None = None, no_exec: bool = False,
                xacro_args: Mapping[str, str] | None = None,
-               physics: bool = False) -> FileResult:
+               physics: bool = False, targets: Sequence[str] = ()) -> FileResult:
     """Run every rule on one file; any failure to read it becomes a ``U000`` finding.
+
+    ``targets`` (:func:`urdfkit.checks.targets.parse_targets`) adds what those consumers
+    refuse or change (``T`` codes).
 
     With ``no_exec`` (or URDFKIT_NO_EXEC set) a xacro file is not expanded: it gets one
     ``U006`` warning saying so, and is otherwise unchecked. With ``physics`` a file with no
@@ -318,7 +321,12 @@ def check_file(display: str, path: str | Path,
         return result
     # Path(name).absolute().parent, as a string (no Path: ~3 us a file).
     folder = os.path.dirname(name if os.path.isabs(name) else os.path.join(os.getcwd(), name))
-    found = run_rules(root, display, ALL_RULES, base=folder,
+    rules = ALL_RULES
+    if targets:
+        from urdfkit.checks.targets import target_rules
+
+        rules = (*rules, *target_rules(targets))
+    found = run_rules(root, display, rules, base=folder,
                       packages=packages, origins=getattr(data, "origins", None))
     if xacro_file:
         # Lines of xacro's output are not lines of the file the user wrote: none, not a false
@@ -382,20 +390,23 @@ def _macro_library(root: object) -> bool:
     return root.tag in ("robot", "root") and root.find("link") is None
 
 
-_Job = tuple[str, str, str | None, dict[str, str], bool, dict[str, str], bool, bool]
+_Job = tuple[str, str, str | None, dict[str, str], bool, dict[str, str], bool, bool,
+             tuple[str, ...]]
 _caches: dict[tuple[object, ...], object] = {}
 
 
 def _result_cache(packages: Mapping[str, str], no_exec: bool, xacro_args: Mapping[str, str],
-                  physics: bool) -> ResultCache | None:
+                  physics: bool, targets: tuple[str, ...] = ()) -> ResultCache | None:
     """The result cache for these options, made once per option set and process."""
     from urdfkit.checks.resultcache import ResultCache
 
     memo = (tuple(sorted(packages.items())), no_exec, tuple(sorted(xacro_args.items())),
-            physics, os.environ.get("URDFKIT_CACHE_DIR"))
+            physics, targets, os.environ.get("URDFKIT_CACHE_DIR"))
     if memo not in _caches:  # the key prefix is made once
         options: dict[str, object] = {"packages": dict(packages), "no_exec": no_exec,
                                       "xacro_args": dict(xacro_args), "physics": physics}
+        if targets:  # only when given: the keys of a plain check stay as they were
+            options["targets"] = list(targets)
         if physics:  # U950/U951 come from PyBullet itself
             from importlib.metadata import version
 
@@ -407,26 +418,27 @@ def _result_cache(packages: Mapping[str, str], no_exec: bool, xacro_args: Mappin
 
 
 def _check_one(job: _Job) -> FileResult:
-    display, path, problem, packages, no_exec, xacro_args, physics, use_cache = job
+    display, path, problem, packages, no_exec, xacro_args, physics, use_cache, targets = job
     if problem is not None:
         return FileResult(display, [Finding("U000", "error", problem, display)])
     pkgs = {k: Path(v) for k, v in packages.items()} if packages else {}
-    cache = _result_cache(packages, no_exec, xacro_args, physics) if use_cache else None
+    cache = _result_cache(packages, no_exec, xacro_args, physics, targets) if use_cache \
+        else None
     if cache is None:
-        return check_file(display, path, pkgs, no_exec, xacro_args, physics)
+        return check_file(display, path, pkgs, no_exec, xacro_args, physics, targets)
     from urdfkit.checks.resultcache import file_stat
     from urdfkit.core import deps
 
     seen = file_stat(path)  # before the bytes are read: an edit after this misses next run
     key = cache.key(display, path)
     if key is None:
-        return check_file(display, path, pkgs, no_exec, xacro_args, physics)
+        return check_file(display, path, pkgs, no_exec, xacro_args, physics, targets)
     hit = cache.get_entry(key)
     if hit is not None:
         return FileResult(display, [Finding(**f) for f in hit[1]], cached=True,
                           entry=(seen, *hit) if seen is not None else None)
     with deps.record() as recorded:  # the file itself is in the key, by its content
-        result = check_file(display, path, pkgs, no_exec, xacro_args, physics)
+        result = check_file(display, path, pkgs, no_exec, xacro_args, physics, targets)
     recorded.pop(os.path.abspath(path), None)
     found = [f.to_dict() for f in result.findings]
     if cache.put(key, recorded, found) and seen is not None:
@@ -473,10 +485,13 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
                 select: Sequence[str] = (), ignore: Sequence[str] = (),
                 jobs: int | None = None, no_exec: bool = False,
                 xacro_args: Mapping[str, str] | None = None,
-                physics: bool = False, cache: bool = True) -> CheckResult:
+                physics: bool = False, cache: bool = True,
+                targets: Sequence[str] = ()) -> CheckResult:
     """Check every file under ``paths``, over ``jobs`` processes (default: every core).
 
-    ``physics`` loads each file without errors in PyBullet for the U95x rules. ``cache``
+    ``physics`` loads each file without errors in PyBullet for the U95x rules. ``targets``
+    (:func:`urdfkit.checks.targets.parse_targets`) adds what those consumers refuse or
+    change. ``cache``
     reuses a file's findings while neither it nor anything it read changed
     (:mod:`urdfkit.checks.resultcache`; also off when ``URDFKIT_CACHE_DIR`` is empty).
 
@@ -492,7 +507,8 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
     files = discover(given)
     pkgs = {k: str(v) for k, v in (packages or {}).items()}
     args = dict(xacro_args or {})
-    manifest = _manifest(given, pkgs, no_exec, args, physics) if cache else None
+    aimed = tuple(targets)
+    manifest = _manifest(given, pkgs, no_exec, args, physics, aimed) if cache else None
     results: list[FileResult | None] = [None] * len(files)
     todo = []
     for n, (display, path, problem) in enumerate(files):
@@ -502,7 +518,7 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
         else:
             todo.append(n)
     if todo:
-        work = [(*files[n], pkgs, no_exec, args, physics, cache) for n in todo]
+        work = [(*files[n], pkgs, no_exec, args, physics, cache, aimed) for n in todo]
         for n, fr in zip(todo, _check_misses(given, work, jobs, manifest), strict=True):
             results[n] = fr
     if manifest is not None:
@@ -637,8 +653,9 @@ def _include_target(raw: str, folder: str, packages: Mapping[str, Path] | None) 
 
 
 def _manifest(paths: Sequence[str], packages: Mapping[str, str], no_exec: bool,
-              xacro_args: Mapping[str, str], physics: bool) -> RunManifest | None:
-    cache = _result_cache(packages, no_exec, xacro_args, physics)
+              xacro_args: Mapping[str, str], physics: bool,
+              targets: tuple[str, ...]) -> RunManifest | None:
+    cache = _result_cache(packages, no_exec, xacro_args, physics, targets)
     if cache is None:
         return None
     from urdfkit.checks.resultcache import RunManifest

@@ -20,6 +20,7 @@ from urdfkit.checks.rules_meshes import (
     rule_meshes,
     rule_visual_meshes,
 )
+from urdfkit.checks.targets import TARGET_CODES
 from urdfkit.model.spec import (
     EXTENSIONS,
     LIMITED_JOINT_TYPES,
@@ -287,4 +288,5 @@ CODES: dict[str, str] = {
     "U901": "PyBullet extension (spherical joint, capsule, plane, cdf): not portable",
     "U950": "links in contact at the zero pose (check --physics: self-collision jitters)",
     "U951": "PyBullet cannot load the file (check --physics)",
+    **TARGET_CODES,
 }

@@ -31,7 +31,8 @@ FLAG_OPTIONS = {"--json": "as_json", "--no-exec": "no_exec", "--all": "show_all"
 VALUE_OPTIONS = {"--format": "output_format", "--fail-on": "fail_on", "--jobs": "jobs",
                  "-j": "jobs"}
 LIST_OPTIONS = {"--select": "select", "--ignore": "ignore", "--arg": "arg", "-a": "arg",
-                "--package": "package", "-p": "package", "--package-path": "package_path"}
+                "--package": "package", "-p": "package", "--package-path": "package_path",
+                "--target": "target"}
 
 
 def run_check(paths: list[str], as_json: bool = False, output_format: str | None = None,
@@ -39,7 +40,8 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
               package_path: list[str] | None = None, select: list[str] | None = None,
               ignore: list[str] | None = None, jobs: int | None = None,
               arg: list[str] | None = None, no_exec: bool = False, show_all: bool = False,
-              physics: bool = False, no_cache: bool = False, strict: bool = False) -> int:
+              physics: bool = False, no_cache: bool = False, strict: bool = False,
+              target: list[str] | None = None) -> int:
     """Check ``paths`` and print the findings in ``output_format``; the exit code.
 
     A folder given that holds no robot file is said (a warning): a CI run over the wrong
@@ -50,6 +52,7 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
             (exit code 2).
     """
     from urdfkit.checks.check import check_paths, parse_codes
+    from urdfkit.checks.targets import parse_targets
     from urdfkit.core.errors import ParameterError
     from urdfkit.core.finding import Finding
     from urdfkit.sources.uris import parse_packages
@@ -68,7 +71,7 @@ def run_check(paths: list[str], as_json: bool = False, output_format: str | None
                              select=parse_codes(select, "`select`"),
                              ignore=parse_codes(ignore, "`ignore`"), jobs=jobs,
                              no_exec=no_exec, xacro_args=xacro_args(arg), physics=physics,
-                             cache=not no_cache)
+                             cache=not no_cache, targets=parse_targets(target))
     finally:
         if enabled:
             gc.enable()

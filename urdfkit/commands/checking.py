@@ -68,6 +68,11 @@ def check(
     strict: Annotated[bool, typer.Option(
         "--strict", help="Exit 2 when a folder given holds no robot file (else a warning), "
         "so a CI run cannot pass on nothing.")] = False,
+    target: Annotated[list[str] | None, typer.Option(
+        "--target", metavar="ros,pinocchio,drake,mujoco",
+        help="Also what these consumers of the file refuse (errors) or silently change "
+        "(warnings), comma-separated; none needs installing (T codes, docs/check.md). "
+        "PyBullet is always a target.")] = None,
 ) -> None:
     """Check URDF files for errors PyBullet crashes on, physics mistakes and typos.
 
@@ -78,7 +83,7 @@ def check(
 
     raise typer.Exit(run_check(paths, as_json, output_format, fail_on, package, package_path,
                                select, ignore, jobs, arg, no_exec, show_all, physics, no_cache,
-                               strict))
+                               strict, target))
 
 
 # ---- diff: two robots compared in meaning (urdfkit/diff.py)
