@@ -143,10 +143,16 @@ class _Worker:
         return Outcome(d["refused"], d.get("message", ""), model=d.get("model", {}))
 
     def close(self) -> None:
+        assert self.proc.stdin is not None and self.proc.stdout is not None
         if self.proc.poll() is None:
-            assert self.proc.stdin is not None
             self.proc.stdin.close()
             self.proc.wait(timeout=30)
+        for pipe in (self.proc.stdin, self.proc.stdout):
+            if not pipe.closed:
+                try:
+                    pipe.close()
+                except BrokenPipeError:  # the worker died with input unread
+                    pass
 
 
 def load(engine: str, paths: list[str]) -> dict[str, Outcome]:
@@ -157,6 +163,7 @@ def load(engine: str, paths: list[str]) -> dict[str, Outcome]:
         for path in paths:
             found[path] = worker.ask(os.path.abspath(path))
             if found[path].crashed:
+                worker.close()
                 worker = _Worker(engine)
     finally:
         worker.close()

@@ -21,10 +21,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from lxml import etree
-
+from urdfkit.checks.targets_pinocchio import CODES as PINOCCHIO_CODES
+from urdfkit.checks.targets_pinocchio import rule_pinocchio
+from urdfkit.checks.targets_ros import CODES as ROS_CODES
+from urdfkit.checks.targets_ros import rule_ros
 from urdfkit.core.errors import ParameterError
-from urdfkit.sources.guard import Rule, RuleReport
+from urdfkit.sources.guard import Rule
 
 #: Every target, by name: who reads the file there.
 TARGETS: dict[str, str] = {
@@ -67,11 +69,7 @@ def target_rules(targets: Sequence[str]) -> tuple[Rule, ...]:
 # --------------------------------------------------------------------------- the rules
 
 #: Each target's rules.
-RULES: dict[str, tuple[Rule, ...]] = {}
+RULES: dict[str, tuple[Rule, ...]] = {"ros": (rule_ros,), "pinocchio": (rule_pinocchio,)}
 
 #: Every target code with a one-line summary (merged into check's codes).
-TARGET_CODES: dict[str, str] = {}
-
-
-def _unused(root: etree._Element, r: RuleReport) -> None:  # pragma: no cover - placeholder
-    """Keeps the module importable while the rule tables are filled."""
+TARGET_CODES: dict[str, str] = {**ROS_CODES, **PINOCCHIO_CODES}

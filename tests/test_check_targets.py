@@ -1,0 +1,334 @@
+"""``check --target`` (issue 51): every rule's fixture loaded in the real consumer.
+
+A refusal rule's fixture is refused by the engine itself (urdfdom's ``check_urdf`` exits 255,
+Pinocchio raises); a change rule's fixture loads, and the engine's model holds what the rule
+says (Pinocchio's masses, coordinates, joint order, kinematics; urdfdom's own log). Each
+fixture has a twin without the fault that the engine loads and that gets no finding of the
+rule. Over pybullet_data, ``check --target`` reports an error exactly where the engine
+refuses the file.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from engine_loaders import cmeel_prefix, load
+from urdfkit.checks.check import check_file, check_paths
+from urdfkit.checks.targets import TARGET_CODES, parse_targets
+from urdfkit.core.errors import ParameterError
+
+LIM = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+INERTIAL = ('<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" '
+            'izz="1"/></inertial>')
+
+
+def joint(kind: str = "revolute", inner: str = LIM, *, name: str = "j",
+          version: str = "") -> str:
+    """Two links and one joint between them (links with inertia: Pinocchio's masses)."""
+    v = f' version="{version}"' if version else ""
+    return (f'<robot name="r"{v}><link name="a">{INERTIAL}</link><link name="b">{INERTIAL}'
+            f'</link><joint name="{name}" type="{kind}"><parent link="a"/><child link="b"/>'
+            f'{inner}</joint></robot>')
+
+
+def links(inner: str, version: str = "") -> str:
+    v = f' version="{version}"' if version else ""
+    return f'<robot name="r"{v}><link name="a">{inner}</link></robot>'
+
+
+#: What urdfdom refuses: code -> (fixture, its twin that loads).
+REFUSED: dict[str, tuple[str, str]] = {
+    "T102": ('<model name="r"><link name="a"/></model>', links("")),
+    "T103": ('<robot><link name="a"/></robot>', links("")),
+    "T104": ('<robot name="r" version="1.3"><link name="a"/></robot>', links("", "1.2")),
+    "T105": ('<robot name="r"></robot>', links("")),
+    "T106": ('<robot name="r"><link name="a"/><link name="a"/></robot>', links("")),
+    "T107": ('<robot name="r"><link name="a"/><link name="b"/><link name="c"/><joint name="j" '
+             'type="fixed"><parent link="a"/><child link="b"/></joint><joint name="j" '
+             'type="fixed"><parent link="a"/><child link="c"/></joint></robot>',
+             joint("fixed", "")),
+    "T108": ('<robot name="r"><material name="m"><color rgba="1 0 0 1"/></material><material '
+             'name="m"><color rgba="0 1 0 1"/></material><link name="a"/></robot>', links("")),
+    "T109": ('<robot name="r"><link name="a"/><link name="b"/><joint type="fixed"><parent '
+             'link="a"/><child link="b"/></joint></robot>', joint("fixed", "")),
+    "T110": (joint("", "").replace(' type=""', ""), joint("fixed", "")),
+    "T111": (joint("spherical", ""), joint("fixed", "")),
+    "T112": (joint("revolute", ""), joint()),
+    "T114": (joint("revolute", '<limit lower="-1" upper="1" velocity="1"/>'), joint()),
+    "T116": (joint("revolute", '<limit lower="-1.57." upper="1" effort="1" velocity="1"/>'),
+             joint("revolute", '<limit lower="-1.57" upper="1" effort="1" velocity="1"/>')),
+    "T117": (joint("revolute", '<limit lower="1" upper="-1" effort="1" velocity="1"/>',
+                   version="1.2"), joint(version="1.2")),
+    "T120": (joint("fixed", '<origin xyz="0 0 $(optenv Z 0.1)"/>'),
+             joint("fixed", '<origin xyz="0 0 0.1"/>')),
+    "T121": (joint("fixed", '<origin rpy="0 0 1" quat_xyzw="0 0 0.7071068 0.7071068"/>',
+                   version="1.1"), joint("fixed", '<origin rpy="0 0 1"/>', version="1.1")),
+    "T122": (joint("revolute", '<axis xyz="0 1"/>' + LIM),
+             joint("revolute", '<axis xyz="0 1 0"/>' + LIM)),
+    "T123": (joint("revolute", LIM + "<dynamics/>"),
+             joint("revolute", LIM + '<dynamics damping="0.1"/>')),
+    "T124": (joint("revolute", LIM + '<safety_controller soft_lower_limit="-1" '
+                   'soft_upper_limit="1" k_position="1"/>'),
+             joint("revolute", LIM + '<safety_controller k_velocity="1"/>')),
+    "T125": (joint("revolute", LIM + '<calibration rising="x"/>'),
+             joint("revolute", LIM + '<calibration rising="0.5"/>')),
+    "T126": (joint("revolute", LIM + '<mimic multiplier="2"/>'),
+             joint("revolute", LIM)),
+    "T127": ('<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="fixed">'
+             '<child link="b"/></joint></robot>', joint("fixed", "")),
+    "T128": ('<robot name="r"><link name="a"/><joint name="j" type="fixed"><parent link="a"/>'
+             '<child link="zz"/></joint></robot>', joint("fixed", "")),
+    "T130": ('<robot name="r"><link name="a"/><link name="b"/></robot>', links("")),
+    "T131": ('<robot name="r"><link name="a"/><link name="b"/><joint name="j1" type="fixed">'
+             '<parent link="a"/><child link="b"/></joint><joint name="j2" type="fixed">'
+             '<parent link="b"/><child link="a"/></joint></robot>', joint("fixed", "")),
+}
+
+
+def _write(tmp_path: Path, text: str, name: str = "r.urdf") -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _codes(path: Path, targets: tuple[str, ...]) -> dict[str, str]:
+    return {f.code: f.level for f in check_file(str(path), path, targets=targets).findings
+            if f.code.startswith("T")}
+
+
+def check_urdf(path: Path) -> tuple[int, str]:
+    """urdfdom's own ``check_urdf``: its exit status and its log."""
+    prefix = cmeel_prefix()
+    assert prefix is not None, "pip install pin (urdfkit[engines]) brings urdfdom's check_urdf"
+    p = subprocess.run([str(prefix / "bin" / "check_urdf"), str(path)], capture_output=True,
+                       text=True, timeout=20,
+                       env=dict(os.environ, LD_LIBRARY_PATH=str(prefix / "lib")))
+    return p.returncode, p.stderr
+
+
+def pinocchio_model(path: Path):  # type: ignore[no-untyped-def]
+    import pinocchio
+
+    return pinocchio.buildModelFromUrdf(str(path))
+
+
+@pytest.mark.parametrize("code", sorted(REFUSED))
+def test_each_urdfdom_refusal_is_refused_by_urdfdom_and_pinocchio(code: str,
+                                                                   tmp_path: Path) -> None:
+    bad, good = REFUSED[code]
+    path = _write(tmp_path, bad)
+    found = _codes(path, ("ros", "pinocchio"))
+    assert found.get(code) == "error" and found.get("T200") == "error", found
+    status, log = check_urdf(path)
+    assert status == 255, (status, log)
+    with pytest.raises(ValueError, match="valid URDF model"):
+        pinocchio_model(path)
+    twin = _write(tmp_path, good, "twin.urdf")
+    assert not any(level == "error" for level in _codes(twin, ("ros", "pinocchio")).values())
+    assert check_urdf(twin)[0] == 0
+    pinocchio_model(twin)
+
+
+#: What urdfdom loads but logs it could not read: code -> (fixture, urdfdom's log line).
+DROPPED = {
+    "inertial without mass": (links('<inertial><inertia ixx="1" ixy="0" ixz="0" iyy="1" '
+                                    'iyz="0" izz="1"/></inertial>'), "Could not parse inertial"),
+    "mass with a trailing space": (links('<inertial><mass value="1 "/><inertia ixx="1" ixy="0" '
+                                         'ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'),
+                                   "Could not parse inertial"),
+    "box of two sizes": (links('<visual><geometry><box size="1 1"/></geometry></visual>'
+                               '<collision><geometry><box size="1 1 1"/></geometry></collision>'),
+                         "Could not parse visual"),
+    "mesh scale of four": (links('<collision><geometry><mesh filename="m.stl" scale="1 1 1 1"/>'
+                                 '</geometry></collision>'), "Could not parse collision"),
+    "PyBullet's plane shape": (links('<collision><geometry><plane normal="0 0 1"/></geometry>'
+                                     '</collision>'), "Could not parse collision"),
+    "capsule before 1.1": (links('<collision><geometry><capsule radius="0.1" length="1"/>'
+                                 '</geometry></collision>'), "Could not parse collision"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(DROPPED))
+def test_a_link_part_urdfdom_cannot_read_is_dropped_not_refused(case: str,
+                                                                 tmp_path: Path) -> None:
+    text, logged = DROPPED[case]
+    path = _write(tmp_path, text)
+    assert _codes(path, ("ros",)) == {"T150": "warning"}
+    status, log = check_urdf(path)
+    assert status == 0 and logged in log, (status, log)
+
+
+def test_a_limit_without_lower_and_upper_pins_the_joint_at_zero(tmp_path: Path) -> None:
+    path = _write(tmp_path, joint("revolute", '<limit effort="1" velocity="1"/>'))
+    assert _codes(path, ("ros",)).get("T163") == "warning"
+    m = pinocchio_model(path)  # urdfdom's reading, as Pinocchio builds its model from it
+    assert (m.lowerPositionLimit[0], m.upperPositionLimit[0]) == (0.0, 0.0)
+    assert "T163" not in _codes(_write(tmp_path, joint(), "twin.urdf"), ("ros",))
+
+
+@pytest.mark.parametrize("axis", ['<axis/>', '<axis xyz="0 0 0"/>'])
+def test_a_zero_axis_breaks_pinocchio_kinematics(axis: str, tmp_path: Path) -> None:
+    import numpy as np
+    import pinocchio
+
+    path = _write(tmp_path, joint("revolute", axis + LIM))
+    found = _codes(path, ("ros", "pinocchio"))
+    assert found.get("T226") == "warning"
+    assert ("T169" in found) == (axis == "<axis/>")
+    m = pinocchio_model(path)
+    d = m.createData()
+    pinocchio.forwardKinematics(m, d, np.array([1.0]))
+    rot = d.oMi[1].rotation
+    assert not np.allclose(rot @ rot.T, np.eye(3))  # no rotation: what the rule says
+    twin = _write(tmp_path, joint("revolute", '<axis xyz="0 0 1"/>' + LIM), "twin.urdf")
+    assert "T226" not in _codes(twin, ("pinocchio",))
+
+
+def test_pinocchio_refuses_negative_effort_and_a_child_of_two_joints(tmp_path: Path) -> None:
+    neg = _write(tmp_path, joint("revolute", '<limit lower="-1" upper="1" effort="-5" '
+                                 'velocity="1"/>'))
+    assert _codes(neg, ("pinocchio",)).get("T201") == "error"
+    assert "T117" not in _codes(neg, ("ros",))  # URDF 1.0: urdfdom takes it
+    assert check_urdf(neg)[0] == 0
+    with pytest.raises(ValueError, match="min_effort"):
+        pinocchio_model(neg)
+    two = _write(tmp_path, '<robot name="r"><link name="r"/><link name="a"/><link name="b"/>'
+                 '<link name="c"/><joint name="j1" type="fixed"><parent link="r"/><child '
+                 'link="a"/></joint><joint name="j2" type="fixed"><parent link="r"/><child '
+                 'link="b"/></joint><joint name="j3" type="fixed"><parent link="a"/><child '
+                 'link="c"/></joint><joint name="j4" type="fixed"><parent link="b"/><child '
+                 'link="c"/></joint></robot>', "two.urdf")
+    assert _codes(two, ("pinocchio",)).get("T204") == "error"
+    with pytest.raises(ValueError, match="does not have any body"):
+        pinocchio_model(two)
+
+
+def test_pinocchio_masses_coordinates_and_fixed_joints(tmp_path: Path) -> None:
+    """T222 (no inertial: 0 kg), T223 (continuous: nq 2), T220 (fixed: a frame, merged)."""
+    bare = _write(tmp_path, '<robot name="r"><link name="a"/><link name="b"/><joint name="j" '
+                  f'type="revolute"><parent link="a"/><child link="b"/>{LIM}</joint></robot>')
+    assert _codes(bare, ("pinocchio",)).get("T222") == "warning"
+    assert pinocchio_model(bare).inertias[1].mass == 0.0
+    spin = _write(tmp_path, joint("continuous", ""), "spin.urdf")
+    assert _codes(spin, ("pinocchio",)).get("T223") == "info"
+    m = pinocchio_model(spin)
+    assert (m.nq, m.nv) == (2, 1)
+    welded = _write(tmp_path, '<robot name="r"><link name="a"/><link name="b">' + INERTIAL +
+                    '</link><link name="c"><inertial><mass value="2"/><inertia ixx="1" ixy="0" '
+                    'ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link><joint name="j" '
+                    f'type="revolute"><parent link="a"/><child link="b"/>{LIM}</joint><joint '
+                    'name="f" type="fixed"><parent link="b"/><child link="c"/></joint></robot>',
+                    "welded.urdf")
+    assert _codes(welded, ("pinocchio",)).get("T220") == "info"
+    m = pinocchio_model(welded)
+    assert list(m.names) == ["universe", "j"] and m.inertias[1].mass == 3.0
+
+
+def test_a_planar_joint_moves_in_xy_in_pinocchio_whatever_its_axis(tmp_path: Path) -> None:
+    import numpy as np
+    import pinocchio
+
+    path = _write(tmp_path, joint("planar", '<axis xyz="1 0 0"/>'))
+    assert _codes(path, ("pinocchio",)).get("T225") == "warning"
+    m = pinocchio_model(path)
+    d = m.createData()
+    pinocchio.forwardKinematics(m, d, np.array([0.5, 0.0, 1.0, 0.0]))
+    # along x, the axis itself: no motion in the plane normal to (1, 0, 0) would go there
+    assert np.allclose(d.oMi[1].translation, [0.5, 0.0, 0.0])
+
+
+def test_pinocchio_joint_order_against_pybullet(tmp_path: Path) -> None:
+    """T227's two orders are the engines' own: PyBullet's joint indices, Pinocchio's names."""
+    from urdfkit.engine.api import LoadSettings
+    from urdfkit.engine.pybullet import PyBulletEngine
+
+    text = ('<robot name="r"><link name="base">' + INERTIAL + '</link>' +
+            "".join(f'<link name="l{i}">{INERTIAL}</link>' for i in range(1, 5)) +
+            "".join(f'<joint name="{n}" type="revolute"><parent link="{p}"/><child '
+                    f'link="{c}"/>{LIM}</joint>'
+                    for n, p, c in (("zeta", "base", "l1"), ("alpha", "base", "l2"),
+                                    ("mid", "l1", "l3"), ("beta", "l2", "l4"))) + "</robot>")
+    path = _write(tmp_path, text)
+    findings = [f for f in check_file(str(path), path, targets=("pinocchio",)).findings
+                if f.code == "T227"]
+    assert len(findings) == 1
+    engine = PyBulletEngine()
+    try:
+        body = engine.load(str(path), LoadSettings())
+        pybullet = [j.name for j in engine.joints(body)]
+    finally:
+        engine.close()
+    pinocchio = list(pinocchio_model(path).names)[1:]
+    assert pybullet == ["zeta", "mid", "alpha", "beta"]
+    assert pinocchio == ["alpha", "beta", "zeta", "mid"]
+    assert "PyBullet has zeta, mid, alpha, Pinocchio alpha, beta, zeta" in findings[0].message
+
+
+def test_every_target_code_has_a_summary_and_targets_are_checked() -> None:
+    assert all(code.startswith("T") and text for code, text in TARGET_CODES.items())
+    assert parse_targets(["ros,pinocchio", "pybullet"]) == ("ros", "pinocchio")
+    with pytest.raises(ParameterError, match="did you mean 'ros'"):
+        parse_targets(["rso"])
+
+
+# ---- over pybullet_data: an error exactly where the engine refuses
+
+
+def _pybullet_data_urdfs(limit_random: bool) -> list[str]:
+    import pybullet_data
+
+    root = Path(pybullet_data.getDataPath())
+    return sorted(str(p) for p in root.rglob("*.urdf")
+                  if not (limit_random and "random_urdfs" in p.parts))
+
+
+def _agreement(paths: list[str], target: str, prefix: str) -> list[str]:
+    result = check_paths(paths, targets=(target,), cache=False, jobs=1)
+    predicted = {fr.file: any(f.level == "error" and (f.code.startswith(prefix)
+                                                      or f.code == "U000")
+                              for f in fr.findings) for fr in result.files}
+    actual = load(target, paths)
+    return [f"{p}: predicted {'refused' if predicted[p] else 'loads'}, {target} "
+            f"{'refused: ' + actual[p].message if actual[p].refused else 'loads'}"
+            for p in paths if predicted[p] != actual[p].refused]
+
+
+@pytest.mark.parametrize("target,prefix", [("ros", "T1"), ("pinocchio", "T2")])
+def test_an_error_exactly_where_the_engine_refuses_pybullet_data(target: str,
+                                                                  prefix: str) -> None:
+    paths = _pybullet_data_urdfs(limit_random=True)
+    assert len(paths) > 90
+    assert _agreement(paths, target, prefix) == []
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("target,prefix", [("ros", "T1"), ("pinocchio", "T2")])
+def test_an_error_exactly_where_the_engine_refuses_all_of_pybullet_data(
+        target: str, prefix: str) -> None:
+    paths = _pybullet_data_urdfs(limit_random=False)
+    assert len(paths) > 1000
+    assert _agreement(paths, target, prefix) == []
+
+
+def test_target_findings_are_cached_apart_and_in_every_format(tmp_path: Path,
+                                                             monkeypatch: pytest.MonkeyPatch
+                                                             ) -> None:
+    monkeypatch.setenv("URDFKIT_CACHE_DIR", str(tmp_path / "cache"))
+    path = _write(tmp_path, REFUSED["T120"][0])
+    plain = check_paths([str(path)])
+    aimed = check_paths([str(path)], targets=("ros",))
+    again = check_paths([str(path)], targets=("ros",))
+    assert not any(f.code.startswith("T") for f in plain.findings)
+    assert [f.code for f in aimed.findings if f.code.startswith("T")] == ["T120"]
+    assert again.files[0].cached and again.findings == aimed.findings
+    out = subprocess.run(["urdfkit", "check", str(path), "--target", "ros", "--format",
+                          "sarif"], capture_output=True, text=True)
+    sarif = json.loads(out.stdout)
+    assert out.returncode == 1
+    assert any(r["ruleId"] == "T120" for r in sarif["runs"][0]["results"])
+    assert any(rule["id"] == "T120" for rule in sarif["runs"][0]["tool"]["driver"]["rules"])
