@@ -59,7 +59,8 @@ def ros(path):
                        text=True, env=env, timeout=60)
     text = (p.stderr + p.stdout).strip()
     if p.returncode != 0:
-        return {"refused": True, "message": text.splitlines()[0] if text else f"exit {p.returncode}"}
+        first = text.splitlines()[0] if text else f"exit {p.returncode}"
+        return {"refused": True, "message": first}
     return {"refused": False, "message": ""}
 
 def pinocchio(path):

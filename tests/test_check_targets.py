@@ -16,8 +16,8 @@ import subprocess
 from pathlib import Path
 
 import pytest
-
 from engine_loaders import cmeel_prefix, load
+
 from urdfkit.checks.check import check_file, check_paths
 from urdfkit.checks.targets import TARGET_CODES, parse_targets
 from urdfkit.core.errors import ParameterError
@@ -269,7 +269,30 @@ def test_pinocchio_joint_order_against_pybullet(tmp_path: Path) -> None:
     assert "PyBullet has zeta, mid, alpha, Pinocchio alpha, beta, zeta" in findings[0].message
 
 
-def test_every_target_code_has_a_summary_and_targets_are_checked() -> None:
+def test_a_floating_joint_is_a_free_flyer_in_pinocchio_and_fixed_in_pybullet(
+        tmp_path: Path) -> None:
+    from urdfkit.engine.api import LoadSettings
+    from urdfkit.engine.pybullet import PyBulletEngine
+
+    path = _write(tmp_path, joint("floating", ""))
+    assert _codes(path, ("pinocchio",)).get("T224") == "warning"
+    m = pinocchio_model(path)
+    assert (m.nq, m.nv) == (7, 6)
+    engine = PyBulletEngine()
+    try:
+        kinds = [j.kind for j in engine.joints(engine.load(str(path), LoadSettings()))]
+    finally:
+        engine.close()
+    assert kinds == ["fixed"]
+
+
+#: Every target code, and the test above that holds it against its engine.
+TESTED = {*REFUSED, "T150", "T163", "T169", "T200", "T201", "T204", "T220", "T222", "T223",
+          "T224", "T225", "T226", "T227"}
+
+
+def test_every_target_code_has_a_summary_a_test_and_targets_are_checked() -> None:
+    assert set(TARGET_CODES) == TESTED
     assert all(code.startswith("T") and text for code, text in TARGET_CODES.items())
     assert parse_targets(["ros,pinocchio", "pybullet"]) == ("ros", "pinocchio")
     with pytest.raises(ParameterError, match="did you mean 'ros'"):

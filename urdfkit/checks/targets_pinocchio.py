@@ -67,6 +67,10 @@ def rule_pinocchio(root: El, r: RuleReport) -> None:
               continuous[0])
     for j in moving:
         _axis(j, r)
+        if j.get("type") == "floating":
+            r.add("T224", "warning", f"joint {j.get('name')!r} is floating: a free flyer in "
+                  "Pinocchio (7 coordinates, 6 velocities), a fixed joint in PyBullet, which "
+                  "does not simulate floating joints", j)
     _order(root, joints, r)
 
 
