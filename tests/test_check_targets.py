@@ -106,7 +106,7 @@ def check_urdf(path: Path) -> tuple[int, str]:
     prefix = cmeel_prefix()
     assert prefix is not None, "pip install pin (urdfkit[engines]) brings urdfdom's check_urdf"
     p = subprocess.run([str(prefix / "bin" / "check_urdf"), str(path)], capture_output=True,
-                       text=True, timeout=20,
+                       text=True, errors="replace", timeout=20,
                        env=dict(os.environ, LD_LIBRARY_PATH=str(prefix / "lib")))
     return p.returncode, p.stderr
 
@@ -161,6 +161,32 @@ def test_a_link_part_urdfdom_cannot_read_is_dropped_not_refused(case: str,
     assert _codes(path, ("ros",)) == {"T150": "warning"}
     status, log = check_urdf(path)
     assert status == 0 and logged in log, (status, log)
+
+
+@pytest.mark.parametrize(("depth", "refused"), [(300, False), (496, False), (497, True)])
+def test_nesting_lxml_refuses_is_judged_as_tinyxml2_reads_it(depth: int, refused: bool,
+                                                              tmp_path: Path) -> None:
+    """lxml stops at 256 levels (U000), urdfdom's tinyxml2 at 498: the target says which."""
+    path = _write(tmp_path, '<robot name="r"><link name="a">' + "<x>" * depth + "</x>" * depth
+                  + "</link></robot>")
+    found = check_file(str(path), path, targets=("ros", "pinocchio")).findings
+    assert "U000" in {f.code for f in found}
+    errors = {f.code for f in found if f.level == "error" and f.code.startswith("T")}
+    assert errors == ({"T101", "T200"} if refused else set())
+    assert (check_urdf(path)[0] == 255) is refused
+
+
+def test_bytes_that_are_no_utf8_are_read_as_urdfdom_reads_them(tmp_path: Path) -> None:
+    path = tmp_path / "r.urdf"
+    path.write_bytes(b'<robot name="r\xff"><link name="a"/><link name="b"/></robot>')
+    found = check_file(str(path), path, targets=("ros",)).findings
+    assert "U000" in {f.code for f in found}
+    assert [f.code for f in found if f.code.startswith("T")] == ["T130"]  # two roots, read
+    assert check_urdf(path)[0] == 255
+    path.write_bytes(b'<robot name="r\xff"><link name="a"/></robot>')
+    assert not [f for f in check_file(str(path), path, targets=("ros",)).findings
+                if f.code.startswith("T")]
+    assert check_urdf(path)[0] == 0
 
 
 def test_a_limit_without_lower_and_upper_pins_the_joint_at_zero(tmp_path: Path) -> None:
@@ -287,7 +313,7 @@ def test_a_floating_joint_is_a_free_flyer_in_pinocchio_and_fixed_in_pybullet(
 
 
 #: Every target code, and the test above that holds it against its engine.
-TESTED = {*REFUSED, "T150", "T163", "T169", "T200", "T201", "T204", "T220", "T222", "T223",
+TESTED = {*REFUSED, "T101", "T150", "T163", "T169", "T200", "T201", "T204", "T220", "T222", "T223",
           "T224", "T225", "T226", "T227"}
 
 
@@ -312,8 +338,7 @@ def _pybullet_data_urdfs(limit_random: bool) -> list[str]:
 
 def _agreement(paths: list[str], target: str, prefix: str) -> list[str]:
     result = check_paths(paths, targets=(target,), cache=False, jobs=1)
-    predicted = {fr.file: any(f.level == "error" and (f.code.startswith(prefix)
-                                                      or f.code == "U000")
+    predicted = {fr.file: any(f.level == "error" and f.code.startswith(prefix)
                               for f in fr.findings) for fr in result.files}
     actual = load(target, paths)
     return [f"{p}: predicted {'refused' if predicted[p] else 'loads'}, {target} "

@@ -282,6 +282,7 @@ def check_file(display: str, path: str | Path,
     name = os.fspath(path)
     xacro_file = _is_xacro(name)
     result = FileResult(display)
+    data: bytes | None = None
     try:
         data = _read(name, display, no_exec, packages, xacro_args)
         refuse_oversized(data, display)
@@ -293,6 +294,10 @@ def check_file(display: str, path: str | Path,
     except InputError as e:
         code = getattr(e, "code", "U000")  # U209 for a body refused before parsing
         result.findings.append(Finding(code, "error", e.message, display, e.line))
+        if targets and code == "U000":  # what other parsers make of it
+            from urdfkit.checks.targets import unparsed
+
+            result.findings.extend(unparsed(display, data, targets))
         return result
     except (OSError, ValueError, etree.LxmlError) as e:  # belt and braces: never crash a sweep
         result.findings.append(Finding("U000", "error", f"cannot check: {e}", display))

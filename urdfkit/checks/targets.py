@@ -21,11 +21,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from lxml import etree
+
 from urdfkit.checks.targets_pinocchio import CODES as PINOCCHIO_CODES
 from urdfkit.checks.targets_pinocchio import rule_pinocchio
 from urdfkit.checks.targets_ros import CODES as ROS_CODES
 from urdfkit.checks.targets_ros import rule_ros
 from urdfkit.core.errors import ParameterError
+from urdfkit.core.finding import Finding
 from urdfkit.sources.guard import Rule
 
 #: Every target, by name: who reads the file there.
@@ -59,6 +62,54 @@ def parse_targets(items: Sequence[str] | None) -> tuple[str, ...]:
                                      param="target")
             asked.add(name)
     return tuple(t for t in TARGETS if t in asked and t != "pybullet")
+
+
+#: The deepest element urdfdom's XML parser (tinyxml2 11) reads, the root at depth 1: one
+#: level more is XML_ELEMENT_DEPTH_EXCEEDED (measured with check_urdf).
+TINYXML2_DEPTH = 498
+
+
+def unparsed(display: str, data: bytes | None, targets: Sequence[str]) -> list[Finding]:
+    """The targets' findings for a file check's own parser refused (its ``U000``).
+
+    urdfdom's XML parser is tinyxml2, which reads what lxml refuses in two ways: bytes that are
+    no UTF-8 (kept as they are) and elements nested deeper than lxml's 256 levels (to
+    :data:`TINYXML2_DEPTH`). Such a file is parsed again as tinyxml2 would take it and judged
+    by the targets' rules; anything else not well-formed, or not readable, they refuse.
+    """
+    from urdfkit.sources.guard import run_rules
+
+    root = _tinyxml2_tree(data) if data is not None else None
+    if root is None or _depth(root) > TINYXML2_DEPTH:
+        why = "cannot be read" if data is None else "is not XML its parser (tinyxml2) reads" \
+            if root is None else f"nests elements deeper than tinyxml2's {TINYXML2_DEPTH} " \
+            "levels (XML_ELEMENT_DEPTH_EXCEEDED)"
+        return [Finding(code, "error", f"{who} refuses the file: it {why}", display)
+                for target, (code, who) in _UNREADABLE.items() if target in targets]
+    return run_rules(root, display, target_rules(targets))
+
+
+#: Who refuses a file its XML parser cannot read, by target, and with what code.
+_UNREADABLE = {"ros": ("T101", "urdfdom"), "pinocchio": ("T200", "Pinocchio (its urdfdom)")}
+
+
+def _tinyxml2_tree(data: bytes) -> etree._Element | None:
+    parser = etree.XMLParser(huge_tree=True, resolve_entities=False, no_network=True,
+                             load_dtd=False)
+    for text in (data, data.decode("utf-8", "replace").encode("utf-8")):
+        try:
+            return etree.fromstring(text, parser)
+        except (etree.XMLSyntaxError, ValueError):
+            continue
+    return None
+
+
+def _depth(root: etree._Element) -> int:
+    deepest = depth = 0
+    for event, _el in etree.iterwalk(root, events=("start", "end")):
+        depth += 1 if event == "start" else -1
+        deepest = max(deepest, depth)
+    return deepest
 
 
 def target_rules(targets: Sequence[str]) -> tuple[Rule, ...]:

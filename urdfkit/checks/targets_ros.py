@@ -33,6 +33,7 @@ JOINT_TYPES = frozenset({"revolute", "continuous", "prismatic", "fixed", "floati
 SHAPES = frozenset({"box", "cylinder", "sphere", "mesh", "capsule"})
 
 CODES: dict[str, str] = {
+    "T101": "ros: XML urdfdom's parser (tinyxml2) cannot read, or nested over 498 levels",
     "T102": "ros: no top-level <robot> (urdfdom refuses the file)",
     "T103": "ros: <robot> without a name",
     "T104": "ros: <robot version> not 1.0, 1.1 or 1.2",
