@@ -87,7 +87,7 @@ def drake(path):
     try:
         Parser(plant).AddModels(path)
         plant.Finalize()
-    except Exception as e:
+    except BaseException as e:  # Drake's failed conditions raise SystemExit
         return {"refused": True, "message": f"{type(e).__name__}: {e}".splitlines()[0]}
     bodies = {}
     for i in range(plant.num_bodies()):

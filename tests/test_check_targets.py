@@ -11,6 +11,7 @@ refuses the file.
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 from pathlib import Path
@@ -312,19 +313,6 @@ def test_a_floating_joint_is_a_free_flyer_in_pinocchio_and_fixed_in_pybullet(
     assert kinds == ["fixed"]
 
 
-#: Every target code, and the test above that holds it against its engine.
-TESTED = {*REFUSED, "T101", "T150", "T163", "T169", "T200", "T201", "T204", "T220", "T222", "T223",
-          "T224", "T225", "T226", "T227"}
-
-
-def test_every_target_code_has_a_summary_a_test_and_targets_are_checked() -> None:
-    assert set(TARGET_CODES) == TESTED
-    assert all(code.startswith("T") and text for code, text in TARGET_CODES.items())
-    assert parse_targets(["ros,pinocchio", "pybullet"]) == ("ros", "pinocchio")
-    with pytest.raises(ParameterError, match="did you mean 'ros'"):
-        parse_targets(["rso"])
-
-
 # ---- over pybullet_data: an error exactly where the engine refuses
 
 
@@ -403,3 +391,135 @@ def test_at_least_98_percent_agreement_on_seeded_mutants(target: str, prefix: st
         paths.append(str(path))
     wrong = _agreement(paths, target, prefix)
     assert len(wrong) <= 0.02 * len(paths), wrong
+
+
+# ---- Drake (its MultibodyPlant: kinematics and dynamics)
+
+I3 = ('<inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" '
+      'iyz="0"/></inertial>')
+
+#: What Drake refuses: code -> (fixture, its twin that loads).
+DRAKE_REFUSED: dict[str, tuple[str, str]] = {
+    "T301": ('<model name="r"><link name="a"/></model>', links(I3)),
+    "T303": (f'<robot><link name="a">{I3}</link></robot>', links(I3)),
+    "T305": (f'<robot name="r"><link name="a">{I3}</link><link>{I3}</link></robot>',
+             links(I3)),
+    "T307": (f'<robot name="r"><link name="a">{I3}</link><link name="a">{I3}</link></robot>',
+             links(I3)),
+    "T309": (joint("revolute").replace(' type="revolute"', ""), joint()),
+    "T311": ('<robot name="r"><link name="a">' + I3 + '</link><link name="b">' + I3 +
+             f'</link><joint name="j" type="revolute"><child link="b"/>{LIM}</joint></robot>',
+             joint()),
+    "T312": ('<robot name="r"><link name="a">' + I3 + '</link><joint name="j" '
+             f'type="revolute"><parent link="a"/><child link="zz"/>{LIM}</joint></robot>',
+             joint()),
+    "T313": (joint("spherical", ""), joint("fixed", "")),
+    "T315": (joint("revolute", LIM + '<axis xyz="0 0 0"/>'),
+             joint("revolute", LIM + '<axis xyz="0 0 1"/>')),
+    "T316": (joint("fixed", '<origin xyz="0 0 $(optenv Z 0.1)"/>'),
+             joint("fixed", '<origin xyz="0 0 0.1"/>')),
+    "T317": (joint("revolute", '<limit lower="-inf" upper="1" effort="1" velocity="1"/>'),
+             joint()),
+    "T318": (joint("revolute", '<limit lower="1" upper="-1" effort="1" velocity="1"/>'),
+             joint()),
+    "T321": ('<robot name="r"><link name="a">' + I3 + '</link><link name="b">' + I3 +
+             '</link><link name="c">' + I3 + '</link><joint name="j1" type="fixed"><parent '
+             'link="a"/><child link="b"/></joint><joint name="j2" type="fixed"><parent '
+             'link="b"/><child link="c"/></joint><joint name="j3" type="fixed"><parent '
+             'link="c"/><child link="a"/></joint></robot>', joint("fixed", "")),
+    "T324": ('<robot name="r"><material name="m"/><link name="a">' + I3 + '</link></robot>',
+             '<robot name="r"><material name="m"><color rgba="1 0 0 1"/></material><link '
+             'name="a">' + I3 + '</link></robot>'),
+    "T328": (joint("revolute", LIM + '<mimic joint="zz"/>'), joint()),
+    "T329": (joint("revolute", LIM).replace("</robot>", '<transmission name="t"><joint '
+             'name="j"/><actuator name="m"/></transmission></robot>'),
+             joint("revolute", LIM).replace("</robot>", '<transmission name="t"><type>'
+             'transmission_interface/SimpleTransmission</type><joint name="j"/><actuator '
+             'name="m"/></transmission></robot>')),
+}
+
+
+def _drake(path: Path) -> object:
+    return load("drake", [str(path)])[str(path)]
+
+
+@pytest.mark.parametrize("code", sorted(DRAKE_REFUSED))
+def test_each_drake_refusal_is_refused_by_drake(code: str, tmp_path: Path) -> None:
+    bad, good = DRAKE_REFUSED[code]
+    path = _write(tmp_path, bad)
+    assert _codes(path, ("drake",)).get(code) == "error"
+    outcome = _drake(path)
+    assert outcome.refused, outcome  # type: ignore[attr-defined]
+    twin = _write(tmp_path, good, "twin.urdf")
+    assert not any(level == "error" for level in _codes(twin, ("drake",)).values())
+    assert not _drake(twin).refused  # type: ignore[attr-defined]
+
+
+def test_drake_masses_and_dropped_joints(tmp_path: Path) -> None:
+    """T353 (no inertial: 0 kg), T355 (mass 0 with inertia: 1 kg), T361 (1,5 read as 1),
+    T363 and T370 (a floating or nameless joint dropped: its child a free body, nq 14)."""
+    cases = {
+        "T353": ('<robot name="r"><link name="a">' + I3 + '</link><link name="b"/><joint '
+                 f'name="j" type="revolute"><parent link="a"/><child link="b"/>{LIM}</joint>'
+                 '</robot>', "b", 0.0),
+        "T355": (joint().replace('<link name="b"><inertial><mass value="1"/>',
+                                 '<link name="b"><inertial><mass value="0"/>'), "b", 1.0),
+        "T361": (joint().replace('<link name="b"><inertial><mass value="1"/>',
+                                 '<link name="b"><inertial><mass value="2,5"/>'), "b", 2.0),
+    }
+    for code, (text, link, mass) in cases.items():
+        path = _write(tmp_path, text, f"{code}.urdf")
+        assert _codes(path, ("drake",)).get(code) == "warning", code
+        outcome = _drake(path)
+        got = outcome.model["masses"][link]  # type: ignore[attr-defined]
+        assert math.isclose(got, mass, abs_tol=1e-12), (code, outcome)
+    for code, text in (("T363", joint("floating", "")),
+                       ("T370", joint("revolute").replace('name="j"', 'name=""'))):
+        path = _write(tmp_path, text, f"{code}.urdf")
+        assert _codes(path, ("drake",)).get(code) == "warning", code
+        assert _drake(path).model["nq"] == 14, code  # type: ignore[attr-defined]
+    assert _drake(_write(tmp_path, joint(), "twin.urdf")).model["nq"] == 8  # type: ignore[attr-defined]
+
+
+def test_drake_drops_joint_friction_with_a_warning(tmp_path: Path) -> None:
+    import logging
+
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    path = _write(tmp_path, joint("revolute", LIM + '<dynamics damping="0.1" friction="0.2"/>'))
+    assert _codes(path, ("drake",)).get("T362") == "warning"
+    said: list[str] = []
+
+    class Keep(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            said.append(record.getMessage())
+
+    handler = Keep()
+    logging.getLogger("drake").addHandler(handler)
+    try:
+        plant = MultibodyPlant(0.0)
+        Parser(plant).AddModels(str(path))
+    finally:
+        logging.getLogger("drake").removeHandler(handler)
+    assert any("friction" in m for m in said), said
+
+
+@pytest.mark.parametrize("slow_all", [False, pytest.param(True, marks=pytest.mark.slow)])
+def test_drake_refuses_exactly_where_check_says_on_pybullet_data(slow_all: bool) -> None:
+    paths = _pybullet_data_urdfs(limit_random=not slow_all)
+    assert _agreement(paths, "drake", "T3") == []
+
+
+#: Every target code, and the test above that holds it against its engine.
+TESTED = {*REFUSED, "T101", "T150", "T163", "T169", "T200", "T201", "T204", "T220", "T222", "T223",
+          "T224", "T225", "T226", "T227", "T353", "T355", "T361", "T362", "T363", "T370",
+          *DRAKE_REFUSED}
+
+
+def test_every_target_code_has_a_summary_a_test_and_targets_are_checked() -> None:
+    assert set(TARGET_CODES) == TESTED
+    assert all(code.startswith("T") and text for code, text in TARGET_CODES.items())
+    assert parse_targets(["ros,pinocchio", "pybullet"]) == ("ros", "pinocchio")
+    with pytest.raises(ParameterError, match="did you mean 'ros'"):
+        parse_targets(["rso"])

@@ -23,6 +23,8 @@ from collections.abc import Sequence
 
 from lxml import etree
 
+from urdfkit.checks.targets_drake import CODES as DRAKE_CODES
+from urdfkit.checks.targets_drake import rule_drake
 from urdfkit.checks.targets_pinocchio import CODES as PINOCCHIO_CODES
 from urdfkit.checks.targets_pinocchio import rule_pinocchio
 from urdfkit.checks.targets_ros import CODES as ROS_CODES
@@ -36,7 +38,7 @@ TARGETS: dict[str, str] = {
     "pybullet": "PyBullet 3.2.7 (check's own rules; always on)",
     "ros": "urdfdom, the parser of robot_state_publisher, RViz and MoveIt",
     "pinocchio": "Pinocchio 4 (through urdfdom)",
-    "drake": "Drake's URDF parser",
+    "drake": "Drake's URDF parser into a MultibodyPlant (its kinematics and dynamics)",
     "mujoco": "MuJoCo's own URDF reader (not urdfkit's export)",
 }
 
@@ -90,7 +92,8 @@ def unparsed(display: str, data: bytes | None, targets: Sequence[str]) -> list[F
 
 
 #: Who refuses a file its XML parser cannot read, by target, and with what code.
-_UNREADABLE = {"ros": ("T101", "urdfdom"), "pinocchio": ("T200", "Pinocchio (its urdfdom)")}
+_UNREADABLE = {"ros": ("T101", "urdfdom"), "pinocchio": ("T200", "Pinocchio (its urdfdom)"),
+               "drake": ("T301", "Drake")}
 
 
 def _tinyxml2_tree(data: bytes) -> etree._Element | None:
@@ -120,7 +123,8 @@ def target_rules(targets: Sequence[str]) -> tuple[Rule, ...]:
 # --------------------------------------------------------------------------- the rules
 
 #: Each target's rules.
-RULES: dict[str, tuple[Rule, ...]] = {"ros": (rule_ros,), "pinocchio": (rule_pinocchio,)}
+RULES: dict[str, tuple[Rule, ...]] = {"ros": (rule_ros,), "pinocchio": (rule_pinocchio,),
+                                      "drake": (rule_drake,)}
 
 #: Every target code with a one-line summary (merged into check's codes).
-TARGET_CODES: dict[str, str] = {**ROS_CODES, **PINOCCHIO_CODES}
+TARGET_CODES: dict[str, str] = {**ROS_CODES, **PINOCCHIO_CODES, **DRAKE_CODES}
