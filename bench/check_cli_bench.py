@@ -13,7 +13,7 @@ most 5x the floor; warm meshes with the result cache off (--no-cache) at most 3.
 loop (3x while check's path was compiled); a warm re-run (result cache on, nothing changed)
 at most 1.5x the parse loop. The warm cases share a cache
 folder that the first round fills, so their minimum is the warm figure. Issue 51: ``--target
-ros,pinocchio`` at most 1.5x the same check without it, warm (and, to see the rules' own cost,
+ros,pinocchio,drake`` at most 1.5x the same check without it, warm (and, to see the rules' own cost,
 with ``--no-cache``).
 """
 
@@ -35,15 +35,15 @@ def cases(ctx: Context) -> list[Case]:
     warm = "urdfkit check pybullet_data --json --jobs 1, warm result cache"
     fresh = "urdfkit check pybullet_data --json --jobs 1 --no-cache, warm meshes"
     # issue 51: the targets' rules, warm (goal 1.5x check alone) and their cost unmasked
-    targets = ["--target", "ros,pinocchio"]
+    targets = ["--target", "ros,pinocchio,drake"]
     return [
         Case(base, [ctx.python, str(ctx.baselines / "parse_loop.py"), data]),
         Case(floor, [ctx.python, str(ctx.baselines / "floor.py"), data]),
         Case(warm, check, [(base, 1.5)], ok=(0, 1), env=cache),
         Case(fresh, [*check, "--no-cache"], [(base, 3.5)], ok=(0, 1), env=cache),
-        Case("urdfkit check pybullet_data --target ros,pinocchio, warm result cache",
+        Case("urdfkit check pybullet_data --target ros,pinocchio,drake, warm result cache",
              [*check, *targets], [(warm, 1.5)], ok=(0, 1), env=cache),
-        Case("urdfkit check pybullet_data --target ros,pinocchio --no-cache, warm meshes",
+        Case("urdfkit check pybullet_data --target ros,pinocchio,drake --no-cache, warm meshes",
              [*check, *targets, "--no-cache"], [(fresh, 1.5)], ok=(0, 1), env=cache),
         Case("urdfkit check pybullet_data --json --no-cache (every core), warm meshes",
              [*ctx.urdfkit, "check", data, "--json", "--no-cache"], [(base, 3.5)], ok=(0, 1),
