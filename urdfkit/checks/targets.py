@@ -25,6 +25,8 @@ from lxml import etree
 
 from urdfkit.checks.targets_drake import CODES as DRAKE_CODES
 from urdfkit.checks.targets_drake import rule_drake
+from urdfkit.checks.targets_mujoco import CODES as MUJOCO_CODES
+from urdfkit.checks.targets_mujoco import rule_mujoco
 from urdfkit.checks.targets_pinocchio import CODES as PINOCCHIO_CODES
 from urdfkit.checks.targets_pinocchio import rule_pinocchio
 from urdfkit.checks.targets_ros import CODES as ROS_CODES
@@ -93,7 +95,7 @@ def unparsed(display: str, data: bytes | None, targets: Sequence[str]) -> list[F
 
 #: Who refuses a file its XML parser cannot read, by target, and with what code.
 _UNREADABLE = {"ros": ("T101", "urdfdom"), "pinocchio": ("T200", "Pinocchio (its urdfdom)"),
-               "drake": ("T301", "Drake")}
+               "drake": ("T301", "Drake"), "mujoco": ("T401", "MuJoCo")}
 
 
 def _tinyxml2_tree(data: bytes) -> etree._Element | None:
@@ -124,7 +126,8 @@ def target_rules(targets: Sequence[str]) -> tuple[Rule, ...]:
 
 #: Each target's rules.
 RULES: dict[str, tuple[Rule, ...]] = {"ros": (rule_ros,), "pinocchio": (rule_pinocchio,),
-                                      "drake": (rule_drake,)}
+                                      "drake": (rule_drake,), "mujoco": (rule_mujoco,)}
 
 #: Every target code with a one-line summary (merged into check's codes).
-TARGET_CODES: dict[str, str] = {**ROS_CODES, **PINOCCHIO_CODES, **DRAKE_CODES}
+TARGET_CODES: dict[str, str] = {**ROS_CODES, **PINOCCHIO_CODES, **DRAKE_CODES,
+                                **MUJOCO_CODES}
