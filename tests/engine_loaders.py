@@ -106,6 +106,7 @@ def mujoco(path):
     names = [mj.mj_id2name(m, mj.mjtObj.mjOBJ_BODY, i) for i in range(m.nbody)]
     return {"refused": False, "model": {"nq": int(m.nq), "nv": int(m.nv), "bodies": names,
             "masses": {n: float(m.body_mass[i]) for i, n in enumerate(names)},
+            "limited": [bool(x) for x in m.jnt_limited],
             "nvisual": int(sum(1 for g in range(m.ngeom) if m.geom_contype[g] == 0
                                and m.geom_conaffinity[g] == 0))}}
 

@@ -511,10 +511,126 @@ def test_drake_refuses_exactly_where_check_says_on_pybullet_data(slow_all: bool)
     assert _agreement(paths, "drake", "T3") == []
 
 
+# ---- MuJoCo's own URDF reader
+
+BOX = '<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>'
+
+#: What MuJoCo's reader refuses: code -> (fixture, its twin that loads).
+MUJOCO_REFUSED: dict[str, tuple[str, str]] = {
+    "T401": ('<model name="r"><link name="a"/></model>', links(I3)),
+    "T403": (joint("revolute", LIM + "<axis/>"), joint("revolute", LIM + '<axis xyz="0 0 1"/>')),
+    "T404": (links(I3 + "<collision/>"), links(I3 + BOX)),
+    "T405": (joint("fixed", '<origin xyz="0 0 1"/><origin xyz="0 0 1"/>'),
+             joint("fixed", '<origin xyz="0 0 1"/>')),
+    "T406": (f'<robot name="r"><link name="a">{I3}</link><link name="a">{I3}</link></robot>',
+             links(I3)),
+    "T407": (joint("fixed", "").replace('<parent link="a"/>', '<parent link="world"/>'),
+             joint("fixed", "")),
+    "T408": (DRAKE_REFUSED["T321"][0], joint("fixed", "")),
+    "T410": (joint("hinge", LIM), joint("revolute", LIM)),
+    "T411": (joint("revolute", '<limit lower="-1.57." upper="1" effort="1" velocity="1"/>'),
+             joint()),
+    "T412": (joint("fixed", '<origin rpy="0 0 0 0"/>'), joint("fixed", '<origin rpy="0 0 0"/>')),
+    "T414": (links(I3 + '<collision><geometry><plane normal="0 0 1"/></geometry></collision>'),
+             links(I3 + BOX)),
+    "T420": ('<robot name="r"><link name="a">' + I3 + '</link><link name="b"/><joint name="j" '
+             f'type="revolute"><parent link="a"/><child link="b"/>{LIM}</joint></robot>',
+             joint()),
+    "T421": (joint().replace('<link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" '
+                             'ixz="0" iyy="1" iyz="0" izz="1"/>', '<link name="b"><inertial><mass '
+                             'value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" '
+                             'izz="0.5"/>'), joint()),
+    "T423": (joint("revolute", LIM + '<axis xyz="0 0 0"/>'),
+             joint("revolute", LIM + '<axis xyz="0 0 1"/>')),
+    "T424": (links(I3 + '<collision><geometry><sphere radius="0"/></geometry></collision>'),
+             links(I3 + '<collision><geometry><sphere radius="0.1"/></geometry></collision>')),
+    "T425": ('<robot name="r"><link name="a">' + I3 + '</link><link name="b">' + I3 + '</link>'
+             '<link name="c">' + I3 + f'</link><joint name="j" type="revolute"><parent link="a"/>'
+             f'<child link="b"/>{LIM}</joint><joint name="f" type="floating"><parent link="b"/>'
+             '<child link="c"/></joint></robot>', joint("floating", "")),
+    "T426": (links(I3 + '<collision><geometry><mesh filename="package://nopkg/m.stl"/>'
+                   '</geometry></collision>'), links(I3 + BOX)),
+}
+
+
+@pytest.mark.parametrize("code", sorted(MUJOCO_REFUSED))
+def test_each_mujoco_refusal_is_refused_by_mujoco(code: str, tmp_path: Path) -> None:
+    bad, good = MUJOCO_REFUSED[code]
+    path = _write(tmp_path, bad)
+    assert _codes(path, ("mujoco",)).get(code) == "error"
+    outcome = load("mujoco", [str(path)])[str(path)]
+    assert outcome.refused, outcome
+    twin = _write(tmp_path, good, "twin.urdf")
+    assert not any(level == "error" for level in _codes(twin, ("mujoco",)).values())
+    assert not load("mujoco", [str(twin)])[str(twin)].refused
+
+
+def test_mujoco_meshes_as_its_reader_finds_and_decodes_them(tmp_path: Path) -> None:
+    """T426: an ASCII STL and COLLADA refuse; the extension's meshdir is where meshes are."""
+    import struct
+
+    (tmp_path / "m").mkdir()
+    faces = (((0, 0, 0), (0.1, 0, 0), (0, 0.1, 0)), ((0, 0, 0), (0, 0, 0.1), (0.1, 0, 0)),
+             ((0, 0, 0), (0, 0.1, 0), (0, 0, 0.1)), ((0.1, 0, 0), (0, 0, 0.1), (0, 0.1, 0)))
+    tetrahedron = b"".join(struct.pack("<12f", 0, 0, 0, *a, *b, *c) + b"\0\0"
+                           for a, b, c in faces)  # normal, three corners, attribute
+    (tmp_path / "m" / "t.stl").write_bytes(b"\0" * 80 + struct.pack("<I", 4) + tetrahedron)
+    (tmp_path / "m" / "a.stl").write_text("solid a\nendsolid a\n", encoding="ascii")
+    mesh = '<collision><geometry><mesh filename="{}"/></geometry></collision>'
+    cases = {
+        "binary STL beside meshdir": ('<robot name="r"><mujoco><compiler meshdir="m"/></mujoco>'
+                                      '<link name="a">' + I3 + mesh.format("t.stl") +
+                                      "</link></robot>", False),
+        "the same without meshdir": (links(I3 + mesh.format("t.stl")), True),
+        "ASCII STL": (links(I3 + mesh.format("m/a.stl")), True),
+        "package:// with strippath": ('<robot name="r"><mujoco><compiler meshdir="m" '
+                                      'strippath="true"/></mujoco><link name="a">' + I3 +
+                                      mesh.format("package://p/t.stl") + "</link></robot>",
+                                      False),
+    }
+    for case, (text, refused) in cases.items():
+        path = _write(tmp_path, text, "r.urdf")
+        assert ("T426" in _codes(path, ("mujoco",))) is refused, case
+        assert load("mujoco", [str(path)])[str(path)].refused is refused, case
+
+
+def test_mujoco_welds_fuses_fills_and_drops_limits(tmp_path: Path) -> None:
+    """T450 (the root welded: no free joint), T451 (a fixed child fused away), T453 (a link
+    without <inertial> weighs its shapes in water), T455 (limits dropped)."""
+    welded = _write(tmp_path, joint(), "welded.urdf")
+    assert _codes(welded, ("mujoco",)).get("T450") == "warning"
+    model = load("mujoco", [str(welded)])[str(welded)].model
+    assert model["nq"] == 1 and "a" not in model["bodies"]  # PyBullet: a free base, nq 7 + 1
+    fused = _write(tmp_path, joint("revolute").replace("</robot>", '<link name="c">' + I3 +
+                   '</link><joint name="f" type="fixed"><parent link="b"/><child link="c"/>'
+                   "</joint></robot>"), "fused.urdf")
+    assert _codes(fused, ("mujoco",)).get("T451") == "info"
+    model = load("mujoco", [str(fused)])[str(fused)].model
+    assert "c" not in model["bodies"] and math.isclose(model["masses"]["b"], 2.0)
+    water = _write(tmp_path, '<robot name="r"><link name="a">' + I3 + '</link><link name="b">'
+                   f'{BOX}</link><joint name="j" type="revolute"><parent link="a"/><child '
+                   f'link="b"/>{LIM}</joint></robot>', "water.urdf")
+    assert _codes(water, ("mujoco",)).get("T453") == "warning"
+    model = load("mujoco", [str(water)])[str(water)].model
+    assert math.isclose(model["masses"]["b"], 1000 * 0.2 ** 3)  # PyBullet: 1 kg
+    for inner in ('<limit lower="-1" effort="1" velocity="1"/>', LIM):
+        kind = "continuous" if inner == LIM else "revolute"
+        path = _write(tmp_path, joint(kind, inner), "limit.urdf")
+        assert _codes(path, ("mujoco",)).get("T455") == "warning"
+        assert load("mujoco", [str(path)])[str(path)].model["limited"] == [False]
+    assert load("mujoco", [str(welded)])[str(welded)].model["limited"] == [True]
+
+
+@pytest.mark.parametrize("slow_all", [False, pytest.param(True, marks=pytest.mark.slow)])
+def test_mujoco_refuses_exactly_where_check_says_on_pybullet_data(slow_all: bool) -> None:
+    paths = _pybullet_data_urdfs(limit_random=not slow_all)
+    assert _agreement(paths, "mujoco", "T4") == []
+
+
 #: Every target code, and the test above that holds it against its engine.
 TESTED = {*REFUSED, "T101", "T150", "T163", "T169", "T200", "T201", "T204", "T220", "T222", "T223",
           "T224", "T225", "T226", "T227", "T353", "T355", "T361", "T362", "T363", "T370",
-          *DRAKE_REFUSED}
+          *DRAKE_REFUSED, *MUJOCO_REFUSED, "T450", "T451", "T453", "T455"}
 
 
 def test_every_target_code_has_a_summary_a_test_and_targets_are_checked() -> None:
