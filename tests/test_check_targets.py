@@ -371,11 +371,12 @@ def test_target_findings_are_cached_apart_and_in_every_format(tmp_path: Path,
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("target,prefix", [("ros", "T1"), ("pinocchio", "T2")])
+@pytest.mark.parametrize("target,prefix", [("ros", "T1"), ("pinocchio", "T2"), ("drake", "T3"),
+                                           ("mujoco", "T4")])
 def test_at_least_98_percent_agreement_on_seeded_mutants(target: str, prefix: str,
                                                           tmp_path: Path) -> None:
     """The fuzzer's mutants of real robots (tests/fuzz): byte flips, deleted and moved
-    elements, hostile numbers and names. Measured: 99.8-99.9% on 1,000 (docs/engines.md)."""
+    elements, hostile numbers and names. Measured: 99.3-99.9% on 1,000 (docs/engines.md)."""
     import random
 
     from fuzz.mutate import mutate, seeds
