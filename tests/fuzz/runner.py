@@ -42,7 +42,9 @@ MJCF_SEEDS = ("r2d2.urdf", "kuka_iiwa/model.urdf", "racecar/racecar.urdf")
 def commands(file: str, verify: bool = False) -> list[list[str]]:
     """Every file-reading command, as a user would type it (``verify``: export --verify too)."""
     return [
-        ["check", file], ["check", file, "--json"], ["joints", file, "--json"],
+        ["check", file], ["check", file, "--json"],
+        ["check", file, "--json", "--target", "ros,pinocchio,drake,mujoco"],
+        ["joints", file, "--json"],
         ["links", file, "--json"], ["tree", file], ["tree", file, "--json"],
         ["info", file, "--json"], ["render", file, "-o", "out.png", "--size", "64x48", "--force"],
         ["drive", "--urdf", file, "--steps", "24", "--json"], ["sim", "scenario.json", "--json"],

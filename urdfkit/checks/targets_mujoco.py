@@ -411,7 +411,7 @@ def _axis_and_limits(j: El, r: RuleReport) -> None:
     limit = _first(j, "limit")
     if limit is None or kind not in MOVING:
         return
-    lower, upper = limit.get("lower"), limit.get("upper")
+    lower, upper = limit.get("lower") or None, limit.get("upper") or None  # "" is absent
     why = None
     if kind == "continuous" and (lower is not None or upper is not None):
         why = "MuJoCo never limits a continuous joint (PyBullet reports the bounds)"
