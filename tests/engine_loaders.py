@@ -81,11 +81,27 @@ def pinocchio(path):
             "joint_masses": masses, "frames": frames}}
 
 def drake(path):
+    # as a simulation loads it: a plant with a SceneGraph (which reads visuals and
+    # collisions), its package_map holding the packages the file names that can be found
+    import re
     from pydrake.multibody.parsing import Parser
-    from pydrake.multibody.plant import MultibodyPlant
-    plant = MultibodyPlant(0.0)
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.framework import DiagramBuilder
+    from pathlib import Path
+    from urdfkit.sources.uris import find_package
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, 0.0)
+    parser = Parser(plant)
     try:
-        Parser(plant).AddModels(path)
+        text = Path(path).read_text("utf-8", "replace")
+    except OSError:
+        text = ""
+    for name in set(re.findall(r"(?:package|model)://([^/\"']+)/", text)):
+        root = find_package(name, Path(path).parent)
+        if root is not None and not parser.package_map().Contains(name):
+            parser.package_map().Add(name, str(root))
+    try:
+        parser.AddModels(path)
         plant.Finalize()
     except BaseException as e:  # Drake's failed conditions raise SystemExit
         return {"refused": True, "message": f"{type(e).__name__}: {e}".splitlines()[0]}

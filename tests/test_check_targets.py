@@ -440,6 +440,49 @@ DRAKE_REFUSED: dict[str, tuple[str, str]] = {
 }
 
 
+BOX = '<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>'
+
+#: What Drake refuses in geometry, as a simulation loads it (a plant with a SceneGraph).
+DRAKE_GEOMETRY: dict[str, tuple[str, str]] = {
+    "T331": (links(I3 + "<collision><origin/></collision>"), links(I3 + BOX)),
+    "T334": (links(I3 + '<collision><geometry><cylinder radius="0" length="1"/></geometry>'
+                   "</collision>"),
+             links(I3 + '<collision><geometry><cylinder radius="0.1" length="1"/></geometry>'
+                   "</collision>")),
+    "T336": (links(I3 + '<visual><geometry><mesh filename="package://nopkg/m.obj"/>'
+                   "</geometry></visual>"), links(I3 + BOX)),
+    "T338": (links(I3 + '<visual><geometry><mesh filename="nope.obj"/></geometry></visual>'),
+             links(I3 + BOX)),
+    "T339": (links(I3 + '<collision><geometry><mesh filename="m.stl"/></geometry>'
+                   "</collision>"),
+             links(I3 + '<collision><geometry><mesh filename="m.obj"/></geometry>'
+                   "</collision>")),
+    "T340": (links(I3 + '<visual><geometry><box size="1 1 1"/></geometry><material '
+                   'name="nope"/></visual>'),
+             links(I3 + '<visual><geometry><box size="1 1 1"/></geometry><material '
+                   'name="red"><color rgba="1 0 0 1"/></material></visual>')),
+}
+
+OBJ_TETRA = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+
+
+@pytest.mark.parametrize("code", sorted(DRAKE_GEOMETRY))
+def test_each_drake_geometry_refusal_is_refused_by_drake(code: str, tmp_path: Path) -> None:
+    import struct
+
+    (tmp_path / "m.obj").write_text(OBJ_TETRA, encoding="ascii")
+    (tmp_path / "m.stl").write_bytes(b"\0" * 80 + struct.pack("<I", 1) +
+                                     struct.pack("<12f", 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0)
+                                     + b"\0\0")
+    bad, good = DRAKE_GEOMETRY[code]
+    path = _write(tmp_path, bad)
+    assert _codes(path, ("drake",)).get(code) == "error"
+    assert _drake(path).refused  # type: ignore[attr-defined]
+    twin = _write(tmp_path, good, "twin.urdf")
+    assert not any(level == "error" for level in _codes(twin, ("drake",)).values())
+    assert not _drake(twin).refused  # type: ignore[attr-defined]
+
+
 def _drake(path: Path) -> object:
     return load("drake", [str(path)])[str(path)]
 
@@ -513,8 +556,6 @@ def test_drake_refuses_exactly_where_check_says_on_pybullet_data(slow_all: bool)
 
 
 # ---- MuJoCo's own URDF reader
-
-BOX = '<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>'
 
 #: What MuJoCo's reader refuses: code -> (fixture, its twin that loads).
 MUJOCO_REFUSED: dict[str, tuple[str, str]] = {
@@ -651,7 +692,7 @@ def test_no_value_in_any_number_stops_a_target(value: str, tmp_path: Path) -> No
 #: Every target code, and the test above that holds it against its engine.
 TESTED = {*REFUSED, "T101", "T150", "T163", "T169", "T200", "T201", "T204", "T220", "T222", "T223",
           "T224", "T225", "T226", "T227", "T353", "T355", "T361", "T362", "T363", "T370",
-          *DRAKE_REFUSED, *MUJOCO_REFUSED, "T450", "T451", "T453", "T455"}
+          *DRAKE_REFUSED, *DRAKE_GEOMETRY, *MUJOCO_REFUSED, "T450", "T451", "T453", "T455"}
 
 
 def test_every_target_code_has_a_summary_a_test_and_targets_are_checked() -> None:

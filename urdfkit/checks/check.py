@@ -297,7 +297,9 @@ def check_file(display: str, path: str | Path,
         if targets and code == "U000":  # what other parsers make of it
             from urdfkit.checks.targets import unparsed
 
-            result.findings.extend(unparsed(display, data, targets))
+            folder = os.path.dirname(os.path.abspath(name))
+            result.findings.extend(unparsed(display, data, targets, base=folder,
+                                            packages=packages))
         return result
     except (OSError, ValueError, etree.LxmlError) as e:  # belt and braces: never crash a sweep
         result.findings.append(Finding("U000", "error", f"cannot check: {e}", display))

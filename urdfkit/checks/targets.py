@@ -19,7 +19,8 @@ consumer's source and is proven against the consumer itself by
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from pathlib import Path
 
 from lxml import etree
 
@@ -73,7 +74,9 @@ def parse_targets(items: Sequence[str] | None) -> tuple[str, ...]:
 TINYXML2_DEPTH = 498
 
 
-def unparsed(display: str, data: bytes | None, targets: Sequence[str]) -> list[Finding]:
+def unparsed(display: str, data: bytes | None, targets: Sequence[str], *,
+             base: str | None = None,
+             packages: Mapping[str, Path] | None = None) -> list[Finding]:
     """The targets' findings for a file check's own parser refused (its ``U000``).
 
     urdfdom's XML parser is tinyxml2, which reads what lxml refuses in two ways: bytes that are
@@ -90,7 +93,7 @@ def unparsed(display: str, data: bytes | None, targets: Sequence[str]) -> list[F
             "levels (XML_ELEMENT_DEPTH_EXCEEDED)"
         return [Finding(code, "error", f"{who} refuses the file: it {why}", display)
                 for target, (code, who) in _UNREADABLE.items() if target in targets]
-    return run_rules(root, display, target_rules(targets))
+    return run_rules(root, display, target_rules(targets), base=base, packages=packages)
 
 
 #: Who refuses a file its XML parser cannot read, by target, and with what code.

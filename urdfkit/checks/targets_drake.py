@@ -1,11 +1,11 @@
 """What Drake's URDF parser refuses, and what its MultibodyPlant holds that PyBullet's does not.
 
 Read from Drake 1.51.1 (``multibody/parsing/detail_urdf_parser.cc``, ``detail_tinyxml.cc``,
-``detail_common.cc``) and measured with ``Parser(plant).AddModels`` and ``plant.Finalize()``
-(tests/test_check_targets.py loads every rule's fixture in it). These are the plant's rules:
-the kinematics and dynamics every Drake user loads. A plant with a SceneGraph also reads
-``<visual>`` and ``<collision>`` (refusing, among others, STL and COLLADA collision meshes);
-those rules are not here yet (docs/check.md).
+``detail_common.cc``) and measured with ``Parser(plant).AddModels`` and
+``plant.Finalize()``, the plant made with ``AddMultibodyPlantSceneGraph`` as a simulation
+makes it (so ``<visual>`` and ``<collision>`` are read: a collision mesh must be OBJ, VTK or
+glTF), its ``package_map`` holding the packages the file names that can be found
+(tests/test_check_targets.py loads every rule's fixture in it).
 
 Drake reads numbers with C++ streams: a vector must be exactly its count of whole numbers
 (``$(optenv ...)``, ``0.07,`` and ``nan`` refuse), a single value must start with a number and
@@ -16,6 +16,7 @@ hold only one (``abc`` and ``1 2`` refuse), and what follows the number is dropp
 from __future__ import annotations
 
 import math
+import os
 
 from lxml import etree
 
@@ -45,6 +46,15 @@ CODES: dict[str, str] = {
     "T328": "drake: a <mimic> without its joint, naming a missing joint or itself",
     "T329": "drake: a <transmission> without a type, naming a missing joint, or two "
             "SimpleTransmissions with one actuator name",
+    "T331": "drake: a <visual> or <collision> without a <geometry> shape, or one without "
+            "its size, radius, length or filename",
+    "T334": "drake: a box size or cylinder radius <= 0, a sphere radius < 0, a mesh scale ~0",
+    "T336": "drake: a mesh package Drake's package_map cannot be given, or a URI scheme it "
+            "does not read (http://)",
+    "T338": "drake: a mesh or texture file that does not exist where Drake looks",
+    "T339": "drake: a collision mesh that is no OBJ, VTK or glTF (STL, COLLADA)",
+    "T340": "drake: a visual <material> without a colour not defined before it, or "
+            "defined again with another colour",
     "T353": "drake: a link without <inertial> has mass 0 (PyBullet: 1 kg) (warning)",
     "T355": "drake: mass 0 or less with an inertia: Drake puts a 1 kg sphere there (warning)",
     "T361": "drake: a number with text after it, read up to it (1,5 is 1) (warning)",
@@ -87,6 +97,7 @@ def rule_drake(root: El, r: RuleReport) -> None:
               "robot's name is empty", root)
     _materials(root, r)
     links = _links(root, r)
+    _geometry(root, r)
     joints = list(_children(root, "joint"))
     names: set[str] = set()
     kept = []
@@ -151,6 +162,173 @@ def _links(root: El, r: RuleReport) -> set[str]:
         if name != "world":
             _inertial(link, name, r)
     return names
+
+
+# --------------------------------------------------------------------------- geometry
+
+#: The shapes Drake's URDF parser reads (and its own ``drake:`` ones).
+SHAPES = ("box", "sphere", "cylinder", "capsule", "mesh", "{http://drake.mit.edu}capsule",
+          "{http://drake.mit.edu}ellipsoid")
+#: The collision mesh formats Drake's convex hull reads.
+HULL_FORMATS = (".obj", ".vtk", ".gltf")
+
+
+def _geometry(root: El, r: RuleReport) -> None:
+    """Every ``<visual>`` and ``<collision>``: shapes, sizes, meshes, visual materials."""
+    known: dict[str, str] = {}
+    for m in _children(root, "material"):
+        color = _first(m, "color")
+        if m.get("name") is not None:
+            known[m.get("name") or ""] = color.get("rgba", "") if color is not None else ""
+    for link in _children(root, "link"):
+        for part in link:
+            if part.tag not in ("visual", "collision"):
+                continue
+            _part(part, str(part.tag), link.get("name") or "", r)
+            if part.tag == "visual":
+                for m in _children(part, "material"):
+                    _visual_material(m, known, r)
+
+
+def _part(part: El, tag: str, link: str, r: RuleReport) -> None:
+    origin = _first(part, "origin")
+    for attr in ("xyz", "rpy"):
+        if origin is not None and not _vector(origin.get(attr)):
+            r.add("T316", "error", f"Drake refuses the file: Expected 3 values for attribute "
+                  f"{attr} got {origin.get(attr)}", origin)
+            return
+    geometry = _first(part, "geometry")
+    shape = next((c for c in geometry if c.tag in SHAPES), None) \
+        if geometry is not None else None
+    if shape is None:
+        what = "without geometry" if geometry is None else \
+            "whose geometry has no shape it reads"
+        r.add("T331", "error", f"Drake refuses the file: link {link!r} has a {tag} element "
+              f"{what}", part)
+        return
+    kind = str(shape.tag).rpartition("}")[2]
+    needs = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius", "length"),
+             "capsule": ("radius", "length"), "mesh": ("filename",)}.get(kind, ())
+    missing = [a for a in needs if shape.get(a) is None]
+    if missing:
+        r.add("T331", "error", f"Drake refuses the file: missing {kind} attribute: "
+              f"{missing[0]}", shape)
+        return
+    for attr, count in (("size", 3), ("scale", 3)):
+        if shape.get(attr) is not None and not _vector(shape.get(attr), count):
+            r.add("T316", "error", f"Drake refuses the file: Expected {count} values for "
+                  f"attribute {attr} got {shape.get(attr)}", shape)
+            return
+    for attr in ("radius", "length"):
+        if shape.get(attr) is not None and _number(shape, attr, r) is None:
+            return
+    small = _small(shape, kind)
+    if small:
+        r.add("T334", "error", f"Drake refuses the file: {small}", shape)
+        return
+    if kind == "mesh":
+        _mesh(shape.get("filename") or "", tag, shape, r)
+
+
+def _small(shape: El, kind: str) -> str | None:
+    def values(attr: str) -> list[float]:
+        return [float(p) for p in (shape.get(attr) or "").split()]
+
+    if kind == "box" and any(v <= 0 for v in values("size")):
+        return f"a box's sizes must be positive (size {shape.get('size')!r})"
+    for attr in ("radius", "length"):
+        if kind in ("cylinder", "capsule") and any(not v > 0 for v in values(attr)):
+            return f"a {kind}'s {attr} must be positive ({shape.get(attr)!r})"
+    if kind == "sphere" and any(v < 0 for v in values("radius")):
+        return f"a sphere's radius must not be negative ({shape.get('radius')!r})"
+    if kind == "mesh" and shape.get("scale") is not None and any(
+            abs(v) < 1e-8 for v in values("scale")):
+        return f"Mesh |scale| cannot be < 1e-8 on any axis, given [{shape.get('scale')}]"
+    return None
+
+
+def drake_path(filename: str, folder: str | None,
+               packages: dict[str, object] | None = None) -> str | None:
+    """Where Drake's parser reads a mesh; None when it cannot.
+
+    A ``package://`` mesh is in the package a ``package_map`` can hold: one named by
+    ``--package``, or found by its folder's name or its package.xml above the file.
+    """
+    from pathlib import Path
+
+    from urdfkit.sources.uris import find_package
+
+    if folder is None:
+        return None
+    for scheme in ("package://", "model://"):
+        if filename.startswith(scheme):
+            name, _, rest = filename[len(scheme):].partition("/")
+            root = (packages or {}).get(name) or (find_package(name, Path(folder))
+                                                 if name else None)
+            return None if root is None else os.path.join(str(root), rest)
+    if filename.startswith("file://"):
+        filename = filename[len("file://"):]
+    return filename if os.path.isabs(filename) else os.path.join(folder, filename)
+
+
+def _mesh(filename: str, tag: str, shape: El, r: RuleReport) -> None:
+    scheme = filename.partition("://")[0] if "://" in filename else ""
+    if scheme not in ("", "file", "package", "model"):
+        r.add("T336", "error", f"Drake refuses the file: URI {filename!r} specifies an "
+              "unsupported scheme; supported schemes are 'file://', 'model://', and "
+              "'package://'", shape)
+        return
+    if r.folder is None:
+        return
+    own = filename.partition("://")[2].partition("/")[0] if scheme in ("package", "model") \
+        else None
+    if own in ("drake", "drake_models"):
+        r.add("T336", "error", f"Drake refuses the file: URI {filename!r} names Drake's own "
+              f"package {own!r}, which Drake reads from its install (pip's drake ships none "
+              "of these models), not from the file's folders", shape)
+        return
+    path = drake_path(filename, r.folder, dict(r.packages))
+    if path is None:
+        r.add("T336", "error", f"Drake refuses the file: URI {filename!r} refers to an unknown "
+              "package (nor can one be found above the file: give it with --package, and "
+              "Drake with parser.package_map().Add)", shape)
+    elif not os.path.isfile(path):
+        r.add("T338", "error", f"Drake refuses the file: URI {filename!r} resolved to "
+              f"{path!r}, which does not exist", shape)
+    elif tag == "collision" and not path.lower().endswith(HULL_FORMATS):
+        r.add("T339", "error", f"Drake refuses the file: collision mesh {filename!r}: "
+              "MakeConvexHull only applies to .obj, .vtk, and .gltf meshes (convert it, "
+              "e.g. with trimesh, and point the <collision> at the .obj)", shape)
+    elif tag == "collision" and path.lower().endswith(".obj"):
+        from urdfkit.checks.rules_mass import mesh_properties_of
+
+        props = mesh_properties_of(r, path, (1.0, 1.0, 1.0))
+        if props is None or not max(props.extent) > 1e-12:
+            r.add("T339", "error", f"Drake refuses the file: collision mesh {filename!r}: "
+                  "MakeConvexHull finds no hull in it (no finite vertices apart)", shape)
+
+
+def _visual_material(m: El, known: dict[str, str], r: RuleReport) -> None:
+    name = m.get("name")
+    if not name:
+        return  # unnamed: Drake keeps it to this visual
+    color = _first(m, "color")
+    rgba = color.get("rgba") if color is not None else None
+    if rgba is not None and not _vector(rgba, 4):
+        r.add("T316", "error", f"Drake refuses the file: Expected 4 values for attribute rgba "
+              f"got {rgba}", color)
+        return
+    if rgba is None and _first(m, "texture") is None:
+        if name not in known:
+            r.add("T340", "error", f"Drake refuses the file: Material '{name}' not previously "
+                  "defined, but has no color or texture information.", m)
+        return
+    if name in known and known[name] and rgba is not None and not all(
+            math.isclose(float(a), float(b), rel_tol=1e-9, abs_tol=1e-12)
+            for a, b in zip(known[name].split(), rgba.split(), strict=False)):
+        r.add("T340", "error", f"Drake refuses the file: Material '{name}' was previously "
+              "defined (with another colour).", m)
+    known.setdefault(name, rgba or "")
 
 
 def _inertial(link: El, name: str, r: RuleReport) -> None:
