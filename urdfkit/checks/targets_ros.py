@@ -333,14 +333,21 @@ def link_part_problems(link: El, v: tuple[int, int]) -> Iterator[tuple[str, El]]
                 return
 
 
+def _origin_problem(el: El, tag: str) -> str | None:
+    """Why urdfdom cannot read the ``<origin>`` of ``el`` (a ``tag``), or None."""
+    origin = _first(el, "origin")
+    for attr in ("xyz", "rpy"):
+        if origin is not None and origin.get(attr) is not None:
+            problem = vector_problem(origin.get(attr))
+            if problem:
+                return f"<{tag}><origin {attr}>: {problem}"
+    return None
+
+
 def _inertial_problem(inertial: El) -> str | None:
-    origin = _first(inertial, "origin")
-    if origin is not None:
-        for attr in ("xyz", "rpy"):
-            if origin.get(attr) is not None:
-                problem = vector_problem(origin.get(attr))
-                if problem:
-                    return f"<inertial><origin {attr}>: {problem}"
+    problem = _origin_problem(inertial, "inertial")
+    if problem:
+        return problem
     mass = _first(inertial, "mass")
     if mass is None:
         return "Inertial element must have a mass element"
@@ -361,13 +368,9 @@ def _inertial_problem(inertial: El) -> str | None:
 
 
 def _part_problem(part: El, tag: str, v: tuple[int, int]) -> str | None:
-    origin = _first(part, "origin")
-    if origin is not None:
-        for attr in ("xyz", "rpy"):
-            if origin.get(attr) is not None:
-                problem = vector_problem(origin.get(attr))
-                if problem:
-                    return f"<{tag}><origin {attr}>: {problem}"
+    problem = _origin_problem(part, tag)
+    if problem:
+        return problem
     geometry = _first(part, "geometry")
     if geometry is None:
         return f"<{tag}> without <geometry>"
