@@ -669,7 +669,8 @@ def test_mujoco_refuses_exactly_where_check_says_on_pybullet_data(slow_all: bool
     assert _agreement(paths, "mujoco", "T4") == []
 
 
-@pytest.mark.parametrize("value", ["", " ", "nan", "1e309", "-inf", "1 2", "abc", "0x1"])
+@pytest.mark.parametrize("value", ["", " ", "nan", "1e309", "-inf", "1 2", "abc", "0x1", "1,5",
+                                   "0.1abc", "-1e308", "1e-320", "-0"])
 def test_no_value_in_any_number_stops_a_target(value: str, tmp_path: Path) -> None:
     """Every numeric attribute given a hostile value: each target judges the file, none
     raises (a limit's empty ``lower`` once did, in MuJoCo's limit rule)."""
@@ -678,7 +679,12 @@ def test_no_value_in_any_number_stops_a_target(value: str, tmp_path: Path) -> No
     base = joint("revolute", LIM + '<axis xyz="0 0 1"/><dynamics damping="0.1" '
                  'friction="0.1"/><mimic joint="j" multiplier="1" offset="0"/>')
     base = base.replace("<link name=\"b\">", '<link name="b"><collision><origin xyz="0 0 0"/>'
-                        '<geometry><box size="1 1 1"/></geometry></collision>')
+                        '<geometry><box size="1 1 1"/></geometry></collision><collision>'
+                        '<geometry><cylinder radius="0.1" length="0.2"/></geometry>'
+                        '</collision><visual><geometry><sphere radius="0.1"/></geometry>'
+                        '<material name="m"><color rgba="1 0 0 1"/></material></visual>'
+                        '<visual><geometry><mesh filename="m.obj" scale="1 1 1"/></geometry>'
+                        '</visual>')
     spots = list(re.finditer(r'(\w+)="([^"]*)"', base))
     for k, m in enumerate(spots):
         if m.group(1) in ("name", "type", "link", "joint"):

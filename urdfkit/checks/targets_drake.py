@@ -232,7 +232,12 @@ def _part(part: El, tag: str, link: str, r: RuleReport) -> None:
 
 def _small(shape: El, kind: str) -> str | None:
     def values(attr: str) -> list[float]:
-        return [float(p) for p in (shape.get(attr) or "").split()]
+        """The attribute as Drake reads it (its vectors whole, its scalars up to junk)."""
+        text = shape.get(attr) or ""
+        if attr in ("size", "scale"):
+            return [float(p) for p in text.split()]
+        m = _DOUBLE.match(text.lstrip(" \t\n\r\v\f"))
+        return [float(m.group(0))] if m else []
 
     if kind == "box" and any(v <= 0 for v in values("size")):
         return f"a box's sizes must be positive (size {shape.get('size')!r})"
