@@ -1,15 +1,16 @@
 """Load URDF files in the real consumers ``check --target`` predicts: urdfdom (ROS), Pinocchio,
 Drake and MuJoCo's own URDF reader.
 
-Each engine runs in a worker process of its own (:func:`load`), which reads file paths on
-stdin and answers a JSON line for each: whether the engine refused the file and why, and what
-it loaded (masses, joints). A file that kills the worker (a crash in the engine) is answered
-``crashed`` and the worker restarted, so one file cannot stop a sweep. Used by
-tests/test_check_targets.py, and by bench/target_agreement.py for the corpora.
+Each engine runs in a worker process of its own, kept for the test process (:func:`load`),
+which reads file paths on stdin and answers a JSON line for each: whether the engine refused
+the file and why, and what it loaded (masses, joints). A file that kills the worker (a crash in
+the engine) is answered ``crashed`` and the worker restarted, so one file cannot stop a sweep.
+Used by tests/test_check_targets.py, and by bench/target_agreement.py for the corpora.
 """
 
 from __future__ import annotations
 
+import atexit
 import json
 import os
 import subprocess
@@ -176,16 +177,28 @@ class _Worker:
                     pass
 
 
-def load(engine: str, paths: list[str]) -> dict[str, Outcome]:
-    """Each file loaded in ``engine``, in one worker process (restarted after a crash)."""
-    worker = _Worker(engine)
-    found: dict[str, Outcome] = {}
-    try:
-        for path in paths:
-            found[path] = worker.ask(os.path.abspath(path))
-            if found[path].crashed:
-                worker.close()
-                worker = _Worker(engine)
-    finally:
+#: One worker per engine, kept for the process (an engine's import costs 0.15-0.5 s).
+_WORKERS: dict[str, _Worker] = {}
+
+
+def _close_all() -> None:
+    for worker in _WORKERS.values():
         worker.close()
+    _WORKERS.clear()
+
+
+atexit.register(_close_all)
+
+
+def load(engine: str, paths: list[str]) -> dict[str, Outcome]:
+    """Each file loaded in ``engine``, in its worker process (restarted after a crash)."""
+    found: dict[str, Outcome] = {}
+    for path in paths:
+        worker = _WORKERS.get(engine)
+        if worker is None or worker.proc.poll() is not None:
+            worker = _WORKERS[engine] = _Worker(engine)
+        found[path] = worker.ask(os.path.abspath(path))
+        if found[path].crashed:
+            worker.close()
+            del _WORKERS[engine]
     return found
