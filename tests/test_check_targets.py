@@ -676,6 +676,48 @@ def test_no_value_in_any_number_stops_a_target(value: str, tmp_path: Path) -> No
         assert all(f.code != "U000" for f in found.findings), (m.group(1), found.findings)
 
 
+def test_a_missing_texture_refuses_drake(tmp_path: Path) -> None:
+    """Drake resolves a material's texture as it resolves a mesh (T338, T336)."""
+    for where in ("visual", "top"):
+        material = '<material name="m"><texture filename="t.png"/></material>'
+        text = ('<robot name="r">' + (material if where == "top" else "") + '<link name="a">'
+                + I3 + '<visual><geometry><box size="1 1 1"/></geometry>'
+                + (material if where == "visual" else '<material name="m"/>')
+                + "</visual></link></robot>")
+        path = _write(tmp_path, text, f"{where}.urdf")
+        (tmp_path / "t.png").unlink(missing_ok=True)
+        assert _codes(path, ("drake",)).get("T338") == "error", where
+        assert _drake(path).refused, where  # type: ignore[attr-defined]
+        (tmp_path / "t.png").write_bytes(b"\x89PNG\r\n\x1a\n")
+        assert "T338" not in _codes(path, ("drake",)), where
+        assert not _drake(path).refused, where  # type: ignore[attr-defined]
+
+
+def test_mujoco_reads_hexadecimal_numbers_as_strtod_does(tmp_path: Path) -> None:
+    path = _write(tmp_path, joint("revolute", '<limit lower="-0x1" upper="0x1.8p0" effort="1" '
+                                  'velocity="1"/>'))
+    assert not any(level == "error" for level in _codes(path, ("mujoco",)).values())
+    outcome = load("mujoco", [str(path)])[str(path)]
+    assert not outcome.refused and outcome.model["limited"] == [True]
+
+
+def test_an_empty_target_or_a_selection_of_codes_not_targeted_is_refused(
+        tmp_path: Path) -> None:
+    from urdfkit.checks.targets import check_selection
+
+    for given in ([""], [","], [" , "]):
+        with pytest.raises(ParameterError, match="names no target"):
+            parse_targets(given)
+    with pytest.raises(ParameterError, match="--target drake"):
+        check_selection(("T3",), ("ros",))
+    with pytest.raises(ParameterError, match="--target mujoco"):
+        check_selection(("T426",), ())
+    check_selection(("T", "U6"), ("mujoco",))  # some target's codes: fine
+    path = _write(tmp_path, joint())
+    with pytest.raises(ParameterError):
+        check_paths([str(path)], select=("T1",), cache=False)
+
+
 #: Every target code, and the test above that holds it against its engine.
 TESTED = {*REFUSED, "T101", "T150", "T163", "T169", "T200", "T201", "T204", "T220", "T222", "T223",
           "T224", "T225", "T226", "T227", "T353", "T355", "T361", "T362", "T363", "T370",

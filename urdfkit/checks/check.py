@@ -515,6 +515,10 @@ def check_paths(paths: Iterable[str | Path], *, packages: Mapping[str, Path] | N
     pkgs = {k: str(v) for k, v in (packages or {}).items()}
     args = dict(xacro_args or {})
     aimed = tuple(targets)
+    if select:
+        from urdfkit.checks.targets import check_selection
+
+        check_selection(select, aimed)
     manifest = _manifest(given, pkgs, no_exec, args, physics, aimed) if cache else None
     results: list[FileResult | None] = [None] * len(files)
     todo = []

@@ -66,7 +66,33 @@ def parse_targets(items: Sequence[str] | None) -> tuple[str, ...]:
                                      f"{', '.join(TARGETS)}{hint(name, TARGETS)}",
                                      param="target")
             asked.add(name)
+    if not asked:
+        raise ParameterError(f"`target` names no target; targets: {', '.join(TARGETS)}",
+                             param="target")
     return tuple(t for t in TARGETS if t in asked and t != "pybullet")
+
+
+#: Each target's code family.
+FAMILIES = {"T1": "ros", "T2": "pinocchio", "T3": "drake", "T4": "mujoco"}
+
+
+def check_selection(select: Sequence[str], targets: Sequence[str]) -> None:
+    """Refuse a ``--select`` of target codes whose target is not asked for.
+
+    It would select nothing, and a CI run would pass on nothing.
+
+    Raises:
+        ParameterError: naming the ``--target`` the codes need.
+    """
+    for code in select:
+        if not code.startswith("T"):
+            continue
+        needs = [t for family, t in FAMILIES.items()
+                 if family.startswith(code[:2]) or code.startswith(family)]
+        if not any(t in targets for t in needs):
+            raise ParameterError(f"`select` {code}: {'those are' if len(code) < 4 else 'it is'} "
+                                 f"the codes of --target {','.join(needs)}, which is not "
+                                 "given: nothing would be selected", param="select")
 
 
 #: The deepest element urdfdom's XML parser (tinyxml2 11) reads, the root at depth 1: one

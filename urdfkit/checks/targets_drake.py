@@ -143,6 +143,14 @@ def _materials(root: El, r: RuleReport) -> None:
                   "previously defined, but has no color or texture information.", m)
         if name is not None:
             seen.add(name)
+        _texture(m, r)
+
+
+def _texture(material: El, r: RuleReport) -> None:
+    """A material's ``<texture>`` file, which Drake resolves as it resolves meshes."""
+    texture = _first(material, "texture")
+    if texture is not None and texture.get("filename"):
+        _file(texture.get("filename") or "", "texture", texture, r)
 
 
 def _links(root: El, r: RuleReport) -> set[str]:
@@ -227,7 +235,7 @@ def _part(part: El, tag: str, link: str, r: RuleReport) -> None:
         r.add("T334", "error", f"Drake refuses the file: {small}", shape)
         return
     if kind == "mesh":
-        _mesh(shape.get("filename") or "", tag, shape, r)
+        _file(shape.get("filename") or "", tag, shape, r)
 
 
 def _small(shape: El, kind: str) -> str | None:
@@ -276,7 +284,8 @@ def drake_path(filename: str, folder: str | None,
     return filename if os.path.isabs(filename) else os.path.join(folder, filename)
 
 
-def _mesh(filename: str, tag: str, shape: El, r: RuleReport) -> None:
+def _file(filename: str, tag: str, shape: El, r: RuleReport) -> None:
+    """A mesh (of a ``tag``: visual, collision) or texture file, found as Drake finds it."""
     scheme = filename.partition("://")[0] if "://" in filename else ""
     if scheme not in ("", "file", "package", "model"):
         r.add("T336", "error", f"Drake refuses the file: URI {filename!r} specifies an "
@@ -314,6 +323,7 @@ def _mesh(filename: str, tag: str, shape: El, r: RuleReport) -> None:
 
 
 def _visual_material(m: El, known: dict[str, str], r: RuleReport) -> None:
+    _texture(m, r)
     name = m.get("name")
     if not name:
         return  # unnamed: Drake keeps it to this visual

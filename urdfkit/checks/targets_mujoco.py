@@ -27,8 +27,16 @@ from urdfkit.sources.guard import RuleReport
 El = etree._Element
 
 #: One number as MuJoCo's reader takes it (strtod over the whole token: nan and inf too).
-_NUMBER = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)",
-                     re.IGNORECASE)
+_NUMBER = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan"
+                     r"|0x(?:[0-9a-f]+\.?[0-9a-f]*|\.[0-9a-f]+)(?:p[+-]?\d+)?)", re.IGNORECASE)
+
+
+def number(text: str) -> float:
+    """A token :data:`_NUMBER` matched, as strtod reads it (hexadecimal too: ``-0x1``)."""
+    token = text.strip()
+    if "x" in token.lower():
+        return float.fromhex(token)
+    return float(token)
 JOINT_TYPES = frozenset({"revolute", "continuous", "prismatic", "fixed", "floating", "planar",
                          "spherical"})
 MOVING = frozenset({"revolute", "continuous", "prismatic"})
@@ -150,7 +158,7 @@ def _count(el: El, attr: str, text: str, count: int, r: RuleReport) -> None:
     bad = next((p for p in parts if _NUMBER.fullmatch(p) is None), None)
     if bad is None:
         bad = next((p for p in parts if p.lower().lstrip("+-") not in ("inf", "infinity")
-                    and abs(float(p)) == float("inf")), None)
+                    and abs(number(p)) == float("inf")), None)
         if bad is not None:
             r.add("T411", "error", f"MuJoCo refuses the file: number is too large in "
                   f"attribute '{attr}' ({bad})", el)
@@ -364,7 +372,7 @@ def _collision(col: El, meshes: _MeshPlace, r: RuleReport) -> None:
         return
     sizes = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius", "length")}
     for attr in sizes.get(str(shape.tag), ()):
-        values = [float(p) for p in (shape.get(attr) or "").split()]
+        values = [number(p) for p in (shape.get(attr) or "").split()]
         if any(v <= 0 for v in values):
             r.add("T424", "error", f"MuJoCo refuses the file: {attr} must be positive in "
                   f"geom ({str(shape.tag)} {attr}={shape.get(attr)!r})", shape)
@@ -404,7 +412,7 @@ def _axis_and_limits(j: El, r: RuleReport) -> None:
     kind = j.get("type")
     axis = _first(j, "axis")
     if kind in MOVING and axis is not None and axis.get("xyz") is not None:
-        values = [float(p) for p in (axis.get("xyz") or "").split()]
+        values = [number(p) for p in (axis.get("xyz") or "").split()]
         if sum(v * v for v in values) < 1e-20:
             r.add("T423", "error", f"MuJoCo refuses the file: axis too small in joint "
                   f"{j.get('name')!r}", axis)
@@ -417,9 +425,9 @@ def _axis_and_limits(j: El, r: RuleReport) -> None:
         why = "MuJoCo never limits a continuous joint (PyBullet reports the bounds)"
     elif kind != "continuous" and (lower is None) != (upper is None):
         why = "with only one of lower and upper MuJoCo leaves it unlimited"
-    elif lower is not None and upper is not None and float(lower) >= float(upper):
+    elif lower is not None and upper is not None and number(lower) >= number(upper):
         why = "with lower >= upper MuJoCo leaves it unlimited (PyBullet's 'no limit' too)" \
-            if float(lower) > float(upper) else "equal lower and upper: MuJoCo ignores " \
+            if number(lower) > number(upper) else "equal lower and upper: MuJoCo ignores " \
             "the limit, with a warning"
     if why:
         r.add("T455", "warning", f"joint {j.get('name')!r}: {why}", limit)
@@ -440,7 +448,7 @@ def _masses(links: dict[str, El], parent_of: dict[str, tuple[str, El]],
             own[name] = (1.0 if shapes else 0.0, shapes)
             continue
         mass_el, inertia = _first(inertial, "mass"), _first(inertial, "inertia")
-        mass = float(mass_el.get("value") or 0) if mass_el is not None else 0.0
+        mass = number(mass_el.get("value") or "0") if mass_el is not None else 0.0
         found = principal_moments(inertia) if inertia is not None else None
         own[name] = (mass, found is not None and found[2] > MINVAL)
     body_of = {}
