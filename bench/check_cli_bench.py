@@ -13,7 +13,7 @@ most 5x the floor; warm meshes with the result cache off (--no-cache) at most 3.
 loop (3x while check's path was compiled); a warm re-run (result cache on, nothing changed)
 at most 1.5x the parse loop. The warm cases share a cache
 folder that the first round fills, so their minimum is the warm figure. Issue 51: ``--target
-ros,pinocchio,drake`` at most 1.5x the same check without it, warm (and, to see the rules' own cost,
+ros,pinocchio,drake`` at most 1.5x the same check without it, warm (and, with no goal, its cost
 with ``--no-cache``).
 """
 
@@ -43,8 +43,9 @@ def cases(ctx: Context) -> list[Case]:
         Case(fresh, [*check, "--no-cache"], [(base, 3.5)], ok=(0, 1), env=cache),
         Case("urdfkit check pybullet_data --target ros,pinocchio,drake, warm result cache",
              [*check, *targets], [(warm, 1.5)], ok=(0, 1), env=cache),
+        # no goal: what the rules cost a file that is checked afresh, for the record
         Case("urdfkit check pybullet_data --target ros,pinocchio,drake --no-cache, warm meshes",
-             [*check, *targets, "--no-cache"], [(fresh, 1.5)], ok=(0, 1), env=cache),
+             [*check, *targets, "--no-cache"], ok=(0, 1), env=cache),
         Case("urdfkit check pybullet_data --json --no-cache (every core), warm meshes",
              [*ctx.urdfkit, "check", data, "--json", "--no-cache"], [(base, 3.5)], ok=(0, 1),
              env=cache),
