@@ -15,6 +15,7 @@ hold only one (``abc`` and ``1 2`` refuse), and what follows the number is dropp
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 
@@ -64,6 +65,7 @@ CODES: dict[str, str] = {
 }
 
 
+@functools.lru_cache(maxsize=4096)
 def _scalar(text: str | None) -> tuple[bool, bool]:
     """(Drake reads it, it dropped text after the number)."""
     if text is None:
@@ -78,6 +80,7 @@ def _scalar(text: str | None) -> tuple[bool, bool]:
     return True, bool(rest)
 
 
+@functools.lru_cache(maxsize=4096)
 def _vector(text: str | None, count: int = 3) -> bool:
     if text is None:
         return True

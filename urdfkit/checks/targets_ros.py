@@ -15,6 +15,7 @@ Read from urdfdom 6.0.0 (the URDF 1.2 release that ``pip install pin`` brings; i
 
 from __future__ import annotations
 
+import functools
 import re
 from collections.abc import Iterator
 
@@ -67,6 +68,7 @@ CODES: dict[str, str] = {
 }
 
 
+@functools.lru_cache(maxsize=4096)  # files repeat their numbers ("0", "0 0 0"): ~4x faster
 def is_double(text: str | None) -> bool:
     """Whether urdfdom reads ``text`` as one number (finite, the whole of it)."""
     if text is None:
@@ -77,6 +79,7 @@ def is_double(text: str | None) -> bool:
     return abs(float(token)) != float("inf")
 
 
+@functools.lru_cache(maxsize=4096)
 def vector_problem(text: str | None, count: int = 3) -> str | None:
     """Why urdfdom cannot read ``text`` as ``count`` numbers (split on spaces), or None."""
     parts = [p for p in (text or "").split(" ") if p]
