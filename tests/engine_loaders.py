@@ -11,6 +11,7 @@ Used by tests/test_check_targets.py, and by bench/target_agreement.py for the co
 from __future__ import annotations
 
 import atexit
+import contextlib
 import json
 import os
 import subprocess
@@ -173,11 +174,8 @@ class _Worker:
             self.proc.stdin.close()
             self.proc.wait(timeout=30)
         for pipe in (self.proc.stdin, self.proc.stdout):
-            if not pipe.closed:
-                try:
-                    pipe.close()
-                except BrokenPipeError:  # the worker died with input unread
-                    pass
+            with contextlib.suppress(BrokenPipeError):  # the worker died with input unread
+                pipe.close()
 
 
 #: One worker per engine, kept for the process (an engine's import costs 0.15-0.5 s).

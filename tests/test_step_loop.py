@@ -50,18 +50,15 @@ def callers(monkeypatch: pytest.MonkeyPatch) -> Iterator[set[str]]:
         self.step = watched(self.step)
 
     monkeypatch.setattr(PyBulletEngine, "_bind", bind_watched)
-    try:
-        from urdfkit.engine.mujoco import MuJoCoEngine
-    except ImportError:  # pragma: no cover - the dev install has the extra
-        pass
-    else:
-        mujoco_step = MuJoCoEngine.step
+    from urdfkit.engine.mujoco import MuJoCoEngine  # [test] installs mujoco
 
-        def mujoco_watched(self: MuJoCoEngine) -> None:
-            seen.add(sys._getframe(1).f_code.co_filename)
-            mujoco_step(self)
+    mujoco_step = MuJoCoEngine.step
 
-        monkeypatch.setattr(MuJoCoEngine, "step", mujoco_watched)
+    def mujoco_watched(self: MuJoCoEngine) -> None:
+        seen.add(sys._getframe(1).f_code.co_filename)
+        mujoco_step(self)
+
+    monkeypatch.setattr(MuJoCoEngine, "step", mujoco_watched)
     yield seen
 
 
@@ -185,7 +182,7 @@ class _Counting:
     """An engine that only counts its steps, and can fail at one."""
 
     class Error(Exception):
-        pass
+        """What its step raises at ``fail_at`` (a closed window's ``pybullet.error``)."""
 
     error = Error
 
