@@ -14,10 +14,11 @@ from urdfkit.checks.targets_ros import (
     _children,
     _first,
     is_double,
-    urdfdom_refusals,
+    read_by_urdfdom,
     vector_problem,
     version,
 )
+from urdfkit.model.spec import depth_first
 from urdfkit.sources.guard import RuleReport
 
 El = etree._Element
@@ -38,7 +39,7 @@ CODES: dict[str, str] = {
 
 def rule_pinocchio(root: El, r: RuleReport) -> None:
     """T2xx: what Pinocchio refuses (errors) and changes (warnings, info)."""
-    refusals = urdfdom_refusals(root)
+    refusals = read_by_urdfdom(root, r)
     for _code, reason, el in refusals:
         r.add("T200", "error", f"Pinocchio refuses the file: its urdfdom says: {reason}", el)
     if refusals:
@@ -141,6 +142,10 @@ def pinocchio_order(root: El, joints: list[El]) -> list[str]:
 
 
 def _depth_first(root: El, joints: list[El], *, sort: bool) -> list[str]:
+    """The moving joints in a pre-order walk from the root (``model.spec.depth_first``).
+
+    A link's child joints are taken in file order, or by name (``sort``).
+    """
     below: dict[str, list[tuple[str, str, str]]] = {}
     children = set()
     for j in joints:
@@ -151,30 +156,14 @@ def _depth_first(root: El, joints: list[El], *, sort: bool) -> list[str]:
             continue
         below.setdefault(p, []).append((j.get("name") or "", c, j.get("type") or ""))
         children.add(c)
-    roots = [link.get("name") for link in _children(root, "link")
-             if link.get("name") not in children]
-    return _walk(roots, below, sort)
-
-
-def _walk(roots: list[str | None], below: dict[str, list[tuple[str, str, str]]],
-          sort: bool) -> list[str]:
-    order: list[str] = []
-    if not roots or roots[0] is None:
-        return order
-    stack: list[tuple[str, str, str]] = []
-    first = below.get(roots[0], [])
-    stack.extend(reversed(sorted(first) if sort else first))
-    seen: set[str] = set()
-    while stack:
-        name, child, kind = stack.pop()
-        if child in seen:
-            continue
-        seen.add(child)
-        if kind != "fixed":
-            order.append(name)
-        kids = below.get(child, [])
-        stack.extend(reversed(sorted(kids) if sort else kids))
-    return order
+    roots = [name for link in _children(root, "link")
+             if (name := link.get("name")) is not None and name not in children]
+    if not roots:
+        return []
+    if sort:
+        below = {link: sorted(edges) for link, edges in below.items()}
+    return [name for name, _, kind in depth_first(roots[0], below, lambda e: e[1])
+            if kind != "fixed"]
 
 
 def _order(root: El, joints: list[El], r: RuleReport) -> None:

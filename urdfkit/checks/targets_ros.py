@@ -120,6 +120,14 @@ def _children(el: El, tag: str) -> Iterator[El]:
 Refusal = tuple[str, str, El]  # code, urdfdom's reason, the element
 
 
+def read_by_urdfdom(root: El, r: RuleReport) -> list[Refusal]:
+    """:func:`urdfdom_refusals`, worked out once per file (ros and pinocchio both ask)."""
+    found = r.memo.get("urdfdom")
+    if found is None:
+        found = r.memo["urdfdom"] = urdfdom_refusals(root)
+    return list(found)
+
+
 def urdfdom_refusals(root: El) -> list[Refusal]:
     """Every reason urdfdom 6.0.0 returns no model for this document (empty: it loads)."""
     if root.tag != "robot":
@@ -428,7 +436,7 @@ def _shape_problem(shape: El, v: tuple[int, int]) -> str | None:
 
 def rule_ros(root: El, r: RuleReport) -> None:
     """T1xx: what urdfdom refuses (errors) and what it reads otherwise (warnings)."""
-    refusals = urdfdom_refusals(root)
+    refusals = read_by_urdfdom(root, r)
     for code, reason, el in refusals:
         r.add(code, "error", f"urdfdom refuses the file: {reason}", el)
     v = version(root)
