@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 
+from urdfkit.engine.session import import_pybullet
 from urdfkit.motion.drive import DriveConfig, Scenario, drive
 
 WHEEL_R = 0.08  # every wheel's radius below
@@ -361,3 +362,42 @@ def test_wheels_named_on_free_swivels_are_said_to_hang_from_them() -> None:
     held = drive(DriveConfig(urdf=str(SWIVEL_WHEELS), throttle=5, seconds=1, wheels=wheels,
                              hinges=swivels))
     assert not [w for w in held.warnings if "free swivel" in w], held.warnings
+
+
+HIGH_WHEELS = Path(__file__).parent / "fixtures" / "robots" / "high_wheels.urdf"
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_wheels_that_carry_no_weight_are_said_not_taken_for_slipping(engine: str) -> None:
+    """A base resting on casters below its wheels (linorobot2's 2wd on PyBullet): drive says
+    the wheels carry no weight, as raw PyBullet's contact forces show, and not that they slip."""
+    r = drive(DriveConfig(urdf=str(HIGH_WHEELS), throttle=10, steer=0.3, seconds=2,
+                          engine=engine))
+    said = " ".join(r.problems)
+    assert "stuck" in said and "the wheels carry 0 N" in said
+    assert "front_caster, rear_caster" in said and "slip sideways" not in said
+
+    p = import_pybullet()
+    client = p.connect(p.DIRECT)
+    try:
+        p.setGravity(0, 0, -9.81, physicsClientId=client)
+        ground = p.createMultiBody(0, p.createCollisionShape(p.GEOM_PLANE,
+                                                            physicsClientId=client),
+                                   physicsClientId=client)
+        car = p.loadURDF(str(HIGH_WHEELS), [0, 0, 0.1], physicsClientId=client,
+                         flags=p.URDF_USE_IMPLICIT_CYLINDER | p.URDF_USE_INERTIA_FROM_FILE)
+        for _ in range(480):
+            p.stepSimulation(physicsClientId=client)
+        load: dict[str, float] = {}
+        for c in p.getContactPoints(car, ground, physicsClientId=client):
+            name = p.getJointInfo(car, c[3], physicsClientId=client)[12].decode()
+            load[name] = load.get(name, 0.0) + c[9]
+    finally:
+        p.disconnect(client)
+    assert load.get("left_wheel", 0.0) == load.get("right_wheel", 0.0) == 0.0
+    assert load["front_caster"] > 0 and load["rear_caster"] > 0
+
+
+def test_a_car_on_its_wheels_is_not_said_to_carry_no_weight() -> None:
+    r = drive(DriveConfig(throttle=10, steer=0.2, seconds=2))
+    assert not any("carry" in m for m in r.problems + r.warnings)

@@ -56,6 +56,7 @@ from urdfkit.motion.drive_advice import (
     gazebo_differences,
     phantom_mass,
     start_problems,
+    unloaded_wheels,
     yaw_shortfall,
 )
 from urdfkit.motion.drive_result import (
@@ -638,8 +639,14 @@ class Scenario:
         rate = stats.yaw_rate()
         train = self.drivetrain
         warnings = list(self.warnings)
-        # A base that flipped, fell or left the ground has no yaw rate worth advice on.
+        # A base that flipped, fell or left the ground has no yaw rate worth advice on, nor
+        # one whose wheels carry no weight (which is said instead).
         upset = bool(monitor.seen & {"flipped", "fell", "left"})
+        if "stuck" in monitor.seen and self.engine is not None:
+            bare = unloaded_wheels(self.engine, self.body, self.plane, train)
+            if bare is not None:
+                problems.append(bare)
+                upset = True
         if train.yaw_steered and self.steer and rate is not None and not self._probe \
                 and not interrupted and c.drivetrain != "locked" and not upset:
             share = rate / self.steer

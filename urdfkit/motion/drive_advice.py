@@ -130,6 +130,25 @@ def free_swivels(engine: Simulator, body: int, train: Drivetrain) -> str | None:
     return None
 
 
+def unloaded_wheels(engine: Simulator, body: int, ground: int, train: Drivetrain) -> str | None:
+    """Said when the wheels carry none of the weight on the ground now; else None.
+
+    The body then rests on something else: ball casters as low as the wheels, a chassis.
+    """
+    contacts = engine.contacts(body, other=ground)
+    total = sum(c.normal_force for c in contacts)
+    wheels = set(train.wheels)
+    on_wheels = sum(c.normal_force for c in contacts if c.link_a in wheels)
+    if total <= 0 or on_wheels > 0.01 * total:
+        return None
+    bearers = sorted({train.link_names.get(c.link_a, str(c.link_a)) for c in contacts
+                      if c.link_a not in wheels and c.normal_force > 0})
+    return (f"the wheels carry {on_wheels:.3g} N of the {total:.3g} N on the ground: the "
+            f"body rests on {', '.join(bearers)}, and the wheels spin without weight; lower "
+            "the wheels or raise what it rests on (a ball caster as low as the wheels can "
+            "take all of it)")
+
+
 def yaw_shortfall(train: Drivetrain, steer: float, throttle: float, max_force: float | None,
                   rate: float, share: float, sim_time: float,
                   probe: Callable[..., float | None]) -> str:
