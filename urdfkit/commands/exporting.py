@@ -59,7 +59,8 @@ def agreement_dict(a: Any) -> dict[str, Any]:
                       "tolerance": r.tolerance, "unit": r.unit, "status": r.status,
                       "detail": r.detail} for r in a.rows],
             "unmatched_links": a.unmatched_links, "unmatched_joints": a.unmatched_joints,
-            "extra_joints": a.extra_joints, "matched_by": a.matched_by, "warnings": a.warnings}
+            "extra_joints": a.extra_joints, "matched_by": a.matched_by, "warnings": a.warnings,
+            "engine": a.engine, "indices": a.indices}
 
 
 def agreement_report(a: Any, show_all: bool = False) -> None:
@@ -71,11 +72,14 @@ def agreement_report(a: Any, show_all: bool = False) -> None:
                                   ("worst", 0, "right"), ("tolerance", 0, "right"),
                                   ("unit", 2, "left"), ("", 0, "left"), ("where", 1, "left")]
     failed = sum(not r.ok for r in a.rows)
-    title = (f"{a.file} in PyBullet vs {a.model} in MuJoCo: "
+    title = (f"{a.file} in PyBullet vs " + (f"{a.model} in " if a.model != a.file else "")
+             + f"{a.engine}: "
              + ("every row agrees" if not failed else f"{failed} row(s) disagree"))
     for w in a.warnings:
-        show.warn(f"{a.model}: MuJoCo: {w}")
+        show.warn(f"{a.model}: {a.engine}: {w}")
     show.table(title, columns, rows, show_all)
+    if a.indices:
+        _indices_report(a, show_all)
     if a.unmatched_links:
         show.note(f"{len(a.unmatched_links)} link(s) with no body or site matched: "
                   + ", ".join(a.unmatched_links), stderr=False)
@@ -84,7 +88,28 @@ def agreement_report(a: Any, show_all: bool = False) -> None:
                   + ", ".join(f"{p['urdf']} = {p['mjcf']} ({p['how']})" for p in a.matched_by),
                   stderr=False)
     show.note("PyBullet loaded with " + (" | ".join(a.load_flags) or "no flags")
-              + "; its link damping and velocity motors off for the swing", stderr=False)
+              + ("; its link damping and velocity motors off for the swing"
+                 if any(r.group == "swing" for r in a.rows) else ""), stderr=False)
+
+
+def _indices_report(a: Any, show_all: bool) -> None:
+    """Each movable joint's indices in both engines, side by side (``--engine``)."""
+    def cell(side: dict[str, Any] | None, *keys: str) -> str:
+        if side is None:
+            return "-"
+        return " ".join(f"{side[k]}" + (f"..{side[k] + side['n' + k] - 1}"
+                                         if side.get("n" + k, 1) > 1 else "") for k in keys)
+
+    rows = [[str(r["joint"]), cell(r["pybullet"], "index"), cell(r["pybullet"], "action"),
+             cell(r["pybullet"], "q"), cell(r["pybullet"], "u"), cell(r["engine"], "q"),
+             cell(r["engine"], "v"), r["engine"]["kind"] if r["engine"] else "-"]
+            for r in a.indices]
+    columns: list[show.Column] = [("joint", 1, "left"), ("index", 0, "right"),
+                                  ("action", 0, "right"), ("q", 0, "right"),
+                                  ("u", 0, "right"), (f"{a.engine} q", 0, "right"),
+                                  ("v", 0, "right"), ("kind", 1, "left")]
+    show.table(f"joint indices: PyBullet (getJointInfo index, action order, qIndex, uIndex) "
+               f"and {a.engine} (base welded)", columns, rows, show_all)
 
 
 def _export_dict(file: str, e: Export, flags: list[str]) -> dict[str, Any]:
@@ -217,10 +242,17 @@ def export(
 
 @command(examples(
     "urdfkit agree kuka_iiwa/model.urdf iiwa.xml",
-    "urdfkit agree panda.urdf mujoco_menagerie/franka_emika_panda/panda.xml --json"))
+    "urdfkit agree panda.urdf mujoco_menagerie/franka_emika_panda/panda.xml --json",
+    "urdfkit agree ur5e.urdf --engine pinocchio"))
 def agree(
     file: FileArg,
-    model: Annotated[str, typer.Argument(metavar="MODEL.xml", help="The MJCF to compare.")],
+    model: Annotated[str | None, typer.Argument(
+        metavar="[MODEL.xml]", help="The MJCF to compare (with --engine mujoco, the "
+        "default).")] = None,
+    engine: Annotated[str, typer.Option(
+        "--engine", metavar="ENGINE", help="mujoco: the MJCF given; mujoco-loader: the URDF "
+        "through MuJoCo's own URDF reader; pinocchio, drake: the URDF as that engine loads "
+        "it (urdfkit[engines]).")] = "mujoco",
     fixed_base: FixedBaseOpt = False,
     inertia_from_shapes: ShapesOpt = False,
     self_collision: SelfCollisionOpt = False,
@@ -237,21 +269,39 @@ def agree(
     arg: ArgOpt = None,
     no_guard: NoGuardOpt = False,
 ) -> None:
-    """Does a MuJoCo model agree with the URDF PyBullet loads? Both engines, compared.
+    """Does another engine's model agree with the URDF PyBullet loads? Both, compared.
 
-    Links are matched to bodies or sites and joints to joints by name; structure, link frames
-    at seeded poses, mass matrix, inverse dynamics and a 1 s free swing are compared, each
-    with its tolerance. Exit 0: every row holds; 1: rows disagree (named); 2: bad input.
-    Needs urdfkit[mujoco]. See docs/export.md.
+    With an MJCF: links are matched to bodies or sites and joints to joints by name;
+    structure, link frames at seeded poses, mass matrix, inverse dynamics and a 1 s free
+    swing are compared, each with its tolerance. With --engine pinocchio, drake or
+    mujoco-loader, the URDF as that engine reads it: joints, each joint's indices in both,
+    masses, frames, mass matrix and inverse dynamics. Exit 0: every row holds; 1: rows
+    disagree (named); 2: bad input, or the engine refuses the file. Needs urdfkit[mujoco]
+    (urdfkit[engines] for --engine). See docs/export.md and docs/engines.md.
     """
+    from urdfkit.core.errors import ParameterError
     from urdfkit.exchange.agree import agree as run_agree
+    from urdfkit.exchange.agree_engines import AGREE_ENGINES, agree_engine
     from urdfkit.exchange.agree_tree import parse_map
 
+    if engine not in AGREE_ENGINES:
+        from urdfkit.core.suggest import hint
+
+        raise ParameterError(f"--engine: no engine named {engine!r}; engines: "
+                             f"{', '.join(AGREE_ENGINES)}{hint(engine, AGREE_ENGINES)}",
+                             param="engine")
+    if (engine == "mujoco") == (model is None):
+        raise ParameterError("give an MJCF file (MODEL.xml), or --engine mujoco-loader, "
+                             "pinocchio or drake without one", param="MODEL.xml")
+    if name_map and engine in ("pinocchio", "drake"):
+        raise ParameterError(f"--map: {engine} loads the URDF itself: every name matches",
+                             param="map")
     options = _verify_options(fixed_base, inertia_from_shapes, self_collision, poses, seed)
     options.name_map = parse_map(name_map)
     with open_input_and_warn(file, packages=package, xacro_args=arg, guard=not no_guard,
                              package_paths=package_path) as resolved:
-        result = run_agree(resolved, model, options)
+        result = run_agree(resolved, model, options) if model is not None else \
+            agree_engine(resolved, engine, options)
     if as_json:
         show.print_json(agreement_dict(result))
     else:

@@ -10,12 +10,16 @@ self-contacts, none unless self-collision was asked for.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from urdfkit.exchange.agree_report import TOL_DYNAMICS, TOL_FK, TOL_PYBULLET_FRAME, worst
-from urdfkit.exchange.agree_sides import Sides
+from urdfkit.exchange.agree_sides import PyBulletSide, Sides
 from urdfkit.formats.fk import link_frames
 from urdfkit.formats.robot import LoadedRobot
+
+if TYPE_CHECKING:
+    from urdfkit.engine.api import Model
+    from urdfkit.exchange.agree_engines import EngineSides
 
 #: How far from the point of its range nearest zero a limited joint is sampled: a turn each
 #: way (a revolute pose repeats past it), a metre along a prismatic one. Real ranges fit
@@ -51,7 +55,8 @@ def sample_range(j: Any) -> tuple[float, float]:
     return max(j.lower, near - reach), min(j.upper, near + reach)
 
 
-def _sample(robot: LoadedRobot, names: list[str], rng: Any) -> dict[str, float]:
+def sample_pose(robot: LoadedRobot, names: list[str], rng: Any) -> dict[str, float]:
+    """A seeded value for each of these joints: within its limits, else a turn or a metre."""
     q = {}
     joints = {j.name: j for j in robot.joints}
     for n in names:
@@ -65,20 +70,21 @@ def _sample(robot: LoadedRobot, names: list[str], rng: Any) -> dict[str, float]:
     return q
 
 
-def _frame_error(a: Any, b: Any) -> tuple[float, float]:
+def frame_error(a: Any, b: Any) -> tuple[float, float]:
+    """Two frames' (4 x 4) largest position and rotation-matrix differences."""
     import numpy as np
 
     return float(np.abs(a[:3, 3] - b[:3, 3]).max()), float(np.abs(a[:3, :3] - b[:3, :3]).max())
 
 
-def poses(s: Sides) -> None:
+def poses(s: Sides | EngineSides) -> None:
     """The rows at seeded poses: frames, mass matrix and inverse dynamics, self-contacts."""
     import numpy as np
 
     from urdfkit.model.spec import quat_to_matrix
 
     pb, res, robot, model = s.pb, s.result, s.robot, s.model
-    links = [n for n in pb.link_index if n in s.body or n in s.site]
+    links = [n for n in pb.link_index if s.linked(n)]
     res.unmatched_links = [n for n in pb.link_index if n not in links and n != "world"]
     index = [pb.link_index[n] for n in links]
     rng = np.random.default_rng(s.options.seed)
@@ -97,30 +103,31 @@ def poses(s: Sides) -> None:
     tol = pybullet_frame_tolerances(robot)
     base_inertial = np.array(quat_to_matrix(
         pb.engine.dynamics(pb.body, -1).inertial_orientation))
-    turned_back = base_inertial.T @ np.array(s.mjcf.gravity)
-    snapped = _snapped_sites(s, links)
+    turned_back = base_inertial.T @ np.array(s.gravity)
+    snapped = s.snapped_sites(links)
     for _ in range(s.options.poses):
-        q = _sample(robot, pb.one_names, rng)
-        qd = _sample(robot, pb.one_names, rng)
-        qdd = _sample(robot, pb.one_names, rng)
+        q = sample_pose(robot, pb.one_names, rng)
+        qd = sample_pose(robot, pb.one_names, rng)
+        qdd = sample_pose(robot, pb.one_names, rng)
         # the matched joints at q; those PyBullet turns with a spherical joint (NaN) stay
         # at the file's reference
         model.set_joint_positions(0, [q.get(n, math.nan) for n in s.matched])
         theirs = dict(zip(links, model.link_matrices(0, index), strict=True))
         pb.pose(q)
         # none where PyBullet cannot report the body's state (_say_unreadable)
-        pb_err = {n: _frame_error(theirs[n], t) for n, t in pb.frames(links).items()}
+        pb_err = {n: frame_error(theirs[n], t) for n, t in pb.frames(links).items()}
         pb_pos += [(a / tol[n], n) for n, (a, _) in pb_err.items()]
         pb_rot += [(b / tol[n], n) for n, (_, b) in pb_err.items()]
         exact = link_frames(robot, q)
         for n in links:
             ref = exact[n] if n not in snapped else exact[snapped[n][0]] @ snapped[n][1]
-            a, b = _frame_error(theirs[n], ref)
+            a, b = frame_error(theirs[n], ref)
             fk_pos.append((a, n))
             fk_rot.append((b, n))
         contacts += [f"{a}/{b}" for a, b in model.self_contacts(0)]
         if dyn and refused is None:
-            got = _dynamics_errors(s, q, qd, qdd, turned_back)
+            got = dynamics_errors(pb, model, s.matched, (q, qd, qdd), turned_back,
+                                  s.gravity)
             if isinstance(got, str):
                 refused = got  # PyBullet cannot answer for this model: not compared
             else:
@@ -144,46 +151,51 @@ def poses(s: Sides) -> None:
                 f"{n} ({len(links)} frames x {s.options.poses} poses)")
     _say_snapped(s, snapped)
     _dynamics_rows(s, bool(dyn), refused, mass_err, id_err)
+    if not s.geometry:
+        return  # the engine's model has none (agree --engine pinocchio, drake)
     pairs = sorted(set(contacts))
     res.add("contacts", "self-contacts at the poses", float(len(contacts)), 0.0, "contacts",
             ", ".join(pairs[:4]) + (" ..." if len(pairs) > 4 else ""),
             status="info" if s.options.self_collision else None)
 
 
-def _dynamics_errors(s: Sides, q: dict[str, float], qd: dict[str, float],
-                     qdd: dict[str, float], turned_back: Any
-                     ) -> tuple[tuple[float, str], tuple[float, str]] | str:
-    """The worst relative mass-matrix and inverse-dynamics errors at one pose.
+def dynamics_errors(pb: PyBulletSide, model: Model, matched: list[str],
+                    state: tuple[dict[str, float], dict[str, float], dict[str, float]],
+                    turned_back: Any, gravity: tuple[float, float, float]
+                    ) -> tuple[tuple[float, str], tuple[float, str]] | str:
+    """The worst relative mass-matrix and inverse-dynamics errors at one state (q, qd, qdd).
 
     Each with its joint; or, when PyBullet cannot build its inverse-dynamics model of this
     robot (:func:`urdfkit.engine.session.dynamics_call`), the call that failed and why.
+    ``model`` answers over ``matched`` (every movable joint of PyBullet's: the caller compares
+    only then) in PyBullet's order; PyBullet is given ``gravity``.
     """
     import numpy as np
 
     from urdfkit.exchange.bullet_state import unreliable_dynamics
 
-    pb, names = s.pb, s.pb.names
+    q, qd, qdd = state
+    names = pb.names
     if unreliable_dynamics(len(names)):
         return unreliable_dynamics(len(names))
     got = pb.dynamics([q[n] for n in names], [qd[n] for n in names], [qdd[n] for n in names],
-                      turned_back, s.mjcf.gravity)
+                      turned_back, gravity)
     if isinstance(got, str):
         return got
     pm, tau_pb = got
-    # every movable joint is matched here: the file's joints in PyBullet's order are these
-    mm = np.array(s.model.mass_matrix(0, [q[n] for n in s.matched]))
+    mm = np.array(model.mass_matrix(0, [q[n] for n in matched]))
     scale = max(float(np.abs(pm).max()), 1e-300)
     e = np.abs(pm - mm) / scale
     mass = (float(e.max()), names[int(np.unravel_index(e.argmax(), e.shape)[0])])
-    tau_mj = np.array(s.model.inverse_dynamics(0, [q[n] for n in s.matched],
-                                               [qd[n] for n in s.matched],
-                                               [qdd[n] for n in s.matched]))
+    tau_mj = np.array(model.inverse_dynamics(0, [q[n] for n in matched],
+                                             [qd[n] for n in matched],
+                                             [qdd[n] for n in matched]))
     scale = max(float(np.abs(tau_pb).max()), 1e-300)
     e = np.abs(tau_pb - tau_mj) / scale
     return mass, (float(e.max()), names[int(e.argmax())])
 
 
-def _dynamics_rows(s: Sides, dyn: bool, refused: str | None,
+def _dynamics_rows(s: Sides | EngineSides, dyn: bool, refused: str | None,
                    mass_err: list[tuple[float, str]], id_err: list[tuple[float, str]]) -> None:
     res, pb = s.result, s.pb
     if dyn and refused is not None:
@@ -206,7 +218,7 @@ def _dynamics_rows(s: Sides, dyn: bool, refused: str | None,
                 "not compared: the joints differ")
 
 
-def _say_unreadable(s: Sides, links: list[str]) -> None:
+def _say_unreadable(s: Sides | EngineSides, links: list[str]) -> None:
     """Known rows saying why the frames are not compared with PyBullet's, if they are not."""
     from urdfkit.exchange.bullet_state import unreadable_state
 
@@ -218,7 +230,7 @@ def _say_unreadable(s: Sides, links: list[str]) -> None:
                      "exact-FK rows cover every frame", status="known")
 
 
-def _say_snapped(s: Sides, snapped: dict[str, tuple[str, Any, float]]) -> None:
+def _say_snapped(s: Sides | EngineSides, snapped: dict[str, tuple[str, Any, float]]) -> None:
     """A known row naming the sites MuJoCo computes at their body's frame, if any."""
     if not snapped:
         return
@@ -228,23 +240,3 @@ def _say_snapped(s: Sides, snapped: dict[str, tuple[str, Any, float]]) -> None:
                  "m|rad", f"{most}{more}; MuJoCo's compiler places a site this close "
                  "to its body's frame at that frame (site_sameframe), so its frame is "
                  "compared there; the MJCF writes it where the file does", status="known")
-
-
-def _snapped_sites(s: Sides, links: list[str]) -> dict[str, tuple[str, Any, float]]:
-    """Matched sites MuJoCo's compiler moved onto their body's frame: link -> (body, where, by).
-
-    ``body`` is the URDF link of the site's body (matched by name or by the tree's shape);
-    ``where`` and ``by`` are :meth:`~urdfkit.engine.mujoco_file.MjcfFile.snapped_sites`'.
-    """
-    moved = s.mjcf.snapped_sites()
-    frames = {j.child for j in s.robot.joints} | {s.robot.root}
-    out: dict[str, tuple[str, Any, float]] = {}
-    for n in links:
-        if n in s.body or n not in s.site or s.site[n] not in moved:
-            continue
-        where, by = moved[s.site[n]]
-        b = s.mjcf.tree.site_body[s.site[n]]
-        body = next((link for link, i in s.body.items() if i == b), "")
-        if body in frames:
-            out[n] = (body, where, by)
-    return out

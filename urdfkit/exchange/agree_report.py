@@ -79,8 +79,13 @@ class Agreement:
     #: pairs not matched by name: {"urdf", "mjcf", "how": "map" | "structure"}
     matched_by: list[dict[str, str]] = field(default_factory=list)
     load_flags: list[str] = field(default_factory=list)
-    #: What MuJoCo said while loading the model (its decoders' warnings).
+    #: What the other engine said while loading the model (MuJoCo's decoders', Drake's).
     warnings: list[str] = field(default_factory=list)
+    #: The other engine, as messages name it.
+    engine: str = "MuJoCo"
+    #: ``--engine``: each joint's indices in PyBullet and in the other engine, side by side
+    #: ({"joint", "pybullet": {"index", "q", "u"}, "engine": {"kind", "q", "nq", "v", "nv"}}).
+    indices: list[dict[str, object]] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:

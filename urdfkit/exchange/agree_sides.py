@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from urdfkit.core.errors import EngineError
-from urdfkit.engine.api import JointInfo, LoadSettings
+from urdfkit.engine.api import JointInfo, LinkDynamics, LoadSettings
 from urdfkit.exchange.agree_report import Agreement, AgreeOptions
 from urdfkit.exchange.agree_tree import Matching, match_models
 from urdfkit.formats.robot import LoadedInertial, LoadedRobot
@@ -42,6 +42,18 @@ def _matrix(pos: Any, orn: Any) -> Any:
     t[:3, :3] = quat_to_matrix([c / norm for c in orn])
     t[:3, 3] = pos
     return t
+
+
+def loaded_inertial(d: LinkDynamics) -> LoadedInertial:
+    """A link's mass properties as an engine reports them, as the file's: link frame axes."""
+    import numpy as np
+
+    from urdfkit.model.spec import quat_to_matrix
+
+    r = np.array(quat_to_matrix(d.inertial_orientation))
+    tensor = r @ np.diag(d.inertia) @ r.T
+    return LoadedInertial(float(d.mass), d.inertial_position,
+                          tuple(map(tuple, tensor)))  # type: ignore[arg-type]
 
 
 class PyBulletSide:
@@ -90,15 +102,7 @@ class PyBulletSide:
         engine.remove_body(free)
 
     def _inertial(self, body: int, index: int) -> LoadedInertial:
-        import numpy as np
-
-        from urdfkit.model.spec import quat_to_matrix
-
-        d = self.engine.dynamics(body, index)
-        r = np.array(quat_to_matrix(d.inertial_orientation))
-        tensor = r @ np.diag(d.inertia) @ r.T
-        return LoadedInertial(float(d.mass), d.inertial_position,
-                        tuple(map(tuple, tensor)))  # type: ignore[arg-type]
+        return loaded_inertial(self.engine.dynamics(body, index))
 
     def inertial(self, link: str) -> LoadedInertial:
         """A link's mass properties as PyBullet loaded them (floating load), link frame."""
@@ -244,6 +248,38 @@ class Sides:
     def root_free(self) -> int | None:
         """The free joint of the robot's root body in the MJCF as written (no other's)."""
         return self.mjcf.root_free(self.body.get(self.robot.root))
+
+    def snapped_sites(self, links: list[str]) -> dict[str, tuple[str, Any, float]]:
+        """Matched sites MuJoCo's compiler moved onto their body's frame.
+
+        Link -> (body, where, by): ``body`` is the URDF link of the site's body (matched by
+        name or by the tree's shape); ``where`` and ``by`` are
+        :meth:`~urdfkit.engine.mujoco_file.MjcfFile.snapped_sites`'.
+        """
+        moved = self.mjcf.snapped_sites()
+        frames = {j.child for j in self.robot.joints} | {self.robot.root}
+        out: dict[str, tuple[str, Any, float]] = {}
+        for n in links:
+            if n in self.body or n not in self.site or self.site[n] not in moved:
+                continue
+            where, by = moved[self.site[n]]
+            b = self.mjcf.tree.site_body[self.site[n]]
+            body = next((link for link, i in self.body.items() if i == b), "")
+            if body in frames:
+                out[n] = (body, where, by)
+        return out
+
+    @property
+    def gravity(self) -> tuple[float, float, float]:
+        """The MJCF's gravity, which PyBullet is given too."""
+        return self.mjcf.gravity
+
+    #: The MJCF has collision geometry (self-contacts at the poses are compared).
+    geometry = True
+
+    def linked(self, link: str) -> bool:
+        """Whether a link has a body or site in the MJCF."""
+        return link in self.body or link in self.site
 
     def pybullet_static(self) -> bool:
         """Whether PyBullet's root does not move: welded, ``world``, or of mass 0."""

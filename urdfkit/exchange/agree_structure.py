@@ -17,7 +17,7 @@ from urdfkit.exchange.agree_sides import Sides
 from urdfkit.exchange.agree_tree import tree_errors
 from urdfkit.formats.fk import fused, link_frames
 from urdfkit.formats.mjcf import combine
-from urdfkit.formats.robot import LoadedInertial
+from urdfkit.formats.robot import LoadedInertial, LoadedRobot
 
 _ZERO3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
@@ -142,7 +142,7 @@ def joint_rows(s: Sides) -> None:
         if ours.kind == "spherical":  # PyBullet's spherical joint has no limit
             limits.append((math.inf if mj.limited else 0.0, n))
             continue
-        limits.append((_limit_error(joints[n], ours.lower, ours.upper, mj.limited,
+        limits.append((limit_error(joints[n], ours.lower, ours.upper, mj.limited,
                                     mj.lower, mj.upper), n))
         if ours.kind == mj.kind:
             damping.append((abs(ours.damping - mj.damping), n))
@@ -165,7 +165,7 @@ def joint_rows(s: Sides) -> None:
                 "frictionloss does: " + "; ".join(known_friction[:4]), status="known")
 
 
-def _limit_error(joint: Any, lower: float, upper: float, limited: bool, mj_lower: float,
+def limit_error(joint: Any, lower: float, upper: float, limited: bool, mj_lower: float,
                  mj_upper: float) -> float:
     """How far MuJoCo's range is from the limits PyBullet loaded (inf: one side only)."""
     # PyBullet limits a revolute or prismatic joint with lower <= upper, never a
@@ -198,7 +198,7 @@ def masses(s: Sides) -> None:
     total_mj = s.mjcf.total_mass()
     res.add("structure", "total mass", abs(total_pb - total_mj) / max(total_pb, 1e-300),
             TOL_EXACT, "relative", f"PyBullet {total_pb!r} kg, MuJoCo {total_mj!r} kg"
-            + _defaults_said(s, list(robot.links), abs(total_pb - total_mj)))
+            + defaults_said(s.robot, list(robot.links), abs(total_pb - total_mj)))
     mass: list[tuple[float, str]] = []
     com: list[tuple[float, str]] = []
     inertia: list[tuple[float, str]] = []
@@ -239,7 +239,7 @@ def masses(s: Sides) -> None:
         v, dd = worst(mass)
         members = [n for n, (g, _) in where.items() if g == dd]
         res.add("structure", "body masses", v, TOL_EXACT, "relative",
-                dd + (_defaults_said(s, members, v) if v > TOL_EXACT else ""))
+                dd + (defaults_said(s.robot, members, v) if v > TOL_EXACT else ""))
     for what, items, tol in (("centres of mass", com, TOL_COM),
                              ("inertia tensors", inertia, TOL_INERTIA)):
         if items:
@@ -283,11 +283,11 @@ def _mujoco_weld_groups(s: Sides) -> tuple[dict[int, list[tuple[LoadedInertial, 
     return weld, snapped
 
 
-def _defaults_said(s: Sides, links: list[str], off: float) -> str:
+def defaults_said(robot: LoadedRobot, links: list[str], off: float) -> str:
     """A mass difference's likely cause: links PyBullet gives its default 1 kg."""
     if off <= 0:
         return ""
-    made = [n for n in links if not s.robot.links[n].inertial.given]
+    made = [n for n in links if not robot.links[n].inertial.given]
     if not made:
         return ""
     return (f"; {len(made)} link(s) without <inertial> ({', '.join(made[:3])}"
