@@ -55,11 +55,22 @@ class PinocchioModel(WeldedModel):
     def __init__(self, path: str, display: str, root: str,
                  layout: Sequence[JointInfo]) -> None:
         super().__init__(root, layout)
+        from urdfkit.engine.session import quiet_stderr
+
         pin = self.pin = import_pinocchio()
-        try:
-            self.model = pin.buildModelFromUrdf(str(path))
-        except Exception as e:  # noqa: BLE001 - its C++ exceptions: std::invalid_argument ...
-            raise engine_refusal(self.label, e, display) from None
+        with quiet_stderr() as said:  # urdfdom prints its reasons on fd 2
+            try:
+                self.model = pin.buildModelFromUrdf(str(path))
+            except Exception as e:  # noqa: BLE001 - its C++ exceptions: invalid_argument ...
+                failed: Exception | None = e
+            else:
+                failed = None
+        #: What urdfdom said while parsing (its "Error:" and warning lines), each once.
+        self.warnings = list(dict.fromkeys(
+            ln.removeprefix("Error:").strip() for ln in said.lines if not ln.startswith("at ")))
+        if failed is not None:
+            first = self.warnings[0] if self.warnings else ""
+            raise engine_refusal(self.label, failed, display, first) from None
         self.data = self.model.createData()
         self._q = pin.neutral(self.model)
         self._v: Any = None
@@ -88,7 +99,9 @@ class PinocchioModel(WeldedModel):
                 lower, upper = -math.inf, math.inf
             axis = (0.0, 0.0, 0.0)
             if j.nv == 1:  # the joint's motion in its own (the child link's) frame
-                s = pin.getJointJacobian(m, d, i, pin.ReferenceFrame.LOCAL)[:, j.idx_v]
+                # (eigenpy gives a one-column matrix as a vector: shaped back)
+                s = np.reshape(pin.getJointJacobian(m, d, i, pin.ReferenceFrame.LOCAL),
+                               (6, m.nv))[:, j.idx_v]
                 a = s[3:] if kind == "revolute" else s[:3]
                 axis = (float(a[0]), float(a[1]), float(a[2]))
             v = int(j.idx_v)
@@ -113,7 +126,7 @@ class PinocchioModel(WeldedModel):
 
         m = self.model
         f = m.frames[self._frame_id(link)]
-        first = link == self._links[0] or m.frames[f.previousFrame].type == \
+        first = link == self._links[0] or m.frames[f.parentFrame].type == \
             self.pin.FrameType.JOINT
         if not first:
             return 0.0, np.zeros(3), np.zeros((3, 3))
@@ -154,7 +167,8 @@ class PinocchioModel(WeldedModel):
     def _engine_mass_matrix(self) -> Any:
         import numpy as np
 
-        full = np.array(self.pin.crba(self.model, self.data, self._q))
+        nv = self.model.nv
+        full = np.reshape(self.pin.crba(self.model, self.data, self._q), (nv, nv))
         self._placed = False
         return np.triu(full) + np.triu(full, 1).T  # crba fills the upper triangle
 
@@ -176,7 +190,8 @@ class PinocchioModel(WeldedModel):
         pin.updateFramePlacements(m, d)
         self._placed = True
         f = self._frame_id(link)
-        j = pin.getFrameJacobian(m, d, f, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        j = np.reshape(pin.getFrameJacobian(m, d, f, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED),
+                       (6, m.nv))
         r = d.oMf[f].rotation @ point
         skew = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
         return j[:3] - skew @ j[3:], j[3:]

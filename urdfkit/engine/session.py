@@ -113,6 +113,32 @@ def _capture_fd1(captured: Captured) -> Iterator[Captured]:
         sink.close()
 
 
+@contextmanager
+def quiet_stderr() -> Iterator[Captured]:
+    """Keep what C code prints on fd 2 (urdfdom's "Error:" lines) while the block runs.
+
+    The text is on the returned :class:`Captured` once the block ends; fd 2 is back.
+    """
+    from urdfkit.core.stdio import LOCK
+
+    captured = Captured()
+    with LOCK:  # no other thread writes to fd 2 while it points elsewhere
+        sys.stderr.flush()
+        _c_fflush()
+        saved = os.dup(2)
+        sink = _sink()
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield captured
+        finally:
+            _c_fflush()
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            captured.text = sink.read().decode("utf-8", "replace")
+            sink.close()
+
+
 def import_pybullet() -> Any:
     """Import pybullet without letting its "build time" banner reach stdout."""
     if "pybullet" in sys.modules:

@@ -274,11 +274,16 @@ class WeldedModel:
         raise NotImplementedError
 
 
-def engine_refusal(label: str, error: BaseException, file: str) -> Exception:
-    """The engine's refusal as an :class:`~urdfkit.core.errors.InputError`: one bounded line."""
+def engine_refusal(label: str, error: BaseException, file: str, why: str = "") -> Exception:
+    """The engine's refusal as an :class:`~urdfkit.core.errors.InputError`: one bounded line.
+
+    ``why`` is the engine's first reason where its exception says less (urdfdom's line).
+    """
     from urdfkit.core.errors import InputError
 
     text = " ".join(str(error).split()) or type(error).__name__
+    if why:
+        text = f"{why} ({text})"
     if len(text) > 300:
         text = text[:297] + "..."
     return InputError(f"{label} cannot load it: {text}", file=file)
