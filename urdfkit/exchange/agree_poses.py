@@ -127,7 +127,7 @@ def poses(s: Sides | EngineSides) -> None:
         contacts += [f"{a}/{b}" for a, b in model.self_contacts(0)]
         if dyn and refused is None:
             got = dynamics_errors(pb, model, s.matched, (q, qd, qdd), turned_back,
-                                  s.gravity)
+                                  s.gravity, s.inertia_slack)
             if isinstance(got, str):
                 refused = got  # PyBullet cannot answer for this model: not compared
             else:
@@ -161,7 +161,8 @@ def poses(s: Sides | EngineSides) -> None:
 
 def dynamics_errors(pb: PyBulletSide, model: Model, matched: list[str],
                     state: tuple[dict[str, float], dict[str, float], dict[str, float]],
-                    turned_back: Any, gravity: tuple[float, float, float]
+                    turned_back: Any, gravity: tuple[float, float, float],
+                    slack: float = 0.0
                     ) -> tuple[tuple[float, str], tuple[float, str]] | str:
     """The worst relative mass-matrix and inverse-dynamics errors at one state (q, qd, qdd).
 
@@ -169,6 +170,12 @@ def dynamics_errors(pb: PyBulletSide, model: Model, matched: list[str],
     robot (:func:`urdfkit.engine.session.dynamics_call`), the call that failed and why.
     ``model`` answers over ``matched`` (every movable joint of PyBullet's: the caller compares
     only then) in PyBullet's order; PyBullet is given ``gravity``.
+
+    ``slack`` (kg m^2) is the sum over links of how far PyBullet's rotational inertia may be
+    from the other side's by PyBullet's own rounding (spectral norm): a mass-matrix entry
+    takes at most ``slack`` of it (each joint's angular Jacobian column is a unit vector or
+    zero), a torque at most ``slack (sum |qdd| + 2 (sum |qd|)^2)`` (a link's angular
+    acceleration and squared speed are bounded so). That much is taken off each error first.
     """
     import numpy as np
 
@@ -185,13 +192,15 @@ def dynamics_errors(pb: PyBulletSide, model: Model, matched: list[str],
     pm, tau_pb = got
     mm = np.array(model.mass_matrix(0, [q[n] for n in matched]))
     scale = max(float(np.abs(pm).max()), 1e-300)
-    e = np.abs(pm - mm) / scale
+    e = np.maximum(np.abs(pm - mm) - slack, 0.0) / scale
     mass = (float(e.max()), names[int(np.unravel_index(e.argmax(), e.shape)[0])])
     tau_mj = np.array(model.inverse_dynamics(0, [q[n] for n in matched],
                                              [qd[n] for n in matched],
                                              [qdd[n] for n in matched]))
     scale = max(float(np.abs(tau_pb).max()), 1e-300)
-    e = np.abs(tau_pb - tau_mj) / scale
+    speeds = sum(abs(qd[n]) for n in names)
+    allowed = slack * (sum(abs(qdd[n]) for n in names) + 2.0 * speeds * speeds)
+    e = np.maximum(np.abs(tau_pb - tau_mj) - allowed, 0.0) / scale
     return mass, (float(e.max()), names[int(e.argmax())])
 
 

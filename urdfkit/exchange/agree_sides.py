@@ -276,6 +276,8 @@ class Sides:
 
     #: The MJCF has collision geometry (self-contacts at the poses are compared).
     geometry = True
+    #: No rounding of PyBullet's to allow for: export writes the inertia PyBullet loaded.
+    inertia_slack = 0.0
 
     def linked(self, link: str) -> bool:
         """Whether a link has a body or site in the MJCF."""
