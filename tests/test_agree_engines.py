@@ -16,7 +16,7 @@ import pinocchio as pin
 import pybullet as p
 import pybullet_data
 import pytest
-from pydrake.all import JointIndex, MultibodyPlant, Parser
+from pydrake.all import MultibodyPlant, Parser
 from typer.testing import CliRunner
 
 from urdfkit.cli import app
@@ -246,3 +246,66 @@ def test_a_file_the_engine_refuses_is_one_line_exit_2(engine: str, tmp_path: Pat
             pin.buildModelFromUrdf(str(DATA / "husky/husky.urdf"))
         else:
             _drake(DATA / "husky/husky.urdf", "base_link")
+
+
+def _two_links(inertia: str) -> str:
+    return f"""<robot name="t">
+  <link name="base"><inertial><mass value="1"/>
+    <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="0.1 0.02 0.3" rpy="0.3 0.2 0.1"/><mass value="2"/>
+    <inertia {inertia}/></inertial></link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/>
+    <axis xyz="0.3 0.4 0.866"/><limit lower="-2" upper="2" effort="5" velocity="3"/></joint>
+  <link name="tip"><inertial><mass value="0.5"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="k" type="revolute"><parent link="arm"/><child link="tip"/>
+    <origin xyz="0 0 0.4"/><axis xyz="1 0 0"/>
+    <limit lower="-2" upper="2" effort="5" velocity="3"/></joint>
+</robot>
+"""
+
+
+def _bullet_tensor(path: Path, link: int) -> np.ndarray:
+    client = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(str(path), flags=p.URDF_USE_INERTIA_FROM_FILE,
+                          physicsClientId=client)
+        mass, _, moments, _, turn = p.getDynamicsInfo(body, link, physicsClientId=client)[:5]
+    finally:
+        p.disconnect(client)
+    r = np.array(p.getMatrixFromQuaternion(turn)).reshape(3, 3)
+    return r @ np.diag(moments) @ r.T
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_products_of_inertia_pass_within_bullets_diagonalisation(engine: str,
+                                                                 tmp_path: Path) -> None:
+    """PyBullet diagonalises a tensor with products and drops what its sweeps leave."""
+    path = tmp_path / "t.urdf"
+    path.write_text(_two_links('ixx="0.03" ixy="0.004" ixz="-0.002" iyy="0.05" iyz="0.0015" '
+                               'izz="0.04"'))
+    code, data = _agree(path, engine)
+    rows = _rows(data)
+    assert code == 0, [r for r in data["rows"] if r["status"] == "fail"]
+    assert "diagonalisation allowed for" in rows["inertia tensors"]["detail"]
+    # raw PyBullet's tensor (in the inertial frame's axes) is off the file's, within the
+    # bound allowed: 2e-6 x its trace
+    file = np.array([[0.03, 0.004, -0.002], [0.004, 0.05, 0.0015], [-0.002, 0.0015, 0.04]])
+    turn = np.array(p.getMatrixFromQuaternion(p.getQuaternionFromEuler((0.3, 0.2, 0.1))))
+    turn = turn.reshape(3, 3)
+    off = np.linalg.norm(_bullet_tensor(path, 0) - turn @ file @ turn.T, 2)
+    assert 0 < off <= 2e-6 * np.trace(file)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_tensor_bullet_zeroes_fails_naming_the_link(engine: str, tmp_path: Path) -> None:
+    """ixx > iyy + izz: Bullet zeroes the tensor; Pinocchio and Drake keep the file's."""
+    path = tmp_path / "t.urdf"
+    path.write_text(_two_links('ixx="0.3" ixy="0" ixz="0" iyy="0.05" iyz="0" izz="0.05"'))
+    assert not np.any(_bullet_tensor(path, 0))
+    code, data = _agree(path, engine)
+    rows = _rows(data)
+    assert code == 1
+    assert rows["inertia tensors"]["status"] == "fail"
+    assert "zero tensor on arm" in rows["inertia tensors"]["detail"]
+    assert rows["mass matrix"]["status"] == "fail"

@@ -310,9 +310,10 @@ def masses(s: EngineSides) -> None:
         scale = max(float(np.abs(a.tensor).max()), float(np.abs(b.tensor).max()), 1e-300)
         off = float(np.abs(a.tensor - b.tensor).max()) - slack.get(group, 0.0)
         said = group
-        zeroed = [n for n, (i, _), (j, _) in zip(names[group], parts, theirs[group],
-                                                 strict=True)
-                  if not np.any(i.tensor) and np.any(j.tensor)]
+        # Bullet keeps the mass of a link whose tensor it zeroes (a `world` it weighs 0)
+        zeroed = [n for n, (i, _) in zip(names[group], parts, strict=True)
+                  if i.mass > 0 and not np.any(i.tensor)
+                  and np.any(robot.links[n].inertial.tensor)]
         if zeroed:
             said += f": PyBullet holds a zero tensor on {', '.join(zeroed[:3])} (the " \
                 "file's breaks the triangle inequality: Bullet zeroes it)"

@@ -285,9 +285,12 @@ def _mujoco_weld_groups(s: Sides) -> tuple[dict[int, list[tuple[LoadedInertial, 
 
 def defaults_said(robot: LoadedRobot, links: list[str], off: float) -> str:
     """A mass difference's likely cause: links PyBullet gives its default 1 kg."""
+    from urdfkit.model.spec import default_mass
+
     if off <= 0:
         return ""
-    made = [n for n in links if not robot.links[n].inertial.given]
+    # (a link named `world` without one weighs 0 in PyBullet, not 1 kg)
+    made = [n for n in links if not robot.links[n].inertial.given and default_mass(n) > 0]
     if not made:
         return ""
     return (f"; {len(made)} link(s) without <inertial> ({', '.join(made[:3])}"
