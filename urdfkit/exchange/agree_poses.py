@@ -13,13 +13,12 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from urdfkit.exchange.agree_report import TOL_DYNAMICS, TOL_FK, TOL_PYBULLET_FRAME, worst
-from urdfkit.exchange.agree_sides import PyBulletSide, Sides
+from urdfkit.exchange.agree_sides import PoseSides, PyBulletSide
 from urdfkit.formats.fk import link_frames
 from urdfkit.formats.robot import LoadedRobot
 
 if TYPE_CHECKING:
     from urdfkit.engine.api import Model
-    from urdfkit.exchange.agree_engines import EngineSides
 
 #: How far from the point of its range nearest zero a limited joint is sampled: a turn each
 #: way (a revolute pose repeats past it), a metre along a prismatic one. Real ranges fit
@@ -77,7 +76,7 @@ def frame_error(a: Any, b: Any) -> tuple[float, float]:
     return float(np.abs(a[:3, 3] - b[:3, 3]).max()), float(np.abs(a[:3, :3] - b[:3, :3]).max())
 
 
-def poses(s: Sides | EngineSides) -> None:
+def poses(s: PoseSides) -> None:
     """The rows at seeded poses: frames, mass matrix and inverse dynamics, self-contacts."""
     import numpy as np
 
@@ -204,7 +203,7 @@ def dynamics_errors(pb: PyBulletSide, model: Model, matched: list[str],
     return mass, (float(e.max()), names[int(e.argmax())])
 
 
-def _dynamics_rows(s: Sides | EngineSides, dyn: bool, refused: str | None,
+def _dynamics_rows(s: PoseSides, dyn: bool, refused: str | None,
                    mass_err: list[tuple[float, str]], id_err: list[tuple[float, str]]) -> None:
     res, pb = s.result, s.pb
     if dyn and refused is not None:
@@ -227,7 +226,7 @@ def _dynamics_rows(s: Sides | EngineSides, dyn: bool, refused: str | None,
                 "not compared: the joints differ")
 
 
-def _say_unreadable(s: Sides | EngineSides, links: list[str]) -> None:
+def _say_unreadable(s: PoseSides, links: list[str]) -> None:
     """Known rows saying why the frames are not compared with PyBullet's, if they are not."""
     from urdfkit.exchange.bullet_state import unreadable_state
 
@@ -239,7 +238,7 @@ def _say_unreadable(s: Sides | EngineSides, links: list[str]) -> None:
                      "exact-FK rows cover every frame", status="known")
 
 
-def _say_snapped(s: Sides | EngineSides, snapped: dict[str, tuple[str, Any, float]]) -> None:
+def _say_snapped(s: PoseSides, snapped: dict[str, tuple[str, Any, float]]) -> None:
     """A known row naming the sites MuJoCo computes at their body's frame, if any."""
     if not snapped:
         return

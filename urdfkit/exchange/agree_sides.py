@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from urdfkit.core.errors import EngineError
 from urdfkit.engine.api import JointInfo, LinkDynamics, LoadSettings
@@ -179,6 +179,41 @@ class PyBulletSide:
         finally:
             e.set_gravity(gravity)
         return pm, tau
+
+
+class PoseSides(Protocol):
+    """What the rows at seeded poses ask of a comparison.
+
+    :class:`Sides` (an MJCF file) and :class:`~urdfkit.exchange.agree_engines.EngineSides`
+    (``--engine``) both answer it.
+    """
+
+    robot: LoadedRobot
+    options: AgreeOptions
+    pb: PyBulletSide
+    result: Agreement
+    matched: list[str]
+    repaired: list[str]
+    geometry: bool
+    inertia_slack: float
+
+    @property
+    def model(self) -> Any:
+        """The other side, a :class:`~urdfkit.engine.api.Model` with ``link_matrices``."""
+        ...
+
+    @property
+    def gravity(self) -> tuple[float, float, float]:
+        """The gravity both sides are given."""
+        ...
+
+    def linked(self, link: str) -> bool:
+        """Whether the other side has this link."""
+        ...
+
+    def snapped_sites(self, links: list[str]) -> dict[str, tuple[str, Any, float]]:
+        """Links the other side computes at another frame: link -> (body, where, by)."""
+        ...
 
 
 @dataclass
