@@ -142,7 +142,8 @@ class DrakeModel(WeldedModel):
         import numpy as np
 
         plant, ctx = self.plant, self.context
-        qs = np.zeros(plant.num_positions())
+        # the plant's defaults, not zeros: a floating joint's quaternion starts at 1 0 0 0
+        qs = np.array(plant.GetDefaultPositions(), dtype=float)
         vs = np.zeros(plant.num_velocities())
         for name, value in q.items():
             c = self._joint[name].coordinate
