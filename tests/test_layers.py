@@ -22,7 +22,7 @@ PACKAGE = Path(urdfkit.__file__).parent
 #: cycles between modules. ``formats`` shares the engine's floor: an engine builds its model
 #: from the MJCF export.
 FLOOR_FOLDERS = [["core"], ["model"], ["sources"], ["engine", "formats"],
-                 ["checks", "motion", "draw", "exchange"], ["commands"]]
+                 ["checks", "motion", "draw", "exchange"], ["commands", "serve"]]
 FLOORS: dict[str, int] = {name: n for n, names in enumerate(FLOOR_FOLDERS) for name in names}
 FOLDERS = [name for names in FLOOR_FOLDERS for name in names]
 #: The public modules at the top of the package, each on the floor of what it fronts. The last

@@ -251,7 +251,7 @@ def _is_xacro(name: str) -> bool:
 
 def _read(path: str, display: str, no_exec: bool = False,
           packages: Mapping[str, Path] | None = None,
-          xacro_args: Mapping[str, str] | None = None) -> bytes:
+          xacro_args: Mapping[str, str] | None = None, data: bytes | None = None) -> bytes:
     if _is_xacro(path):
         from urdfkit.sources.expand import expand_xacro
         from urdfkit.sources.uris import not_a_file
@@ -262,15 +262,20 @@ def _read(path: str, display: str, no_exec: bool = False,
             raise InputError(f"is {why}, not a regular file; urdfkit reads only regular files"
                              if why != "missing" else "no such file", file=display)
         return expand_xacro(source, xacro_args, display=display, no_exec=no_exec,
-                            packages=packages, strict_args=False)
-    return read_bytes(path)
+                            packages=packages, strict_args=False, text=data)
+    return read_bytes(path) if data is None else data
 
 
 def check_file(display: str, path: str | Path,
                packages: Mapping[str, Path] | None = None, no_exec: bool = False,
                xacro_args: Mapping[str, str] | None = None,
-               physics: bool = False, targets: Sequence[str] = ()) -> FileResult:
+               physics: bool = False, targets: Sequence[str] = (),
+               data: bytes | None = None, expanded: bytes | None = None) -> FileResult:
     """Run every rule on one file; any failure to read it becomes a ``U000`` finding.
+
+    ``data`` stands for the file's bytes (an editor's unsaved buffer; a xacro is expanded as
+    if it held them, its includes found beside it). ``expanded`` is a xacro's expansion
+    already made (:func:`urdfkit.sources.expand.expand_xacro`, with its origins): not made again.
 
     ``targets`` (:func:`urdfkit.checks.targets.parse_targets`) adds what those consumers
     refuse or change (``T`` codes).
@@ -282,9 +287,9 @@ def check_file(display: str, path: str | Path,
     name = os.fspath(path)
     xacro_file = _is_xacro(name)
     result = FileResult(display)
-    data: bytes | None = None
-    try:
-        data = _read(name, display, no_exec, packages, xacro_args)
+    try:  # (a file that cannot be read leaves data as given: None, or the buffer)
+        data = expanded if expanded is not None and xacro_file else \
+            _read(name, display, no_exec, packages, xacro_args, data)
         refuse_oversized(data, display)
         fixed, quirks = tolerate_quirks(data)
         tree = parse_xml(fixed, display, tolerated=True)

@@ -66,7 +66,7 @@ FIXABLE = ("U601", "U602", "U603", "U604", "U605", "U606", "U608", "U609", "U610
 def fix_file(path: str | Path, *, balance: bool = False, density: float | None = None,
              packages: Mapping[str, Path] | None = None,
              select: Sequence[str] = (), gazebo_contacts: bool = False,
-             output: str | Path | None = None) -> FixResult:
+             output: str | Path | None = None, buffer: bytes | None = None) -> FixResult:
     """Repair a URDF file's fixable findings; return the new text (nothing is written).
 
     Args:
@@ -87,12 +87,14 @@ def fix_file(path: str | Path, *, balance: bool = False, density: float | None =
             relative mesh and texture path is rewritten to name the same file from there
             (:func:`urdfkit.sources.uris.rebased`), so the written file loads as the
             original does; only those ``filename`` attributes change.
+        buffer: The file's bytes as an editor holds them (unsaved): repaired as if the file
+            held them.
 
     Raises:
         InputError: the file cannot be read or parsed, or is xacro.
         ParameterError: a bad ``density``.
     """
-    display, source, data, text = _read_source(path, density)
+    display, source, data, text = _read_source(path, density, buffer)
     root = parse_xml(data, display).getroot()
     report = RuleReport(display, source.absolute().parent, packages)
     for rule in ALL_RULES:
@@ -132,7 +134,8 @@ def _elsewhere(source: Path, output: str | Path | None) -> Path | None:
     return None if same else folder
 
 
-def _read_source(path: str | Path, density: float | None) -> tuple[str, Path, bytes, str]:
+def _read_source(path: str | Path, density: float | None, given: bytes | None = None
+                 ) -> tuple[str, Path, bytes, str]:
     """The file's name as shown, its path, bytes and text; refusals before any work."""
     from urdfkit.sources.resolve import locate
 
@@ -145,7 +148,7 @@ def _read_source(path: str | Path, density: float | None) -> tuple[str, Path, by
         raise InputError("fix edits URDF files, and a xacro file's values come from its macros "
                          "and arguments: fix the macro, or expand the file first (urdfkit build "
                          "or xacro) and fix that", file=display)
-    data = read_bytes(source)
+    data = read_bytes(source) if given is None else given
     refuse_oversized(data, display)
     try:
         text = data.decode("utf-8")

@@ -67,8 +67,11 @@ def _refuse_special(xacro: object, filename: str, path: str) -> None:
             f"included file {filename}: {what}; urdfkit reads only regular files")
 
 
-def _tag_origins(xacro: object) -> None:
-    """Make xacro's file reader tag every element it reads with ``index:line``."""
+def _tag_origins(xacro: object, overlay: tuple[str, str] | None = None) -> None:
+    """Make xacro's file reader tag every element it reads with ``index:line``.
+
+    ``overlay`` is (a file, the file whose bytes stand for it): an editor's unsaved buffer.
+    """
     from lxml import etree
 
     original = xacro.parse  # type: ignore[attr-defined]
@@ -80,7 +83,8 @@ def _tag_origins(xacro: object) -> None:
         path = os.path.join(xacro.root_dir, filename)  # type: ignore[attr-defined]
         _refuse_special(xacro, filename, path)
         try:
-            with open(path, "rb") as f:
+            read = overlay[1] if overlay and os.path.realpath(path) == overlay[0] else path
+            with open(read, "rb") as f:
                 text = f.read()
             root = etree.fromstring(text, etree.XMLParser(
                 resolve_entities=False, no_network=True, strip_cdata=False,
@@ -263,7 +267,8 @@ def main(argv: list[str]) -> int:
         return 2
     out, _err, timeout, memory, packages, source, *items = argv
     lenient = "--lenient-args" in items
-    items = [i for i in items if i != "--lenient-args"]
+    overlay = next((i.partition("=")[2] for i in items if i.startswith("--overlay=")), None)
+    items = [i for i in items if i != "--lenient-args" and not i.startswith("--overlay=")]
     _limits(float(timeout), int(memory))
     _install_find(packages, source)
     _subreaper()
@@ -279,7 +284,7 @@ def main(argv: list[str]) -> int:
     try:
         import xacro
 
-        _tag_origins(xacro)
+        _tag_origins(xacro, (os.path.realpath(source), overlay) if overlay else None)
         doc = xacro.process_file(source, mappings=mappings)
         origins = _take_origins(doc)
         data = doc.toxml(encoding="utf-8")

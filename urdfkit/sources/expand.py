@@ -76,8 +76,11 @@ def redact(message: str, secrets: Mapping[str, str]) -> str:
 def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
                  timeout: float | None = None, display: str | None = None,
                  no_exec: bool = False, packages: Mapping[str, Path] | None = None,
-                 strict_args: bool = True) -> Expanded:
+                 strict_args: bool = True, text: bytes | None = None) -> Expanded:
     """Expand a xacro file in a contained subprocess; return the URDF bytes (with origins).
+
+    ``text`` stands for the file's bytes (an editor's unsaved buffer): the file is expanded
+    as if it held them, its includes found from where it lies.
 
     ``$(find NAME)`` resolves without ROS through ``packages`` (a
     :class:`~urdfkit.sources.uris.PackageIndex`, or plain ``NAME: PATH`` pairs), then the
@@ -97,7 +100,7 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
     source_path = Path(path).resolve()
     from urdfkit.model.xmlio import read_bytes
 
-    source = read_bytes(source_path)
+    source = read_bytes(source_path) if text is None else text
     limit = XACRO_TIMEOUT if timeout is None else timeout
     secrets = _secrets(source)
     with tempfile.TemporaryDirectory(prefix="urdfkit-xacro-") as tmp:
@@ -116,6 +119,9 @@ def expand_xacro(path: str | Path, args: Mapping[str, str] | None = None,
         cmd += [f"{k}:={v}" for k, v in (args or {}).items() if v != ""]
         if not strict_args:
             cmd.append("--lenient-args")
+        if text is not None:
+            (Path(tmp) / "buffer.xacro").write_bytes(text)
+            cmd.append(f"--overlay={Path(tmp) / 'buffer.xacro'}")
         with open(os.devnull, "rb") as stdin, open(err, "ab") as log:
             proc = subprocess.Popen(cmd, stdin=stdin, stdout=log, stderr=log,
                                     cwd=str(source_path.parent), start_new_session=True)
