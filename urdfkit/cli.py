@@ -38,7 +38,7 @@ COMMANDS = {
     "check": "checking", "diff": "checking", "fix": "checking",
     "drive": "driving", "sweep": "driving",
     "render": "drawing", "view": "drawing", "collisions": "checking", "sim": "simulating",
-    "export": "exporting", "agree": "exporting", "lsp": "serving",
+    "export": "exporting", "agree": "exporting", "lsp": "serving", "mcp": "serving",
 }
 
 

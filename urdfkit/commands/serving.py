@@ -35,3 +35,20 @@ def lsp(
     server = build_server(parse_targets(target), parse_packages(package, package_path),
                           xacro_args(arg))
     server.start_io()
+
+
+@command(examples("urdfkit mcp", "urdfkit mcp --root ~/robots"))
+def mcp(
+    root: Annotated[list[str] | None, typer.Option(
+        "--root", metavar="DIR", help="A folder the tools may read and write in, for clients "
+        "that send no roots (repeatable; default: the working folder).")] = None,
+) -> None:
+    """An MCP server over stdio: check, joints, links, info, collisions, fix, build, render, agree.
+
+    Each tool runs the command as a user runs it, in a process of its own, and answers with its
+    JSON (render with a PNG); a refusal is a tool error with the command's own line. Paths
+    outside the client's roots are refused; fix writes only when asked. See docs/editor.md.
+    """
+    from urdfkit.serve.mcp import build_mcp
+
+    build_mcp(root or ()).run("stdio")

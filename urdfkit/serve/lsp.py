@@ -231,6 +231,7 @@ class Handlers:
         name = doc.at(params.position.line, params.position.character)
         if name is None:
             return None
+        said: str | None
         if name.kind in ("link", "joint"):
             said = hover_text(self.state.analysis.get(uri), name.kind, name.name) or \
                 f"**{name.kind} `{name.name}`**: not loaded (the file as it is cannot be " \
