@@ -1,4 +1,4 @@
-"""``urdfkit mcp``'s tools: each runs its command (:func:`urdfkit.serve.mcp.answer`).
+"""``urdfkit mcp``'s tools: each runs its command (:func:`urdfkit.serve.tool_runs.answer`).
 
 Imported only once the ``mcp`` SDK is known to be there (:func:`urdfkit.serve.mcp.build_mcp`):
 the SDK reads each tool's signature, ``Context`` included, to build its schema.
@@ -13,7 +13,7 @@ from typing import Any
 from mcp.server.mcpserver import Context, Image
 from mcp.server.mcpserver.exceptions import ToolError
 
-from urdfkit.serve.mcp import Roots, ToolRefused, answer, common_options, run_command
+from urdfkit.serve.tool_runs import Roots, ToolRefused, answer, common_options, run_command
 
 
 def _last_line(err: str, what: str, code: int) -> str:
