@@ -113,6 +113,7 @@ TARGETS: list[tuple[str, str, str]] = [
     ("core/finding.py", "Finding.to_dict", "self"),
     ("checks/build.py", "_unloadable", "root"),
     ("gym.py", "SimpleDrivingEnv.step", "self"),
+    ("serve/analysis.py", "_read_robot", "out"),
 ]
 
 
