@@ -296,11 +296,11 @@ def masses(s: EngineSides) -> None:
     res.add("structure", "total mass", off / max(total_pb, total_e, 1e-300), TOL_EXACT,
             "relative", f"PyBullet {total_pb!r} kg, {label} {total_e!r} kg"
             + defaults_said(robot, list(robot.links), off))
-    slack = _rounding(ours, theirs)
-    s.inertia_slack = sum(slack.values())
-    mass, com, inertia = [], [], []
     names = {g: [n for n, (h, _) in where.items() if h == g and n in pb.link_index]
              for g in ours}
+    slack = _rounding(ours, names, robot)
+    s.inertia_slack = sum(slack.values())
+    mass, com, inertia = [], [], []
     for group, parts in ours.items():
         a, b = combine(parts), combine(theirs[group])
         mass.append((abs(a.mass - b.mass) / max(a.mass, b.mass, 1e-300), group))
@@ -332,20 +332,23 @@ def masses(s: EngineSides) -> None:
             res.add("structure", what, v, tol, "m" if what[0] == "c" else "relative", d)
 
 
-def _rounding(ours: dict[str, list[Any]], theirs: dict[str, list[Any]]) -> dict[str, float]:
+def _rounding(ours: dict[str, list[Any]], names: dict[str, list[str]], robot: LoadedRobot
+              ) -> dict[str, float]:
     """Each body's allowance for PyBullet's diagonalisation (:data:`DIAGONALISE`), kg m^2.
 
-    The sum over its links whose tensor has products of inertia and is off the other side's
-    by no more than Bullet's stopping rule explains; a link off by more gets none (the row
-    shows it whole).
+    The sum over its links whose tensor in the file has products of inertia and which
+    PyBullet loaded off the file's by no more than Bullet's stopping rule explains (measured
+    against the file, not the other engine, which may hold a fused body's inertia on one of
+    its links); a link off by more gets none (the row shows it whole).
     """
     import numpy as np
 
     out: dict[str, float] = {}
     for group, parts in ours.items():
         total = 0.0
-        for (mine, _), (other, _) in zip(parts, theirs[group], strict=True):
-            t, u = np.array(mine.tensor, dtype=float), np.array(other.tensor, dtype=float)
+        for name, (mine, _) in zip(names[group], parts, strict=True):
+            t = np.array(mine.tensor, dtype=float)
+            u = np.array(robot.links[name].inertial.tensor, dtype=float)
             if not np.isfinite(t).all() or not np.isfinite(u).all():
                 continue
             if not np.any(u - np.diag(np.diag(u))):
