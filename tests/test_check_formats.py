@@ -160,19 +160,25 @@ def test_sarif_outside_the_current_folder_is_an_absolute_file_uri(
     assert location["region"] == {"startLine": 3}
 
 
-def test_sarif_related_location_is_where_xacro_wrote_the_element(
+def test_sarif_location_is_where_xacro_wrote_the_element(
         repo: Path, sarif_validator: object) -> None:
     f = Finding("U606", "warning", "<link name='a'> has no <inertial>", "robots/arm.urdf.xacro",
                 None, "robots/inc/macros.xacro:12")
     log = sarif_log(CheckResult([FileResult(f.file, [f])]))
     assert_valid_sarif(sarif_validator, log)
     [result] = log["runs"][0]["results"]
-    assert "region" not in result["locations"][0]["physicalLocation"]
-    [related] = result["relatedLocations"]
-    assert related["physicalLocation"] == {
+    assert result["locations"][0]["physicalLocation"] == {
         "artifactLocation": {"uri": "robots/inc/macros.xacro", "uriBaseId": "%SRCROOT%"},
         "region": {"startLine": 12}}
+    [related] = result["relatedLocations"]
+    assert related["physicalLocation"] == {
+        "artifactLocation": {"uri": "robots/arm.urdf.xacro", "uriBaseId": "%SRCROOT%"}}
     assert result["message"]["text"].endswith("(written at robots/inc/macros.xacro:12)")
+    # and GitHub annotates that line
+    from urdfkit.checks.ci import github_commands
+
+    [command] = github_commands(CheckResult([FileResult(f.file, [f])]))
+    assert command.startswith("::warning file=robots/inc/macros.xacro,line=12,title=U606::")
 
 
 def test_sarif_of_a_clean_run_is_valid_and_empty(repo: Path, sarif_validator: object) -> None:

@@ -127,6 +127,14 @@ async def _settled(client: LanguageClient, uri: str, version: int | None = None)
     await asyncio.wait_for(wait(), 60)
 
 
+def _rss(client: LanguageClient) -> int:
+    """The server process's resident memory, bytes."""
+    pid = client._server.pid  # type: ignore[union-attr]
+    status = Path(f"/proc/{pid}/status").read_text()
+    return int(next(ln.split()[1] for ln in status.splitlines()
+                    if ln.startswith("VmRSS:"))) * 1024
+
+
 def _codes(client: LanguageClient, uri: str) -> dict[str, int]:
     return {str(d.code): d.range.start.line for d in client.diagnostics[uri]}
 
@@ -295,6 +303,7 @@ async def test_a_thousand_edits_leave_the_newest_diagnostics(client: LanguageCli
     path = tmp_path / "bad.urdf"
     path.write_text(BAD)
     uri = await _open(client, path)
+    before = _rss(client)
     for version in range(2, 1002):
         # every odd version has the misspelling, every even one mends it
         text = BAD if version % 2 else BAD.replace("colision", "collision")
@@ -303,6 +312,8 @@ async def test_a_thousand_edits_leave_the_newest_diagnostics(client: LanguageCli
             [lsp.TextDocumentContentChangeWholeDocument(text=text)]))
     await _settled(client, uri, 1001)
     assert "U801" in _codes(client, uri)  # 1001 is odd: the misspelt text
+    # bounded: the stale runs were dropped, not queued (measured: a few MiB)
+    assert _rss(client) - before < 64 * 1024 * 1024
     hover = await client.text_document_hover_async(lsp.HoverParams(
         lsp.TextDocumentIdentifier(uri), lsp.Position(_line(BAD, '<link name="arm">'), 14)))
     assert hover is not None and "PyBullet index" in hover.contents.value

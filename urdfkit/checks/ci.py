@@ -113,10 +113,11 @@ def sarif_log(result: CheckResult) -> dict[str, Any]:
     depending on the model); every result carries its own level as well.
 
     Every result has a location, because GitHub shows nothing without one: the file checked,
-    and its line when known. A finding without a line (xacro input, whose expanded lines are
-    not the file's; a file that cannot be read) points at the whole file, with no
-    ``region``: SARIF has no line 0, and line 1 would be a guess. Where xacro says the element
-    was written, that place is a ``relatedLocation``.
+    and its line when known. A xacro finding's location is where xacro says the element was
+    written (the file and line to edit, which code scanning then marks), and the file checked
+    is its ``relatedLocation``. Any other finding without a line (a file that cannot be read)
+    points at the whole file, with no ``region``: SARIF has no line 0, and line 1 would be a
+    guess.
     """
     findings = result.findings
     worst: dict[str, str] = {}
@@ -138,7 +139,12 @@ def sarif_log(result: CheckResult) -> dict[str, Any]:
                                  "level": SARIF_LEVEL[f.level], "message": {"text": f.text},
                                  "locations": [_physical(f.file, f.line)]}
         origin = _origin(f.origin)
-        if origin is not None:
+        if origin is not None and f.line is None:
+            entry["locations"] = [_physical(*origin)]
+            entry["relatedLocations"] = [{"id": 0, "message": {"text": "checked through "
+                                                               "this file"},
+                                          **_physical(f.file, None)}]
+        elif origin is not None:
             entry["relatedLocations"] = [{"id": 0, "message": {"text": "written here"},
                                           **_physical(*origin)}]
         results.append(entry)
@@ -219,15 +225,20 @@ def github_commands(result: CheckResult) -> list[str]:
     """One GitHub Actions workflow command per finding, in file order.
 
     ``::error file=robots/a.urdf,line=12,title=U102::duplicate link name 'b' ...``, and
-    ``::warning`` and ``::notice`` for warnings and info. A finding without a line has no
-    ``line=``: GitHub annotates the file. A file outside the current folder keeps its path
-    as given (the log shows it; GitHub cannot place it in the pull request).
+    ``::warning`` and ``::notice`` for warnings and info. A xacro finding annotates where
+    xacro says the element was written (its file and line). Any other finding without a line
+    has no ``line=``: GitHub annotates the file. A file outside the current folder keeps its
+    path as given (the log shows it; GitHub cannot place it in the pull request).
     """
     out = []
     for f in result.findings:
-        props = [f"file={_command_property(relative_path(f.file) or f.file)}"]
-        if f.line is not None:
-            props.append(f"line={f.line}")
+        file, line = f.file, f.line
+        origin = _origin(f.origin)
+        if origin is not None and line is None:
+            file, line = origin
+        props = [f"file={_command_property(relative_path(file) or file)}"]
+        if line is not None:
+            props.append(f"line={line}")
         props.append(f"title={_command_property(f.code)}")
         out.append(f"::{GITHUB_COMMAND[f.level]} {','.join(props)}::{_command_data(f.text)}")
     return out
