@@ -23,7 +23,7 @@ from urdfkit.serve.analysis import Analysis, Placed, analyse, hover_text, is_xac
 from urdfkit.serve.document import XACRO_TAGS, Document, Name, read
 
 #: Seconds an edit waits for the next before it is checked.
-DEBOUNCE = 0.15
+DEBOUNCE = 0.05
 #: A xacro's expansion is stopped after this many seconds (said as a diagnostic).
 XACRO_TIMEOUT = 20.0
 _LEVELS = {"error": 1, "warning": 2, "info": 3}
