@@ -15,7 +15,6 @@ from contextlib import asynccontextmanager
 from pathlib import Path
 
 import anyio
-import pytest
 from mcp import types
 from mcp.client.session import ClientSession
 from mcp.client.stdio import StdioServerParameters, stdio_client
@@ -151,13 +150,16 @@ READERS = [("check", lambda f: {"paths": [f]}), ("joints", lambda f: {"file": f}
            ("agree", lambda f: {"file": f, "engine": "pinocchio", "poses": 2})]
 
 
-@pytest.mark.parametrize("every", [False, pytest.param(True, marks=pytest.mark.slow)])
-def test_the_hostile_corpus_never_takes_the_server_down(every: bool, tmp_path: Path) -> None:
-    """Every tool on hostile files: the command's one line as a tool error, or its answer."""
+def test_the_hostile_corpus_never_takes_the_server_down(tmp_path: Path) -> None:
+    """Every tool on hostile files: the command's one line as a tool error, or its answer.
+
+    A sample of each kind: the commands themselves go through the whole corpus in
+    tests/test_hostile.py (all 48 files through every tool took 55 s, measured).
+    """
     corpus = tmp_path / "hostile"
     expected = make_corpus(corpus)
-    names = sorted(expected) if every else [n for n in SAMPLE if n in expected]
-    assert len(names) >= (40 if every else len(SAMPLE) - 1)
+    names = [n for n in SAMPLE if n in expected]
+    assert len(names) >= len(SAMPLE) - 1
 
     async def main() -> None:
         async with session(tmp_path) as s:
