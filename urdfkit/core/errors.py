@@ -8,6 +8,7 @@ file and, where known, the line, so the message reads like a compiler's: ``car.u
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 
 class UrdfkitError(Exception):
@@ -72,3 +73,19 @@ class EngineError(UrdfkitError):
 
 class MissingDependencyError(UrdfkitError):
     """An optional dependency is needed; the message says what to install."""
+
+
+def import_optional(module: str, label: str, needed_by: str, extra: str) -> Any:
+    """``module`` imported, or :class:`MissingDependencyError` naming the extra to install.
+
+    ``label`` is the package as people call it ("Pinocchio"), ``needed_by`` what needs it
+    ("agree --engine pinocchio").
+    """
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError as e:
+        raise MissingDependencyError(f"{needed_by} needs {label}: pip install "
+                                     f"'urdfkit[{extra}]'") from e
+

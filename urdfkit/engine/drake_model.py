@@ -12,7 +12,7 @@ import logging
 from collections.abc import Sequence
 from typing import Any
 
-from urdfkit.core.errors import MissingDependencyError
+from urdfkit.core.errors import import_optional
 from urdfkit.engine.api import JointInfo
 from urdfkit.engine.welded import Coordinate, EngineJoint, WeldedModel, engine_refusal
 
@@ -28,12 +28,7 @@ def import_drake() -> Any:
     Raises:
         MissingDependencyError: Drake is not installed (``urdfkit[engines]`` named).
     """
-    try:
-        import pydrake.all
-    except ImportError as e:
-        raise MissingDependencyError("agree --engine drake needs Drake: "
-                                     "pip install 'urdfkit[engines]'") from e
-    return pydrake.all
+    return import_optional("pydrake.all", "Drake", "agree --engine drake", "engines")
 
 
 class _Kept(logging.Handler):

@@ -14,7 +14,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from urdfkit.core.errors import MissingDependencyError
+from urdfkit.core.errors import import_optional
 from urdfkit.engine.api import JointInfo
 from urdfkit.engine.welded import Coordinate, EngineJoint, WeldedModel, engine_refusal
 
@@ -33,12 +33,7 @@ def import_pinocchio() -> Any:
     Raises:
         MissingDependencyError: It is not installed (``urdfkit[engines]`` named).
     """
-    try:
-        import pinocchio
-    except ImportError as e:
-        raise MissingDependencyError("agree --engine pinocchio needs Pinocchio: "
-                                     "pip install 'urdfkit[engines]'") from e
-    return pinocchio
+    return import_optional("pinocchio", "Pinocchio", "agree --engine pinocchio", "engines")
 
 
 class PinocchioModel(WeldedModel):

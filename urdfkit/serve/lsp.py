@@ -74,14 +74,11 @@ def build_server(targets: Sequence[str] = (), packages: Mapping[str, Path] | Non
     Raises:
         MissingDependencyError: pygls is not installed (``urdfkit[lsp]`` named).
     """
-    try:
-        from lsprotocol import types as lsp
-        from pygls.lsp.server import LanguageServer
-    except ImportError as e:
-        from urdfkit.core.errors import MissingDependencyError
+    from urdfkit.core.errors import import_optional
 
-        raise MissingDependencyError("urdfkit lsp needs pygls: pip install "
-                                     "'urdfkit[lsp]'") from e
+    import_optional("pygls.lsp.server", "pygls", "urdfkit lsp", "lsp")
+    from lsprotocol import types as lsp
+    from pygls.lsp.server import LanguageServer
 
     from urdfkit import __version__
 

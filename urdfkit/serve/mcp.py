@@ -20,16 +20,13 @@ def build_mcp(roots: Sequence[str | Path] = ()) -> Any:
     Raises:
         MissingDependencyError: the ``mcp`` SDK is not installed (``urdfkit[mcp]`` named).
     """
-    try:
-        from mcp.server.mcpserver import MCPServer
+    from urdfkit.core.errors import import_optional
 
-        from urdfkit.serve.mcp_tools import register
-    except ImportError as e:
-        from urdfkit.core.errors import MissingDependencyError
+    import_optional("mcp.server.mcpserver", "the MCP SDK", "urdfkit mcp", "mcp")
+    from mcp.server.mcpserver import MCPServer
 
-        raise MissingDependencyError("urdfkit mcp needs the MCP SDK: pip install "
-                                     "'urdfkit[mcp]'") from e
     from urdfkit import __version__
+    from urdfkit.serve.mcp_tools import register
 
     server = MCPServer(name="urdfkit", version=__version__, log_level="WARNING", instructions=(
         "Check, inspect, repair, build, render and compare URDF and xacro robot descriptions "
