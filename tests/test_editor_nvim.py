@@ -39,7 +39,8 @@ XACRO = """<?xml version="1.0"?>
       <mass value="${m}"/>
       <inertia ixx="1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/>
     </inertial>
-    <colision><geometry><box size="0.2 0.2 0.2"/></geometry></colision>
+    <visul><geometry><box size="0.2 0.2 0.2"/></geometry></visul>
+    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>
   </link>
 </robot>
 """
@@ -61,15 +62,31 @@ def _line(text: str, needle: str) -> int:
     return next(i for i, line in enumerate(text.splitlines()) if needle in line)
 
 
-def test_neovim_gets_a_xacros_diagnostics_at_their_lines(tmp_path: Path) -> None:
+def _built(path: Path, out: Path) -> bytes:
+    subprocess.run([sys.executable, "-m", "urdfkit", "build", str(path), "-o", str(out),
+                    "--force"], capture_output=True, check=False)
+    return out.read_bytes()
+
+
+def test_neovim_gets_a_xacros_diagnostics_and_applies_fix_in_the_xacro(tmp_path: Path) -> None:
+    """Both diagnostics at their xacro lines; fix's action written into the xacro itself.
+
+    fix edits URDF: the xacro fixed in Neovim must expand to exactly what `urdfkit fix`
+    writes for the xacro's expansion.
+    """
     robot = tmp_path / "robot.urdf.xacro"
     robot.write_text(XACRO)
-    said = _nvim(robot, tmp_path / "out.txt", "Change <colision>", 3)
+    expanded = _built(robot, tmp_path / "expanded.urdf")
+    subprocess.run([sys.executable, "-m", "urdfkit", "fix", str(tmp_path / "expanded.urdf"),
+                    "-o", str(tmp_path / "fixed.urdf")], capture_output=True, check=False)
+    said = _nvim(robot, tmp_path / "out.txt", "urdfkit fix", 3)
     found = {tuple(line.split()) for line in said if not line.startswith("applied")}
-    assert ("U801", str(_line(XACRO, "<colision>"))) in found
+    assert ("U801", str(_line(XACRO, "<visul>"))) in found
     assert ("U604", str(_line(XACRO, 'ixx="1"'))) in found
-    assert "applied Change <colision> to <collision>" in said
-    assert robot.read_text() == XACRO.replace("colision", "collision")
+    assert said[-1].startswith("applied urdfkit fix")
+    assert robot.read_text() != XACRO and "${m}" in robot.read_text()
+    assert _built(robot, tmp_path / "after.urdf") == (tmp_path / "fixed.urdf").read_bytes() \
+        != expanded
 
 
 def test_neovim_applies_fix_and_the_file_is_fixs_output(tmp_path: Path) -> None:

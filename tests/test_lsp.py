@@ -338,3 +338,21 @@ def test_completion_offers_what_the_place_takes(tmp_path: Path) -> None:
     assert at_end(head + '<link name="c">\n    <') >= {"inertial", "visual", "collision"}
     assert "mass" in at_end(head + '<link name="c"><inertial><')
     assert {"name", "type"} <= at_end(head + "<joint ")
+
+
+def test_fix_in_a_xacro_is_offered_only_where_the_numbers_are_written(tmp_path: Path) -> None:
+    """A repair whose value comes from ${} cannot be carried back: no partial action."""
+    from urdfkit.serve.analysis import analyse
+    from urdfkit.serve.xacro_fix import xacro_fix
+
+    head = '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">\n' \
+        '  <xacro:property name="big" value="1"/>\n  <link name="base">\n' \
+        '    <inertial><mass value="2"/>\n'
+    tail = '\n    </inertial>\n    <collision><geometry><box size="0.2 0.2 0.2"/></geometry>' \
+        '</collision>\n  </link>\n</robot>\n'
+    path = str(tmp_path / "r.xacro")
+    written = head + '      <inertia ixx="1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/>' + tail
+    fixed = xacro_fix(path, written, {"U604"}, analyse(path, written), {})
+    assert fixed is not None and 'ixx="1"' not in fixed[0] and "in the xacro" in fixed[1]
+    computed = written.replace('ixx="1"', 'ixx="${big}"')
+    assert xacro_fix(path, computed, {"U604"}, analyse(path, computed), {}) is None

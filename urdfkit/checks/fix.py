@@ -140,7 +140,9 @@ def _read_source(path: str | Path, density: float | None, given: bytes | None = 
     from urdfkit.sources.resolve import locate
 
     display = str(path)
-    source = locate(path)  # a bare name is found in pybullet_data, as every command finds it
+    # a bare name is found in pybullet_data, as every command finds it; an editor's buffer
+    # names where it is, saved or not
+    source = locate(path) if given is None else Path(path)
     if density is not None and not (math.isfinite(density) and density > 0):
         raise ParameterError(f"`density` must be a positive number of kg/m^3, got {density!r}",
                              param="density")

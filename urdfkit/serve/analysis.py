@@ -39,6 +39,7 @@ class Analysis:
         joint_index: PyBullet's index of each joint (depth-first from the root).
         link_index: PyBullet's index of each link (-1: the base).
         urdf: The URDF text checked (a xacro's expansion), for fixes.
+        origins: A xacro's expansion's origins (``file:line`` per element, document order).
     """
 
     path: str
@@ -47,6 +48,7 @@ class Analysis:
     joint_index: dict[str, int] = field(default_factory=dict)
     link_index: dict[str, int] = field(default_factory=dict)
     urdf: bytes = b""
+    origins: list[str | None] = field(default_factory=list)
 
 
 def is_xacro(path: str) -> bool:
@@ -81,6 +83,7 @@ def analyse(path: str, text: str, *, packages: Mapping[str, Path] | None = None,
         result = check_file(display, path, packages=packages, xacro_args=xacro_args,
                             targets=targets, expanded=expanded)
         out.urdf = bytes(expanded)
+        out.origins = list(expanded.origins)
     else:
         result = check_file(display, path, packages=packages, targets=targets, data=data)
         out.urdf = data

@@ -309,9 +309,16 @@ class Handlers:
             if d.code == "U801":
                 out += _did_you_mean(uri, doc, d)
         codes = {str(d.code) for d in params.context.diagnostics}
-        fixed = _fixed(path_of(uri), text, codes, self.state.packages)
-        if fixed is not None:
-            new, summary = fixed
+        path = path_of(uri)
+        if is_xacro(path):
+            from urdfkit.serve.xacro_fix import xacro_fix
+
+            found = xacro_fix(path, text, codes, self.state.analysis.get(uri),
+                              self.state.packages)
+        else:
+            found = _fixed(path, text, codes, self.state.packages)
+        if found is not None:
+            new, summary = found
             end = doc.position(len(text))
             out.append(lsp.CodeAction(
                 title=f"urdfkit fix: {summary}", kind=lsp.CodeActionKind.QuickFix,
