@@ -217,15 +217,19 @@ class Handlers:
         text = self.server.workspace.get_text_document(uri).source
         return text, self.state.outline(uri, text)
 
+    def name_at(self, params: Any) -> tuple[str, Document, Name | None]:
+        """The request's document, its names, and the name at the request's position."""
+        uri = params.text_document.uri
+        _, doc = self.here(uri)
+        return uri, doc, doc.at(params.position.line, params.position.character)
+
     # ---- questions
 
     def hover(self, params: Any) -> Any:
         """A link's or joint's facts as PyBullet loads them; a xacro name's definition."""
         from lsprotocol import types as lsp
 
-        uri = params.text_document.uri
-        _, doc = self.here(uri)
-        name = doc.at(params.position.line, params.position.character)
+        uri, doc, name = self.name_at(params)
         if name is None:
             return None
         said: str | None
@@ -246,9 +250,7 @@ class Handlers:
         from lsprotocol import types as lsp
         from pygls.uris import from_fs_path
 
-        uri = params.text_document.uri
-        _, doc = self.here(uri)
-        name = doc.at(params.position.line, params.position.character)
+        uri, doc, name = self.name_at(params)
         if name is None:
             return None
         if name.kind == "include":
@@ -264,9 +266,7 @@ class Handlers:
         """Every use of a link, joint, macro, property or arg in the document."""
         from lsprotocol import types as lsp
 
-        uri = params.text_document.uri
-        _, doc = self.here(uri)
-        name = doc.at(params.position.line, params.position.character)
+        uri, doc, name = self.name_at(params)
         if name is None or name.kind == "include":
             return None
         out = doc.uses(name.kind, name.name)
