@@ -356,3 +356,46 @@ def test_fix_in_a_xacro_is_offered_only_where_the_numbers_are_written(tmp_path: 
     assert fixed is not None and 'ixx="1"' not in fixed[0] and "in the xacro" in fixed[1]
     computed = written.replace('ixx="1"', 'ixx="${big}"')
     assert xacro_fix(path, computed, {"U604"}, analyse(path, computed), {}) is None
+
+
+def test_a_half_typed_xacro_is_its_own_parse_error_not_the_saved_files(tmp_path: Path) -> None:
+    """The buffer, not the file on disk, is what xacro is told of when it does not parse."""
+    from urdfkit.serve.analysis import analyse
+
+    (tmp_path / "parts.xacro").write_text(PARTS)
+    path = tmp_path / "robot.urdf.xacro"
+    path.write_text(MAIN)
+    broken = MAIN.replace('<origin xyz="0 0 ${reach}"/>', '<origin xyz="0 0 ${re')
+    found = analyse(str(path), broken).findings
+    assert [p.finding.code for p in found] == ["U000"]
+    assert "not well-formed" in found[0].finding.message
+
+
+def test_a_document_opened_through_a_symlink_keeps_its_findings(tmp_path: Path) -> None:
+    from urdfkit.serve.analysis import analyse
+
+    real = tmp_path / "real"
+    real.mkdir()
+    (real / "parts.xacro").write_text(PARTS)
+    (real / "robot.urdf.xacro").write_text(MAIN)
+    (tmp_path / "link").symlink_to(real)
+    path = str(tmp_path / "link" / "robot.urdf.xacro")
+    found = analyse(path, MAIN).findings
+    assert any(p.path == path and p.finding.code == "U801" for p in found)
+
+
+@pytest.mark.asyncio
+async def test_a_link_a_macro_makes_is_defined_where_xacro_wrote_it(
+        client: LanguageClient, tmp_path: Path) -> None:
+    (tmp_path / "parts.xacro").write_text(PARTS)
+    main = tmp_path / "robot.urdf.xacro"
+    main.write_text(MAIN)
+    uri = await _open(client, main)
+    at = _line(MAIN, '<child link="arm"/>')
+    found = await client.text_document_definition_async(lsp.DefinitionParams(
+        lsp.TextDocumentIdentifier(uri), lsp.Position(at, MAIN.splitlines()[at].index("arm"))))
+    assert found and found[0].uri == (tmp_path / "parts.xacro").as_uri()
+    assert found[0].range.start.line == _line(PARTS, '<link name="${name}">')
+    # an included file open beside its robot keeps what the robot's check placed there
+    parts = await _open(client, tmp_path / "parts.xacro")
+    assert "U604" in _codes(client, parts)

@@ -40,6 +40,8 @@ class Analysis:
         link_index: PyBullet's index of each link (-1: the base).
         urdf: The URDF text checked (a xacro's expansion), for fixes.
         origins: A xacro's expansion's origins (``file:line`` per element, document order).
+        written: Where each link and joint of a xacro's expansion was written, by kind and
+            name: (file, 0-based line), for a name a macro makes (``${name}``).
     """
 
     path: str
@@ -49,6 +51,7 @@ class Analysis:
     link_index: dict[str, int] = field(default_factory=dict)
     urdf: bytes = b""
     origins: list[str | None] = field(default_factory=list)
+    written: dict[tuple[str, str], tuple[str, int]] = field(default_factory=dict)
 
 
 def is_xacro(path: str) -> bool:
@@ -97,8 +100,11 @@ def place(path: str, f: Finding) -> Placed:
     if f.origin:
         file, _, line = f.origin.rpartition(":")
         if file and line.isdigit():
-            where = file if os.path.isabs(file) else os.path.join(os.getcwd(), file)
-            return Placed(os.path.normpath(where), int(line) - 1, f)
+            where = os.path.normpath(file if os.path.isabs(file) else
+                                     os.path.join(os.getcwd(), file))
+            if os.path.realpath(where) == os.path.realpath(path):
+                where = path  # the document as the editor named it (xacro resolves links)
+            return Placed(where, int(line) - 1, f)
     return Placed(path, (f.line - 1) if f.line else -1, f)
 
 
@@ -115,6 +121,13 @@ def _read_robot(out: Analysis) -> None:
     except (UrdfkitError, ValueError, KeyError):
         return
     out.robot = robot
+    if out.origins:
+        from urdfkit.sources.guard import origin_map
+
+        for el, at in (origin_map(root, out.origins) or {}).items():
+            if el.tag in ("link", "joint") and el.getparent() is root:
+                p = place(out.path, Finding("", "info", "", out.path, None, at))
+                out.written[(str(el.tag), el.get("name") or "")] = (p.path, p.line)
     below: dict[str, list[Any]] = {}
     for j in robot.joints:
         below.setdefault(j.parent, []).append(j)

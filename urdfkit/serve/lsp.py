@@ -46,6 +46,8 @@ class State:
         self.timeout = XACRO_TIMEOUT
         self.analysis: dict[str, Analysis] = {}
         self.published: dict[str, set[str]] = {}
+        #: Each document's diagnostics by the document whose check placed them there.
+        self.contrib: dict[str, dict[str, list[Any]]] = {}
         self.pending: dict[str, asyncio.Task[None]] = {}
         self.pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="urdfkit-check")
         self._outline: dict[str, tuple[str, Document]] = {}
@@ -167,16 +169,23 @@ class Handlers:
         for p in analysis.findings:
             by_path.setdefault(p.path, []).append(p)
         sent = set()
+        contrib = self.state.contrib
         for path, placed in by_path.items():
             target = uri if path == me else (from_fs_path(path) or path)
             lines = text.splitlines() if path == me else _lines_of(path)
-            self.server.text_document_publish_diagnostics(lsp.PublishDiagnosticsParams(
-                uri=target, diagnostics=[diagnostic(p, lines) for p in placed],
-                version=version if path == me else None))
+            contrib.setdefault(target, {})[uri] = [diagnostic(p, lines) for p in placed]
             sent.add(target)
         for gone in self.state.published.get(uri, set()) - sent:
+            contrib.get(gone, {}).pop(uri, None)
             self.server.text_document_publish_diagnostics(lsp.PublishDiagnosticsParams(
-                uri=gone, diagnostics=[]))
+                uri=gone, diagnostics=[d for ds in contrib.get(gone, {}).values()
+                                             for d in ds]))
+        for target in sent:
+            # a file's diagnostics are its own check's and those that files including it
+            # placed there (a macro file open beside its robot gets both)
+            self.server.text_document_publish_diagnostics(lsp.PublishDiagnosticsParams(
+                uri=target, diagnostics=[d for ds in contrib[target].values() for d in ds],
+                version=version if target == uri else None))
         self.state.published[uri] = sent
 
     # ---- the document's life
@@ -260,6 +269,13 @@ class Handlers:
             return [lsp.Location(from_fs_path(str(target)) or str(target),
                                  lsp.Range(lsp.Position(0, 0), lsp.Position(0, 0)))]
         found = _definitions(path_of(uri), doc, name, self.state.packages)
+        if not found and name.kind in ("link", "joint"):  # made by a macro: where xacro says
+            analysis = self.state.analysis.get(uri)
+            at = analysis.written.get((name.kind, name.name)) if analysis else None
+            if at is not None:
+                where = uri if at[0] == path_of(uri) else (from_fs_path(at[0]) or at[0])
+                spot = lsp.Position(max(at[1], 0), 0)
+                return [lsp.Location(where, lsp.Range(spot, spot))]
         return [lsp.Location(from_fs_path(p) or p, _range(n)) for p, n in found] or None
 
     def references(self, params: Any) -> Any:
@@ -495,8 +511,8 @@ def complete(text: str, doc: Document, line: int, column: int, path: str,
             names.update({n.name: n.detail for n in d.defined("property")})
         return [(n, 21, f"= {v}") for n, v in sorted(names.items())]
     m = re.search(r"<(parent|child)\s[^<>]*link\s*=\s*\"[^\"]*$", before)
-    if m:
-        return [(n.name, 22, "link") for n in doc.defined("link")]
+    if m:  # (a macro body's `${name}` is no link's name)
+        return [(n.name, 22, "link") for n in doc.defined("link") if "$" not in n.name]
     m = re.search(r"<xacro:([\w-]*)$", before)
     if m:
         macros = {n.name: n.detail for n in doc.defined("macro")}

@@ -37,16 +37,19 @@ class Roots:
 
     async def of(self, ctx: Any) -> list[Path]:
         """The client's roots (file:// URIs) if it has any, else the fallback folders."""
+        import warnings
         from urllib.parse import unquote, urlparse
 
-        caps = getattr(ctx.session, "client_params", None)
-        has = caps is not None and getattr(caps.capabilities, "roots", None) is not None
-        if not has:
-            return self.fallback
-        try:
-            listed = await ctx.session.list_roots()
-        except Exception:  # noqa: BLE001 - a client that says it has roots and fails
-            return self.fallback
+        with warnings.catch_warnings():  # (the SDK 2.3 calls roots deprecated; clients send
+            warnings.simplefilter("ignore")  # them, and the issue asks them kept)
+            caps = getattr(ctx.session, "client_params", None)
+            has = caps is not None and getattr(caps.capabilities, "roots", None) is not None
+            if not has:
+                return self.fallback
+            try:
+                listed = await ctx.session.list_roots()
+            except Exception:  # noqa: BLE001 - a client that says it has roots and fails
+                return self.fallback
         out = []
         for root in listed.roots:
             url = urlparse(str(root.uri))

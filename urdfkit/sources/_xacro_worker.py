@@ -82,15 +82,19 @@ def _tag_origins(xacro: object, overlay: tuple[str, str] | None = None) -> None:
             return original(inp, filename)
         path = os.path.join(xacro.root_dir, filename)  # type: ignore[attr-defined]
         _refuse_special(xacro, filename, path)
+        text: bytes | None = None
+        read = overlay[1] if overlay and os.path.realpath(path) == overlay[0] else path
         try:
-            read = overlay[1] if overlay and os.path.realpath(path) == overlay[0] else path
             with open(read, "rb") as f:
                 text = f.read()
             root = etree.fromstring(text, etree.XMLParser(
                 resolve_entities=False, no_network=True, strip_cdata=False,
                 remove_comments=False))
         except (OSError, etree.XMLSyntaxError, ValueError):
-            return original(inp, filename)  # xacro says what is wrong, its own way
+            # xacro says what is wrong, its own way: of the overlay's text, not the file's
+            if read != path and text is not None:
+                return original(text.decode("utf-8", "replace"), filename)
+            return original(inp, filename)
         FILES.append(os.path.abspath(path))
         index = len(FILES) - 1
         for el in root.iter(etree.Element):
