@@ -134,6 +134,8 @@ def test_paths_outside_the_roots_are_refused(tmp_path: Path) -> None:
                 assert result.is_error and "outside the client's roots" in \
                     result.content[0].text, (tool, result.content)
             assert sorted(p.name for p in outside.iterdir()) == ["r.urdf"]
+            result = await s.call_tool("agree", {"file": "r.urdf", "engine": "mujoco"})
+            assert result.is_error and "give `model`" in result.content[0].text
             assert not _json(await s.call_tool("joints", {"file": "r.urdf"}))["exit_code"]
 
     anyio.run(main)

@@ -147,6 +147,9 @@ class Tools:
         engine: pinocchio, drake, mujoco-loader, or mujoco with model (an MJCF file).
         """
         try:
+            if engine == "mujoco" and model is None:
+                raise ToolRefused("engine mujoco compares an MJCF file: give `model`, or use "
+                                  "engine mujoco-loader, pinocchio or drake")
             path = await self.allowed.check(ctx, file)
             args = ["agree", str(path)]
             if model is not None:
