@@ -150,10 +150,6 @@ class WeldedModel:
                             (float(com[0]), float(com[1]), float(com[2])), (x, y, z, w),
                             0.0, 0.0, 0.0, 0.0, -1.0, -1.0)
 
-    def inertial(self, link: str) -> tuple[float, Any, Any]:
-        """A link's mass, centre of mass and tensor about it (link frame), as held."""
-        return self._engine_inertial(link)
-
     # ---- a pose
 
     def _values(self, values: Sequence[float]) -> dict[str, float]:
